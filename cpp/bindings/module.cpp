@@ -1,0 +1,14 @@
+// The compiled module revcol._core: it only converts types and registers; all physics is
+// in the core library. One register_<area>() per area.
+#include <pybind11/pybind11.h>
+
+#include "bindings.hpp"
+#include "revcol/error.hpp"
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "revcol core (private): use the revcol package";
+  pybind11::register_exception<revcol::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
+  revcol::bind::register_rng(m);
+  revcol::bind::register_collide(m);
+  revcol::bind::register_verify(m);
+}
