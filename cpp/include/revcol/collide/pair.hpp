@@ -1,0 +1,86 @@
+// The velocities of a colliding pair and its contact frame, shared by the pair operators.
+#pragma once
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "revcol/collide/common.hpp"
+
+namespace revcol {
+
+/// Velocities of a colliding pair: particle i and particle j. The contact normal points
+/// from j to i, so the pair approaches when normal . (v_i - v_j) < 0 and separates when > 0.
+template <int Dim>
+struct PairV {
+  std::array<double, Dim> i;  ///< velocity of particle i (the paper's particle 1, smaller id)
+  std::array<double, Dim> j;  ///< velocity of particle j
+  friend bool operator==(const PairV&, const PairV&) = default;
+};
+
+/// Relative velocity w = v_i - v_j, computed as a difference (DESIGN.md §4: never as
+/// velocity minus half the momentum, which cancels when the centre of mass moves fast).
+template <int Dim>
+inline std::array<double, Dim> relative(const PairV<Dim>& v) {
+  std::array<double, Dim> w;
+  for (int k = 0; k < Dim; ++k) w[k] = v.i[k] - v.j[k];
+  return w;
+}
+
+/// Throws InvalidArgument unless every velocity component is finite.
+template <int Dim>
+inline void require_finite(const PairV<Dim>& v) {
+  require(all_finite(v.i.data(), Dim) && all_finite(v.j.data(), Dim),
+          "velocities must be finite (got a NaN or infinity)");
+}
+
+/// Unit contact normal a and, in 2D, its tangent t = (-a_y, a_x): an orthonormal frame
+/// decided by the contact geometry alone.
+struct Frame2 {
+  double a[2];  ///< unit normal, from j to i
+  double t[2];  ///< unit tangent, a rotated by +90 degrees
+
+  /// Builds the frame from any non-zero finite normal; throws InvalidArgument otherwise.
+  explicit Frame2(const std::array<double, 2>& normal) {
+    require(std::isfinite(normal[0]) && std::isfinite(normal[1]),
+            "contact normal must be finite");
+    const double n = std::hypot(normal[0], normal[1]);
+    require(n > 0.0, "contact normal is zero");
+    a[0] = normal[0] / n;
+    a[1] = normal[1] / n;
+    t[0] = -a[1];
+    t[1] = a[0];
+  }
+  /// Component of w along the normal.
+  double normal_part(const std::array<double, 2>& w) const { return w[0] * a[0] + w[1] * a[1]; }
+  /// Component of w along the tangent.
+  double tangent_part(const std::array<double, 2>& w) const { return w[0] * t[0] + w[1] * t[1]; }
+};
+
+/// Relative speed squared |v_i - v_j|^2 implied by held invariants: 2E - |M|^2.
+template <int Dim>
+inline double relative_speed2(const Invariants<Dim>& inv) {
+  double m2 = 0.0;
+  for (int k = 0; k < Dim; ++k) m2 += inv.momentum[k] * inv.momentum[k];
+  return 2.0 * inv.energy - m2;
+}
+
+/// Checks held invariants against the velocities: finite, 2E > |M|^2, and |v_i - v_j|^2
+/// equal to 2E - |M|^2 within 1e-8 relative plus the rounding of that difference, which
+/// cancels when the centre of mass is fast (the momentum itself is not compared: the
+/// paper's illustrations negate the velocities but hold the momentum).
+template <int Dim>
+inline double checked_relative_speed(const Invariants<Dim>& inv, double w_norm) {
+  require(all_finite(inv.momentum, Dim) && std::isfinite(inv.energy),
+          "invariants must be finite");
+  const double r2 = relative_speed2(inv);
+  require(r2 > 0.0, "invariants leave no relative kinetic energy (2E <= |M|^2)");
+  const double rho = std::sqrt(r2);
+  const double cancel = 16.0 * std::numeric_limits<double>::epsilon() * (2.0 * inv.energy);
+  require(std::fabs(w_norm * w_norm - r2) <= 1e-8 * r2 + cancel,
+          "velocities are inconsistent with the given energy and momentum (relative speed " +
+              std::to_string(w_norm) + " vs " + std::to_string(rho) + ")");
+  return rho;
+}
+
+}  // namespace revcol

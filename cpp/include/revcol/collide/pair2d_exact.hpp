@@ -1,0 +1,227 @@
+// Exact-mode collision of 2 particles in 2 dimensions: the reference operator.
+//
+// Physics (DESIGN.md §3). Two unit masses collide; momentum M = v_i + v_j and energy
+// E = |v_i|^2 + |v_j|^2 fix the centre-of-mass velocity M/2 and the relative speed
+// |w| = |v_i - v_j| = sqrt(2E - |M|^2). What is free is the direction of w: a point on a
+// circle (D = (n-1)d = 2, so d_n = 1 free parameter). The contact normal a (unit, from
+// particle j to particle i) splits the circle: the pair separates after the collision iff
+// a.w > 0 (the permitted set P, a half circle, m = 1 contact) and approached before it iff
+// a.w < 0 (the pre set -P). With t the tangent, write a point of P as
+//     w = |w| (cos(eta) a + sin(eta) t),   eta in (-pi/2, pi/2)
+// (the general chart's f = 1 case: the free part z = +-1 merges with eta into this signed
+// angle).
+//
+// The chart c: P -> [0,1) is measure-preserving for the chosen law:
+//   uniform  (uniform on P, the paper's requirement):  c = eta/pi + 1/2
+//   flux     (density ~ a.w = cos(eta), the time reverse of the arrival law of an
+//             event-driven gas, DESIGN.md "Which law"):  c = (1 + sin(eta)) / 2
+// Forward:  c' = chart(-w_pre), c = c' + G (mod 1), w_post = chart^-1(c).
+// Reverse:  c = chart(w_post), c' = c - G (mod 1), w_pre = -chart^-1(c').
+// Whatever c' is, c is distributed by the law (a torus shift of a uniform variable), so
+// every post state is sampled exactly, with exactly one random number, and no folding.
+//
+// Numerics (DESIGN.md §4). c is held as a K-bit integer (FixedPoint): the shift is exact
+// integer arithmetic, and decoding at a cell centre makes a post state re-encode to its own
+// cell whenever the round trip through the stored velocities is accurate to half a cell.
+// That accuracy is lost only when the relative speed is tiny next to the velocities
+// themselves (rounding cm +- w/2 costs eps |v| in w): there the forward step pushes the pre
+// cell onto the rare log and the reverse step pops it. The decision is a function of the
+// post velocities alone, evaluated bit-identically in both directions.
+#pragma once
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "revcol/collide/common.hpp"
+#include "revcol/collide/pair.hpp"
+#include "revcol/fixed_point.hpp"
+
+namespace revcol {
+
+/// Exact-mode pair collision in 2D: chart + K-bit torus shift, flux or uniform law.
+class Pair2DExact {
+ public:
+  static constexpr int dim = 2;        ///< spatial dimension d
+  static constexpr int particles = 2;  ///< particles n
+  static constexpr int draws = 1;      ///< random numbers per collision, d_n = nd - d - 1
+
+  /// An operator for the given law with K-bit chart coordinates.
+  explicit Pair2DExact(Law law = Law::flux, int bits = FixedPoint::default_bits)
+      : law_(law), fp_(bits) {}
+
+  /// The target law.
+  Law law() const { return law_; }
+  /// K.
+  int bits() const { return fp_.bits(); }
+
+  /// Pre -> post with the random number g in (0,1). Pushes onto `log` when the post state
+  /// cannot give the pre cell back (rare). With `inv`, momentum and energy are taken from
+  /// it (held invariants) instead of the velocities. Throws InvalidArgument on bad input,
+  /// before anything changes.
+  PairV<2> forward(const PairV<2>& pre, const std::array<double, 2>& normal, double g,
+                   RareLog& log, const Invariants<2>* inv = nullptr) const {
+    const Frame2 f(normal);
+    const Split s = split(pre, f, inv, /*post=*/false);
+    // chart of -w_pre, which lies in P because w_pre approaches
+    const std::uint64_t cell_pre = fp_.encode(chart(-s.p, -s.q, s.norm));
+    const std::uint64_t cell_post = fp_.add(cell_pre, shift(g));
+    PairV<2> post = assemble(f, s, fp_.decode(cell_post), +1.0);
+    if (needs_log(post, f)) log.push(cell_pre);
+    return post;
+  }
+
+  /// Post -> pre with the same random number g that forward used (the RNG stepped back).
+  /// Pops from `log` when the forward step pushed. Throws InvalidArgument on bad input
+  /// (including a post state that does not separate), before anything changes.
+  PairV<2> reverse(const PairV<2>& post, const std::array<double, 2>& normal, double g,
+                   RareLog& log, const Invariants<2>* inv = nullptr) const {
+    const Frame2 f(normal);
+    const bool logged = needs_log(post, f);
+    const Split s = split(post, f, inv, /*post=*/true, logged);
+    std::uint64_t cell_pre;
+    if (logged) {
+      cell_pre = log.pop();
+    } else {
+      cell_pre = fp_.sub(fp_.encode(chart(s.p, s.q, s.norm)), shift(g));
+    }
+    return assemble(f, s, fp_.decode(cell_pre), -1.0);
+  }
+
+  /// Throws InvalidArgument unless `post` can be reversed with this log (used to check
+  /// before stepping a random number generator back).
+  void check_post(const PairV<2>& post, const std::array<double, 2>& normal,
+                  const RareLog& log, const Invariants<2>* inv = nullptr) const {
+    const Frame2 f(normal);
+    const bool logged = needs_log(post, f);
+    split(post, f, inv, /*post=*/true, logged);
+    require(!logged || log.size() > 0,
+            "rare log is empty: this post-collision state needs a logged coordinate");
+  }
+  /// Throws InvalidArgument unless `pre` is a valid pre-collision state.
+  void check_pre(const PairV<2>& pre, const std::array<double, 2>& normal,
+                 const Invariants<2>* inv = nullptr) const {
+    split(pre, Frame2(normal), inv, /*post=*/false);
+  }
+
+  /// The pre state as reversal restores it: its chart cell decoded at the cell centre
+  /// (the "first quantization"; afterwards a reversed sequence is exact bit for bit).
+  PairV<2> quantize(const PairV<2>& pre, const std::array<double, 2>& normal,
+                    const Invariants<2>* inv = nullptr) const {
+    const Frame2 f(normal);
+    const Split s = split(pre, f, inv, /*post=*/false);
+    return assemble(f, s, fp_.decode(fp_.encode(chart(-s.p, -s.q, s.norm))), -1.0);
+  }
+
+  /// The K-bit chart cell of a pre-collision state (what reversal restores exactly).
+  std::uint64_t pre_cell(const PairV<2>& pre, const std::array<double, 2>& normal) const {
+    const Frame2 f(normal);
+    const Split s = split(pre, f, nullptr, /*post=*/false);
+    return fp_.encode(chart(-s.p, -s.q, s.norm));
+  }
+
+  /// The chart coordinate in [0,1] of a separating relative velocity with normal part
+  /// p > 0, tangent part q and norm |w| (exposed for coverage tests).
+  double chart(double p, double q, double norm) const {
+    if (law_ == Law::uniform) return std::atan2(q, p) / kPi + 0.5;
+    return 0.5 + 0.5 * (q / norm);
+  }
+
+  /// Whether a post state is too close to rounding trouble for its cell to be recovered:
+  /// the rare-log condition, evaluated on the velocities alone (both directions agree).
+  bool needs_log(const PairV<2>& post, const Frame2& f) const {
+    (void)f;  // the bound below is rotation-invariant
+    // Rounding v = cm +- w/2 to doubles moves w by up to u (|v_i| + |v_j|) per component
+    // (u = 2^-53); computing w, its frame components, the chart and the decoded direction
+    // add about ten more roundings relative to |w|. The chart coordinate's error is then
+    // below u (S/|w| + 10) with S the sum of |components|; a cell is 2^-K, and the cell
+    // round-trips when the error stays below half a cell. We log beyond a quarter cell,
+    // with a factor 2 of safety on the bound. Measure before changing: this is the whole
+    // cost of the rare log on the hot path.
+    const double w0 = post.i[0] - post.j[0], w1 = post.i[1] - post.j[1];
+    const double norm2 = w0 * w0 + w1 * w1;
+    const double sum = std::fabs(post.i[0]) + std::fabs(post.i[1]) + std::fabs(post.j[0]) +
+                       std::fabs(post.j[1]);
+    // 2 u 2^K (sum/|w| + 10) > 1/4  <=>  (sum + 10|w|)^2 > |w|^2 (1 / (8 u 2^K))^2
+    const double lim = 1.0 / (8.0 * kUnitRoundoff * fp_.cells());
+    const double lhs = sum + 10.0 * std::sqrt(norm2);
+    return !(lhs * lhs <= norm2 * lim * lim);  // also true for a zero or non-finite norm
+  }
+
+ private:
+  static constexpr double kPi = 3.141592653589793238462643383279502884;
+  static constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
+
+  /// The relative velocity in the contact frame plus what assembling needs.
+  struct Split {
+    double p, q;     // w . a, w . t
+    double norm;     // |w| from the velocities
+    double rho;      // |w| to build the output with (held or computed)
+    double cm[2];    // centre-of-mass velocity (held or computed)
+  };
+
+  std::uint64_t shift(double g) const {
+    require(g > 0.0 && g < 1.0, "random number must be in (0,1)");
+    return fp_.shift(g);
+  }
+
+  // Validates and splits a pre (post = false: must approach) or post (must separate,
+  // unless the rare log serves it) state.
+  Split split(const PairV<2>& v, const Frame2& f, const Invariants<2>* inv, bool post,
+              bool logged = false) const {
+    require_finite(v);
+    const std::array<double, 2> w = relative(v);
+    Split s;
+    s.p = f.normal_part(w);
+    s.q = f.tangent_part(w);
+    s.norm = std::sqrt(w[0] * w[0] + w[1] * w[1]);
+    require(s.norm > 0.0, "zero relative speed: the particles cannot collide");
+    require(std::isfinite(s.norm), "velocities too large (relative speed overflows)");
+    if (post) {
+      require(s.p > 0.0 || logged,
+              "post-collision state does not separate along the contact normal "
+              "(normal relative velocity " + std::to_string(s.p) + " <= 0)");
+    } else {
+      require(s.p < 0.0, "pre-collision state is not approaching along the contact normal "
+                         "(normal relative velocity " + std::to_string(s.p) + " >= 0)");
+    }
+    if (inv) {
+      s.rho = checked_relative_speed(*inv, s.norm);
+      s.cm[0] = 0.5 * inv->momentum[0];
+      s.cm[1] = 0.5 * inv->momentum[1];
+    } else {
+      s.rho = s.norm;
+      s.cm[0] = 0.5 * (v.i[0] + v.j[0]);
+      s.cm[1] = 0.5 * (v.i[1] + v.j[1]);
+    }
+    return s;
+  }
+
+  // Velocities from a decoded chart coordinate c; sign -1 gives the pre state (-chart^-1).
+  PairV<2> assemble(const Frame2& f, const Split& s, double c, double sign) const {
+    double cn, ct;  // unit direction in the frame: cos(eta), sin(eta)
+    if (law_ == Law::uniform) {
+      // eta = pi (c - 1/2); cos(eta) = sin(pi min(c, 1-c)) keeps full relative precision at
+      // the grazing edges, where the textbook cos(eta) would cancel.
+      cn = std::sin(kPi * std::fmin(c, 1.0 - c));
+      ct = std::sin(kPi * (c - 0.5));
+    } else {
+      // sin(eta) = 2c - 1 exactly (c is a cell centre); cos(eta) from the factored form
+      const double sn = 2.0 * c - 1.0;
+      cn = std::sqrt((1.0 - sn) * (1.0 + sn));
+      ct = sn;
+    }
+    const double r = sign * 0.5 * s.rho;  // half of w: v_i = cm + w/2, v_j = cm - w/2
+    const double h0 = r * (cn * f.a[0] + ct * f.t[0]);
+    const double h1 = r * (cn * f.a[1] + ct * f.t[1]);
+    PairV<2> out;
+    out.i = {s.cm[0] + h0, s.cm[1] + h1};
+    out.j = {s.cm[0] - h0, s.cm[1] - h1};
+    return out;
+  }
+
+  Law law_;
+  FixedPoint fp_;
+};
+
+}  // namespace revcol

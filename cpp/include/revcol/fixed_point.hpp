@@ -1,0 +1,62 @@
+// K-bit fixed-point chart coordinates (DESIGN.md §4).
+//
+// A chart coordinate c in [0,1) is stored as the integer U = floor(c 2^K); a random number
+// G in (0,1) as floor(G 2^K). The torus shift u = u' + G (mod 1) is then exact integer
+// arithmetic, U = (U' + G) mod 2^K, and so is its inverse. A coordinate is decoded at the
+// centre of its cell, c = (U + 1/2) 2^-K: a decoded point is never on a cell edge, and it
+// re-encodes to the same integer whenever the chart's round-trip error is below half a cell.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "revcol/error.hpp"
+
+namespace revcol {
+
+/// The number of bits of each fixed-point chart coordinate.
+class FixedPoint {
+ public:
+  /// Smallest and largest supported K (K + 1 <= 53 keeps every cell centre exact in a double).
+  static constexpr int min_bits = 8, max_bits = 52, default_bits = 40;
+
+  /// K bits per coordinate; throws InvalidArgument outside [min_bits, max_bits].
+  explicit FixedPoint(int bits = default_bits) : bits_(bits) {
+    require(bits >= min_bits && bits <= max_bits,
+            "bits must be in [" + std::to_string(min_bits) + ", " + std::to_string(max_bits) +
+                "], got " + std::to_string(bits));
+    cells_ = std::ldexp(1.0, bits);
+    mask_ = (std::uint64_t{1} << bits) - 1;
+  }
+  /// K.
+  int bits() const { return bits_; }
+  /// 2^K as a double.
+  double cells() const { return cells_; }
+  /// Cell of c in [0,1]: floor(c 2^K), clamped to [0, 2^K - 1] (c = 1 can come from rounding).
+  std::uint64_t encode(double c) const {
+    const double s = std::floor(c * cells_);
+    if (!(s > 0.0)) return 0;  // also catches a NaN, which validation rules out earlier
+    const auto u = static_cast<std::uint64_t>(s);
+    return u > mask_ ? mask_ : u;
+  }
+  /// Position of c inside its cell, in [0,1): 1/2 at the centre. Used to detect round-trip error.
+  double offset_in_cell(double c) const {
+    const double s = c * cells_;
+    return s - std::floor(s);
+  }
+  /// Centre of cell U: (U + 1/2) 2^-K, exact in double.
+  double decode(std::uint64_t u) const { return (static_cast<double>(u) + 0.5) / cells_; }
+  /// A random number G in (0,1) as a K-bit shift.
+  std::uint64_t shift(double g) const { return encode(g); }
+  /// (U + G) mod 2^K.
+  std::uint64_t add(std::uint64_t u, std::uint64_t g) const { return (u + g) & mask_; }
+  /// (U - G) mod 2^K.
+  std::uint64_t sub(std::uint64_t u, std::uint64_t g) const { return (u - g) & mask_; }
+
+ private:
+  int bits_;
+  double cells_;
+  std::uint64_t mask_;
+};
+
+}  // namespace revcol

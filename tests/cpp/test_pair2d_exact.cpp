@@ -1,0 +1,201 @@
+#include "revcol/collide/pair2d_exact.hpp"
+
+#include <random>
+
+#include "check.hpp"
+
+using namespace revcol;
+using V = PairV<2>;
+
+namespace {
+// A random approaching pre state for a random unit normal.
+struct Sample {
+  V v;
+  std::array<double, 2> n;
+};
+Sample random_pre(std::mt19937_64& rng, double cm_scale = 1.0) {
+  std::normal_distribution<double> N(0.0, 1.0);
+  Sample s;
+  for (;;) {
+    s.v.i = {N(rng), N(rng)};
+    s.v.j = {N(rng), N(rng)};
+    const double c0 = cm_scale * N(rng), c1 = cm_scale * N(rng);
+    s.v.i[0] += c0; s.v.j[0] += c0; s.v.i[1] += c1; s.v.j[1] += c1;
+    s.n = {N(rng), N(rng)};
+    const double p = (s.v.i[0] - s.v.j[0]) * s.n[0] + (s.v.i[1] - s.v.j[1]) * s.n[1];
+    if (p < 0) return s;
+  }
+}
+double uniform01(std::mt19937_64& rng) {
+  return (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53;
+}
+Invariants<2> invariants(const V& v) {
+  return {{v.i[0] + v.j[0], v.i[1] + v.j[1]},
+          v.i[0] * v.i[0] + v.i[1] * v.i[1] + v.j[0] * v.j[0] + v.j[1] * v.j[1]};
+}
+double max_diff(const V& a, const V& b) {
+  double m = 0;
+  for (int k = 0; k < 2; ++k)
+    m = std::max({m, std::fabs(a.i[k] - b.i[k]), std::fabs(a.j[k] - b.j[k])});
+  return m;
+}
+double scale(const V& v) {
+  return std::max({std::fabs(v.i[0]), std::fabs(v.i[1]), std::fabs(v.j[0]), std::fabs(v.j[1])});
+}
+// One collision forward and back. With held invariants the restored state is the quantized
+// pre state bit for bit; with invariants recomputed from the velocities, the chart cell is
+// restored exactly and the velocities to rounding (|cm| and |w| are rebuilt from the post).
+// (The cell of a restored state is compared only when it is well conditioned, check_cell.)
+bool round_trip(const Pair2DExact& op, const V& pre, const std::array<double, 2>& n, double g,
+                RareLog& log, bool check_cell = true) {
+  const Invariants<2> inv = invariants(pre);
+  const V held = op.reverse(op.forward(pre, n, g, log, &inv), n, g, log, &inv);
+  if (!(held == op.quantize(pre, n, &inv))) return false;
+  const V back = op.reverse(op.forward(pre, n, g, log), n, g, log);
+  const V q = op.quantize(pre, n);
+  return (!check_cell || op.pre_cell(back, n) == op.pre_cell(pre, n)) && max_diff(back, q) <= 1e-15 * 8 * scale(pre);
+}
+double rel_p(const V& v, const std::array<double, 2>& n) {
+  return (v.i[0] - v.j[0]) * n[0] + (v.i[1] - v.j[1]) * n[1];
+}
+}  // namespace
+
+TEST_CASE("forward then reverse restores the quantized pre state bit for bit") {
+  std::mt19937_64 rng(1);
+  for (Law law : {Law::flux, Law::uniform}) {
+    const Pair2DExact op(law);
+    RareLog log;
+    for (int k = 0; k < 100000; ++k) {
+      const Sample s = random_pre(rng);
+      const double g = uniform01(rng);
+      const V post = op.forward(s.v, s.n, g, log);
+      REQUIRE(rel_p(post, s.n) > 0.0);
+      REQUIRE(round_trip(op, s.v, s.n, g, log));
+    }
+    CHECK(log.size() == 0);
+  }
+}
+
+TEST_CASE("momentum and energy are conserved to 1e-13 relative per collision") {
+  std::mt19937_64 rng(2);
+  const Pair2DExact op;
+  RareLog log;
+  double worst_m = 0, worst_e = 0;
+  for (int k = 0; k < 100000; ++k) {
+    const Sample s = random_pre(rng);
+    const V post = op.forward(s.v, s.n, uniform01(rng), log);
+    const double scale = std::fabs(s.v.i[0]) + std::fabs(s.v.i[1]) + std::fabs(s.v.j[0]) +
+                         std::fabs(s.v.j[1]);
+    for (int a = 0; a < 2; ++a)
+      worst_m = std::max(worst_m, std::fabs((post.i[a] + post.j[a]) - (s.v.i[a] + s.v.j[a])) / scale);
+    auto e = [](const V& v) { return v.i[0] * v.i[0] + v.i[1] * v.i[1] + v.j[0] * v.j[0] + v.j[1] * v.j[1]; };
+    worst_e = std::max(worst_e, std::fabs(e(post) - e(s.v)) / e(s.v));
+  }
+  CHECK(worst_m <= 1e-13);
+  CHECK(worst_e <= 1e-13);
+}
+
+TEST_CASE("the paper's illustration: held invariants, negation, 1e5 collisions, bit exact") {
+  for (Law law : {Law::flux, Law::uniform}) {
+    const Pair2DExact op(law);
+    RareLog log;
+    std::mt19937_64 rng(3);
+    std::vector<double> gs(100000);
+    for (double& g : gs) g = uniform01(rng);
+    const std::array<double, 2> n{1.0, 1.0};
+    V v{{0.25, -0.5}, {1.0, 0.75}};
+    const Invariants<2> inv{{v.i[0] + v.j[0], v.i[1] + v.j[1]},
+                            v.i[0] * v.i[0] + v.i[1] * v.i[1] + v.j[0] * v.j[0] + v.j[1] * v.j[1]};
+    const V q0 = op.quantize(v, n, &inv);
+    auto negate = [](V& x) { for (int a = 0; a < 2; ++a) { x.i[a] = -x.i[a]; x.j[a] = -x.j[a]; } };
+    for (double g : gs) { v = op.forward(v, n, g, log, &inv); negate(v); }
+    for (auto it = gs.rbegin(); it != gs.rend(); ++it) { negate(v); v = op.reverse(v, n, *it, log, &inv); }
+    CHECK(v == q0);
+    CHECK(log.size() == 0);
+  }
+}
+
+TEST_CASE("a fast centre of mass triggers the rare log, and reversal stays exact") {
+  std::mt19937_64 rng(4);
+  for (Law law : {Law::flux, Law::uniform}) {
+    const Pair2DExact op(law);
+    RareLog log;
+    int logged = 0;
+    for (int k = 0; k < 20000; ++k) {
+      const Sample s = random_pre(rng, k % 2 ? 1e4 : 1e2);
+      const double g = uniform01(rng);
+      const std::size_t before = log.size();
+      const Invariants<2> inv = invariants(s.v);
+      const V post = op.forward(s.v, s.n, g, log, &inv);
+      logged += log.size() > before;
+      REQUIRE(op.reverse(post, s.n, g, log, &inv) == op.quantize(s.v, s.n, &inv));
+      REQUIRE(log.size() == before);
+      REQUIRE(round_trip(op, s.v, s.n, g, log, /*check_cell=*/k % 2 == 0));
+      REQUIRE(log.size() == before);
+    }
+    CHECK(logged > 5000);  // the 1e4 half must log: |cm|/|w| ~ 1e4 is beyond the ~1e3 bound at K = 40
+    // and in the 1e2 half nothing needs to
+    CHECK(logged < 15000);
+  }
+}
+
+TEST_CASE("chart edges: cells 0 and 2^K-1, grazing pre states, g next to 0 and 1") {
+  for (Law law : {Law::flux, Law::uniform}) {
+    const Pair2DExact op(law);
+    RareLog log;
+    const std::array<double, 2> n{1.0, 0.0};
+    // grazing pre states: tiny approach, large tangential speed, both tangential signs
+    for (double tiny : {1e-300, 1e-200, 1e-17, 1e-12, 1e-6}) {
+      for (double tang : {-1.0, 1.0}) {
+        const V pre{{-tiny, tang}, {0.0, 0.0}};
+        for (double g : {0x1.0p-53, 1e-12, 0.5, 1.0 - 1e-12, 1.0 - 0x1.0p-53}) {
+          const V post = op.forward(pre, n, g, log);
+          CHECK(rel_p(post, n) > 0.0);
+          const V back = op.reverse(post, n, g, log);
+          CHECK(rel_p(back, n) < 0.0);
+          CHECK(round_trip(op, pre, n, g, log));
+        }
+      }
+    }
+    CHECK(log.size() == 0);
+  }
+}
+
+TEST_CASE("bad input is rejected with a clear error and nothing changes") {
+  const Pair2DExact op;
+  RareLog log;
+  const V pre{{1.0, 0.0}, {-1.0, 0.0}};
+  const std::array<double, 2> n{-1.0, 0.0};  // from j to i points left: they approach
+  const double nan = std::nan("");
+  CHECK_THROWS_AS(op.forward(V{{nan, 0}, {0, 0}}, n, 0.5, log), InvalidArgument);
+  CHECK_THROWS_AS(op.forward(pre, {0.0, 0.0}, 0.5, log), InvalidArgument);
+  CHECK_THROWS_AS(op.forward(pre, {nan, 1.0}, 0.5, log), InvalidArgument);
+  CHECK_THROWS_AS(op.forward(pre, {1.0, 0.0}, 0.5, log), InvalidArgument);  // separating
+  CHECK_THROWS_AS(op.forward(pre, {0.0, 1.0}, 0.5, log), InvalidArgument);  // grazing
+  CHECK_THROWS_AS(op.forward(V{{1, 1}, {1, 1}}, n, 0.5, log), InvalidArgument);  // zero speed
+  CHECK_THROWS_AS(op.forward(pre, n, 0.0, log), InvalidArgument);
+  CHECK_THROWS_AS(op.forward(pre, n, 1.0, log), InvalidArgument);
+  CHECK_THROWS_AS(op.reverse(pre, n, 0.5, log), InvalidArgument);  // post must separate
+  const Invariants<2> bad{{0.0, 0.0}, 100.0};
+  CHECK_THROWS_AS(op.forward(pre, n, 0.5, log, &bad), InvalidArgument);
+  const Invariants<2> none{{0.0, 0.0}, 0.0};
+  CHECK_THROWS_AS(op.forward(pre, n, 0.5, log, &none), InvalidArgument);
+  CHECK_THROWS_AS(Pair2DExact(Law::flux, 60), InvalidArgument);
+  CHECK(log.size() == 0);
+  CHECK(log.pushed() == 0);
+}
+
+TEST_CASE("an empty rare log is reported, not read past") {
+  const Pair2DExact op;
+  RareLog log;
+  const std::array<double, 2> n{1.0, 0.0};
+  const V pre{{1e7 - 1e-3, 1e7}, {1e7, 1e7}};  // |cm| / |w| ~ 1e10: must log
+  const V post = op.forward(pre, n, 0.25, log);
+  REQUIRE(log.size() == 1);
+  RareLog empty;
+  CHECK_THROWS_AS(op.check_post(post, n, empty), InvalidArgument);
+  CHECK_THROWS_AS(op.reverse(post, n, 0.25, empty), InvalidArgument);
+  CHECK(op.pre_cell(op.reverse(post, n, 0.25, log), n) == op.pre_cell(pre, n));
+}
+
+CHECK_MAIN()
