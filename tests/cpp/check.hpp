@@ -55,10 +55,11 @@ inline int run_all() {
   static void CHECK_CAT(test_fn_, __LINE__)();                                       \
   static check::Register CHECK_CAT(test_reg_, __LINE__)(name, CHECK_CAT(test_fn_, __LINE__)); \
   static void CHECK_CAT(test_fn_, __LINE__)()
-#define CHECK(cond) \
-  do { if (!(cond)) check::fail(__FILE__, __LINE__, #cond); } while (0)
-#define REQUIRE(cond) \
-  do { if (!(cond)) { check::fail(__FILE__, __LINE__, #cond); throw check::Abort{}; } } while (0)
+// variadic so that a condition with template commas (f<1, 2>(x) == y) needs no parentheses
+#define CHECK(...) \
+  do { if (!(__VA_ARGS__)) check::fail(__FILE__, __LINE__, #__VA_ARGS__); } while (0)
+#define REQUIRE(...) \
+  do { if (!(__VA_ARGS__)) { check::fail(__FILE__, __LINE__, #__VA_ARGS__); throw check::Abort{}; } } while (0)
 #define CHECK_NEAR(a, b, tol)                                                              \
   do {                                                                                     \
     const double check_a_ = (a), check_b_ = (b);                                           \

@@ -2,6 +2,7 @@
 #pragma once
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace revcol {
 
@@ -11,9 +12,20 @@ class InvalidArgument : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
-/// Throws InvalidArgument(msg) when cond is false.
+/// Throws InvalidArgument(msg) when cond is false. Checks sit on hot paths, so a message
+/// is never built unless it is thrown: pass a literal, or a callable returning the message.
+inline void require(bool cond, const char* msg) {
+  if (!cond) [[unlikely]] throw InvalidArgument(msg);
+}
+/// As above, for a message that has already been built (cold paths only).
 inline void require(bool cond, const std::string& msg) {
-  if (!cond) throw InvalidArgument(msg);
+  if (!cond) [[unlikely]] throw InvalidArgument(msg);
+}
+/// As above, with the message built by make_msg() only when cond is false.
+template <class F>
+  requires std::is_invocable_r_v<std::string, F>
+inline void require(bool cond, F&& make_msg) {
+  if (!cond) [[unlikely]] throw InvalidArgument(make_msg());
 }
 
 }  // namespace revcol

@@ -77,9 +77,8 @@ inline double checked_relative_speed(const Invariants<Dim>& inv, double w_norm) 
   require(r2 > 0.0, "invariants leave no relative kinetic energy (2E <= |M|^2)");
   const double rho = std::sqrt(r2);
   const double cancel = 16.0 * std::numeric_limits<double>::epsilon() * (2.0 * inv.energy);
-  require(std::fabs(w_norm * w_norm - r2) <= 1e-8 * r2 + cancel,
-          "velocities are inconsistent with the given energy and momentum (relative speed " +
-              std::to_string(w_norm) + " vs " + std::to_string(rho) + ")");
+  require(std::fabs(w_norm * w_norm - r2) <= 1e-8 * r2 + cancel, [&] { return std::string("velocities are inconsistent with the given energy and momentum (relative speed " +
+              std::to_string(w_norm) + " vs " + std::to_string(rho) + ")"); });
   return rho;
 }
 

@@ -37,9 +37,10 @@ class Pair2DPaper {
   /// Whether this operator reproduces the printed (faulty) Procedure 2.
   bool printed_reverse() const { return printed_; }
 
-  /// Procedure 1: pre -> post with g in (0,1); held invariants optional.
+  /// Procedure 1: pre -> post with g in (0,1); held invariants optional. The log is part
+  /// of the common operator signature; this operator never needs it.
   PairV<2> forward(const PairV<2>& pre, const std::array<double, 2>& normal, double g,
-                   const Invariants<2>* inv = nullptr) const {
+                   RareLog& /*log*/, const Invariants<2>* inv = nullptr) const {
     const Frame2 f(normal);
     const Parts s = parts(pre, f, inv, /*post=*/false, g);
     double phi = wrap(s.phi + kTwoPi * g);
@@ -49,7 +50,7 @@ class Pair2DPaper {
 
   /// Procedure 2 (candidate test fixed): post -> pre with the g forward used.
   PairV<2> reverse(const PairV<2>& post, const std::array<double, 2>& normal, double g,
-                   const Invariants<2>* inv = nullptr) const {
+                   RareLog& /*log*/, const Invariants<2>* inv = nullptr) const {
     const Frame2 f(normal);
     const Parts s = parts(post, f, inv, /*post=*/true, g);
     double phi_pre = wrap(s.phi - kTwoPi * g);
@@ -69,6 +70,8 @@ class Pair2DPaper {
                   const Invariants<2>* inv = nullptr) const {
     parts(post, Frame2(normal), inv, true, 0.5);
   }
+  /// Whether reversing `post` pops the log: never in this operator.
+  bool logs(const PairV<2>&, const std::array<double, 2>&) const { return false; }
 
   /// V-to-Phi: the angle of the relative velocity in [0, 2pi).
   static double angle(const PairV<2>& v) {
@@ -102,11 +105,11 @@ class Pair2DPaper {
     require(std::isfinite(norm), "velocities too large (relative speed overflows)");
     const double p = f.normal_part(w);
     if (post)
-      require(p > 0.0, "post-collision state does not separate along the contact normal "
-                       "(normal relative velocity " + std::to_string(p) + " <= 0)");
+      require(p > 0.0, [&] { return std::string("post-collision state does not separate along the contact normal "
+                       "(normal relative velocity " + std::to_string(p) + " <= 0)"); });
     else
-      require(p < 0.0, "pre-collision state is not approaching along the contact normal "
-                       "(normal relative velocity " + std::to_string(p) + " >= 0)");
+      require(p < 0.0, [&] { return std::string("pre-collision state is not approaching along the contact normal "
+                       "(normal relative velocity " + std::to_string(p) + " >= 0)"); });
     Parts s;
     s.phi = wrap(std::atan2(w[1], w[0]));
     if (inv) {

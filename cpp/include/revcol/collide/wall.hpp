@@ -56,8 +56,7 @@ class Wall {
     for (int k = 0; k < box.dim; ++k) {
       require(std::isfinite(x[k]) && std::isfinite(v[k]),
               "position and velocity must be finite");
-      require(box.hi[k] - box.lo[k] > 2.0 * radius,
-              "box is narrower than a particle on axis " + std::to_string(k));
+      require(box.hi[k] - box.lo[k] > 2.0 * radius, [&] { return std::string("box is narrower than a particle on axis " + std::to_string(k)); });
       const bool at_lo = std::fabs(x[k] - (box.lo[k] + radius)) <= tol;
       const bool at_hi = std::fabs(x[k] - (box.hi[k] - radius)) <= tol;
       if (!at_lo && !at_hi) continue;
@@ -65,15 +64,14 @@ class Wall {
       // moving towards the touched wall: v < 0 at the lower, v > 0 at the upper one
       const bool towards = (at_lo && v[k] < 0.0) || (at_hi && v[k] > 0.0);
       const bool away = (at_lo && v[k] > 0.0) || (at_hi && v[k] < 0.0);
-      require(!(at_lo && at_hi), "particle touches both walls of axis " + std::to_string(k));
+      require(!(at_lo && at_hi), [&] { return std::string("particle touches both walls of axis " + std::to_string(k)); });
       // before (forward) a touched wall may be approached or grazed, never left; after
       // (reverse) it may be left or grazed, never approached
-      require(approaching ? !away : !towards,
-              std::string(approaching ? "pre" : "post") +
+      require(approaching ? !away : !towards, [&] { return std::string(std::string(approaching ? "pre" : "post") +
                   "-collision particle touches the " + (at_lo ? "lower" : "upper") +
                   " wall of axis " + std::to_string(k) + " while moving " +
                   (approaching ? "away from" : "towards") +
-                  " it: not one reversible wall event");
+                  " it: not one reversible wall event"); });
       if (approaching ? towards : away) {
         out[k] = -v[k];
         ++flipped;
