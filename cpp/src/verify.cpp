@@ -75,12 +75,21 @@ void run_pair2d(const Op& op, Gen& gen, const VerifyConfig& c, VerifyResult& r,
   r.random_numbers_drawn = c.collisions;
 
   t0 = Clock::now();
-  for (std::uint64_t k = 0; k < c.collisions; ++k) {
-    negate(v);
-    v = op.reverse(v, n, gen.prev(), log, &inv);
+  std::uint64_t undone = 0;
+  try {
+    for (; undone < c.collisions; ++undone) {
+      negate(v);
+      const double g = gen.prev();
+      v = op.reverse(v, n, g, log, &inv);
+    }
+  } catch (const InvalidArgument& e) {
+    // a wrong reversal (the printed Procedure 2) hands the next step an invalid state
+    r.error = "reverse step " + std::to_string(undone + 1) + " of " +
+              std::to_string(c.collisions) + ": " + e.what();
+    ++undone;  // its number was stepped back
   }
   r.reverse_s = seconds_since(t0);
-  r.random_numbers_undone = c.collisions;
+  r.random_numbers_undone = undone;
   r.final_velocities = flat(v);
   r.rng_restored = gen == start_state;
   r.passed = log.size() == 0;
@@ -141,9 +150,20 @@ VerifyResult verify(const VerifyConfig& c) {
   r.forward_per_s = r.forward_s > 0 ? static_cast<double>(c.collisions) / r.forward_s : 0.0;
   r.reverse_per_s = r.reverse_s > 0 ? static_cast<double>(c.collisions) / r.reverse_s : 0.0;
   const bool exact = c.case_name == "pair1d" || c.mode == Mode::exact;
-  r.passed = r.passed && r.rng_restored && r.max_rel_error <= 1e-9 && (!exact || r.bit_exact);
+  r.passed = r.passed && r.error.empty() && r.rng_restored && r.max_rel_error <= 1e-9 && (!exact || r.bit_exact);
   return r;
 }
+
+namespace {
+std::string escaped(const std::string& s) {
+  std::string out;
+  for (char ch : s) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out;
+}
+}  // namespace
 
 std::string to_json(const VerifyResult& r) {
   auto num = [](double x) {
@@ -172,6 +192,7 @@ std::string to_json(const VerifyResult& r) {
     << ", \"random_numbers_drawn\": " << r.random_numbers_drawn
     << ", \"random_numbers_undone\": " << r.random_numbers_undone
     << ", \"rng_restored\": " << (r.rng_restored ? "true" : "false")
+    << ", \"error\": \"" << escaped(r.error) << "\""
     << ", \"initial\": " << arr(r.initial) << ", \"final\": " << arr(r.final_velocities)
     << ", \"reference\": " << arr(r.reference) << "}";
   return o.str();

@@ -1,1 +1,21 @@
-from ._core import *  # noqa
+"""revcol: reversible simulation of randomized elastic hard-sphere collisions.
+
+Collisions whose outcome is randomized over all permitted phase space, run forward and
+then backwards to any earlier point with essentially no memory: the collision operators
+are invertible and driven by reversible random number generators (Perumalla &
+Protopopescu, ACM TOMACS 2013, and beyond).
+
+    >>> import numpy as np, revcol
+    >>> g = revcol.CLCG4()
+    >>> op = revcol.Pair2D()                 # exact mode, flux law
+    >>> v = np.array([[1.0, 0.0], [-1.0, 0.0]])
+    >>> post = op.forward(v, [-1.0, 0.0], rng=g)
+    >>> np.allclose(op.reverse(post, [-1.0, 0.0], rng=g), v)
+    True
+"""
+from .collide import Pair1D, Pair2D, Wall
+from .rng import CLCG4, Philox, philox4x32
+from .verify import VERIFY_CASES, verify
+
+__all__ = ["CLCG4", "Philox", "philox4x32", "Pair1D", "Pair2D", "Wall", "verify", "VERIFY_CASES"]
+__version__ = "0.1.0"

@@ -22,9 +22,8 @@ class FixedPoint {
 
   /// K bits per coordinate; throws InvalidArgument outside [min_bits, max_bits].
   explicit FixedPoint(int bits = default_bits) : bits_(bits) {
-    require(bits >= min_bits && bits <= max_bits,
-            "bits must be in [" + std::to_string(min_bits) + ", " + std::to_string(max_bits) +
-                "], got " + std::to_string(bits));
+    require(bits >= min_bits && bits <= max_bits, [&] { return std::string("bits must be in [" + std::to_string(min_bits) + ", " + std::to_string(max_bits) +
+                "], got " + std::to_string(bits)); });
     cells_ = std::ldexp(1.0, bits);
     mask_ = (std::uint64_t{1} << bits) - 1;
   }

@@ -40,6 +40,7 @@ struct VerifyResult {
   std::uint64_t random_numbers_drawn = 0;   ///< next() calls forward
   std::uint64_t random_numbers_undone = 0;  ///< prev() calls in reverse
   bool rng_restored = false;             ///< the generator is back at its start
+  std::string error;                     ///< why the reversal stopped early; empty if it did not
   std::vector<double> initial, final_velocities, reference;  ///< start, end, quantized start
 };
 

@@ -19,7 +19,7 @@ void forward_batch(const Op& op, PairV<2>* v, const std::array<double, 2>* n, st
   for (std::size_t b = 0; b < B; ++b) {
     try {
       op.check_pre(v[b], n[b], inv ? inv + b : nullptr);
-      require(g[b] > 0.0 && g[b] < 1.0, "random number must be in (0,1)");
+      require(g[b] >= 0.0 && g[b] <= 1.0, "random number must be in [0,1]");
     } catch (const InvalidArgument& e) {
       throw InvalidArgument("entry " + std::to_string(b) + ": " + e.what());
     }
@@ -35,7 +35,7 @@ void reverse_batch(const Op& op, PairV<2>* v, const std::array<double, 2>* n, st
   for (std::size_t b = 0; b < B; ++b) {
     try {
       op.check_post(v[b], n[b], inv ? inv + b : nullptr);
-      require(g[b] > 0.0 && g[b] < 1.0, "random number must be in (0,1)");
+      require(g[b] >= 0.0 && g[b] <= 1.0, "random number must be in [0,1]");
     } catch (const InvalidArgument& e) {
       throw InvalidArgument("entry " + std::to_string(b) + ": " + e.what());
     }

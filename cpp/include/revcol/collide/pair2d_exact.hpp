@@ -55,7 +55,7 @@ class Pair2DExact {
   /// K.
   int bits() const { return fp_.bits(); }
 
-  /// Pre -> post with the random number g in (0,1). Pushes onto `log` when the post state
+  /// Pre -> post with the random number g in [0,1] (CLCG4 can return either end). Pushes onto `log` when the post state
   /// cannot give the pre cell back (rare). With `inv`, momentum and energy are taken from
   /// it (held invariants) instead of the velocities. Throws InvalidArgument on bad input,
   /// before anything changes.
@@ -162,7 +162,7 @@ class Pair2DExact {
   };
 
   std::uint64_t shift(double g) const {
-    require(g > 0.0 && g < 1.0, "random number must be in (0,1)");
+    require(g >= 0.0 && g <= 1.0, "random number must be in [0,1]");
     return fp_.shift(g);
   }
 

@@ -37,7 +37,7 @@ class Pair2DPaper {
   /// Whether this operator reproduces the printed (faulty) Procedure 2.
   bool printed_reverse() const { return printed_; }
 
-  /// Procedure 1: pre -> post with g in (0,1); held invariants optional. The log is part
+  /// Procedure 1: pre -> post with g in [0,1]; held invariants optional. The log is part
   /// of the common operator signature; this operator never needs it.
   PairV<2> forward(const PairV<2>& pre, const std::array<double, 2>& normal, double g,
                    RareLog& /*log*/, const Invariants<2>* inv = nullptr) const {
@@ -98,7 +98,7 @@ class Pair2DPaper {
   Parts parts(const PairV<2>& v, const Frame2& f, const Invariants<2>* inv, bool post,
               double g) const {
     require_finite(v);
-    require(g > 0.0 && g < 1.0, "random number must be in (0,1)");
+    require(g >= 0.0 && g <= 1.0, "random number must be in [0,1]");
     const std::array<double, 2> w = relative(v);
     const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1]);
     require(norm > 0.0, "zero relative speed: the particles cannot collide");

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs everything revcol needs, on a fresh Debian machine as root, and is cheap to run
+# again: Debian packages (compiler, Eigen 3, GSL, Python) only when missing, then a virtual
+# environment .venv with the build tools from PyPI and revcol itself (an incremental build).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+missing=()
+command -v g++ >/dev/null 2>&1 || missing+=(g++)
+command -v make >/dev/null 2>&1 || missing+=(make)
+[ -f /usr/include/eigen3/Eigen/Core ] || missing+=(libeigen3-dev)
+[ -f /usr/include/gsl/gsl_sf_ellint.h ] || missing+=(libgsl-dev)
+command -v python3 >/dev/null 2>&1 || missing+=(python3 python3-dev python3-venv)
+if command -v python3 >/dev/null 2>&1 && ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
+  missing+=(python3-venv)
+fi
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing Debian packages: ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" python3-dev >/dev/null
+fi
+
+if [ ! -x .venv/bin/python ]; then
+  python3 -m venv .venv
+fi
+py=.venv/bin/python
+$py -m pip install -q --disable-pip-version-check --upgrade pip >/dev/null
+$py -m pip install -q --disable-pip-version-check \
+  "scikit-build-core>=0.10" "pybind11>=2.12" "cmake>=3.20" ninja numpy "scipy>=1.8" "pytest>=7" "matplotlib>=3.5"
+# no build isolation: the tools above are in .venv, and build/ is reused between runs
+$py -m pip install -q --disable-pip-version-check --no-build-isolation --no-deps .
+echo "setup: ok ($($py -c 'import revcol, sys; print("revcol", revcol.__version__, "python", sys.version.split()[0])'))"
