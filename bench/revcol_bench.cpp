@@ -14,23 +14,15 @@
 #include <string>
 #include <vector>
 
+#include "bench.hpp"
 #include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
 #include "revcol/verify.hpp"
 
+namespace revcol::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-struct Metric {
-  std::string name;  // e.g. forward_per_s
-  double value;
-};
-struct Bench {
-  std::string name;
-  std::string unit;
-  std::function<std::vector<Metric>(std::uint64_t n)> run;
-};
 
 std::vector<Metric> verify_metrics(const revcol::VerifyConfig& c) {
   const revcol::VerifyResult r = revcol::verify(c);
@@ -58,8 +50,9 @@ std::vector<Metric> rng_metrics(Gen gen, std::uint64_t n) {
   return {{"next_per_s", n / fwd}, {"prev_per_s", n / rev}};
 }
 
-std::vector<Bench> all_benches() {
-  std::vector<Bench> out;
+}  // namespace
+
+void add_pair_benches(std::vector<Bench>& out) {
   for (const char* rng : {"clcg4", "philox"}) {
     for (const char* variant : {"exact-flux", "exact-uniform", "paper"}) {
       const std::string v = variant, g = rng;
@@ -84,6 +77,20 @@ std::vector<Bench> all_benches() {
                  [](std::uint64_t n) { return rng_metrics(revcol::rng::CLCG4(0), n); }});
   out.push_back({"rng/philox", "draws/s",
                  [](std::uint64_t n) { return rng_metrics(revcol::rng::Philox({0, 0}, 0), n); }});
+}
+
+}  // namespace revcol::bench
+
+namespace {
+using revcol::bench::Bench;
+using revcol::bench::Metric;
+
+std::vector<Bench> all_benches() {
+  std::vector<Bench> out;
+  revcol::bench::add_pair_benches(out);
+  revcol::bench::add_exact_benches(out);
+  revcol::bench::add_paper_benches(out);
+  revcol::bench::add_statesave_benches(out);
   return out;
 }
 

@@ -6,4 +6,7 @@ namespace revcol::bind {
 void register_rng(pybind11::module_& m);
 void register_collide(pybind11::module_& m);
 void register_verify(pybind11::module_& m);
+void register_exact(pybind11::module_& m);      ///< exact.cpp: the general exact operator
+void register_paper(pybind11::module_& m);      ///< paper.cpp: paper-mode 3D pair and triples
+void register_statesave(pybind11::module_& m);  ///< statesave.cpp: the SS1/SS2/RC study
 }  // namespace revcol::bind

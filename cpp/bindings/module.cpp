@@ -11,4 +11,7 @@ PYBIND11_MODULE(_core, m) {
   revcol::bind::register_rng(m);
   revcol::bind::register_collide(m);
   revcol::bind::register_verify(m);
+  revcol::bind::register_exact(m);
+  revcol::bind::register_paper(m);
+  revcol::bind::register_statesave(m);
 }

@@ -63,6 +63,8 @@ void register_verify(py::module_& m) {
       py::arg("bits") = 40, py::arg("printed_reverse") = false,
       py::arg("velocities") = std::vector<double>{}, py::arg("normal") = std::vector<double>{},
       "The paper's reversal illustration (see revcol.verify).");
+  m.def("verify_cases", [](const std::string& mode) { return verify_cases(parse_mode(mode)); },
+        py::arg("mode") = "exact", "Case names verify() knows for a mode.");
 }
 
 }  // namespace revcol::bind

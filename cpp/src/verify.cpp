@@ -129,7 +129,11 @@ void run_case(const VerifyConfig& c, VerifyResult& r) {
     r.rng_restored = true;
     r.passed = true;
   } else {
-    throw InvalidArgument("unknown verify case '" + c.case_name + "' (this build has: pair1d, pair2d)");
+    if (detail::run_exact_case(c, r) || detail::run_paper_case(c, r)) return;
+    std::string known;
+    for (const std::string& name : verify_cases(c.mode)) known += (known.empty() ? "" : ", ") + name;
+    throw InvalidArgument("unknown verify case '" + c.case_name + "' for mode " +
+                          to_string(c.mode) + " (known: " + known + ")");
   }
 }
 
@@ -149,9 +153,22 @@ VerifyResult verify(const VerifyConfig& c) {
   r.bit_exact = r.final_velocities == r.reference;
   r.forward_per_s = r.forward_s > 0 ? static_cast<double>(c.collisions) / r.forward_s : 0.0;
   r.reverse_per_s = r.reverse_s > 0 ? static_cast<double>(c.collisions) / r.reverse_s : 0.0;
-  const bool exact = c.case_name == "pair1d" || c.mode == Mode::exact;
+  const bool exact = detail::promises_bit_exact(c);
   r.passed = r.passed && r.error.empty() && r.rng_restored && r.max_rel_error <= 1e-9 && (!exact || r.bit_exact);
   return r;
+}
+
+std::vector<std::string> verify_cases(Mode mode) {
+  std::vector<std::string> out{"pair1d", "pair2d"};
+  const std::vector<std::string> more =
+      mode == Mode::exact ? detail::exact_case_names() : detail::paper_case_names();
+  for (const std::string& n : more)
+    if (n != "pair1d" && n != "pair2d") out.push_back(n);
+  return out;
+}
+
+bool detail::promises_bit_exact(const VerifyConfig& c) {
+  return c.case_name == "pair1d" || c.mode == Mode::exact;
 }
 
 namespace {

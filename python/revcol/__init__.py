@@ -15,7 +15,7 @@ Protopopescu, ACM TOMACS 2013, and beyond).
 """
 from .collide import Pair1D, Pair2D, Wall
 from .rng import CLCG4, Philox, philox4x32
-from .verify import VERIFY_CASES, verify
+from .verify import VERIFY_CASES, verify, verify_cases
 
-__all__ = ["CLCG4", "Philox", "philox4x32", "Pair1D", "Pair2D", "Wall", "verify", "VERIFY_CASES"]
+__all__ = ["CLCG4", "Philox", "philox4x32", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES"]
 __version__ = "0.1.0"

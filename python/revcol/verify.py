@@ -22,9 +22,16 @@ from typing import Sequence
 
 from . import _core
 
-VERIFY_CASES = ("pair1d", "pair2d")
+__all__ = ["verify", "verify_cases", "VERIFY_CASES"]
 
-__all__ = ["verify", "VERIFY_CASES"]
+
+def verify_cases(mode: str = "exact") -> tuple[str, ...]:
+    """The case names :func:`verify` knows for a mode ("exact" or "paper")."""
+    return tuple(_core.verify_cases(mode))
+
+
+#: every case name, either mode
+VERIFY_CASES = tuple(dict.fromkeys(verify_cases("exact") + verify_cases("paper")))
 
 
 def verify(case: str = "pair2d", *, collisions: int = 1_000_000, mode: str = "exact",
@@ -32,8 +39,10 @@ def verify(case: str = "pair2d", *, collisions: int = 1_000_000, mode: str = "ex
            printed_reverse: bool = False, velocities: Sequence[float] | None = None,
            normal: Sequence[float] | None = None) -> dict:
     """Run a reversal illustration and return its report (a dict; see the module doc)."""
-    if case not in VERIFY_CASES:
-        raise ValueError(f"unknown case {case!r}; this build has: {', '.join(VERIFY_CASES)}")
+    if mode not in ("exact", "paper"):
+        raise ValueError(f"mode must be 'exact' or 'paper', got {mode!r}")
+    if case not in verify_cases(mode):
+        raise ValueError(f"unknown case {case!r} for mode {mode}; known: {', '.join(verify_cases(mode))}")
     if isinstance(collisions, bool) or int(collisions) != collisions or collisions < 1:
         raise ValueError(f"collisions must be a positive integer, got {collisions!r}")
     if isinstance(seed, bool) or int(seed) != seed or seed < 0:

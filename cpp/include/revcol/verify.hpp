@@ -47,6 +47,22 @@ struct VerifyResult {
 /// Runs the illustration. Throws InvalidArgument on a bad configuration.
 VerifyResult verify(const VerifyConfig& config);
 
+/// The case names verify() knows, for a mode ("pair1d", "pair2d", then each family's).
+std::vector<std::string> verify_cases(Mode mode);
+
+namespace detail {
+// Families of cases, one source file each (cpp/src/verify_<family>.cpp). Each returns false
+// when it does not know config.case_name for config.mode; otherwise it fills r (initial,
+// final_velocities, reference, timings, draws, rng_restored, error, and passed = false when
+// its own checks fail) and verify() derives max_rel_error, bit_exact and passed from it.
+bool run_exact_case(const VerifyConfig& config, VerifyResult& r);  ///< verify_exact.cpp
+bool run_paper_case(const VerifyConfig& config, VerifyResult& r);  ///< verify_paper.cpp
+std::vector<std::string> exact_case_names();                        ///< verify_exact.cpp
+std::vector<std::string> paper_case_names();                        ///< verify_paper.cpp
+/// Whether the case's reversal promises bit-exactness (exact mode and pair1d do).
+bool promises_bit_exact(const VerifyConfig& config);
+}  // namespace detail
+
 /// The result as a JSON object (one line).
 std::string to_json(const VerifyResult& r);
 

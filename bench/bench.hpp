@@ -1,0 +1,29 @@
+// Shared types of the revcol-bench binary. Each family of benchmarks lives in its own
+// bench/<family>_bench.cpp and appends to the list in add_<family>_benches().
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace revcol::bench {
+
+/// One measured number of a benchmark run.
+struct Metric {
+  std::string name;  ///< e.g. forward_per_s
+  double value;      ///< its value
+};
+
+/// A benchmark: run(n) does n units of work (collisions, draws, ...) and reports metrics.
+struct Bench {
+  std::string name;  ///< family/variant/..., selected by prefix with --bench
+  std::string unit;  ///< what the main metric counts
+  std::function<std::vector<Metric>(std::uint64_t n)> run;
+};
+
+void add_pair_benches(std::vector<Bench>& out);       ///< revcol_bench.cpp: pair1d, pair2d, rng
+void add_exact_benches(std::vector<Bench>& out);      ///< exact_bench.cpp: the general exact operator
+void add_paper_benches(std::vector<Bench>& out);      ///< paper_bench.cpp: paper-mode 3D pair, triples
+void add_statesave_benches(std::vector<Bench>& out);  ///< statesave_bench.cpp: SS1/SS2/RC study
+
+}  // namespace revcol::bench

@@ -1,0 +1,5 @@
+#include "bindings.hpp"
+
+namespace revcol::bind {
+void register_paper(pybind11::module_& m) { (void)m; }
+}  // namespace revcol::bind
