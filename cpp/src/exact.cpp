@@ -251,20 +251,29 @@ void ExactCollision::check_post(const double* post, const Held* held) const {
 
 void ExactCollision::arvo_inverse(const Eigen::Vector3d& P, double& u1, double& u2,
                                   double& amp1, double& amp2) const {
+  // Conditioning: moving P by dy turns the great circle BP by dy / |P - B| and so moves C'
+  // along edge AC by about dy |C' - B| / (|P - B| sin psi), psi the angle between the two
+  // great circles at C'. The sub-area changes by at most that arc length, so
+  // du1 <= dy |C'-B| / (Omega |P-B| sin psi); u2 = (|P-B| / |C'-B|)^2 moves by at most
+  // 2 dy (1 + 1/sin psi) / |C' - B|. (Checked against measured errors: test_exact.)
   const double dPB = (P - B_).norm();
-  amp1 = 4.0 * kPi / (Omega_ * std::max(dPB, 1e-300));
-  amp2 = 4.0 * (2.0 + 2.0 * kPi / hB_) / (hB_ * hB_);
   const Eigen::Vector3d bp = B_.cross(P);
-  if (bp.norm() == 0.0) {  // P is the apex itself (only a pre state on the boundary can be)
+  const double bpn = bp.norm();
+  if (bpn == 0.0) {  // P is the apex itself (only a pre state on the boundary can be)
     u1 = 0.0;
     u2 = 0.0;
+    amp1 = amp2 = std::numeric_limits<double>::infinity();
     return;
   }
   Eigen::Vector3d Cp = bp.cross(nAC_).normalized();  // great circle BP meets edge AC
   if (Cp.dot(mid_) < 0.0) Cp = -Cp;
+  const double sinpsi = std::max((bp / bpn).cross(nAC_).norm(), 1e-300);
+  const double dCB = (Cp - B_).norm();
+  amp1 = dCB / (Omega_ * std::max(dPB, 1e-300) * sinpsi);
+  amp2 = 2.0 * (1.0 + 1.0 / sinpsi) / dCB;
   const double tau = (Cp - A_).norm() / (Cp + A_).norm();  // tan(theta/2)
   u1 = 2.0 * std::atan2(g_ * tau, (1.0 + k_) + bt_ * tau) / Omega_;
-  const double ratio = dPB / (Cp - B_).norm();
+  const double ratio = dPB / dCB;
   u2 = ratio * ratio;
 }
 
@@ -285,8 +294,8 @@ void ExactCollision::encode(const Vec& x, Point& p) const {
   const double rv = xv.norm(), rw = xw.norm();
   const double rho = std::hypot(rv, rw);
   const double ce = rv / rho, se = rw / rho;  // cos(eta), sin(eta)
-  // a relative perturbation e of x moves y by <= 2e / cos(eta) and z by <= 2e / sin(eta)
-  const double ay = 2.0 / std::max(ce, 1e-300), az = 2.0 / std::max(se, 1e-300);
+  // a relative perturbation e of x moves y by <= e / cos(eta) and z by <= e / sin(eta)
+  const double ay = 1.0 / std::max(ce, 1e-300), az = 1.0 / std::max(se, 1e-300);
   int k = 0;
   if (m_ == 2) {
     const Eigen::Vector2d y = xv / rv;
@@ -303,10 +312,10 @@ void ExactCollision::encode(const Vec& x, Point& p) const {
   }
   if (f_ == 1) {
     p.c[k] = signed_.cdf_sc(xw(0) / rho, ce);
-    p.amp[k++] = 2.0 * signed_.max_density();
+    p.amp[k++] = signed_.max_density();
   } else if (f_ >= 2) {
     p.c[k] = eta_.cdf_sc(se, ce);
-    p.amp[k++] = 2.0 * eta_.max_density();
+    p.amp[k++] = eta_.max_density();
     // hyperspherical angles of z = xw / rw; tails |z_{j..}| from the end
     std::array<double, max_dim + 1> tail{};
     tail[f_] = 0.0;
@@ -317,7 +326,7 @@ void ExactCollision::encode(const Vec& x, Point& p) const {
       const double r = tail[j];
       const double s = r > 0 ? tail[j + 1] / r : 0.0, c = r > 0 ? xw(j) / r : 1.0;
       p.c[k] = zlaws_[j].cdf_sc(s, c);
-      p.amp[k++] = 2.0 * zlaws_[j].max_density() * az * rw / std::max(r, 1e-300);
+      p.amp[k++] = zlaws_[j].max_density() * az * rw / std::max(r, 1e-300);
     }
     // the last angle, uniform on [0, 2 pi)
     double phi = std::atan2(xw(f_ - 1), xw(f_ - 2));
@@ -366,18 +375,36 @@ ExactCollision::Vec ExactCollision::decode(const Cells& u) const {
   return ce * x + se * (Q_.rightCols(f_) * zv);
 }
 
+std::vector<double> ExactCollision::recovery_bound(const double* post) const {
+  check_common(post, nullptr);
+  std::vector<double> out(D_ - 1);
+  const Vec x = relative(post);
+  Point p;
+  encode(x, p);
+  const double e = relative_error(post, x.norm());
+  for (int k = 0; k < D_ - 1; ++k) out[k] = p.amp[k] * e * fp_.cells();
+  return out;
+}
+
+double ExactCollision::relative_error(const double* post, double rho) const {
+  // Rounding v = cm + (H^T (x) I) x to doubles moves each component by u |v_ik|, hence x by
+  // at most u sum |v|; computing x, its V/W components and the chart adds a few roundings
+  // per dimension relative to |x|.
+  double sum = 0.0;
+  for (int k = 0; k < n_ * d_; ++k) sum += std::fabs(post[k]);
+  return kU * (2.0 * sum / rho + 2.0 * D_ + 8.0);
+}
+
 bool ExactCollision::needs_log(const double* post) const {
   // A relative perturbation e of x moves chart coordinate k by at most amp_k e (the
-  // bounds in encode), and rounding the velocities cm + (H^T (x) I) x moves x by at most
-  // about u sum |v| plus a few roundings of |x| itself. Log when that can reach an eighth of
-  // a cell, or when the recovered coordinate is not within a quarter cell of a cell centre
-  // (a safety net for the bound). Both directions evaluate this on the same post velocities.
+  // bounds in encode). Log when that can reach an eighth of a cell, or when the recovered
+  // coordinate is not within a quarter cell of a cell centre: a safety net, so that a
+  // wrong recovery needs an error six times the bound. Both directions evaluate this on
+  // the same post velocities. Measure before changing: it decides the log's size.
   const Vec x = relative(post);
   const double rho = x.norm();
   if (!(rho > 0.0) || !std::isfinite(rho)) return true;
-  double sum = 0.0;
-  for (int k = 0; k < n_ * d_; ++k) sum += std::fabs(post[k]);
-  const double e = 4.0 * kU * (sum / rho + 4.0 * D_ + 16.0);
+  const double e = relative_error(post, rho);
   Point p;
   encode(x, p);
   for (int k = 0; k < D_ - 1; ++k) {

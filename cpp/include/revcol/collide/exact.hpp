@@ -97,6 +97,9 @@ class ExactCollision {
   /// Whether reversing `post` pops the rare log (D-1 cells).
   bool logs(const double* post) const;
 
+  /// The bound, in cells, on how far each chart coordinate of `post` can move when its
+  /// velocities are rounded (the rare log fires above 1/8).
+  std::vector<double> recovery_bound(const double* post) const;
   /// Chart coordinates in [0,1] of a post state (D-1 values; uniform under the law).
   std::vector<double> chart(const double* post) const;
   /// The pre state as a reversal restores it: its cells decoded at their centres.
@@ -124,6 +127,7 @@ class ExactCollision {
                     double& amp2) const;
   Eigen::Vector3d arvo_forward(double u1, double u2) const;
   bool needs_log(const double* post) const;
+  double relative_error(const double* post, double rho) const;
   void build(const double* pre_or_post, const Cells& cells, double sign, const Held* held,
              double* out) const;
 
