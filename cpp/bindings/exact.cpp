@@ -1,5 +1,245 @@
+// Binding of the general exact operator (revcol.Collision) and the named cases: numpy in
+// and out, nothing else.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+
 #include "bindings.hpp"
+#include "revcol/collide/cases.hpp"
+#include "revcol/collide/collision.hpp"
+#include "revcol/rng/clcg4.hpp"
+#include "revcol/rng/philox.hpp"
+
+namespace py = pybind11;
 
 namespace revcol::bind {
-void register_exact(pybind11::module_& m) { (void)m; }
+namespace {
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+std::string shape_of(const Array& a) {
+  std::string s = "(";
+  for (py::ssize_t k = 0; k < a.ndim(); ++k) s += (k ? ", " : "") + std::to_string(a.shape(k));
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+std::vector<Contact> contacts_from(const std::vector<std::pair<int, int>>& pairs) {
+  std::vector<Contact> out;
+  for (const auto& p : pairs) out.push_back({p.first, p.second});
+  return out;
+}
+
+// (n, d) or (B, n, d) -> B
+std::size_t batch_of(const ExactCollision& op, const Array& v, const char* what) {
+  const int n = op.particles(), d = op.dim();
+  const bool one = v.ndim() == 2 && v.shape(0) == n && v.shape(1) == d;
+  const bool many = v.ndim() == 3 && v.shape(1) == n && v.shape(2) == d;
+  require(one || many, [&] {
+    return std::string(what) + " must have shape (" + std::to_string(n) + ", " + std::to_string(d) +
+           ") or (B, " + std::to_string(n) + ", " + std::to_string(d) + "), got " + shape_of(v);
+  });
+  return one ? 1 : static_cast<std::size_t>(v.shape(0));
+}
+
+struct HeldArrays {
+  std::vector<Held> held;
+  Array m;  // keeps the data alive
+};
+
+std::optional<HeldArrays> held_from(const ExactCollision& op, std::optional<Array> momentum,
+                                    std::optional<Array> energy, std::size_t B, bool batched) {
+  require(momentum.has_value() == energy.has_value(),
+          "give both momentum and energy (held invariants), or neither");
+  if (!momentum) return std::nullopt;
+  const int d = op.dim();
+  const Array& m = *momentum;
+  const Array& e = *energy;
+  const bool one = !batched && m.ndim() == 1 && m.shape(0) == d && e.ndim() == 0;
+  const bool many = batched && m.ndim() == 2 && static_cast<std::size_t>(m.shape(0)) == B &&
+                    m.shape(1) == d && e.ndim() == 1 && static_cast<std::size_t>(e.shape(0)) == B;
+  require(one || many, [&] {
+    return "momentum/energy must have shapes (d,)/() for one state or (B, d)/(B,) for a batch, got " +
+           shape_of(m) + "/" + shape_of(e);
+  });
+  HeldArrays h{{}, m};
+  for (std::size_t b = 0; b < B; ++b) h.held.push_back(Held{m.data() + b * d, e.data()[b]});
+  return h;
+}
+
+Array run(Collision& c, const Array& v, py::object rng, std::optional<Array> g,
+          std::optional<Array> momentum, std::optional<Array> energy, int dir) {
+  const ExactCollision& op = c.op();
+  const std::size_t B = batch_of(op, v, "velocities");
+  const bool batched = v.ndim() == 3;
+  const auto held = held_from(op, std::move(momentum), std::move(energy), B, batched);
+  const Held* hp = held ? held->held.data() : nullptr;
+  Array out(std::vector<py::ssize_t>(v.shape(), v.shape() + v.ndim()));
+  double* o = out.mutable_data();
+  require(rng.is_none() != !g.has_value(), "give exactly one of rng= (a generator) or g= (draws)");
+  const std::size_t k = op.draws();
+  if (g) {
+    const Array& ga = *g;
+    require(static_cast<std::size_t>(ga.size()) == B * k &&
+                (batched ? ga.ndim() == 2 : ga.ndim() <= 1),
+            [&] {
+              return "g must have shape (" + std::to_string(k) + ",) or (B, " + std::to_string(k) +
+                     "), got " + shape_of(ga);
+            });
+    if (dir > 0) c.forward(v.data(), B, ga.data(), o, hp);
+    else c.reverse(v.data(), B, ga.data(), o, hp);
+  } else if (py::isinstance<rng::CLCG4>(rng)) {
+    auto& gen = rng.cast<rng::CLCG4&>();
+    if (dir > 0) c.forward(v.data(), B, gen, o, hp); else c.reverse(v.data(), B, gen, o, hp);
+  } else if (py::isinstance<rng::Philox>(rng)) {
+    auto& gen = rng.cast<rng::Philox&>();
+    if (dir > 0) c.forward(v.data(), B, gen, o, hp); else c.reverse(v.data(), B, gen, o, hp);
+  } else {
+    throw InvalidArgument("rng must be a revcol.CLCG4 or revcol.Philox");
+  }
+  return out;
+}
+
+const char* kDoc = R"(The exact collision operator for n particles in d dimensions (d = 1..3) with at
+most 3 independent contacts.
+
+The relative velocities, in orthonormal (Helmert) coordinates x of the zero-momentum
+subspace (dimension D = (n-1) d), lie on the sphere |x| = rho; each contact (i, j), with
+normal r from j to i, must separate after the collision: r . (v_i - v_j) > 0. The post state
+is drawn exactly from `law` over that permitted cone: "flux" (default; density ~ the
+separation rate, cos(eta) of the angle to the contacts' span) or "uniform". A
+measure-preserving chart maps the cone onto [0,1)^(D-1); a K-bit torus shift by the
+d_n = D - 1 random numbers moves the pre state's cell to the post state's, so reverse()
+recovers the pre state exactly (after its first quantization) with the same numbers.
+
+    >>> import numpy as np, revcol
+    >>> op = revcol.Collision.named("triple1d")          # 3 particles in a row, 1D
+    >>> g = revcol.CLCG4()
+    >>> v = np.array([[1.0], [0.0], [0.0]])               # Newton's cradle
+    >>> post = op.forward(v, rng=g)
+    >>> np.allclose(op.reverse(post, rng=g), v)
+    True
+)";
+
+}  // namespace
+
+void register_exact(py::module_& m) {
+  py::class_<Collision>(m, "Collision", kDoc)
+      .def(py::init([](int n, int d, const std::vector<std::pair<int, int>>& contacts,
+                       std::optional<Array> normals, std::optional<Array> positions,
+                       double diameter, const std::string& law, int bits, double tol) {
+             require(normals.has_value() != positions.has_value(),
+                     "give exactly one of normals= (m x d) or positions= (n x d)");
+             if (positions) {
+               require(positions->ndim() == 2 && positions->shape(0) == n && positions->shape(1) == d,
+                       [&] { return "positions must have shape (" + std::to_string(n) + ", " + std::to_string(d) + "), got " + shape_of(*positions); });
+               std::vector<double> p(positions->data(), positions->data() + n * d);
+               return Collision(ExactCollision::from_positions(n, d, contacts_from(contacts), p,
+                                                               diameter, parse_law(law), bits, tol));
+             }
+             require(normals->ndim() == 2 && normals->shape(1) == d &&
+                         normals->shape(0) == static_cast<py::ssize_t>(contacts.size()),
+                     [&] { return "normals must have shape (" + std::to_string(contacts.size()) + ", " + std::to_string(d) + "), got " + shape_of(*normals); });
+             std::vector<double> nv(normals->data(), normals->data() + normals->size());
+             return Collision(ExactCollision(n, d, contacts_from(contacts), nv, parse_law(law), bits));
+           }),
+           py::arg("n"), py::arg("d"), py::arg("contacts"), py::kw_only(),
+           py::arg("normals") = py::none(), py::arg("positions") = py::none(),
+           py::arg("diameter") = 1.0, py::arg("law") = "flux", py::arg("bits") = 40,
+           py::arg("tol") = 1e-9)
+      .def_static("named",
+                  [](const std::string& name, const std::string& law, int bits) {
+                    return Collision(exact_operator(named_case(name), parse_law(law), bits));
+                  },
+                  py::arg("name"), py::kw_only(), py::arg("law") = "flux", py::arg("bits") = 40,
+                  "The operator of a named case (see revcol.named_cases()).")
+      .def("forward",
+           [](Collision& c, const Array& v, py::object rng, std::optional<Array> g,
+              std::optional<Array> mo, std::optional<Array> en) { return run(c, v, std::move(rng), std::move(g), std::move(mo), std::move(en), +1); },
+           py::arg("velocities"), py::kw_only(), py::arg("rng") = py::none(), py::arg("g") = py::none(),
+           py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
+           "Pre -> post. velocities (n, d) or (B, n, d); exactly one of rng or g ((d_n,) or (B, d_n)).")
+      .def("reverse",
+           [](Collision& c, const Array& v, py::object rng, std::optional<Array> g,
+              std::optional<Array> mo, std::optional<Array> en) { return run(c, v, std::move(rng), std::move(g), std::move(mo), std::move(en), -1); },
+           py::arg("velocities"), py::kw_only(), py::arg("rng") = py::none(), py::arg("g") = py::none(),
+           py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
+           "Post -> pre with the draws forward used (rng steps back).")
+      .def("chart",
+           [](const Collision& c, const Array& v) {
+             const ExactCollision& op = c.op();
+             const std::size_t B = batch_of(op, v, "velocities");
+             const std::size_t nd = op.particles() * op.dim(), k = op.draws();
+             Array out = v.ndim() == 3 ? Array({static_cast<py::ssize_t>(B), static_cast<py::ssize_t>(k)})
+                                       : Array({static_cast<py::ssize_t>(k)});
+             for (std::size_t b = 0; b < B; ++b) {
+               const std::vector<double> cb = op.chart(v.data() + b * nd);
+               std::copy(cb.begin(), cb.end(), out.mutable_data() + b * k);
+             }
+             return out;
+           },
+           py::arg("velocities"), "Chart coordinates in [0, 1] of post states: uniform under the law.")
+      .def("quantize",
+           [](const Collision& c, const Array& v, std::optional<Array> mo, std::optional<Array> en) {
+             const ExactCollision& op = c.op();
+             const std::size_t B = batch_of(op, v, "velocities");
+             const std::size_t nd = op.particles() * op.dim();
+             const auto held = held_from(op, std::move(mo), std::move(en), B, v.ndim() == 3);
+             Array out(std::vector<py::ssize_t>(v.shape(), v.shape() + v.ndim()));
+             for (std::size_t b = 0; b < B; ++b)
+               op.quantize(v.data() + b * nd, out.mutable_data() + b * nd, held ? &held->held[b] : nullptr);
+             return out;
+           },
+           py::arg("velocities"), py::kw_only(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
+           "The pre state as reversal restores it (its cells decoded at the centre).")
+      .def("normal_speeds",
+           [](const Collision& c, const Array& v) {
+             const ExactCollision& op = c.op();
+             require(batch_of(op, v, "velocities") == 1 && v.ndim() == 2, "one state of shape (n, d)");
+             return op.normal_speeds(v.data());
+           },
+           py::arg("velocities"), "r_k . (v_i - v_j) for each contact (< 0 approaching).")
+      .def_property_readonly("particles", [](const Collision& c) { return c.op().particles(); })
+      .def_property_readonly("dim", [](const Collision& c) { return c.op().dim(); })
+      .def_property_readonly("relative_dim", [](const Collision& c) { return c.op().relative_dim(); })
+      .def_property_readonly("free_dim", [](const Collision& c) { return c.op().free_dim(); })
+      .def_property_readonly("draws", [](const Collision& c) { return c.op().draws(); })
+      .def_property_readonly("contacts", [](const Collision& c) {
+        std::vector<std::pair<int, int>> out;
+        for (const Contact& k : c.op().contact_list()) out.emplace_back(k.i, k.j);
+        return out;
+      })
+      .def_property_readonly("law", [](const Collision& c) { return to_string(c.op().law()); })
+      .def_property_readonly("bits", [](const Collision& c) { return c.op().bits(); })
+      .def_property_readonly("log_size", [](const Collision& c) { return c.log().size(); })
+      .def_property_readonly("log_bytes", [](const Collision& c) { return c.log().bytes(); })
+      .def_property_readonly("log_pushed", [](const Collision& c) { return c.log().pushed(); })
+      .def("clear_log", [](Collision& c) { c.log().clear(); })
+      .def("__repr__", [](const Collision& c) {
+        return "revcol.Collision(n=" + std::to_string(c.op().particles()) + ", d=" +
+               std::to_string(c.op().dim()) + ", contacts=" + std::to_string(c.op().contacts()) +
+               ", law='" + to_string(c.op().law()) + "')";
+      });
+
+  m.def("named_cases", [] {
+    py::list out;
+    for (const NamedCase& c : named_cases()) {
+      py::dict d;
+      d["name"] = c.name;
+      d["n"] = c.n;
+      d["d"] = c.d;
+      std::vector<std::pair<int, int>> pairs;
+      for (const Contact& k : c.contacts) pairs.emplace_back(k.i, k.j);
+      d["contacts"] = pairs;
+      Array pos({static_cast<py::ssize_t>(c.n), static_cast<py::ssize_t>(c.d)});
+      std::copy(c.positions.begin(), c.positions.end(), pos.mutable_data());
+      d["positions"] = pos;
+      d["description"] = c.description;
+      out.append(d);
+    }
+    return out;
+  }, "The named collision geometries (the paper's configurations and beyond).");
+}
+
 }  // namespace revcol::bind

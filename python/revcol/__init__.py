@@ -13,9 +13,10 @@ Protopopescu, ACM TOMACS 2013, and beyond).
     >>> np.allclose(op.reverse(post, [-1.0, 0.0], rng=g), v)
     True
 """
-from .collide import Pair1D, Pair2D, Wall
+from .collide import Collision, Pair1D, Pair2D, Wall, named_cases
 from .rng import CLCG4, Philox, philox4x32
 from .verify import VERIFY_CASES, verify, verify_cases
+from . import statesave
 
-__all__ = ["CLCG4", "Philox", "philox4x32", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES"]
+__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave"]
 __version__ = "0.1.0"
