@@ -98,7 +98,7 @@ class ExactCollision {
   bool logs(const double* post) const;
 
   /// The bound, in cells, on how far each chart coordinate of `post` can move when its
-  /// velocities are rounded (the rare log fires above 1/8).
+  /// velocities are rounded (the rare log fires above 1/4).
   std::vector<double> recovery_bound(const double* post) const;
   /// Chart coordinates in [0,1] of a post state (D-1 values; uniform under the law).
   std::vector<double> chart(const double* post) const;
@@ -120,6 +120,10 @@ class ExactCollision {
   void velocities(const Vec& x, const double* cm, double* v) const;  // v = cm + (H^T (x) I) x
   void centre(const double* v, const Held* held, double* cm) const;
   double radius(const Vec& x, const Held* held) const;
+  struct Energy {
+    double hi, lo;  // a double-double: hi + lo
+  };
+  Energy relative_energy(const double* v, const double* cm, const Held* held) const;
   void check_common(const double* v, const Held* held) const;
   void encode(const Vec& x, Point& p) const;
   Vec decode(const Cells& u) const;  // unit vector in P
