@@ -16,7 +16,9 @@ Protopopescu, ACM TOMACS 2013, and beyond).
 from .collide import Collision, Pair1D, Pair2D, Wall, named_cases
 from .rng import CLCG4, Philox, philox4x32
 from .verify import VERIFY_CASES, verify, verify_cases
+from .paper import Pair3DPaper, Triple1DPaper, Triple2DPaper
+from . import paper
 from . import statesave
 
-__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave"]
+__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper"]
 __version__ = "0.1.0"
