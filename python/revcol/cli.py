@@ -1,6 +1,7 @@
 """The ``revcol`` command line.
 
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
+    revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
 """
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import argparse
 import json
 import sys
 
+from . import statesave
 from .verify import VERIFY_CASES, verify
 
 
@@ -36,6 +38,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="paper mode: use the printed Procedure 2 (tests the post angle)")
     v.add_argument("--json", nargs="?", const="-", metavar="FILE",
                    help="write the report as JSON to FILE (or stdout when no FILE)")
+    b = sub.add_parser("bench", help="benchmark studies")
+    bsub = b.add_subparsers(dest="study", required=True)
+    statesave.add_arguments(bsub.add_parser(
+        "statesave", help="the paper's state saving vs reverse computation study (and lazy transport)"))
     return p
 
 
@@ -72,6 +78,8 @@ def main(argv: list[str] | None = None) -> int:
                 with open(args.json, "w") as f:
                     json.dump(report, f, indent=1)
         return 0 if report["passed"] else 1
+    if args.command == "bench":
+        return statesave.cli_main(args, argv)
     return 2
 
 
