@@ -25,5 +25,7 @@ void add_pair_benches(std::vector<Bench>& out);       ///< revcol_bench.cpp: pai
 void add_exact_benches(std::vector<Bench>& out);      ///< exact_bench.cpp: the general exact operator
 void add_paper_benches(std::vector<Bench>& out);      ///< paper_bench.cpp: paper-mode 3D pair, triples
 void add_statesave_benches(std::vector<Bench>& out);  ///< statesave_bench.cpp: SS1/SS2/RC study
+void add_pair3d_benches(std::vector<Bench>& out);     ///< pair3d_bench.cpp: the fast exact 3D pair operator
+void add_engine_benches(std::vector<Bench>& out);     ///< engine_bench.cpp: the event-driven engine
 
 }  // namespace revcol::bench

@@ -91,6 +91,8 @@ std::vector<Bench> all_benches() {
   revcol::bench::add_exact_benches(out);
   revcol::bench::add_paper_benches(out);
   revcol::bench::add_statesave_benches(out);
+  revcol::bench::add_pair3d_benches(out);
+  revcol::bench::add_engine_benches(out);
   return out;
 }
 

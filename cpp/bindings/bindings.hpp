@@ -9,4 +9,5 @@ void register_verify(pybind11::module_& m);
 void register_exact(pybind11::module_& m);      ///< exact.cpp: the general exact operator
 void register_paper(pybind11::module_& m);      ///< paper.cpp: paper-mode 3D pair and triples
 void register_statesave(pybind11::module_& m);  ///< statesave.cpp: the SS1/SS2/RC study
+void register_engine(pybind11::module_& m);     ///< engine.cpp: the event-driven engine (Simulation)
 }  // namespace revcol::bind

@@ -14,4 +14,5 @@ PYBIND11_MODULE(_core, m) {
   revcol::bind::register_exact(m);
   revcol::bind::register_paper(m);
   revcol::bind::register_statesave(m);
+  revcol::bind::register_engine(m);
 }
