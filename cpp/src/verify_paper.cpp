@@ -84,6 +84,7 @@ void run_chain(const Op& op, Gen& gen, const paper::PaperCase& pc, const VerifyC
     }
   }
   r.forward_s = seconds_since(t0);
+  r.collisions = done;  // the rates are per collision actually taken
   r.log_bytes = log.bytes();
   r.log_entries = log.size();
   r.random_numbers_drawn = done * Op::draws;

@@ -51,6 +51,8 @@ def test_cli_verify_triple2d_stops_with_a_reason(case):
     assert code == 1 and not r["passed"]
     assert "forward step" in r["error"] and "not approaching" in r["error"]
     assert r["random_numbers_drawn"] % 3 == 0 and len(r["initial"]) == 6
+    # the report counts the collisions actually taken, and its rates are per those
+    assert r["collisions"] < N_C and r["random_numbers_drawn"] == 3 * r["collisions"]
 
 
 def test_verify_cases_listed():

@@ -32,7 +32,7 @@ struct VerifyResult {
   bool passed = false;                   ///< rng restored, error <= 1e-9, log empty, exact: bit_exact
   bool bit_exact = false;                ///< exact: equals the quantized start; else equals the start
   double max_rel_error = 0.0;            ///< max |v_end - v_0| / max |v_0|
-  std::uint64_t collisions = 0;          ///< collisions forward (and as many back)
+  std::uint64_t collisions = 0;          ///< collisions carried out forward: N_c, or fewer when the chain stopped early (see error)
   double forward_s = 0.0, reverse_s = 0.0;             ///< wall time of each loop
   double forward_per_s = 0.0, reverse_per_s = 0.0;     ///< collisions per second
   std::uint64_t log_bytes = 0;           ///< rare log bytes at the turn (after forward)
