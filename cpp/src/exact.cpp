@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "revcol/double_double.hpp"
 #include "revcol/error.hpp"
 
 namespace revcol {
@@ -15,45 +16,9 @@ constexpr double kU = std::numeric_limits<double>::epsilon() / 2;  // unit round
 
 std::string str(double x) { return std::to_string(x); }
 
-// Double-double arithmetic (error-free transformations: Knuth's TwoSum, TwoProd by an
-// explicit fma) for the one place a double is not enough: the relative kinetic energy the
-// post state is scaled to. Its values sit at the same place on the double grid collision
-// after collision (energy is conserved), so the rounding of a plain sum is not random but
-// a bias that accumulates linearly (measured 3-8e-17 per collision before this).
-struct DD {
-  double hi, lo;
-};
-DD quick_two_sum(double a, double b) {
-  const double s = a + b;
-  return {s, b - (s - a)};
-}
-DD two_sum(double a, double b) {
-  const double s = a + b, bb = s - a;
-  return {s, (a - (s - bb)) + (b - bb)};
-}
-DD two_prod(double a, double b) {
-  const double p = a * b;
-  return {p, std::fma(a, b, -p)};
-}
-DD dd_add(DD x, DD y) {
-  const DD s = two_sum(x.hi, y.hi);
-  return quick_two_sum(s.hi, s.lo + (x.lo + y.lo));
-}
-DD dd_square(DD x) {  // (hi + lo)^2 to double-double accuracy
-  const DD p = two_prod(x.hi, x.hi);
-  return quick_two_sum(p.hi, p.lo + 2.0 * x.hi * x.lo);
-}
-DD dd_div(DD a, DD b) {
-  const double q1 = a.hi / b.hi;
-  const DD p = two_prod(q1, b.hi);
-  const double r = ((a.hi - p.hi) - p.lo + a.lo) - q1 * b.lo;
-  return quick_two_sum(q1, r / b.hi);
-}
-DD dd_sqrt(DD x) {
-  const double r = std::sqrt(x.hi);
-  const DD p = two_prod(r, r);
-  return quick_two_sum(r, ((x.hi - p.hi) - p.lo + x.lo) / (2.0 * r));
-}
+using dd::DD;
+using dd::two_prod;
+using dd::two_sum;
 
 }  // namespace
 
@@ -247,12 +212,12 @@ ExactCollision::Energy ExactCollision::relative_energy(const double* v, const do
   DD r{0.0, 0.0};
   if (held) {
     DD m2{0.0, 0.0};
-    for (int a = 0; a < d_; ++a) m2 = dd_add(m2, two_prod(held->momentum[a], held->momentum[a]));
-    const DD q = dd_div(m2, {static_cast<double>(n_), 0.0});
-    r = dd_add({held->energy, 0.0}, {-q.hi, -q.lo});
+    for (int a = 0; a < d_; ++a) m2 = dd::add(m2, two_prod(held->momentum[a], held->momentum[a]));
+    const DD q = dd::div(m2, {static_cast<double>(n_), 0.0});
+    r = dd::add({held->energy, 0.0}, {-q.hi, -q.lo});
   } else {
     for (int i = 0; i < n_; ++i)
-      for (int a = 0; a < d_; ++a) r = dd_add(r, dd_square(two_sum(v[i * d_ + a], -cm[a])));
+      for (int a = 0; a < d_; ++a) r = dd::add(r, dd::square(two_sum(v[i * d_ + a], -cm[a])));
   }
   return {r.hi, r.lo};
 }
@@ -508,8 +473,8 @@ void ExactCollision::build(const double* v, const Cells& cells, double sign, con
   const Vec zero_cm = Vec::Zero(3);
   velocities(u, zero_cm.data(), h.data());
   DD s2{0.0, 0.0};
-  for (int k = 0; k < n_ * d_; ++k) s2 = dd_add(s2, two_prod(h[k], h[k]));
-  const DD scale = dd_sqrt(dd_div({e.hi, e.lo}, s2));
+  for (int k = 0; k < n_ * d_; ++k) s2 = dd::add(s2, two_prod(h[k], h[k]));
+  const DD scale = dd::sqrt(dd::div({e.hi, e.lo}, s2));
   const double hi = sign * scale.hi, lo = sign * scale.lo;
   for (int i = 0; i < n_; ++i)
     for (int a = 0; a < d_; ++a) {
