@@ -1,8 +1,339 @@
-// Binding of the event-driven engine: to be filled.
+// Binding of the event-driven engine: numpy in and out, dicts for results, diagnostics and
+// checkpoints. No physics here (revcol/engine/engine.hpp).
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <optional>
+
 #include "bindings.hpp"
+#include "revcol/engine/engine.hpp"
+#include "revcol/error.hpp"
+
+namespace py = pybind11;
 
 namespace revcol::bind {
+namespace {
 
-void register_engine(pybind11::module_& m) { (void)m; }
+namespace en = revcol::engine;
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+std::vector<double> flat(const Array& a, const char* what, int& n, int& d) {
+  require(a.ndim() == 2, [&] { return std::string(what) + " must be a 2-d array (n, dim), got " + std::to_string(a.ndim()) + " dimensions"; });
+  n = static_cast<int>(a.shape(0));
+  d = static_cast<int>(a.shape(1));
+  return std::vector<double>(a.data(), a.data() + a.size());
+}
+
+py::array_t<double> to_array(const std::vector<double>& v, std::size_t n, int d) {
+  py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(d)});
+  std::memcpy(out.mutable_data(), v.data(), v.size() * sizeof(double));
+  return out;
+}
+
+template <class T>
+py::array_t<T> vec_array(const std::vector<T>& v) {
+  py::array_t<T> out(static_cast<py::ssize_t>(v.size()));
+  if (!v.empty()) std::memcpy(out.mutable_data(), v.data(), v.size() * sizeof(T));
+  return out;
+}
+
+template <class T>
+std::vector<T> array_vec(const py::dict& d, const char* key) {
+  require(d.contains(key), [&] { return std::string("checkpoint is missing '") + key + "'"; });
+  auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(d[key]);
+  require(static_cast<bool>(a), [&] { return std::string("checkpoint entry '") + key + "' is not an array"; });
+  return std::vector<T>(a.data(), a.data() + a.size());
+}
+
+en::Config make_config(int dim, const std::vector<double>& box, const std::vector<std::string>& boundary,
+                       double diameter, const std::string& mode, const std::string& law, std::uint64_t seed,
+                       int bits, bool groups, double group_tol) {
+  en::Config c;
+  c.dim = dim;
+  require(dim >= 1 && dim <= 3, [&] { return "dim must be 1, 2 or 3, got " + std::to_string(dim); });
+  require(static_cast<int>(box.size()) == dim, [&] {
+    return "box must have one length per axis (" + std::to_string(dim) + "), got " + std::to_string(box.size());
+  });
+  require(boundary.size() == 1 || static_cast<int>(boundary.size()) == dim,
+          "boundary must be one name or one per axis");
+  for (int k = 0; k < dim; ++k) {
+    c.box[k] = box[k];
+    c.boundary[k] = en::parse_boundary(boundary.size() == 1 ? boundary[0] : boundary[k]);
+  }
+  c.diameter = diameter;
+  c.mode = parse_mode(mode);
+  c.law = parse_law(law);
+  require(seed <= 0xFFFFFFFFull, "seed must be < 2^32");
+  c.seed = static_cast<std::uint32_t>(seed);
+  c.bits = bits;
+  c.groups = groups;
+  c.group_tol = group_tol;
+  return c;
+}
+
+py::dict counters_dict(const en::Counters& c) {
+  py::dict d;
+  d["events"] = c.events;
+  d["pair_collisions"] = c.pair_collisions;
+  d["group_collisions"] = c.group_collisions;
+  d["group_particles"] = c.group_particles;
+  d["group_fallbacks"] = c.group_fallbacks;
+  d["wall_events"] = c.wall_events;
+  d["cell_crossings"] = c.cell_crossings;
+  d["invalid_events"] = c.invalid_events;
+  d["grazing_skipped"] = c.grazing_skipped;
+  d["reverse_failures"] = c.reverse_failures;
+  d["forward_collisions"] = c.forward_collisions;
+  d["reverse_collisions"] = c.reverse_collisions;
+  return d;
+}
+
+py::dict run_dict(const en::RunResult& r) {
+  py::dict d;
+  d["collisions"] = r.collisions;
+  d["events"] = r.events;
+  d["time"] = r.time;
+  d["interrupted"] = r.interrupted;
+  return d;
+}
+
+class PyEngine {
+ public:
+  explicit PyEngine(std::unique_ptr<en::Simulation> s) : s_(std::move(s)) {}
+
+  py::dict run(std::optional<std::uint64_t> collisions, std::optional<double> time,
+               std::optional<std::function<bool(std::uint64_t)>> cb, std::uint64_t every) {
+    require(collisions.has_value() || time.has_value(), "give collisions, time, or both");
+    const std::uint64_t nc = collisions.value_or(std::numeric_limits<std::uint64_t>::max());
+    const double te = time.value_or(std::numeric_limits<double>::infinity());
+    require(!time || *time >= s_->time(), "run: end time is earlier than the current time (use run_back)");
+    en::Progress p;
+    if (cb) p = *cb;
+    return run_dict(s_->run(nc, te, p, cb ? every : 0));
+  }
+  py::dict run_back(std::optional<std::uint64_t> collisions, std::optional<double> time) {
+    const std::uint64_t nc = collisions.value_or(std::numeric_limits<std::uint64_t>::max());
+    const double tt = time.value_or(collisions ? -std::numeric_limits<double>::infinity() : s_->start_time());
+    return run_dict(s_->run_back(nc, tt));
+  }
+  py::array_t<double> positions() const { return to_array(s_->positions(), s_->size(), s_->config().dim); }
+  py::array_t<double> velocities() const { return to_array(s_->velocities(), s_->size(), s_->config().dim); }
+  py::array_t<std::uint64_t> collision_counts() const { return vec_array(s_->collision_counts()); }
+
+  py::dict diagnostics() const {
+    const en::Diagnostics g = s_->diagnostics();
+    py::dict d;
+    d["energy"] = g.energy;
+    d["momentum"] = std::vector<double>(g.momentum.begin(), g.momentum.begin() + s_->config().dim);
+    d["energy_drift"] = g.energy_drift;
+    d["momentum_drift"] = g.momentum_drift;
+    d["log_bytes"] = g.log_bytes;
+    d["log_pushed"] = g.log_pushed;
+    d["exact_pre_pushed"] = g.exact_pre_pushed;
+    d["exact_pre_entries"] = g.exact_pre_entries;
+    d["wall_log_entries"] = g.wall_log_entries;
+    d["collisions_per_particle"] = g.collisions_per_particle;
+    d["net_collisions"] = g.net_collisions;
+    d["memory_bytes"] = s_->memory_bytes();
+    d["events"] = counters_dict(g.counters);
+    return d;
+  }
+
+  py::dict snapshot() const {
+    const en::Snapshot s = s_->snapshot();
+    py::dict d;
+    const en::Config& c = s.config;
+    d["format"] = 1;
+    d["dim"] = c.dim;
+    d["box"] = vec_array(std::vector<double>(c.box.begin(), c.box.begin() + c.dim));
+    std::vector<std::int64_t> bnd;
+    for (int k = 0; k < c.dim; ++k) bnd.push_back(c.boundary[k] == en::Boundary::periodic ? 1 : 0);
+    d["periodic"] = vec_array(bnd);
+    d["diameter"] = c.diameter;
+    d["mode"] = std::string(to_string(c.mode));
+    d["law"] = std::string(to_string(c.law));
+    d["seed"] = c.seed;
+    d["bits"] = c.bits;
+    d["groups"] = c.groups;
+    d["group_tol"] = c.group_tol;
+    d["n"] = s.n;
+    d["time"] = s.time;
+    d["start_time"] = s.start_time;
+    d["net_collisions"] = s.net_collisions;
+    d["x"] = vec_array(s.x);
+    d["v"] = vec_array(s.v);
+    d["t_local"] = vec_array(s.t_local);
+    d["cell"] = vec_array(s.cell);
+    d["stamp"] = vec_array(s.stamp);
+    d["ncoll"] = vec_array(s.ncoll);
+    d["rng"] = vec_array(s.rng);
+    d["ev_t"] = vec_array(s.ev_t);
+    d["ev_kind"] = vec_array(s.ev_kind);
+    d["ev_partner"] = vec_array(s.ev_partner);
+    d["ev_stamp"] = vec_array(s.ev_stamp);
+    d["second"] = vec_array(s.second);
+    d["touching"] = vec_array(s.touching);
+    d["log_cells"] = vec_array(s.log_cells);
+    d["log_pushed"] = s.log_pushed;
+    d["netc"] = vec_array(s.netc);
+    d["wall_keys"] = vec_array(s.wall_keys);
+    d["wall_sizes"] = vec_array(s.wall_sizes);
+    d["wall_masks"] = vec_array(s.wall_masks);
+    d["wall_ids"] = vec_array(s.wall_ids);
+    d["wall_netc"] = vec_array(s.wall_netc);
+    d["wall_times"] = vec_array(s.wall_times);
+    d["pre_keys"] = vec_array(s.pre_keys);
+    d["pre_sizes"] = vec_array(s.pre_sizes);
+    d["pre_vals"] = vec_array(s.pre_vals);
+    d["pre_pushed"] = s.pre_pushed;
+    const en::Counters& k = s.counters;
+    d["counters"] = vec_array(std::vector<std::uint64_t>{
+        k.events, k.pair_collisions, k.group_collisions, k.group_particles, k.group_fallbacks, k.wall_events,
+        k.cell_crossings, k.invalid_events, k.grazing_skipped, k.reverse_failures, k.forward_collisions,
+        k.reverse_collisions});
+    d["energy0"] = s.energy0;
+    d["momentum0"] = vec_array(std::vector<double>(s.momentum0.begin(), s.momentum0.end()));
+    return d;
+  }
+
+  static PyEngine from_snapshot(const py::dict& d) {
+    auto get = [&](const char* key) {
+      require(d.contains(key), [&] { return std::string("checkpoint is missing '") + key + "'"; });
+      return d[key];
+    };
+    require(py::cast<int>(get("format")) == 1, "checkpoint format must be 1");
+    en::Snapshot s;
+    en::Config& c = s.config;
+    c.dim = py::cast<int>(get("dim"));
+    require(c.dim >= 1 && c.dim <= 3, "checkpoint: dim must be 1, 2 or 3");
+    const auto box = array_vec<double>(d, "box");
+    const auto per = array_vec<std::int64_t>(d, "periodic");
+    require(static_cast<int>(box.size()) == c.dim && static_cast<int>(per.size()) == c.dim,
+            "checkpoint: box and periodic need one entry per axis");
+    for (int k = 0; k < c.dim; ++k) {
+      c.box[k] = box[k];
+      c.boundary[k] = per[k] ? en::Boundary::periodic : en::Boundary::wall;
+    }
+    c.diameter = py::cast<double>(get("diameter"));
+    c.mode = parse_mode(py::cast<std::string>(get("mode")));
+    c.law = parse_law(py::cast<std::string>(get("law")));
+    c.seed = py::cast<std::uint32_t>(get("seed"));
+    c.bits = py::cast<int>(get("bits"));
+    c.groups = py::cast<bool>(get("groups"));
+    c.group_tol = py::cast<double>(get("group_tol"));
+    s.n = py::cast<std::size_t>(get("n"));
+    s.time = py::cast<double>(get("time"));
+    s.start_time = py::cast<double>(get("start_time"));
+    s.net_collisions = py::cast<std::int64_t>(get("net_collisions"));
+    s.x = array_vec<double>(d, "x");
+    s.v = array_vec<double>(d, "v");
+    s.t_local = array_vec<double>(d, "t_local");
+    s.cell = array_vec<std::int64_t>(d, "cell");
+    s.stamp = array_vec<std::uint64_t>(d, "stamp");
+    s.ncoll = array_vec<std::uint64_t>(d, "ncoll");
+    s.rng = array_vec<std::uint64_t>(d, "rng");
+    s.ev_t = array_vec<double>(d, "ev_t");
+    s.ev_kind = array_vec<std::int64_t>(d, "ev_kind");
+    s.ev_partner = array_vec<std::int64_t>(d, "ev_partner");
+    s.ev_stamp = array_vec<std::uint64_t>(d, "ev_stamp");
+    s.second = array_vec<double>(d, "second");
+    s.touching = array_vec<std::int64_t>(d, "touching");
+    s.log_cells = array_vec<std::uint64_t>(d, "log_cells");
+    s.log_pushed = py::cast<std::uint64_t>(get("log_pushed"));
+    s.netc = array_vec<std::int64_t>(d, "netc");
+    s.wall_keys = array_vec<std::uint64_t>(d, "wall_keys");
+    s.wall_sizes = array_vec<std::uint64_t>(d, "wall_sizes");
+    s.wall_masks = array_vec<std::uint64_t>(d, "wall_masks");
+    s.wall_ids = array_vec<std::uint64_t>(d, "wall_ids");
+    s.wall_netc = array_vec<std::int64_t>(d, "wall_netc");
+    s.wall_times = array_vec<double>(d, "wall_times");
+    s.pre_keys = array_vec<std::uint64_t>(d, "pre_keys");
+    s.pre_sizes = array_vec<std::uint64_t>(d, "pre_sizes");
+    s.pre_vals = array_vec<double>(d, "pre_vals");
+    s.pre_pushed = py::cast<std::uint64_t>(get("pre_pushed"));
+    const auto k = array_vec<std::uint64_t>(d, "counters");
+    require(k.size() == 12, "checkpoint: counters must have 12 entries");
+    en::Counters& q = s.counters;
+    q.events = k[0];
+    q.pair_collisions = k[1];
+    q.group_collisions = k[2];
+    q.group_particles = k[3];
+    q.group_fallbacks = k[4];
+    q.wall_events = k[5];
+    q.cell_crossings = k[6];
+    q.invalid_events = k[7];
+    q.grazing_skipped = k[8];
+    q.reverse_failures = k[9];
+    q.forward_collisions = k[10];
+    q.reverse_collisions = k[11];
+    s.energy0 = py::cast<double>(get("energy0"));
+    const auto p0 = array_vec<double>(d, "momentum0");
+    require(p0.size() == 3, "checkpoint: momentum0 must have 3 entries");
+    for (int k2 = 0; k2 < 3; ++k2) s.momentum0[k2] = p0[k2];
+    return PyEngine(en::restore_simulation(s));
+  }
+
+  en::Simulation& sim() { return *s_; }
+  const en::Simulation& sim() const { return *s_; }
+
+ private:
+  std::unique_ptr<en::Simulation> s_;
+};
+
+}  // namespace
+
+void register_engine(py::module_& m) {
+  py::class_<PyEngine>(m, "Engine", "The event-driven engine (revcol/engine/engine.hpp); use revcol.Simulation.")
+      .def(py::init([](const Array& x, const Array& v, const std::vector<double>& box,
+                       const std::vector<std::string>& boundary, double diameter, const std::string& mode,
+                       const std::string& law, std::uint64_t seed, int bits, bool groups, double group_tol,
+                       double time) {
+             int n = 0, d = 0, nv = 0, dv = 0;
+             auto xs = flat(x, "positions", n, d);
+             auto vs = flat(v, "velocities", nv, dv);
+             require(n == nv && d == dv, "positions and velocities must have the same shape");
+             const en::Config c = make_config(d, box, boundary, diameter, mode, law, seed, bits, groups, group_tol);
+             return PyEngine(en::make_simulation(c, xs, vs, time));
+           }),
+           py::arg("positions"), py::arg("velocities"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
+           py::arg("mode"), py::arg("law"), py::arg("seed"), py::arg("bits"), py::arg("groups"),
+           py::arg("group_tol"), py::arg("time"))
+      .def_static("from_snapshot", &PyEngine::from_snapshot, py::arg("state"))
+      .def("run", &PyEngine::run, py::arg("collisions") = py::none(), py::arg("time") = py::none(),
+           py::arg("callback") = py::none(), py::arg("every") = 10000)
+      .def("run_back", &PyEngine::run_back, py::arg("collisions") = py::none(), py::arg("time") = py::none())
+      .def_property_readonly("positions", &PyEngine::positions)
+      .def_property_readonly("velocities", &PyEngine::velocities)
+      .def_property_readonly("collision_counts", &PyEngine::collision_counts)
+      .def_property_readonly("time", [](const PyEngine& e) { return e.sim().time(); })
+      .def_property_readonly("start_time", [](const PyEngine& e) { return e.sim().start_time(); })
+      .def_property_readonly("n", [](const PyEngine& e) { return e.sim().size(); })
+      .def_property_readonly("dim", [](const PyEngine& e) { return e.sim().config().dim; })
+      .def("diagnostics", &PyEngine::diagnostics)
+      .def("snapshot", &PyEngine::snapshot);
+
+  m.def(
+      "engine_random_state",
+      [](int dim, std::size_t n, double phi, const std::vector<std::string>& boundary, double diameter,
+         std::uint64_t seed, double energy, const std::string& init, bool equal_speeds) {
+        en::Config c;
+        c.dim = dim;
+        require(dim >= 1 && dim <= 3, [&] { return "dim must be 1, 2 or 3, got " + std::to_string(dim); });
+        require(boundary.size() == 1 || static_cast<int>(boundary.size()) == dim,
+                "boundary must be one name or one per axis");
+        for (int k = 0; k < dim; ++k) c.boundary[k] = en::parse_boundary(boundary.size() == 1 ? boundary[0] : boundary[k]);
+        c.diameter = diameter;
+        const en::InitialState s = en::random_state(c, n, phi, seed, energy, init, equal_speeds);
+        return py::make_tuple(to_array(s.x, n, dim), to_array(s.v, n, dim),
+                              std::vector<double>(s.config.box.begin(), s.config.box.begin() + dim));
+      },
+      py::arg("dim"), py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"), py::arg("seed"),
+      py::arg("energy"), py::arg("init"), py::arg("equal_speeds"));
+}
 
 }  // namespace revcol::bind

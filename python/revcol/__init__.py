@@ -19,6 +19,7 @@ from .verify import VERIFY_CASES, verify, verify_cases
 from .paper import Pair3DPaper, Triple1DPaper, Triple2DPaper
 from . import paper
 from . import statesave
+from .engine import Simulation
 
-__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper"]
+__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper", "Simulation"]
 __version__ = "0.1.0"

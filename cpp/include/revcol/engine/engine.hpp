@@ -1,0 +1,237 @@
+// The event-driven engine (DESIGN.md §2 and §5): N hard spheres of one diameter in d = 1, 2, 3,
+// run forward with randomized elastic collisions, and back to any earlier time with no
+// per-collision memory (the paper §3.2).
+//
+// Forward. Per-particle local times (a particle's stored position is where it was at its
+// local time; x(t) = x_i + v_i (t - t_i)), a cell list with cells at least one diameter
+// wide, one event per particle (its earliest wall contact, cell crossing or collision) in an
+// indexed binary heap, invalidation by a per-particle stamp that changes whenever the
+// particle's stored state changes. Collision times use the cancellation-free root
+// t = (r^2 - D^2) / (-b + sqrt(b^2 - w^2 (r^2 - D^2))), b = r.w < 0 (only approaching pairs
+// are candidates), computed for the pair ordered by id from the later of the two local
+// times, so that both partners predict the same bits.
+//
+// Reverse. Negate every velocity and every time (local times and the clock), run the same
+// event search, and at each collision apply v -> -reverse(-v) with the generator stepping
+// back; wall events are their own inverse (a reflection of the approached component).
+// Negating again at the end returns the state to the forward orientation. Negation is exact,
+// so free flight is bit-identical both ways; what is not is the collision time and the
+// contact normal, recomputed from positions that carry round-off. A hard-sphere gas is
+// chaotic and amplifies that round-off, and exact mode's K-bit chart cells return each
+// pre-collision state to its cell centre (a relative error ~2^-K of the relative speed):
+// round trips are exact to 1e-9 only within a horizon of collisions per particle, which
+// bench/engine_study.py measures.
+//
+// Random numbers: one Philox stream per particle (key {id, seed}); a pair collision draws
+// from the stream of its smaller id, a group from that of its smallest id (the paper's
+// per-particle policy, §4.6). Two collisions that share no particle commute: if round-off
+// swaps their order in the reversed run, each still steps back its own stream.
+//
+// Ties and groups. The heap orders events by (time, kind, particle id) with walls before
+// cell crossings before collisions, so at one instant a particle reflects on walls first and
+// collides after; the reversed run meets the same instant with the particle approaching the
+// walls again, so it undoes the walls first there too, which is the opposite order of the
+// forward sequence (collision, then the wall it was sent into). When a collision of a and b
+// is processed at time t, every particle whose contact with the pair's component is closed
+// within `group_tol` (|r| - D <= group_tol D, from r^2 - D^2 <= 2 group_tol D^2) and
+// approaching or at rest (r.w <= 0) joins it: the connected component of that contact graph
+// is one collision of n particles resolved by ExactCollision (any n, d, at most 3
+// independent contacts), drawing (n-1)d-1 numbers from the stream of its smallest id. The
+// reversed run meets the negated post state, in which every one of those contacts
+// approaches, and gathers the same component. Particles and contacts are sorted by id, so
+// the operator's geometry does not depend on the order of discovery. A group the operator
+// refuses (more than 3 independent contacts, more than 8 particles) falls back to the pair
+// alone and is counted (`group_fallbacks`). The gather scans two neighbourhoods, so it runs
+// only when a group is possible: a neighbour in contact (approaching or at rest) at a
+// prediction, or a second collision predicted within a relative 1e-9 of the first.
+//
+// Walls at a collision. A particle of a collision that touches a wall (within group_tol D)
+// and approaches it reflects before the operator (W1), and again after it if the operator
+// sends it into a touched wall (W2). Which components W1 and W2 flipped cannot be read off
+// the post state (the wall operator's two-to-one case), so the forward run keeps them, in a
+// small log keyed by (smallest id, its net collision count), for collisions at a wall only;
+// the reversed collision undoes W2, reverses the operator, undoes W1, and a reversed run
+// schedules no standalone wall event for a particle already touching a wall unless that
+// log says W2 flipped it at this instant.
+//
+// The exact-pre log. At singular points of a chart (a 3D pair almost head-on, groups with
+// resting contacts such as Newton's cradle) a pre state's K-bit cell spans up to
+// ~2^(-K/2) and its centre is far from the state; when the cell centre is off by more than
+// 1e-10 (relative), the forward run keeps the pre velocities, keyed by (stream, generator
+// counter), and the reversed collision restores them. In a gas this is a few entries per
+// million collisions (measured: 7 KB after 1e7 collisions at N = 1e4, docs/engine.md).
+//
+// A state at an event (a particle touching a wall or another particle at the start time)
+// is ambiguous for a run back to that time: start between events (random_state keeps
+// 1e-6 D from the walls).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "revcol/collide/common.hpp"
+
+namespace revcol::engine {
+
+/// Boundary condition of one axis: reflecting walls at 0 and L, or periodic.
+enum class Boundary { wall, periodic };
+
+/// "wall" / "periodic".
+inline const char* to_string(Boundary b) { return b == Boundary::wall ? "wall" : "periodic"; }
+/// Parses "wall" / "periodic"; throws InvalidArgument otherwise.
+Boundary parse_boundary(const std::string& s);
+
+/// Everything that defines a simulation besides its particles.
+struct Config {
+  int dim = 2;                                   ///< d = 1, 2, 3
+  std::array<double, 3> box{1.0, 1.0, 1.0};      ///< box lengths L_k: the box is [0, L_k] per axis
+  std::array<Boundary, 3> boundary{Boundary::periodic, Boundary::periodic, Boundary::periodic};  ///< per axis
+  double diameter = 1.0;                         ///< D
+  Mode mode = Mode::exact;                       ///< exact (default) or paper (2D pairs: Pair2DPaper)
+  Law law = Law::flux;                           ///< exact mode's target law
+  std::uint32_t seed = 1;                        ///< Philox key {particle id, seed}
+  int bits = 40;                                 ///< K, exact mode's chart bits
+  bool groups = true;                            ///< gather multi-particle contacts into one collision
+  double group_tol = 1e-9;                       ///< contact tolerance, relative to D
+};
+
+/// Event counts (cumulative over both directions).
+struct Counters {
+  std::uint64_t events = 0;            ///< events popped from the heap
+  std::uint64_t pair_collisions = 0;   ///< two-particle collisions
+  std::uint64_t group_collisions = 0;  ///< collisions of three or more particles
+  std::uint64_t group_particles = 0;   ///< particles taking part in those
+  std::uint64_t group_fallbacks = 0;   ///< groups the operator refused (processed as a pair)
+  std::uint64_t wall_events = 0;       ///< wall reflections
+  std::uint64_t cell_crossings = 0;    ///< cell-list moves
+  std::uint64_t invalid_events = 0;    ///< predictions whose partner had changed
+  std::uint64_t grazing_skipped = 0;   ///< predicted contacts found not approaching at contact
+  std::uint64_t reverse_failures = 0;  ///< reversed collisions the operator refused (beyond the horizon)
+  std::uint64_t forward_collisions = 0;  ///< collisions processed forward
+  std::uint64_t reverse_collisions = 0;  ///< collisions processed in reverse
+};
+
+/// What one run or run_back call did.
+struct RunResult {
+  std::uint64_t collisions = 0;  ///< collisions processed (pairs and groups)
+  std::uint64_t events = 0;      ///< events popped
+  double time = 0.0;             ///< the clock at the end
+  bool interrupted = false;      ///< the progress callback asked to stop
+};
+
+/// The full state, for checkpoints: restoring it resumes bit for bit.
+struct Snapshot {
+  Config config;
+  std::size_t n = 0;
+  double time = 0.0, start_time = 0.0;
+  std::int64_t net_collisions = 0;             ///< forward minus reverse collisions
+  std::vector<double> x, v;                    ///< n x dim, stored positions (at local times) and velocities
+  std::vector<double> t_local;                 ///< n
+  std::vector<std::int64_t> cell;              ///< n x dim cell coordinates
+  std::vector<std::uint64_t> stamp, ncoll, rng;  ///< n: state stamps, collisions, Philox counters
+  std::vector<double> ev_t;                    ///< n: scheduled event times
+  std::vector<std::int64_t> ev_kind, ev_partner;  ///< n
+  std::vector<std::uint64_t> ev_stamp;         ///< n
+  std::vector<double> second;                  ///< n: second earliest predicted collision (group gate)
+  std::vector<std::int64_t> touching;          ///< n: a neighbour within the contact tolerance (group gate)
+  std::vector<std::uint64_t> log_cells;        ///< the rare log, oldest first
+  std::uint64_t log_pushed = 0;                ///< entries ever pushed
+  std::vector<std::int64_t> netc;              ///< n: net collisions per particle (wall-log keys)
+  std::vector<std::uint64_t> wall_keys;        ///< wall-mask log: (smallest id, its net count) per entry
+  std::vector<std::uint64_t> wall_sizes;       ///< wall-mask log: members per entry
+  std::vector<std::uint64_t> wall_masks;       ///< wall-mask log: W1 | W2 << 8 per member
+  std::vector<std::uint64_t> wall_ids;         ///< wall-mask log: member ids
+  std::vector<std::int64_t> wall_netc;         ///< wall-mask log: members' net counts before
+  std::vector<double> wall_times;              ///< wall-mask log: forward time per entry
+  std::vector<std::uint64_t> pre_keys;         ///< exact-pre log: (stream, counter) per entry
+  std::vector<std::uint64_t> pre_sizes;        ///< exact-pre log: values per entry
+  std::vector<double> pre_vals;                ///< exact-pre log: kept pre velocities
+  std::uint64_t pre_pushed = 0;                ///< exact-pre entries ever pushed
+  Counters counters;
+  double energy0 = 0.0;                        ///< kinetic energy at construction
+  std::array<double, 3> momentum0{};           ///< momentum at construction
+};
+
+/// Conservation and activity diagnostics.
+struct Diagnostics {
+  double energy = 0.0;                    ///< sum v^2 / 2 (unit mass)
+  std::array<double, 3> momentum{};       ///< sum v
+  double energy_drift = 0.0;              ///< (E - E0) / E0
+  double momentum_drift = 0.0;            ///< |P - P0| / sqrt(2 E0 N)
+  std::size_t log_bytes = 0;              ///< rare log and exact-pre log now held
+  std::uint64_t exact_pre_pushed = 0;     ///< exact-pre entries ever pushed (singular pre states)
+  std::size_t exact_pre_entries = 0;      ///< exact-pre entries now held
+  std::size_t wall_log_entries = 0;       ///< wall-mask entries now held (collisions at walls)
+  std::uint64_t log_pushed = 0;           ///< rare-log entries ever pushed
+  double collisions_per_particle = 0.0;   ///< 2 pairs + group particles, over N (cumulative)
+  std::int64_t net_collisions = 0;        ///< forward minus reverse
+  Counters counters;
+};
+
+/// Called every `every` collisions with the collisions done so far in this call;
+/// returning false stops the run between events.
+using Progress = std::function<bool(std::uint64_t)>;
+
+/// The engine for any d (runtime); one implementation per d behind it.
+class Simulation {
+ public:
+  virtual ~Simulation() = default;
+  /// Runs forward until `max_collisions` more collisions or the clock reaches t_end,
+  /// whichever first, ending between events.
+  virtual RunResult run(std::uint64_t max_collisions, double t_end, const Progress& cb = {},
+                        std::uint64_t every = 0) = 0;
+  /// Runs backwards until `max_collisions` collisions are undone or the clock is back at
+  /// t_target (<= time()), whichever first, ending between events.
+  virtual RunResult run_back(std::uint64_t max_collisions, double t_target) = 0;
+  /// Positions at the current time (n x dim, row-major).
+  virtual std::vector<double> positions() const = 0;
+  /// Velocities (n x dim).
+  virtual std::vector<double> velocities() const = 0;
+  /// Collisions per particle (n).
+  virtual std::vector<std::uint64_t> collision_counts() const = 0;
+  /// The clock.
+  virtual double time() const = 0;
+  /// The time the simulation was built at.
+  virtual double start_time() const = 0;
+  /// Number of particles.
+  virtual std::size_t size() const = 0;
+  /// The configuration.
+  virtual const Config& config() const = 0;
+  /// Energy, momentum, counters.
+  virtual Diagnostics diagnostics() const = 0;
+  /// The full state.
+  virtual Snapshot snapshot() const = 0;
+  /// Approximate bytes held by the engine's arrays.
+  virtual std::size_t memory_bytes() const = 0;
+};
+
+/// Builds a simulation from positions and velocities (n x dim each, row-major) at time t0.
+/// Validates everything first (throws InvalidArgument naming the problem): n > 0, finite
+/// values, box and diameter, particles inside the box, no overlap (|r| < D (1 - 1e-9)),
+/// non-zero kinetic energy, at least 3 cells on a periodic axis, paper mode only in 1D/2D.
+std::unique_ptr<Simulation> make_simulation(const Config& config, const std::vector<double>& x,
+                                            const std::vector<double>& v, double t0 = 0.0);
+
+/// Rebuilds a simulation from a snapshot (validated the same way); resumes bit for bit.
+std::unique_ptr<Simulation> restore_simulation(const Snapshot& s);
+
+/// A random initial state: box of side L with n particles at packing fraction phi
+/// (phi = n v_D / L^d), placed by random sequential addition ("rsa"), or on a simple
+/// lattice with random displacements ("lattice"; "auto" picks rsa for phi <= 0.3 (1D), 0.35
+/// (2D), 0.2 (3D), else lattice), velocities Gaussian with zero total momentum scaled to
+/// kinetic energy `energy` (<= 0: n d / 2, that is kT = 1), or, with equal_speeds, all of
+/// the same speed in random directions (then zero momentum is not enforced).
+struct InitialState {
+  Config config;          ///< config with its box set
+  std::vector<double> x;  ///< n x dim
+  std::vector<double> v;  ///< n x dim
+};
+/// See InitialState.
+InitialState random_state(Config config, std::size_t n, double phi, std::uint64_t seed,
+                          double energy = 0.0, const std::string& init = "auto",
+                          bool equal_speeds = false);
+
+}  // namespace revcol::engine

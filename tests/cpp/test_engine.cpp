@@ -1,0 +1,367 @@
+// The event-driven engine: round trips in 1/2/3D with walls and periodic boxes, checkpoints
+// resumed bit for bit, conservation, validation, and constructed multi-particle events
+// (symmetric triple contact, Newton's cradles in 1D and 2D, a hit on a particle in a corner).
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "check.hpp"
+#include "revcol/engine/engine.hpp"
+#include "revcol/error.hpp"
+
+using namespace revcol;
+using namespace revcol::engine;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr std::uint64_t kAll = std::numeric_limits<std::uint64_t>::max();
+
+Config config(int d, Boundary b, Law law = Law::flux, Mode mode = Mode::exact) {
+  Config c;
+  c.dim = d;
+  c.boundary = {b, b, b};
+  c.law = law;
+  c.mode = mode;
+  return c;
+}
+
+struct Err {
+  double x = 0.0, v = 0.0;
+};
+
+// Max position error over the box length (periodic images folded) and max velocity error
+// over the largest speed.
+Err error(const Simulation& s, const std::vector<double>& x0, const std::vector<double>& v0) {
+  const auto x = s.positions();
+  const auto v = s.velocities();
+  const int d = s.config().dim;
+  double vmax = 0.0;
+  for (double q : v0) vmax = std::fmax(vmax, std::fabs(q));
+  Err e;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double L = s.config().box[i % d];
+    double dx = std::fabs(x[i] - x0[i]);
+    if (s.config().boundary[i % d] == Boundary::periodic) dx = std::fmin(dx, std::fabs(dx - L));
+    e.x = std::fmax(e.x, dx / L);
+    e.v = std::fmax(e.v, std::fabs(v[i] - v0[i]) / vmax);
+  }
+  return e;
+}
+
+Err round_trip(const Config& c, std::size_t n, double phi, std::uint64_t nc, std::uint64_t seed = 3) {
+  const InitialState st = random_state(c, n, phi, seed);
+  auto s = make_simulation(st.config, st.x, st.v);
+  const auto x0 = s->positions();
+  const auto v0 = s->velocities();
+  const RunResult f = s->run(nc, kInf);
+  CHECK(f.collisions == nc);
+  CHECK(s->time() > 0.0);
+  s->run_back(kAll, s->start_time());
+  CHECK(s->time() == s->start_time());
+  CHECK(s->diagnostics().net_collisions == 0);
+  CHECK(s->diagnostics().counters.reverse_failures == 0);
+  return error(*s, x0, v0);
+}
+
+}  // namespace
+
+TEST_CASE("1D gas: exchange collisions restore to 1e-12 after 1e5 collisions, walls and periodic") {
+  for (Boundary b : {Boundary::periodic, Boundary::wall}) {
+    const Err e = round_trip(config(1, b), 200, 0.3, 100000);
+    CHECK(e.x < 1e-12);
+    CHECK(e.v == 0.0);  // exchanges and wall flips are exact
+  }
+}
+
+TEST_CASE("2D and 3D gases restore to 1e-9 within the horizon (1 collision per particle)") {
+  for (int d : {2, 3})
+    for (Boundary b : {Boundary::periodic, Boundary::wall})
+      for (Law law : {Law::flux, Law::uniform}) {
+        const Err e = round_trip(config(d, b, law), 200, 0.3, 100);
+        CHECK(e.x < 1e-9);
+        CHECK(e.v < 1e-9);
+      }
+  const Err p = round_trip(config(2, Boundary::periodic, Law::flux, Mode::paper), 200, 0.3, 100);
+  CHECK(p.x < 1e-9);
+  CHECK(p.v < 1e-9);
+}
+
+TEST_CASE("far beyond the horizon (400 collisions per particle) chaos wins: the error is visible") {
+  const InitialState st = random_state(config(2, Boundary::periodic), 100, 0.3, 3);
+  auto s = make_simulation(st.config, st.x, st.v);
+  const auto x0 = s->positions();
+  const auto v0 = s->velocities();
+  s->run(20000, kInf);
+  s->run_back(kAll, s->start_time());
+  CHECK(error(*s, x0, v0).v > 1e-6);
+}
+
+TEST_CASE("energy and momentum are conserved to round-off") {
+  for (int d : {1, 2, 3}) {
+    const InitialState st = random_state(config(d, Boundary::periodic), 300, 0.3, 5);
+    auto s = make_simulation(st.config, st.x, st.v);
+    s->run(5000, kInf);
+    const Diagnostics g = s->diagnostics();
+    CHECK(std::fabs(g.energy_drift) < 1e-12);
+    CHECK(g.momentum_drift < 1e-12);
+    CHECK(g.counters.pair_collisions == 5000);
+    CHECK(std::fabs(g.collisions_per_particle - 2.0 * 5000 / 300) < 1e-12);
+  }
+}
+
+TEST_CASE("walls: particles stay inside the box") {
+  for (int d : {1, 2, 3}) {
+    const InitialState st = random_state(config(d, Boundary::wall), 100, 0.2, 9);
+    auto s = make_simulation(st.config, st.x, st.v);
+    s->run(3000, kInf);
+    CHECK(s->diagnostics().counters.wall_events > 0);
+    const auto x = s->positions();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const double L = st.config.box[i % d];
+      CHECK(x[i] >= 0.5 - 1e-9);
+      CHECK(x[i] <= L - 0.5 + 1e-9);
+    }
+  }
+}
+
+TEST_CASE("checkpoint: a run resumed from a snapshot is bit-identical to an uninterrupted one") {
+  for (int d : {1, 2, 3}) {
+    const InitialState st = random_state(config(d, Boundary::periodic), 150, 0.35, 11);
+    auto a = make_simulation(st.config, st.x, st.v);
+    auto b = make_simulation(st.config, st.x, st.v);
+    a->run(4000, kInf);
+    b->run(1700, kInf);
+    auto c = restore_simulation(b->snapshot());
+    b.reset();
+    c->run(2300, kInf);
+    CHECK(a->positions() == c->positions());
+    CHECK(a->velocities() == c->velocities());
+    CHECK(a->time() == c->time());
+    a->run_back(1500, -kInf);
+    c->run_back(1500, -kInf);
+    CHECK(a->velocities() == c->velocities());
+    CHECK(a->snapshot().rng == c->snapshot().rng);
+  }
+}
+
+TEST_CASE("run_back to an earlier time or collision count, then forward again") {
+  const InitialState st = random_state(config(2, Boundary::periodic), 200, 0.3, 13);
+  auto s = make_simulation(st.config, st.x, st.v);
+  s->run(60, kInf);
+  const double t1 = s->time();
+  const auto x1 = s->positions();
+  const auto v1 = s->velocities();
+  s->run(60, kInf);
+  s->run_back(kAll, t1);
+  CHECK(s->time() == t1);
+  const Err e = error(*s, x1, v1);
+  CHECK(e.x < 1e-9);
+  CHECK(e.v < 1e-9);
+  CHECK(s->diagnostics().net_collisions == 60);
+  s->run_back(25, -kInf);
+  CHECK(s->diagnostics().net_collisions == 35);
+  s->run(25, kInf);
+  CHECK(s->diagnostics().net_collisions == 60);
+  CHECK_THROWS_AS(s->run_back(1, s->time() + 1.0), InvalidArgument);
+}
+
+TEST_CASE("progress callback is called and can stop the run") {
+  const InitialState st = random_state(config(2, Boundary::periodic), 100, 0.3, 17);
+  auto s = make_simulation(st.config, st.x, st.v);
+  int calls = 0;
+  const RunResult r = s->run(1000, kInf, [&](std::uint64_t k) { ++calls; return k < 300; }, 100);
+  CHECK(calls == 3);
+  CHECK(r.interrupted);
+  CHECK(r.collisions == 300);
+}
+
+TEST_CASE("validation: every bad state is refused with InvalidArgument, nothing built") {
+  Config c = config(2, Boundary::wall);
+  c.box = {10, 10, 1};
+  const std::vector<double> x = {2, 2, 5, 5}, v = {1, 0, -1, 0};
+  CHECK(make_simulation(c, x, v) != nullptr);
+  CHECK_THROWS_AS(make_simulation(c, {}, {}), InvalidArgument);                        // N = 0
+  CHECK_THROWS_AS(make_simulation(c, {2, 2, 2.5, 2}, v), InvalidArgument);              // overlap
+  CHECK_THROWS_AS(make_simulation(c, {0.2, 2, 5, 5}, v), InvalidArgument);              // outside (wall)
+  CHECK_THROWS_AS(make_simulation(c, {2, 2, 5, 10.2}, v), InvalidArgument);             // outside
+  CHECK_THROWS_AS(make_simulation(c, {2, NAN, 5, 5}, v), InvalidArgument);              // non-finite
+  CHECK_THROWS_AS(make_simulation(c, x, {1, INFINITY, 0, 0}), InvalidArgument);
+  CHECK_THROWS_AS(make_simulation(c, x, {0, 0, 0, 0}), InvalidArgument);                // zero energy
+  CHECK_THROWS_AS(make_simulation(c, x, {1, 0, 0}), InvalidArgument);                   // shapes
+  Config big = c;
+  big.diameter = 12.0;
+  CHECK_THROWS_AS(make_simulation(big, {6, 6, 6, 6}, v), InvalidArgument);              // D too large
+  Config per = config(2, Boundary::periodic);
+  per.box = {2.5, 10, 1};
+  CHECK_THROWS_AS(make_simulation(per, {1, 2, 1, 5}, v), InvalidArgument);              // < 3 cells
+  per.box = {10, 10, 1};
+  CHECK_THROWS_AS(make_simulation(per, {-0.1, 2, 5, 5}, v), InvalidArgument);           // outside [0, L)
+  CHECK_THROWS_AS(make_simulation(per, {0.2, 2, 9.5, 2}, v), InvalidArgument);          // overlap through the boundary
+  Config paper3 = config(3, Boundary::periodic, Law::flux, Mode::paper);
+  paper3.box = {10, 10, 10};
+  CHECK_THROWS_AS(make_simulation(paper3, {2, 2, 2, 5, 5, 5}, {1, 0, 0, -1, 0, 0}), InvalidArgument);
+  Config bad = c;
+  bad.dim = 4;
+  CHECK_THROWS_AS(make_simulation(bad, x, v), InvalidArgument);
+  // the message names the problem
+  try {
+    make_simulation(c, {2, 2, 2.5, 2}, v);
+  } catch (const InvalidArgument& e) {
+    CHECK(std::string(e.what()).find("overlap") != std::string::npos);
+  }
+}
+
+// ---- constructed multi-particle events ---------------------------------------------------
+
+namespace {
+
+struct Built {
+  std::unique_ptr<Simulation> s;
+  std::vector<double> x0, v0;
+};
+
+Built build(const Config& c, const std::vector<double>& x, const std::vector<double>& v) {
+  Built b;
+  b.s = make_simulation(c, x, v);
+  b.x0 = b.s->positions();
+  b.v0 = b.s->velocities();
+  return b;
+}
+
+// Runs to time t, back to the start; returns the errors and the forward counters.
+Err there_and_back(Built& b, double t, Counters& fwd) {
+  b.s->run(kAll, t);
+  fwd = b.s->diagnostics().counters;
+  b.s->run_back(kAll, b.s->start_time());
+  return error(*b.s, b.x0, b.v0);
+}
+
+}  // namespace
+
+TEST_CASE("three disks meeting symmetrically: one group collision, reversed") {
+  Config c = config(2, Boundary::wall);
+  c.box = {20, 20, 1};
+  const double kPi = 3.141592653589793;
+  const double R = 1.0 / std::sqrt(3.0) + 2.0;  // contact at R = D / sqrt(3)
+  std::vector<double> x, v;
+  for (int k = 0; k < 3; ++k) {
+    const double a = kPi / 2 + 2 * kPi * k / 3;
+    x.push_back(10 + R * std::cos(a));
+    x.push_back(10 + R * std::sin(a));
+    v.push_back(-std::cos(a));
+    v.push_back(-std::sin(a));
+  }
+  Built b = build(c, x, v);
+  Counters f;
+  const Err e = there_and_back(b, 4.0, f);
+  CHECK(f.group_collisions == 1);
+  CHECK(f.group_particles == 3);
+  CHECK(f.pair_collisions == 0);
+  CHECK(e.x < 1e-9);
+  CHECK(e.v < 1e-9);
+  // without grouping the same start is three sequential pair collisions
+  Config nog = c;
+  nog.groups = false;
+  Built p = build(nog, x, v);
+  p.s->run(kAll, 4.0);
+  CHECK(p.s->diagnostics().counters.group_collisions == 0);
+  CHECK(p.s->diagnostics().counters.pair_collisions >= 2);
+}
+
+TEST_CASE("Newton's cradle in 1D (3 and 4 particles): one group, reversed") {
+  for (int rest : {2, 3}) {
+    Config c = config(1, Boundary::wall);
+    c.box = {30, 1, 1};
+    std::vector<double> x = {5.0}, v = {1.0};
+    for (int k = 0; k < rest; ++k) {
+      x.push_back(10.0 + k);
+      v.push_back(0.0);
+    }
+    Built b = build(c, x, v);
+    Counters f;
+    const Err e = there_and_back(b, 6.0, f);
+    CHECK(f.group_collisions == 1);
+    CHECK(f.group_particles == static_cast<std::uint64_t>(rest + 1));
+    CHECK(e.x < 1e-9);
+    CHECK(e.v < 1e-9);
+  }
+}
+
+TEST_CASE("Newton's cradle in 2D (a row of 3 at rest, hit along the row): one group, reversed") {
+  Config c = config(2, Boundary::wall);
+  c.box = {30, 30, 1};
+  std::vector<double> x = {5.0, 15.0}, v = {1.0, 0.0};
+  for (int k = 0; k < 3; ++k) {
+    x.push_back(10.0 + k);
+    x.push_back(15.0);
+    v.push_back(0.0);
+    v.push_back(0.0);
+  }
+  Built b = build(c, x, v);
+  Counters f;
+  const Err e = there_and_back(b, 5.5, f);
+  CHECK(f.group_collisions == 1);
+  CHECK(f.group_particles == 4);
+  CHECK(e.x < 1e-9);
+  CHECK(e.v < 1e-9);
+}
+
+TEST_CASE("a particle hit while touching a corner: walls and collision reversed in order") {
+  for (int d : {2, 3})
+  for (std::uint32_t seed = 1; seed <= 12; ++seed) {  // the draws decide how often it chatters
+    Config c = config(d, Boundary::wall);
+    c.seed = seed;
+    c.box = {10, 10, 10};
+    // particle 0 at rest in the lower corner, particle 1 arriving along the diagonal
+    std::vector<double> x(2 * d), v(2 * d, 0.0);
+    const double s = 1.0 / std::sqrt(static_cast<double>(d));
+    for (int k = 0; k < d; ++k) {
+      x[k] = 0.5;
+      x[d + k] = 0.5 + 3.0 * s;
+      v[d + k] = -s;
+    }
+    Built b = build(c, x, v);
+    Counters f;
+    const Err e = there_and_back(b, 6.0, f);
+    CHECK(f.pair_collisions >= 1);
+    CHECK(f.wall_events >= 1);
+    CHECK(e.x < 1e-9);
+    CHECK(e.v < 1e-9);
+  }
+}
+
+TEST_CASE("checkpoint keeps the keyed logs: a corner hit and a 2D cradle reversed after a restore") {
+  // corner: the wall-mask log; cradle: the exact-pre log (resting contacts)
+  Config corner = config(3, Boundary::wall);
+  corner.box = {10, 10, 10};
+  const double s3 = 1.0 / std::sqrt(3.0);
+  const std::vector<double> xc = {0.5, 0.5, 0.5, 0.5 + 3 * s3, 0.5 + 3 * s3, 0.5 + 3 * s3};
+  const std::vector<double> vc = {0, 0, 0, -s3, -s3, -s3};
+  Config cradle = config(2, Boundary::wall);
+  cradle.box = {30, 30, 1};
+  const std::vector<double> xr = {5, 15, 10, 15, 11, 15, 12, 15}, vr = {1, 0, 0, 0, 0, 0, 0, 0};
+  for (int which = 0; which < 2; ++which) {
+    const Config& c = which ? cradle : corner;
+    const auto& x = which ? xr : xc;
+    const auto& v = which ? vr : vc;
+    auto a = make_simulation(c, x, v);
+    a->run(kAll, 6.0);
+    const Snapshot snap = a->snapshot();
+    CHECK(snap.wall_sizes.size() + snap.pre_sizes.size() > 0);  // something was kept
+    auto b = restore_simulation(snap);
+    a->run_back(kAll, 0.0);
+    b->run_back(kAll, 0.0);
+    CHECK(a->velocities() == b->velocities());
+    CHECK(a->positions() == b->positions());
+    const Err e = error(*b, x, v);
+    CHECK(e.x < 1e-9);
+    CHECK(e.v < 1e-9);
+    CHECK(b->snapshot().wall_sizes.empty());  // every kept entry was used
+    CHECK(b->snapshot().pre_sizes.empty());
+  }
+}
+
+CHECK_MAIN()

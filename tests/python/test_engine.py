@@ -1,0 +1,157 @@
+"""revcol.Simulation: the same code paths as the studies (bench/engine_study.py) at small N."""
+import numpy as np
+import pytest
+from scipy import stats
+
+import revcol
+from revcol import Simulation
+
+
+def _err(sim, x0, v0):
+    x, v = sim.positions, sim.velocities
+    box = sim.state()["box"]
+    dx = np.abs(x - x0)
+    per = sim.state()["periodic"].astype(bool)
+    dx[:, per] = np.minimum(dx[:, per], np.abs(dx[:, per] - box[per]))
+    return (dx / box).max(), np.abs(v - v0).max() / np.abs(v0).max()
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+@pytest.mark.parametrize("boundary", ["periodic", "wall"])
+def test_round_trip_within_horizon(dim, boundary):
+    sim = Simulation.random(n=150, dim=dim, phi=0.3, boundary=boundary, seed=4)
+    x0, v0 = sim.positions, sim.velocities
+    r = sim.run(collisions=75)
+    assert r["collisions"] == 75 and sim.time > 0
+    sim.run_back()
+    assert sim.time == sim.start_time
+    ex, ev = _err(sim, x0, v0)
+    assert ex < 1e-9 and ev < 1e-9
+    d = sim.diagnostics()
+    assert d["net_collisions"] == 0 and d["events"]["reverse_failures"] == 0
+
+
+def test_1d_gas_exact_after_many_collisions():
+    sim = Simulation.random(n=100, dim=1, phi=0.3, seed=2)
+    x0, v0 = sim.positions, sim.velocities
+    sim.run(collisions=100_000)
+    sim.run_back()
+    ex, ev = _err(sim, x0, v0)
+    assert ex < 1e-12 and ev == 0.0
+
+
+@pytest.mark.parametrize("law,mode", [("uniform", "exact"), ("flux", "paper")])
+def test_other_laws_round_trip(law, mode):
+    sim = Simulation.random(n=120, dim=2, phi=0.3, seed=5, law=law, mode=mode)
+    x0, v0 = sim.positions, sim.velocities
+    sim.run(collisions=60)
+    sim.run_back()
+    ex, ev = _err(sim, x0, v0)
+    assert ex < 1e-9 and ev < 1e-9
+
+
+def test_conservation_and_diagnostics():
+    sim = Simulation.random(n=200, dim=3, phi=0.3, seed=6)
+    sim.run(collisions=2000)
+    d = sim.diagnostics()
+    assert abs(d["energy_drift"]) < 1e-12 and d["momentum_drift"] < 1e-12
+    assert d["events"]["pair_collisions"] == 2000
+    assert d["collisions_per_particle"] == pytest.approx(2 * 2000 / 200)
+    assert sim.collision_counts.sum() == 4000
+    assert d["log_bytes"] == 0
+    assert sim.positions.shape == (200, 3) and sim.velocities.shape == (200, 3)
+
+
+def test_checkpoint_resume_is_bit_identical(tmp_path):
+    a = Simulation.random(n=100, dim=2, phi=0.4, boundary="wall", seed=7)
+    b = Simulation.from_state(a.state())
+    a.run(collisions=3000)
+    b.run(collisions=1234)
+    path = tmp_path / "ck.npz"
+    b.save(path)
+    c = Simulation.load(path)
+    c.run(collisions=3000 - 1234)
+    assert np.array_equal(a.positions, c.positions)
+    assert np.array_equal(a.velocities, c.velocities)
+    assert a.time == c.time
+    a.run_back(collisions=500)
+    c.run_back(collisions=500)
+    assert np.array_equal(a.velocities, c.velocities)
+
+
+def test_run_back_to_time_and_callback():
+    sim = Simulation.random(n=100, dim=2, phi=0.3, seed=8)
+    sim.run(collisions=40)
+    t1, x1, v1 = sim.time, sim.positions, sim.velocities
+    seen = []
+    r = sim.run(collisions=1000, callback=lambda k: seen.append(k) or k < 200, every=50)
+    assert r["interrupted"] and r["collisions"] == 200 and seen == [50, 100, 150, 200]
+    sim.run_back(time=t1)
+    assert sim.time == t1
+    ex, ev = _err(sim, x1, v1)
+    assert ex < 1e-9 and ev < 1e-9
+
+
+@pytest.mark.parametrize("bad,match", [
+    (dict(positions=[[1.0, 1.0], [1.5, 1.0]]), "overlap"),
+    (dict(positions=[[0.2, 1.0], [5.0, 5.0]], boundary="wall"), "outside"),
+    (dict(positions=[[np.nan, 1.0], [5.0, 5.0]]), "finite"),
+    (dict(velocities=[[0.0, 0.0], [0.0, 0.0]]), "kinetic energy"),
+    (dict(diameter=20.0, boundary="wall", positions=[[5.0, 5.0], [5.0, 5.0]]), "too large"),
+    (dict(box=[2.5, 10.0]), "periodic box too small"),
+    (dict(positions=np.zeros((0, 2)), velocities=np.zeros((0, 2))), "N = 0"),
+    (dict(law="nope"), "law"),
+])
+def test_validation(bad, match):
+    kw = dict(positions=[[1.0, 1.0], [5.0, 5.0]], velocities=[[1.0, 0.0], [-1.0, 0.0]], box=[10.0, 10.0])
+    kw.update(bad)
+    with pytest.raises(ValueError, match=match):
+        Simulation(kw.pop("positions"), kw.pop("velocities"), kw.pop("box"), **kw)
+
+
+def test_symmetric_triple_is_one_group():
+    ang = np.pi / 2 + 2 * np.pi * np.arange(3) / 3
+    u = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    x = 10 + (1 / np.sqrt(3) + 2) * u
+    sim = Simulation(x, -u, [20.0, 20.0], boundary="wall")
+    sim.run(time=4.0)
+    assert sim.diagnostics()["events"]["group_collisions"] == 1
+    sim.run_back()
+    assert np.abs(sim.positions - x).max() < 1e-9 and np.abs(sim.velocities + u).max() < 1e-9
+
+
+def test_maxwell_relaxation_small():
+    """From equal speeds, the flux law relaxes a 2D gas to Maxwell-Boltzmann speeds (the
+    study's check at N = 1000; here N = 200 and pooled samples)."""
+    sim = Simulation.random(n=200, dim=2, phi=0.2, seed=9, equal_speeds=True)
+    sim.run(collisions=4000)
+    samples = []
+    for _ in range(10):
+        sim.run(collisions=400)
+        samples.append(np.linalg.norm(sim.velocities, axis=1))
+    s = np.concatenate(samples)
+    kT = (s ** 2).mean() / 2
+    p = stats.kstest(s, lambda q: 1 - np.exp(-q ** 2 / (2 * kT))).pvalue
+    assert p > 1e-3
+    # and the start was far from it
+    assert np.ptp(np.linalg.norm(Simulation.random(n=200, dim=2, phi=0.2, seed=9, equal_speeds=True).velocities, axis=1)) < 1e-12
+
+
+def test_exported():
+    assert "Simulation" in revcol.__all__ and revcol.Simulation is Simulation
+
+
+def test_cradle_2d_through_npz_checkpoint(tmp_path):
+    """A 2D Newton's cradle (one group with resting contacts: the exact-pre log) saved
+    after the hit, loaded, and run back."""
+    x = np.array([[5.0, 15.0], [10.0, 15.0], [11.0, 15.0], [12.0, 15.0]])
+    v = np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]])
+    sim = Simulation(x, v, [30.0, 30.0], boundary="wall")
+    sim.run(time=6.0)
+    assert sim.diagnostics()["events"]["group_collisions"] == 1
+    assert sim.diagnostics()["exact_pre_entries"] == 1
+    sim.save(tmp_path / "cradle.npz")
+    back = Simulation.load(tmp_path / "cradle.npz")
+    back.run_back()
+    assert np.abs(back.positions - x).max() < 1e-9 and np.abs(back.velocities - v).max() < 1e-9
+    assert back.diagnostics()["exact_pre_entries"] == 0
