@@ -1,0 +1,268 @@
+"""Studies of the event-driven engine (docs/engine.md): the round-trip horizon, relaxation to
+Maxwell-Boltzmann speeds, and memory over long runs. Writes bench/results/engine_*.
+
+    PYTHONPATH=build-dev/pkg python3 bench/engine_study.py horizon   [--n 1000] [--max 1e6]
+    PYTHONPATH=build-dev/pkg python3 bench/engine_study.py maxwell   [--n 1000]
+    PYTHONPATH=build-dev/pkg python3 bench/engine_study.py memory    [--n 10000] [--max 1e7]
+    PYTHONPATH=build-dev/pkg python3 bench/engine_study.py throughput [--bin build-dev/revcol-bench]
+    PYTHONPATH=build-dev/pkg python3 bench/engine_study.py all
+
+horizon: for each (d, phi) a fresh random gas (N particles, periodic box, exact mode, flux
+law) runs N_c collisions forward and then back to its start time; the error is
+max |x - x0| / L (periodic images folded) and max |v - v0| / max |v0|. The horizon is the
+largest N_c on the grid with both below 1e-9, in collisions per particle (2 N_c / N).
+A 1D gas is run to 1e6 collisions the same way.
+
+maxwell: from all speeds equal (random directions), N particles relax for `relax` collisions
+per particle; then `samples` snapshots, `gap` collisions per particle apart, are pooled and
+the speeds compared with the Maxwell-Boltzmann law of the measured kT by Kolmogorov-Smirnov
+(p > 0.001 is the criterion; pooled snapshots are correlated, so p is optimistic).
+
+throughput: revcol-bench --bench engine/<case> --collisions 1e6 (2e6 for N = 1e5) --repeats 3,
+one process per case (peak RSS per case), merged into engine_throughput.json with the
+reference rates of the fastest public EDMD code measured on this machine.
+
+memory: one process per run (peak RSS is the process's VmHWM); the RSS after 1e5, 1e6 and
+1e7 collisions at N = 1e4 spheres, and the engine's log bytes.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "results")
+
+
+def _revcol():
+    import revcol
+    return revcol
+
+
+def roundtrip(dim, n, phi, nc, seed=1, mode="exact", law="flux", boundary="periodic"):
+    revcol = _revcol()
+    sim = revcol.Simulation.random(n=n, dim=dim, phi=phi, seed=seed, mode=mode, law=law, boundary=boundary)
+    x0, v0 = sim.positions, sim.velocities
+    st = sim.state()
+    box, per = st["box"], st["periodic"].astype(bool)
+    t0 = time.perf_counter()
+    sim.run(collisions=nc)
+    t1 = time.perf_counter()
+    sim.run_back()
+    t2 = time.perf_counter()
+    dx = np.abs(sim.positions - x0)
+    dx[:, per] = np.minimum(dx[:, per], np.abs(dx[:, per] - box[per]))
+    d = sim.diagnostics()
+    return dict(dim=dim, n=n, phi=phi, collisions=int(nc), mode=mode, law=law,
+                per_particle=2.0 * nc / n,
+                err_x=float((dx / box).max()),
+                err_v=float(np.abs(sim.velocities - v0).max() / np.abs(v0).max()),
+                net_collisions=int(d["net_collisions"]),
+                reverse_failures=int(d["events"]["reverse_failures"]),
+                log_bytes=int(d["log_bytes"]),
+                forward_s=t1 - t0, back_s=t2 - t1)
+
+
+def horizon(args):
+    grid = [int(round(m * 10 ** e)) for e in range(2, 7) for m in (1, 2, 5)]
+    grid = [g for g in grid if g <= args.max]
+    rows = []
+    curves = [(2, 0.3, "exact"), (2, 0.5, "exact"), (3, 0.3, "exact"), (3, 0.45, "exact"), (2, 0.3, "paper")]
+    for dim, phi, mode in curves:
+        for nc in grid:
+            r = roundtrip(dim, args.n, phi, nc, mode=mode)
+            rows.append(r)
+            print(f"d={dim} phi={phi} {mode:5s} Nc={nc:>8d} ({r['per_particle']:8.1f}/particle) "
+                  f"err_x={r['err_x']:.2e} err_v={r['err_v']:.2e}", flush=True)
+    r1 = roundtrip(1, args.n, 0.3, int(args.max))
+    rows.append(r1)
+    print(f"d=1 phi=0.3 Nc={int(args.max)} err_x={r1['err_x']:.2e} err_v={r1['err_v']:.2e}")
+    summary = []
+    for dim, phi, mode in curves:
+        sel = [r for r in rows if r["dim"] == dim and r["phi"] == phi and r["mode"] == mode]
+        ok = [r for r in sel if r["err_x"] <= 1e-9 and r["err_v"] <= 1e-9]
+        h = max((r["collisions"] for r in ok), default=0)
+        summary.append(dict(dim=dim, phi=phi, mode=mode, horizon_collisions=h,
+                            horizon_per_particle=2.0 * h / args.n))
+    for s in summary:
+        print(f"horizon d={s['dim']} phi={s['phi']} {s['mode']}: N_c = {s['horizon_collisions']} "
+              f"({s['horizon_per_particle']:.1f} collisions per particle)")
+    os.makedirs(RESULTS, exist_ok=True)
+    out = dict(command=" ".join(sys.argv), n=args.n, rows=rows, horizon=summary,
+               one_d=dict(collisions=r1["collisions"], err_x=r1["err_x"], err_v=r1["err_v"]))
+    with open(os.path.join(RESULTS, "engine_horizon.json"), "w") as f:
+        json.dump(out, f, indent=1)
+    with open(os.path.join(RESULTS, "engine_horizon.csv"), "w") as f:
+        keys = list(rows[0].keys())
+        f.write(",".join(keys) + "\n")
+        for r in rows:
+            f.write(",".join(str(r[k]) for k in keys) + "\n")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    for dim, phi, mode in curves:
+        sel = [r for r in rows if r["dim"] == dim and r["phi"] == phi and r["mode"] == mode]
+        c = np.array([r["per_particle"] for r in sel])
+        lab = f"d={dim}, phi={phi}" + (" (paper mode)" if mode == "paper" else "")
+        ax[0].loglog(c, [max(r["err_v"], 1e-17) for r in sel], "o-", label=lab)
+        ax[1].loglog(c, [max(r["err_x"], 1e-17) for r in sel], "o-", label=lab)
+    for a, t in zip(ax, ["velocities: max |v - v0| / max |v0|", "positions: max |x - x0| / L"]):
+        a.axhline(1e-9, color="k", ls=":", lw=1)
+        a.set_xlabel("collisions per particle (2 N_c / N), forward then back")
+        a.set_title(t)
+        a.grid(True, which="both", alpha=0.3)
+    ax[0].set_ylabel(f"round-trip error, N = {args.n}")
+    ax[1].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(RESULTS, "engine_horizon.png"), dpi=120)
+    print("wrote bench/results/engine_horizon.{json,csv,png}")
+
+
+def _mb_cdf(s, dim, kT):
+    from scipy import special
+    return special.gammainc(dim / 2.0, s * s / (2.0 * kT))
+
+
+def maxwell(args):
+    from scipy import stats
+    revcol = _revcol()
+    out = []
+    cases = [(2, "exact", "flux"), (3, "exact", "flux"), (2, "exact", "uniform"), (3, "exact", "uniform"),
+             (2, "paper", "flux")]
+    for dim, mode, law in cases:
+        sim = revcol.Simulation.random(n=args.n, dim=dim, phi=0.3, seed=3, equal_speeds=True, mode=mode, law=law)
+        sim.run(collisions=int(args.relax * args.n / 2))
+        pooled = []
+        for _ in range(args.samples):
+            sim.run(collisions=int(args.gap * args.n / 2))
+            pooled.append(np.linalg.norm(sim.velocities, axis=1))
+        s = np.concatenate(pooled)
+        kT = float((s ** 2).mean() / dim)
+        ks = stats.kstest(s, lambda q: _mb_cdf(q, dim, kT))
+        one = stats.kstest(pooled[-1], lambda q: _mb_cdf(q, dim, kT))
+        r = dict(dim=dim, mode=mode, law=law, n=args.n, samples=len(s), kT=kT, ks_stat=float(ks.statistic),
+                 p_value=float(ks.pvalue), p_value_last_snapshot=float(one.pvalue),
+                 passes=bool(ks.pvalue > 1e-3))
+        out.append(r)
+        print(f"d={dim} {mode:5s} {law:7s}: KS D={r['ks_stat']:.4f} p={r['p_value']:.3g} "
+              f"(last snapshot alone p={r['p_value_last_snapshot']:.3g}) {'PASS' if r['passes'] else 'FAIL'}")
+    os.makedirs(RESULTS, exist_ok=True)
+    with open(os.path.join(RESULTS, "engine_maxwell.json"), "w") as f:
+        json.dump(dict(command=" ".join(sys.argv), relax_per_particle=args.relax, gap_per_particle=args.gap,
+                       rows=out), f, indent=1)
+    print("wrote bench/results/engine_maxwell.json")
+
+
+_MEMORY_CHILD = r"""
+import resource, sys, json, revcol
+n, top = int(sys.argv[1]), int(float(sys.argv[2]))
+sim = revcol.Simulation.random(n=n, dim=3, phi=0.3, seed=1)
+done, rows, mark = 0, [], 100000
+while mark <= top:
+    sim.run(collisions=mark - done); done = mark
+    d = sim.diagnostics()
+    with open('/proc/self/status') as f:
+        rss = [int(l.split()[1]) * 1024 for l in f if l.startswith(('VmHWM', 'VmRSS'))]
+    rows.append(dict(collisions=done, peak_rss_bytes=rss[0], rss_bytes=rss[1], log_bytes=d['log_bytes'],
+                     engine_bytes=d['memory_bytes']))
+    print(json.dumps(rows[-1]), flush=True)
+    mark *= 10
+"""
+
+
+def memory(args):
+    env = dict(os.environ)
+    p = subprocess.run([sys.executable, "-c", _MEMORY_CHILD, str(args.n), str(args.max)], capture_output=True,
+                       text=True, env=env, check=True)
+    rows = [json.loads(l) for l in p.stdout.splitlines() if l.startswith("{")]
+    for r in rows:
+        print(r)
+    first, last = rows[0], rows[-1]
+    growth = (last["peak_rss_bytes"] - first["peak_rss_bytes"]) / first["peak_rss_bytes"]
+    print(f"peak RSS {first['peak_rss_bytes']} -> {last['peak_rss_bytes']} bytes ({100 * growth:+.3f}%), "
+          f"log {last['log_bytes']} bytes after {last['collisions']} collisions")
+    os.makedirs(RESULTS, exist_ok=True)
+    with open(os.path.join(RESULTS, "engine_memory.json"), "w") as f:
+        json.dump(dict(command=" ".join(sys.argv), n=args.n, rows=rows, peak_rss_growth=growth,
+                       flat_within_1_percent=bool(abs(growth) <= 0.01)), f, indent=1)
+    print("wrote bench/results/engine_memory.json")
+
+
+REFERENCE = {  # collisions/s of the fastest public EDMD code on this machine (the issue's numbers)
+    "engine/d3/n10000/phi0.3": 6.1e5, "engine/d3/n10000/phi0.45": 9.8e5,
+    "engine/d3/n100000/phi0.3": 2.7e5, "engine/d3/n100000/phi0.45": 4.5e5,
+}
+
+
+def throughput(args):
+    import tempfile
+    rows = []
+    for case in ["engine/d3/n10000/phi0.3", "engine/d3/n10000/phi0.45", "engine/d3/n100000/phi0.3",
+                 "engine/d3/n100000/phi0.45", "engine/d2/n10000/phi0.5"]:
+        nc = 2000000 if "n100000" in case else 1000000
+        with tempfile.TemporaryDirectory() as tmp:
+            js = os.path.join(tmp, "b.json")
+            subprocess.run([args.bin, "--bench", case, "--collisions", str(nc), "--repeats", "3", "--json", js],
+                           check=True, capture_output=True)
+            with open(js) as f:
+                data = json.load(f)
+        med = {r["metric"]: r["median"] for r in data["results"] if r["bench"] == case}
+        row = dict(case=case, collisions=nc, **med)
+        ref = REFERENCE.get(case)
+        if ref:
+            row["reference_per_s"] = ref
+            row["target_per_s"] = ref / 2
+            row["meets_target"] = bool(row["forward_per_s"] >= ref / 2 and row["reverse_per_s"] >= ref / 2)
+        rows.append(row)
+        print(f"{case:28s} forward {row['forward_per_s']:.3g}/s reverse {row['reverse_per_s']:.3g}/s "
+              f"peak RSS {row['peak_rss_bytes'] / 2**20:.1f} MiB"
+              + (f"  target {ref / 2:.3g}: {'met' if row['meets_target'] else 'MISSED'}" if ref else ""))
+    os.makedirs(RESULTS, exist_ok=True)
+    with open(os.path.join(RESULTS, "engine_throughput.json"), "w") as f:
+        json.dump(dict(command=" ".join(sys.argv), rows=rows), f, indent=1)
+    with open(os.path.join(RESULTS, "engine_throughput.csv"), "w") as f:
+        keys = ["case", "collisions", "forward_per_s", "reverse_per_s", "peak_rss_bytes", "events_per_collision",
+                "invalid_per_collision", "log_bytes", "reference_per_s", "meets_target"]
+        f.write(",".join(keys) + "\n")
+        for r in rows:
+            f.write(",".join(str(r.get(k, "")) for k in keys) + "\n")
+    print("wrote bench/results/engine_throughput.{json,csv}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("study", choices=["horizon", "maxwell", "memory", "throughput", "all"])
+    ap.add_argument("--bin", default=os.path.join(HERE, "..", "build-dev", "revcol-bench"))
+    ap.add_argument("--n", type=int, default=None)
+    ap.add_argument("--max", type=float, default=None)
+    ap.add_argument("--relax", type=float, default=40.0, help="maxwell: collisions per particle to relax")
+    ap.add_argument("--gap", type=float, default=4.0, help="maxwell: collisions per particle between samples")
+    ap.add_argument("--samples", type=int, default=25, help="maxwell: snapshots pooled")
+    args = ap.parse_args()
+    todo = ["horizon", "maxwell", "memory", "throughput"] if args.study == "all" else [args.study]
+    for s in todo:
+        a = argparse.Namespace(**vars(args))
+        if s == "horizon":
+            a.n = a.n or 1000
+            a.max = a.max or 1e6
+            horizon(a)
+        elif s == "maxwell":
+            a.n = a.n or 1000
+            maxwell(a)
+        elif s == "throughput":
+            throughput(a)
+        else:
+            a.n = a.n or 10000
+            a.max = a.max or 1e7
+            memory(a)
+
+
+if __name__ == "__main__":
+    main()
