@@ -52,7 +52,8 @@ std::vector<T> array_vec(const py::dict& d, const char* key) {
 
 en::Config make_config(int dim, const std::vector<double>& box, const std::vector<std::string>& boundary,
                        double diameter, const std::string& mode, const std::string& law, std::uint64_t seed,
-                       int bits, bool groups, double group_tol) {
+                       int bits, bool groups, double group_tol, const std::string& generator,
+                       const std::string& streams) {
   en::Config c;
   c.dim = dim;
   require(dim >= 1 && dim <= 3, [&] { return "dim must be 1, 2 or 3, got " + std::to_string(dim); });
@@ -70,6 +71,8 @@ en::Config make_config(int dim, const std::vector<double>& box, const std::vecto
   c.law = parse_law(law);
   require(seed <= 0xFFFFFFFFull, "seed must be < 2^32");
   c.seed = static_cast<std::uint32_t>(seed);
+  c.generator = en::parse_generator(generator);
+  c.streams = en::parse_engine_streams(streams);
   c.bits = bits;
   c.groups = groups;
   c.group_tol = group_tol;
@@ -158,6 +161,8 @@ class PyEngine {
     d["mode"] = std::string(to_string(c.mode));
     d["law"] = std::string(to_string(c.law));
     d["seed"] = c.seed;
+    d["generator"] = std::string(en::to_string(c.generator));
+    d["streams"] = std::string(rng::to_string(c.streams));
     d["bits"] = c.bits;
     d["groups"] = c.groups;
     d["group_tol"] = c.group_tol;
@@ -223,6 +228,11 @@ class PyEngine {
     c.mode = parse_mode(py::cast<std::string>(get("mode")));
     c.law = parse_law(py::cast<std::string>(get("law")));
     c.seed = py::cast<std::uint32_t>(get("seed"));
+    // absent in checkpoints written before the generator choice existed: Philox per particle
+    c.generator = d.contains("generator") ? en::parse_generator(py::cast<std::string>(d["generator"]))
+                                          : en::Generator::philox;
+    c.streams = d.contains("streams") ? en::parse_engine_streams(py::cast<std::string>(d["streams"]))
+                                      : rng::StreamPolicy::per_particle;
     c.bits = py::cast<int>(get("bits"));
     c.groups = py::cast<bool>(get("groups"));
     c.group_tol = py::cast<double>(get("group_tol"));
@@ -292,17 +302,19 @@ void register_engine(py::module_& m) {
       .def(py::init([](const Array& x, const Array& v, const std::vector<double>& box,
                        const std::vector<std::string>& boundary, double diameter, const std::string& mode,
                        const std::string& law, std::uint64_t seed, int bits, bool groups, double group_tol,
-                       double time) {
+                       double time, const std::string& generator, const std::string& streams) {
              int n = 0, d = 0, nv = 0, dv = 0;
              auto xs = flat(x, "positions", n, d);
              auto vs = flat(v, "velocities", nv, dv);
              require(n == nv && d == dv, "positions and velocities must have the same shape");
-             const en::Config c = make_config(d, box, boundary, diameter, mode, law, seed, bits, groups, group_tol);
+             const en::Config c = make_config(d, box, boundary, diameter, mode, law, seed, bits, groups, group_tol, generator,
+                                             streams);
              return PyEngine(en::make_simulation(c, xs, vs, time));
            }),
            py::arg("positions"), py::arg("velocities"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
            py::arg("mode"), py::arg("law"), py::arg("seed"), py::arg("bits"), py::arg("groups"),
-           py::arg("group_tol"), py::arg("time"))
+           py::arg("group_tol"), py::arg("time"), py::arg("generator") = "philox",
+           py::arg("streams") = "per_particle")
       .def_static("from_snapshot", &PyEngine::from_snapshot, py::arg("state"))
       .def("run", &PyEngine::run, py::arg("collisions") = py::none(), py::arg("time") = py::none(),
            py::arg("callback") = py::none(), py::arg("every") = 10000)

@@ -14,7 +14,9 @@
 #include "revcol/collide/pair2d_paper.hpp"
 #include "revcol/engine/pair3d.hpp"
 #include "revcol/error.hpp"
+#include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
+#include "revcol/rng/streams.hpp"
 
 namespace revcol::engine {
 
@@ -22,6 +24,19 @@ Boundary parse_boundary(const std::string& s) {
   if (s == "wall") return Boundary::wall;
   if (s == "periodic") return Boundary::periodic;
   throw InvalidArgument("boundary must be 'wall' or 'periodic', got '" + s + "'");
+}
+
+Generator parse_generator(const std::string& s) {
+  if (s == "philox") return Generator::philox;
+  if (s == "clcg4") return Generator::clcg4;
+  throw InvalidArgument("generator must be 'philox' or 'clcg4', got '" + s + "'");
+}
+
+rng::StreamPolicy parse_engine_streams(const std::string& s) {
+  if (s == "per_particle" || s == "per-particle") return rng::StreamPolicy::per_particle;
+  if (s == "single") return rng::StreamPolicy::single;
+  throw InvalidArgument("streams must be 'per_particle' or 'single', got '" + s +
+                        "' (a per-draw policy needs a fixed draw count per collision)");
 }
 
 namespace {
@@ -49,6 +64,9 @@ void validate_config(const Config& c) {
   require(c.dim >= 1 && c.dim <= 3, [&] { return "dim must be 1, 2 or 3, got " + std::to_string(c.dim); });
   require(std::isfinite(c.diameter) && c.diameter > 0.0, "diameter must be finite and > 0");
   require(c.bits >= 8 && c.bits <= 52, "bits must be in [8, 52]");
+  require(c.streams == rng::StreamPolicy::per_particle || c.streams == rng::StreamPolicy::single,
+          "streams must be per_particle or single (a per-draw policy needs a fixed draw count per collision)");
+  require(c.generator == Generator::philox || c.generator == Generator::clcg4, "generator must be philox or clcg4");
   require(std::isfinite(c.group_tol) && c.group_tol >= 0.0 && c.group_tol < 1e-3,
           "group_tol must be finite and in [0, 1e-3)");
   require(!(c.mode == Mode::paper && c.dim == 3),
@@ -90,7 +108,8 @@ class EngineImpl final : public Simulation {
     clock_ = t0;
     start_ = t0;
     ncoll_.assign(n_, 0);
-    rng_.assign(n_, 0);
+    rng_.assign(stream_count(), 0);
+    make_generators();
     cell_.assign(n_ * Dim, 0);
     for (std::size_t i = 0; i < n_; ++i)
       for (int k = 0; k < Dim; ++k) cell_[i * Dim + k] = cell_of(p_[i].x[k], k);
@@ -121,7 +140,9 @@ class EngineImpl final : public Simulation {
     start_ = s.start_time;
     net_ = s.net_collisions;
     ncoll_ = s.ncoll;
+    require(s.rng.size() == stream_count(), "snapshot: rng must hold one draw count per stream");
     rng_ = s.rng;
+    make_generators();
     cell_.resize(n_ * Dim);
     for (std::size_t i = 0; i < n_ * Dim; ++i) {
       const int k = static_cast<int>(i % Dim);
@@ -293,7 +314,7 @@ class EngineImpl final : public Simulation {
     return n_ * (Dim * (2 * sizeof(double) + sizeof(int)) + sizeof(double) + 3 * sizeof(std::uint64_t) +
                  sizeof(Ev) + 4 * sizeof(int)) +
            head_.size() * sizeof(int) + log_.bytes() + pre_vals_.size() * sizeof(double) +
-           (pre_keys_.size() + pre_sizes_.size()) * sizeof(std::uint64_t);
+           (pre_keys_.size() + pre_sizes_.size()) * sizeof(std::uint64_t) + clcg_.size() * sizeof(rng::CLCG4);
   }
 
  private:
@@ -636,7 +657,38 @@ class EngineImpl final : public Simulation {
     repredict(i);
   }
 
+  // ---- random numbers -----------------------------------------------------------------
+
+  std::size_t stream_count() const { return cfg_.streams == rng::StreamPolicy::single ? 1 : n_; }
+
+  // The stream a collision whose smallest particle id is `id` draws from.
+  int stream_of(int id) const { return cfg_.streams == rng::StreamPolicy::single ? 0 : id; }
+
+  // CLCG4 only: each stream's state, from the family and the draws taken (rng_).
+  void make_generators() {
+    clcg_.clear();
+    if (cfg_.generator != Generator::clcg4) return;
+    clcg_ = rng::generator_traits<rng::CLCG4>::family(cfg_.seed, stream_count());
+    for (std::size_t i = 0; i < clcg_.size(); ++i) {
+      if (rng_[i] == 0) continue;
+      rng::CLCG4::State st = clcg_[i].state();
+      for (int j = 0; j < 4; ++j)
+        st[j] = rng::clcg4_detail::mulmod(
+            st[j], rng::clcg4_detail::powmod(rng::CLCG4::multiplier[j], rng_[i], rng::CLCG4::modulus[j]),
+            rng::CLCG4::modulus[j]);
+      clcg_[i].set_state(st);
+    }
+  }
+
   double draw(int stream, bool reversed) {
+    if (cfg_.generator == Generator::clcg4) {
+      if (reversed) {
+        --rng_[stream];
+        return clcg_[stream].prev();
+      }
+      ++rng_[stream];
+      return clcg_[stream].next();
+    }
     const rng::Philox p({static_cast<std::uint32_t>(stream), cfg_.seed}, 0);
     if (reversed) return p.at(--rng_[stream]);
     return p.at(rng_[stream]++);
@@ -849,7 +901,7 @@ class EngineImpl final : public Simulation {
     }
     PairV<Dim> out;
     try {
-      out = apply_pair(in, r, a, reversed);
+      out = apply_pair(in, r, stream_of(a), reversed);
     } catch (const InvalidArgument&) {
       // Only a reversed run can get here: a post state this operator cannot reverse (the
       // rare log is empty, or the state fails validation) means the reversed trajectory has
@@ -1045,7 +1097,7 @@ class EngineImpl final : public Simulation {
         const double vk = p_[g.id[order[u]]].v[k];
         pre[u * Dim + k] = reversed ? -vk : vk;
       }
-    const int stream = g.id[order[0]];
+    const int stream = stream_of(g.id[order[0]]);
     try {
       const ExactCollision op(n, Dim, contacts, normals, cfg_.law, cfg_.bits);
       const int m = op.draws();
@@ -1187,7 +1239,8 @@ class EngineImpl final : public Simulation {
   std::vector<Particle> p_;
   std::vector<int> cell_, head_, nxt_, prv_, hpos_;
   std::vector<Node> heap_;
-  std::vector<std::uint64_t> ncoll_, rng_;
+  std::vector<std::uint64_t> ncoll_, rng_;  // rng_: draws taken, per stream
+  std::vector<rng::CLCG4> clcg_;             // CLCG4 only: one generator per stream
   std::vector<Ev> ev_;
   mutable std::vector<double> second_;           // second earliest collision time per particle
   mutable std::vector<unsigned char> touching_;  // a neighbour within the contact tolerance
@@ -1324,10 +1377,12 @@ std::unique_ptr<Simulation> restore_simulation(const Snapshot& s) {
   require(n > 0, "snapshot: no particles (N = 0)");
   require(s.x.size() == n * d && s.v.size() == n * d && s.cell.size() == n * d,
           "snapshot: x, v and cell must have n x dim entries");
-  require(s.t_local.size() == n && s.stamp.size() == n && s.ncoll.size() == n && s.rng.size() == n &&
+  require(s.t_local.size() == n && s.stamp.size() == n && s.ncoll.size() == n &&
               s.ev_t.size() == n && s.ev_kind.size() == n && s.ev_partner.size() == n && s.ev_stamp.size() == n &&
               s.second.size() == n && s.touching.size() == n,
           "snapshot: per-particle arrays must have n entries");
+  require(s.rng.size() == (s.config.streams == rng::StreamPolicy::single ? 1 : n),
+          "snapshot: rng must hold one draw count per stream (n, or 1 for a single stream)");
   require(std::isfinite(s.time) && std::isfinite(s.start_time), "snapshot: times must be finite");
   for (double t : s.t_local) require(std::isfinite(t), "snapshot: local times must be finite");
   for (double q : s.x) require(std::isfinite(q), "snapshot: positions must be finite");

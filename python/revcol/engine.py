@@ -9,9 +9,12 @@ forward; ``run_back`` negates every velocity, runs the same event search applyin
 ``v -> -reverse(-v)`` with the generators stepping back, and negates again, so the state
 returns to an earlier time without any stored history (the rare log aside, usually empty).
 
-Random numbers: one Philox stream per particle, keyed ``{id, seed}``; a collision draws from
-the stream of its smallest particle id (the paper's per-particle policy), so collisions that
-share no particle commute. Contacts closed within ``group_tol * D`` at one instant form one
+Random numbers: by default one Philox stream per particle, keyed ``{id, seed}``; a collision
+draws from the stream of its smallest particle id (the paper's per-particle policy), so
+collisions that share no particle commute. ``generator="clcg4"`` uses the paper's CLCG4
+(stream ``seed * count + i``), and ``streams="single"`` one stream for the whole system
+(disjoint collisions then do not commute, so round-off that swaps two of them in the
+reversed run breaks the round trip: its horizon is at most per-particle's). Contacts closed within ``group_tol * D`` at one instant form one
 multi-particle collision (``revcol.Collision``'s operator). Round-off grows chaotically, so
 a round trip restores the start to 1e-9 only within a horizon of some collisions per
 particle (docs/engine.md).
@@ -51,12 +54,16 @@ class Simulation:
     (``Simulation.random(n, dim, phi)``). Everything is validated first; a bad state raises
     ``ValueError`` naming the problem (overlap, outside the box, non-finite, zero kinetic
     energy, diameter too large, N = 0, periodic box under 3 cells).
+
+    ``generator``: ``"philox"`` (default) or ``"clcg4"``; ``streams``: ``"per-particle"``
+    (default; the smallest id of a collision draws) or ``"single"``.
     """
 
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  bits: int = 40, groups: bool = True, group_tol: float = 1e-9,
-                 time: float = 0.0, _engine=None):
+                 time: float = 0.0, generator: str = "philox", streams: str = "per-particle",
+                 _engine=None):
         if _engine is not None:
             self._e = _engine
             return
@@ -68,7 +75,8 @@ class Simulation:
             v = v[:, None]
         box = np.atleast_1d(np.asarray(box, dtype=float)).tolist()
         self._e = _core.Engine(x, v, box, _boundary_list(boundary), float(diameter), mode, law,
-                               int(seed), int(bits), bool(groups), float(group_tol), float(time))
+                               int(seed), int(bits), bool(groups), float(group_tol), float(time),
+                               str(generator), str(streams))
 
     @classmethod
     def random(cls, n: int, dim: int = 3, phi: float = 0.3, *, boundary: _Boundary = "periodic",

@@ -11,7 +11,7 @@ class Simulation:
     def __init__(self, positions: np.ndarray, velocities: np.ndarray, box: Sequence[float], *,
                  boundary: _Boundary = ..., diameter: float = ..., mode: str = ..., law: str = ...,
                  seed: int = ..., bits: int = ..., groups: bool = ..., group_tol: float = ...,
-                 time: float = ...) -> None: ...
+                 time: float = ..., generator: str = ..., streams: str = ...) -> None: ...
     @classmethod
     def random(cls, n: int, dim: int = ..., phi: float = ..., *, boundary: _Boundary = ...,
                diameter: float = ..., seed: int = ..., energy: Optional[float] = ...,

@@ -79,6 +79,33 @@ def test_checkpoint_resume_is_bit_identical(tmp_path):
     assert np.array_equal(a.velocities, c.velocities)
 
 
+@pytest.mark.parametrize("streams", ["per-particle", "single"])
+def test_clcg4_streams_round_trip_and_npz_resume(tmp_path, streams):
+    kw = dict(boundary="wall", seed=9, generator="clcg4", streams=streams)
+    a = Simulation.random(n=200, dim=2, phi=0.3, **kw)
+    x0, v0 = a.positions, a.velocities
+    b = Simulation.from_state(a.state())
+    a.run(collisions=300)
+    b.run(collisions=120)
+    b.save(tmp_path / "ck.npz")
+    c = Simulation.load(tmp_path / "ck.npz")
+    assert c.state()["generator"] == "clcg4"
+    assert c.state()["rng"].shape == ((1,) if streams == "single" else (200,))
+    c.run(collisions=180)
+    assert np.array_equal(a.velocities, c.velocities) and np.array_equal(a.positions, c.positions)
+    c.run_back()
+    ex, ev = _err(c, x0, v0)
+    assert ex < 1e-9 and ev < 1e-9
+    assert not c.state()["rng"].any()  # every stream back at its start
+
+
+def test_generator_and_streams_rejected():
+    with pytest.raises(ValueError, match="generator"):
+        Simulation.random(n=20, dim=2, phi=0.2, generator="mt19937")
+    with pytest.raises(ValueError, match="streams"):
+        Simulation.random(n=20, dim=2, phi=0.2, streams="per_draw")
+
+
 def test_run_back_to_time_and_callback():
     sim = Simulation.random(n=100, dim=2, phi=0.3, seed=8)
     sim.run(collisions=40)

@@ -22,10 +22,16 @@
 // round trips are exact to 1e-9 only within a horizon of collisions per particle, which
 // bench/engine_study.py measures.
 //
-// Random numbers: one Philox stream per particle (key {id, seed}); a pair collision draws
-// from the stream of its smaller id, a group from that of its smallest id (the paper's
-// per-particle policy, §4.6). Two collisions that share no particle commute: if round-off
-// swaps their order in the reversed run, each still steps back its own stream.
+// Random numbers: by default one Philox stream per particle (key {id, seed}); a pair
+// collision draws from the stream of its smaller id, a group from that of its smallest id
+// (the paper's per-particle policy, §4.6). Two collisions that share no particle commute: if
+// round-off swaps their order in the reversed run, each still steps back its own stream.
+// CLCG4 (stream seed * count + i, rng/streams.hpp) is the other generator, and `single`
+// the other policy: one stream for the system. A single stream does not commute: two
+// disjoint collisions at exactly the same time are met in the same (id) order by the
+// reversed run, and two that round-off swaps step the stream back out of order, so its
+// horizon can only be shorter than per-particle's. Each stream keeps its draw count (the
+// snapshot's `rng`); a CLCG4 state is rebuilt from it by a modular power on restore.
 //
 // Ties and groups. The heap orders events by (time, kind, particle id) with walls before
 // cell crossings before collisions, so at one instant a particle reflects on walls first and
@@ -73,6 +79,7 @@
 #include <vector>
 
 #include "revcol/collide/common.hpp"
+#include "revcol/rng/streams.hpp"
 
 namespace revcol::engine {
 
@@ -84,6 +91,17 @@ inline const char* to_string(Boundary b) { return b == Boundary::wall ? "wall" :
 /// Parses "wall" / "periodic"; throws InvalidArgument otherwise.
 Boundary parse_boundary(const std::string& s);
 
+/// The reversible generator behind the collisions' random numbers.
+enum class Generator { philox, clcg4 };
+
+/// "philox" / "clcg4".
+inline const char* to_string(Generator g) { return g == Generator::philox ? "philox" : "clcg4"; }
+/// Parses "philox" / "clcg4"; throws InvalidArgument otherwise.
+Generator parse_generator(const std::string& s);
+/// Parses "per_particle" (or "per-particle") / "single"; throws InvalidArgument otherwise
+/// (the engine has no per-draw policy: a collision's draw count depends on its size).
+rng::StreamPolicy parse_engine_streams(const std::string& s);
+
 /// Everything that defines a simulation besides its particles.
 struct Config {
   int dim = 2;                                   ///< d = 1, 2, 3
@@ -92,7 +110,9 @@ struct Config {
   double diameter = 1.0;                         ///< D
   Mode mode = Mode::exact;                       ///< exact (default) or paper (2D pairs: Pair2DPaper)
   Law law = Law::flux;                           ///< exact mode's target law
-  std::uint32_t seed = 1;                        ///< Philox key {particle id, seed}
+  std::uint32_t seed = 1;                        ///< the generator family (rng/streams.hpp)
+  Generator generator = Generator::philox;       ///< Philox (key {stream, seed}) or CLCG4 (stream seed * count + i)
+  rng::StreamPolicy streams = rng::StreamPolicy::per_particle;  ///< per_particle (smallest id draws) or single
   int bits = 40;                                 ///< K, exact mode's chart bits
   bool groups = true;                            ///< gather multi-particle contacts into one collision
   double group_tol = 1e-9;                       ///< contact tolerance, relative to D
@@ -131,7 +151,8 @@ struct Snapshot {
   std::vector<double> x, v;                    ///< n x dim, stored positions (at local times) and velocities
   std::vector<double> t_local;                 ///< n
   std::vector<std::int64_t> cell;              ///< n x dim cell coordinates
-  std::vector<std::uint64_t> stamp, ncoll, rng;  ///< n: state stamps, collisions, Philox counters
+  std::vector<std::uint64_t> stamp, ncoll;     ///< n: state stamps, collisions
+  std::vector<std::uint64_t> rng;              ///< per stream (n, or 1 for a single stream): draws taken
   std::vector<double> ev_t;                    ///< n: scheduled event times
   std::vector<std::int64_t> ev_kind, ev_partner;  ///< n
   std::vector<std::uint64_t> ev_stamp;         ///< n
