@@ -27,5 +27,6 @@ void add_paper_benches(std::vector<Bench>& out);      ///< paper_bench.cpp: pape
 void add_statesave_benches(std::vector<Bench>& out);  ///< statesave_bench.cpp: SS1/SS2/RC study
 void add_pair3d_benches(std::vector<Bench>& out);     ///< pair3d_bench.cpp: the fast exact 3D pair operator
 void add_engine_benches(std::vector<Bench>& out);     ///< engine_bench.cpp: the event-driven engine
+void add_skip_benches(std::vector<Bench>& out);       ///< skip_bench.cpp: what a pair-only scene does not pay for
 
 }  // namespace revcol::bench

@@ -93,6 +93,7 @@ std::vector<Bench> all_benches() {
   revcol::bench::add_statesave_benches(out);
   revcol::bench::add_pair3d_benches(out);
   revcol::bench::add_engine_benches(out);
+  revcol::bench::add_skip_benches(out);
   return out;
 }
 

@@ -1,5 +1,6 @@
 // Calotte-area tables of the paper's Procedure 5 (see calotte.hpp for the maths).
 #include "revcol/collide/calotte.hpp"
+#include "revcol/collide/tables.hpp"
 
 #include <gsl/gsl_integration.h>
 
@@ -63,6 +64,7 @@ double cap_integral(int s, double a, double b, int panels, const GlTable& outer,
 }  // namespace
 
 CalotteTable::CalotteTable(int s) : s_(s), F_(cells + 1), dF_(cells + 1) {
+  detail::note_table_built();
   const GlTable outer(10), inner(64);
   const double h = kPi / cells;
   F_[0] = 0.0;

@@ -1,5 +1,6 @@
 // The arc-length sampler of the paper's §4.4 (see ellipse_arc.hpp for the maths).
 #include "revcol/collide/ellipse_arc.hpp"
+#include "revcol/collide/tables.hpp"
 
 #include <gsl/gsl_mode.h>
 #include <gsl/gsl_sf_ellint.h>  // gsl_sf_ellint_Ecomp, _RF, _RD
@@ -112,6 +113,7 @@ struct EllipseArc::Table {
 const EllipseArc::Table& EllipseArc::paper_table() {
   // Built once, on first use, thread-safe (a function-local static).
   static const Table table = [] {
+    detail::note_table_built();
     const EllipseArc ell(ArcMethod::elliptic, ArcAngle::parametric, kPaperAspect);
     Table tb;
     tb.perimeter = ell.perimeter();

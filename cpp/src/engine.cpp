@@ -861,7 +861,8 @@ class EngineImpl final : public Simulation {
     // neighbour was within the contact tolerance at a prediction (resting contacts), or a
     // second collision of a or b was predicted within a relative 1e-9 of t (ties).
     const double window = t + 1e-9 * (std::fabs(t) + 1.0);
-    const bool maybe = touching_[a] || touching_[b] || second_[a] <= window || second_[b] <= window;
+    const bool maybe = cfg_.force_group_search || touching_[a] || touching_[b] || second_[a] <= window ||
+                       second_[b] <= window;
     if (cfg_.groups && maybe) {
       Group g;
       gather(a, b, s, t, g);

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "check.hpp"
+#include "revcol/collide/calotte.hpp"
+#include "revcol/collide/tables.hpp"
 #include "revcol/engine/engine.hpp"
 #include "revcol/error.hpp"
 
@@ -405,3 +407,17 @@ TEST_CASE("checkpoint keeps the keyed logs: a corner hit and a 2D cradle reverse
 }
 
 CHECK_MAIN()
+
+TEST_CASE("a pair-only scene builds none of paper mode's GSL tables; they are counted when built") {
+  Config c = config(2, Boundary::wall);
+  c.force_group_search = true;  // the group machinery itself builds no table either
+  const InitialState st = random_state(c, 300, 0.3, 2);
+  auto s = make_simulation(st.config, st.x, st.v);
+  s->run(2000, kInf);
+  s->run_back(kAll, s->start_time());
+  CHECK(revcol::paper::tables_built() == 0);
+  (void)revcol::paper::CalotteTable::h3();
+  CHECK(revcol::paper::tables_built() == 1);
+  (void)revcol::paper::CalotteTable::h3();  // once per process
+  CHECK(revcol::paper::tables_built() == 1);
+}

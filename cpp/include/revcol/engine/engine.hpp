@@ -116,6 +116,8 @@ struct Config {
   int bits = 40;                                 ///< K, exact mode's chart bits
   bool groups = true;                            ///< gather multi-particle contacts into one collision
   double group_tol = 1e-9;                       ///< contact tolerance, relative to D
+  bool force_group_search = false;  ///< benchmarks only: search for a group at every collision, as an
+                                    ///< engine without the gate would (not saved in snapshots)
 };
 
 /// Event counts (cumulative over both directions).
