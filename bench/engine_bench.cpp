@@ -9,7 +9,9 @@
 // random start. engine/custom takes everything from the environment, and every key there
 // also overrides the named cases:
 //
-//   REVCOL_ENGINE="d=3,n=10000,phi=0.3,boundary=periodic,law=flux,mode=exact,seed=1,warm=10,groups=1"
+//   REVCOL_ENGINE="d=3,n=10000,phi=0.3,boundary=periodic,law=flux,mode=exact,seed=1,warm=10,groups=1,shell=0"
+//
+// (shell: the neighbour-list shell in diameters, Config::shell; 0, the default, chooses it from phi)
 //
 // Metrics: forward_per_s, reverse_per_s, events_per_collision, invalid_per_collision,
 // log_bytes, engine_bytes, peak_rss_bytes (the process's VmHWM: run one case per process
@@ -42,6 +44,7 @@ struct Case {
   std::uint64_t seed = 1;
   double warm = 10.0;
   bool groups = true;
+  double shell = 0.0;  // Config::shell: 0 chooses it from phi
 };
 
 void apply_environment(Case& c) {
@@ -68,8 +71,9 @@ void apply_environment(Case& c) {
       else if (key == "seed") c.seed = std::stoull(value);
       else if (key == "warm") c.warm = std::stod(value);
       else if (key == "groups") c.groups = value != "0";
+      else if (key == "shell") c.shell = std::stod(value);
       else throw InvalidArgument("REVCOL_ENGINE: unknown key '" + key +
-                                 "' (known: d, n, phi, boundary, law, mode, seed, warm, groups)");
+                                 "' (known: d, n, phi, boundary, law, mode, seed, warm, groups, shell)");
     } catch (const std::logic_error& e) {
       if (dynamic_cast<const InvalidArgument*>(&e)) throw;
       throw InvalidArgument("REVCOL_ENGINE: bad value for " + key + ": '" + value + "'");
@@ -94,6 +98,7 @@ std::vector<Metric> run_case(Case c, std::uint64_t nc) {
   cfg.mode = c.mode;
   cfg.seed = static_cast<std::uint32_t>(c.seed);
   cfg.groups = c.groups;
+  cfg.shell = c.shell;
   const en::InitialState st = en::random_state(cfg, c.n, c.phi, c.seed);
   auto sim = en::make_simulation(st.config, st.x, st.v);
   const auto warm = static_cast<std::uint64_t>(c.warm * static_cast<double>(c.n) / 2.0);

@@ -174,6 +174,7 @@ class PyEngine {
     d["v"] = vec_array(s.v);
     d["t_local"] = vec_array(s.t_local);
     d["cell"] = vec_array(s.cell);
+    d["centre"] = vec_array(s.centre);
     d["stamp"] = vec_array(s.stamp);
     d["ncoll"] = vec_array(s.ncoll);
     d["rng"] = vec_array(s.rng);
@@ -244,6 +245,8 @@ class PyEngine {
     s.v = array_vec<double>(d, "v");
     s.t_local = array_vec<double>(d, "t_local");
     s.cell = array_vec<std::int64_t>(d, "cell");
+    // absent in checkpoints written before the neighbour lists: centres from x, events predicted anew
+    if (d.contains("centre")) s.centre = array_vec<double>(d, "centre");
     s.stamp = array_vec<std::uint64_t>(d, "stamp");
     s.ncoll = array_vec<std::uint64_t>(d, "ncoll");
     s.rng = array_vec<std::uint64_t>(d, "rng");

@@ -3,24 +3,34 @@
 // per-collision memory (the paper §3.2).
 //
 // Forward. Per-particle local times (a particle's stored position is where it was at its
-// local time; x(t) = x_i + v_i (t - t_i)), a cell list with cells at least one diameter
-// wide, one event per particle (its earliest wall contact, cell crossing or collision) in an
-// indexed binary heap, invalidation by a per-particle stamp that changes whenever the
-// particle's stored state changes. Collision times use the cancellation-free root
+// local time; x(t) = x_i + v_i (t - t_i)), neighbour lists with a shell, one event per
+// particle (its earliest wall contact, list renewal or collision) in an event queue,
+// invalidation by a per-particle stamp that changes whenever the particle's stored state
+// changes. Each particle has a list centre (where it was at its last renewal) and lists
+// the particles whose centres lie within D + shell of it, each with its periodic image;
+// the lists are symmetric and a function of the centres alone (a snapshot keeps the
+// centres, a restore rebuilds the lists). Its renewal event fires when it is h =
+// (shell - 1e-3 D) / 2 from its centre: the centre moves there, the list is rebuilt from a
+// cell grid of the centres, and nothing physical changes; a pair off each other's lists is
+// more than D (1 + 1e-3) apart, so a prediction scans the list alone. The queue is Paul's
+// O(1) queue (time buckets, the current one a binary heap); its keys (time, kind, id) are
+// distinct, so the order of events does not depend on its bucket width. Collision times
+// use the cancellation-free root
 // t = (r^2 - D^2) / (-b + sqrt(b^2 - w^2 (r^2 - D^2))), b = r.w < 0 (only approaching pairs
 // are candidates), computed for the pair ordered by id from the later of the two local
 // times, so that both partners predict the same bits.
 //
 // Reverse. Negate every velocity and every time (local times and the clock), run the same
 // event search, and at each collision apply v -> -reverse(-v) with the generator stepping
-// back; wall events are their own inverse (a reflection of the approached component).
-// Negating again at the end returns the state to the forward orientation. Negation is exact,
-// so free flight is bit-identical both ways; what is not is the collision time and the
-// contact normal, recomputed from positions that carry round-off. A hard-sphere gas is
-// chaotic and amplifies that round-off, and exact mode's K-bit chart cells return each
-// pre-collision state to its cell centre (a relative error ~2^-K of the relative speed):
-// round trips are exact to 1e-9 only within a horizon of collisions per particle, which
-// bench/engine_study.py measures.
+// back; wall events are their own inverse (a reflection of the approached component), and
+// so are list renewals (no physical change: a reversed run renews where its own trajectory
+// leaves its spheres). Negating again at the end returns the state to the forward
+// orientation. Negation is exact, so free flight is bit-identical both ways; what is not is
+// the collision time and the contact normal, recomputed from positions that carry
+// round-off. A hard-sphere gas is chaotic and amplifies that round-off, and exact mode's
+// K-bit chart cells return each pre-collision state to its cell centre (a relative error
+// ~2^-K of the relative speed): round trips are exact to 1e-9 only within a horizon of
+// collisions per particle, which bench/engine_study.py measures.
 //
 // Random numbers: by default one Philox stream per particle (key {id, seed}); a pair
 // collision draws from the stream of its smaller id, a group from that of its smallest id
@@ -33,8 +43,8 @@
 // horizon can only be shorter than per-particle's. Each stream keeps its draw count (the
 // snapshot's `rng`); a CLCG4 state is rebuilt from it by a modular power on restore.
 //
-// Ties and groups. The heap orders events by (time, kind, particle id) with walls before
-// cell crossings before collisions, so at one instant a particle reflects on walls first and
+// Ties and groups. The queue orders events by (time, kind, particle id) with walls before
+// list renewals before collisions, so at one instant a particle reflects on walls first and
 // collides after; the reversed run meets the same instant with the particle approaching the
 // walls again, so it undoes the walls first there too, which is the opposite order of the
 // forward sequence (collision, then the wall it was sent into). When a collision of a and b
@@ -118,6 +128,8 @@ struct Config {
   double group_tol = 1e-9;                       ///< contact tolerance, relative to D
   bool force_group_search = false;  ///< benchmarks only: search for a group at every collision, as an
                                     ///< engine without the gate would (not saved in snapshots)
+  double shell = 0.0;  ///< benchmarks only: the neighbour-list shell in diameters; 0 (the default)
+                       ///< chooses it from the packing fraction (not saved in snapshots)
 };
 
 /// Event counts (cumulative over both directions).
@@ -128,7 +140,7 @@ struct Counters {
   std::uint64_t group_particles = 0;   ///< particles taking part in those
   std::uint64_t group_fallbacks = 0;   ///< groups the operator refused (processed as a pair)
   std::uint64_t wall_events = 0;       ///< wall reflections
-  std::uint64_t cell_crossings = 0;    ///< cell-list moves
+  std::uint64_t cell_crossings = 0;    ///< neighbour-list renewals (named when they were cell crossings)
   std::uint64_t invalid_events = 0;    ///< predictions whose partner had changed
   std::uint64_t grazing_skipped = 0;   ///< predicted contacts found not approaching at contact
   std::uint64_t reverse_failures = 0;  ///< reversed collisions the operator refused (beyond the horizon)
@@ -152,7 +164,8 @@ struct Snapshot {
   std::int64_t net_collisions = 0;             ///< forward minus reverse collisions
   std::vector<double> x, v;                    ///< n x dim, stored positions (at local times) and velocities
   std::vector<double> t_local;                 ///< n
-  std::vector<std::int64_t> cell;              ///< n x dim cell coordinates
+  std::vector<std::int64_t> cell;              ///< n x dim cell coordinates of the list centres
+  std::vector<double> centre;                  ///< n x dim list centres (empty: from x, events predicted anew)
   std::vector<std::uint64_t> stamp, ncoll;     ///< n: state stamps, collisions
   std::vector<std::uint64_t> rng;              ///< per stream (n, or 1 for a single stream): draws taken
   std::vector<double> ev_t;                    ///< n: scheduled event times
