@@ -1,5 +1,7 @@
 """The ``revcol`` command line.
 
+    revcol run [SCENE.toml] [--json FILE] [--plot DIR] [--trajectory FILE.xyz|.gsd] [--collisions N] [--seed S]
+    revcol run [SCENE.toml] --horizon [--seeds K] [--max-collisions N] [--json FILE] [--plot DIR]
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
 """
@@ -23,9 +25,37 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer 0 .. 2^32 - 1, got {text!r}") from None
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"expected an integer 0 .. 2^32 - 1, got {text!r}")
+    return value
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="revcol", description="Reversible elastic collisions.")
     sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="run a scene forward and back to its start, and report the round trip",
+                       description="Run a scene (TOML; default: the built-in 2D hard-disk gas) forward and "
+                       "back to its start and report the round trip. Exit 0 when it passes (both errors "
+                       "<= 1e-9), 1 when it fails, 2 on a bad scene or option, 130 when interrupted.")
+    r.add_argument("scene", nargs="?", help="scene file (see scenes/ and docs/run.md)")
+    r.add_argument("--json", metavar="FILE", help="write the report as JSON")
+    r.add_argument("--plot", metavar="DIR", help="write PNG figures into DIR (needs matplotlib)")
+    r.add_argument("--trajectory", metavar="FILE",
+                   help="write frames forward and through the reversal: FILE.xyz (extended XYZ) or FILE.gsd")
+    r.add_argument("--horizon", action="store_true",
+                   help="measure the round-trip error against collisions per particle instead")
+    r.add_argument("--seeds", type=_positive_int, default=None, metavar="K",
+                   help="--horizon: worst error over this many seeds, from the scene's (default 1)")
+    r.add_argument("--max-collisions", type=_positive_int, default=1_000_000, metavar="N",
+                   help="--horizon: the largest N_c tried (default 1e6)")
+    r.add_argument("--collisions", type=_positive_int, metavar="N", help="N_c instead of the scene's [run] collisions/time")
+    r.add_argument("--seed", type=_seed, metavar="S", help="seed instead of the scene's [rng] seed")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
     v = sub.add_parser("verify", help="run the paper's reversal illustration and check the round trip")
     v.add_argument("case", choices=VERIFY_CASES)
     v.add_argument("--collisions", type=_positive_int, default=1_000_000, help="N_c (default 1e6)")
@@ -46,22 +76,43 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _summary(r: dict) -> str:
+    from .run import _verify_lines
+
     mode = r["mode"] + (f"/{r['law']}" if r["mode"] == "exact" and r["case"] != "pair1d" else "")
-    return "\n".join([
-        f"revcol verify {r['case']}  mode={mode}  rng={r['rng']}  seed={r['seed']}",
-        f"  collisions          {r['collisions']:,} forward, {r['collisions']:,} back",
-        f"  forward             {r['forward_per_s']:.3g} collisions/s",
-        f"  reverse             {r['reverse_per_s']:.3g} collisions/s",
-        f"  max relative error  {r['max_rel_error']:.3g}  (bar: 1e-9)",
-        f"  bit exact           {r['bit_exact']}",
-        f"  rng restored        {r['rng_restored']}  ({r['random_numbers_drawn']:,} drawn)",
-        f"  rare log            {r['log_bytes']} bytes at the turn",
-        f"  result              {'PASSED' if r['passed'] else 'FAILED'}",
-    ] + ([f"  stopped             {r['error']}"] if r.get("error") else []))
+    return "\n".join([f"revcol verify {r['case']}  mode={mode}  rng={r['rng']}  seed={r['seed']}"] + _verify_lines(r))
+
+
+def _run(args: argparse.Namespace) -> int:
+    """``revcol run``: exit 0 passed, 1 failed, 2 bad scene/option, 130 interrupted."""
+    from .run import format_report, run_scene
+    from .scene import SceneError
+
+    if args.seeds is not None and not args.horizon:
+        print("revcol run: error: --seeds applies to --horizon only", file=sys.stderr)
+        return 2
+    try:
+        report = run_scene(args.scene, json_path=args.json, plot=args.plot, trajectory=args.trajectory,
+                           horizon_seeds=(args.seeds or 1) if args.horizon else None,
+                           max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
+                           progress=False if args.no_progress else None)
+    except SceneError as e:
+        print(f"revcol run: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:  # an output that cannot be written (permissions, a file where a directory goes)
+        print(f"revcol run: error: {e}", file=sys.stderr)
+        return 2
+    print(format_report(report))
+    if report.get("interrupted"):
+        return 130
+    if report["kind"] == "horizon":
+        return 0
+    return 0 if report["passed"] else 1
 
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    if args.command == "run":
+        return _run(args)
     if args.command == "verify":
         try:
             report = verify(args.case, collisions=args.collisions, mode=args.mode, law=args.law,

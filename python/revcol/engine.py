@@ -53,7 +53,7 @@ class Simulation:
     Build from arrays (``Simulation(positions, velocities, box=...)``) or at random
     (``Simulation.random(n, dim, phi)``). Everything is validated first; a bad state raises
     ``ValueError`` naming the problem (overlap, outside the box, non-finite, zero kinetic
-    energy, diameter too large, N = 0, periodic box under 3 cells).
+    energy, diameter too large, N = 0, a periodic axis under 3 diameters).
 
     ``generator``: ``"philox"`` (default) or ``"clcg4"``; ``streams``: ``"per-particle"``
     (default; the smallest id of a collision draws) or ``"single"``.

@@ -1,52 +1,84 @@
 """Scene files: a simulation described in TOML, read with the standard library.
 
-A scene has five tables; every field is optional except where said, and every field is
-checked: an unknown table or field, a wrong type or a value out of range raises
+A scene is one of three kinds (``[scene] kind``):
+
+- ``"gas"`` (the default): N hard spheres in a box, run forward N_c collisions (or to an
+  end time) with the event-driven engine, then back to the start (``revcol run``);
+- ``"reversal"``: the paper's reversal illustration for a named case (2 or 3 particles,
+  momentum and energy held, velocities only: no positions are built), ``revcol verify``'s
+  machinery;
+- ``"statesave"``: the paper's performance study (§6), state saving against reverse
+  computation, ``revcol bench statesave``'s machinery.
+
+Every field is optional except where said, and every field is checked: an unknown table or
+field, a field the scene's kind does not use, a wrong type or a value out of range raises
 :class:`SceneError` (a ``ValueError``) whose one-line message names the file, the field and
-what is allowed.
+what is allowed. An explicit initial state is checked in full (inside the box, no two
+particles overlapping) by building the engine from it once.
 
 .. code-block:: toml
 
-    [system]
+    [scene]
+    name = "spheres"              # default: the file's stem
+    description = "..."
+    kind = "gas"                  # "gas" | "reversal" | "statesave"
+    case = "pair2d"               # reversal only (required there): revcol verify's case
+
+    [system]                      # gas only
     dimension = 2                 # 1, 2 or 3 (required)
     particles = 1000              # N >= 1 (required unless initial_state gives it)
     diameter = 1.0                # sigma > 0
     packing_fraction = 0.3        # sets a cubic box; or give box = [Lx, Ly]
     boundaries = "walls"          # "walls" | "periodic", or one per axis
-    start = "random"              # "random" (sequential addition) | "lattice" (dense cases)
+    start = "auto"                # "auto" | "random" (sequential addition) | "lattice";
+                                  # an explicit box always starts on a jittered lattice
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
 
     [collisions]
-    mode = "exact"                # "exact" | "paper"
+    mode = "exact"                # "exact" | "paper" (gas: 2D only)
     law = "flux"                  # exact mode: "flux" | "uniform"
-    bits = 40                     # K, bits per chart coordinate, 8..52
+    bits = 40                     # K, bits per chart coordinate, 8..52 (not statesave)
 
     [rng]
     generator = "clcg4"           # "clcg4" | "philox"
-    streams = "per-particle"      # "per-particle" | "single"
-    seed = 0                      # >= 0
+    streams = "per-particle"      # gas only: "per-particle" | "single"
+    seed = 0                      # 0 .. 2^32 - 1
 
     [run]
-    collisions = 20000            # N_c forward, then as many back; or
+    collisions = 1000             # N_c forward, then as many back; or (gas only)
     time = 10.0                   # an end time instead
-    checkpoint_interval = 0       # collisions between checkpoints, 0 = none
+    checkpoint_interval = 0       # gas: collisions between .npz checkpoints, 0 = none
 
-    [output]
-    json = "report.json"          # paths relative to the scene file
-    plot = "figures"
-    trajectory = "run.xyz"        # extended XYZ (OVITO) or .gsd
-    trajectory_every = 100        # collisions between frames
+    [statesave]                   # statesave only
+    particles = [1000, 10000]     # N per run, each >= 2
+    variants = ["ss1", "ss2", "rc"]   # default: all the transport supports
+    lazy = false                  # lazy transport (adds variant "ssp")
+    repeats = 3
+    budget_gib = 8.0              # skip state saving that would save more
+    runner = "auto"               # "process" (fresh revcol-bench per run) | "inline" | "auto"
+
+    [output]                      # paths relative to the scene file
+    json = "report.json"
+    plot = "figures"              # a directory of PNGs (gas, statesave)
+    trajectory = "run.xyz"        # gas: extended XYZ (OVITO) or .gsd
+    trajectory_every = 100        # gas: collisions between frames
+    checkpoints = "checkpoints"   # gas: where checkpoint_interval writes (default NAME-checkpoints)
 """
 from __future__ import annotations
 
+import dataclasses
 import math
+import os
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "DEFAULT_SCENE"]
+__all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "engine_options", "DEFAULT_SCENE", "KINDS"]
+
+#: the kinds of scene
+KINDS = ("gas", "reversal", "statesave")
 
 
 class SceneError(ValueError):
@@ -55,15 +87,21 @@ class SceneError(ValueError):
 
 @dataclass(frozen=True)
 class Scene:
-    """A validated scene. Lengths are in units of the diameter's unit; mass 1."""
+    """A validated scene. Lengths are in units of the diameter's unit; mass 1.
 
-    dimension: int
-    particles: int
+    ``dimension``, ``particles``, ``box`` and ``boundaries`` describe a gas; they are 0 / empty
+    for the other kinds. ``collisions`` is N_c (None when a gas runs to ``time``).
+    """
+
+    dimension: int = 0
+    particles: int = 0
+    kind: str = "gas"
+    case: str | None = None
     diameter: float = 1.0
     box: tuple[float, ...] = ()
     packing_fraction: float | None = None
     boundaries: tuple[str, ...] = ()
-    start: str = "random"
+    start: str = "auto"
     kinetic_energy: float | None = None
     initial_state: Path | None = None
     mode: str = "exact"
@@ -75,27 +113,54 @@ class Scene:
     collisions: int | None = None
     time: float | None = None
     checkpoint_interval: int = 0
+    statesave_particles: tuple[int, ...] = ()
+    variants: tuple[str, ...] = ()
+    lazy: bool = False
+    repeats: int = 3
+    budget_gib: float = 8.0
+    runner: str = "auto"
     json: Path | None = None
     plot: Path | None = None
     trajectory: Path | None = None
     trajectory_every: int = 100
+    checkpoints: Path | None = None
     name: str = "scene"
+    description: str = ""
     source: str = "<built-in>"
     extra: dict[str, Any] = field(default_factory=dict)
 
     def summary(self) -> str:
         """One line describing the scene, for reports."""
-        box = " x ".join(f"{b:g}" for b in self.box)
         law = f"/{self.law}" if self.mode == "exact" else ""
+        if self.kind == "reversal":
+            return (f"{self.name}: the paper's reversal illustration, case {self.case}, {self.mode}{law}, "
+                    f"{self.generator} seed {self.seed}, {self.collisions:,} collisions forward and back")
+        if self.kind == "statesave":
+            ns = ", ".join(f"{n:,}" for n in self.statesave_particles)
+            return (f"{self.name}: state saving vs reverse computation (the paper's §6), N = {ns}, "
+                    f"{self.collisions:,} collisions, {'lazy' if self.lazy else 'eager'} transport, "
+                    f"{self.mode}{law}, {self.generator} seed {self.seed}")
+        box = " x ".join(f"{b:g}" for b in self.box)
         end = f"{self.collisions:,} collisions" if self.collisions is not None else f"t = {self.time:g}"
         return (f"{self.name}: {self.particles} particles in {self.dimension}D, sigma = {self.diameter:g}, "
                 f"box {box} ({', '.join(self.boundaries)}), {self.mode}{law}, {self.generator} "
                 f"{self.streams} seed {self.seed}, {end}")
 
+    def to_dict(self) -> dict[str, Any]:
+        """The scene's fields as plain JSON-able values (paths as strings)."""
+        out = {}
+        for f in dataclasses.fields(self):
+            if f.name == "extra":
+                continue
+            v = getattr(self, f.name)
+            out[f.name] = str(v) if isinstance(v, Path) else (list(v) if isinstance(v, tuple) else v)
+        return out
+
 
 # the schema: table -> field -> (type check name, allowed values or range)
 _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
-    "scene": {"name": ("str", None), "description": ("str", None)},
+    "scene": {"name": ("str", None), "description": ("str", None), "kind": ("str", KINDS),
+              "case": ("str", None)},
     "system": {
         "dimension": ("int", (1, 3)),
         "particles": ("int", (1, None)),
@@ -103,7 +168,7 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "packing_fraction": ("float", (0.0, None)),
         "box": ("floats", (0.0, None)),
         "boundaries": ("strs", ("walls", "periodic")),
-        "start": ("str", ("random", "lattice")),
+        "start": ("str", ("auto", "random", "lattice")),
         "kinetic_energy": ("float", (0.0, None)),
         "initial_state": ("str", None),
     },
@@ -115,24 +180,49 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
     "rng": {
         "generator": ("str", ("clcg4", "philox")),
         "streams": ("str", ("per-particle", "single")),
-        "seed": ("int", (0, None)),
+        "seed": ("int", (0, 2**32 - 1)),   # the engine's and the generators' keys are 32-bit
     },
     "run": {
         "collisions": ("int", (1, None)),
         "time": ("float", (0.0, None)),
         "checkpoint_interval": ("int", (0, None)),
     },
+    "statesave": {
+        "particles": ("ints", (2, 1 << 26)),
+        "variants": ("strs", ("ss1", "ss2", "ssp", "rc")),
+        "lazy": ("bool", None),
+        "repeats": ("int", (1, 1000)),
+        "budget_gib": ("float", (0.0, None)),
+        "runner": ("str", ("auto", "process", "inline")),
+    },
     "output": {
         "json": ("str", None),
         "plot": ("str", None),
         "trajectory": ("str", None),
         "trajectory_every": ("int", (1, None)),
+        "checkpoints": ("str", None),
     },
 }
 
-# the largest packing fractions a start can reach (random sequential addition jams near
-# 0.547 in 2D and 0.38 in 3D; the lattice start goes to close packing, minus a margin)
-_MAX_FRACTION = {1: 0.95, 2: 0.85, 3: 0.70}
+# what each kind uses; any other field is an error naming it ("*" = the whole table)
+_USES: dict[str, dict[str, Any]] = {
+    "gas": {"scene": {"name", "description", "kind"}, "system": "*", "collisions": "*", "rng": "*",
+            "run": "*", "output": "*"},
+    "reversal": {"scene": {"name", "description", "kind", "case"}, "collisions": "*",
+                 "rng": {"generator", "seed"}, "run": {"collisions"}, "output": {"json"}},
+    "statesave": {"scene": {"name", "description", "kind"}, "statesave": "*", "collisions": {"mode", "law"},
+                  "rng": {"generator", "seed"}, "run": {"collisions"}, "output": {"json", "plot"}},
+}
+
+# the largest packing fractions the engine's random start reaches (engine_init.cpp: random
+# sequential addition, falling back to a jittered lattice that goes towards close packing)
+_MAX_FRACTION = {1: 0.95, 2: 0.75, 3: 0.70}
+
+# N_c when a gas scene gives neither collisions nor time: 2 collisions per particle. A gas is
+# chaotic and round-off grows by about an order of magnitude per collision per particle, so
+# a round trip restores the start to 1e-9 only within a horizon of 4-10 collisions per
+# particle in 2D/3D (docs/engine.md); 2 per particle sits well inside it (docs/run.md).
+_DEFAULT_PER_PARTICLE = 2
 
 DEFAULT_SCENE: dict[str, Any] = {
     "scene": {"name": "default", "description": "2D hard-disk gas, N = 1000, area fraction 0.3, walls"},
@@ -140,7 +230,11 @@ DEFAULT_SCENE: dict[str, Any] = {
                "boundaries": "walls"},
     "collisions": {"mode": "exact", "law": "flux"},
     "rng": {"generator": "clcg4", "streams": "per-particle", "seed": 0},
-    "run": {"collisions": 20000},
+    # N_c = 1000 (2 collisions per particle), measured with
+    #   revcol run --horizon --seeds 200 (docs/run.md): over seeds 0..199 the worst round-trip
+    #   error at N_c = 1000 is 3.6e-10 (99th percentile 2.2e-10, median 1.4e-11); at N_c = 2000
+    #   4 seeds of 200 fail the 1e-9 bar.
+    "run": {"collisions": 1000},
 }
 
 
@@ -164,16 +258,20 @@ def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: An
         if not value > allowed[0]:
             raise _fail(source, where, f"must be > {allowed[0]:g}, got {value}")
         return float(value)
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise _fail(source, where, f"must be true or false, got {value!r}")
+        return value
     if kind == "str":
         if not isinstance(value, str):
             raise _fail(source, where, f"must be a string, got {value!r}")
         if allowed is not None and value not in allowed:
             raise _fail(source, where, f"must be one of {', '.join(map(repr, allowed))}, got {value!r}")
         return value
-    if kind == "floats":
+    if kind in ("floats", "ints"):
         if not isinstance(value, list) or not value:
-            raise _fail(source, where, f"must be a list of numbers, got {value!r}")
-        return tuple(_check(source, table, key, v, "float", allowed) for v in value)
+            raise _fail(source, where, f"must be a non-empty list of numbers, got {value!r}")
+        return tuple(_check(source, table, key, v, kind[:-1], allowed) for v in value)
     if kind == "strs":
         items = [value] if isinstance(value, str) else value
         if not isinstance(items, list) or not items:
@@ -183,10 +281,14 @@ def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: An
 
 
 def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | None = None) -> Scene:
-    """Validates a parsed scene document (tables of fields) and returns the :class:`Scene`."""
+    """Validates a parsed scene document (tables of fields) and returns the :class:`Scene`.
+
+    Relative paths (initial state, outputs) are taken relative to ``base`` (default: the
+    current directory).
+    """
     if not isinstance(doc, dict):
         raise SceneError(f"{source}: a scene is a TOML document of tables")
-    values: dict[str, Any] = {}
+    values: dict[tuple[str, str], Any] = {}
     for table, fields in doc.items():
         if table not in _SCHEMA:
             raise _fail(source, f"[{table}]", f"unknown table; allowed: {', '.join(_SCHEMA)}")
@@ -199,18 +301,54 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
             kind, allowed = _SCHEMA[table][key]
             values[(table, key)] = _check(source, table, key, value, kind, allowed)
 
+    # fields the kind does not use are errors, not silently ignored
+    kind = values.get(("scene", "kind"), "gas")
+    uses = _USES[kind]
+    for table, key in values:
+        used = uses.get(table)
+        if used is None or (used != "*" and key not in used):
+            whose = [k for k in KINDS if _USES[k].get(table) == "*" or key in _USES[k].get(table, ())]
+            raise _fail(source, f"[{table}] {key}",
+                        f"does not apply to kind = {kind!r} (used by: {', '.join(map(repr, whose))})")
+
     def get(table: str, key: str, default: Any = None) -> Any:
         return values.get((table, key), default)
 
     base = base or Path.cwd()
+    name = get("scene", "name", Path(source).stem if source.endswith(".toml") else "scene")
+    common = dict(kind=kind, name=name, description=get("scene", "description", ""), source=source,
+                  generator=get("rng", "generator", "clcg4"), seed=get("rng", "seed", 0),
+                  extra={"fields": sorted(f"{a}.{b}" for a, b in values)})
+
+    def out(key: str) -> Path | None:
+        p = get("output", key)
+        return Path(os.path.normpath(base / p)) if p is not None else None
+
+    mode = get("collisions", "mode", "exact")
+    law = get("collisions", "law", "flux")
+    if mode == "paper" and ("collisions", "law") in values:
+        raise _fail(source, "[collisions] law", "applies to mode = 'exact' only")
+
+    if kind == "reversal":
+        return _reversal(source, get, common, mode, law, out)
+    if kind == "statesave":
+        return _statesave(source, get, common, mode, law, out)
+
     d = get("system", "dimension")
     if d is None:
         raise _fail(source, "[system] dimension", "is required (1, 2 or 3)")
     initial = get("system", "initial_state")
-    initial_path = (base / initial) if initial is not None else None
+    initial_path = Path(os.path.normpath(base / initial)) if initial is not None else None
     n = get("system", "particles")
+    arrays = None
     if initial_path is not None:
-        n = _initial_count(source, initial_path, d, n)
+        for key in ("start", "kinetic_energy"):
+            if ("system", key) in values:
+                raise _fail(source, f"[system] {key}", "applies to random starts only, not with initial_state")
+        arrays = _read_initial(source, initial_path, d)
+        if n is not None and n != arrays[0].shape[0]:
+            raise _fail(source, "[system] particles", f"is {n} but initial_state holds {arrays[0].shape[0]} particles")
+        n = int(arrays[0].shape[0])
     if n is None:
         raise _fail(source, "[system] particles", "is required (a positive integer) unless initial_state gives it")
     sigma = get("system", "diameter", 1.0)
@@ -239,11 +377,17 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         bounds = bounds * d
     if len(bounds) != d:
         raise _fail(source, "[system] boundaries", f"needs 1 or {d} entries, got {len(bounds)}")
+    for k, (b, length) in enumerate(zip(bounds, box)):
+        # the neighbour lists need a periodic axis of at least 3 diameters (docs/engine.md)
+        if b == "periodic" and length < 3 * sigma:
+            raise _fail(source, "[system] box", f"periodic axis {k} length {length:g} is under 3 diameters "
+                        f"({3 * sigma:g}); make it larger or use walls")
 
-    mode = get("collisions", "mode", "exact")
-    law = get("collisions", "law", "flux")
-    if mode == "paper" and ("collisions", "law") in values:
-        raise _fail(source, "[collisions] law", "applies to mode = 'exact' only")
+    start = get("system", "start", "auto")
+    if start == "random" and get("system", "box") is not None:
+        raise _fail(source, "[system] start", "'random' (sequential addition) needs packing_fraction; "
+                    "an explicit box starts on a jittered lattice ('auto' or 'lattice')")
+
     if mode == "paper" and d != 2:
         raise _fail(source, "[collisions] mode",
                     f"'paper' runs gases in 2D only (its pair operator of Procedures 1-2), got dimension {d}")
@@ -252,44 +396,102 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
     if nc is not None and t_end is not None:
         raise _fail(source, "[run] time", "give either collisions or time, not both")
     if nc is None and t_end is None:
-        nc = 10 * n
+        nc = max(1, _DEFAULT_PER_PARTICLE * n // 2)
+    if nc is not None and n == 1:
+        raise _fail(source, "[run] collisions", "a single particle never collides; give [run] time instead")
+    checkpoint_interval = get("run", "checkpoint_interval", 0)
+    checkpoints = out("checkpoints")
+    if checkpoints is not None and checkpoint_interval == 0:
+        raise _fail(source, "[output] checkpoints", "needs [run] checkpoint_interval > 0")
+    if checkpoint_interval > 0 and checkpoints is None:
+        checkpoints = base / f"{name}-checkpoints"
+    trajectory = out("trajectory")
+    if trajectory is not None and trajectory.suffix.lower() not in (".xyz", ".gsd"):
+        raise _fail(source, "[output] trajectory", f"must end in .xyz (extended XYZ) or .gsd, got {trajectory.name!r}")
 
-    def out(key: str) -> Path | None:
-        p = get("output", key)
-        return (base / p) if p is not None else None
-
-    known = {k for k in values}
-    return Scene(
+    scene = Scene(
         dimension=d, particles=n, diameter=sigma, box=tuple(box), packing_fraction=phi,
-        boundaries=tuple(bounds), start=get("system", "start", "random"),
+        boundaries=tuple(bounds), start=start,
         kinetic_energy=get("system", "kinetic_energy"), initial_state=initial_path,
         mode=mode, law=law, bits=get("collisions", "bits", 40),
-        generator=get("rng", "generator", "clcg4"), streams=get("rng", "streams", "per-particle"),
-        seed=get("rng", "seed", 0), collisions=nc, time=t_end,
-        checkpoint_interval=get("run", "checkpoint_interval", 0),
-        json=out("json"), plot=out("plot"), trajectory=out("trajectory"),
-        trajectory_every=get("output", "trajectory_every", 100),
-        name=get("scene", "name", Path(source).stem if source.endswith(".toml") else "scene"),
-        source=source, extra={"fields": sorted(f"{a}.{b}" for a, b in known)},
-    )
+        streams=get("rng", "streams", "per-particle"), collisions=nc, time=t_end,
+        checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
+        json=out("json"), plot=out("plot"), trajectory=trajectory,
+        trajectory_every=get("output", "trajectory_every", 100), **common)
+    if arrays is not None:
+        _check_initial(source, scene, *arrays)
+    return scene
 
 
-def _initial_count(source: str, path: Path, d: int, n: int | None) -> int:
+def _reversal(source, get, common, mode, law, out) -> Scene:
+    from .verify import verify_cases
+
+    case = get("scene", "case")
+    if case is None:
+        raise _fail(source, "[scene] case", f"is required for kind = 'reversal'; one of {', '.join(verify_cases(mode))}")
+    if case not in verify_cases(mode):
+        raise _fail(source, "[scene] case", f"must be one of {', '.join(verify_cases(mode))} "
+                    f"for mode = {mode!r}, got {case!r}")
+    return Scene(case=case, mode=mode, law=law, bits=get("collisions", "bits", 40),
+                 collisions=get("run", "collisions", 1_000_000), json=out("json"), **common)
+
+
+def _statesave(source, get, common, mode, law, out) -> Scene:
+    from .statesave import variants as supported
+
+    lazy = get("statesave", "lazy", False)
+    have = supported(lazy)
+    vs = get("statesave", "variants", have)
+    for v in vs:
+        if v not in have:
+            need = " (ssp needs lazy = true)" if v == "ssp" else ""
+            raise _fail(source, "[statesave] variants", f"must be among {', '.join(map(repr, have))}, got {v!r}{need}")
+    return Scene(mode=mode, law=law, collisions=get("run", "collisions", 1000),
+                 statesave_particles=get("statesave", "particles", (1000, 10000, 100000, 1000000)),
+                 variants=tuple(v for v in have if v in vs), lazy=lazy, repeats=get("statesave", "repeats", 3),
+                 budget_gib=get("statesave", "budget_gib", 8.0), runner=get("statesave", "runner", "auto"),
+                 json=out("json"), plot=out("plot"), **common)
+
+
+def _read_initial(source: str, path: Path, d: int):
     import numpy as np
 
     where = "[system] initial_state"
     if not path.is_file():
         raise _fail(source, where, f"file not found: {path}")
     try:
-        with np.load(path) as z:
-            x, v = z["positions"], z["velocities"]
+        with np.load(path, allow_pickle=False) as z:
+            x, v = np.asarray(z["positions"], dtype=float), np.asarray(z["velocities"], dtype=float)
     except Exception as e:  # noqa: BLE001 - any unreadable file is the same user error
         raise _fail(source, where, f"cannot read arrays 'positions' and 'velocities' from {path}: {e}") from None
-    if x.ndim != 2 or x.shape[1] != d or v.shape != x.shape:
-        raise _fail(source, where, f"positions and velocities must both have shape (N, {d}), got {x.shape} and {v.shape}")
-    if n is not None and n != x.shape[0]:
-        raise _fail(source, "[system] particles", f"is {n} but initial_state holds {x.shape[0]} particles")
-    return int(x.shape[0])
+    if d == 1:  # allow flat (N,) arrays in 1D
+        x, v = x.reshape(-1, 1) if x.ndim == 1 else x, v.reshape(-1, 1) if v.ndim == 1 else v
+    if x.ndim != 2 or x.shape[1] != d or v.shape != x.shape or x.shape[0] == 0:
+        raise _fail(source, where, f"positions and velocities must both have shape (N, {d}) with N >= 1, "
+                    f"got {x.shape} and {v.shape}")
+    return x, v
+
+
+def _check_initial(source: str, scene: Scene, x, v) -> None:
+    """Builds the engine once from the explicit state: its validation (finite values, inside
+    the box, no overlap, non-zero kinetic energy) is the one the run will meet."""
+    from .engine import Simulation
+
+    try:
+        Simulation(x, v, scene.box, **engine_options(scene))
+    except ValueError as e:
+        raise _fail(source, "[system] initial_state", f"{scene.initial_state.name}: {e}") from None
+
+
+# scene files say "walls" (a box has two per axis); the engine says "wall"
+_ENGINE_BOUNDARY = {"walls": "wall", "periodic": "periodic"}
+
+
+def engine_options(scene: Scene) -> dict[str, Any]:
+    """The keyword arguments of :class:`revcol.Simulation` that a gas scene sets."""
+    return dict(boundary=[_ENGINE_BOUNDARY[b] for b in scene.boundaries],
+                diameter=scene.diameter, mode=scene.mode, law=scene.law, seed=scene.seed,
+                bits=scene.bits, generator=scene.generator, streams=scene.streams)
 
 
 def load_scene(path: str | Path | None = None) -> Scene:
@@ -302,5 +504,7 @@ def load_scene(path: str | Path | None = None) -> Scene:
     try:
         doc = tomllib.loads(p.read_text())
     except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"{p}: not valid TOML: {e}") from None
+        raise SceneError(f"{p}: not valid TOML: {' '.join(str(e).split())}") from None
+    except UnicodeDecodeError as e:
+        raise SceneError(f"{p}: not a text file: {e}") from None
     return scene_from_dict(doc, str(p), p.parent)

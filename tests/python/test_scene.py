@@ -104,3 +104,94 @@ def test_missing_file_and_dict_input():
     with pytest.raises(SceneError, match="no such scene file"):
         load_scene("/nonexistent/scene.toml")
     assert scene_from_dict(DEFAULT_SCENE).particles == 1000
+
+
+SCENES = Path(__file__).resolve().parents[2] / "scenes"
+
+
+def test_default_scene_file_is_the_built_in_one():
+    a, b = load_scene(None).to_dict(), load_scene(SCENES / "default.toml").to_dict()
+    for k in ("source",):
+        a.pop(k), b.pop(k)
+    assert a == b
+
+
+@pytest.mark.parametrize("path", sorted(SCENES.glob("*.toml")), ids=lambda p: p.stem)
+def test_example_scenes_load(path):
+    s = load_scene(path)
+    assert s.name == path.stem and (s.collisions is not None or s.time is not None)
+    assert "\n" not in s.summary()
+
+
+def test_kinds():
+    rev = scene_from_dict({"scene": {"kind": "reversal", "case": "triple1d"}, "collisions": {"mode": "paper"},
+                           "rng": {"generator": "philox", "seed": 3}})
+    assert (rev.kind, rev.case, rev.mode, rev.generator, rev.seed, rev.collisions) == \
+        ("reversal", "triple1d", "paper", "philox", 3, 1_000_000)
+    assert rev.dimension == 0 and rev.particles == 0 and "case triple1d" in rev.summary()
+    ss = scene_from_dict({"scene": {"kind": "statesave"}, "statesave": {"particles": [1000, 5000], "lazy": True,
+                                                                         "variants": ["rc", "ssp"]}})
+    assert ss.statesave_particles == (1000, 5000) and ss.variants == ("ssp", "rc") and ss.collisions == 1000
+    assert ss.lazy and ss.runner == "auto"
+
+
+@pytest.mark.parametrize("doc,needle", [
+    ({"scene": {"kind": "reversal", "case": "pair2d"}, "system": {"dimension": 2}},
+     "[system] dimension: does not apply to kind = 'reversal' (used by: 'gas')"),
+    ({"scene": {"kind": "reversal", "case": "pair2d"}, "rng": {"streams": "single"}},
+     "[rng] streams: does not apply to kind = 'reversal'"),
+    ({"scene": {"kind": "reversal", "case": "pair2d"}, "output": {"plot": "figs"}},
+     "[output] plot: does not apply to kind = 'reversal' (used by: 'gas', 'statesave')"),
+    ({"scene": {"kind": "reversal"}}, "[scene] case: is required"),
+    ({"scene": {"kind": "reversal", "case": "pair9d"}}, "[scene] case: must be one of"),
+    ({"scene": {"kind": "reversal", "case": "chain4-2d"}, "collisions": {"mode": "paper"}},
+     "for mode = 'paper', got 'chain4-2d'"),
+    ({"scene": {"kind": "gas", "case": "pair2d"}, "system": {"dimension": 2}},
+     "[scene] case: does not apply to kind = 'gas' (used by: 'reversal')"),
+    ({"scene": {"kind": "movie"}}, "[scene] kind: must be one of 'gas', 'reversal', 'statesave'"),
+    ({"scene": {"kind": "statesave"}, "statesave": {"variants": ["ssp"]}}, "ssp needs lazy = true"),
+    ({"scene": {"kind": "statesave"}, "statesave": {"lazy": 1}}, "[statesave] lazy: must be true or false"),
+    ({"scene": {"kind": "statesave"}, "statesave": {"particles": [1000, 1]}}, "[statesave] particles: must be 2.."),
+    ({"scene": {"kind": "statesave"}, "statesave": {"particles": []}}, "must be a non-empty list"),
+    ({"scene": {"kind": "statesave"}, "collisions": {"bits": 30}}, "[collisions] bits: does not apply"),
+    ({"scene": {"kind": "statesave"}, "system": {"particles": 10}}, "[system] particles: does not apply"),
+    ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.1}, "rng": {"seed": 2**32}},
+     "[rng] seed: must be 0..4294967295"),
+    ({"system": {"dimension": 2, "particles": 5, "box": [2.5, 9.0], "boundaries": ["periodic", "walls"]}},
+     "[system] box: periodic axis 0 length 2.5 is under 3 diameters"),
+    ({"system": {"dimension": 2, "particles": 5, "box": [9.0, 9.0], "start": "random"}},
+     "[system] start: 'random' (sequential addition) needs packing_fraction"),
+    ({"system": {"dimension": 2, "particles": 1, "packing_fraction": 0.1}},
+     "[run] collisions: a single particle never collides"),
+    ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.1}, "output": {"trajectory": "t.pdb"}},
+     "[output] trajectory: must end in .xyz (extended XYZ) or .gsd"),
+    ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.1}, "output": {"checkpoints": "c"}},
+     "[output] checkpoints: needs [run] checkpoint_interval > 0"),
+    ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.8}}, "must be at most 0.75 in 2D"),
+    ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.1}, "output": "x"}, "[output]: must be a table"),
+])
+def test_bad_scene_dicts(doc, needle):
+    with pytest.raises(SceneError) as e:
+        scene_from_dict(doc, "s.toml")
+    msg = str(e.value)
+    assert needle in msg and "\n" not in msg and msg.startswith("s.toml: ")
+
+
+def test_initial_state_checked_by_the_engine(tmp_path):
+    v = np.array([[1.0, 0.0], [-1.0, 0.0]])
+    bad = {"overlap.npz": ([[1.0, 1.0], [1.5, 1.0]], "particles 0 and 1 overlap: distance 0.5"),
+           "outside.npz": ([[1.0, 1.0], [4.8, 1.0]], "particle 1 is outside the box on axis 0"),
+           "nan.npz": ([[1.0, 1.0], [np.nan, 1.0]], "position of particle 1 is not finite")}
+    for name, (x, needle) in bad.items():
+        np.savez(tmp_path / name, positions=np.array(x), velocities=v)
+        with pytest.raises(SceneError) as e:
+            load_scene(write(tmp_path, f"[system]\ndimension = 2\ninitial_state = '{name}'\nbox = [5.0, 5.0]\n"))
+        msg = str(e.value)
+        assert f"[system] initial_state: {name}: " in msg and needle in msg and "\n" not in msg, msg
+    np.savez(tmp_path / "still.npz", positions=np.array([[1.0, 1.0], [3.0, 1.0]]), velocities=np.zeros((2, 2)))
+    with pytest.raises(SceneError, match="zero kinetic energy"):
+        load_scene(write(tmp_path, "[system]\ndimension = 2\ninitial_state = 'still.npz'\nbox = [5.0, 5.0]\n"))
+    np.savez(tmp_path / "ok.npz", positions=np.array([[1.0, 1.0], [3.0, 1.0]]), velocities=v)
+    with pytest.raises(SceneError, match=r"\[system\] kinetic_energy: applies to random starts only"):
+        load_scene(write(tmp_path, "[system]\ndimension = 2\ninitial_state = 'ok.npz'\nbox = [5.0, 5.0]\n"
+                                   "kinetic_energy = 3.0\n"))
