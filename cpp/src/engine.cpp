@@ -402,6 +402,7 @@ class EngineImpl final : public Simulation {
       shift_tab_[k][2] = -L_[k];
       shift_tab_[k][3] = 0.0;
     }
+    adj_ = Dim == 1 && (!periodic_[0] || n_ >= 3);
   }
 
   int cell_of(double x, int k) const {
@@ -561,6 +562,10 @@ class EngineImpl final : public Simulation {
   }
   // Every list from the centres (construction, restore).
   void build_lists() {
+    if (adj_) {
+      build_adjacent();
+      return;
+    }
     for (std::size_t i = 0; i < n_; ++i) place(static_cast<int>(i));
     link_all();
     nbcap_ = 16;
@@ -573,6 +578,41 @@ class EngineImpl final : public Simulation {
         if (near(static_cast<int>(i), j, code)) list_insert(static_cast<int>(i), j, code);
       });
   }
+  // 1D: the rods in order of position (a rotation of the ring's order on a periodic axis,
+  // where a stored position lies within kWrap of the box and at most one rod within kWrap
+  // of its ends), each listed with the rods beside it.
+  static constexpr double kWrap = 0.25;  // in D: a rod is wrapped kWrap D past the box's end
+  void build_adjacent() {
+    nbcap_ = 2;
+    nb_.assign(n_ * nbcap_, 0);
+    nbc_.assign(n_ * nbcap_, 0);
+    nbn_.assign(n_, 0);
+    left_.assign(n_, -1);
+    right_.assign(n_, -1);
+    std::vector<int> order(n_);
+    for (std::size_t i = 0; i < n_; ++i) order[i] = static_cast<int>(i);
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      const double xa = pos_at(a, 0, clock_), xb = pos_at(b, 0, clock_);
+      return xa < xb || (xa == xb && a < b);
+    });
+    const std::size_t pairs = periodic_[0] ? n_ : (n_ > 0 ? n_ - 1 : 0);
+    for (std::size_t u = 0; u < pairs; ++u) {
+      const int a = order[u], b = order[(u + 1) % n_];  // b is the rod to the right of a
+      right_[a] = b;
+      left_[b] = a;
+      const unsigned code = right_code(a, b);
+      list_insert(a, b, code);
+      list_insert(b, a, mirror(code));
+    }
+  }
+  // The image of b, the rod to the right of a, seen from a: b itself (code 0) when it lies
+  // to the right, else b + L (code 1). Unambiguous: stored positions are within kWrap D < D
+  // of the box, and b lies between D and L - 2 D to the right of a on the ring.
+  unsigned right_code(int a, int b) const {
+    if (!periodic_[0]) return 0u;
+    return pos_at(b, 0, clock_) > pos_at(a, 0, clock_) ? 0u : 1u;
+  }
+
   // i's list from its (new) centre, and i on the lists of its old and new neighbours: a
   // merge of the old and new sorted lists, so that only the lists whose entry for i changes
   // are touched (most neighbours stay, and keep their image unless i was wrapped).
@@ -646,6 +686,11 @@ class EngineImpl final : public Simulation {
 
   // Image shift s of the pair (a, b), a < b, with r = x_a - x_b - s, from the centres.
   Vec pair_shift(int a, int b) const {
+    if (adj_) {
+      const std::size_t base = static_cast<std::size_t>(a) * nbcap_;
+      for (int u = 0; u < nbn_[a]; ++u)
+        if (nb_[base + u] == b) return shift_of(nbc_[base + u]);
+    }
     unsigned code;
     near(a, b, code);
     return shift_of(code);
@@ -711,7 +756,16 @@ class EngineImpl final : public Simulation {
         if (earlier(t, kWall, 2 * k + up, best)) best = Ev{t, kWall, 2 * k + up, 0};
       }
     }
-    {
+    if (adj_) {
+      // 1D: no renewal; on a periodic axis the wrap, kWrap D past either end of the box
+      const double vk = p_[i].v[0];
+      if (periodic_[0] && vk != 0.0) {
+        const double edge = vk > 0.0 ? L_[0] + kWrap * cfg_.diameter : -kWrap * cfg_.diameter;
+        double t = ti + (edge - p_[i].x[0]) / vk;
+        if (t < clock_) t = clock_;
+        if (earlier(t, kRenew, 0, best)) best = Ev{t, kRenew, 0, 0};
+      }
+    } else {
       // the list renewal: |x_i + v (t - t_i) - c_i| = h, the later root, cancellation-free
       double dd = 0.0, b = 0.0, vv = 0.0;
       for (int k = 0; k < Dim; ++k) {
@@ -1017,6 +1071,10 @@ class EngineImpl final : public Simulation {
   // axes, moving the stored position by L: its line, and so every prediction, is unchanged),
   // i's list is rebuilt and i is predicted again. Nothing physical changes: no stamp.
   void renew_event(int i, const Ev& e) {
+    if (adj_) {
+      wrap_event(i, e);
+      return;
+    }
     unlink(i);
     const double dt = e.t - p_[i].t;
     for (int k = 0; k < Dim; ++k) {
@@ -1030,6 +1088,23 @@ class EngineImpl final : public Simulation {
     place(i);
     link(i);
     rebuild_list(i);
+    ++counters_.cell_crossings;
+    repredict(i);
+  }
+
+  // 1D periodic: i has gone kWrap D past an end of the box; its stored position moves by L
+  // (its line is unchanged: no stamp) and the images of the rods beside it are recoded.
+  void wrap_event(int i, const Ev& e) {
+    const double c = p_[i].x[0] + p_[i].v[0] * (e.t - p_[i].t);
+    if (c >= L_[0]) p_[i].x[0] -= L_[0];
+    else if (c < 0.0) p_[i].x[0] += L_[0];
+    cn_[i].c[0] = p_[i].x[0] + p_[i].v[0] * (e.t - p_[i].t);
+    const int r = right_[i], l = left_[i];
+    const unsigned cr = right_code(i, r), cl = right_code(l, i);
+    list_recode(i, r, cr);
+    list_recode(r, i, mirror(cr));
+    list_recode(l, i, cl);
+    list_recode(i, l, mirror(cl));
     ++counters_.cell_crossings;
     repredict(i);
   }
@@ -1624,6 +1699,11 @@ class EngineImpl final : public Simulation {
     int next = -1, prev = -1;
   };
   std::vector<Centre> cn_;
+  // 1D (walls, or a periodic ring of 3 or more): rods keep their order, so each one's
+  // neighbours are the rods beside it for the whole run: no cell grid and no list renewals,
+  // only a wrap event on a periodic axis (adj_; left_/right_: the rods beside, -1 at a wall)
+  bool adj_ = false;
+  std::vector<int> left_, right_;
   std::vector<int> nb_, nbn_;                        // neighbour lists (nbcap_ slots each), lengths
   std::vector<unsigned char> nbc_;                   // their image codes
   int nbcap_ = 16;

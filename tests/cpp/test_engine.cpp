@@ -489,7 +489,7 @@ TEST_CASE("checkpoint at 0.45 resumes bit for bit; one without list centres resu
 }
 
 TEST_CASE("the shell follows the packing fraction: sparse gases round trip, any shell gives the same run") {
-  // the automatic shells here are wide (1D 0.05: 10 D; 2D 0.05: 2.5 D; 3D 0.05: 1 D)
+  // the automatic shells here are wide (2D 0.05: 2.5 D; 3D 0.05: 1 D; 1D lists the rods beside)
   for (int d : {1, 2, 3})
     for (Boundary b : {Boundary::periodic, Boundary::wall}) {
       const Err e = round_trip(config(d, b), 300, 0.05, 300);
@@ -514,7 +514,8 @@ TEST_CASE("the shell follows the packing fraction: sparse gases round trip, any 
       colls.push_back(s->collision_counts());
       renewals.push_back(s->diagnostics().counters.cell_crossings);
     }
-    CHECK(renewals[1] > renewals[2]);  // a thin shell renews more often
+    if (d == 1) CHECK(renewals[0] + renewals[1] + renewals[2] == 0u);  // 1D: rods beside, no lists renewed
+    else CHECK(renewals[1] > renewals[2]);                              // a thin shell renews more often
     std::uint64_t total = 0;
     for (auto c : colls[0]) total += c;
     CHECK(total > 2 * 100);  // each collision counts for both partners: over 100 collisions
@@ -529,4 +530,50 @@ TEST_CASE("the shell follows the packing fraction: sparse gases round trip, any 
   bad.shell = -0.1;
   const InitialState st = random_state(config(3, Boundary::periodic), 10, 0.1, 1);
   CHECK_THROWS_AS(make_simulation(bad, st.x, st.v), InvalidArgument);
+}
+
+TEST_CASE("1D: each rod lists the rods beside it, no cell grid; a periodic ring wraps") {
+  // walls: nothing is ever renewed; a periodic ring of N >= 3: only the wraps, kWrap D past
+  // either end, each moving a stored position by L
+  for (Boundary b : {Boundary::wall, Boundary::periodic}) {
+    const InitialState st = random_state(config(1, b), 500, 0.3, 11);
+    auto s = make_simulation(st.config, st.x, st.v);
+    const auto x0 = s->positions();
+    const auto v0 = s->velocities();
+    s->run(20000, kInf);  // 40 per rod
+    const Diagnostics d = s->diagnostics();
+    if (b == Boundary::wall) {
+      CHECK(d.counters.cell_crossings == 0u);
+    } else {
+      CHECK(d.counters.cell_crossings > 0u);
+      for (double x : s->positions()) {
+        CHECK(x >= -0.25);
+        CHECK(x <= st.config.box[0] + 0.25);
+      }
+    }
+    // the engine's memory: the lists are two slots a rod, no grid
+    CHECK(s->memory_bytes() < 500u * 256u);
+    s->run_back(kAll, s->start_time());
+    const Err e = error(*s, x0, v0);
+    CHECK(e.x < 1e-9);
+    CHECK(e.v == 0.0);  // 1D exchanges: velocities bit for bit
+  }
+  // a ring of 3 rods in a box of 3.5 D: every rod is both neighbours' neighbour, images flip
+  Config c = config(1, Boundary::periodic);
+  c.box = {3.5, 1.0, 1.0};
+  Built r = build(c, {0.5, 1.7, 2.9}, {1.0, -0.3, 0.6});
+  r.s->run(300, kInf);
+  CHECK(r.s->diagnostics().counters.pair_collisions == 300u);
+  CHECK(r.s->diagnostics().counters.cell_crossings > 0u);
+  // a checkpoint mid-run resumes bit for bit (the order is rebuilt from the positions)
+  const Snapshot snap = r.s->snapshot();
+  auto q = restore_simulation(snap);
+  r.s->run(300, kInf);
+  q->run(300, kInf);
+  CHECK(q->positions() == r.s->positions());
+  CHECK(q->velocities() == r.s->velocities());
+  r.s->run_back(kAll, r.s->start_time());
+  const Err e = error(*r.s, r.x0, r.v0);
+  CHECK(e.x < 1e-9);
+  CHECK(e.v == 0.0);
 }

@@ -12,7 +12,10 @@
 // centres, a restore rebuilds the lists). Its renewal event fires when it is h =
 // (shell - 1e-3 D) / 2 from its centre: the centre moves there, the list is rebuilt from a
 // cell grid of the centres, and nothing physical changes; a pair off each other's lists is
-// more than D (1 + 1e-3) apart, so a prediction scans the list alone. The queue is Paul's
+// more than D (1 + 1e-3) apart, so a prediction scans the list alone. In 1D (walls, or a
+// periodic ring of 3 rods or more) rods keep their order, so each lists the rods beside it
+// for the whole run: no cell grid, no renewals, only a wrap event on a periodic axis (a
+// stored position moves by L a quarter diameter past the box's end). The queue is Paul's
 // O(1) queue (time buckets, the current one a binary heap); its keys (time, kind, id) are
 // distinct, so the order of events does not depend on its bucket width. Collision times
 // use the cancellation-free root
