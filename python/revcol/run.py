@@ -448,10 +448,14 @@ def run_reversal(scene: Scene) -> dict:
     """The paper's reversal illustration for the scene's case (:func:`revcol.verify`)."""
     from .verify import verify
 
-    r = dict(verify(scene.case, collisions=scene.collisions, mode=scene.mode, law=scene.law,
-                    rng=scene.generator, seed=scene.seed, bits=scene.bits))
+    # one C++ call (10^6 collisions both ways in about a second): a Ctrl-C waits for it to end,
+    # and the report, marked interrupted, is still written
+    with _Interrupt() as stop:
+        r = dict(verify(scene.case, collisions=scene.collisions, mode=scene.mode, law=scene.law,
+                        rng=scene.generator, seed=scene.seed, bits=scene.bits))
     r.update({"kind": "reversal", "scene": scene.to_dict(), "summary": scene.summary(),
-              "peak_rss_bytes": _peak_rss(), "interrupted": None, "written": []})
+              "peak_rss_bytes": _peak_rss(), "interrupted": "reversal" if stop.presses else None,
+              "written": []})
     return r
 
 
@@ -473,16 +477,19 @@ def run_statesave(scene: Scene, plot: str | os.PathLike | None = None, progress:
                                  "(installed next to python by pip install ., or set REVCOL_BENCH); "
                                  "or use runner = 'auto' or 'inline'") from None
             inline = True
+    # Ctrl-C ends the study after the run under way (each run is one C++ call or process);
+    # the runs done are reported and written
     try:
-        r = statesave.study(scene.statesave_particles, scene.collisions, lazy=scene.lazy, modes=(scene.mode,),
-                            law=scene.law, variants=scene.variants, repeats=scene.repeats,
-                            budget_gib=scene.budget_gib, seed=scene.seed,
-                            rng=scene.generator, inline=inline, progress=progress,
-                            command=f"revcol run {scene.source}")
+        with _Interrupt() as stop:
+            r = statesave.study(scene.statesave_particles, scene.collisions, lazy=scene.lazy,
+                                modes=(scene.mode,), law=scene.law, variants=scene.variants,
+                                repeats=scene.repeats, budget_gib=scene.budget_gib, seed=scene.seed,
+                                rng=scene.generator, inline=inline, progress=progress,
+                                command=f"revcol run {scene.source}", stop=lambda: stop.presses > 0)
     except (ValueError, FileNotFoundError) as e:
         raise SceneError(f"{scene.source}: {e}") from None
     r.update({"kind": "statesave", "scene": scene.to_dict(), "summary": scene.summary(),
-              "interrupted": None, "written": []})
+              "interrupted": "statesave" if r["interrupted"] or stop.presses else None, "written": []})
     if plot is not None:
         out = Path(plot) / "statesave.png"
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -704,10 +711,14 @@ def format_report(r: dict) -> str:
         return format_horizon(r)
     if r["kind"] == "reversal":
         lines = [head, f"  scene               {r['summary']}"] + _verify_lines(r)
+        if r["interrupted"]:
+            lines.append("  interrupted         (Ctrl-C) after the reversal, which is one call: it ran to the end")
     elif r["kind"] == "statesave":
         from .statesave import format_table
 
         lines = [head, f"  scene   {r['summary']}", f"  runner  {r['runner']}: {r['rss_note']}", format_table(r)]
+        if r["interrupted"]:
+            lines.append(f"  interrupted (Ctrl-C): the table covers the runs done; {r.get('not_run', 0)} not run")
     else:
         drift_p = ("n/a (walls on every axis)" if r["momentum_drift_turn"] is None else
                    f"{r['momentum_drift_turn']:+.2g} at the turn, {_si(r['momentum_drift_end'])} after reversal "

@@ -42,7 +42,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
-from typing import Any, Iterable, Sequence
+from typing import Any, Callable, Iterable, Sequence
 
 from . import _core
 
@@ -201,7 +201,10 @@ def _run_process(binary: str, kw: dict, repeats: int) -> list[dict]:
         out = Path(tmp) / "run.json"
         cmd = [binary, "--bench", name, "--collisions", str(kw["collisions"]), "--repeats", str(repeats),
                "--json", str(out)]
-        p = subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        # its own session: a terminal's Ctrl-C reaches the study (which stops after this run)
+        # and not the run (a KeyboardInterrupt here makes subprocess.run kill the run)
+        p = subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                           start_new_session=True)
         if p.returncode != 0:
             raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}): {p.stderr.strip()}")
         data = json.loads(out.read_text())
@@ -311,14 +314,16 @@ def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1
           variants: Sequence[str] | None = None, repeats: int = 3, budget_gib: float = 8.0,
           seed: int = 0, rng: str = "clcg4", mean_dt: float = 1e-5, grazing_tol: float = 1e-11,
           prefault: bool = True, binary: str | None = None, inline: bool = False,
-          progress: bool | None = None, command: str | None = None) -> dict:
+          progress: bool | None = None, command: str | None = None,
+          stop: Callable[[], bool] | None = None) -> dict:
     """Runs every (mode, N, variant) and returns the report (see the module doc).
 
     Each run is a fresh ``revcol-bench`` process (``binary``: explicit, ``$REVCOL_BENCH``,
     next to this Python, or on PATH), repeated ``repeats`` times in it; ``inline=True`` runs
     in this process instead (peak RSS is then this whole process's). Runs whose saved
     state exceeds ``budget_gib`` are not attempted. ``progress``: None = when stdout is a
-    terminal.
+    terminal. ``stop``: asked before each run; when it returns True the study ends there
+    (the report has the runs done, ``interrupted`` True and ``not_run`` the rest).
     """
     ns = list(n) if not isinstance(n, (int, float)) else [n]
     if not ns:
@@ -340,8 +345,12 @@ def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1
     plan = [(m, N, v) for m in modes for N in ns for v in vs]
     bar = _Progress(len(plan), progress)
     runs = []
+    not_run = 0
     try:
-        for m, N, v in plan:
+        for k, (m, N, v) in enumerate(plan):
+            if stop is not None and stop():
+                not_run = len(plan) - k
+                break
             kw = dict(base, mode=m, particles=N, variant=v)
             proj = _core.statesave_projected_bytes(**kw)
             label = f"{m} N={N:,} {_LABEL[v]}"
@@ -369,6 +378,7 @@ def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1
         "binary": exe, "command": command, "machine": _machine(),
         "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
         "runs": runs, "ratios": _ratios(runs), "passed": passed,
+        "interrupted": not_run > 0, "not_run": not_run,
     }
 
 

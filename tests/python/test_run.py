@@ -1,5 +1,6 @@
 """``revcol run``: round trips of scenes, reports, outputs, errors, Ctrl-C, and the tutorial."""
 import dataclasses
+import importlib
 import json
 import os
 import re
@@ -346,3 +347,46 @@ def _has(module: str) -> bool:
         return True
     except ImportError:
         return False
+
+
+def test_ctrl_c_ends_a_statesave_study_after_the_run_under_way(tmp_path, capsys, monkeypatch):
+    # the SIGINT arrives during the first run (each run is one C++ call): the study ends
+    # after it, reports that run, writes the JSON, and exits 130
+    import revcol.statesave as ss
+
+    real = ss._run_inline
+    calls = []
+
+    def run_inline(kw, repeats):
+        if not calls:
+            os.kill(os.getpid(), signal.SIGINT)
+        calls.append(kw["variant"])
+        return real(kw, repeats)
+    monkeypatch.setattr(ss, "_run_inline", run_inline)
+    p = tmp_path / "ss.toml"
+    p.write_text('[scene]\nkind = "statesave"\n[statesave]\nparticles = [1000, 2000]\nrepeats = 1\n'
+                 'runner = "inline"\n[run]\ncollisions = 20\n')
+    before = signal.getsignal(signal.SIGINT)
+    rc = cli_main(["run", str(p), "--json", str(tmp_path / "r.json"), "--no-progress"])
+    assert rc == 130
+    assert "interrupted (Ctrl-C): the table covers the runs done; 5 not run" in capsys.readouterr().out
+    r = json.loads((tmp_path / "r.json").read_text())
+    assert r["interrupted"] == "statesave" and r["not_run"] == 5 and len(r["runs"]) == 1 == len(calls)
+    assert r["runs"][0]["restored"]
+    assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_ctrl_c_during_a_reversal_scene_still_reports(tmp_path, capsys, monkeypatch):
+    ver = importlib.import_module("revcol.verify")  # the module (revcol.verify is also the function)
+    real = ver.verify
+
+    def verify(*a, **k):
+        os.kill(os.getpid(), signal.SIGINT)  # arrives during the (one) call
+        return real(*a, **k)
+    monkeypatch.setattr(ver, "verify", verify)
+    rc = cli_main(["run", str(SCENES / "paper-triple1d-reversal.toml"), "--collisions", "500",
+                   "--json", str(tmp_path / "r.json"), "--no-progress"])
+    assert rc == 130
+    assert "interrupted         (Ctrl-C) after the reversal" in capsys.readouterr().out
+    r = json.loads((tmp_path / "r.json").read_text())
+    assert r["interrupted"] == "reversal" and r["passed"] and r["collisions"] == 500
