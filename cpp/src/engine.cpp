@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "revcol/collide/exact.hpp"
@@ -42,7 +43,6 @@ rng::StreamPolicy parse_engine_streams(const std::string& s) {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kPi = 3.141592653589793238462643383279502884;
 constexpr int kMaxGroup = 8;  // particles in one group collision
 // A renewal's new list on the stack. Listed centres are within D + shell of c_i, so their
 // particles (disjoint spheres) are within D + shell + h of it: at most ((1.5 D + shell + h) /
@@ -353,23 +353,20 @@ class EngineImpl final : public Simulation {
   // 1.0-1.4 (0.3), 0.8 (0.5); 1D >= 8 (0.1), 4-8 (0.3), 2.4-4 (0.5).
   static double auto_shell(double phi) {
     const double sqrt2 = std::sqrt(2.0);
-    double lam = 0.0, s = 0.0;
+    double lam, lo, base, slope, hi;
     if constexpr (Dim == 3) {
       const double g = (1.0 - 0.5 * phi) / ((1.0 - phi) * (1.0 - phi) * (1.0 - phi));
       lam = 1.0 / (6.0 * sqrt2 * phi * g);
-      s = std::clamp(0.35 + 0.3 * lam, 0.4, 1.0);
-      if (!std::isfinite(lam)) s = 0.4;
+      lo = 0.4, base = 0.35, slope = 0.3, hi = 1.0;
     } else if constexpr (Dim == 2) {
       const double g = (1.0 - 7.0 * phi / 16.0) / ((1.0 - phi) * (1.0 - phi));
-      lam = kPi / (8.0 * sqrt2 * phi * g);
-      s = std::clamp(0.6 + lam, 0.8, 2.5);
-      if (!std::isfinite(lam)) s = 0.8;
+      lam = std::numbers::pi / (8.0 * sqrt2 * phi * g);
+      lo = 0.8, base = 0.6, slope = 1.0, hi = 2.5;
     } else {
       lam = (1.0 - phi) / phi;
-      s = std::clamp(1.5 + lam, 1.5, 10.0);
-      if (!std::isfinite(lam)) s = 1.5;
+      lo = 1.5, base = 1.5, slope = 1.0, hi = 10.0;
     }
-    return s;
+    return std::isfinite(lam) ? std::clamp(base + slope * lam, lo, hi) : lo;
   }
 
   void setup_geometry() {
@@ -378,9 +375,9 @@ class EngineImpl final : public Simulation {
     contact_tol_ = 2.0 * cfg_.group_tol * sigma2_;
     // listed centres must be within D + shell < L / 2, so that each listed pair has one
     // nearest image: a small periodic box (L >= 3 D) takes a thinner shell
-    double vol = 1.0, ball = Dim == 3 ? kPi / 6.0 : Dim == 2 ? kPi / 4.0 : 1.0;  // of diameter 1
+    double vol = 1.0;  // in diameters^d
     for (int k = 0; k < Dim; ++k) vol *= cfg_.box[k] / cfg_.diameter;
-    const double phi = static_cast<double>(n_) * ball / vol;
+    const double phi = static_cast<double>(n_) * particle_volume(Dim, 1.0) / vol;
     shell_ = (cfg_.shell > 0.0 ? cfg_.shell : auto_shell(phi)) * cfg_.diameter;
     for (int k = 0; k < Dim; ++k)
       if (cfg_.boundary[k] == Boundary::periodic)
@@ -562,7 +559,7 @@ class EngineImpl final : public Simulation {
   }
   // Every list from the centres (construction, restore).
   void build_lists() {
-    if (adj_) {
+    if (adjacent()) {
       build_adjacent();
       return;
     }
@@ -590,11 +587,12 @@ class EngineImpl final : public Simulation {
     left_.assign(n_, -1);
     right_.assign(n_, -1);
     std::vector<int> order(n_);
-    for (std::size_t i = 0; i < n_; ++i) order[i] = static_cast<int>(i);
-    std::sort(order.begin(), order.end(), [&](int a, int b) {
-      const double xa = pos_at(a, 0, clock_), xb = pos_at(b, 0, clock_);
-      return xa < xb || (xa == xb && a < b);
-    });
+    std::vector<double> x(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      order[i] = static_cast<int>(i);
+      x[i] = pos_at(static_cast<int>(i), 0, clock_);
+    }
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
     const std::size_t pairs = periodic_[0] ? n_ : (n_ > 0 ? n_ - 1 : 0);
     for (std::size_t u = 0; u < pairs; ++u) {
       const int a = order[u], b = order[(u + 1) % n_];  // b is the rod to the right of a
@@ -686,7 +684,7 @@ class EngineImpl final : public Simulation {
 
   // Image shift s of the pair (a, b), a < b, with r = x_a - x_b - s, from the centres.
   Vec pair_shift(int a, int b) const {
-    if (adj_) {
+    if (adjacent()) {
       const std::size_t base = static_cast<std::size_t>(a) * nbcap_;
       for (int u = 0; u < nbn_[a]; ++u)
         if (nb_[base + u] == b) return shift_of(nbc_[base + u]);
@@ -756,7 +754,7 @@ class EngineImpl final : public Simulation {
         if (earlier(t, kWall, 2 * k + up, best)) best = Ev{t, kWall, 2 * k + up, 0};
       }
     }
-    if (adj_) {
+    if (adjacent()) {
       // 1D: no renewal; on a periodic axis the wrap, kWrap D past either end of the box
       const double vk = p_[i].v[0];
       if (periodic_[0] && vk != 0.0) {
@@ -1069,14 +1067,26 @@ class EngineImpl final : public Simulation {
 
   // The list renewal: the centre moves to where i is now (wrapped into the box on periodic
   // axes, moving the stored position by L: its line, and so every prediction, is unchanged),
-  // i's list is rebuilt and i is predicted again. Nothing physical changes: no stamp.
+  // i's list is rebuilt (in 1D, the images of the rods beside it recoded: this is then the
+  // wrap) and i is predicted again. Nothing physical changes: no stamp.
   void renew_event(int i, const Ev& e) {
-    if (adj_) {
-      wrap_event(i, e);
-      return;
+    move_centre(i, e.t);
+    if (adjacent()) {
+      recode_beside(i);
+    } else {
+      unlink(i);  // from the cell it was linked in (cell_ still holds it)
+      place(i);
+      link(i);
+      rebuild_list(i);
     }
-    unlink(i);
-    const double dt = e.t - p_[i].t;
+    ++counters_.cell_crossings;
+    repredict(i);
+  }
+
+  // i's centre to where i is at t; on a periodic axis a position outside the box is first
+  // moved by L (its line, and so every prediction, is unchanged).
+  void move_centre(int i, double t) {
+    const double dt = t - p_[i].t;
     for (int k = 0; k < Dim; ++k) {
       double c = p_[i].x[k] + p_[i].v[k] * dt;
       if (periodic_[k] && (c >= L_[k] || c < 0.0)) {
@@ -1085,28 +1095,17 @@ class EngineImpl final : public Simulation {
       }
       cn_[i].c[k] = c;
     }
-    place(i);
-    link(i);
-    rebuild_list(i);
-    ++counters_.cell_crossings;
-    repredict(i);
   }
 
-  // 1D periodic: i has gone kWrap D past an end of the box; its stored position moves by L
-  // (its line is unchanged: no stamp) and the images of the rods beside it are recoded.
-  void wrap_event(int i, const Ev& e) {
-    const double c = p_[i].x[0] + p_[i].v[0] * (e.t - p_[i].t);
-    if (c >= L_[0]) p_[i].x[0] -= L_[0];
-    else if (c < 0.0) p_[i].x[0] += L_[0];
-    cn_[i].c[0] = p_[i].x[0] + p_[i].v[0] * (e.t - p_[i].t);
+  // 1D periodic: i has gone kWrap D past an end of the box and been moved by L: the images
+  // of its pairs with the rods beside it are recoded.
+  void recode_beside(int i) {
     const int r = right_[i], l = left_[i];
     const unsigned cr = right_code(i, r), cl = right_code(l, i);
     list_recode(i, r, cr);
     list_recode(r, i, mirror(cr));
     list_recode(l, i, cl);
     list_recode(i, l, mirror(cl));
-    ++counters_.cell_crossings;
-    repredict(i);
   }
 
   // ---- random numbers -----------------------------------------------------------------
@@ -1703,6 +1702,7 @@ class EngineImpl final : public Simulation {
   // neighbours are the rods beside it for the whole run: no cell grid and no list renewals,
   // only a wrap event on a periodic axis (adj_; left_/right_: the rods beside, -1 at a wall)
   bool adj_ = false;
+  bool adjacent() const { return Dim == 1 && adj_; }  // a constant false in 2D and 3D
   std::vector<int> left_, right_;
   std::vector<int> nb_, nbn_;                        // neighbour lists (nbcap_ slots each), lengths
   std::vector<unsigned char> nbc_;                   // their image codes

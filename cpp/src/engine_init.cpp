@@ -26,13 +26,13 @@ struct Draws {
   }
 };
 
-double unit_volume(int d, double D) {
+}  // namespace
+
+double particle_volume(int d, double D) {
   if (d == 1) return D;
   if (d == 2) return kPi * D * D / 4.0;
   return kPi * D * D * D / 6.0;
 }
-
-}  // namespace
 
 InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t seed, double energy,
                           const std::string& init, bool equal_speeds) {
@@ -48,7 +48,7 @@ InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t see
   require(phi <= maxphi, "packing fraction " + std::to_string(phi) + " above what the initialiser reaches (" +
                              std::to_string(maxphi) + " in " + std::to_string(d) + "D)");
   const double D = c.diameter;
-  const double L = std::pow(static_cast<double>(n) * unit_volume(d, D) / phi, 1.0 / d);
+  const double L = std::pow(static_cast<double>(n) * particle_volume(d, D) / phi, 1.0 / d);
   for (int k = 0; k < 3; ++k) c.box[k] = k < d ? L : 1.0;
   const double rsa_max = d == 1 ? 0.3 : d == 2 ? 0.35 : 0.2;
   const bool rsa = init == "rsa" || (init == "auto" && phi <= rsa_max);

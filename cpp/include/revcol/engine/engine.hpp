@@ -268,6 +268,10 @@ struct InitialState {
   std::vector<double> x;  ///< n x dim
   std::vector<double> v;  ///< n x dim
 };
+/// The volume (length in 1D, area in 2D) of one particle of diameter D in d dimensions:
+/// packing fraction = n particle_volume(d, D) / box volume.
+double particle_volume(int d, double D);
+
 /// See InitialState.
 InitialState random_state(Config config, std::size_t n, double phi, std::uint64_t seed,
                           double energy = 0.0, const std::string& init = "auto",
