@@ -1,0 +1,152 @@
+"""Two builds side by side, interleaved (A B A B ...), for a change that must keep the engine's
+figures: throughput of `revcol-bench --bench engine/<case>`, and the horizon and memory
+studies of bench/engine_study.py run against each build's staged package.
+
+    python3 bench/ab_compare.py throughput OLD_BUILD NEW_BUILD [--rounds 5] [--cpu 1]
+    python3 bench/ab_compare.py studies    OLD_BUILD NEW_BUILD
+
+A build directory is one made by scripts/dev_build.sh (it holds revcol-bench and pkg/).
+Throughput: each round runs every case once per build, alternating which build goes first,
+one process per run pinned to one core (`taskset -c CPU`), and records the load average
+before each run; the report gives per build and case the median and the range over rounds,
+and new/old of the medians. Studies: engine_study.py horizon and memory, once per build,
+with each build's package on PYTHONPATH; their JSON goes to a temporary folder and the
+report keeps both. Writes bench/results/ab_<what>.json.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "results")
+
+CASES = ["engine/d3/n10000/phi0.3", "engine/d3/n10000/phi0.45", "engine/d3/n100000/phi0.3",
+         "engine/d3/n100000/phi0.45", "engine/d2/n10000/phi0.5"]
+
+
+def _load() -> float:
+    with open("/proc/loadavg") as f:
+        return float(f.read().split()[0])
+
+
+def _bench(build: str, case: str, collisions: int, cpu: int | None) -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        js = os.path.join(tmp, "b.json")
+        cmd = [os.path.join(build, "revcol-bench"), "--bench", case, "--collisions", str(collisions),
+               "--repeats", "1", "--json", js]
+        if cpu is not None and shutil.which("taskset"):
+            cmd = ["taskset", "-c", str(cpu)] + cmd
+        subprocess.run(cmd, check=True, capture_output=True)
+        with open(js) as f:
+            data = json.load(f)
+    return {r["metric"]: r["median"] for r in data["results"] if r["bench"] == case}
+
+
+def _summary(values: list[float]) -> dict:
+    return dict(median=statistics.median(values), min=min(values), max=max(values), runs=values)
+
+
+def throughput(args) -> dict:
+    builds = {"old": args.old, "new": args.new}
+    raw = {b: {c: [] for c in CASES} for b in builds}
+    loads = []
+    for k in range(args.rounds):
+        order = ["old", "new"] if k % 2 == 0 else ["new", "old"]
+        for case in CASES:
+            nc = 2 * args.collisions if "n100000" in case else args.collisions
+            for b in order:
+                loads.append(_load())
+                r = _bench(builds[b], case, nc, args.cpu)
+                raw[b][case].append(r)
+                print(f"round {k} {b:3s} {case:28s} forward {r['forward_per_s']:.3g}/s "
+                      f"reverse {r['reverse_per_s']:.3g}/s (load {loads[-1]:.2f})", flush=True)
+    rows = []
+    for case in CASES:
+        row = dict(case=case)
+        for b in builds:
+            for m in ("forward_per_s", "reverse_per_s"):
+                row[f"{b}_{m}"] = _summary([r[m] for r in raw[b][case]])
+        for m in ("forward_per_s", "reverse_per_s"):
+            row[f"new_over_old_{m}"] = row[f"new_{m}"]["median"] / row[f"old_{m}"]["median"]
+        rows.append(row)
+    for r in rows:
+        print(f"{r['case']:28s} forward old {r['old_forward_per_s']['median']:.3g} "
+              f"[{r['old_forward_per_s']['min']:.3g}, {r['old_forward_per_s']['max']:.3g}] "
+              f"new {r['new_forward_per_s']['median']:.3g} "
+              f"[{r['new_forward_per_s']['min']:.3g}, {r['new_forward_per_s']['max']:.3g}] "
+              f"new/old {r['new_over_old_forward_per_s']:.3f} | reverse new/old {r['new_over_old_reverse_per_s']:.3f}")
+    return dict(rows=rows, load_avg=_summary(loads), rounds=args.rounds, cpu=args.cpu,
+                collisions=args.collisions)
+
+
+def _study(build: str, study: str, extra: list[str]) -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        # engine_study.py writes into bench/results next to itself: run a copy in tmp
+        os.makedirs(os.path.join(tmp, "results"))
+        shutil.copy(os.path.join(HERE, "engine_study.py"), tmp)
+        env = dict(os.environ, PYTHONPATH=os.path.join(os.path.abspath(build), "pkg"), MPLBACKEND="Agg")
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, os.path.join(tmp, "engine_study.py"), study] + extra, check=True,
+                       env=env, capture_output=True)
+        with open(os.path.join(tmp, "results", f"engine_{study}.json")) as f:
+            out = json.load(f)
+        out["wall_s"] = time.perf_counter() - t0
+        return out
+
+
+def studies(args) -> dict:
+    out = {}
+    for study in ("horizon", "memory"):
+        for b, build in (("old", args.old), ("new", args.new)):
+            load = _load()
+            r = _study(build, study, [])
+            r["load_before"] = load
+            out[f"{study}_{b}"] = r
+            print(f"{study} {b}: done in {r['wall_s']:.0f} s (load {load:.2f})", flush=True)
+    for key in ("horizon",):
+        old, new = out[f"{key}_old"], out[f"{key}_new"]
+        same = [(a["err_x"], a["err_v"]) == (b["err_x"], b["err_v"]) for a, b in zip(old["rows"], new["rows"])]
+        out[f"{key}_rows_identical"] = all(same) and len(old["rows"]) == len(new["rows"])
+        for s_old, s_new in zip(old["horizon"], new["horizon"]):
+            print(f"horizon d={s_old['dim']} phi={s_old['phi']} {s_old['mode']}: old {s_old['horizon_collisions']} "
+                  f"new {s_new['horizon_collisions']}")
+        print(f"horizon rows bit-identical: {out[f'{key}_rows_identical']}")
+    mo, mn = out["memory_old"], out["memory_new"]
+    print(f"memory: peak RSS growth old {100 * mo['peak_rss_growth']:+.3f}% new {100 * mn['peak_rss_growth']:+.3f}%; "
+          f"last row old {mo['rows'][-1]} new {mn['rows'][-1]}")
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("what", choices=["throughput", "studies"])
+    ap.add_argument("old")
+    ap.add_argument("new")
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--collisions", type=int, default=1_000_000, help="per run (twice that at N = 1e5)")
+    ap.add_argument("--cpu", type=int, default=1, help="core to pin each run to (taskset); -1: no pinning")
+    args = ap.parse_args()
+    if args.cpu is not None and args.cpu < 0:
+        args.cpu = None
+    report = throughput(args) if args.what == "throughput" else studies(args)
+    report.update(command=" ".join(sys.argv), date=time.strftime("%Y-%m-%d %H:%M:%S %Z"), machine=os.uname().nodename,
+                  old=os.path.abspath(args.old), new=os.path.abspath(args.new))
+    os.makedirs(RESULTS, exist_ok=True)
+    path = os.path.join(RESULTS, f"ab_{args.what}.json")
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(report, f, indent=1)
+    os.replace(tmp, path)
+    print(f"wrote {os.path.relpath(path)}")
+
+
+if __name__ == "__main__":
+    main()
