@@ -220,6 +220,9 @@ TEST_CASE("cells: boundaries monotone, |B| = 2^62, close to cos/sin, exactly sym
     const i64 wy = static_cast<i64>(rng() >> (2 + rng() % 60)) - static_cast<i64>(rng() >> (2 + rng() % 60));
     if (wx == 0 && wy == 0) continue;
     const std::int64_t k = dir_cell(wx, wy);
+    CHECK(in_cell(wx, wy, k));
+    CHECK(!in_cell(wx, wy, (k + 1) & (kCells - 1)));
+    CHECK(!in_cell(wx, wy, (k - 1) & (kCells - 1)));
     for (int t = 1; t < 4; ++t) {
       const IVec r = rot90({wx, wy}, t);
       CHECK(dir_cell(r.x, r.y) == ((k + t * kQuarterTurn) & (kCells - 1)));
@@ -252,8 +255,9 @@ TEST_CASE("flux table: every f >= 1, total 2^48, decode exact at every boundary"
   std::mt19937_64 rng(9);
   for (int i = 0; i < 100000; ++i) {
     const std::uint64_t s = rng() >> 16;
-    const std::int64_t b = flux_decode(s);
-    if (!(flux_cum(b) <= s && s < flux_cum(b + 1))) ++bad;
+    std::uint64_t c, f;
+    const std::int64_t b = flux_decode(s, c, f);
+    if (!(flux_cum(b) <= s && s < flux_cum(b + 1) && c == flux_cum(b) && f == flux_cum(b + 1) - c)) ++bad;
   }
   CHECK(bad == 0);
   const LatticePair2D uni(1LL << 60, Law::uniform);
@@ -589,6 +593,39 @@ TEST_CASE("post law, uniform: KS against the uniform angle law; X grows ~1 bit p
   CHECK(r.p > 0.001);
   // head-on pre (cos = 1) and uniform post: E[log2(m/m2)] = -E[log2 cos theta] = 1 bit
   CHECK(rate > 0.9 && rate < 1.1);
+}
+
+TEST_CASE("X's size over a gas of pre states: bounded under flux, +0.557 bit/collision under uniform") {
+  // Random pre states with flux-law incidence (an equilibrium gas), X chained. Per collision X
+  // changes by log2(m f_post / (f_pre m2)), m ~ cos(pre), m2 ~ cos(post): under the flux law
+  // (f ~ cos) that is ~0 every time; under the uniform law its mean is
+  // E_flux[log2 cos] - E_uniform[log2 cos] = log2(e) (2 ln 2 - 1) = 0.5573 bit.
+  const long n = 20000;
+  for (const Law law : {Law::flux, Law::uniform}) {
+    const LatticePair2D op(1LL << 60, law);
+    Rng rng(law == Law::flux ? 61 : 62);
+    BitsBack X = random_bits(rng.gen, 256), X2;
+    const double start = static_cast<double>(X.bit_length());
+    double lo = start, hi = start;
+    int bad = 0;
+    for (long k = 0; k < n;) {
+      Vec2 q, w;
+      if (!make_pre(op.sigma(), 6.3 * rng.uni(), std::asin(2 * rng.uni() - 1), std::ldexp(1 + rng.uni(), 40), rng.uni(), q, w) ||
+          op.check_pre(q, w) != Refusal::none)
+        continue;
+      while (round_trip(op, q, w, rng.draw(), X, bad) != Refusal::none) {
+      }
+      lo = std::min(lo, static_cast<double>(X.bit_length()));
+      hi = std::max(hi, static_cast<double>(X.bit_length()));
+      ++k;
+    }
+    const double rate = (static_cast<double>(X.bit_length()) - start) / static_cast<double>(n);
+    std::printf("  %s: X %g -> %zu bits over %ld collisions (min %g, max %g): %.4f bit/collision\n", to_string(law), start,
+                X.bit_length(), n, lo, hi, rate);
+    CHECK(bad == 0);
+    if (law == Law::flux) CHECK(hi - lo <= 16);
+    if (law == Law::uniform) CHECK(std::fabs(rate - 0.5573) < 0.05);
+  }
 }
 
 int main(int argc, char** argv) {
