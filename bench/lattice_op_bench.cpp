@@ -176,6 +176,36 @@ std::vector<Metric> run_drift(std::uint64_t n) {
   return out;
 }
 
+// The fraction of draws the operator refuses with cell_readback (the lifting round-off moved
+// w2 across a cell boundary) at relative speeds 2^20 .. 2^44 lattice units per tick.
+std::vector<Metric> run_readback(std::uint64_t n) {
+  std::vector<Metric> out;
+  const LatticePair2D op(1LL << 60);
+  const BitsBack X = x256();
+  BitsBack x2 = X;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const double s = static_cast<double>(op.sigma());
+  for (int e = 20; e <= 44; e += 4) {
+    std::uint64_t tried = 0, readback = 0;
+    while (tried < n) {
+      const double ang = 2 * std::numbers::pi * U(rng), a = ang + std::numbers::pi + std::asin(2 * U(rng) - 1);
+      const double speed = std::ldexp(1.0 + U(rng), e), frac = U(rng);
+      const Vec2 w{static_cast<std::int64_t>(speed * std::cos(a)), static_cast<std::int64_t>(speed * std::sin(a))};
+      const Vec2 q{static_cast<std::int64_t>(s * std::cos(ang) - static_cast<double>(w[0]) * frac),
+                   static_cast<std::int64_t>(s * std::sin(ang) - static_cast<double>(w[1]) * frac)};
+      auto n2 = [](std::int64_t x, std::int64_t y) { return static_cast<__int128>(x) * x + static_cast<__int128>(y) * y; };
+      const __int128 s2 = static_cast<__int128>(op.sigma()) * op.sigma();
+      if (n2(q[0], q[1]) < s2 || n2(q[0] + w[0], q[1] + w[1]) >= s2 || op.check_pre(q, w) != Refusal::none) continue;
+      Vec2 q2, w2;
+      ++tried;
+      readback += op.forward(q, w, rng() >> 16, X, q2, w2, x2) == Refusal::cell_readback;
+    }
+    out.push_back({"readback_at_2^" + std::to_string(e), static_cast<double>(readback) / static_cast<double>(n)});
+  }
+  return out;
+}
+
 }  // namespace
 
 void add_lattice_op_benches(std::vector<Bench>& out) {
@@ -185,6 +215,7 @@ void add_lattice_op_benches(std::vector<Bench>& out) {
   out.push_back({"lattice/pair2d/uniform/forward", "calls",
                  [](std::uint64_t n) { return run_forward(revcol::Law::uniform, n); }});
   out.push_back({"lattice/pair2d/drift", "collisions", [](std::uint64_t n) { return run_drift(n); }});
+  out.push_back({"lattice/pair2d/readback", "draws per speed", [](std::uint64_t n) { return run_readback(n); }});
 }
 
 }  // namespace revcol::bench
