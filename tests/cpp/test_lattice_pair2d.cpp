@@ -493,6 +493,19 @@ TEST_CASE("edges: head-on, grazing, each face, axis-parallel, tiny and huge spee
   CHECK(accepted > 2500);
 }
 
+// A pre state with p within `depth` |w| inside the circle, within `width` |w| along it of one
+// of the 4 corners where the circle meets a diagonal, -w within +-spread/2 rad of the normal.
+static bool corner_pre(Rng& rng, i64 S, double V, double depth, double width, double spread, Vec2& q, Vec2& w) {
+  const double corner = (2 * static_cast<int>(rng.gen() % 4) + 1) * std::numbers::pi / 4;
+  const double r = static_cast<double>(S) - V * depth * rng.uni();
+  const double ang = corner + (rng.uni() - 0.5) * width * V / static_cast<double>(S);
+  const Vec2 p{static_cast<i64>(r * std::cos(ang)), static_cast<i64>(r * std::sin(ang))};
+  const double a = ang + std::numbers::pi + (rng.uni() - 0.5) * spread;
+  w = {static_cast<i64>(V * std::cos(a)), static_cast<i64>(V * std::sin(a))};
+  q = sub(p, w);
+  return norm2(q) >= sq(S) && norm2(p) < sq(S);
+}
+
 TEST_CASE("face corners: phase intervals that reach the diagonal (odd faces exclude it)") {
   // p within a few |w| of a corner where the circle meets a diagonal: the pre and post phase
   // columns run into the face boundary, and a post phase on the diagonal of an odd face would
@@ -504,14 +517,8 @@ TEST_CASE("face corners: phase intervals that reach the diagonal (odd faces excl
   int bad = 0, accepted = 0, tried = 0;
   for (int t = 0; t < 40000; ++t) {
     const double V = std::ldexp(1.0 + rng.uni(), 18 + static_cast<int>(rng.gen() % 6));
-    const double corner = (2 * static_cast<int>(rng.gen() % 4) + 1) * std::numbers::pi / 4;
-    const double r = static_cast<double>(S) - V * rng.uni();
-    const double ang = corner + (rng.uni() - 0.5) * 6 * V / static_cast<double>(S);
-    const Vec2 p{static_cast<i64>(r * std::cos(ang)), static_cast<i64>(r * std::sin(ang))};
-    const double a = ang + std::numbers::pi + (rng.uni() - 0.5) * 3.0;  // inward, up to +-86 deg
-    const Vec2 w{static_cast<i64>(V * std::cos(a)), static_cast<i64>(V * std::sin(a))};
-    const Vec2 q = sub(p, w);
-    if (norm2(q) < sq(S) || norm2(p) >= sq(S)) continue;
+    Vec2 q, w;
+    if (!corner_pre(rng, S, V, 1.0, 6.0, 3.0, q, w)) continue;  // inward, up to +-86 deg
     ++tried;
     accepted += round_trip(op, q, w, rng.draw(), X, bad) == Refusal::none;
   }
@@ -531,15 +538,10 @@ TEST_CASE("face corners: post phases steered onto the lowest point of an odd fac
   const LatticePair2D op(S);
   int bad = 0, at_diagonal = 0, accepted = 0;
   for (int t = 0; t < 400; ++t) {
-    const double V = std::ldexp(1.0 + rng.uni(), 24);
-    const double corner = (2 * static_cast<int>(rng.gen() % 4) + 1) * std::numbers::pi / 4;
-    const double ang = corner + (rng.uni() - 0.5) * 2 * V / static_cast<double>(S);
-    const double r = static_cast<double>(S) - V * rng.uni() * 0.5;
-    const Vec2 p{static_cast<i64>(r * std::cos(ang)), static_cast<i64>(r * std::sin(ang))};
-    const double a = ang + std::numbers::pi + (rng.uni() - 0.5) * 2.0;
-    const Vec2 w{static_cast<i64>(V * std::cos(a)), static_cast<i64>(V * std::sin(a))};
-    const Vec2 q = sub(p, w);
-    if (norm2(q) < sq(S) || norm2(p) >= sq(S) || op.check_pre(q, w) != Refusal::none) continue;
+    Vec2 q, w;
+    if (!corner_pre(rng, S, std::ldexp(1.0 + rng.uni(), 24), 0.5, 2.0, 2.0, q, w) || op.check_pre(q, w) != Refusal::none)
+      continue;
+    const Vec2 p = add(q, w);
     const int f = face_of(p[0], p[1]);
     const IVec P = rot90({p[0], p[1]}, f), W = rot90({w[0], w[1]}, f);
     const i64 lo = *lo_pre(sq(S), P.x, f & 1, W.x, W.y);
