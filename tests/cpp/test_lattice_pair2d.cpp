@@ -572,6 +572,31 @@ TEST_CASE("face corners: post phases steered onto the lowest point of an odd fac
   CHECK(at_diagonal > 20);
 }
 
+TEST_CASE("small sigma (2 .. 1000): every pre state either refused cleanly or exact") {
+  // At a few lattice units per diameter almost every draw is refused by the read-back (w has
+  // too few directions); what is accepted must still invert exactly.
+  Rng rng(606);
+  BitsBack X = random_bits(rng.gen, 128);
+  int bad = 0, accepted = 0, tried = 0;
+  for (const i64 S : {2LL, 3LL, 5LL, 17LL, 1000LL}) {
+    const LatticePair2D op(S);
+    for (i64 px = -S; px <= S; ++px)
+      for (i64 py = -S; py <= S; ++py)
+        for (i64 wx = -3; wx <= 3; ++wx)
+          for (i64 wy = -3; wy <= 3; ++wy) {
+            const Vec2 p{px * std::max<i64>(1, S / 8), py * std::max<i64>(1, S / 8)}, w{wx * (S + 1) / 3, wy * (S + 1) / 3};
+            const Vec2 q = sub(p, w);
+            if (norm2(q) < sq(S) || norm2(p) >= sq(S)) continue;
+            ++tried;
+            accepted += round_trip(op, q, w, rng.draw(), X, bad) == Refusal::none;
+          }
+  }
+  std::printf("  small sigma: %d pre states, %d accepted\n", tried, accepted);
+  CHECK(bad == 0);
+  CHECK(tried > 1000);
+  CHECK(accepted > 0);
+}
+
 TEST_CASE("refusals: G-independent ones agree with check_pre; X and X_out stay equal") {
   Rng rng(41);
   const LatticePair2D op(1LL << 60);

@@ -10,7 +10,8 @@
 //     strictly |px| < py). In that frame p = (xc, Py), w = (Wx, Wy); the column xc is fixed.
 //  2. Phase interval: the inside points of column xc in the face, Y <= Yin = isqrt(sigma^2 -
 //     xc^2 - 1), Y >= max(1, |xc| + (f odd)), whose point minus W is outside, form [lo, Yin]
-//     (exact integer square roots; if they do not form an interval: out_of_domain);
+//     (exact integer square roots; if they do not form an interval, or p = 0 has no face:
+//     out_of_domain);
 //     m = Yin - lo + 1. X <- X*m + (Py - lo).
 //  3. Pre direction: jn = normal cell of column xc, jd = cell of W, jpre = ((jd - jn) mod ND)
 //     - ND/2 is the cell of -W about the normal; it must lie in [-ND/4, ND/4) (else
