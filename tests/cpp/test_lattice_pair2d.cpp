@@ -202,6 +202,7 @@ TEST_CASE("cells: boundaries monotone, |B| = 2^62, close to cos/sin, exactly sym
   IVec prev = boundary(0);
   for (std::int64_t h = 1; h <= (1LL << 21); ++h) {
     const IVec b = boundary(h);
+    if (boundary_x(h) != b.x || boundary_y(h) != b.y) CHECK(boundary_x(h) == b.x && boundary_y(h) == b.y);
     const i128 cr = static_cast<i128>(prev.x) * b.y - static_cast<i128>(prev.y) * b.x;
     const i128 dt = static_cast<i128>(prev.x) * b.x + static_cast<i128>(prev.y) * b.y;
     if (!(cr > 0 && dt > 0)) CHECK(cr > 0 && dt > 0);
