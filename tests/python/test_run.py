@@ -352,7 +352,7 @@ def _has(module: str) -> bool:
 def test_ctrl_c_ends_a_statesave_study_after_the_run_under_way(tmp_path, capsys, monkeypatch):
     # the SIGINT arrives during the first run (each run is one C++ call): the study ends
     # after it, reports that run, writes the JSON, and exits 130
-    import revcol.statesave as ss
+    import revcol.statesave_study as ss
 
     real = ss._run_inline
     calls = []
