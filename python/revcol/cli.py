@@ -76,7 +76,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _summary(r: dict) -> str:
-    from .run import _verify_lines
+    from .report import verify_lines as _verify_lines
 
     mode = r["mode"] + (f"/{r['law']}" if r["mode"] == "exact" and r["case"] != "pair1d" else "")
     return "\n".join([f"revcol verify {r['case']}  mode={mode}  rng={r['rng']}  seed={r['seed']}"] + _verify_lines(r))

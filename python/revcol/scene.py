@@ -31,7 +31,7 @@ particles overlapping) by building the engine from it once.
     packing_fraction = 0.3        # sets a cubic box; or give box = [Lx, Ly]
     boundaries = "walls"          # "walls" | "periodic", or one per axis
     start = "auto"                # "auto" | "random" (sequential addition) | "lattice";
-                                  # an explicit box always starts on a jittered lattice
+                                  # auto: random at low packing fraction, else lattice
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
 
@@ -345,7 +345,7 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         for key in ("start", "kinetic_energy"):
             if ("system", key) in values:
                 raise _fail(source, f"[system] {key}", "applies to random starts only, not with initial_state")
-        arrays = _read_initial(source, initial_path, d)
+        arrays = read_initial(source, initial_path, d)
         if n is not None and n != arrays[0].shape[0]:
             raise _fail(source, "[system] particles", f"is {n} but initial_state holds {arrays[0].shape[0]} particles")
         n = int(arrays[0].shape[0])
@@ -384,9 +384,6 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
                         f"({3 * sigma:g}); make it larger or use walls")
 
     start = get("system", "start", "auto")
-    if start == "random" and get("system", "box") is not None:
-        raise _fail(source, "[system] start", "'random' (sequential addition) needs packing_fraction; "
-                    "an explicit box starts on a jittered lattice ('auto' or 'lattice')")
 
     if mode == "paper" and d != 2:
         raise _fail(source, "[collisions] mode",
@@ -453,7 +450,9 @@ def _statesave(source, get, common, mode, law, out) -> Scene:
                  json=out("json"), plot=out("plot"), **common)
 
 
-def _read_initial(source: str, path: Path, d: int):
+def read_initial(source: str, path: Path, d: int):
+    """The (positions, velocities) arrays of an initial-state file, each (N, d); SceneError
+    naming ``[system] initial_state`` when the file is missing, unreadable or misshapen."""
     import numpy as np
 
     where = "[system] initial_state"
@@ -481,6 +480,9 @@ def _check_initial(source: str, scene: Scene, x, v) -> None:
         Simulation(x, v, scene.box, **engine_options(scene))
     except ValueError as e:
         raise _fail(source, "[system] initial_state", f"{scene.initial_state.name}: {e}") from None
+
+
+_read_initial = read_initial  # its name before it was public
 
 
 # scene files say "walls" (a box has two per axis); the engine says "wall"

@@ -159,8 +159,6 @@ def test_kinds():
      "[rng] seed: must be 0..4294967295"),
     ({"system": {"dimension": 2, "particles": 5, "box": [2.5, 9.0], "boundaries": ["periodic", "walls"]}},
      "[system] box: periodic axis 0 length 2.5 is under 3 diameters"),
-    ({"system": {"dimension": 2, "particles": 5, "box": [9.0, 9.0], "start": "random"}},
-     "[system] start: 'random' (sequential addition) needs packing_fraction"),
     ({"system": {"dimension": 2, "particles": 1, "packing_fraction": 0.1}},
      "[run] collisions: a single particle never collides"),
     ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.1}, "output": {"trajectory": "t.pdb"}},
@@ -195,3 +193,9 @@ def test_initial_state_checked_by_the_engine(tmp_path):
     with pytest.raises(SceneError, match=r"\[system\] kinetic_energy: applies to random starts only"):
         load_scene(write(tmp_path, "[system]\ndimension = 2\ninitial_state = 'ok.npz'\nbox = [5.0, 5.0]\n"
                                    "kinetic_energy = 3.0\n"))
+
+
+def test_random_start_in_an_explicit_box():
+    s = scene_from_dict({"system": {"dimension": 2, "particles": 20, "box": [30.0, 6.0], "start": "random"}},
+                        "s.toml")
+    assert s.start == "random" and s.packing_fraction is None
