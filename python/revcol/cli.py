@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 
 from . import statesave
 from .verify import VERIFY_CASES, verify
@@ -82,6 +83,10 @@ def _summary(r: dict) -> str:
     return "\n".join([f"revcol verify {r['case']}  mode={mode}  rng={r['rng']}  seed={r['seed']}"] + _verify_lines(r))
 
 
+def _warn_line(message, category, *rest) -> None:
+    print(f"revcol run: warning: {message}", file=sys.stderr)
+
+
 def _run(args: argparse.Namespace) -> int:
     """``revcol run``: exit 0 passed, 1 failed, 2 bad scene/option, 130 interrupted."""
     from .run import format_report, run_scene
@@ -91,10 +96,13 @@ def _run(args: argparse.Namespace) -> int:
         print("revcol run: error: --seeds applies to --horizon only", file=sys.stderr)
         return 2
     try:
-        report = run_scene(args.scene, json_path=args.json, plot=args.plot, trajectory=args.trajectory,
-                           horizon_seeds=(args.seeds or 1) if args.horizon else None,
-                           max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
-                           progress=False if args.no_progress else None)
+        with warnings.catch_warnings():  # a scene's deprecated spellings: one line each on stderr
+            warnings.simplefilter("always", DeprecationWarning)
+            warnings.showwarning = _warn_line
+            report = run_scene(args.scene, json_path=args.json, plot=args.plot, trajectory=args.trajectory,
+                               horizon_seeds=(args.seeds or 1) if args.horizon else None,
+                               max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
+                               progress=False if args.no_progress else None)
     except SceneError as e:
         print(f"revcol run: error: {e}", file=sys.stderr)
         return 2

@@ -78,7 +78,7 @@ def test_default_report_cli(tmp_path, capsys):
     assert "\r" not in text  # no progress bar when stdout is not a terminal
     r = json.loads(out.read_text())
     assert r["passed"] and r["collisions_forward"] == r["collisions_back"] == 1000
-    assert r["scene"]["generator"] == "clcg4" and r["scene"]["streams"] == "per-particle"
+    assert r["scene"]["generator"] == "clcg4" and r["scene"]["streams"] == "per_particle"
     assert r["forward_per_s"] > 0 and r["reverse_per_s"] > 0 and r["peak_rss_bytes"] > 0
     assert set(r["error_definitions"]) == {"error_x", "error_v"}
 
@@ -215,7 +215,7 @@ def test_bad_scene_files_one_line_exit_2(tmp_path, capsys, text, needle):
 @pytest.mark.parametrize("start", ["auto", "random", "lattice"])
 def test_explicit_box_starts_from_the_engine(start):
     doc = {"system": {"dimension": 3, "particles": 60, "box": [5.0, 6.0, 9.0], "start": start,
-                      "boundaries": ["walls", "periodic", "walls"], "kinetic_energy": 30.0},
+                      "boundaries": ["wall", "periodic", "wall"], "kinetic_energy": 30.0},
            "run": {"collisions": 60}}
     scene = scene_from_dict(doc, "box.toml")
     sim = build_simulation(scene)
@@ -234,6 +234,17 @@ def test_a_lattice_that_does_not_fit_is_a_scene_error():
     doc = {"system": {"dimension": 2, "particles": 9, "box": [3.5, 3.5], "start": "lattice"}}
     with pytest.raises(SceneError, match=r"\[system\] box: 9 particles of diameter 1.* do not fit on a lattice"):
         build_simulation(scene_from_dict(doc, "tight.toml"))
+
+
+def test_deprecated_spellings_warn_on_stderr_and_run(tmp_path, capsys):
+    p = tmp_path / "old.toml"
+    p.write_text("[system]\ndimension = 1\nparticles = 50\npacking_fraction = 0.3\nboundaries = 'walls'\n"
+                 "[rng]\nstreams = 'per-particle'\n[run]\ncollisions = 100\n")
+    assert cli_main(["run", str(p), "--no-progress"]) == 0
+    cap = capsys.readouterr()
+    assert f"revcol run: warning: {p}: [system] boundaries: 'walls' is deprecated, write 'wall'" in cap.err
+    assert f"revcol run: warning: {p}: [rng] streams: 'per-particle' is deprecated, write 'per_particle'" in cap.err
+    assert "result           PASSED" in cap.out and "(wall)" in cap.out
 
 
 def test_checkpoints_resume_and_reverse(tmp_path):
