@@ -235,7 +235,8 @@ InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, do
     return use_rsa ? place_rsa(g, n, pos, s.x) : place_lattice(g, n, pos, s.x);
   };
   if (!place(rsa) && !(fallback && place(!rsa))) {
-    if (rsa && !fallback) throw InvalidArgument("random sequential addition did not place every particle; use init='lattice'");
+    if (rsa && !fallback)
+      throw InvalidArgument("random sequential addition did not place every particle; use init='lattice'");
     throw InvalidArgument(std::to_string(n) + " particles of diameter " + std::to_string(c.diameter) +
                           " do not fit on a lattice in this box (nearest sites closer than D)" +
                           (fallback ? ", nor by random sequential addition" : "") +

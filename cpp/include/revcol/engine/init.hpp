@@ -7,12 +7,13 @@
 // ("lattice"): m_k sites per axis (square in 1D/2D; face-centred cubic in 3D, 4 sites per
 // cell) until the sites hold N: a cube takes the same m on every axis, any other box
 // refines one axis at a time, the one whose refined spacing (hi_k - lo_k) / (m_k + 1) is the
-// widest (so the smallest spacing of the counts that hold N is the largest). Sites sit
-// at the cell centres of [lo_k, hi_k] (lo, hi: the centre range, D/2 (1 + 2e-6) inside a
-// wall, [0, L) on a periodic axis), N of them chosen at random, each moved by up to j = 0.49 (s - D) / sqrt(d) per axis,
-// s the nearest-site distance: any two particles stay s - 2 sqrt(d) j > D apart. "auto" picks
-// rsa when the packing fraction is at most limits::rsa_fraction(d), and tries the other
-// placement when the first fails.
+// widest (so the smallest spacing of the counts that hold N is the largest). Sites sit at
+// the cell centres of [lo_k, hi_k] (lo, hi: the centre range, D/2 (1 + 2e-6) inside a wall,
+// [0, L) on a periodic axis); N of them are chosen at random and each is moved by up to
+// j = 0.49 (s - D) / sqrt(d) per axis, s the nearest-site distance (the smallest spacing a1;
+// in 3D min(a1, |(a1, a2)| / 2) over the two smallest), so any two particles stay
+// s - 2 sqrt(d) j = s - 0.98 (s - D) > D apart. "auto" picks rsa when the packing fraction
+// is at most limits::rsa_fraction(d), and tries the other placement when the first fails.
 //
 // Velocities. Gaussian components with the mean removed (zero momentum; not for N = 1),
 // scaled to the kinetic energy asked (<= 0: N d / 2, that is kT = 1 at unit mass); or, with
