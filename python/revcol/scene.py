@@ -349,7 +349,12 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         return _reversal(source, get, common, mode, law, out)
     if kind == "statesave":
         return _statesave(source, get, common, mode, law, out)
+    return _gas(source, get, values, base, common, mode, law, out)
 
+
+def _gas(source, get, values, base, common, mode, law, out) -> Scene:
+    """A gas scene from its checked fields (``values``; ``get`` reads one with a default)."""
+    name = common["name"]
     d = get("system", "dimension")
     if d is None:
         raise _fail(source, "[system] dimension", "is required (1, 2 or 3)")
