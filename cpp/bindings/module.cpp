@@ -15,4 +15,5 @@ PYBIND11_MODULE(_core, m) {
   revcol::bind::register_paper(m);
   revcol::bind::register_statesave(m);
   revcol::bind::register_engine(m);
+  revcol::bind::register_engine_init(m);
 }

@@ -1,19 +1,21 @@
-// Random initial states for the engine: random sequential addition or a jittered lattice,
-// Gaussian (or equal-speed) velocities. Draws come from Philox keys {stream, seed} with
-// streams 0xFFFFFF00+ (never a particle id the engine uses for collisions).
+// Random initial states for the engine (engine/init.hpp): random sequential addition or a
+// jittered lattice in any box, Gaussian (or equal-speed) velocities. Draws come from Philox
+// keys {stream, seed} with streams 0xFFFFFF00+ (never a particle id the engine uses for
+// collisions).
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <string>
+#include <vector>
 
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
+#include "revcol/engine/limits.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/philox.hpp"
 
 namespace revcol::engine {
 namespace {
-
-constexpr double kPi = 3.141592653589793238462643383279502884;
 
 struct Draws {
   rng::Philox gen;
@@ -22,193 +24,295 @@ struct Draws {
   double u() { return gen.next(); }
   double normal() {  // Box-Muller, one value per call (the other discarded: simple, deterministic)
     const double a = u(), b = u();
-    return std::sqrt(-2.0 * std::log(a)) * std::cos(2.0 * kPi * b);
+    return std::sqrt(-2.0 * std::log(a)) * std::cos(2.0 * limits::kPi * b);
   }
 };
 
-}  // namespace
+// The box as the placements see it: per axis its length, whether it is walled, and the
+// range [lo, hi] a centre may take (a wall keeps centres D/2 (1 + 2e-6) inside).
+struct Geometry {
+  int d = 0;
+  double D = 1.0;
+  double L[3] = {1, 1, 1}, lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  bool wall[3] = {false, false, false};
 
-double particle_volume(int d, double D) {
-  if (d == 1) return D;
-  if (d == 2) return kPi * D * D / 4.0;
-  return kPi * D * D * D / 6.0;
+  Geometry(const Config& c) : d(c.dim), D(c.diameter) {
+    for (int k = 0; k < d; ++k) {
+      L[k] = c.box[k];
+      wall[k] = c.boundary[k] == Boundary::wall;
+      // a margin of 1e-6 D from the walls: a particle touching a wall at the start would be
+      // at an event at t0, which a reversed run cannot tell from a departure (engine.hpp)
+      lo[k] = wall[k] ? 0.5 * D * (1.0 + limits::kWallMargin) : 0.0;
+      hi[k] = wall[k] ? L[k] - 0.5 * D * (1.0 + limits::kWallMargin) : L[k];
+    }
+  }
+};
+
+// Random sequential addition into x (n x d); false when it gives up.
+bool place_rsa(const Geometry& g, std::size_t n, Draws& pos, std::vector<double>& x) {
+  const int d = g.d;
+  int nc[3] = {1, 1, 1};
+  double cw[3] = {1, 1, 1};
+  std::size_t total = 1;
+  for (int k = 0; k < d; ++k) {
+    nc[k] = std::max(1, static_cast<int>(std::floor(g.L[k] / g.D)));
+    cw[k] = g.L[k] / nc[k];
+    total *= static_cast<std::size_t>(nc[k]);
+  }
+  std::vector<std::vector<int>> cells(total);
+  const double min2 = g.D * g.D * (1.0 + limits::kMinGap);
+  const std::size_t max_tries = 1000 * n + 100000;
+  const int noff = d == 1 ? 3 : d == 2 ? 9 : 27;
+  std::size_t tries = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (;;) {
+      if (++tries >= max_tries) return false;
+      double p[3];
+      int cc[3];
+      for (int k = 0; k < d; ++k) {
+        p[k] = g.lo[k] + (g.hi[k] - g.lo[k]) * pos.u();
+        if (p[k] >= g.L[k]) p[k] = 0.0;
+        cc[k] = std::min(nc[k] - 1, static_cast<int>(p[k] / cw[k]));
+      }
+      bool ok = true;
+      for (int o = 0; o < noff && ok; ++o) {  // the 3^d cells around, periodic images included
+        int rem = o;
+        std::size_t id = 0, stride = 1;
+        double sh[3] = {0, 0, 0};
+        bool in = true;
+        for (int k = 0; k < d; ++k) {
+          int ck = cc[k] + rem % 3 - 1;
+          rem /= 3;
+          if (ck < 0 || ck >= nc[k]) {
+            if (g.wall[k] || nc[k] < 3) { in = false; break; }
+            if (ck < 0) { ck += nc[k]; sh[k] = -g.L[k]; } else { ck -= nc[k]; sh[k] = g.L[k]; }
+          }
+          id += static_cast<std::size_t>(ck) * stride;
+          stride *= static_cast<std::size_t>(nc[k]);
+        }
+        if (!in) continue;
+        for (int j : cells[id]) {
+          double r2 = 0.0;
+          for (int k = 0; k < d; ++k) {
+            const double dx = p[k] - (x[j * d + k] + sh[k]);
+            r2 += dx * dx;
+          }
+          if (r2 < min2) { ok = false; break; }
+        }
+      }
+      if (!ok) continue;
+      std::size_t id = 0, stride = 1;
+      for (int k = 0; k < d; ++k) {
+        x[i * d + k] = p[k];
+        id += static_cast<std::size_t>(cc[k]) * stride;
+        stride *= static_cast<std::size_t>(nc[k]);
+      }
+      cells[id].push_back(static_cast<int>(i));
+      break;
+    }
+  }
+  return true;
 }
 
-InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t seed, double energy,
-                          const std::string& init, bool equal_speeds) {
-  require(c.dim >= 1 && c.dim <= 3, "dim must be 1, 2 or 3");
-  require(n > 0, "no particles (N = 0)");
-  require(std::isfinite(phi) && phi > 0.0, "packing fraction must be finite and > 0");
-  require(std::isfinite(c.diameter) && c.diameter > 0.0, "diameter must be finite and > 0");
-  require(seed <= 0xFFFFFFFFu, "seed must be < 2^32");
-  require(init == "auto" || init == "rsa" || init == "lattice",
-          "init must be 'auto', 'rsa' or 'lattice', got '" + init + "'");
-  const int d = c.dim;
-  const double maxphi = d == 1 ? 0.95 : d == 2 ? 0.75 : 0.7;
-  require(phi <= maxphi, "packing fraction " + std::to_string(phi) + " above what the initialiser reaches (" +
-                             std::to_string(maxphi) + " in " + std::to_string(d) + "D)");
-  const double D = c.diameter;
-  const double L = std::pow(static_cast<double>(n) * particle_volume(d, D) / phi, 1.0 / d);
-  for (int k = 0; k < 3; ++k) c.box[k] = k < d ? L : 1.0;
-  const double rsa_max = d == 1 ? 0.3 : d == 2 ? 0.35 : 0.2;
-  const bool rsa = init == "rsa" || (init == "auto" && phi <= rsa_max);
-  InitialState s;
-  s.x.assign(n * d, 0.0);
-  s.v.assign(n * d, 0.0);
-  Draws vel(0xFFFFFF01u, seed);
-  // per-axis allowed centre range
-  double lo[3], hi[3];
-  for (int k = 0; k < d; ++k) {
-    const bool wall = c.boundary[k] == Boundary::wall;
-    // a margin of 1e-6 D from the walls: a particle touching a wall at the start would be
-    // at an event at t0, which a reversed run cannot tell from a departure (engine.hpp)
-    lo[k] = wall ? 0.5 * D * (1.0 + 2e-6) : 0.0;
-    hi[k] = wall ? L - 0.5 * D * (1.0 + 2e-6) : L;
+// The nearest-site distance of a lattice of spacings a[0..d): square (1D/2D) or
+// face-centred cubic (3D: min(a1, |(a1, a2)| / 2) over the two smallest spacings, written
+// so that a cube gives a / sqrt(2) to the bit).
+double nearest_site(int d, const double* a) {
+  double s0 = a[0], s1 = d > 1 ? a[1] : a[0];  // the two smallest spacings, s0 <= s1
+  if (s1 < s0) std::swap(s0, s1);
+  if (d < 3) return s0;
+  if (a[2] < s0) {
+    s1 = s0;
+    s0 = a[2];
+  } else if (a[2] < s1) {
+    s1 = a[2];
   }
-  // positions: the preferred method, and under "auto" the other one if it fails
-  auto place = [&](bool use_rsa) {
-    Draws pos(0xFFFFFF00u, seed);
-    if (use_rsa) {
-      const int nc = std::max(1, static_cast<int>(std::floor(L / D)));
-      const double cw = L / nc;
-      std::size_t total = 1;
-      for (int k = 0; k < d; ++k) total *= static_cast<std::size_t>(nc);
-      std::vector<std::vector<int>> cells(total);
-      const double min2 = D * D * (1.0 + 1e-12);
-      const std::size_t max_tries = 1000 * n + 100000;
-      std::size_t tries = 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        for (;;) {
-          require(++tries < max_tries, "random sequential addition did not place every particle; use init='lattice'");
-          double p[3];
-          int cc[3];
-          for (int k = 0; k < d; ++k) {
-            p[k] = lo[k] + (hi[k] - lo[k]) * pos.u();
-            if (p[k] >= L) p[k] = 0.0;
-            cc[k] = std::min(nc - 1, static_cast<int>(p[k] / cw));
-          }
-          bool ok = true;
-          const int noff = d == 1 ? 3 : d == 2 ? 9 : 27;
-          for (int o = 0; o < noff && ok; ++o) {
-            int rem = o;
-            std::size_t id = 0, stride = 1;
-            double sh[3] = {0, 0, 0};
-            bool in = true;
-            for (int k = 0; k < d; ++k) {
-              int ck = cc[k] + rem % 3 - 1;
-              rem /= 3;
-              if (ck < 0 || ck >= nc) {
-                if (c.boundary[k] == Boundary::wall || nc < 3) { in = false; break; }
-                if (ck < 0) { ck += nc; sh[k] = -L; } else { ck -= nc; sh[k] = L; }
-              }
-              id += static_cast<std::size_t>(ck) * stride;
-              stride *= static_cast<std::size_t>(nc);
-            }
-            if (!in) continue;
-            for (int j : cells[id]) {
-              double r2 = 0.0;
-              for (int k = 0; k < d; ++k) {
-                const double dx = p[k] - (s.x[j * d + k] + sh[k]);
-                r2 += dx * dx;
-              }
-              if (r2 < min2) { ok = false; break; }
-            }
-          }
-          if (!ok) continue;
-          std::size_t id = 0, stride = 1;
-          for (int k = 0; k < d; ++k) {
-            s.x[i * d + k] = p[k];
-            id += static_cast<std::size_t>(cc[k]) * stride;
-            stride *= static_cast<std::size_t>(nc);
-          }
-          cells[id].push_back(static_cast<int>(i));
-          break;
-        }
-      }
-    } else {
-      // a lattice of `sites` >= n sites (square in 1D/2D, face-centred cubic in 3D: 4 per
-      // cubic cell), a random subset of n of them, each displaced by up to `jitter` per axis
-      const int basis = d == 3 ? 4 : 1;
-      int m = 1;
-      while (std::pow(static_cast<double>(m), d) * basis < static_cast<double>(n)) ++m;
-      // spacing per axis: the lattice spans [lo, hi] (walls: centres stay D/2 inside)
-      double a = L;
-      double ak[3];
-      for (int k = 0; k < d; ++k) {
-        ak[k] = (hi[k] - lo[k]) / m;
-        a = std::min(a, ak[k]);
-      }
-      const double nearest = d == 3 ? a / std::sqrt(2.0) : a;
-      require(nearest >= D * (1.0 + 1e-9), "packing fraction too high for a lattice start");
-      const double jitter = 0.49 * (nearest - D) / std::sqrt(static_cast<double>(d));
-      static constexpr double fcc[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
-      std::size_t sites = basis;
-      for (int k = 0; k < d; ++k) sites *= static_cast<std::size_t>(m);
-      std::vector<std::size_t> idx(sites);
-      std::iota(idx.begin(), idx.end(), std::size_t{0});
-      for (std::size_t i = 0; i < n; ++i) {  // partial Fisher-Yates
-        const std::size_t j = i + static_cast<std::size_t>(pos.u() * static_cast<double>(sites - i));
-        std::swap(idx[i], idx[std::min(j, sites - 1)]);
-      }
-      std::sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(n));
-      for (std::size_t i = 0; i < n; ++i) {
-        std::size_t q = idx[i];
-        const std::size_t b = q % static_cast<std::size_t>(basis);
-        q /= static_cast<std::size_t>(basis);
-        for (int k = 0; k < d; ++k) {
-          const int ck = static_cast<int>(q % static_cast<std::size_t>(m));
-          q /= static_cast<std::size_t>(m);
-          const double off = d == 3 ? fcc[b][k] + 0.25 : 0.5;
-          double p = lo[k] + (ck + off) * ak[k] + jitter * (2.0 * pos.u() - 1.0);
-          p = std::clamp(p, lo[k], hi[k]);
-          if (p >= L) p -= L;
-          s.x[i * d + k] = p;
-        }
-      }
-    }
+  const double r = s1 / s0;
+  return std::min(s0, s0 / std::sqrt(2.0) * std::sqrt(0.5 * (1.0 + r * r)));
+}
+
+// A jittered lattice into x (n x d); false when the sites are closer than D.
+bool place_lattice(const Geometry& g, std::size_t n, Draws& pos, std::vector<double>& x) {
+  const int d = g.d;
+  const int basis = d == 3 ? 4 : 1;
+  int m[3] = {1, 1, 1};
+  auto sites_of = [&] {
+    std::size_t s = static_cast<std::size_t>(basis);
+    for (int k = 0; k < d; ++k) s *= static_cast<std::size_t>(m[k]);
+    return s;
   };
-  if (init != "auto") {
-    place(rsa);
-  } else {
-    try {
-      place(rsa);
-    } catch (const InvalidArgument&) {
-      place(!rsa);
+  bool cube = true;
+  for (int k = 1; k < d; ++k) cube = cube && g.L[k] == g.L[0];
+  while (sites_of() < n) {
+    if (cube) {  // the same m on every axis, as random_state always did
+      for (int k = 0; k < d; ++k) ++m[k];
+      continue;
+    }
+    // else refine the axis whose refined spacing stays widest (ties: the lowest axis): the
+    // counts that hold N with the largest smallest spacing
+    int best = 0;
+    for (int k = 1; k < d; ++k)
+      if ((g.hi[k] - g.lo[k]) / (m[k] + 1) > (g.hi[best] - g.lo[best]) / (m[best] + 1)) best = k;
+    ++m[best];
+  }
+  double ak[3] = {1.0, 1.0, 1.0};
+  for (int k = 0; k < d; ++k) ak[k] = (g.hi[k] - g.lo[k]) / m[k];
+  const double nearest = nearest_site(d, ak);
+  if (!(nearest >= g.D * (1.0 + limits::kLatticeGap))) return false;
+  const double jitter = 0.49 * (nearest - g.D) / std::sqrt(static_cast<double>(d));
+  static constexpr double fcc[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
+  const std::size_t sites = sites_of();
+  std::vector<std::size_t> idx(sites);
+  std::iota(idx.begin(), idx.end(), std::size_t{0});
+  for (std::size_t i = 0; i < n; ++i) {  // partial Fisher-Yates
+    const std::size_t j = i + static_cast<std::size_t>(pos.u() * static_cast<double>(sites - i));
+    std::swap(idx[i], idx[std::min(j, sites - 1)]);
+  }
+  std::sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t q = idx[i];
+    const std::size_t b = q % static_cast<std::size_t>(basis);
+    q /= static_cast<std::size_t>(basis);
+    for (int k = 0; k < d; ++k) {
+      const int ck = static_cast<int>(q % static_cast<std::size_t>(m[k]));
+      q /= static_cast<std::size_t>(m[k]);
+      const double off = d == 3 ? fcc[b][k] + 0.25 : 0.5;
+      double p = g.lo[k] + (ck + off) * ak[k] + jitter * (2.0 * pos.u() - 1.0);
+      p = std::clamp(p, g.lo[k], g.hi[k]);
+      if (p >= g.L[k]) p -= g.L[k];
+      x[i * d + k] = p;
     }
   }
-  // velocities
+  return true;
+}
+
+// Velocities into v (n x d): see init.hpp.
+void draw_velocities(int d, std::size_t n, std::uint64_t seed, double energy, bool equal_speeds,
+                     std::vector<double>& v) {
+  Draws vel(0xFFFFFF01u, seed);
   if (equal_speeds) {
     for (std::size_t i = 0; i < n; ++i) {
       double nrm2 = 0.0;
       do {
         nrm2 = 0.0;
         for (int k = 0; k < d; ++k) {
-          s.v[i * d + k] = vel.normal();
-          nrm2 += s.v[i * d + k] * s.v[i * d + k];
+          v[i * d + k] = vel.normal();
+          nrm2 += v[i * d + k] * v[i * d + k];
         }
       } while (!(nrm2 > 0.0));
       const double nrm = std::sqrt(nrm2);
-      for (int k = 0; k < d; ++k) s.v[i * d + k] /= nrm;
+      for (int k = 0; k < d; ++k) v[i * d + k] /= nrm;
     }
   } else {
-    for (auto& q : s.v) q = vel.normal();
+    for (auto& q : v) q = vel.normal();
     if (n > 1)
       for (int k = 0; k < d; ++k) {
-        double m = 0.0;
-        for (std::size_t i = 0; i < n; ++i) m += s.v[i * d + k];
-        m /= static_cast<double>(n);
-        for (std::size_t i = 0; i < n; ++i) s.v[i * d + k] -= m;
+        double mean = 0.0;
+        for (std::size_t i = 0; i < n; ++i) mean += v[i * d + k];
+        mean /= static_cast<double>(n);
+        for (std::size_t i = 0; i < n; ++i) v[i * d + k] -= mean;
       }
   }
   double e = 0.0;
-  for (double q : s.v) e += 0.5 * q * q;
+  for (double q : v) e += 0.5 * q * q;
   require(e > 0.0, "drawn velocities have zero kinetic energy (N = 1 with zero momentum?)");
   const double target = energy > 0.0 ? energy : 0.5 * static_cast<double>(n) * d;
   require(std::isfinite(target), "kinetic energy must be finite");
   const double scale = std::sqrt(target / e);
-  for (auto& q : s.v) q *= scale;
+  for (auto& q : v) q *= scale;
+}
+
+// The start in c's box (validated by the caller): the preferred placement, then under
+// `fallback` the other one; each placement restarts the position stream.
+InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, double energy, bool rsa,
+                          bool fallback, bool equal_speeds) {
+  const Geometry g(c);
+  InitialState s;
+  s.x.assign(n * c.dim, 0.0);
+  s.v.assign(n * c.dim, 0.0);
+  auto place = [&](bool use_rsa) {
+    Draws pos(0xFFFFFF00u, seed);
+    return use_rsa ? place_rsa(g, n, pos, s.x) : place_lattice(g, n, pos, s.x);
+  };
+  if (!place(rsa) && !(fallback && place(!rsa))) {
+    if (rsa && !fallback)
+      throw InvalidArgument("random sequential addition did not place every particle; use init='lattice'");
+    throw InvalidArgument(std::to_string(n) + " particles of diameter " + std::to_string(c.diameter) +
+                          " do not fit on a lattice in this box (nearest sites closer than D)" +
+                          (fallback ? ", nor by random sequential addition" : "") +
+                          ": make the box larger or the packing fraction lower");
+  }
+  draw_velocities(c.dim, n, seed, energy, equal_speeds, s.v);
   s.config = c;
   return s;
+}
+
+void check_common(const Config& c, std::size_t n, std::uint64_t seed) {
+  require(c.dim >= limits::kMinDim && c.dim <= limits::kMaxDim, "dim must be 1, 2 or 3");
+  require(n > 0, "no particles (N = 0)");
+  require(std::isfinite(c.diameter) && c.diameter > 0.0, "diameter must be finite and > 0");
+  require(seed <= limits::kMaxSeed, "seed must be < 2^32");
+}
+
+}  // namespace
+
+Placement parse_placement(const std::string& s) {
+  if (s == "auto") return Placement::automatic;
+  if (s == "rsa") return Placement::rsa;
+  if (s == "lattice") return Placement::lattice;
+  throw InvalidArgument("init must be 'auto', 'rsa' or 'lattice', got '" + s + "'");
+}
+
+double particle_volume(int d, double D) { return limits::particle_volume(d, D); }
+
+double box_fraction(const Config& c, std::size_t n) {
+  double vol = 1.0;
+  for (int k = 0; k < c.dim; ++k) vol *= c.box[k];
+  return static_cast<double>(n) * limits::particle_volume(c.dim, c.diameter) / vol;
+}
+
+InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, double energy,
+                          const std::string& init, bool equal_speeds) {
+  check_common(c, n, seed);
+  const Placement how = parse_placement(init);
+  const int d = c.dim;
+  const double D = c.diameter;
+  for (int k = 0; k < d; ++k) {
+    const double L = c.box[k];
+    const std::string axis = "axis " + std::to_string(k) + " has length " + std::to_string(L);
+    require(std::isfinite(L) && L > 0.0, "box length on " + axis + ": must be finite and > 0");
+    if (c.boundary[k] == Boundary::wall)
+      require(L > D * (1.0 + limits::kWallMargin),
+              "diameter " + std::to_string(D) + " is too large for the box: " + axis + " (walls need L > D)");
+    else
+      require(limits::periodic_axis_fits(L, D), "periodic box too small for the neighbour lists: " + axis +
+                                                    " < 3 diameters");
+  }
+  const double phi = box_fraction(c, n);
+  require(phi <= limits::max_fraction(d), [&] {
+    return std::to_string(n) + " particles of diameter " + std::to_string(D) +
+           " do not fit in this box: packing fraction " + std::to_string(phi) +
+           " above what the initialiser reaches (" + std::to_string(limits::max_fraction(d)) + " in " +
+           std::to_string(d) + "D)";
+  });
+  const bool rsa = how == Placement::rsa || (how == Placement::automatic && phi <= limits::rsa_fraction(d));
+  return start_in_box(c, n, seed, energy, rsa, how == Placement::automatic, equal_speeds);
+}
+
+InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t seed, double energy,
+                          const std::string& init, bool equal_speeds) {
+  check_common(c, n, seed);
+  require(std::isfinite(phi) && phi > 0.0, "packing fraction must be finite and > 0");
+  const Placement how = parse_placement(init);
+  const int d = c.dim;
+  const double maxphi = limits::max_fraction(d);
+  require(phi <= maxphi, "packing fraction " + std::to_string(phi) + " above what the initialiser reaches (" +
+                             std::to_string(maxphi) + " in " + std::to_string(d) + "D)");
+  const double L = std::pow(static_cast<double>(n) * limits::particle_volume(d, c.diameter) / phi, 1.0 / d);
+  for (int k = 0; k < 3; ++k) c.box[k] = k < d ? L : 1.0;
+  // "auto" decides on the phi asked for, not on the cube's (which differs in the last bits)
+  const bool rsa = how == Placement::rsa || (how == Placement::automatic && phi <= limits::rsa_fraction(d));
+  return start_in_box(c, n, seed, energy, rsa, how == Placement::automatic, equal_speeds);
 }
 
 }  // namespace revcol::engine

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 
 from . import statesave
 from .verify import VERIFY_CASES, verify
@@ -76,10 +77,14 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _summary(r: dict) -> str:
-    from .run import _verify_lines
+    from .report import verify_lines as _verify_lines
 
     mode = r["mode"] + (f"/{r['law']}" if r["mode"] == "exact" and r["case"] != "pair1d" else "")
     return "\n".join([f"revcol verify {r['case']}  mode={mode}  rng={r['rng']}  seed={r['seed']}"] + _verify_lines(r))
+
+
+def _warn_line(message, category, *rest) -> None:
+    print(f"revcol run: warning: {message}", file=sys.stderr)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -91,10 +96,13 @@ def _run(args: argparse.Namespace) -> int:
         print("revcol run: error: --seeds applies to --horizon only", file=sys.stderr)
         return 2
     try:
-        report = run_scene(args.scene, json_path=args.json, plot=args.plot, trajectory=args.trajectory,
-                           horizon_seeds=(args.seeds or 1) if args.horizon else None,
-                           max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
-                           progress=False if args.no_progress else None)
+        with warnings.catch_warnings():  # a scene's deprecated spellings: one line each on stderr
+            warnings.simplefilter("always", DeprecationWarning)
+            warnings.showwarning = _warn_line
+            report = run_scene(args.scene, json_path=args.json, plot=args.plot, trajectory=args.trajectory,
+                               horizon_seeds=(args.seeds or 1) if args.horizon else None,
+                               max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
+                               progress=False if args.no_progress else None)
     except SceneError as e:
         print(f"revcol run: error: {e}", file=sys.stderr)
         return 2

@@ -16,6 +16,13 @@ field, a field the scene's kind does not use, a wrong type or a value out of ran
 what is allowed. An explicit initial state is checked in full (inside the box, no two
 particles overlapping) by building the engine from it once.
 
+The limits a scene is checked against (the largest packing fraction, the particle volume,
+periodic axes of at least 3 diameters, the dimensions paper mode runs in, the bits and the
+seed range) are the engine's own, read from C++ (``revcol._core.engine_limits``, header
+``revcol/engine/limits.hpp``), and so are the names: the engine's vocabulary ``"wall"`` and
+``"per_particle"``. The older spellings ``"walls"`` and ``"per-particle"`` are still read,
+with a :class:`DeprecationWarning` naming the file and the replacement.
+
 .. code-block:: toml
 
     [scene]
@@ -29,20 +36,20 @@ particles overlapping) by building the engine from it once.
     particles = 1000              # N >= 1 (required unless initial_state gives it)
     diameter = 1.0                # sigma > 0
     packing_fraction = 0.3        # sets a cubic box; or give box = [Lx, Ly]
-    boundaries = "walls"          # "walls" | "periodic", or one per axis
+    boundaries = "wall"           # "wall" | "periodic", or one per axis ("walls": deprecated)
     start = "auto"                # "auto" | "random" (sequential addition) | "lattice";
-                                  # an explicit box always starts on a jittered lattice
+                                  # auto: random up to the engine's rsa_fraction, else lattice
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
 
     [collisions]
-    mode = "exact"                # "exact" | "paper" (gas: 2D only)
+    mode = "exact"                # "exact" | "paper" (gas: 1D and 2D, the engine's limit)
     law = "flux"                  # exact mode: "flux" | "uniform"
     bits = 40                     # K, bits per chart coordinate, 8..52 (not statesave)
 
     [rng]
     generator = "clcg4"           # "clcg4" | "philox"
-    streams = "per-particle"      # gas only: "per-particle" | "single"
+    streams = "per_particle"      # gas only: "per_particle" | "single" ("per-particle": deprecated)
     seed = 0                      # 0 .. 2^32 - 1
 
     [run]
@@ -71,9 +78,12 @@ import dataclasses
 import math
 import os
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+from . import _core
 
 __all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "engine_options", "DEFAULT_SCENE", "KINDS"]
 
@@ -108,7 +118,7 @@ class Scene:
     law: str = "flux"
     bits: int = 40
     generator: str = "clcg4"
-    streams: str = "per-particle"
+    streams: str = "per_particle"
     seed: int = 0
     collisions: int | None = None
     time: float | None = None
@@ -157,17 +167,26 @@ class Scene:
         return out
 
 
+#: the engine's limits and names (revcol/engine/limits.hpp), the one source of truth
+LIMITS: dict[str, Any] = _core.engine_limits()
+
+# old spellings still read: (table, field) -> {old: new}, with a DeprecationWarning
+_DEPRECATED: dict[tuple[str, str], dict[str, str]] = {
+    ("system", "boundaries"): {"walls": "wall"},
+    ("rng", "streams"): {"per-particle": "per_particle"},
+}
+
 # the schema: table -> field -> (type check name, allowed values or range)
 _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
     "scene": {"name": ("str", None), "description": ("str", None), "kind": ("str", KINDS),
               "case": ("str", None)},
     "system": {
-        "dimension": ("int", (1, 3)),
+        "dimension": ("int", tuple(LIMITS["dimensions"])),
         "particles": ("int", (1, None)),
         "diameter": ("float", (0.0, None)),
         "packing_fraction": ("float", (0.0, None)),
         "box": ("floats", (0.0, None)),
-        "boundaries": ("strs", ("walls", "periodic")),
+        "boundaries": ("strs", tuple(LIMITS["boundaries"])),
         "start": ("str", ("auto", "random", "lattice")),
         "kinetic_energy": ("float", (0.0, None)),
         "initial_state": ("str", None),
@@ -175,12 +194,12 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
     "collisions": {
         "mode": ("str", ("exact", "paper")),
         "law": ("str", ("flux", "uniform")),
-        "bits": ("int", (8, 52)),
+        "bits": ("int", tuple(LIMITS["bits"])),
     },
     "rng": {
-        "generator": ("str", ("clcg4", "philox")),
-        "streams": ("str", ("per-particle", "single")),
-        "seed": ("int", (0, 2**32 - 1)),   # the engine's and the generators' keys are 32-bit
+        "generator": ("str", tuple(sorted(LIMITS["generators"]))),
+        "streams": ("str", tuple(LIMITS["streams"])),
+        "seed": ("int", (0, int(LIMITS["max_seed"]))),   # the engine's and the generators' keys are 32-bit
     },
     "run": {
         "collisions": ("int", (1, None)),
@@ -214,10 +233,6 @@ _USES: dict[str, dict[str, Any]] = {
                   "rng": {"generator", "seed"}, "run": {"collisions"}, "output": {"json", "plot"}},
 }
 
-# the largest packing fractions the engine's random start reaches (engine_init.cpp: random
-# sequential addition, falling back to a jittered lattice that goes towards close packing)
-_MAX_FRACTION = {1: 0.95, 2: 0.75, 3: 0.70}
-
 # N_c when a gas scene gives neither collisions nor time: 2 collisions per particle. A gas is
 # chaotic and round-off grows by about an order of magnitude per collision per particle, so
 # a round trip restores the start to 1e-9 only within a horizon of 4-10 collisions per
@@ -227,9 +242,9 @@ _DEFAULT_PER_PARTICLE = 2
 DEFAULT_SCENE: dict[str, Any] = {
     "scene": {"name": "default", "description": "2D hard-disk gas, N = 1000, area fraction 0.3, walls"},
     "system": {"dimension": 2, "particles": 1000, "diameter": 1.0, "packing_fraction": 0.3,
-               "boundaries": "walls"},
+               "boundaries": "wall"},
     "collisions": {"mode": "exact", "law": "flux"},
-    "rng": {"generator": "clcg4", "streams": "per-particle", "seed": 0},
+    "rng": {"generator": "clcg4", "streams": "per_particle", "seed": 0},
     # N_c = 1000 (2 collisions per particle), measured with
     #   revcol run --horizon --seeds 200 (docs/run.md): over seeds 0..199 the worst round-trip
     #   error at N_c = 1000 is 3.6e-10 (99th percentile 2.2e-10, median 1.4e-11); at N_c = 2000
@@ -299,6 +314,7 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
                 raise _fail(source, f"[{table}] {key}",
                             f"unknown field; allowed in [{table}]: {', '.join(_SCHEMA[table])}")
             kind, allowed = _SCHEMA[table][key]
+            value = _modernize(source, table, key, value)
             values[(table, key)] = _check(source, table, key, value, kind, allowed)
 
     # fields the kind does not use are errors, not silently ignored
@@ -333,7 +349,12 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         return _reversal(source, get, common, mode, law, out)
     if kind == "statesave":
         return _statesave(source, get, common, mode, law, out)
+    return _gas(source, get, values, base, common, mode, law, out)
 
+
+def _gas(source, get, values, base, common, mode, law, out) -> Scene:
+    """A gas scene from its checked fields (``values``; ``get`` reads one with a default)."""
+    name = common["name"]
     d = get("system", "dimension")
     if d is None:
         raise _fail(source, "[system] dimension", "is required (1, 2 or 3)")
@@ -345,7 +366,7 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         for key in ("start", "kinetic_energy"):
             if ("system", key) in values:
                 raise _fail(source, f"[system] {key}", "applies to random starts only, not with initial_state")
-        arrays = _read_initial(source, initial_path, d)
+        arrays = read_initial(source, initial_path, d)
         if n is not None and n != arrays[0].shape[0]:
             raise _fail(source, "[system] particles", f"is {n} but initial_state holds {arrays[0].shape[0]} particles")
         n = int(arrays[0].shape[0])
@@ -360,11 +381,10 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
     if box is None and phi is None:
         raise _fail(source, "[system] box", "give box = [lengths] or packing_fraction")
     if phi is not None:
-        if phi > _MAX_FRACTION[d]:
-            raise _fail(source, "[system] packing_fraction",
-                        f"must be at most {_MAX_FRACTION[d]} in {d}D, got {phi}")
-        unit = {1: sigma, 2: math.pi * sigma**2 / 4, 3: math.pi * sigma**3 / 6}[d]
-        side = (n * unit / phi) ** (1.0 / d)
+        top = LIMITS["max_fraction"][d]
+        if phi > top:
+            raise _fail(source, "[system] packing_fraction", f"must be at most {top} in {d}D, got {phi}")
+        side = (n * _core.engine_particle_volume(d, sigma) / phi) ** (1.0 / d)
         box = (side,) * d
     if len(box) != d:
         raise _fail(source, "[system] box", f"needs {d} lengths for dimension {d}, got {len(box)}")
@@ -372,25 +392,24 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         if length <= sigma:
             raise _fail(source, "[system] box", f"axis {k} length {length:g} is not larger than the diameter {sigma:g}")
 
-    bounds = get("system", "boundaries", ("walls",))
+    bounds = get("system", "boundaries", ("wall",))
     if len(bounds) == 1:
         bounds = bounds * d
     if len(bounds) != d:
         raise _fail(source, "[system] boundaries", f"needs 1 or {d} entries, got {len(bounds)}")
     for k, (b, length) in enumerate(zip(bounds, box)):
         # the neighbour lists need a periodic axis of at least 3 diameters (docs/engine.md)
-        if b == "periodic" and length < 3 * sigma:
-            raise _fail(source, "[system] box", f"periodic axis {k} length {length:g} is under 3 diameters "
-                        f"({3 * sigma:g}); make it larger or use walls")
+        cells = LIMITS["min_periodic_cells"]
+        if b == "periodic" and length < cells * sigma:
+            raise _fail(source, "[system] box", f"periodic axis {k} length {length:g} is under {cells} diameters "
+                        f"({cells * sigma:g}); make it larger or use walls")
 
     start = get("system", "start", "auto")
-    if start == "random" and get("system", "box") is not None:
-        raise _fail(source, "[system] start", "'random' (sequential addition) needs packing_fraction; "
-                    "an explicit box starts on a jittered lattice ('auto' or 'lattice')")
 
-    if mode == "paper" and d != 2:
-        raise _fail(source, "[collisions] mode",
-                    f"'paper' runs gases in 2D only (its pair operator of Procedures 1-2), got dimension {d}")
+    paper_dims = tuple(LIMITS["paper_mode_dimensions"])
+    if mode == "paper" and d not in paper_dims:
+        raise _fail(source, "[collisions] mode", f"'paper' runs gases in {' and '.join(f'{k}D' for k in paper_dims)} "
+                    f"only (it has no invertible {d}D pair operator), got dimension {d}")
 
     nc, t_end = get("run", "collisions"), get("run", "time")
     if nc is not None and t_end is not None:
@@ -414,7 +433,7 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         boundaries=tuple(bounds), start=start,
         kinetic_energy=get("system", "kinetic_energy"), initial_state=initial_path,
         mode=mode, law=law, bits=get("collisions", "bits", 40),
-        streams=get("rng", "streams", "per-particle"), collisions=nc, time=t_end,
+        streams=get("rng", "streams", "per_particle"), collisions=nc, time=t_end,
         checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
         json=out("json"), plot=out("plot"), trajectory=trajectory,
         trajectory_every=get("output", "trajectory_every", 100), **common)
@@ -453,7 +472,9 @@ def _statesave(source, get, common, mode, law, out) -> Scene:
                  json=out("json"), plot=out("plot"), **common)
 
 
-def _read_initial(source: str, path: Path, d: int):
+def read_initial(source: str, path: Path, d: int):
+    """The (positions, velocities) arrays of an initial-state file, each (N, d); SceneError
+    naming ``[system] initial_state`` when the file is missing, unreadable or misshapen."""
     import numpy as np
 
     where = "[system] initial_state"
@@ -483,13 +504,27 @@ def _check_initial(source: str, scene: Scene, x, v) -> None:
         raise _fail(source, "[system] initial_state", f"{scene.initial_state.name}: {e}") from None
 
 
-# scene files say "walls" (a box has two per axis); the engine says "wall"
-_ENGINE_BOUNDARY = {"walls": "wall", "periodic": "periodic"}
+_read_initial = read_initial  # its name before it was public
+
+
+def _modernize(source: str, table: str, key: str, value: Any) -> Any:
+    """``value`` with deprecated spellings replaced, warning once per field (DeprecationWarning)."""
+    old_new = _DEPRECATED.get((table, key))
+    if old_new is None:
+        return value
+    items = value if isinstance(value, list) else [value]
+    old = sorted({v for v in items if isinstance(v, str) and v in old_new})
+    if not old:
+        return value
+    said = ", ".join(f"{o!r} is deprecated, write {old_new[o]!r}" for o in old)
+    warnings.warn(f"{source}: [{table}] {key}: {said}", DeprecationWarning, stacklevel=4)
+    new = [old_new.get(v, v) if isinstance(v, str) else v for v in items]
+    return new if isinstance(value, list) else new[0]
 
 
 def engine_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.Simulation` that a gas scene sets."""
-    return dict(boundary=[_ENGINE_BOUNDARY[b] for b in scene.boundaries],
+    return dict(boundary=list(scene.boundaries),
                 diameter=scene.diameter, mode=scene.mode, law=scene.law, seed=scene.seed,
                 bits=scene.bits, generator=scene.generator, streams=scene.streams)
 

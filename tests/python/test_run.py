@@ -78,7 +78,7 @@ def test_default_report_cli(tmp_path, capsys):
     assert "\r" not in text  # no progress bar when stdout is not a terminal
     r = json.loads(out.read_text())
     assert r["passed"] and r["collisions_forward"] == r["collisions_back"] == 1000
-    assert r["scene"]["generator"] == "clcg4" and r["scene"]["streams"] == "per-particle"
+    assert r["scene"]["generator"] == "clcg4" and r["scene"]["streams"] == "per_particle"
     assert r["forward_per_s"] > 0 and r["reverse_per_s"] > 0 and r["peak_rss_bytes"] > 0
     assert set(r["error_definitions"]) == {"error_x", "error_v"}
 
@@ -212,17 +212,39 @@ def test_bad_scene_files_one_line_exit_2(tmp_path, capsys, text, needle):
     assert not (tmp_path / "r.json").exists()
 
 
-def test_explicit_box_starts_on_a_lattice():
-    doc = {"system": {"dimension": 3, "particles": 60, "box": [5.0, 6.0, 9.0],
-                      "boundaries": ["walls", "periodic", "walls"], "kinetic_energy": 30.0},
+@pytest.mark.parametrize("start", ["auto", "random", "lattice"])
+def test_explicit_box_starts_from_the_engine(start):
+    doc = {"system": {"dimension": 3, "particles": 60, "box": [5.0, 6.0, 9.0], "start": start,
+                      "boundaries": ["wall", "periodic", "wall"], "kinetic_energy": 30.0},
            "run": {"collisions": 60}}
     scene = scene_from_dict(doc, "box.toml")
     sim = build_simulation(scene)
     assert sim.n == 60 and sim.diagnostics()["energy"] == pytest.approx(30.0)
     assert np.abs(sim.velocities.sum(axis=0)).max() < 1e-12
+    # the start is the engine's (C++ engine/init.hpp), bit for bit
+    init = {"auto": "auto", "random": "rsa", "lattice": "lattice"}[start]
+    x, v = revcol._core.engine_random_start(60, [5.0, 6.0, 9.0], ["wall", "periodic", "wall"], 1.0, 0, 30.0, init)
+    assert np.array_equal(sim.positions, x) and np.array_equal(sim.velocities, v)
     assert run_gas(scene, progress=False)["passed"]
     with pytest.raises(SceneError, match=r"box\.toml: \[system\] box: 500 particles .* do not fit"):
         build_simulation(scene_from_dict({**doc, "system": {**doc["system"], "particles": 500}}, "box.toml"))
+
+
+def test_a_lattice_that_does_not_fit_is_a_scene_error():
+    doc = {"system": {"dimension": 2, "particles": 9, "box": [3.5, 3.5], "start": "lattice"}}
+    with pytest.raises(SceneError, match=r"\[system\] box: 9 particles of diameter 1.* do not fit on a lattice"):
+        build_simulation(scene_from_dict(doc, "tight.toml"))
+
+
+def test_deprecated_spellings_warn_on_stderr_and_run(tmp_path, capsys):
+    p = tmp_path / "old.toml"
+    p.write_text("[system]\ndimension = 1\nparticles = 50\npacking_fraction = 0.3\nboundaries = 'walls'\n"
+                 "[rng]\nstreams = 'per-particle'\n[run]\ncollisions = 100\n")
+    assert cli_main(["run", str(p), "--no-progress"]) == 0
+    cap = capsys.readouterr()
+    assert f"revcol run: warning: {p}: [system] boundaries: 'walls' is deprecated, write 'wall'" in cap.err
+    assert f"revcol run: warning: {p}: [rng] streams: 'per-particle' is deprecated, write 'per_particle'" in cap.err
+    assert "result           PASSED" in cap.out and "(wall)" in cap.out
 
 
 def test_checkpoints_resume_and_reverse(tmp_path):
@@ -310,12 +332,13 @@ def test_ctrl_c_during_the_reversal_stops_it(tmp_path, capsys, monkeypatch):
 
 
 def test_reversal_builds_no_particles(monkeypatch):
-    import revcol.run as run
+    import revcol.gas as gas_module
 
     def refuse(*a, **k):
         raise AssertionError("a reversal scene must not build a gas")
-    monkeypatch.setattr(run, "build_simulation", refuse)
-    monkeypatch.setattr(run, "Simulation", None)
+    monkeypatch.setattr(gas_module, "build_simulation", refuse)
+    monkeypatch.setattr(gas_module, "_GasRun", refuse)
+    monkeypatch.setattr(gas_module, "Simulation", None)
     r = run_scene(SCENES / "paper-triple1d-reversal.toml", collisions=500, seed=4)
     assert r["passed"] and r["case"] == "triple1d" and r["mode"] == "paper" and r["seed"] == 4
 
@@ -352,7 +375,7 @@ def _has(module: str) -> bool:
 def test_ctrl_c_ends_a_statesave_study_after_the_run_under_way(tmp_path, capsys, monkeypatch):
     # the SIGINT arrives during the first run (each run is one C++ call): the study ends
     # after it, reports that run, writes the JSON, and exits 130
-    import revcol.statesave as ss
+    import revcol.statesave_study as ss
 
     real = ss._run_inline
     calls = []

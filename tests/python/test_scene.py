@@ -16,7 +16,7 @@ def write(tmp_path: Path, text: str) -> Path:
 def test_default_scene():
     s = load_scene(None)
     assert (s.dimension, s.particles, s.mode, s.law, s.generator) == (2, 1000, "exact", "flux", "clcg4")
-    assert s.boundaries == ("walls", "walls") and s.packing_fraction == 0.3
+    assert s.boundaries == ("wall", "wall") and s.packing_fraction == 0.3 and s.streams == "per_particle"
     # area fraction 0.3 of 1000 unit disks: side^2 = 1000 pi / 4 / 0.3
     assert s.box[0] == pytest.approx((1000 * np.pi / 4 / 0.3) ** 0.5, rel=1e-15)
     assert "1000 particles in 2D" in s.summary()
@@ -31,7 +31,7 @@ dimension = 3
 particles = 64
 diameter = 0.5
 box = [4.0, 4.0, 5.0]
-boundaries = ["periodic", "periodic", "walls"]
+boundaries = ["periodic", "periodic", "wall"]
 start = "lattice"
 kinetic_energy = 96.0
 [collisions]
@@ -51,7 +51,7 @@ trajectory = "t.xyz"
 trajectory_every = 10
 """)
     s = load_scene(p)
-    assert s.name == "spheres" and s.box == (4.0, 4.0, 5.0) and s.boundaries == ("periodic", "periodic", "walls")
+    assert s.name == "spheres" and s.box == (4.0, 4.0, 5.0) and s.boundaries == ("periodic", "periodic", "wall")
     assert (s.law, s.bits, s.generator, s.streams, s.seed, s.time, s.collisions) == ("uniform", 36, "philox", "single", 7, 2.5, None)
     assert s.json == tmp_path / "out/r.json" and s.trajectory == tmp_path / "t.xyz"
 
@@ -67,10 +67,10 @@ trajectory_every = 10
     ("[system]\ndimension = 2\nparticles = 5\n", "[system] box: give box"),
     ("[system]\ndimension = 2\nparticles = 5\nbox = [3.0, 3.0]\npacking_fraction = 0.2\n", "not both"),
     ("[system]\ndimension = 3\nparticles = 5\npacking_fraction = 0.9\n", "[system] packing_fraction: must be at most 0.7"),
-    ("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\nboundaries = 'sticky'\n", "[system] boundaries: must be one of 'walls', 'periodic'"),
+    ("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\nboundaries = 'sticky'\n", "[system] boundaries: must be one of 'wall', 'periodic'"),
     ("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\ndiameter = -1.0\n", "[system] diameter: must be > 0"),
     ("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\n[collisions]\nmode = 'fast'\n", "[collisions] mode: must be one of"),
-    ("[system]\ndimension = 3\nparticles = 5\npacking_fraction = 0.1\n[collisions]\nmode = 'paper'\n", "'paper' runs gases in 2D only"),
+    ("[system]\ndimension = 3\nparticles = 5\npacking_fraction = 0.1\n[collisions]\nmode = 'paper'\n", "'paper' runs gases in 1D and 2D only (it has no invertible 3D pair operator)"),
     ("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\n[run]\ncollisions = 0\n", "[run] collisions: must be >= 1"),
     ("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\n[run]\ncollisions = 5\ntime = 1.0\n", "[run] time: give either"),
     ("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\n[rng]\nseed = 1.5\n", "[rng] seed: must be an integer"),
@@ -157,10 +157,10 @@ def test_kinds():
     ({"scene": {"kind": "statesave"}, "system": {"particles": 10}}, "[system] particles: does not apply"),
     ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.1}, "rng": {"seed": 2**32}},
      "[rng] seed: must be 0..4294967295"),
-    ({"system": {"dimension": 2, "particles": 5, "box": [2.5, 9.0], "boundaries": ["periodic", "walls"]}},
+    ({"system": {"dimension": 2, "particles": 5, "box": [2.5, 9.0], "boundaries": ["periodic", "wall"]}},
      "[system] box: periodic axis 0 length 2.5 is under 3 diameters"),
-    ({"system": {"dimension": 2, "particles": 5, "box": [9.0, 9.0], "start": "random"}},
-     "[system] start: 'random' (sequential addition) needs packing_fraction"),
+    ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.1}, "rng": {"streams": "per_draw"}},
+     "[rng] streams: must be one of 'per_particle', 'single', got 'per_draw'"),
     ({"system": {"dimension": 2, "particles": 1, "packing_fraction": 0.1}},
      "[run] collisions: a single particle never collides"),
     ({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.1}, "output": {"trajectory": "t.pdb"}},
@@ -195,3 +195,60 @@ def test_initial_state_checked_by_the_engine(tmp_path):
     with pytest.raises(SceneError, match=r"\[system\] kinetic_energy: applies to random starts only"):
         load_scene(write(tmp_path, "[system]\ndimension = 2\ninitial_state = 'ok.npz'\nbox = [5.0, 5.0]\n"
                                    "kinetic_energy = 3.0\n"))
+
+
+def test_deprecated_spellings_warn_and_mean_the_same(tmp_path):
+    new = load_scene(write(tmp_path, "[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\n"
+                                     "boundaries = ['wall', 'periodic']\n[rng]\nstreams = 'per_particle'\n"))
+    p = tmp_path / "old.toml"
+    p.write_text("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\n"
+                 "boundaries = ['walls', 'periodic']\n[rng]\nstreams = 'per-particle'\n")
+    with pytest.warns(DeprecationWarning) as got:
+        old = load_scene(p)
+    said = [str(w.message) for w in got]
+    assert f"{p}: [system] boundaries: 'walls' is deprecated, write 'wall'" in said
+    assert f"{p}: [rng] streams: 'per-particle' is deprecated, write 'per_particle'" in said
+    assert old.boundaries == new.boundaries == ("wall", "periodic") and old.streams == new.streams == "per_particle"
+    assert old.summary().replace("old", "s") == new.summary()
+
+
+def test_no_warning_for_the_current_spellings(tmp_path, recwarn):
+    load_scene(write(tmp_path, "[system]\ndimension = 1\nparticles = 5\npacking_fraction = 0.1\n"
+                               "boundaries = 'wall'\n[rng]\nstreams = 'single'\n"))
+    assert not [w for w in recwarn if issubclass(w.category, DeprecationWarning)]
+
+
+def test_limits_are_the_engines(monkeypatch):
+    """The scene reads its limits from C++ (revcol/engine/limits.hpp), not its own copy."""
+    import revcol.scene as sc
+    from revcol import _core
+
+    lim = _core.engine_limits()
+    assert lim["max_fraction"] == {1: 0.95, 2: 0.75, 3: 0.7} and lim["min_periodic_cells"] == 3
+    assert tuple(lim["paper_mode_dimensions"]) == (1, 2) and tuple(lim["boundaries"]) == ("wall", "periodic")
+    assert tuple(lim["streams"]) == ("per_particle", "single") and tuple(lim["bits"]) == (8, 52)
+    assert _core.engine_particle_volume(2, 2.0) == pytest.approx(np.pi)
+    # a scene follows whatever the engine says
+    monkeypatch.setitem(sc.LIMITS, "max_fraction", {1: 0.5, 2: 0.5, 3: 0.5})
+    with pytest.raises(SceneError, match=r"must be at most 0.5 in 2D, got 0.6"):
+        scene_from_dict({"system": {"dimension": 2, "particles": 5, "packing_fraction": 0.6}}, "s.toml")
+    monkeypatch.setitem(sc.LIMITS, "min_periodic_cells", 4)
+    with pytest.raises(SceneError, match="periodic axis 0 length 3.5 is under 4 diameters"):
+        scene_from_dict({"system": {"dimension": 2, "particles": 2, "box": [3.5, 9.0], "boundaries": "periodic"}},
+                        "s.toml")
+
+
+def test_paper_mode_gases_in_1d_and_2d_as_the_engine(tmp_path):
+    from revcol.run import run_scene
+
+    for d in (1, 2):
+        s = scene_from_dict({"system": {"dimension": d, "particles": 40, "packing_fraction": 0.2},
+                             "collisions": {"mode": "paper"}, "run": {"collisions": 40}}, "p.toml")
+        r = run_scene(s, progress=False)
+        assert r["passed"] and r["scene"]["mode"] == "paper" and r["dimension"] == d
+
+
+def test_random_start_in_an_explicit_box():
+    s = scene_from_dict({"system": {"dimension": 2, "particles": 20, "box": [30.0, 6.0], "start": "random"}},
+                        "s.toml")
+    assert s.start == "random" and s.packing_fraction is None

@@ -1,0 +1,69 @@
+// The engine's limits, in one place: what a configuration and a random start may ask for.
+// The engine's validation, the random start (engine/init.hpp) and, through the binding
+// (revcol._core.engine_limits), the Python scene reader all read them from here, so a scene
+// is refused for exactly the reasons the engine would refuse it.
+//
+// Geometry. Particles are spheres of diameter D; the box is [0, L_k] per axis, each axis
+// walled or periodic. A walled axis needs L_k > D (a particle fits between its walls). A
+// periodic axis needs floor(L_k / D) >= 3: with at least three diameters per period, and a
+// neighbour-list shell of at least 0.45 D, each listed neighbour has a unique nearest image.
+// Packing fraction phi = N v_D / prod L_k with v_D the particle's volume: D (1D), pi D^2 / 4
+// (2D), pi D^3 / 6 (3D).
+//
+// Random starts. Random sequential addition (RSA) jams near phi 0.75 (1D), 0.547 (2D),
+// 0.38 (3D) and slows down well before: "auto" uses it up to kRsaFraction and a jittered
+// lattice above (square in 1D/2D, face-centred cubic in 3D, whose close packing is 0.74).
+// kMaxFraction is the highest phi the start accepts: the lattice's spacing must exceed D.
+// A particle starts at least kWallMargin D / 2 inside the wall contact (centre in
+// [D/2 (1 + m), L - D/2 (1 + m)]): touching a wall at t0 is an event at t0, which a
+// reversed run cannot tell from a departure.
+//
+// Collisions. Paper mode has pair operators in 1D (the exchange) and 2D (Procedures 1-2);
+// its 3D pair operator is not a bijection, so the engine refuses paper mode in 3D.
+#pragma once
+#include <cstdint>
+
+#include "revcol/fixed_point.hpp"
+
+namespace revcol::engine::limits {
+
+/// Pi, to double precision.
+inline constexpr double kPi = 3.141592653589793238462643383279502884;
+/// Smallest and largest dimension d.
+inline constexpr int kMinDim = 1, kMaxDim = 3;
+/// Least number of whole diameters along a periodic axis (floor(L / D) >= this).
+inline constexpr int kMinPeriodicCells = 3;
+/// Smallest and largest K, exact mode's bits per chart coordinate (FixedPoint's).
+inline constexpr int kMinBits = FixedPoint::min_bits, kMaxBits = FixedPoint::max_bits;
+/// group_tol must lie in [0, kMaxGroupTol).
+inline constexpr double kMaxGroupTol = 1e-3;
+/// Seeds (and generator keys) are 32-bit: seed <= kMaxSeed.
+inline constexpr std::uint64_t kMaxSeed = 0xFFFFFFFFull;
+/// Relative margin kept from a wall at the start (centre >= D/2 (1 + kWallMargin) inside).
+inline constexpr double kWallMargin = 2e-6;
+/// Two particles of a start are at least D (1 + kMinGap) apart (RSA); a lattice's spacing at least D (1 + kLatticeGap).
+inline constexpr double kMinGap = 1e-12, kLatticeGap = 1e-9;
+
+/// Largest packing fraction the random start accepts in d dimensions (1..3).
+constexpr double max_fraction(int d) { return d == 1 ? 0.95 : d == 2 ? 0.75 : 0.70; }
+
+/// Largest packing fraction at which "auto" starts by random sequential addition (1..3).
+constexpr double rsa_fraction(int d) { return d == 1 ? 0.3 : d == 2 ? 0.35 : 0.2; }
+
+/// The volume (length in 1D, area in 2D) of one particle of diameter D in d dimensions.
+constexpr double particle_volume(int d, double D) {
+  return d == 1 ? D : d == 2 ? kPi * D * D / 4.0 : kPi * D * D * D / 6.0;
+}
+
+/// True when a walled axis of length L holds a particle of diameter D (L > D).
+constexpr bool wall_axis_fits(double L, double D) { return L > D; }
+
+/// True when a periodic axis of length L is long enough for the neighbour lists (floor(L / D) >= 3).
+constexpr bool periodic_axis_fits(double L, double D) {
+  return L / D >= static_cast<double>(kMinPeriodicCells);  // floor(x) >= 3 iff x >= 3
+}
+
+/// True when paper mode has an (invertible) pair operator in d dimensions: 1D and 2D.
+constexpr bool paper_mode_allowed(int d) { return d == 1 || d == 2; }
+
+}  // namespace revcol::engine::limits

@@ -1,0 +1,154 @@
+"""Reports of ``revcol run`` as text and as JSON: a gas round trip, a reversal scene, a
+state-saving study and the horizon table (:func:`format_report`, :func:`format_horizon`,
+:func:`write_json`; numpy values and non-finite floats become plain JSON).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .roundtrip import BAR, ERROR_DEFINITIONS
+
+__all__ = ["format_report", "format_horizon", "verify_lines", "write_json", "version"]
+
+
+def version() -> str:
+    """The package version (for reports)."""
+    from . import __version__
+
+    return __version__
+
+
+def _si(x: float | None, unit: str = "") -> str:
+    return "n/a" if x is None else f"{x:.3g}{unit}"
+
+
+def _duration(s: float) -> str:
+    return f"{s * 1e3:.3g} ms" if s < 1 else f"{s:.3g} s"
+
+
+def _mib(b: int | None) -> str:
+    return "n/a" if b is None else f"{b / 2**20:.1f} MiB (this process)"
+
+
+def format_report(r: dict) -> str:
+    """The report as text (any kind)."""
+    scene = r["scene"]
+    head = f"revcol run {scene['name']}  ({scene['source']})"
+    if r["kind"] == "horizon":
+        return format_horizon(r)
+    if r["kind"] == "reversal":
+        lines = [head, f"  scene               {r['summary']}"] + verify_lines(r)
+        if r["interrupted"]:
+            lines.append("  interrupted         (Ctrl-C) after the reversal, which is one call: it ran to the end")
+    elif r["kind"] == "statesave":
+        from .statesave import format_table
+
+        lines = [head, f"  scene   {r['summary']}", f"  runner  {r['runner']}: {r['rss_note']}", format_table(r)]
+        if r["interrupted"]:
+            lines.append(f"  interrupted (Ctrl-C): the table covers the runs done; {r.get('not_run', 0)} not run")
+    else:
+        drift_p = ("n/a (walls on every axis)" if r["momentum_drift_turn"] is None else
+                   f"{r['momentum_drift_turn']:+.2g} at the turn, {_si(r['momentum_drift_end'])} after reversal "
+                   "(periodic axes)")
+        fwd_end = f"t = {r['time_turn']:.6g}"
+        lines = [
+            head,
+            f"  scene            {r['summary']}",
+            f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:.3g} per particle) to "
+            f"{fwd_end} in {_duration(r['forward_s'])}: {_si(r['forward_per_s'])} collisions/s",
+            f"  reverse          {r['collisions_back']:,} collisions back to t = {r['time_end']:.6g} in "
+            f"{_duration(r['reverse_s'])}: {_si(r['reverse_per_s'])} collisions/s",
+            f"  positions error  {r['error_x']:.3g}   {ERROR_DEFINITIONS['error_x']}",
+            f"  velocity error   {r['error_v']:.3g}   {ERROR_DEFINITIONS['error_v']}",
+            f"  bar              {BAR:g} (both)",
+            f"  energy drift     {r['energy_drift_turn']:+.2g} at the turn, {r['energy_drift_end']:+.2g} after "
+            "reversal   ((E - E0) / E0)",
+            f"  momentum drift   {drift_p}",
+            f"  log bytes        {r['log_bytes_turn']} at the turn, {r['log_bytes_end']} after reversal",
+            f"  peak RSS         {_mib(r['peak_rss_bytes'])}",
+        ]
+        if r["reverse_failures"]:
+            lines.append(f"  reverse failures {r['reverse_failures']} (the reversed run left the forward one)")
+        if r["checkpoints"]:
+            lines.append(f"  checkpoints      {len(r['checkpoints'])} in {Path(r['checkpoints'][0]).parent}")
+        if r["trajectory"]:
+            lines.append(f"  trajectory       {r['trajectory_frames']} frames in {r['trajectory']}")
+        if r["interrupted"]:
+            lines.append(f"  interrupted      during the {r['interrupted']} run (Ctrl-C)"
+                         + ("; the round trip is incomplete" if not r["round_trip_complete"] else
+                            "; went back from where it stopped"))
+        lines.append(f"  result           {'PASSED' if r['passed'] else 'FAILED'}")
+    if r.get("written"):
+        lines.append("  written          " + " ".join(r["written"]))
+    return "\n".join(lines)
+
+
+def verify_lines(r: dict) -> list[str]:
+    """``revcol verify``'s report lines (shared with the CLI's verify command)."""
+    return [
+        f"  collisions          {r['collisions']:,} forward, {r['collisions']:,} back",
+        f"  forward             {r['forward_per_s']:.3g} collisions/s",
+        f"  reverse             {r['reverse_per_s']:.3g} collisions/s",
+        f"  max relative error  {r['max_rel_error']:.3g}  (bar: 1e-9)",
+        f"  bit exact           {r['bit_exact']}",
+        f"  rng restored        {r['rng_restored']}  ({r['random_numbers_drawn']:,} drawn)",
+        f"  rare log            {r['log_bytes']} bytes at the turn",
+        f"  result              {'PASSED' if r['passed'] else 'FAILED'}",
+    ] + ([f"  stopped             {r['error']}"] if r.get("error") else [])
+
+
+def format_horizon(r: dict) -> str:
+    """The horizon table as text."""
+    lines = [f"revcol run --horizon {r['scene']['name']}  ({r['scene']['source']})",
+             f"  scene  {r['summary']}",
+             f"  worst round-trip error over {r['seeds']} seed(s) from {r['seed_first']}; "
+             f"bar {BAR:g}; stop at {r['o1']:g}",
+             f"  {'N_c':>10}  {'per particle':>12}  {'error_x':>9}  {'error_v':>9}  {'median':>9}  fails"]
+    def e(x: float) -> str:  # a seed that already reached O(1) counts as infinite
+        return f"{x:>9.2e}" if math.isfinite(x) else f"{'O(1)':>9}"
+
+    for row in r["rows"]:
+        lines.append(f"  {row['collisions']:>10,}  {row['per_particle']:>12.3g}  {e(row['error_x'])}  "
+                     f"{e(row['error_v'])}  {e(row['median'])}  {row['fails']}/{row['seeds']}")
+    if r["horizon_reached"]:
+        lines.append(f"  horizon: N_c = {r['horizon_collisions']:,} ({r['horizon_per_particle']:.3g} collisions "
+                     f"per particle) is the largest grid point with every error <= {BAR:g}")
+    else:
+        lines.append(f"  horizon: not reached up to N_c = {r['rows'][-1]['collisions']:,} "
+                     f"(--max-collisions {r['max_collisions']:,})")
+    if r["interrupted"]:
+        lines.append("  interrupted (Ctrl-C): the table covers what ran")
+    if r.get("written"):
+        lines.append("  written  " + " ".join(r["written"]))
+    return "\n".join(lines)
+
+
+def _jsonable(o: Any) -> Any:
+    if isinstance(o, dict):
+        return {str(k): _jsonable(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_jsonable(v) for v in o]
+    if isinstance(o, np.ndarray):
+        return _jsonable(o.tolist())
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, (np.floating, float)):
+        return float(o) if math.isfinite(o) else str(o)
+    if isinstance(o, Path):
+        return str(o)
+    return o
+
+
+def write_json(report: dict, path: str | os.PathLike) -> str:
+    """Writes the report as indented JSON (creating the directory); returns the path."""
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    p.write_text(json.dumps(_jsonable(report), indent=1) + "\n")
+    return str(p)
+
