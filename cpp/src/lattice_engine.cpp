@@ -45,12 +45,13 @@ LatticeStart quantize_start(const LatticeConfig& c, const std::vector<double>& x
   return s;
 }
 
-LatticeStart random_start(const LatticeConfig& c, std::size_t n, double phi, std::uint64_t seed) {
+LatticeStart random_start(const LatticeConfig& c, std::size_t n, double phi, std::uint64_t seed,
+                          const std::string& init) {
   engine::Config fc;
   fc.dim = 2;
   fc.diameter = c.diameter;
   for (int k = 0; k < 2; ++k) fc.boundary[k] = c.wall[k] ? engine::Boundary::wall : engine::Boundary::periodic;
-  const engine::InitialState st = engine::random_state(fc, n, phi, seed);
+  const engine::InitialState st = engine::random_state(fc, n, phi, seed, 0.0, init);
   LatticeConfig lc = c;
   lc.box = {st.config.box[0], st.config.box[1]};
   return quantize_start(lc, st.x, st.v);

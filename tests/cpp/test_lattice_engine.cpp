@@ -65,7 +65,7 @@ LatticeStart start(std::size_t n, double phi, bool walls, std::uint64_t seed) {
   LatticeConfig c;
   c.wall = {walls, walls};
   c.seed = static_cast<std::uint32_t>(seed);
-  return random_start(c, n, phi, seed);
+  return random_start(c, n, phi, seed, phi > 0.5 ? "lattice" : "auto");
 }
 
 LatticeEngine make(std::size_t n, double phi, bool walls, std::uint64_t seed) {
@@ -82,6 +82,8 @@ void round_trip(E& e, std::uint64_t collisions, const char* what) {
   CHECK(e.collisions() == collisions);
   const Snapshot s1 = e.snapshot();
   CHECK(!same_state(s0, s1));
+  CHECK(s1.bits != s0.bits);  // X carried the collisions' phases
+  const double E0 = static_cast<double>(kinetic2(s0.v)), E1 = static_cast<double>(kinetic2(s1.v));
   e.run_back(0, e.origin());
   const Snapshot s2 = e.snapshot();
   const bool ok = same_state(s0, s2);
@@ -97,9 +99,10 @@ void round_trip(E& e, std::uint64_t collisions, const char* what) {
   std::printf("  %s: %llu collisions, %llu walls, redraws", what, static_cast<unsigned long long>(collisions),
               static_cast<unsigned long long>(c.walls));
   for (int k = 1; k < 8; ++k) std::printf(" %s=%llu", redraw_names[k], static_cast<unsigned long long>(c.redraws[k]));
-  std::printf(", log %llu, multi-body %llu, wall-body %llu, X %zu bits at the end\n",
+  std::printf(", energy drift %.2e", (E1 - E0) / E0);
+  std::printf(", log %llu, multi-body %llu, wall-body %llu, X %zu -> %zu bits\n",
               static_cast<unsigned long long>(c.log_entries), static_cast<unsigned long long>(c.multi_body),
-              static_cast<unsigned long long>(c.wall_body), s1.bits.size() * 64);
+              static_cast<unsigned long long>(c.wall_body), BitsBack(s0.bits).bit_length(), BitsBack(s1.bits).bit_length());
 }
 
 }  // namespace
@@ -222,6 +225,98 @@ TEST_CASE("test operator, walls: 100 collisions per particle forward and back bi
   BounceEngine e(s.units, s.x, s.v, 4, BounceOp{s.units.sigma});
   round_trip(e, 10000, "bounce walls 0.5");
   CHECK(e.counters().walls > 100);
+}
+
+
+TEST_CASE("lattice operator: N = 100-400, area fractions 0.1-0.7, walls and periodic, forward and back bit for bit") {
+  struct Case { std::size_t n; double phi; bool walls; std::uint64_t per; };
+  for (const Case c : {Case{400, 0.1, false, 50}, Case{200, 0.3, false, 100}, Case{200, 0.5, true, 100},
+                       Case{100, 0.7, false, 100}, Case{100, 0.3, true, 100}, Case{144, 0.6, true, 50}}) {
+    LatticeEngine e = make(c.n, c.phi, c.walls, 17 + c.n);
+    char what[64];
+    std::snprintf(what, sizeof what, "N=%zu phi=%.1f %s", c.n, c.phi, c.walls ? "walls" : "periodic");
+    round_trip(e, c.n * c.per, what);
+    const Diagnostics d = diagnostics(e);
+    CHECK(d.bits_length == 256);  // X back to its 256 start bits
+  }
+}
+
+TEST_CASE("a reversal to collision k of n equals the snapshot taken at k; by time too") {
+  LatticeEngine e = make(150, 0.4, true, 5);
+  const Snapshot s0 = e.snapshot();
+  e.run(4000, tick_limit - 1);
+  const Snapshot sk = e.snapshot();
+  e.run(3000, tick_limit - 1);
+  const std::int64_t tmid = e.clock();
+  const Snapshot sm = e.snapshot();
+  e.run(3000, tick_limit - 1);
+  e.run(UINT64_MAX, e.clock() + 5000000);  // a time stop between events
+  CHECK(e.collisions() > 10000);
+  e.run_back(7000, e.origin());
+  CHECK(same_state(e.snapshot(), sm));
+  CHECK(e.clock() == tmid);
+  e.run_back(4000, e.origin());
+  CHECK(same_state(e.snapshot(), sk));
+  // on from k again: the same future
+  e.run(3000, tick_limit - 1);
+  CHECK(same_state(e.snapshot(), sm));
+  // back by time: to a tick between collisions, then forward to the same tick from the start
+  const std::int64_t t = s0.clock + (tmid - s0.clock) / 3;
+  e.run_back(0, t);
+  const Snapshot st = e.snapshot();
+  CHECK(e.clock() == t);
+  LatticeEngine f(s0, LatticePair2D(s0.units.sigma));
+  f.run(UINT64_MAX, t);
+  CHECK(same_state(f.snapshot(), st));
+  e.run_back(0, e.origin());
+  CHECK(same_state(e.snapshot(), s0));
+}
+
+TEST_CASE("a snapshot resumes bit for bit (also one taken right after a collision, mid-tick)") {
+  LatticeEngine e = make(200, 0.5, false, 8);
+  e.run(5000, tick_limit - 1);
+  const Snapshot s = e.snapshot();
+  e.run(5000, tick_limit - 1);
+  const Snapshot a = e.snapshot();
+  LatticeEngine f(s, LatticePair2D(s.units.sigma));
+  CHECK(same_state(f.snapshot(), s));
+  f.run(5000, tick_limit - 1);
+  CHECK(same_state(f.snapshot(), a));
+  f.run_back(0, f.origin());
+  e.run_back(0, e.origin());
+  CHECK(same_state(f.snapshot(), e.snapshot()));
+}
+
+TEST_CASE("bad input: a clear error, and the state is unchanged") {
+  LatticeEngine e = make(100, 0.3, false, 9);
+  e.run(1000, tick_limit - 1);
+  const Snapshot s = e.snapshot();
+  auto throws = [&](auto&& f, const char* word) {
+    try {
+      f();
+    } catch (const revcol::InvalidArgument& ex) {
+      const bool named = std::string(ex.what()).find(word) != std::string::npos;
+      if (!named) std::fprintf(stderr, "message '%s' lacks '%s'\n", ex.what(), word);
+      return named;
+    }
+    return false;
+  };
+  CHECK(throws([&] { e.run_back(2000, e.origin()); }, "ahead"));
+  CHECK(throws([&] { e.run_back(0, e.clock() + 1); }, "target tick"));
+  CHECK(throws([&] { e.run(10, e.clock() - 1); }, "before the clock"));
+  CHECK(throws([&] { e.run(10, tick_limit); }, "tick limit"));
+  Snapshot bad = s;
+  bad.x[3] = bad.x[4];
+  CHECK(throws([&] { e.restore(bad); }, "overlap"));
+  bad = s;
+  bad.v[0][0] = s.units.vmax + 1;
+  CHECK(throws([&] { e.restore(bad); }, "faster"));
+  bad = s;
+  bad.streams.pop_back();
+  CHECK(throws([&] { e.restore(bad); }, "stream"));
+  CHECK(same_state(e.snapshot(), s));
+  e.run_back(0, e.origin());
+  CHECK(e.collisions() == 0);
 }
 
 TEST_CASE("event sequence equals the prototype's (20 disks, periodic, S = 60, test operator)") {

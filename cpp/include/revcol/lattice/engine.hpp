@@ -49,9 +49,11 @@ struct LatticeStart {
 /// cannot hold, an overlap after quantization).
 LatticeStart quantize_start(const LatticeConfig& c, const std::vector<double>& x, const std::vector<double>& v);
 
-/// A random start as the float engine's engine::random_state (2D, that box, n disks at area
-/// fraction phi, Gaussian velocities with zero momentum, kT = 1), quantized once.
-LatticeStart random_start(const LatticeConfig& c, std::size_t n, double phi, std::uint64_t seed);
+/// A random start as the float engine's engine::random_state (2D, n disks at area fraction phi in
+/// the square box it chooses, Gaussian velocities with zero momentum, kT = 1, init "auto", "rsa" or
+/// "lattice"), quantized once.
+LatticeStart random_start(const LatticeConfig& c, std::size_t n, double phi, std::uint64_t seed,
+                          const std::string& init = "auto");
 
 /// Diagnostics of a lattice state (all exact integers converted only for reporting).
 struct Diagnostics {
