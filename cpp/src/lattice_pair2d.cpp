@@ -153,12 +153,12 @@ Refusal LatticePair2D::forward(const Vec2& q, const Vec2& w, std::uint64_t g, co
   const std::int64_t k = (fr.jn + tr.jpost - jd) & kMask;
   const IVec W2 = rotate(fr.w, rot_coef(k));
   if (!small(W2.x, kMaxComp) || !small(W2.y, kMaxComp)) return refuse(Refusal::out_of_domain);
-  if (dir_cell(W2.x, W2.y) != ((fr.jn + tr.jpost) & kMask)) return refuse(Refusal::cell_readback);
-  // 6. post phase
+  // 6. post phase (the refusals in the prototype's order: interval, empty, then read-back)
   const auto lo2 = lo_post(sigma2_, fr.xc, fr.strict, W2.x, W2.y);
   if (!lo2) return refuse(Refusal::out_of_domain);
   tr.m2 = fr.yin - *lo2 + 1;
   if (tr.m2 <= 0) return refuse(Refusal::empty_post);
+  if (dir_cell(W2.x, W2.y) != ((fr.jn + tr.jpost) & kMask)) return refuse(Refusal::cell_readback);
   const std::uint64_t idx2 = X_out.pop_uniform(static_cast<std::uint64_t>(tr.m2));
   const i128 qx = static_cast<i128>(fr.xc) + W2.x;
   const i128 qy = static_cast<i128>(*lo2) + static_cast<i128>(idx2) + W2.y;
