@@ -43,10 +43,10 @@
 #include <utility>
 #include <vector>
 
+#include "revcol/engine/event_queue.hpp"
 #include "revcol/error.hpp"
 #include "revcol/lattice/cell_grid.hpp"
 #include "revcol/lattice/geometry.hpp"
-#include "revcol/lattice/queue_fallback.hpp"
 #include "revcol/lattice/units.hpp"
 #include "revcol/rng/philox.hpp"
 
@@ -110,7 +110,7 @@ std::vector<std::uint64_t> initial_bits(std::uint32_t seed);
 
 /// The lattice engine's event machinery over a pair operator Op (pair_forward / pair_reverse as
 /// LatticePair2D) and a bits-back integer Bits (BitsBack).
-template <class Op, class Bits, class Queue = EventQueueFallback<std::int64_t>>
+template <class Op, class Bits, class Queue = engine::EventQueue<std::int64_t>>
 class BasicEngine {
  public:
   /// An engine on a validated integer state at tick clock, X from initial_bits(seed).
@@ -354,7 +354,9 @@ class BasicEngine {
       ta_[p] = clock_;
       grid_.insert(static_cast<int>(p), grid_.cell_id(x_[p]));
     }
-    queue_.reset(n, clock_, 1);
+    // first bucket width: ~2^20 ticks per mean free time per particle, over N particles (the
+    // queue adapts it; a speed setting only)
+    queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << 20) / static_cast<std::int64_t>(n)));
     // forward: events at the clock may still be pending (a run stopped after a collision);
     // reverse: the clock's tick is done (see run_back), the search starts one tick later
     const std::int64_t lo = reversed_ ? clock_ + 1 : clock_;
