@@ -215,6 +215,8 @@ void CellGrid::build(const Units& u, std::size_t n) {
   for (int k = 0; k < 2; ++k) {
     all_[k] = !u.wall[k] && ncl[k] < 5;
     nc_[k] = static_cast<int>(all_[k] ? 8 : ncl[k]);
+    bounds_[k].resize(static_cast<std::size_t>(nc_[k]) + 1);
+    for (int c = 0; c <= nc_[k]; ++c) bounds_[k][c] = static_cast<std::int64_t>(static_cast<i128>(c) * L_[k] / nc_[k]);
   }
   members_.assign(static_cast<std::size_t>(nc_[0]) * nc_[1], {});
   where_.assign(n, -1);
@@ -222,7 +224,8 @@ void CellGrid::build(const Units& u, std::size_t n) {
 }
 
 int CellGrid::cell_of(int k, std::int64_t x) const noexcept {
-  int c = static_cast<int>(static_cast<i128>(x) * nc_[k] / L_[k]);
+  // a double guess, corrected exactly against the integer boundaries
+  int c = static_cast<int>(static_cast<double>(x) / static_cast<double>(L_[k]) * nc_[k]);
   c = std::clamp(c, 0, nc_[k] - 1);
   while (c > 0 && x < boundary(k, c)) --c;
   while (c + 1 < nc_[k] && x >= boundary(k, c + 1)) ++c;

@@ -56,9 +56,7 @@ class CellGrid {
   /// Number of cells along axis k.
   int count(int k) const noexcept { return nc_[k]; }
   /// Lower boundary of cell c (0 <= c <= nc) on axis k: floor(c L / nc).
-  std::int64_t boundary(int k, int c) const noexcept {
-    return static_cast<std::int64_t>(static_cast<i128>(c) * L_[k] / nc_[k]);
-  }
+  std::int64_t boundary(int k, int c) const noexcept { return bounds_[k][static_cast<std::size_t>(c)]; }
   /// The cell index on axis k of a position in [0, L).
   int cell_of(int k, std::int64_t x) const noexcept;
   /// Ticks from an anchor x0 in cell c of axis k until the line x0 + v dt leaves the cell; -1 if never.
@@ -89,6 +87,7 @@ class CellGrid {
   int axis_range(int k, int c, int* out) const noexcept;
   std::array<std::int64_t, 2> L_{};
   std::array<int, 2> nc_{1, 1};
+  std::array<std::vector<std::int64_t>, 2> bounds_;  // b(c) = floor(c L / nc), c = 0..nc
   std::array<bool, 2> all_{false, false};  // small periodic axis: every cell is a neighbour
   std::array<bool, 2> wall_{false, false};
   std::vector<std::vector<int>> members_;

@@ -263,9 +263,24 @@ class BasicEngine {
   // ---- geometry of the lines ----
   Vec2 pos(int p, std::int64_t t) const noexcept {
     Vec2 out;
+    const std::int64_t dt = t - ta_[p];
     for (int k = 0; k < 2; ++k) {
-      const i128 y = static_cast<i128>(x_[p][k]) + static_cast<i128>(v_[p][k]) * (t - ta_[p]);
-      out[k] = u_.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u_.L[k]);
+      std::int64_t m, y;
+      // fast path (measure before changing): the displacement fits int64 and at most one wrap
+      if (!__builtin_mul_overflow(v_[p][k], dt, &m) && !__builtin_add_overflow(x_[p][k], m, &y)) {
+        if (u_.wall[k]) {
+          out[k] = y;
+          continue;
+        }
+        if (y >= u_.L[k]) y -= u_.L[k];
+        else if (y < 0) y += u_.L[k];
+        if (y >= 0 && y < u_.L[k]) {
+          out[k] = y;
+          continue;
+        }
+      }
+      const i128 z = static_cast<i128>(x_[p][k]) + static_cast<i128>(v_[p][k]) * dt;
+      out[k] = u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
     }
     return out;
   }
