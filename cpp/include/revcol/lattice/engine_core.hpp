@@ -181,7 +181,7 @@ class BasicEngine {
     s.origin = origin_;
     s.collisions = ncoll_;
     s.x = positions();
-    s.v = v_;
+    s.v = velocities();
     s.streams = ctr_;
     s.bits = X_.words();
     s.log.assign(log_.begin(), log_.end());
@@ -192,11 +192,16 @@ class BasicEngine {
   }
   /// Positions at the clock, wrapped.
   std::vector<Vec2> positions() const {
-    std::vector<Vec2> out(x_.size());
-    for (std::size_t p = 0; p < x_.size(); ++p) out[p] = pos(static_cast<int>(p), clock_);
+    std::vector<Vec2> out(ln_.size());
+    for (std::size_t p = 0; p < ln_.size(); ++p) out[p] = pos(static_cast<int>(p), clock_);
     return out;
   }
-  const std::vector<Vec2>& velocities() const noexcept { return v_; }   ///< velocities
+  /// Velocities (a copy).
+  std::vector<Vec2> velocities() const {
+    std::vector<Vec2> out(ln_.size());
+    for (std::size_t p = 0; p < ln_.size(); ++p) out[p] = ln_[p].v;
+    return out;
+  }
   std::int64_t clock() const noexcept { return clock_; }                ///< the current tick
   std::int64_t origin() const noexcept { return origin_; }              ///< the initial tick
   std::uint64_t collisions() const noexcept { return ncoll_; }          ///< collisions since the start
@@ -204,7 +209,7 @@ class BasicEngine {
   const Counters& counters() const noexcept { return cnt_; }            ///< statistics
   std::size_t log_size() const noexcept { return log_.size(); }         ///< rare-log entries held
   const Units& units() const noexcept { return u_; }                    ///< units and box
-  std::size_t size() const noexcept { return x_.size(); }               ///< N
+  std::size_t size() const noexcept { return ln_.size(); }               ///< N
   std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
   const std::vector<std::uint64_t>& streams() const noexcept { return ctr_; }  ///< stream counters
   const Op& op() const noexcept { return op_; }                         ///< the pair operator
@@ -214,7 +219,7 @@ class BasicEngine {
   std::vector<std::array<std::int64_t, 3>>* trace = nullptr;
   /// Bytes held by the engine's arrays, queue, grid and log.
   std::size_t memory_bytes() const noexcept {
-    const std::size_t n = x_.size();
+    const std::size_t n = ln_.size();
     return n * (2 * sizeof(Vec2) + 4 * 8 + 3 * 8 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
            log_.size() * 48 + X_.words().size() * 8;
   }
@@ -239,9 +244,8 @@ class BasicEngine {
     u_ = s.units;
     seed_ = s.seed;
     const std::size_t n = s.x.size();
-    x_ = s.x;
-    v_ = s.v;
-    ta_.assign(n, s.clock);
+    ln_.resize(n);
+    for (std::size_t p = 0; p < n; ++p) ln_[p] = Line{s.x[p], s.v[p], s.clock};
     ver_.assign(n, 0);
     ctr_ = s.streams;
     X_ = Bits(s.bits);
@@ -263,11 +267,11 @@ class BasicEngine {
   // ---- geometry of the lines ----
   Vec2 pos(int p, std::int64_t t) const noexcept {
     Vec2 out;
-    const std::int64_t dt = t - ta_[p];
+    const std::int64_t dt = t - ln_[p].ta;
     for (int k = 0; k < 2; ++k) {
       std::int64_t m, y;
       // fast path (measure before changing): the displacement fits int64 and at most one wrap
-      if (!__builtin_mul_overflow(v_[p][k], dt, &m) && !__builtin_add_overflow(x_[p][k], m, &y)) {
+      if (!__builtin_mul_overflow(ln_[p].v[k], dt, &m) && !__builtin_add_overflow(ln_[p].x[k], m, &y)) {
         if (u_.wall[k]) {
           out[k] = y;
           continue;
@@ -279,7 +283,7 @@ class BasicEngine {
           continue;
         }
       }
-      const i128 z = static_cast<i128>(x_[p][k]) + static_cast<i128>(v_[p][k]) * dt;
+      const i128 z = static_cast<i128>(ln_[p].x[k]) + static_cast<i128>(ln_[p].v[k]) * dt;
       out[k] = u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
     }
     return out;
@@ -296,7 +300,7 @@ class BasicEngine {
   std::int64_t hhi(int k) const noexcept { return u_.L[k] - hlo_; }
 
   // ---- keys ----
-  std::int32_t n32() const noexcept { return static_cast<std::int32_t>(x_.size()); }
+  std::int32_t n32() const noexcept { return static_cast<std::int32_t>(ln_.size()); }
   std::int32_t coll_kind(int a, int b) const noexcept {
     const int lo = std::min(a, b);
     return reversed_ ? 1 + (n32() - 1 - lo) : 2 + lo;
@@ -305,9 +309,9 @@ class BasicEngine {
 
   // ---- prediction ----
   void reanchor(int p, std::int64_t t) {
-    x_[p] = pos(p, t);
-    ta_[p] = t;
-    const int id = grid_.cell_id(x_[p]);
+    ln_[p].x = pos(p, t);
+    ln_[p].ta = t;
+    const int id = grid_.cell_id(ln_[p].x);
     if (grid_.cell_of_particle(p) != id) {
       grid_.remove(p);
       grid_.insert(p, id);
@@ -336,17 +340,17 @@ class BasicEngine {
     const int cell = grid_.cell_of_particle(p);
     const int c[2] = {cell / grid_.count(1), cell % grid_.count(1)};
     for (int k = 0; k < 2; ++k) {
-      const std::int64_t dt = grid_.exit_ticks(k, c[k], x_[p][k], v_[p][k]);
+      const std::int64_t dt = grid_.exit_ticks(k, c[k], ln_[p].x[k], ln_[p].v[k]);
       if (dt > 0) offer(lo + dt, 0, cross, -1);
       if (u_.wall[k]) {
-        const std::int64_t dw = wall_ticks(x_[p][k], v_[p][k], hlo_, hhi(k));
+        const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(k));
         if (dw > 0) offer(lo + dw, wall_kind(), wall, -1);
       }
     }
     grid_.for_neighbours(cell, [&](int q) {
       if (q == p) return;
-      const Vec2 r = diff(x_[p], pos(q, lo));
-      const Vec2 w{v_[p][0] - v_[q][0], v_[p][1] - v_[q][1]};
+      const Vec2 r = diff(ln_[p].x, pos(q, lo));
+      const Vec2 w{ln_[p].v[0] - ln_[q].v[0], ln_[p].v[1] - ln_[q].v[1]};
       const std::int64_t tau = first_overlap(r, w, sigma2_);
       if (tau >= 0) offer(lo + tau, coll_kind(p, q), coll, q);
     });
@@ -358,16 +362,16 @@ class BasicEngine {
     }
   }
   void rebuild() {
-    const std::size_t n = x_.size();
+    const std::size_t n = ln_.size();
     type_.assign(n, none);
     partner_.assign(n, -1);
     vself_.assign(n, 0);
     vpart_.assign(n, 0);
     grid_.build(u_, n);
     for (std::size_t p = 0; p < n; ++p) {
-      x_[p] = pos(static_cast<int>(p), clock_);
-      ta_[p] = clock_;
-      grid_.insert(static_cast<int>(p), grid_.cell_id(x_[p]));
+      ln_[p].x = pos(static_cast<int>(p), clock_);
+      ln_[p].ta = clock_;
+      grid_.insert(static_cast<int>(p), grid_.cell_id(ln_[p].x));
     }
     // first bucket width: ~2^20 ticks per mean free time per particle, over N particles (the
     // queue adapts it; a speed setting only)
@@ -379,8 +383,10 @@ class BasicEngine {
     last_key_ = {std::numeric_limits<std::int64_t>::min(), 0};
   }
   void flip() {
-    for (auto& a : v_) a = {-a[0], -a[1]};
-    for (auto& t : ta_) t = -t;
+    for (Line& l : ln_) {
+      l.v = {-l.v[0], -l.v[1]};
+      l.ta = -l.ta;
+    }
     clock_ = -clock_;
     for (auto& t : wall_tick_) t = std::numeric_limits<std::int64_t>::min();
     reversed_ = !reversed_;
@@ -441,7 +447,7 @@ class BasicEngine {
 
   // ---- walls ----
   void reflect(int p, std::int64_t a) {
-    Vec2 x = pos(p, a - 1), v = v_[p];
+    Vec2 x = pos(p, a - 1), v = ln_[p].v;
     Vec2 old_line_at_a = pos(p, a);
     for (int k = 0; k < 2; ++k) {
       if (!(u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(k)))) x[k] += v[k];
@@ -457,9 +463,9 @@ class BasicEngine {
       }
       if (overlap(old_line_at_a, pos(q, a))) ++cnt_.wall_body;
     });
-    x_[p] = x;
-    v_[p] = v;
-    ta_[p] = a;
+    ln_[p].x = x;
+    ln_[p].v = v;
+    ln_[p].ta = a;
     ++ver_[p];
     wall_tick_[p] = a;
     ++cnt_.walls;
@@ -483,7 +489,11 @@ class BasicEngine {
     return o;
   }
   // why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none
-  int post_reason(int i, int j, const Vec2& xi, const Vec2& xj, const Vec2& vi, const Vec2& vj, std::int64_t a) const {
+  // why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none.
+  // The same scan flags `multi` when a pre line (pre_a: i's and j's pre lines at tick a) overlaps
+  // a third body at a: complete whenever 0 is returned (every neighbour was looked at).
+  int post_reason(int i, int j, const Vec2& xi, const Vec2& xj, const Vec2& vi, const Vec2& vj, std::int64_t a,
+                  const Vec2 (&pre_a)[2], bool& multi) const {
     for (int k = 0; k < 2; ++k) {
       for (const Vec2* vv : {&vi, &vj})
         if ((*vv)[k] > u_.vmax || (*vv)[k] < -u_.vmax) return redraw_outside;
@@ -492,35 +502,27 @@ class BasicEngine {
         if ((*xx)[k] < hlo_ || (*xx)[k] > hhi(k)) return redraw_outside;
     }
     int why = 0;
+    multi = false;
     for (int s = 0; s < 2 && why == 0; ++s) {
       const Vec2& x = s == 0 ? xi : xj;
       const Vec2& v = s == 0 ? vi : vj;
       const Vec2 ghost = wrapped(Vec2{x[0] - v[0], x[1] - v[1]});
       grid_.for_neighbours(grid_.cell_id(x), [&](int q) {
         if (why != 0 || q == i || q == j) return;
-        if (overlap(x, pos(q, a))) why = redraw_overlap_after;
+        const Vec2 qa = pos(q, a);
+        if (overlap(x, qa)) why = redraw_overlap_after;
         else if (overlap(ghost, pos(q, a - 1))) why = redraw_ghost_tie;
+        if (overlap(pre_a[0], qa) || overlap(pre_a[1], qa)) multi = true;
       });
     }
     return why;
   }
-  void count_rare(int i, int j, std::int64_t a) {
-    if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
-    bool multi = false;
-    for (int s : {i, j}) {
-      const Vec2 xs = pos(s, a);
-      grid_.for_neighbours(grid_.cell_of_particle(s), [&](int q) {
-        if (q != i && q != j && overlap(xs, pos(q, a))) multi = true;
-      });
-    }
-    if (multi) ++cnt_.multi_body;
-  }
   void apply(int i, int j, const Vec2& xi, const Vec2& xj, const Vec2& vi, const Vec2& vj, std::int64_t a) {
-    x_[i] = xi;
-    x_[j] = xj;
-    v_[i] = vi;
-    v_[j] = vj;
-    ta_[i] = ta_[j] = a;
+    ln_[i].x = xi;
+    ln_[j].x = xj;
+    ln_[i].v = vi;
+    ln_[j].v = vj;
+    ln_[i].ta = ln_[j].ta = a;
     ++ver_[i];
     ++ver_[j];
     ++cnt_.collisions;
@@ -528,7 +530,10 @@ class BasicEngine {
     predict(j, a);
   }
   void collide_forward(int i, int j, std::int64_t a) {
-    count_rare(i, j, a);
+    if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
+    const Vec2 pre_a[2] = {pos(i, a), pos(j, a)};
+    bool multi = false;
+    const std::uint64_t ctr0 = ctr_[i];
     // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
     // values stay within a few sigma of 0 whatever the box
     const Vec2 xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{0, 0};
@@ -537,23 +542,25 @@ class BasicEngine {
     std::uint32_t redraws = 0;
     for (;;) {
       if (redraws > static_cast<std::uint32_t>(max_redraws)) {
+        ctr_[i] = ctr0;  // nothing changed
         throw std::runtime_error("lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
                                  std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
                                  " found no acceptable post state in " + std::to_string(max_redraws) +
                                  " redraws (a multi-body tick the rule cannot resolve)");
       }
       const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
-      const auto rf = op_.pair_forward(xi, zero, v_[i], v_[j], g, X_, xi2, xj2, vi2, vj2, out);
+      const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_, xi2, xj2, vi2, vj2, out);
       int why = static_cast<int>(rf);
       if (why == 0) {
         xi2 = shifted(xj, xi2);
         xj2 = shifted(xj, xj2);
-        why = post_reason(i, j, xi2, xj2, vi2, vj2, a);
+        why = post_reason(i, j, xi2, xj2, vi2, vj2, a, pre_a, multi);
       }
       if (why == 0) break;
       ++cnt_.redraws[std::min(why, 7)];
       ++redraws;
     }
+    if (multi) ++cnt_.multi_body;
     if (redraws > 0) {
       log_[ncoll_ + 1] = redraws;
       ++cnt_.log_entries;
@@ -571,7 +578,7 @@ class BasicEngine {
     if (ctr_[i] < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i] - 1);
     Vec2 xi0, xj0, vi0, vj0;
-    op_.pair_reverse(xi, zero, Vec2{-v_[i][0], -v_[i][1]}, Vec2{-v_[j][0], -v_[j][1]}, g, X_, xi0, xj0, vi0, vj0);
+    op_.pair_reverse(xi, zero, Vec2{-ln_[i].v[0], -ln_[i].v[1]}, Vec2{-ln_[j].v[0], -ln_[j].v[1]}, g, X_, xi0, xj0, vi0, vj0);
     xi0 = shifted(xj, xi0);
     xj0 = shifted(xj, xj0);
     ctr_[i] -= 1 + redraws;
@@ -583,8 +590,14 @@ class BasicEngine {
   Op op_;
   Units u_;
   std::uint32_t seed_ = 1;
-  std::vector<Vec2> x_, v_;
-  std::vector<std::int64_t> ta_, wall_tick_;
+  // one particle's line, together in memory (the prediction loop reads all three)
+  struct Line {
+    Vec2 x;              // anchor position (wrapped)
+    Vec2 v;              // velocity
+    std::int64_t ta;     // anchor tick
+  };
+  std::vector<Line> ln_;
+  std::vector<std::int64_t> wall_tick_;
   std::vector<std::uint64_t> ver_, ctr_, vself_, vpart_;
   std::vector<Type> type_;
   std::vector<int> partner_;
