@@ -111,6 +111,10 @@ std::int64_t dir_cell(i64 wx, i64 wy) {
   return k;
 }
 
+bool in_cell(i64 wx, i64 wy, std::int64_t k) {
+  return cross(boundary(2 * k), wx, wy) >= 0 && cross(boundary(2 * k + 2), wx, wy) < 0;
+}
+
 std::int64_t normal_cell(i64 xc, i64 sigma) {
   require(sigma >= 1 && xc > -sigma && xc < sigma, "normal_cell: needs |xc| < sigma");
   const double phi = std::acos(static_cast<double>(xc) / static_cast<double>(sigma));
@@ -155,14 +159,21 @@ std::uint64_t flux_cum(std::int64_t a) {
   return static_cast<std::uint64_t>((1LL << 47) + ((y + (1LL << 14)) >> 15));
 }
 
-std::int64_t flux_decode(std::uint64_t s) {
+std::int64_t flux_decode(std::uint64_t s, std::uint64_t& cum, std::uint64_t& freq) {
   constexpr std::int64_t n = kHalfTurn;  // relative cells 0..2^19-1
   const double u = static_cast<double>(s) / static_cast<double>(1ULL << 47) - 1.0;
   const double th = std::asin(u < -1.0 ? -1.0 : (u > 1.0 ? 1.0 : u));
   std::int64_t b = static_cast<std::int64_t>(std::floor(th * kCellsPerRadian)) + kQuarterTurn;
   b = b < 0 ? 0 : (b >= n ? n - 1 : b);
-  while (b > 0 && flux_cum(b) > s) --b;
-  while (b + 1 < n && flux_cum(b + 1) <= s) ++b;
+  std::uint64_t lo = flux_cum(b);
+  while (lo > s) lo = flux_cum(--b);  // cum(0) = 0 <= s stops it
+  std::uint64_t hi = flux_cum(b + 1);
+  while (hi <= s) {                    // cum(2^19) = 2^48 > s stops it
+    lo = hi;
+    hi = flux_cum(++b + 1);
+  }
+  cum = lo;
+  freq = hi - lo;
   return b;
 }
 

@@ -99,7 +99,16 @@ std::uint64_t LatticePair2D::cum(std::int64_t a) const {
 }
 
 std::int64_t LatticePair2D::decode(std::uint64_t s) const {
-  return law_ == Law::flux ? flux_decode(s) : static_cast<std::int64_t>(s / kUniformFreq);
+  std::uint64_t c, f;
+  return decode(s, c, f);
+}
+
+std::int64_t LatticePair2D::decode(std::uint64_t s, std::uint64_t& c, std::uint64_t& f) const {
+  if (law_ == Law::flux) return flux_decode(s, c, f);
+  const std::int64_t b = static_cast<std::int64_t>(s / kUniformFreq);
+  c = static_cast<std::uint64_t>(b) * kUniformFreq;
+  f = kUniformFreq;
+  return b;
 }
 
 Refusal LatticePair2D::check_pre(const Vec2& q, const Vec2& w) const {
@@ -146,9 +155,9 @@ Refusal LatticePair2D::forward(const Vec2& q, const Vec2& w, std::uint64_t g, co
   X_out.push_rans(ca, cum(a + 1) - ca);
   // 4. torus shift, 5. post direction
   X_out.add_low48(g);
-  const std::int64_t b = decode(X_out.low48());
-  const std::uint64_t cb = cum(b);
-  X_out.pop_rans(cb, cum(b + 1) - cb);
+  std::uint64_t cb, fb;
+  const std::int64_t b = decode(X_out.low48(), cb, fb);
+  X_out.pop_rans(cb, fb);
   tr.jpost = b - kQuarterTurn;
   const std::int64_t k = (fr.jn + tr.jpost - jd) & kMask;
   const IVec W2 = rotate(fr.w, rot_coef(k));
@@ -158,7 +167,7 @@ Refusal LatticePair2D::forward(const Vec2& q, const Vec2& w, std::uint64_t g, co
   if (!lo2) return refuse(Refusal::out_of_domain);
   tr.m2 = fr.yin - *lo2 + 1;
   if (tr.m2 <= 0) return refuse(Refusal::empty_post);
-  if (dir_cell(W2.x, W2.y) != ((fr.jn + tr.jpost) & kMask)) return refuse(Refusal::cell_readback);
+  if (!in_cell(W2.x, W2.y, (fr.jn + tr.jpost) & kMask)) return refuse(Refusal::cell_readback);
   const std::uint64_t idx2 = X_out.pop_uniform(static_cast<std::uint64_t>(tr.m2));
   const i128 qx = static_cast<i128>(fr.xc) + W2.x;
   const i128 qy = static_cast<i128>(*lo2) + static_cast<i128>(idx2) + W2.y;
@@ -188,8 +197,8 @@ void LatticePair2D::reverse(const Vec2& q2, const Vec2& w2, std::uint64_t g, Bit
   X.push_uniform(static_cast<std::uint64_t>(idx2), static_cast<std::uint64_t>(m2));
   X.push_rans(cb, fb);
   X.sub_low48(g);
-  const std::int64_t a = decode(X.low48());
-  const std::uint64_t ca = cum(a), fa = cum(a + 1) - ca;
+  std::uint64_t ca, fa;
+  const std::int64_t a = decode(X.low48(), ca, fa);
   X.pop_rans(ca, fa);
   const std::int64_t jd = (a - kQuarterTurn + fr.jn + kHalfTurn) & kMask;
   const IVec W = rotate_inv(fr.w, rot_coef((fr.jn + jpost - jd) & kMask));

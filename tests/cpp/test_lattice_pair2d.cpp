@@ -220,6 +220,9 @@ TEST_CASE("cells: boundaries monotone, |B| = 2^62, close to cos/sin, exactly sym
     const i64 wy = static_cast<i64>(rng() >> (2 + rng() % 60)) - static_cast<i64>(rng() >> (2 + rng() % 60));
     if (wx == 0 && wy == 0) continue;
     const std::int64_t k = dir_cell(wx, wy);
+    CHECK(in_cell(wx, wy, k));
+    CHECK(!in_cell(wx, wy, (k + 1) & (kCells - 1)));
+    CHECK(!in_cell(wx, wy, (k - 1) & (kCells - 1)));
     for (int t = 1; t < 4; ++t) {
       const IVec r = rot90({wx, wy}, t);
       CHECK(dir_cell(r.x, r.y) == ((k + t * kQuarterTurn) & (kCells - 1)));
@@ -252,8 +255,9 @@ TEST_CASE("flux table: every f >= 1, total 2^48, decode exact at every boundary"
   std::mt19937_64 rng(9);
   for (int i = 0; i < 100000; ++i) {
     const std::uint64_t s = rng() >> 16;
-    const std::int64_t b = flux_decode(s);
-    if (!(flux_cum(b) <= s && s < flux_cum(b + 1))) ++bad;
+    std::uint64_t c, f;
+    const std::int64_t b = flux_decode(s, c, f);
+    if (!(flux_cum(b) <= s && s < flux_cum(b + 1) && c == flux_cum(b) && f == flux_cum(b + 1) - c)) ++bad;
   }
   CHECK(bad == 0);
   const LatticePair2D uni(1LL << 60, Law::uniform);
@@ -489,6 +493,83 @@ TEST_CASE("edges: head-on, grazing, each face, axis-parallel, tiny and huge spee
   CHECK(accepted > 2500);
 }
 
+TEST_CASE("face corners: phase intervals that reach the diagonal (odd faces exclude it)") {
+  // p within a few |w| of a corner where the circle meets a diagonal: the pre and post phase
+  // columns run into the face boundary, and a post phase on the diagonal of an odd face would
+  // be read back in the neighbouring face. Round trips must stay exact.
+  Rng rng(404);
+  const i64 S = 1LL << 40;
+  const LatticePair2D op(S);
+  BitsBack X = random_bits(rng.gen, 256);
+  int bad = 0, accepted = 0, tried = 0;
+  for (int t = 0; t < 40000; ++t) {
+    const double V = std::ldexp(1.0 + rng.uni(), 18 + static_cast<int>(rng.gen() % 6));
+    const double corner = (2 * static_cast<int>(rng.gen() % 4) + 1) * std::numbers::pi / 4;
+    const double r = static_cast<double>(S) - V * rng.uni();
+    const double ang = corner + (rng.uni() - 0.5) * 6 * V / static_cast<double>(S);
+    const Vec2 p{static_cast<i64>(r * std::cos(ang)), static_cast<i64>(r * std::sin(ang))};
+    const double a = ang + std::numbers::pi + (rng.uni() - 0.5) * 3.0;  // inward, up to +-86 deg
+    const Vec2 w{static_cast<i64>(V * std::cos(a)), static_cast<i64>(V * std::sin(a))};
+    const Vec2 q = sub(p, w);
+    if (norm2(q) < sq(S) || norm2(p) >= sq(S)) continue;
+    ++tried;
+    accepted += round_trip(op, q, w, rng.draw(), X, bad) == Refusal::none;
+  }
+  std::printf("  corners: %d pre states, %d accepted\n", tried, accepted);
+  CHECK(bad == 0);
+  CHECK(accepted > 5000);
+}
+
+TEST_CASE("face corners: post phases steered onto the lowest point of an odd face's column") {
+  // With X = 0 the draw G fixes the post cell b and makes the post phase the lowest of its
+  // interval (X after the pops is 0): G = cum(b) - s, s the low 48 bits after the pre pushes.
+  // Near a corner that lowest point sits just off the diagonal of an odd face (|x| + 1); a
+  // face rule that let the diagonal in would put it on the diagonal, which the reverse reads
+  // in the neighbouring face. Every steered forward must invert exactly.
+  Rng rng(505);
+  const i64 S = 1LL << 40;
+  const LatticePair2D op(S);
+  int bad = 0, at_diagonal = 0, accepted = 0;
+  for (int t = 0; t < 400; ++t) {
+    const double V = std::ldexp(1.0 + rng.uni(), 24);
+    const double corner = (2 * static_cast<int>(rng.gen() % 4) + 1) * std::numbers::pi / 4;
+    const double ang = corner + (rng.uni() - 0.5) * 2 * V / static_cast<double>(S);
+    const double r = static_cast<double>(S) - V * rng.uni() * 0.5;
+    const Vec2 p{static_cast<i64>(r * std::cos(ang)), static_cast<i64>(r * std::sin(ang))};
+    const double a = ang + std::numbers::pi + (rng.uni() - 0.5) * 2.0;
+    const Vec2 w{static_cast<i64>(V * std::cos(a)), static_cast<i64>(V * std::sin(a))};
+    const Vec2 q = sub(p, w);
+    if (norm2(q) < sq(S) || norm2(p) >= sq(S) || op.check_pre(q, w) != Refusal::none) continue;
+    const int f = face_of(p[0], p[1]);
+    const IVec P = rot90({p[0], p[1]}, f), W = rot90({w[0], w[1]}, f);
+    const i64 lo = *lo_pre(sq(S), P.x, f & 1, W.x, W.y);
+    Trace tr;
+    Vec2 q2, w2;
+    BitsBack X0, X2;
+    (void)op.forward(q, w, 0, X0, q2, w2, X2, &tr);
+    BitsBack Xs;  // the pre pushes of the forward, from X = 0
+    Xs.push_uniform(static_cast<std::uint64_t>(P.y - lo), static_cast<std::uint64_t>(tr.m));
+    const std::uint64_t ca = op.cum(tr.jpre + kQuarterTurn);
+    Xs.push_rans(ca, op.cum(tr.jpre + kQuarterTurn + 1) - ca);
+    for (int k = 0; k < 64; ++k) {
+      const std::int64_t b = (k * 8191 + static_cast<std::int64_t>(rng.gen() % 8191)) % kHalfTurn;
+      const std::uint64_t g = (op.cum(b) - Xs.low48()) & (BitsBack::rans_total - 1);
+      if (op.forward(q, w, g, X0, q2, w2, X2, &tr) != Refusal::none) continue;
+      ++accepted;
+      if (!X2.is_zero()) ++bad;  // the steering worked: the post phase is the lowest
+      const IVec P2 = rot90({q2[0] - w2[0], q2[1] - w2[1]}, f);
+      if ((f & 1) && P2.y == std::llabs(P2.x) + 1) ++at_diagonal;
+      BitsBack Xb = X2;
+      Vec2 qb, wb;
+      op.reverse(q2, w2, g, Xb, qb, wb);
+      if (!(qb == q && wb == w && Xb == X0)) ++bad;
+    }
+  }
+  std::printf("  steered: %d accepted, %d next to an odd face's diagonal\n", accepted, at_diagonal);
+  CHECK(bad == 0);
+  CHECK(at_diagonal > 20);
+}
+
 TEST_CASE("refusals: G-independent ones agree with check_pre; X and X_out stay equal") {
   Rng rng(41);
   const LatticePair2D op(1LL << 60);
@@ -589,6 +670,39 @@ TEST_CASE("post law, uniform: KS against the uniform angle law; X grows ~1 bit p
   CHECK(r.p > 0.001);
   // head-on pre (cos = 1) and uniform post: E[log2(m/m2)] = -E[log2 cos theta] = 1 bit
   CHECK(rate > 0.9 && rate < 1.1);
+}
+
+TEST_CASE("X's size over a gas of pre states: bounded under flux, +0.557 bit/collision under uniform") {
+  // Random pre states with flux-law incidence (an equilibrium gas), X chained. Per collision X
+  // changes by log2(m f_post / (f_pre m2)), m ~ cos(pre), m2 ~ cos(post): under the flux law
+  // (f ~ cos) that is ~0 every time; under the uniform law its mean is
+  // E_flux[log2 cos] - E_uniform[log2 cos] = log2(e) (2 ln 2 - 1) = 0.5573 bit.
+  const long n = 20000;
+  for (const Law law : {Law::flux, Law::uniform}) {
+    const LatticePair2D op(1LL << 60, law);
+    Rng rng(law == Law::flux ? 61 : 62);
+    BitsBack X = random_bits(rng.gen, 256), X2;
+    const double start = static_cast<double>(X.bit_length());
+    double lo = start, hi = start;
+    int bad = 0;
+    for (long k = 0; k < n;) {
+      Vec2 q, w;
+      if (!make_pre(op.sigma(), 6.3 * rng.uni(), std::asin(2 * rng.uni() - 1), std::ldexp(1 + rng.uni(), 40), rng.uni(), q, w) ||
+          op.check_pre(q, w) != Refusal::none)
+        continue;
+      while (round_trip(op, q, w, rng.draw(), X, bad) != Refusal::none) {
+      }
+      lo = std::min(lo, static_cast<double>(X.bit_length()));
+      hi = std::max(hi, static_cast<double>(X.bit_length()));
+      ++k;
+    }
+    const double rate = (static_cast<double>(X.bit_length()) - start) / static_cast<double>(n);
+    std::printf("  %s: X %g -> %zu bits over %ld collisions (min %g, max %g): %.4f bit/collision\n", to_string(law), start,
+                X.bit_length(), n, lo, hi, rate);
+    CHECK(bad == 0);
+    if (law == Law::flux) CHECK(hi - lo <= 16);
+    if (law == Law::uniform) CHECK(std::fabs(rate - 0.5573) < 0.05);
+  }
 }
 
 int main(int argc, char** argv) {

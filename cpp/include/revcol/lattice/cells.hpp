@@ -70,6 +70,8 @@ inline IVec rot90(IVec v, int k) {
 IVec boundary(std::int64_t h);
 /// The direction cell in [0, ND) of w != 0 (exact; see above).
 std::int64_t dir_cell(i64 wx, i64 wy);
+/// dir_cell(wx, wy) == k, decided by two exact cross products (w != 0, 0 <= k < ND).
+bool in_cell(i64 wx, i64 wy, std::int64_t k);
 /// The cell nearest to the normal angle acos(xc/sigma); needs |xc| < sigma, sigma <= 2^61.
 std::int64_t normal_cell(i64 xc, i64 sigma);
 
@@ -88,7 +90,13 @@ IVec rotate_inv(IVec w, const RotCoef& c);
 
 /// The flux-law cumulative frequency cum(a), 0 <= a <= 2^19 (cum(2^19) = 2^48).
 std::uint64_t flux_cum(std::int64_t a);
-/// The relative cell b with flux_cum(b) <= s < flux_cum(b + 1), for s < 2^48.
-std::int64_t flux_decode(std::uint64_t s);
+/// The relative cell b with flux_cum(b) <= s < flux_cum(b + 1), for s < 2^48; writes
+/// cum = flux_cum(b) and freq = flux_cum(b + 1) - flux_cum(b).
+std::int64_t flux_decode(std::uint64_t s, std::uint64_t& cum, std::uint64_t& freq);
+/// As above, without the frequencies.
+inline std::int64_t flux_decode(std::uint64_t s) {
+  std::uint64_t c, f;
+  return flux_decode(s, c, f);
+}
 
 }  // namespace revcol::lattice

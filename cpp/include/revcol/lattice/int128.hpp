@@ -19,18 +19,27 @@ using u64 = std::uint64_t;             ///< an unsigned machine word
 using i128 = __int128;                 ///< products of two coordinates
 using u128 = unsigned __int128;        ///< squares up to 2^128 - 1
 
+/// An approximation of n as a double (two word conversions; only ever a first guess).
+inline double approx_double(u128 n) {
+  return static_cast<double>(static_cast<u64>(n >> 64)) * 0x1p64 + static_cast<double>(static_cast<u64>(n));
+}
+/// An approximation of a signed n as a double (only ever a first guess).
+inline double approx_double(i128 n) {
+  return static_cast<double>(static_cast<std::int64_t>(n >> 64)) * 0x1p64 + static_cast<double>(static_cast<u64>(n));
+}
+
 /// floor(sqrt(n)), exact for every unsigned 128-bit n.
 inline u64 isqrt(u128 n) {
   if (n == 0) return 0;
   constexpr u64 kMax = std::numeric_limits<u64>::max();
-  const double d = std::sqrt(static_cast<double>(n));
+  const double d = std::sqrt(approx_double(n));
   u64 r = d >= 18446744073709551615.0 ? kMax : static_cast<u64>(d);
   if (r == 0) r = 1;
-  // The guess is within ~2^-52 r of the root: one correction from the exact residual
+  // The guess is within ~2^-51 r of the root: one correction from the exact residual
   // e = n - r^2 (small, so the wrapped unsigned difference read as signed is exact).
   const i128 e = static_cast<i128>(n - static_cast<u128>(r) * r);
-  const i128 step = static_cast<i128>(std::floor(static_cast<double>(e) / (2.0 * static_cast<double>(r))));
-  i128 rr = static_cast<i128>(r) + step;
+  const double step = std::floor(approx_double(e) / (2.0 * static_cast<double>(r)));
+  i128 rr = static_cast<i128>(r) + static_cast<std::int64_t>(step);
   if (rr < 1) rr = 1;
   if (rr > static_cast<i128>(kMax)) rr = static_cast<i128>(kMax);
   r = static_cast<u64>(rr);

@@ -121,6 +121,8 @@ class LatticePair2D {
   std::uint64_t cum(std::int64_t a) const;
   /// The relative cell b with cum(b) <= s < cum(b+1), s < 2^48.
   std::int64_t decode(std::uint64_t s) const;
+  /// As decode, also writing c = cum(b) and f = cum(b+1) - cum(b).
+  std::int64_t decode(std::uint64_t s, std::uint64_t& c, std::uint64_t& f) const;
 
  private:
   std::int64_t sigma_;
