@@ -2,7 +2,7 @@
 bench/results/lattice_*.json.
 
     python3 bench/lattice_study.py throughput [--bin build-dev/revcol-bench] [--collisions 2e5]
-    PYTHONPATH=build-dev/pkg python3 bench/lattice_study.py roundtrip [--n 1000] [--phi 0.3] [--max 1e6]
+    PYTHONPATH=build-dev/pkg python3 bench/lattice_study.py roundtrip [--n 1000] [--phi 0.3] [--max 1e6] [--law flux]
     python3 bench/lattice_study.py all
 
 throughput: one revcol-bench invocation running the lattice family (periodic N = 1e4 at area
@@ -15,7 +15,8 @@ roundtrip: one gas (N, area fraction, periodic and walls) run forward in steps o
 to --max and back to the start after each step, from Python: bit-for-bit restoration of positions,
 velocities, stream counters, X and clock; X's bit length, rare-log entries, redraws, multi-body and
 wall-body ticks, energy drift (relative) and momentum drift (lattice units) after the forward run.
-Writes lattice_roundtrip.json.
+Under the uniform law X grows (the entropy the non-equilibrium law produces): its bit length after
+each forward run is the measurement. Writes lattice_roundtrip_<law>.json.
 """
 from __future__ import annotations
 
@@ -51,7 +52,8 @@ def throughput(args) -> dict:
 
 
 def _same(a: dict, b: dict) -> bool:
-    keys = ["clock", "origin", "collisions", "x", "v", "streams", "bits", "log_index", "log_redraws"]
+    keys = ["clock", "origin", "collisions", "x", "v", "streams", "bits", "log_index", "log_redraws",
+            "group_index", "group_drawer", "group_size", "group_members"]
     return all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in keys)
 
 
@@ -60,7 +62,7 @@ def roundtrip(args) -> dict:
     rows = []
     for boundary in ("periodic", "wall"):
         sim = LatticeSimulation.random(n=args.n, phi=args.phi, boundary=boundary, seed=args.seed,
-                                       init="lattice" if args.phi > 0.35 else "auto")
+                                       init="lattice" if args.phi > 0.35 else "auto", law=args.law)
         s0 = sim.state()
         nc = args.n * 10
         while nc <= float(args.max):
@@ -71,12 +73,13 @@ def roundtrip(args) -> dict:
             sim.run_back()
             t2 = time.perf_counter()
             ok = _same(sim.state(), s0)
-            row = {"boundary": boundary, "n": args.n, "phi": args.phi, "collisions": nc,
+            row = {"boundary": boundary, "law": args.law, "n": args.n, "phi": args.phi, "collisions": nc,
                    "per_particle": 2 * nc / args.n, "bit_for_bit": bool(ok),
                    "forward_s": t1 - t0, "reverse_s": t2 - t1,
                    "bits_length": d["bits_length"], "log_entries": d["log_entries"],
                    "log_entries_written": d["log_entries_written"],
                    "redraws": d["redraws"], "multi_body": d["multi_body"], "wall_body": d["wall_body"],
+                   "group_bounces": d["group_bounces"],
                    "energy_drift": d["energy_drift"], "momentum_drift": list(d["momentum_drift"]),
                    "quantization": sim.quantization}
             print(json.dumps(row))
@@ -84,7 +87,7 @@ def roundtrip(args) -> dict:
             if not ok:
                 break
             nc *= 10
-    path = os.path.join(RESULTS, "lattice_roundtrip.json")
+    path = os.path.join(RESULTS, f"lattice_roundtrip_{args.law}.json")
     with open(path, "w") as f:
         json.dump({"rows": rows}, f, indent=1)
     print("wrote", path)
@@ -101,6 +104,7 @@ def main(argv=None) -> int:
     ap.add_argument("--phi", type=float, default=0.3)
     ap.add_argument("--max", default="1e5")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--law", default="flux", choices=["flux", "uniform"])
     a = ap.parse_args(argv)
     os.makedirs(RESULTS, exist_ok=True)
     if a.what in ("throughput", "all"):

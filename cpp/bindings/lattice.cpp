@@ -102,6 +102,7 @@ py::dict counters_dict(const la::Counters& c) {
   d["log_entries_written"] = c.log_entries;
   d["multi_body"] = c.multi_body;
   d["wall_body"] = c.wall_body;
+  d["group_bounces"] = c.group_bounces;
   return d;
 }
 
@@ -125,6 +126,18 @@ py::dict snapshot_dict(const la::Snapshot& s, revcol::Law law) {
   }
   d["log_index"] = flat_array(li.data(), li.size());
   d["log_redraws"] = flat_array(lr.data(), lr.size());
+  std::vector<std::uint64_t> gi;
+  std::vector<std::int64_t> gd, gs, gm;
+  for (const auto& [k, g] : s.groups) {
+    gi.push_back(k);
+    gd.push_back(g.first);
+    gs.push_back(static_cast<std::int64_t>(g.second.size()));
+    for (int m : g.second) gm.push_back(m);
+  }
+  d["group_index"] = flat_array(gi.data(), gi.size());
+  d["group_drawer"] = flat_array(gd.data(), gd.size());
+  d["group_size"] = flat_array(gs.data(), gs.size());
+  d["group_members"] = flat_array(gm.data(), gm.size());
   d["energy0"] = flat_array(s.energy0.data(), 2);
   d["momentum0"] = flat_array(s.momentum0.data(), 4);
   return d;
@@ -145,6 +158,18 @@ la::Snapshot snapshot_from(const py::dict& d) {
   const auto lr = get_flat<std::uint64_t>(d, "log_redraws");
   require(li.size() == lr.size(), "lattice checkpoint: log_index and log_redraws differ in length");
   for (std::size_t k = 0; k < li.size(); ++k) s.log.emplace_back(li[k], static_cast<std::uint32_t>(lr[k]));
+  const auto gi = get_flat<std::uint64_t>(d, "group_index");
+  const auto gd = get_flat<std::int64_t>(d, "group_drawer");
+  const auto gs = get_flat<std::int64_t>(d, "group_size");
+  const auto gm = get_flat<std::int64_t>(d, "group_members");
+  require(gi.size() == gd.size() && gi.size() == gs.size(), "lattice checkpoint: group arrays differ in length");
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < gi.size(); ++k) {
+    require(gs[k] >= 2 && at + static_cast<std::size_t>(gs[k]) <= gm.size(), "lattice checkpoint: group_members too short");
+    std::vector<int> members(gm.begin() + static_cast<std::ptrdiff_t>(at), gm.begin() + static_cast<std::ptrdiff_t>(at + gs[k]));
+    at += static_cast<std::size_t>(gs[k]);
+    s.groups.push_back({gi[k], {static_cast<int>(gd[k]), members}});
+  }
   const auto e0 = get_flat<std::uint64_t>(d, "energy0");
   const auto p0 = get_flat<std::int64_t>(d, "momentum0");
   require(e0.size() == 2 && p0.size() == 4, "lattice checkpoint: energy0 needs 2 words and momentum0 4");
@@ -241,6 +266,7 @@ void register_lattice(py::module_& m) {
         d["momentum_drift"] = py::make_tuple(g.momentum_drift[0], g.momentum_drift[1]);
         d["bits_length"] = g.bits_length;
         d["log_entries"] = g.log_entries;
+        d["group_log_entries"] = p.e.group_log_size();
         d["collisions"] = g.collisions;
         d["clock"] = g.clock;
         d["time"] = g.time;

@@ -27,6 +27,7 @@ bool same_state(const Snapshot& a, const Snapshot& b) {
   return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.vmax == w.vmax &&
          a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&
+         a.groups == b.groups &&
          a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
 }
 

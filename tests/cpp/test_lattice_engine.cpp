@@ -319,6 +319,26 @@ TEST_CASE("bad input: a clear error, and the state is unchanged") {
   CHECK(e.collisions() == 0);
 }
 
+TEST_CASE("group bounce (three bodies within one tick): forced on every collision, forward and back bit for bit") {
+  for (bool walls : {false, true}) {
+    LatticeEngine e = make(120, 0.4, walls, 21);
+    e.max_redraws = -1;  // every collision takes the group path
+    const Snapshot s0 = e.snapshot();
+    e.run(3000, tick_limit - 1);
+    CHECK(e.counters().group_bounces == 3000);
+    CHECK(e.group_log_size() == 3000);
+    const Snapshot s1 = e.snapshot();
+    LatticeEngine f(s1, LatticePair2D(s1.units.sigma));  // a snapshot with group entries resumes
+    f.max_redraws = -1;
+    e.run(1000, tick_limit - 1);
+    f.run(1000, tick_limit - 1);
+    CHECK(same_state(e.snapshot(), f.snapshot()));
+    e.run_back(0, e.origin());
+    CHECK(same_state(e.snapshot(), s0));
+    CHECK(e.group_log_size() == 0);
+  }
+}
+
 TEST_CASE("event sequence equals the prototype's (20 disks, periodic, S = 60, test operator)") {
   for (const char* name : {"engine_bounce_20_0.3_1.txt", "engine_bounce_20_0.5_2.txt"}) {
     std::string dir = __FILE__;  // tests/cpp/this file -> tests/data/lattice

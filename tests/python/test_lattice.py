@@ -8,7 +8,7 @@ from revcol.lattice import LatticeSimulation
 
 def _same(a: dict, b: dict) -> bool:
     keys = ["clock", "origin", "collisions", "x", "v", "streams", "bits", "log_index", "log_redraws",
-            "seed", "law"]
+            "group_index", "group_drawer", "group_size", "group_members", "seed", "law"]
     return all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in keys)
 
 

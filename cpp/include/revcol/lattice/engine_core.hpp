@@ -77,6 +77,7 @@ struct Counters {
   std::uint64_t log_entries = 0;         ///< rare-log entries written (forward)
   std::uint64_t multi_body = 0;          ///< three bodies within one tick (resolved by the rule)
   std::uint64_t wall_body = 0;           ///< a wall and a body within one tick (resolved by the rule)
+  std::uint64_t group_bounces = 0;       ///< three or more bodies resolved by a group bounce (a log entry)
 };
 
 /// Everything that defines a lattice state, in the forward frame, positions at the clock.
@@ -91,6 +92,8 @@ struct Snapshot {
   std::vector<std::uint64_t> streams;          ///< per-particle Philox counters
   std::vector<std::uint64_t> bits;             ///< the bits-back integer X, 64-bit words, low first
   std::vector<std::pair<std::uint64_t, std::uint32_t>> log;  ///< rare log: collision index -> redraws
+  /// rare log: collision index -> (drawing particle, members) of a group bounce
+  std::vector<std::pair<std::uint64_t, std::pair<int, std::vector<int>>>> groups;
   std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
   std::array<std::int64_t, 4> momentum0{};     ///< initial momentum per axis (128 bits: low, high)
   Counters counters;                           ///< statistics (not compared by same_state)
@@ -143,6 +146,13 @@ class BasicEngine {
   void restore(const Snapshot& s) {
     validate_state(s.units, s.x, s.v);
     require(s.streams.size() == s.x.size(), "lattice snapshot: one stream counter per particle");
+    for (const auto& e : s.groups) {
+      const auto& [drawer, members] = e.second;
+      require(e.first >= 1 && e.first <= s.collisions && members.size() >= 2 &&
+                  drawer >= 0 && static_cast<std::size_t>(drawer) < s.x.size(),
+              "lattice snapshot: a group entry out of range");
+      for (int m : members) require(m >= 0 && static_cast<std::size_t>(m) < s.x.size(), "lattice snapshot: a group member out of range");
+    }
     require(s.origin <= s.clock && s.clock < tick_limit / 2 && s.origin > -tick_limit / 2,
             "lattice snapshot: origin <= clock within +-2^60 required");
     require(op_.sigma() == s.units.sigma, "lattice snapshot: the operator's sigma differs from the units'");
@@ -185,6 +195,7 @@ class BasicEngine {
     s.streams = ctr_;
     s.bits = X_.words();
     s.log.assign(log_.begin(), log_.end());
+    for (const auto& [k, g] : groups_) s.groups.push_back({k, {g.drawer, g.members}});
     s.energy0 = energy0_;
     s.momentum0 = momentum0_;
     s.counters = cnt_;
@@ -207,14 +218,16 @@ class BasicEngine {
   std::uint64_t collisions() const noexcept { return ncoll_; }          ///< collisions since the start
   const Bits& bits() const noexcept { return X_; }                      ///< the bits-back integer
   const Counters& counters() const noexcept { return cnt_; }            ///< statistics
-  std::size_t log_size() const noexcept { return log_.size(); }         ///< rare-log entries held
+  std::size_t log_size() const noexcept { return log_.size(); }         ///< rare-log entries held (redraws)
+  std::size_t group_log_size() const noexcept { return groups_.size(); }  ///< group bounces held in the log
   const Units& units() const noexcept { return u_; }                    ///< units and box
   std::size_t size() const noexcept { return ln_.size(); }               ///< N
   std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
   const std::vector<std::uint64_t>& streams() const noexcept { return ctr_; }  ///< stream counters
   const Op& op() const noexcept { return op_; }                         ///< the pair operator
-  /// Largest number of redraws before a collision is an error.
-  int max_redraws = 4096;
+  /// Redraws tried before a collision is resolved as a group bounce (group_bounce); -1 (tests
+  /// only) resolves every collision so.
+  int max_redraws = 256;
   /// When set, every forward collision appends (tick, i, j), i < j (tests, studies).
   std::vector<std::array<std::int64_t, 3>>* trace = nullptr;
   /// Bytes held by the engine's arrays, queue, grid and log.
@@ -251,6 +264,8 @@ class BasicEngine {
     X_ = Bits(s.bits);
     log_.clear();
     for (const auto& e : s.log) log_[e.first] = e.second;
+    groups_.clear();
+    for (const auto& e : s.groups) groups_[e.first] = Group{e.second.first, e.second.second};
     clock_ = s.clock;
     origin_ = s.origin;
     ncoll_ = s.collisions;
@@ -534,6 +549,7 @@ class BasicEngine {
     const Vec2 pre_a[2] = {pos(i, a), pos(j, a)};
     bool multi = false;
     const std::uint64_t ctr0 = ctr_[i];
+    std::array<std::uint64_t, 8> reasons{};
     // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
     // values stay within a few sigma of 0 whatever the box
     const Vec2 xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{0, 0};
@@ -541,12 +557,9 @@ class BasicEngine {
     Bits out;
     std::uint32_t redraws = 0;
     for (;;) {
-      if (redraws > static_cast<std::uint32_t>(max_redraws)) {
-        ctr_[i] = ctr0;  // nothing changed
-        throw std::runtime_error("lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
-                                 std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
-                                 " found no acceptable post state in " + std::to_string(max_redraws) +
-                                 " redraws (a multi-body tick the rule cannot resolve)");
+      if (static_cast<std::int64_t>(redraws) > max_redraws) {
+        group_bounce(i, j, a, ctr0, reasons);
+        return;
       }
       const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
       const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_, xi2, xj2, vi2, vj2, out);
@@ -558,6 +571,7 @@ class BasicEngine {
       }
       if (why == 0) break;
       ++cnt_.redraws[std::min(why, 7)];
+      ++reasons[std::min(why, 7)];
       ++redraws;
     }
     if (multi) ++cnt_.multi_body;
@@ -571,6 +585,10 @@ class BasicEngine {
     apply(i, j, xi2, xj2, vi2, vj2, a);
   }
   void collide_back(int i, int j, std::int64_t a) {
+    if (const auto g = groups_.find(ncoll_); g != groups_.end()) {
+      group_back(i, j, a, g);
+      return;
+    }
     const Vec2 xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{0, 0};
     std::uint32_t redraws = 0;
     const auto it = log_.find(ncoll_);
@@ -585,6 +603,85 @@ class BasicEngine {
     if (it != log_.end()) log_.erase(it);
     --ncoll_;
     apply(i, j, xi0, xj0, Vec2{-vi0[0], -vi0[1]}, Vec2{-vj0[0], -vj0[1]}, a);
+  }
+
+  // ---- three or more bodies within one tick: the group bounce (an exact involution) ----
+  // When no draw is acceptable (a third body k is met within the tick, so every post state of the
+  // pair overlaps it), the group G = {i, j} closed under "a member's pre line overlaps a body at
+  // tick a" bounces back: each member's post state at tick a is its pre position at a-1 with its
+  // velocity negated. Read backwards (velocities negated) the post lines overlap exactly where the
+  // pre lines did, so the reverse meets the group at the same tick, finds the entry in the log, and
+  // applies the same map (position at the event tick - 1, velocity negated). The post state must
+  // meet the invariants against bodies outside G (no overlap at a, no false tie at a-1) and the
+  // walls; otherwise the collision is an error, nothing changed. The draws tried are logged.
+  void group_bounce(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
+    std::vector<int> g{i, j};
+    for (std::size_t m = 0; m < g.size(); ++m) {
+      const Vec2 xa = pos(g[m], a);
+      grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
+        if (std::find(g.begin(), g.end(), q) == g.end() && overlap(xa, pos(q, a))) g.push_back(q);
+      });
+    }
+    std::sort(g.begin(), g.end());
+    std::vector<Vec2> post(g.size());
+    bool ok = true;
+    for (std::size_t m = 0; m < g.size() && ok; ++m) {
+      post[m] = pos(g[m], a - 1);
+      const Vec2 ghost = pos(g[m], a);  // the new line at a-1 is the pre line at a
+      for (int k = 0; k < 2; ++k)
+        if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(k))) ok = false;
+      grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
+        if (!ok || std::find(g.begin(), g.end(), q) != g.end()) return;
+        if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) ok = false;
+      });
+    }
+    if (!ok) {
+      ctr_[i] = ctr0;  // nothing changed
+      std::string why = "lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
+                        std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
+                        " found no acceptable post state in " + std::to_string(max_redraws) +
+                        " redraws, and its group of " + std::to_string(g.size()) + " cannot bounce back (";
+      for (int k = 1; k < 8; ++k) why += std::string(redraw_names[k]) + " " + std::to_string(reasons[k]) + (k < 7 ? ", " : ")");
+      throw std::runtime_error(why);
+    }
+    ++ncoll_;
+    log_[ncoll_] = static_cast<std::uint32_t>(ctr_[i] - ctr0);
+    ++cnt_.log_entries;
+    groups_[ncoll_] = Group{i, g};
+    ++cnt_.multi_body;
+    ++cnt_.group_bounces;
+    if (trace != nullptr) trace->push_back({a, i, j});
+    for (std::size_t m = 0; m < g.size(); ++m) {
+      Line& l = ln_[g[m]];
+      l = Line{post[m], Vec2{-l.v[0], -l.v[1]}, a};
+      ++ver_[g[m]];
+    }
+    ++cnt_.collisions;
+    for (int q : g) predict(q, a);
+  }
+  template <class It>
+  void group_back(int i, int j, std::int64_t a, It entry) {
+    const std::vector<int> g = entry->second.members;
+    if (std::find(g.begin(), g.end(), i) == g.end() || std::find(g.begin(), g.end(), j) == g.end()) {
+      throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
+    }
+    const auto it = log_.find(ncoll_);
+    const std::uint32_t draws = it == log_.end() ? 0 : it->second;
+    const int drawer = entry->second.drawer;
+    if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+    std::vector<Vec2> pre(g.size());
+    for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
+    for (std::size_t m = 0; m < g.size(); ++m) {
+      Line& l = ln_[g[m]];
+      l = Line{pre[m], Vec2{-l.v[0], -l.v[1]}, a};
+      ++ver_[g[m]];
+    }
+    ctr_[drawer] -= draws;
+    if (it != log_.end()) log_.erase(it);
+    groups_.erase(entry);
+    --ncoll_;
+    ++cnt_.collisions;
+    for (int q : g) predict(q, a);
   }
 
   Op op_;
@@ -603,6 +700,11 @@ class BasicEngine {
   std::vector<int> partner_;
   Bits X_;
   std::map<std::uint64_t, std::uint32_t> log_;
+  struct Group {
+    int drawer;                 // whose stream the tried draws came from
+    std::vector<int> members;   // ascending
+  };
+  std::map<std::uint64_t, Group> groups_;  // collision index -> group bounce
   std::int64_t clock_ = 0, origin_ = 0;
   std::uint64_t ncoll_ = 0;
   std::array<std::uint64_t, 2> energy0_{};
