@@ -275,6 +275,7 @@ class BasicEngine {
     wall_tick_.assign(n, std::numeric_limits<std::int64_t>::min());
     reversed_ = false;
     sigma2_ = static_cast<u128>(u_.sigma) * static_cast<u128>(u_.sigma);
+    sigma2d_ = static_cast<double>(sigma2_);
     hlo_ = u_.sigma / 2;
     rebuild();
   }
@@ -366,6 +367,14 @@ class BasicEngine {
       if (q == p) return;
       const Vec2 r = diff(ln_[p].x, pos(q, lo));
       const Vec2 w{ln_[p].v[0] - ln_[q].v[0], ln_[p].v[1] - ln_[q].v[1]};
+      // cheap exits before the exact search (measure before changing): separating and outside
+      // (exact), or a closest approach beyond sigma by far more than double round-off
+      const i128 B = static_cast<i128>(r[0]) * w[0] + static_cast<i128>(r[1]) * w[1];
+      const u128 r2 = norm2(r[0], r[1]);
+      if (B >= 0 && r2 >= sigma2_) return;
+      const double rr = static_cast<double>(r2), bb = static_cast<double>(B);
+      const double aa = static_cast<double>(w[0]) * w[0] + static_cast<double>(w[1]) * w[1];
+      if (rr - bb * (bb / aa) > sigma2d_ * (1.0 + 1e-9) + rr * 1e-12) return;
       const std::int64_t tau = first_overlap(r, w, sigma2_);
       if (tau >= 0) offer(lo + tau, coll_kind(p, q), coll, q);
     });
@@ -712,6 +721,7 @@ class BasicEngine {
   Counters cnt_;
   bool reversed_ = false;
   u128 sigma2_ = 0;
+  double sigma2d_ = 0.0;
   std::int64_t hlo_ = 0;
   CellGrid grid_;
   Queue queue_;
