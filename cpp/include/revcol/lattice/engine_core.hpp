@@ -374,8 +374,9 @@ class BasicEngine {
       const i128 B = static_cast<i128>(r[0]) * w[0] + static_cast<i128>(r[1]) * w[1];
       const u128 r2 = norm2(r[0], r[1]);
       if (B >= 0 && r2 >= sigma2_) return;
-      const double rr = static_cast<double>(r2), bb = static_cast<double>(B);
-      const double aa = static_cast<double>(w[0]) * w[0] + static_cast<double>(w[1]) * w[1];
+      const double r0 = static_cast<double>(r[0]), r1 = static_cast<double>(r[1]);
+      const double w0 = static_cast<double>(w[0]), w1 = static_cast<double>(w[1]);
+      const double rr = r0 * r0 + r1 * r1, bb = r0 * w0 + r1 * w1, aa = w0 * w0 + w1 * w1;
       if (rr - bb * (bb / aa) > sigma2d_ * (1.0 + 1e-9) + rr * 1e-12) return;
       const std::int64_t tau = first_overlap(r, w, sigma2_);
       if (tau >= 0) offer(lo + tau, coll_kind(p, q), coll, q);
