@@ -35,23 +35,29 @@ struct OpState {
   bool ok = false;     // accepted by the operator
 };
 
-std::vector<OpState> make_states(const LatticePair2D& op, std::size_t n, const BitsBack& X) {
-  std::mt19937_64 rng(20261123);
+// A random pre state as an equilibrium gas hands it over: a contact point anywhere, incidence
+// from the flux law, |w| in [2^e, 2^(e+1)), a uniform phase. False when the rounding put it out
+// of the operator's contract or check_pre refuses it (the caller draws again).
+bool gas_pre(const LatticePair2D& op, std::mt19937_64& rng, int e, Vec2& q, Vec2& w) {
   std::uniform_real_distribution<double> U(0.0, 1.0);
   const double s = static_cast<double>(op.sigma());
+  const double ang = 2 * std::numbers::pi * U(rng), a = ang + std::numbers::pi + std::asin(2 * U(rng) - 1);
+  const double speed = std::ldexp(1.0 + U(rng), e), frac = U(rng);
+  w = {static_cast<std::int64_t>(speed * std::cos(a)), static_cast<std::int64_t>(speed * std::sin(a))};
+  q = {static_cast<std::int64_t>(s * std::cos(ang) - static_cast<double>(w[0]) * frac),
+       static_cast<std::int64_t>(s * std::sin(ang) - static_cast<double>(w[1]) * frac)};
+  auto n2 = [](std::int64_t x, std::int64_t y) { return static_cast<__int128>(x) * x + static_cast<__int128>(y) * y; };
+  const __int128 s2 = static_cast<__int128>(op.sigma()) * op.sigma();
+  return n2(q[0], q[1]) >= s2 && n2(q[0] + w[0], q[1] + w[1]) < s2 && op.check_pre(q, w) == Refusal::none;
+}
+
+std::vector<OpState> make_states(const LatticePair2D& op, std::size_t n, const BitsBack& X) {
+  std::mt19937_64 rng(20261123);
   std::vector<OpState> pool;
   pool.reserve(n);
   while (pool.size() < n) {
-    const double ang = 2 * std::numbers::pi * U(rng), inc = std::asin(2 * U(rng) - 1);
-    const double a = ang + std::numbers::pi + inc, speed = std::ldexp(1.0 + U(rng), 40), frac = U(rng);
     OpState st;
-    st.w = {static_cast<std::int64_t>(speed * std::cos(a)), static_cast<std::int64_t>(speed * std::sin(a))};
-    st.q = {static_cast<std::int64_t>(s * std::cos(ang) - static_cast<double>(st.w[0]) * frac),
-            static_cast<std::int64_t>(s * std::sin(ang) - static_cast<double>(st.w[1]) * frac)};
-    auto n2 = [](const Vec2& v) { return static_cast<__int128>(v[0]) * v[0] + static_cast<__int128>(v[1]) * v[1]; };
-    const Vec2 p{st.q[0] + st.w[0], st.q[1] + st.w[1]};
-    const __int128 s2 = static_cast<__int128>(op.sigma()) * op.sigma();
-    if (n2(st.q) < s2 || n2(p) >= s2) continue;
+    if (!gas_pre(op, rng, 40, st.q, st.w)) continue;
     st.g = rng() >> 16;
     st.ok = op.forward(st.q, st.w, st.g, X, st.q2, st.w2, st.x2) == Refusal::none;
     pool.push_back(st);
@@ -144,20 +150,11 @@ std::vector<Metric> run_drift(std::uint64_t n) {
     const double start = static_cast<double>(X.bit_length());
     double lo = start, hi = start;
     std::mt19937_64 rng(99);
-    std::uniform_real_distribution<double> U(0.0, 1.0);
-    const double s = static_cast<double>(op.sigma());
     std::uint64_t redraws = 0;
     const auto t0 = Clock::now();
     for (std::uint64_t k = 0; k < n;) {
-      const double ang = 2 * std::numbers::pi * U(rng), a = ang + std::numbers::pi + std::asin(2 * U(rng) - 1);
-      const double speed = std::ldexp(1.0 + U(rng), 40), frac = U(rng);
-      const Vec2 w{static_cast<std::int64_t>(speed * std::cos(a)), static_cast<std::int64_t>(speed * std::sin(a))};
-      const Vec2 q{static_cast<std::int64_t>(s * std::cos(ang) - static_cast<double>(w[0]) * frac),
-                   static_cast<std::int64_t>(s * std::sin(ang) - static_cast<double>(w[1]) * frac)};
-      auto n2 = [](std::int64_t x, std::int64_t y) { return static_cast<__int128>(x) * x + static_cast<__int128>(y) * y; };
-      const __int128 s2 = static_cast<__int128>(op.sigma()) * op.sigma();
-      if (n2(q[0], q[1]) < s2 || n2(q[0] + w[0], q[1] + w[1]) >= s2 || op.check_pre(q, w) != Refusal::none) continue;
-      Vec2 q2, w2;
+      Vec2 q, w, q2, w2;
+      if (!gas_pre(op, rng, 40, q, w)) continue;
       while (op.forward(q, w, rng() >> 16, X, q2, w2, X2) != Refusal::none) ++redraws;
       std::swap(X, X2);
       const double b = static_cast<double>(X.bit_length());
@@ -184,20 +181,11 @@ std::vector<Metric> run_readback(std::uint64_t n) {
   const BitsBack X = x256();
   BitsBack x2 = X;
   std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> U(0.0, 1.0);
-  const double s = static_cast<double>(op.sigma());
   for (int e = 20; e <= 44; e += 4) {
     std::uint64_t tried = 0, readback = 0;
     while (tried < n) {
-      const double ang = 2 * std::numbers::pi * U(rng), a = ang + std::numbers::pi + std::asin(2 * U(rng) - 1);
-      const double speed = std::ldexp(1.0 + U(rng), e), frac = U(rng);
-      const Vec2 w{static_cast<std::int64_t>(speed * std::cos(a)), static_cast<std::int64_t>(speed * std::sin(a))};
-      const Vec2 q{static_cast<std::int64_t>(s * std::cos(ang) - static_cast<double>(w[0]) * frac),
-                   static_cast<std::int64_t>(s * std::sin(ang) - static_cast<double>(w[1]) * frac)};
-      auto n2 = [](std::int64_t x, std::int64_t y) { return static_cast<__int128>(x) * x + static_cast<__int128>(y) * y; };
-      const __int128 s2 = static_cast<__int128>(op.sigma()) * op.sigma();
-      if (n2(q[0], q[1]) < s2 || n2(q[0] + w[0], q[1] + w[1]) >= s2 || op.check_pre(q, w) != Refusal::none) continue;
-      Vec2 q2, w2;
+      Vec2 q, w, q2, w2;
+      if (!gas_pre(op, rng, e, q, w)) continue;
       ++tried;
       readback += op.forward(q, w, rng() >> 16, X, q2, w2, x2) == Refusal::cell_readback;
     }

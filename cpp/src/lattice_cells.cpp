@@ -101,10 +101,41 @@ IVec boundary(std::int64_t h) {
   return rot90(b, static_cast<int>(h >> 19));
 }
 
+namespace {
+
+// Component `y` (false: x) of the octant vector, as boundary_octant computes it (2 products).
+inline i64 octant_component(std::int64_t h, bool y) {
+  const IVec& a = kTables.coarse[h >> kFineBits];
+  const std::int64_t j = h & (kFine - 1);
+  if (j == 0) return y ? a.y : a.x;
+  const IVec& b = kTables.fine[j];
+  const i128 v = y ? static_cast<i128>(a.y) * b.x + static_cast<i128>(a.x) * b.y
+                   : static_cast<i128>(a.x) * b.x - static_cast<i128>(a.y) * b.y;
+  return static_cast<i64>((v + kHalf) >> kFixBits);
+}
+
+// One component of B(h), the same bits as boundary(h) (half the products).
+inline i64 boundary_component(std::int64_t h, bool y) {
+  h &= kHalfMask;
+  const int q = static_cast<int>(h >> 19);
+  const std::int64_t r = h & (kQuadrant - 1);
+  // rot90 by q: x <- (x, -y, -x, y)[q], y <- (y, x, -y, -x)[q] of the quadrant vector
+  const bool take_y = y ? (q & 1) == 0 : (q & 1) == 1;
+  const bool negate = y ? q >= 2 : (q == 1 || q == 2);
+  const i64 c = r <= kOctant ? octant_component(r, take_y) : octant_component(kQuadrant - r, !take_y);
+  return negate ? -c : c;
+}
+
+}  // namespace
+
+i64 boundary_x(std::int64_t h) { return boundary_component(h, false); }
+i64 boundary_y(std::int64_t h) { return boundary_component(h, true); }
+
 std::int64_t dir_cell(i64 wx, i64 wy) {
   require(wx != 0 || wy != 0, "dir_cell: the zero vector has no direction");
   constexpr std::int64_t mask = kCells - 1;
-  const double a = std::atan2(static_cast<double>(wy), static_cast<double>(wx));
+  // single precision is enough for a guess within a cell or two (6e-6 rad)
+  const double a = std::atan2(static_cast<float>(wy), static_cast<float>(wx));
   std::int64_t k = static_cast<std::int64_t>(std::floor(a * kCellsPerRadian)) & mask;
   while (cross(boundary(2 * k), wx, wy) < 0) k = (k - 1) & mask;
   while (cross(boundary(2 * k + 2), wx, wy) >= 0) k = (k + 1) & mask;
@@ -117,10 +148,10 @@ bool in_cell(i64 wx, i64 wy, std::int64_t k) {
 
 std::int64_t normal_cell(i64 xc, i64 sigma) {
   require(sigma >= 1 && xc > -sigma && xc < sigma, "normal_cell: needs |xc| < sigma");
-  const double phi = std::acos(static_cast<double>(xc) / static_cast<double>(sigma));
+  const double phi = std::acos(static_cast<float>(static_cast<double>(xc) / static_cast<double>(sigma)));
   std::int64_t k = std::llround(phi * kCellsPerRadian);
   const i128 lhs = static_cast<i128>(xc) << kFixBits;
-  auto bound = [&](std::int64_t h) { return static_cast<i128>(sigma) * boundary(h).x; };
+  auto bound = [&](std::int64_t h) { return static_cast<i128>(sigma) * boundary_x(h); };
   // phi in [theta(2k-1), theta(2k+1)) <=> sigma*B(2k+1).x < xc*2^62 <= sigma*B(2k-1).x
   while (lhs > bound(2 * k - 1)) --k;
   while (lhs <= bound(2 * k + 1)) ++k;
@@ -155,7 +186,7 @@ IVec rotate_inv(IVec w, const RotCoef& c) {
 }
 
 std::uint64_t flux_cum(std::int64_t a) {
-  const i64 y = boundary(2 * (a - kQuarterTurn)).y;
+  const i64 y = boundary_y(2 * (a - kQuarterTurn));
   return static_cast<std::uint64_t>((1LL << 47) + ((y + (1LL << 14)) >> 15));
 }
 

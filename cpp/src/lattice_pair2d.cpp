@@ -116,6 +116,7 @@ Refusal LatticePair2D::check_pre(const Vec2& q, const Vec2& w) const {
   const i64 px = q[0] + w[0], py = q[1] + w[1];
   require(norm2(q[0], q[1]) >= sigma2_, "LatticePair2D::forward: q must be outside (|q|^2 >= sigma^2)");
   require(norm2(px, py) < sigma2_, "LatticePair2D::forward: q + w must be inside (|q+w|^2 < sigma^2)");
+  if (px == 0 && py == 0) return Refusal::out_of_domain;  // coinciding centres: no face
   const Frame fr = make_frame(px, py, w, sigma2_, sigma_);
   if (!lo_pre(sigma2_, fr.xc, fr.strict, fr.w.x, fr.w.y)) return Refusal::out_of_domain;
   const std::int64_t jpre = ((dir_cell(fr.w.x, fr.w.y) - fr.jn) & kMask) - kHalfTurn;
@@ -131,6 +132,10 @@ Refusal LatticePair2D::forward(const Vec2& q, const Vec2& w, std::uint64_t g, co
   const i64 px = q[0] + w[0], py = q[1] + w[1];
   require(norm2(q[0], q[1]) >= sigma2_, "LatticePair2D::forward: q must be outside (|q|^2 >= sigma^2)");
   require(norm2(px, py) < sigma2_, "LatticePair2D::forward: q + w must be inside (|q+w|^2 < sigma^2)");
+  if (px == 0 && py == 0) {  // coinciding centres at tick a: no face, no column
+    X_out = X;
+    return Refusal::out_of_domain;
+  }
   const Frame fr = make_frame(px, py, w, sigma2_, sigma_);
   Trace tr;
   tr.face = fr.face;

@@ -202,6 +202,7 @@ TEST_CASE("cells: boundaries monotone, |B| = 2^62, close to cos/sin, exactly sym
   IVec prev = boundary(0);
   for (std::int64_t h = 1; h <= (1LL << 21); ++h) {
     const IVec b = boundary(h);
+    if (boundary_x(h) != b.x || boundary_y(h) != b.y) CHECK(boundary_x(h) == b.x && boundary_y(h) == b.y);
     const i128 cr = static_cast<i128>(prev.x) * b.y - static_cast<i128>(prev.y) * b.x;
     const i128 dt = static_cast<i128>(prev.x) * b.x + static_cast<i128>(prev.y) * b.y;
     if (!(cr > 0 && dt > 0)) CHECK(cr > 0 && dt > 0);
@@ -493,6 +494,19 @@ TEST_CASE("edges: head-on, grazing, each face, axis-parallel, tiny and huge spee
   CHECK(accepted > 2500);
 }
 
+// A pre state with p within `depth` |w| inside the circle, within `width` |w| along it of one
+// of the 4 corners where the circle meets a diagonal, -w within +-spread/2 rad of the normal.
+static bool corner_pre(Rng& rng, i64 S, double V, double depth, double width, double spread, Vec2& q, Vec2& w) {
+  const double corner = (2 * static_cast<int>(rng.gen() % 4) + 1) * std::numbers::pi / 4;
+  const double r = static_cast<double>(S) - V * depth * rng.uni();
+  const double ang = corner + (rng.uni() - 0.5) * width * V / static_cast<double>(S);
+  const Vec2 p{static_cast<i64>(r * std::cos(ang)), static_cast<i64>(r * std::sin(ang))};
+  const double a = ang + std::numbers::pi + (rng.uni() - 0.5) * spread;
+  w = {static_cast<i64>(V * std::cos(a)), static_cast<i64>(V * std::sin(a))};
+  q = sub(p, w);
+  return norm2(q) >= sq(S) && norm2(p) < sq(S);
+}
+
 TEST_CASE("face corners: phase intervals that reach the diagonal (odd faces exclude it)") {
   // p within a few |w| of a corner where the circle meets a diagonal: the pre and post phase
   // columns run into the face boundary, and a post phase on the diagonal of an odd face would
@@ -504,14 +518,8 @@ TEST_CASE("face corners: phase intervals that reach the diagonal (odd faces excl
   int bad = 0, accepted = 0, tried = 0;
   for (int t = 0; t < 40000; ++t) {
     const double V = std::ldexp(1.0 + rng.uni(), 18 + static_cast<int>(rng.gen() % 6));
-    const double corner = (2 * static_cast<int>(rng.gen() % 4) + 1) * std::numbers::pi / 4;
-    const double r = static_cast<double>(S) - V * rng.uni();
-    const double ang = corner + (rng.uni() - 0.5) * 6 * V / static_cast<double>(S);
-    const Vec2 p{static_cast<i64>(r * std::cos(ang)), static_cast<i64>(r * std::sin(ang))};
-    const double a = ang + std::numbers::pi + (rng.uni() - 0.5) * 3.0;  // inward, up to +-86 deg
-    const Vec2 w{static_cast<i64>(V * std::cos(a)), static_cast<i64>(V * std::sin(a))};
-    const Vec2 q = sub(p, w);
-    if (norm2(q) < sq(S) || norm2(p) >= sq(S)) continue;
+    Vec2 q, w;
+    if (!corner_pre(rng, S, V, 1.0, 6.0, 3.0, q, w)) continue;  // inward, up to +-86 deg
     ++tried;
     accepted += round_trip(op, q, w, rng.draw(), X, bad) == Refusal::none;
   }
@@ -531,15 +539,10 @@ TEST_CASE("face corners: post phases steered onto the lowest point of an odd fac
   const LatticePair2D op(S);
   int bad = 0, at_diagonal = 0, accepted = 0;
   for (int t = 0; t < 400; ++t) {
-    const double V = std::ldexp(1.0 + rng.uni(), 24);
-    const double corner = (2 * static_cast<int>(rng.gen() % 4) + 1) * std::numbers::pi / 4;
-    const double ang = corner + (rng.uni() - 0.5) * 2 * V / static_cast<double>(S);
-    const double r = static_cast<double>(S) - V * rng.uni() * 0.5;
-    const Vec2 p{static_cast<i64>(r * std::cos(ang)), static_cast<i64>(r * std::sin(ang))};
-    const double a = ang + std::numbers::pi + (rng.uni() - 0.5) * 2.0;
-    const Vec2 w{static_cast<i64>(V * std::cos(a)), static_cast<i64>(V * std::sin(a))};
-    const Vec2 q = sub(p, w);
-    if (norm2(q) < sq(S) || norm2(p) >= sq(S) || op.check_pre(q, w) != Refusal::none) continue;
+    Vec2 q, w;
+    if (!corner_pre(rng, S, std::ldexp(1.0 + rng.uni(), 24), 0.5, 2.0, 2.0, q, w) || op.check_pre(q, w) != Refusal::none)
+      continue;
+    const Vec2 p = add(q, w);
     const int f = face_of(p[0], p[1]);
     const IVec P = rot90({p[0], p[1]}, f), W = rot90({w[0], w[1]}, f);
     const i64 lo = *lo_pre(sq(S), P.x, f & 1, W.x, W.y);
@@ -568,6 +571,31 @@ TEST_CASE("face corners: post phases steered onto the lowest point of an odd fac
   std::printf("  steered: %d accepted, %d next to an odd face's diagonal\n", accepted, at_diagonal);
   CHECK(bad == 0);
   CHECK(at_diagonal > 20);
+}
+
+TEST_CASE("small sigma (2 .. 1000): every pre state either refused cleanly or exact") {
+  // At a few lattice units per diameter almost every draw is refused by the read-back (w has
+  // too few directions); what is accepted must still invert exactly.
+  Rng rng(606);
+  BitsBack X = random_bits(rng.gen, 128);
+  int bad = 0, accepted = 0, tried = 0;
+  for (const i64 S : {2LL, 3LL, 5LL, 17LL, 1000LL}) {
+    const LatticePair2D op(S);
+    for (i64 px = -S; px <= S; ++px)
+      for (i64 py = -S; py <= S; ++py)
+        for (i64 wx = -3; wx <= 3; ++wx)
+          for (i64 wy = -3; wy <= 3; ++wy) {
+            const Vec2 p{px * std::max<i64>(1, S / 8), py * std::max<i64>(1, S / 8)}, w{wx * (S + 1) / 3, wy * (S + 1) / 3};
+            const Vec2 q = sub(p, w);
+            if (norm2(q) < sq(S) || norm2(p) >= sq(S)) continue;
+            ++tried;
+            accepted += round_trip(op, q, w, rng.draw(), X, bad) == Refusal::none;
+          }
+  }
+  std::printf("  small sigma: %d pre states, %d accepted\n", tried, accepted);
+  CHECK(bad == 0);
+  CHECK(tried > 1000);
+  CHECK(accepted > 0);
 }
 
 TEST_CASE("refusals: G-independent ones agree with check_pre; X and X_out stay equal") {

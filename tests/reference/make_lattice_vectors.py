@@ -10,6 +10,7 @@ semantics, math.isqrt). The whole-operator vectors (op_*.txt, pair.txt) come fro
 C_fwd / pair_fwd patched to use the C++ operator's integer cell index, normal cell, flux table
 and lifting coefficients (lattice_cells.py), because the prototype's own are floating point.
 """
+import bisect
 import math
 import os
 import random
@@ -138,9 +139,7 @@ def gen_bitsback():
                 out.append(("R", c, f, hex(X)))
             elif op == "r":
                 s = X % M
-                a = next(i for i in (rnd.randrange(len(FLUX[0])),) if True)
-                import bisect
-                a = bisect.bisect_right(FLUX[1], s) - 1
+                a = bisect.bisect_right(FLUX[1], s) - 1     # the symbol the low bits decode to
                 f, c = FLUX[0][a], FLUX[1][a]
                 X = f * (X // M) + s - c
                 out.append(("r", c, f, hex(X)))

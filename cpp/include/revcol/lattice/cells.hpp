@@ -13,7 +13,7 @@
 //     rotated by a quarter turn. So the cells are exactly symmetric under the 8 lattice
 //     symmetries: cell(rot90(w)) = cell(w) + ND/4, cell(-w) = cell(w) + ND/2.
 // The cell of an integer vector w != 0 is the k with cross(B(2k), w) >= 0 > cross(B(2k+2), w),
-// decided exactly with 128-bit products; std::atan2 gives only the first guess (a wrong guess
+// decided exactly with 128-bit products; atan2 in single precision gives only the first guess (a wrong guess
 // costs a step, never a different answer). This is the integer "pseudo-angle" of LATTICE.md §6:
 // portable and deterministic, no libm value ever decides a cell.
 //
@@ -68,6 +68,10 @@ inline IVec rot90(IVec v, int k) {
 
 /// The boundary vector B(h) at half-cell resolution (h taken mod 2^21), |B| ~= 2^62.
 IVec boundary(std::int64_t h);
+/// B(h).x with half the work (the same bits).
+i64 boundary_x(std::int64_t h);
+/// B(h).y with half the work (the same bits).
+i64 boundary_y(std::int64_t h);
 /// The direction cell in [0, ND) of w != 0 (exact; see above).
 std::int64_t dir_cell(i64 wx, i64 wy);
 /// dir_cell(wx, wy) == k, decided by two exact cross products (w != 0, 0 <= k < ND).

@@ -10,7 +10,8 @@
 //     strictly |px| < py). In that frame p = (xc, Py), w = (Wx, Wy); the column xc is fixed.
 //  2. Phase interval: the inside points of column xc in the face, Y <= Yin = isqrt(sigma^2 -
 //     xc^2 - 1), Y >= max(1, |xc| + (f odd)), whose point minus W is outside, form [lo, Yin]
-//     (exact integer square roots; if they do not form an interval: out_of_domain);
+//     (exact integer square roots; if they do not form an interval, or p = 0 has no face:
+//     out_of_domain);
 //     m = Yin - lo + 1. X <- X*m + (Py - lo).
 //  3. Pre direction: jn = normal cell of column xc, jd = cell of W, jpre = ((jd - jn) mod ND)
 //     - ND/2 is the cell of -W about the normal; it must lie in [-ND/4, ND/4) (else
@@ -18,7 +19,8 @@
 //  4. Torus shift: the low 48 bits s of X become (s + G) mod 2^48 (u_post = u_pre + G mod 1).
 //  5. Post direction: rANS pop of b, jpost = b - ND/4; rotate W by k = jn + jpost - jd cells
 //     with the lifting rotation (cells.hpp) to W2. If the cell of W2 is not jn + jpost (a
-//     round-off of the lifting across a cell boundary): cell_readback.
+//     round-off of the lifting across a cell boundary): cell_readback (reported after step
+//     6's out_of_domain and empty_post, the prototype's order).
 //  6. Post phase: the inside points of the column whose point plus W2 is outside form
 //     [lo2, Yin] (or out_of_domain); m2 = Yin - lo2 + 1 (m2 <= 0: empty_post). idx2 = X mod
 //     m2, X <- X div m2, P2 = (xc, lo2 + idx2). Post state: q2 = P2 + W2, w2 = W2, turned back
