@@ -16,4 +16,5 @@ PYBIND11_MODULE(_core, m) {
   revcol::bind::register_statesave(m);
   revcol::bind::register_engine(m);
   revcol::bind::register_engine_init(m);
+  revcol::bind::register_lattice(m);
 }
