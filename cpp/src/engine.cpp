@@ -13,6 +13,7 @@
 #include "revcol/collide/pair1d.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
 #include "revcol/collide/pair2d_paper.hpp"
+#include "revcol/engine/event_queue.hpp"
 #include "revcol/engine/pair3d.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/clcg4.hpp"
@@ -323,9 +324,9 @@ class EngineImpl final : public Simulation {
 
   std::size_t memory_bytes() const override {
     return n_ * (Dim * (2 * sizeof(double) + sizeof(int)) + sizeof(double) + 3 * sizeof(std::uint64_t) +
-                 sizeof(Ev) + 4 * sizeof(int)) +  // 4: the queue's hpos_, qnext_, qprev_, qloc_
+                 sizeof(Ev)) +
            head_.size() * sizeof(int) + cn_.size() * sizeof(Centre) + nbn_.size() * sizeof(int) +
-           nb_.size() * (sizeof(int) + 1) + bhead_.size() * sizeof(int) + heap_.capacity() * sizeof(Node) +
+           nb_.size() * (sizeof(int) + 1) + queue_.memory_bytes() +
            log_.bytes() + pre_vals_.size() * sizeof(double) +
            (pre_keys_.size() + pre_sizes_.size()) * sizeof(std::uint64_t) + clcg_.size() * sizeof(rng::CLCG4);
   }
@@ -813,186 +814,11 @@ class EngineImpl final : public Simulation {
     touching_[i] = touch ? 1 : 0;
   }
 
-  // ---- event queue, key (t, kind, id) ----------------------------------------------------
-  // Paul's O(1) queue (G. Paul, J. Comput. Phys. 221, 615 (2007)): the events of the current
-  // time bucket in a binary heap (the key copied into the node, so that sifting reads the
-  // heap array alone), the later buckets of a window (~n / 2 buckets) as unsorted doubly linked
-  // lists, and the events beyond the window in an overflow list that is spread over the
-  // next window when this one is used up. The keys are distinct (the id), so events leave
-  // in key order whatever the bucket width: the width is a speed setting only, set for
-  // ~kPerBucket events per bucket from the rate of the last window. (Measured: a binary
-  // heap over all n particles took 15-25% of the time, most of it sifting new events down.)
+  // ---- the event queue (revcol/engine/event_queue.hpp), key (t, kind, id) ----------------
 
-  struct Node {
-    double t;
-    std::int32_t kind;
-    std::int32_t id;
-  };
-  static bool less(const Node& a, const Node& b) {
-    if (a.t != b.t) return a.t < b.t;
-    if (a.kind != b.kind) return a.kind < b.kind;
-    return a.id < b.id;
-  }
-  static constexpr int kInHeap = -1, kOverflow = -2;
-  static constexpr double kPerBucket = 8.0;  // measured: 2 to 16 within the noise
-
-  void sift_up(int p) {
-    const Node e = heap_[p];
-    while (p > 0) {
-      const int q = (p - 1) / 2;
-      if (!less(e, heap_[q])) break;
-      heap_[p] = heap_[q];
-      hpos_[heap_[p].id] = p;
-      p = q;
-    }
-    heap_[p] = e;
-    hpos_[e.id] = p;
-  }
-  void sift_down(int p) {
-    const Node e = heap_[p];
-    const int m = static_cast<int>(heap_.size());
-    for (;;) {
-      int c = 2 * p + 1;
-      if (c >= m) break;
-      if (c + 1 < m && less(heap_[c + 1], heap_[c])) ++c;
-      if (!less(heap_[c], e)) break;
-      heap_[p] = heap_[c];
-      hpos_[heap_[p].id] = p;
-      p = c;
-    }
-    heap_[p] = e;
-    hpos_[e.id] = p;
-  }
-  // The bucket of time t in the window (kOverflow beyond it, or for an infinite t).
-  int bucket_of(double t) const {
-    const double q = (t - qbase_) * qinv_;
-    if (!(q < static_cast<double>(nbuckets_))) return kOverflow;
-    return q > 0.0 ? static_cast<int>(q) : 0;
-  }
-  void list_push(int& head, int i) {
-    qnext_[i] = head;
-    qprev_[i] = -1;
-    if (head >= 0) qprev_[head] = i;
-    head = i;
-  }
-  void list_pop(int& head, int i) {
-    if (qprev_[i] >= 0) qnext_[qprev_[i]] = qnext_[i];
-    else head = qnext_[i];
-    if (qnext_[i] >= 0) qprev_[qnext_[i]] = qprev_[i];
-  }
-  void heap_push(int i) {
-    heap_.push_back(Node{ev_[i].t, ev_[i].kind, i});
-    qloc_[i] = kInHeap;
-    sift_up(static_cast<int>(heap_.size()) - 1);
-  }
-  void queue_insert(int i) {
-    const int b = bucket_of(ev_[i].t);
-    if (b == kOverflow) {
-      list_push(ohead_, i);
-      qloc_[i] = kOverflow;
-    } else if (b <= cur_) {
-      heap_push(i);
-    } else {
-      list_push(bhead_[b], i);
-      qloc_[i] = b;
-    }
-  }
-  void update(int i) {
-    const int loc = qloc_[i];
-    if (loc == kInHeap) {
-      const int p = hpos_[i];
-      const Node old = heap_[p];
-      const Node e{ev_[i].t, ev_[i].kind, i};
-      const int b = bucket_of(e.t);
-      if (b != kOverflow && b <= cur_) {  // stays in the current bucket
-        heap_[p] = e;
-        if (less(e, old)) sift_up(p);
-        else sift_down(p);
-        return;
-      }
-      const Node last = heap_.back();  // i leaves the heap: the last node takes its place
-      heap_.pop_back();
-      if (p < static_cast<int>(heap_.size())) {
-        heap_[p] = last;
-        hpos_[last.id] = p;
-        if (less(last, old)) sift_up(p);
-        else sift_down(p);
-      }
-    } else {
-      list_pop(loc == kOverflow ? ohead_ : bhead_[loc], i);
-    }
-    queue_insert(i);
-  }
-  // The particle of the earliest event: moves on to the next non-empty bucket, and to the
-  // next window, while the current bucket is empty.
-  int queue_top() {
-    while (heap_.empty()) {
-      if (++cur_ < nbuckets_) {
-        for (int i = bhead_[cur_]; i >= 0;) {
-          const int nx = qnext_[i];
-          heap_.push_back(Node{ev_[i].t, ev_[i].kind, i});
-          hpos_[i] = static_cast<int>(heap_.size()) - 1;
-          qloc_[i] = kInHeap;
-          i = nx;
-        }
-        bhead_[cur_] = -1;
-        for (int p = static_cast<int>(heap_.size()) / 2 - 1; p >= 0; --p) sift_down(p);
-        continue;
-      }
-      next_window();
-    }
-    return heap_[0].id;
-  }
-  // The window is used up (every bucket empty): the next one starts where it ended, with a
-  // width from the rate of events in it, and the overflow is spread over it. With nothing in
-  // reach it starts at the earliest finite event instead; with none, the rest (events at
-  // infinity) go to the heap.
-  void next_window() {
-    const double popped = static_cast<double>(counters_.events - qevents_);
-    const double span = static_cast<double>(nbuckets_) / qinv_;
-    qbase_ += span;
-    if (popped > 0.0) qinv_ = std::clamp(popped / (kPerBucket * span), qinv_ / 8.0, qinv_ * 8.0);
-    qevents_ = counters_.events;
-    cur_ = -1;
-    for (;;) {
-      bool any = false;
-      double tmin = kInf;
-      int i = ohead_;
-      ohead_ = -1;
-      while (i >= 0) {
-        const int nx = qnext_[i];
-        const int b = bucket_of(ev_[i].t);
-        if (b == kOverflow) {
-          list_push(ohead_, i);
-          qloc_[i] = kOverflow;
-          tmin = std::min(tmin, ev_[i].t);
-        } else {
-          list_push(bhead_[b], i);
-          qloc_[i] = b;
-          any = true;
-        }
-        i = nx;
-      }
-      if (any || ohead_ < 0) return;
-      if (!(tmin < kInf)) break;
-      qbase_ = tmin;  // (tmin - qbase_) * qinv_ = 0: bucket 0 next time round
-    }
-    for (int j = ohead_; j >= 0;) {
-      const int nx = qnext_[j];
-      heap_push(j);
-      j = nx;
-    }
-    ohead_ = -1;
-  }
   // Every event into the queue (construction, restore, reversal): the window starts at the
-  // clock, ~kPerBucket events per bucket from the median distance of the events ahead.
+  // clock, ~8 events per bucket from the median distance of the events ahead.
   void build_heap() {
-    hpos_.assign(n_, 0);
-    qnext_.assign(n_, -1);
-    qprev_.assign(n_, -1);
-    qloc_.assign(n_, kOverflow);
-    heap_.clear();
-    heap_.reserve(64);
     std::vector<double> ahead;
     ahead.reserve(n_);
     for (std::size_t i = 0; i < n_; ++i)
@@ -1001,19 +827,13 @@ class EngineImpl final : public Simulation {
     if (!ahead.empty()) {
       auto mid = ahead.begin() + ahead.size() / 2;
       std::nth_element(ahead.begin(), mid, ahead.end());
-      width = kPerBucket * 2.0 * *mid / static_cast<double>(ahead.size());
+      width = 8.0 * 2.0 * *mid / static_cast<double>(ahead.size());
     }
     if (!(width > 0.0) || !std::isfinite(width)) width = 1.0;
-    nbuckets_ = 64;
-    while (nbuckets_ < static_cast<int>(std::min<std::size_t>(n_, 1u << 26) / 2)) nbuckets_ *= 2;
-    bhead_.assign(nbuckets_, -1);
-    ohead_ = -1;
-    qbase_ = clock_;
-    qinv_ = 1.0 / width;
-    qevents_ = counters_.events;
-    cur_ = 0;
-    for (std::size_t i = 0; i < n_; ++i) queue_insert(static_cast<int>(i));
+    queue_.reset(n_, clock_, width);
+    for (std::size_t i = 0; i < n_; ++i) update(static_cast<int>(i));
   }
+  void update(int i) { queue_.set(i, ev_[i].t, ev_[i].kind); }
   void rebuild_events() {
     for (std::size_t i = 0; i < n_; ++i) predict(static_cast<int>(i));
     build_heap();
@@ -1622,7 +1442,8 @@ class EngineImpl final : public Simulation {
     double t_last = clock_;
     bool done_count = max_collisions == 0;
     while (true) {
-      const int i = queue_top();
+      const int i = queue_.top();
+      if (i < 0) break;  // nothing scheduled (never: every particle has an event, maybe at infinity)
       const Ev e = ev_[i];
       if (done_count) {
         // finish the instant of the last collision, then stop half way to the next event
@@ -1691,7 +1512,7 @@ class EngineImpl final : public Simulation {
     std::uint64_t stamp = 0;  // changes whenever x, v or t change (event invalidation)
   };
   std::vector<Particle> p_;
-  std::vector<int> cell_, head_, hpos_;  // cells of the list centres, heads of their chains; heap positions
+  std::vector<int> cell_, head_;  // cells of the list centres, heads of their chains
   // A list centre with the links of its cell's chain: the renewal's scan reads one line each.
   struct alignas(Dim == 3 ? 32 : 8) Centre {
     double c[Dim] = {};
@@ -1707,11 +1528,7 @@ class EngineImpl final : public Simulation {
   std::vector<int> nb_, nbn_;                        // neighbour lists (nbcap_ slots each), lengths
   std::vector<unsigned char> nbc_;                   // their image codes
   int nbcap_ = 16;
-  std::vector<Node> heap_;                      // the event queue: the current bucket's heap
-  std::vector<int> qnext_, qprev_, qloc_, bhead_;  // bucket and overflow lists, where each particle is
-  int ohead_ = -1, nbuckets_ = 64, cur_ = 0;    // overflow list, buckets in the window, current one
-  double qbase_ = 0.0, qinv_ = 1.0;             // the window's start, 1 / bucket width
-  std::uint64_t qevents_ = 0;                   // counters_.events when the window started
+  EventQueue<double> queue_;                   // one event per particle, key (t, kind, id)
   std::vector<std::uint64_t> ncoll_, rng_;  // rng_: draws taken, per stream
   std::vector<rng::CLCG4> clcg_;             // CLCG4 only: one generator per stream
   std::vector<Ev> ev_;
