@@ -86,12 +86,15 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "revcol/collide/common.hpp"
+#include "revcol/error.hpp"
 #include "revcol/rng/streams.hpp"
 
 namespace revcol::engine {
@@ -149,6 +152,35 @@ struct Counters {
   std::uint64_t reverse_failures = 0;  ///< reversed collisions the operator refused (beyond the horizon)
   std::uint64_t forward_collisions = 0;  ///< collisions processed forward
   std::uint64_t reverse_collisions = 0;  ///< collisions processed in reverse
+
+  /// Calls f(name, count) for every counter, in the checkpoint format's order (its
+  /// `counters` array) and with the names of the diagnostics.
+  template <class F>
+  void visit(F&& f) {
+    visit_fields(*this, f);
+  }
+  /// The same, read-only.
+  template <class F>
+  void visit(F&& f) const {
+    visit_fields(*this, f);
+  }
+
+ private:
+  template <class S, class F>
+  static void visit_fields(S& c, F& f) {
+    f("events", c.events);
+    f("pair_collisions", c.pair_collisions);
+    f("group_collisions", c.group_collisions);
+    f("group_particles", c.group_particles);
+    f("group_fallbacks", c.group_fallbacks);
+    f("wall_events", c.wall_events);
+    f("cell_crossings", c.cell_crossings);
+    f("invalid_events", c.invalid_events);
+    f("grazing_skipped", c.grazing_skipped);
+    f("reverse_failures", c.reverse_failures);
+    f("forward_collisions", c.forward_collisions);
+    f("reverse_collisions", c.reverse_collisions);
+  }
 };
 
 /// What one run or run_back call did.
@@ -192,6 +224,83 @@ struct Snapshot {
   Counters counters;
   double energy0 = 0.0;                        ///< kinetic energy at construction
   std::array<double, 3> momentum0{};           ///< momentum at construction
+
+  /// Calls f(name, field) for every field but `config` and `counters`, in the checkpoint
+  /// format's order and with its names: a binding or an archive loops over this instead of
+  /// naming each field (`centre` may be empty: a checkpoint written before the lists).
+  template <class F>
+  void visit(F&& f) {
+    visit_fields(*this, f);
+  }
+  /// The same, read-only.
+  template <class F>
+  void visit(F&& f) const {
+    visit_fields(*this, f);
+  }
+  /// Copies the field `name` into out (its type must match; throws InvalidArgument if no
+  /// field of that name and type exists).
+  template <class T>
+  void field(const char* name, T& out) const {
+    bool found = false;
+    visit([&](const char* key, const auto& v) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(v)>, T>)
+        if (!found && std::strcmp(key, name) == 0) {
+          out = v;
+          found = true;
+        }
+    });
+    require(found, std::string("snapshot has no field '") + name + "' of this type");
+  }
+  /// Sets the field `name` from value (same rules).
+  template <class T>
+  void field(const char* name, const T& value) {
+    bool found = false;
+    visit([&](const char* key, auto& v) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(v)>, T>)
+        if (!found && std::strcmp(key, name) == 0) {
+          v = value;
+          found = true;
+        }
+    });
+    require(found, std::string("snapshot has no field '") + name + "' of this type");
+  }
+
+ private:
+  template <class S, class F>
+  static void visit_fields(S& s, F& f) {
+    f("n", s.n);
+    f("time", s.time);
+    f("start_time", s.start_time);
+    f("net_collisions", s.net_collisions);
+    f("x", s.x);
+    f("v", s.v);
+    f("t_local", s.t_local);
+    f("cell", s.cell);
+    f("centre", s.centre);
+    f("stamp", s.stamp);
+    f("ncoll", s.ncoll);
+    f("rng", s.rng);
+    f("ev_t", s.ev_t);
+    f("ev_kind", s.ev_kind);
+    f("ev_partner", s.ev_partner);
+    f("ev_stamp", s.ev_stamp);
+    f("second", s.second);
+    f("touching", s.touching);
+    f("log_cells", s.log_cells);
+    f("log_pushed", s.log_pushed);
+    f("netc", s.netc);
+    f("wall_keys", s.wall_keys);
+    f("wall_sizes", s.wall_sizes);
+    f("wall_masks", s.wall_masks);
+    f("wall_ids", s.wall_ids);
+    f("wall_netc", s.wall_netc);
+    f("wall_times", s.wall_times);
+    f("pre_keys", s.pre_keys);
+    f("pre_sizes", s.pre_sizes);
+    f("pre_vals", s.pre_vals);
+    f("pre_pushed", s.pre_pushed);
+    f("energy0", s.energy0);
+  }
 };
 
 /// Conservation and activity diagnostics.
