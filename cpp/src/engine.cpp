@@ -11,6 +11,7 @@
 #include <string>
 
 #include "engine_impl.hpp"
+#include "engine_operators.hpp"
 #include "revcol/error.hpp"
 
 namespace revcol::engine {
@@ -25,6 +26,12 @@ Generator parse_generator(const std::string& s) {
   if (s == "philox") return Generator::philox;
   if (s == "clcg4") return Generator::clcg4;
   throw InvalidArgument("generator must be 'philox' or 'clcg4', got '" + s + "'");
+}
+
+Mode parse_engine_mode(const std::string& s) {
+  Mode m;
+  if (detail::engine_only_mode(s, m)) return m;
+  return parse_mode(s);
 }
 
 rng::StreamPolicy parse_engine_streams(const std::string& s) {

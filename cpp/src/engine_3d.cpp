@@ -1,24 +1,8 @@
-// The engine in 3D, for every pair operator of engine_operators.hpp (one instantiation of
-// EngineImpl<3, Op> each; a file per dimension so that they compile in parallel).
-#include "engine_collide.hpp"
-#include "engine_impl.hpp"
-#include "engine_operators.hpp"
+// The engine in 3D: EngineImpl<3, Op> for every pair operator of engine_operators.hpp.
+#include "engine_build.hpp"
 
 namespace revcol::engine::detail {
-
-template <>
-std::unique_ptr<Simulation> make_engine<3>(const Config& c, const std::vector<double>& x,
-                                             const std::vector<double>& v, double t0) {
-  return with_operator<3>(c, [&](auto op) -> std::unique_ptr<Simulation> {
-    return std::make_unique<EngineImpl<3, decltype(op)>>(c, x, v, t0, std::move(op));
-  });
-}
-
-template <>
-std::unique_ptr<Simulation> restore_engine<3>(const Snapshot& s) {
-  return with_operator<3>(s.config, [&](auto op) -> std::unique_ptr<Simulation> {
-    return std::make_unique<EngineImpl<3, decltype(op)>>(s, std::move(op));
-  });
-}
-
+template std::unique_ptr<Simulation> make_engine<3>(const Config&, const std::vector<double>&,
+                                                      const std::vector<double>&, double);
+template std::unique_ptr<Simulation> restore_engine<3>(const Snapshot&);
 }  // namespace revcol::engine::detail

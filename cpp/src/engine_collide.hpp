@@ -4,6 +4,8 @@
 // The protocol (ties, groups, walls at a collision, the exact-pre log) is described in
 // revcol/engine/engine.hpp. Private to cpp/src, included after engine_impl.hpp.
 #pragma once
+#include <stdexcept>
+
 #include "engine_impl.hpp"
 
 namespace revcol::engine::detail {

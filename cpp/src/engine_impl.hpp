@@ -446,7 +446,7 @@ class EngineImpl final : public Simulation {
     move_centre(i, e.t);
     if (adjacent()) nl_.recode_beside(i, [&](int j) { return pos_at(j, 0, clock_); });
     else nl_.renew(i);
-    ++counters_.cell_crossings;
+    ++counters_.list_renewals;
     repredict(i);
   }
 

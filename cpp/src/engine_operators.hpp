@@ -7,11 +7,20 @@
 // Private to cpp/src: included by engine_<d>d.cpp.
 #pragma once
 #include <memory>
+#include <string>
 
 #include "revcol/collide/operator.hpp"
 #include "revcol/engine/engine.hpp"
 
 namespace revcol::engine::detail {
+
+/// The engine-only modes (not parse_mode's, so that the operator-level users refuse them):
+/// sets m and returns true when s names one.
+inline bool engine_only_mode(const std::string& s, Mode& m) {
+  (void)s;
+  (void)m;
+  return false;
+}
 
 /// Calls f(op) with the pair operator for c.mode in dimension Dim; returns what f returns.
 template <int Dim, class F>

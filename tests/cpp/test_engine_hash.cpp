@@ -95,7 +95,7 @@ std::uint64_t hash_snapshot(const Snapshot& s) {
   f.pod(s.pre_pushed);
   const Counters& k = s.counters;
   for (std::uint64_t q : {k.events, k.pair_collisions, k.group_collisions, k.group_particles, k.group_fallbacks,
-                          k.wall_events, k.cell_crossings, k.invalid_events, k.grazing_skipped, k.reverse_failures,
+                          k.wall_events, k.list_renewals, k.invalid_events, k.grazing_skipped, k.reverse_failures,
                           k.forward_collisions, k.reverse_collisions})
     f.pod(q);
   f.pod(s.energy0);
