@@ -215,3 +215,16 @@ def test_box_periodic_and_snapshot_names():
         b = Simulation.from_state(st)
     assert np.array_equal(b.positions, sim.positions)
 
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_specular_mode_draws_nothing_and_round_trips(dim):
+    sim = Simulation.random(n=120, dim=dim, phi=0.3, seed=3, mode="specular", groups=False)
+    x0, v0 = sim.positions, sim.velocities
+    sim.run(collisions=120)
+    assert not sim.snapshot()["rng"].any()  # deterministic: no stream moved
+    assert sim.snapshot()["mode"] == "specular"
+    sim.run_back()
+    ex, ev = _err(sim, x0, v0)
+    assert ex < 1e-9 and ev < 1e-9
+    with pytest.raises(ValueError, match="mode"):
+        Simulation.random(n=10, dim=2, phi=0.1, mode="specularr")
