@@ -4,7 +4,9 @@ per-collision memory.
 Particles of one diameter D and unit mass move freely between elastic collisions in a box
 [0, L_k] per axis (reflecting walls or periodic); each collision's outcome is drawn over all
 permitted post-collision states by a reversible operator (exact mode, ``flux`` law by
-default; ``uniform``; or ``mode="paper"``, the paper's Procedures 1-2, in 2D). ``run`` goes
+default; ``uniform``; ``mode="paper"``, the paper's Procedures 1-2, in 2D; or
+``mode="specular"``, the deterministic elastic reflection: no random number, a baseline for
+benchmarks and physics checks; groups still go through the exact operator). ``run`` goes
 forward; ``run_back`` negates every velocity, runs the same event search applying
 ``v -> -reverse(-v)`` with the generators stepping back, and negates again, so the state
 returns to an earlier time without any stored history (the rare log aside, usually empty).
