@@ -404,7 +404,8 @@ void EngineImpl<Dim, Op>::validate_collision(const int* ids, int n) const {
       }
       if (!(r2 >= sigma2_ * (1.0 - 1e-6)))
         throw std::logic_error("REVCOL_VALIDATE: particles " + std::to_string(i) + " and " + std::to_string(j) +
-                               " overlap after a collision");
+                               " overlap after a collision: |r| / D = " + std::to_string(std::sqrt(r2 / sigma2_)) +
+                               (rev_ ? " (reversed run)" : " (forward run)") + " at t = " + std::to_string(clock_));
     });
   }
   if (!queue_.valid()) throw std::logic_error("REVCOL_VALIDATE: event queue invariants broken");
