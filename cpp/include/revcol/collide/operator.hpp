@@ -77,15 +77,13 @@ struct Exchange1D {
   }
 };
 
-/// 2D, exact mode: Pair2DExact (1 draw).
-struct Exact2D {
+/// 2D, one draw: the adapter of Pair2DExact and Pair2DPaper (their g is one number).
+template <class P, bool Quantizes>
+struct OneDraw2D {
   static constexpr int dim = 2;                         ///< d
   static constexpr int draws = 1;                       ///< random numbers per collision
-  static constexpr bool needs_exact_pre_log = false;    ///< its rare log suffices
-  static constexpr bool quantizes = true;               ///< K-bit chart cells
-  static constexpr const char* name = "exact";          ///< Mode::exact
-  /// The law and K.
-  Exact2D(Law law, int bits) : op(law, bits) {}
+  static constexpr bool needs_exact_pre_log = false;    ///< their rare logs suffice
+  static constexpr bool quantizes = Quantizes;          ///< K-bit chart cells (exact) or not (paper)
   /// Pre -> post.
   PairV<2> forward(const PairV<2>& v, const std::array<double, 2>& r, const double* g, RareLog& log) const {
     return op.forward(v, r, g[0], log);
@@ -94,27 +92,21 @@ struct Exact2D {
   PairV<2> reverse(const PairV<2>& v, const std::array<double, 2>& r, const double* g, RareLog& log) const {
     return op.reverse(v, r, g[0], log);
   }
-  Pair2DExact op;  ///< the operator
+  P op;  ///< the operator
 };
 
-/// 2D, paper mode: Pair2DPaper, Procedures 1-2 with the candidate test fixed (1 draw).
-struct Paper2D {
-  static constexpr int dim = 2;                         ///< d
-  static constexpr int draws = 1;                       ///< random numbers per collision
-  static constexpr bool needs_exact_pre_log = false;    ///< no chart cells
-  static constexpr bool quantizes = false;              ///< angles in double precision
-  static constexpr const char* name = "paper";          ///< Mode::paper
+/// 2D, exact mode: Pair2DExact.
+struct Exact2D : OneDraw2D<Pair2DExact, true> {
+  static constexpr const char* name = "exact";  ///< Mode::exact
+  /// The law and K.
+  Exact2D(Law law, int bits) : OneDraw2D{{Pair2DExact(law, bits)}} {}
+};
+
+/// 2D, paper mode: Pair2DPaper, Procedures 1-2 with the candidate test fixed.
+struct Paper2D : OneDraw2D<Pair2DPaper, false> {
+  static constexpr const char* name = "paper";  ///< Mode::paper
   /// With the candidate test fixed (not the printed one).
-  Paper2D() : op(/*printed_reverse=*/false) {}
-  /// Pre -> post.
-  PairV<2> forward(const PairV<2>& v, const std::array<double, 2>& r, const double* g, RareLog& log) const {
-    return op.forward(v, r, g[0], log);
-  }
-  /// Post -> pre.
-  PairV<2> reverse(const PairV<2>& v, const std::array<double, 2>& r, const double* g, RareLog& log) const {
-    return op.reverse(v, r, g[0], log);
-  }
-  Pair2DPaper op;  ///< the operator
+  Paper2D() : OneDraw2D{{Pair2DPaper(/*printed_reverse=*/false)}} {}
 };
 
 /// 3D, exact mode: Pair3DExact (2 draws); near head-on its polar chart is singular.
