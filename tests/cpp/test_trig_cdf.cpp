@@ -15,14 +15,15 @@ using namespace revcol::trig;
 
 namespace {
 
-// int_a^b cos^A sin^B by 5-point Gauss-Legendre on 2000 panels, in long double.
+// int_a^b cos^A sin^B by 5-point Gauss-Legendre on 400 panels, in long double (error of
+// order (h/2)^10 max|f^(10)| < 1e-19 here, far below the few ulp checked).
 long double quad(int A, int B, long double a, long double b) {
   static const long double x5[5] = {0.0L, -0.5384693101056830910363144L, 0.5384693101056830910363144L,
                                     -0.9061798459386639927976269L, 0.9061798459386639927976269L};
   static const long double w5[5] = {0.5688888888888888888888889L, 0.4786286704993664680412915L,
                                     0.4786286704993664680412915L, 0.2369268850561890875142640L,
                                     0.2369268850561890875142640L};
-  const int panels = 2000;
+  const int panels = 400;
   const long double h = (b - a) / panels;
   long double sum = 0.0L;
   for (int p = 0; p < panels; ++p) {
