@@ -251,7 +251,7 @@ void register_engine(py::module_& m) {
            py::arg("mode"), py::arg("law"), py::arg("seed"), py::arg("bits"), py::arg("groups"),
            py::arg("group_tol"), py::arg("time"), py::arg("generator") = "philox",
            py::arg("streams") = "per_particle")
-      .def_static("from_snapshot", &PyEngine::from_snapshot, py::arg("state"))
+      .def_static("from_snapshot", &PyEngine::from_snapshot, py::arg("snapshot"))
       .def("run", &PyEngine::run, py::arg("collisions") = py::none(), py::arg("time") = py::none(),
            py::arg("callback") = py::none(), py::arg("every") = 10000)
       .def("run_back", &PyEngine::run_back, py::arg("collisions") = py::none(), py::arg("time") = py::none())

@@ -232,7 +232,7 @@ void register_lattice(py::module_& m) {
             const revcol::Law lw = parse_law(get<std::string>(d, "law"));
             return PyLattice{lw, la::LatticeEngine(s, la::LatticePair2D(s.units.sigma, lw))};
           },
-          "Rebuilds an engine from snapshot(); it resumes bit for bit.")
+          py::arg("snapshot"), "Rebuilds an engine from snapshot(); it resumes bit for bit.")
       .def(
           "run",
           [](PyLattice& p, std::optional<std::uint64_t> collisions, std::optional<std::int64_t> until) {

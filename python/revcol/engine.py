@@ -38,6 +38,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
+from ._io import write_npz_atomic
 
 __all__ = ["Simulation"]
 
@@ -62,7 +63,17 @@ class Simulation:
     (default; the smallest id of a collision draws) or ``"single"``.
     """
 
-    def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
+    def __new__(cls, *args, engine: str = "float", **kwargs):
+        # engine="lattice" hands the whole call to the 2D lattice engine (revcol.lattice), which
+        # takes the same positions, velocities, box, boundary, diameter, law and seed
+        if engine == "lattice":
+            from .lattice import LatticeSimulation
+            return LatticeSimulation(*args, **kwargs)
+        if engine != "float":
+            raise ValueError(f"engine must be 'float' or 'lattice', got {engine!r}")
+        return super().__new__(cls)
+
+    def __init__(self, positions, velocities, box, *, engine: str = "float", boundary: _Boundary = "periodic",
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  bits: int = 40, groups: bool = True, group_tol: float = 1e-9,
                  time: float = 0.0, generator: str = "philox", streams: str = "per-particle",
@@ -84,12 +95,22 @@ class Simulation:
     @classmethod
     def random(cls, n: int, dim: int = 3, phi: float = 0.3, *, boundary: _Boundary = "periodic",
                diameter: float = 1.0, seed: int = 1, energy: Optional[float] = None,
-               init: str = "auto", equal_speeds: bool = False, **kwargs) -> "Simulation":
+               init: str = "auto", equal_speeds: bool = False, engine: str = "float", **kwargs) -> "Simulation":
         """n particles at packing fraction phi in a cubic box: random sequential addition
         or a jittered lattice (square; face-centred cubic in 3D), Gaussian velocities with
         zero momentum scaled to kinetic ``energy`` (default n d / 2, kT = 1), or all of one
         speed (``equal_speeds``). Other keywords go to the constructor (mode, law, ...);
-        the same ``seed`` keys the collision streams."""
+        the same ``seed`` keys the collision streams. ``engine="lattice"``: the 2D lattice
+        engine's ``LatticeSimulation.random`` (reversed bit for bit; ``law`` and ``seed`` apply)."""
+        if engine == "lattice":
+            from .lattice import LatticeSimulation
+            if energy is not None or equal_speeds:
+                raise ValueError("engine='lattice' starts at kT = 1 with Gaussian velocities: energy and "
+                                 "equal_speeds are not available")
+            return LatticeSimulation.random(n, dim, phi, boundary=boundary, diameter=diameter, seed=seed,
+                                            init=init, **kwargs)
+        if engine != "float":
+            raise ValueError(f"engine must be 'float' or 'lattice', got {engine!r}")
         x, v, box = _core.engine_random_state(int(dim), int(n), float(phi), _boundary_list(boundary),
                                               float(diameter), int(seed),
                                               float(energy) if energy is not None else 0.0, init,
@@ -196,9 +217,7 @@ class Simulation:
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the full state to ``path`` (numpy ``.npz``)."""
         st = self.snapshot()
-        arrays = {k: np.asarray(v) for k, v in st.items()}
-        with open(path, "wb") as f:
-            np.savez(f, **arrays)
+        write_npz_atomic(path, {k: np.asarray(v) for k, v in st.items()})
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "Simulation":

@@ -24,11 +24,13 @@ round trip is exact from the quantized state on. Times in floats are ``clock * t
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Optional, Sequence, Union
 
 import numpy as np
 
 from . import _core
+from ._io import write_npz_atomic
 
 __all__ = ["LatticeSimulation"]
 
@@ -193,7 +195,7 @@ class LatticeSimulation:
 
     # --- checkpoints -----------------------------------------------------------------------
 
-    def state(self) -> dict:
+    def snapshot(self) -> dict:
         """The full state (units, positions at the clock, velocities, stream counters, X's
         words, rare log, clock, collision count) as numpy arrays and numbers."""
         s = dict(self._e.snapshot())
@@ -201,23 +203,33 @@ class LatticeSimulation:
         return s
 
     @classmethod
-    def from_state(cls, state: dict) -> "LatticeSimulation":
-        """Rebuilds from ``state()``; the run resumes bit for bit."""
-        st = dict(state)
+    def from_snapshot(cls, snapshot: dict) -> "LatticeSimulation":
+        """Rebuilds from ``snapshot()``; the run resumes bit for bit."""
+        st = dict(snapshot)
         q = st.pop("quantization", None)
         return cls(None, None, None, _engine=_core.LatticeEngine.from_snapshot(st), _quantization=q)
 
+    def state(self) -> dict:
+        """Deprecated name of ``snapshot()``."""
+        warnings.warn("LatticeSimulation.state() is now snapshot()", DeprecationWarning, stacklevel=2)
+        return self.snapshot()
+
+    @classmethod
+    def from_state(cls, state: dict) -> "LatticeSimulation":
+        """Deprecated name of ``from_snapshot()``."""
+        warnings.warn("LatticeSimulation.from_state() is now from_snapshot()", DeprecationWarning, stacklevel=2)
+        return cls.from_snapshot(state)
+
     def save(self, path: Union[str, os.PathLike]) -> None:
-        """Writes the full state to ``path`` (numpy ``.npz``; nested dicts as ``a.b`` keys)."""
+        """Writes the full state to ``path`` atomically (numpy ``.npz``; nested dicts as ``a.b`` keys)."""
         flat = {}
-        for k, v in self.state().items():
+        for k, v in self.snapshot().items():
             if isinstance(v, dict):
                 for k2, v2 in v.items():
                     flat[f"{k}.{k2}"] = np.asarray(v2)
             else:
                 flat[k] = np.asarray(v)
-        with open(path, "wb") as f:
-            np.savez(f, **flat)
+        write_npz_atomic(path, flat)
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "LatticeSimulation":
@@ -234,7 +246,7 @@ class LatticeSimulation:
                     st.setdefault(outer, {})[inner] = val
                 else:
                     st[k] = val
-        return cls.from_state(st)
+        return cls.from_snapshot(st)
 
     def __repr__(self) -> str:
         return f"LatticeSimulation(n={self.n}, collisions={self.collisions}, clock={self.clock})"

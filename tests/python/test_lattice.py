@@ -15,13 +15,13 @@ def _same(a: dict, b: dict) -> bool:
 @pytest.mark.parametrize("phi,boundary", [(0.3, "periodic"), (0.5, "wall")])
 def test_round_trip_bit_for_bit(phi, boundary):
     sim = LatticeSimulation.random(n=150, phi=phi, boundary=boundary, seed=3)
-    s0 = sim.state()
+    s0 = sim.snapshot()
     r = sim.run(collisions=150 * 50)
     assert r["collisions"] == 150 * 50 and sim.collisions == 150 * 50
     assert not np.array_equal(sim.lattice_positions, s0["x"])
     back = sim.run_back()
     assert back["collisions"] == 150 * 50
-    assert _same(sim.state(), s0)
+    assert _same(sim.snapshot(), s0)
     assert sim.clock == s0["clock"]
     d = sim.diagnostics()
     assert d["bits_length"] == 256 and d["log_entries"] == 0 and d["energy_drift"] == 0.0
@@ -30,11 +30,11 @@ def test_round_trip_bit_for_bit(phi, boundary):
 def test_midpoint_and_time_reversal_equal_the_forward_states():
     sim = LatticeSimulation.random(n=120, phi=0.4, seed=5)
     sim.run(collisions=3000)
-    mid = sim.state()
+    mid = sim.snapshot()
     t_mid = sim.time
     sim.run(collisions=3000)
     sim.run_back(to_collision=3000)
-    assert _same(sim.state(), mid)
+    assert _same(sim.snapshot(), mid)
     sim.run(collisions=1000)
     sim.run_back(time=t_mid)
     assert sim.clock == mid["clock"]
@@ -50,10 +50,10 @@ def test_save_load_resumes_bit_for_bit(tmp_path):
     path = tmp_path / "lattice.npz"
     sim.save(path)
     other = LatticeSimulation.load(path)
-    assert _same(other.state(), sim.state())
+    assert _same(other.snapshot(), sim.snapshot())
     sim.run(collisions=2000)
     other.run(collisions=2000)
-    assert _same(other.state(), sim.state())
+    assert _same(other.snapshot(), sim.snapshot())
     other.run_back()
     assert other.collisions == 0 and other.clock == 0
 
@@ -80,7 +80,7 @@ def test_bad_input_is_refused_and_changes_nothing():
         LatticeSimulation.random(n=10, dim=3)
     sim = LatticeSimulation.random(n=60, phi=0.3, seed=2)
     sim.run(collisions=300)
-    s = sim.state()
+    s = sim.snapshot()
     with pytest.raises(ValueError, match="only 300"):
         sim.run_back(collisions=301)
     with pytest.raises(ValueError, match="target tick"):
@@ -91,5 +91,27 @@ def test_bad_input_is_refused_and_changes_nothing():
     bad["x"] = np.array(s["x"])
     bad["x"][1] = bad["x"][0]
     with pytest.raises(ValueError, match="overlap"):
-        LatticeSimulation.from_state(bad)
-    assert _same(sim.state(), s)
+        LatticeSimulation.from_snapshot(bad)
+    assert _same(sim.snapshot(), s)
+
+
+def test_simulation_routes_engine_lattice():
+    """revcol.Simulation(..., engine="lattice") and Simulation.random(..., engine="lattice") build
+    the lattice engine; a bad engine name is refused by name."""
+    import revcol
+
+    sim = revcol.Simulation.random(n=80, dim=2, phi=0.3, seed=4, engine="lattice")
+    assert isinstance(sim, LatticeSimulation)
+    x0, v0 = sim.lattice_positions, sim.lattice_velocities
+    sim.run(collisions=500)
+    assert not (sim.lattice_velocities == v0).all()
+    sim.run_back()
+    assert (sim.lattice_positions == x0).all() and (sim.lattice_velocities == v0).all()
+    other = revcol.Simulation(sim.positions, sim.velocities, sim.units["L"][0] * sim.units["length_unit"],
+                              engine="lattice", seed=4)
+    assert isinstance(other, LatticeSimulation) and other.n == 80
+    assert isinstance(revcol.Simulation.random(n=20, dim=2, phi=0.2, seed=1), revcol.Simulation)
+    with pytest.raises(ValueError, match="engine"):
+        revcol.Simulation.random(n=20, dim=2, phi=0.2, engine="cuda")
+    with pytest.raises(ValueError, match="engine"):
+        revcol.Simulation([[1.0, 1.0]], [[1.0, 0.0]], 5.0, engine="cuda")
