@@ -27,6 +27,7 @@
 
 #include "bench.hpp"
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
 #include "revcol/error.hpp"
 
 namespace revcol::bench {

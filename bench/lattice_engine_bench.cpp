@@ -21,6 +21,7 @@
 
 #include "bench.hpp"
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
 #include "revcol/lattice/engine.hpp"
 
 namespace revcol::bench {

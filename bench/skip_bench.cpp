@@ -24,6 +24,7 @@
 #include "revcol/collide/ellipse_arc.hpp"
 #include "revcol/collide/tables.hpp"
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
 
 namespace revcol::bench {
 namespace {

@@ -13,6 +13,7 @@
 
 #include "bindings.hpp"
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
 #include "revcol/error.hpp"
 
 namespace py = pybind11;

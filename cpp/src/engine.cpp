@@ -3,6 +3,7 @@
 // The physics and the reversal protocol are in revcol/engine/engine.hpp, the engine itself
 // in engine_impl.hpp / engine_collide.hpp, instantiated per dimension in engine_<d>d.cpp.
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/limits.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -44,27 +45,31 @@ rng::StreamPolicy parse_engine_streams(const std::string& s) {
 namespace {
 
 void validate_config(const Config& c) {
-  require(c.dim >= 1 && c.dim <= 3, [&] { return "dim must be 1, 2 or 3, got " + std::to_string(c.dim); });
+  // every limit comes from engine/limits.hpp (the scene reader asks the same header)
+  require(c.dim >= limits::kMinDim && c.dim <= limits::kMaxDim,
+          [&] { return "dim must be 1, 2 or 3, got " + std::to_string(c.dim); });
   require(std::isfinite(c.diameter) && c.diameter > 0.0, "diameter must be finite and > 0");
-  require(c.bits >= 8 && c.bits <= 52, "bits must be in [8, 52]");
+  require(c.bits >= limits::kMinBits && c.bits <= limits::kMaxBits, [&] {
+    return "bits must be in [" + std::to_string(limits::kMinBits) + ", " + std::to_string(limits::kMaxBits) + "]";
+  });
   require(c.streams == rng::StreamPolicy::per_particle || c.streams == rng::StreamPolicy::single,
           "streams must be per_particle or single (a per-draw policy needs a fixed draw count per collision)");
   require(c.generator == Generator::philox || c.generator == Generator::clcg4, "generator must be philox or clcg4");
-  require(std::isfinite(c.group_tol) && c.group_tol >= 0.0 && c.group_tol < 1e-3,
+  require(std::isfinite(c.group_tol) && c.group_tol >= 0.0 && c.group_tol < limits::kMaxGroupTol,
           "group_tol must be finite and in [0, 1e-3)");
   require(std::isfinite(c.shell) && c.shell >= 0.0, "shell must be finite and >= 0 (0: from the packing fraction)");
-  require(!(c.mode == Mode::paper && c.dim == 3),
+  require(c.mode != Mode::paper || limits::paper_mode_allowed(c.dim),
           "paper mode has no invertible 3D pair operator (Pair3DPaper is not a bijection): use exact mode in 3D");
   for (int k = 0; k < c.dim; ++k) {
     const double L = c.box[k];
     require(std::isfinite(L) && L > 0.0, [&] { return "box length on axis " + std::to_string(k) + " must be finite and > 0"; });
     if (c.boundary[k] == Boundary::wall) {
-      require(L > c.diameter, [&] {
+      require(limits::wall_axis_fits(L, c.diameter), [&] {
         return "diameter " + std::to_string(c.diameter) + " is too large for the box: axis " + std::to_string(k) +
                " has length " + std::to_string(L) + " (walls need L > D)";
       });
     } else {
-      require(std::floor(L / c.diameter) >= 3.0, [&] {
+      require(limits::periodic_axis_fits(L, c.diameter), [&] {
         return "periodic box too small for the neighbour lists: axis " + std::to_string(k) + " has length " +
                std::to_string(L) + " < 3 diameters (L >= 3 D keeps each listed neighbour's nearest image "
                "unique with a shell of at least 0.45 D)";

@@ -21,6 +21,7 @@
 #include "revcol/collide/specular.hpp"
 #include "revcol/engine/boundary.hpp"
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
 #include "revcol/engine/event_queue.hpp"
 #include "revcol/engine/kinematics.hpp"
 #include "revcol/engine/logs.hpp"

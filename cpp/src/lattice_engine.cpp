@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
 #include "revcol/error.hpp"
 
 namespace revcol::lattice {

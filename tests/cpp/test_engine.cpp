@@ -11,6 +11,7 @@
 #include "revcol/collide/calotte.hpp"
 #include "revcol/collide/tables.hpp"
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
 #include "revcol/error.hpp"
 
 using namespace revcol;

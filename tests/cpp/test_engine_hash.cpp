@@ -19,6 +19,7 @@
 
 #include "check.hpp"
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
 
 using namespace revcol;
 using namespace revcol::engine;

@@ -21,7 +21,7 @@
 //
 // Draws. Philox streams keyed {0xFFFFFF00, seed} (positions) and {0xFFFFFF01, seed}
 // (velocities), never a stream the engine's collisions use: the same seed and box give
-// the same bits. random_state (engine.hpp: the cubic box of a packing fraction) is this
+// the same bits. random_state (below: the cubic box of a packing fraction) is this
 // start in its cube.
 #pragma once
 #include <cstdint>
@@ -30,6 +30,27 @@
 #include "revcol/engine/engine.hpp"
 
 namespace revcol::engine {
+
+/// A random initial state: box of side L with n particles at packing fraction phi
+/// (phi = n v_D / L^d), placed by random sequential addition ("rsa"), or on a simple
+/// lattice with random displacements ("lattice"; "auto" picks rsa for phi <= 0.3 (1D), 0.35
+/// (2D), 0.2 (3D), else lattice), velocities Gaussian with zero total momentum scaled to
+/// kinetic energy `energy` (<= 0: n d / 2, that is kT = 1), or, with equal_speeds, all of
+/// the same speed in random directions (then zero momentum is not enforced).
+struct InitialState {
+  Config config;          ///< config with its box set
+  std::vector<double> x;  ///< n x dim
+  std::vector<double> v;  ///< n x dim
+};
+/// The volume (length in 1D, area in 2D) of one particle of diameter D in d dimensions:
+/// packing fraction = n particle_volume(d, D) / box volume.
+double particle_volume(int d, double D);
+
+/// See InitialState.
+InitialState random_state(Config config, std::size_t n, double phi, std::uint64_t seed,
+                          double energy = 0.0, const std::string& init = "auto",
+                          bool equal_speeds = false);
+
 
 /// How a random start places particles.
 enum class Placement { automatic, rsa, lattice };
