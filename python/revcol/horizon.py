@@ -35,12 +35,17 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
     stops once its error reaches ``o1`` (O(1): the reversed trajectory has left the forward
     one). Each grid point reports the worst error over the seeds (a seed that stopped counts
     as O(1)); the horizon is the largest N_c before the first grid point whose worst error
-    exceeds 1e-9."""
+    exceeds 1e-9. A lattice scene has none: :func:`revcol.lattice_gas.lattice_horizon` checks
+    its round trip bit for bit at a few N_c."""
     if scene.kind != "gas":
         raise SceneError(f"{scene.source}: [scene] kind: --horizon measures gas scenes, not {scene.kind!r}")
     if scene.seed + seeds > 2**32:
         raise SceneError(f"{scene.source}: [rng] seed: seeds {scene.seed} .. {scene.seed + seeds - 1} "
                          "pass 2^32 - 1")
+    if scene.engine == "lattice":  # no horizon: checked bit for bit at a few N_c instead
+        from .lattice_gas import lattice_horizon
+
+        return lattice_horizon(scene, seeds=seeds, max_collisions=max_collisions, progress=progress)
     if progress is None:
         progress = sys.stdout.isatty()
     n = scene.particles
