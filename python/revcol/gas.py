@@ -32,7 +32,7 @@ from .report import version
 from .roundtrip import BAR, ERROR_DEFINITIONS, geometry, round_trip_errors
 from .scene import Scene, SceneError, engine_options, read_initial
 
-__all__ = ["build_simulation", "run_gas", "list_renewals"]
+__all__ = ["build_simulation", "run_gas", "round_trip", "list_renewals"]
 
 
 def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
@@ -300,16 +300,22 @@ def run_gas(scene: Scene, *, plot: str | os.PathLike | None = None,
         from .lattice_gas import run_lattice_gas
 
         return run_lattice_gas(scene, plot=plot, trajectory=trajectory, progress=progress, checkpoints=checkpoints)
-    run = _GasRun(scene, plot, trajectory, progress, checkpoints)
+    return round_trip(_GasRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_gas")
+
+
+def round_trip(run, plot, figures: str) -> dict:
+    """Forward, turn, back (Ctrl-C counted throughout), the report, and with ``plot`` the
+    figures drawn by ``revcol.plots.<figures>``. ``run`` is a gas run (this module's, or the
+    lattice engine's in :mod:`revcol.lattice_gas`)."""
     with Interrupt() as stop:
         run.forward(stop)
         run.turn()
         run.reverse(stop, stop.presses)
     report = run.report()
     if plot is not None:
-        from .plots import plot_gas
+        from . import plots
 
         sim = run.sim
-        report["written"] += plot_gas(report, Path(plot), (run.x0, run.v0), run.shot_turn,
-                                      (sim.positions, sim.velocities))
+        report["written"] += getattr(plots, figures)(report, Path(plot), (run.x0, run.v0), run.shot_turn,
+                                                     (sim.positions, sim.velocities))
     return report

@@ -307,21 +307,11 @@ def run_lattice_gas(scene: Scene, *, plot=None, trajectory=None, progress: bool 
                     checkpoints: bool = True) -> dict:
     """Runs a lattice gas scene forward and back; returns the report (outputs as
     :func:`revcol.gas.run_gas`; the figures are the energy drift, X's size and snapshots)."""
+    from .gas import round_trip
+
     if progress is None:
         progress = sys.stdout.isatty()
-    run = _LatticeRun(scene, plot, trajectory, progress, checkpoints)
-    with Interrupt() as stop:
-        run.forward(stop)
-        run.turn()
-        run.reverse(stop, stop.presses)
-    report = run.report()
-    if plot is not None:
-        from .plots import plot_lattice_gas
-
-        sim = run.sim
-        report["written"] += plot_lattice_gas(report, Path(plot), (run.x0, run.v0), run.shot_turn,
-                                              (sim.positions, sim.velocities))
-    return report
+    return round_trip(_LatticeRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_lattice_gas")
 
 
 def lattice_horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000,

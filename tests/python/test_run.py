@@ -295,12 +295,10 @@ def test_horizon(tmp_path, capsys):
     assert all(a["error_v"] <= b["error_v"] for a, b in zip(one["rows"], rows[:len(one["rows"])]))
 
 
-def test_ctrl_c_stops_forward_and_still_reverses_and_writes(tmp_path, capsys, monkeypatch):
-    import revcol.run as run
-
-    # a 1D gas reverses exactly however long it runs: 1e8 collisions would take a minute.
-    # The SIGINT is sent 0.3 s after the run's handler is installed (never before it).
-    enter = run._Interrupt.__enter__
+def sigint_once_running(monkeypatch, interrupt_class) -> list:
+    """Sends SIGINT 0.3 s after a run's Ctrl-C handler (``interrupt_class``) is installed
+    (never before it); returns the timers, to cancel when the run is over."""
+    enter = interrupt_class.__enter__
     timers = []
 
     def enter_then_interrupt(self):
@@ -308,7 +306,15 @@ def test_ctrl_c_stops_forward_and_still_reverses_and_writes(tmp_path, capsys, mo
         timers.append(threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT)))
         timers[-1].start()
         return out
-    monkeypatch.setattr(run._Interrupt, "__enter__", enter_then_interrupt)
+    monkeypatch.setattr(interrupt_class, "__enter__", enter_then_interrupt)
+    return timers
+
+
+def test_ctrl_c_stops_forward_and_still_reverses_and_writes(tmp_path, capsys, monkeypatch):
+    import revcol.run as run
+
+    # a 1D gas reverses exactly however long it runs: 1e8 collisions would take a minute.
+    timers = sigint_once_running(monkeypatch, run._Interrupt)
     before = signal.getsignal(signal.SIGINT)
     p = tmp_path / "long.toml"
     p.write_text("[system]\ndimension = 1\nparticles = 1000\npacking_fraction = 0.3\n[run]\ncollisions = 100000000\n")

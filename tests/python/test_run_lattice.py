@@ -5,7 +5,6 @@ import copy
 import json
 import os
 import signal
-import threading
 import tomllib
 from pathlib import Path
 
@@ -241,17 +240,11 @@ def test_horizon_check_can_fail(tmp_path, capsys, monkeypatch):
 
 
 def test_ctrl_c_stops_the_lattice_forward_run_and_goes_back(tmp_path, capsys, monkeypatch):
-    import revcol.lattice_gas as mod
+    from test_run import sigint_once_running
 
-    enter = mod.Interrupt.__enter__
-    timers = []
+    from revcol.progress import Interrupt
 
-    def enter_then_interrupt(self):
-        out = enter(self)
-        timers.append(threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT)))
-        timers[-1].start()
-        return out
-    monkeypatch.setattr(mod.Interrupt, "__enter__", enter_then_interrupt)
+    timers = sigint_once_running(monkeypatch, Interrupt)
     before = signal.getsignal(signal.SIGINT)
     try:
         rc = cli_main(["run", str(small(tmp_path, collisions=10**9)), "--json", str(tmp_path / "r.json"),
