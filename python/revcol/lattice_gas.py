@@ -135,6 +135,7 @@ class _LatticeRun:
         self.bits_series: list[tuple[int, int]] = [(0, self.bits0)]
         self.written_ckpt: list[str] = []
         self.done, self.back, self.forward_s, self.reverse_s = 0, 0, 0.0, 0.0
+        self.cpu = {"forward": 0.0, "reverse": 0.0}  # process CPU seconds in the engine calls
         self.interrupted: str | None = None
         self.engine_error: str | None = None
 
@@ -164,7 +165,7 @@ class _LatticeRun:
                 stops += [(self.done // k + 1) * k for k in (self.ckpt_every, self.traj_every) if k]
                 if self.nc is not None:
                     stops.append(self.nc)
-                tick = _time.perf_counter()
+                tick, cpu = _time.perf_counter(), _time.process_time()
                 try:
                     r = sim.run(collisions=min(stops) - self.done,
                                 time=None if self.tick_end is None else self.tick_end * sim.units["tick"])
@@ -174,6 +175,7 @@ class _LatticeRun:
                     break
                 finally:
                     self.forward_s += _time.perf_counter() - tick
+                    self.cpu["forward"] += _time.process_time() - cpu
                 self.done += int(r["collisions"])
                 self.sample(self.done)
                 bar.to(self.done if self.nc is not None else sim.clock)
@@ -219,7 +221,7 @@ class _LatticeRun:
                 if stop.presses > presses_at_turn:
                     self.interrupted = "reverse"
                     break
-                tick = _time.perf_counter()
+                tick, cpu = _time.perf_counter(), _time.process_time()
                 try:
                     if target > 0:
                         sim.run_back(to_collision=target)
@@ -230,6 +232,7 @@ class _LatticeRun:
                     break
                 finally:
                     self.reverse_s += _time.perf_counter() - tick
+                    self.cpu["reverse"] += _time.process_time() - cpu
                 self.back = done - sim.collisions
                 self.bits_max = max(self.bits_max, int(sim.diagnostics()["bits_length"]))
                 bar.to(self.back)
@@ -277,6 +280,9 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "clock_end": sim.clock,
         "forward_s": fs, "reverse_s": rs,
         "forward_per_s": done / fs if fs > 0 else None, "reverse_per_s": run.back / rs if rs > 0 else None,
+        "forward_cpu_s": run.cpu["forward"], "reverse_cpu_s": run.cpu["reverse"],
+        "forward_per_cpu_s": done / run.cpu["forward"] if run.cpu["forward"] > 0 else None,
+        "reverse_per_cpu_s": run.back / run.cpu["reverse"] if run.cpu["reverse"] > 0 else None,
         "restored": same, "bit_for_bit": bool(complete and all(same.values())),
         "error_x": ex, "error_v": ev, "bar": BAR,
         "round_trip_complete": complete, "passed": bool(complete and all(same.values())),

@@ -112,9 +112,10 @@ def _lattice_lines(r: dict) -> list[str]:
         f"within {q['max_velocity_error']:.2g} v_rms; exact from there on",
         f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:,.4g} per particle) to "
         f"t = {r['time_turn']:.6g} (tick {r['clock_turn']:,}) in {_duration(r['forward_s'])}: "
-        f"{_si(r['forward_per_s'])} collisions/s",
+        f"{_si(r['forward_per_s'])} collisions/s ({_si(r['forward_per_cpu_s'])} per CPU second)",
         f"  reverse          {r['collisions_back']:,} collisions back to t = {r['time_end']:.6g} (tick "
-        f"{r['clock_end']:,}) in {_duration(r['reverse_s'])}: {_si(r['reverse_per_s'])} collisions/s",
+        f"{r['clock_end']:,}) in {_duration(r['reverse_s'])}: {_si(r['reverse_per_s'])} collisions/s "
+        f"({_si(r['reverse_per_cpu_s'])} per CPU second)",
         f"  restored         {'bit for bit' if r['bit_for_bit'] else 'NOT bit for bit'}: {same}",
         f"  bits-back X      {x['start']} bits at the start, {x['turn']} at the turn, {x['end']} after reversal; "
         f"max {x['max']} (sampled every {x['sampled_every']:,} collisions)",
