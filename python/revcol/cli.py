@@ -52,7 +52,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--trajectory", metavar="FILE",
                    help="write frames forward and through the reversal: FILE.xyz (extended XYZ) or FILE.gsd")
     r.add_argument("--horizon", action="store_true",
-                   help="measure the round-trip error against collisions per particle instead")
+                   help="measure the round-trip error against collisions per particle instead (a lattice "
+                   "scene has no horizon: its round trip is checked bit for bit at a few N_c)")
     r.add_argument("--seeds", type=_positive_int, default=None, metavar="K",
                    help="--horizon: worst error over this many seeds, from the scene's (default 1)")
     r.add_argument("--max-collisions", type=_positive_int, default=1_000_000, metavar="N",
