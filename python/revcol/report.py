@@ -84,6 +84,10 @@ def _float_lines(r: dict) -> list[str]:
     return lines
 
 
+def _err(e: float, unit: str) -> str:
+    return f"{e:.2g} {unit}" if e > 0 else "0 (the float values lie on the lattice)"
+
+
 def _n(count: int, one: str, many: str | None = None) -> str:
     return f"{count:,} {one if count == 1 else (many or one + 's')}"
 
@@ -108,8 +112,8 @@ def _lattice_lines(r: dict) -> list[str]:
     lines = [
         f"  engine           lattice: sigma = 2^{u['S']} lattice units per diameter, a tick = {u['tick']:.3g} time "
         "units (a typical particle moves 2^-20 sigma per tick)",
-        f"  start            quantized once: positions within {q['max_position_error']:.2g} diameters, velocities "
-        f"within {q['max_velocity_error']:.2g} v_rms; exact from there on",
+        f"  start            quantized once: positions within {_err(q['max_position_error'], 'diameters')}, "
+        f"velocities within {_err(q['max_velocity_error'], 'v_rms')}; exact from there on",
         f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:,.4g} per particle) to "
         f"t = {r['time_turn']:.6g} (tick {r['clock_turn']:,}) in {_duration(r['forward_s'])}: "
         f"{_si(r['forward_per_s'])} collisions/s ({_si(r['forward_per_cpu_s'])} per CPU second)",
