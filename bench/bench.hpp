@@ -28,5 +28,7 @@ void add_statesave_benches(std::vector<Bench>& out);  ///< statesave_bench.cpp: 
 void add_pair3d_benches(std::vector<Bench>& out);     ///< pair3d_bench.cpp: the fast exact 3D pair operator
 void add_engine_benches(std::vector<Bench>& out);     ///< engine_bench.cpp: the event-driven engine
 void add_skip_benches(std::vector<Bench>& out);       ///< skip_bench.cpp: what a pair-only scene does not pay for
+void add_lattice_op_benches(std::vector<Bench>& out);  ///< lattice_op_bench.cpp: the exact lattice pair operator
+void add_lattice_benches(std::vector<Bench>& out);     ///< lattice_engine_bench.cpp: the 2D lattice engine
 
 }  // namespace revcol::bench

@@ -67,7 +67,7 @@ void apply_environment(Case& c) {
       else if (key == "phi") c.phi = std::stod(value);
       else if (key == "boundary") c.boundary = value;
       else if (key == "law") c.law = parse_law(value);
-      else if (key == "mode") c.mode = parse_mode(value);
+      else if (key == "mode") c.mode = revcol::engine::parse_engine_mode(value);
       else if (key == "seed") c.seed = std::stoull(value);
       else if (key == "warm") c.warm = std::stod(value);
       else if (key == "groups") c.groups = value != "0";

@@ -94,6 +94,8 @@ std::vector<Bench> all_benches() {
   revcol::bench::add_pair3d_benches(out);
   revcol::bench::add_engine_benches(out);
   revcol::bench::add_skip_benches(out);
+  revcol::bench::add_lattice_op_benches(out);
+  revcol::bench::add_lattice_benches(out);
   return out;
 }
 

@@ -5,44 +5,31 @@
 #include <pybind11/stl.h>
 
 #include <optional>
+#include <type_traits>
 #include <vector>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "revcol/collide/pair1d.hpp"
 #include "revcol/collide/pair2d.hpp"
 #include "revcol/collide/wall.hpp"
-#include "revcol/rng/clcg4.hpp"
-#include "revcol/rng/philox.hpp"
 
 namespace py = pybind11;
 
 namespace revcol::bind {
 namespace {
 
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-std::string shape_of(const Array& a) {
-  std::string s = "(";
-  for (py::ssize_t k = 0; k < a.ndim(); ++k) s += (k ? ", " : "") + std::to_string(a.shape(k));
-  return s + (a.ndim() == 1 ? ",)" : ")");
-}
-
-// velocities: (2, 2) or (B, 2, 2) -> B pairs; `batched` tells which.
-std::vector<PairV<2>> pairs_from(const Array& v, bool& batched) {
-  batched = v.ndim() == 3;
-  require((v.ndim() == 2 || v.ndim() == 3) && v.shape(v.ndim() - 1) == 2 &&
-              v.shape(v.ndim() - 2) == 2,
-          [&] { return "velocities must have shape (2, 2) or (B, 2, 2), got " + shape_of(v); });
-  const std::size_t B = batched ? v.shape(0) : 1;
-  std::vector<PairV<2>> out(B);
+// velocities: (2, 2) or (B, 2, 2) -> B pairs; `rows` tells which.
+std::vector<PairV<2>> pairs_from(const Array& v, Rows& rows) {
+  rows = rows_of(v, {2, 2}, "velocities");
+  std::vector<PairV<2>> out(rows.count);
   const double* p = v.data();
-  for (std::size_t b = 0; b < B; ++b, p += 4) out[b] = {{p[0], p[1]}, {p[2], p[3]}};
+  for (std::size_t b = 0; b < rows.count; ++b, p += 4) out[b] = {{p[0], p[1]}, {p[2], p[3]}};
   return out;
 }
 
-Array pairs_to(const std::vector<PairV<2>>& v, bool batched) {
-  Array out = batched ? Array({static_cast<py::ssize_t>(v.size()), py::ssize_t{2}, py::ssize_t{2}})
-                      : Array({py::ssize_t{2}, py::ssize_t{2}});
+Array pairs_to(const std::vector<PairV<2>>& v, const Rows& rows) {
+  Array out(rows.batched ? batched({2, 2}, v.size()) : Shape{2, 2});
   double* p = out.mutable_data();
   for (const PairV<2>& x : v) {
     *p++ = x.i[0]; *p++ = x.i[1]; *p++ = x.j[0]; *p++ = x.j[1];
@@ -52,74 +39,33 @@ Array pairs_to(const std::vector<PairV<2>>& v, bool batched) {
 
 // normal: (2,) broadcast to all B, or (B, 2).
 std::vector<std::array<double, 2>> normals_from(const Array& n, std::size_t B) {
-  const bool one = n.ndim() == 1 && n.shape(0) == 2;
-  const bool many = n.ndim() == 2 && n.shape(1) == 2 && static_cast<std::size_t>(n.shape(0)) == B;
-  require(one || many, [&] {
-    return "normal must have shape (2,) or (" + std::to_string(B) + ", 2), got " + shape_of(n);
-  });
   std::vector<std::array<double, 2>> out(B);
-  for (std::size_t b = 0; b < B; ++b) {
-    const double* p = n.data() + (one ? 0 : 2 * b);
-    out[b] = {p[0], p[1]};
-  }
+  const auto p = per_entry(n, {2}, B, "normal");
+  for (std::size_t b = 0; b < B; ++b) out[b] = {p[b][0], p[b][1]};
   return out;
 }
 
-std::vector<double> draws_from(const Array& g, std::size_t B) {
-  require((g.ndim() == 0 && B == 1) || (g.ndim() == 1 && static_cast<std::size_t>(g.shape(0)) == B),
-          [&] { return "g must be a number or have shape (" + std::to_string(B) + ",), got " + shape_of(g); });
-  return std::vector<double>(g.data(), g.data() + B);
-}
-
-std::optional<std::vector<Invariants<2>>> invariants_from(const std::optional<Array>& momentum,
-                                                          const std::optional<Array>& energy,
-                                                          std::size_t B) {
-  require(momentum.has_value() == energy.has_value(),
-          "give both momentum and energy (held invariants), or neither");
-  if (!momentum) return std::nullopt;
-  const Array& m = *momentum;
-  const Array& e = *energy;
-  const bool one = m.ndim() == 1 && m.shape(0) == 2 && e.ndim() == 0;
-  const bool many = m.ndim() == 2 && m.shape(1) == 2 && static_cast<std::size_t>(m.shape(0)) == B &&
-                    e.ndim() == 1 && static_cast<std::size_t>(e.shape(0)) == B;
-  require(one || many, [&] {
-    return "momentum/energy must have shapes (2,)/() or (" + std::to_string(B) + ", 2)/(" +
-           std::to_string(B) + ",), got " + shape_of(m) + "/" + shape_of(e);
-  });
-  std::vector<Invariants<2>> out(B);
-  for (std::size_t b = 0; b < B; ++b) {
-    const double* p = m.data() + (one ? 0 : 2 * b);
-    out[b] = {{p[0], p[1]}, e.data()[one ? 0 : b]};
-  }
-  return out;
-}
-
-// Runs forward (dir = +1) or reverse (dir = -1) with exactly one source of random numbers.
-Array run_pair2d(Pair2D& op, const Array& velocities, const Array& normal, py::object rng,
-                 std::optional<Array> g, std::optional<Array> momentum,
-                 std::optional<Array> energy, int dir) {
-  bool batched = false;
-  std::vector<PairV<2>> v = pairs_from(velocities, batched);
+// Runs forward or reverse with exactly one source of random numbers.
+Array run_pair2d(Pair2D& op, const Array& velocities, const Array& normal, const py::object& rng,
+                 const std::optional<Array>& g, const std::optional<Array>& momentum,
+                 const std::optional<Array>& energy, batch::Dir dir) {
+  Rows rows{};
+  std::vector<PairV<2>> v = pairs_from(velocities, rows);
   const auto n = normals_from(normal, v.size());
-  const auto inv = invariants_from(momentum, energy, v.size());
+  const auto inv = invariants_from<2>(momentum, energy, v.size());
   const Invariants<2>* ip = inv ? inv->data() : nullptr;
-  require(rng.is_none() != !g.has_value(), "give exactly one of rng= (a generator) or g= (draws)");
-  if (g) {
-    const std::vector<double> gv = draws_from(*g, v.size());
-    if (dir > 0) op.forward(v.data(), n.data(), v.size(), gv.data(), ip);
-    else op.reverse(v.data(), n.data(), v.size(), gv.data(), ip);
-  } else if (py::isinstance<rng::CLCG4>(rng)) {
-    auto& gen = rng.cast<rng::CLCG4&>();
-    if (dir > 0) op.forward(v.data(), n.data(), v.size(), gen, ip);
-    else op.reverse(v.data(), n.data(), v.size(), gen, ip);
-  } else if (py::isinstance<rng::Philox>(rng)) {
-    auto& gen = rng.cast<rng::Philox&>();
-    if (dir > 0) op.forward(v.data(), n.data(), v.size(), gen, ip);
-    else op.reverse(v.data(), n.data(), v.size(), gen, ip);
-  } else {
-    throw InvalidArgument("rng must be a revcol.CLCG4 or revcol.Philox");
-  }
-  return pairs_to(v, batched);
+  const bool fwd = dir == batch::Dir::forward;
+  with_draws(rng, g.has_value(), [&](auto gen) {
+    if constexpr (std::is_null_pointer_v<decltype(gen)>) {
+      const std::vector<double> gv = draws_from(*g, rows, Pair2D::draws);
+      if (fwd) op.forward(v.data(), n.data(), v.size(), gv.data(), ip);
+      else op.reverse(v.data(), n.data(), v.size(), gv.data(), ip);
+    } else {
+      if (fwd) op.forward(v.data(), n.data(), v.size(), *gen, ip);
+      else op.reverse(v.data(), n.data(), v.size(), *gen, ip);
+    }
+  });
+  return pairs_to(v, rows);
 }
 
 const char* kPair2DDoc = R"(Pair collisions in 2 dimensions, reversible.
@@ -153,7 +99,7 @@ void register_collide(py::module_& m) {
       .def("forward",
            [](Pair2D& op, const Array& v, const Array& n, py::object rng, std::optional<Array> g,
               std::optional<Array> momentum, std::optional<Array> energy) {
-             return run_pair2d(op, v, n, std::move(rng), std::move(g), std::move(momentum), std::move(energy), +1);
+             return run_pair2d(op, v, n, rng, g, momentum, energy, batch::Dir::forward);
            },
            py::arg("velocities"), py::arg("normal"), py::kw_only(), py::arg("rng") = py::none(),
            py::arg("g") = py::none(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
@@ -163,7 +109,7 @@ void register_collide(py::module_& m) {
       .def("reverse",
            [](Pair2D& op, const Array& v, const Array& n, py::object rng, std::optional<Array> g,
               std::optional<Array> momentum, std::optional<Array> energy) {
-             return run_pair2d(op, v, n, std::move(rng), std::move(g), std::move(momentum), std::move(energy), -1);
+             return run_pair2d(op, v, n, rng, g, momentum, energy, batch::Dir::reverse);
            },
            py::arg("velocities"), py::arg("normal"), py::kw_only(), py::arg("rng") = py::none(),
            py::arg("g") = py::none(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
@@ -171,22 +117,22 @@ void register_collide(py::module_& m) {
       .def("quantize",
            [](const Pair2D& op, const Array& v, const Array& n, std::optional<Array> momentum,
               std::optional<Array> energy) {
-             bool batched = false;
-             std::vector<PairV<2>> pv = pairs_from(v, batched);
+             Rows rows{};
+             std::vector<PairV<2>> pv = pairs_from(v, rows);
              const auto nv = normals_from(n, pv.size());
-             const auto inv = invariants_from(momentum, energy, pv.size());
+             const auto inv = invariants_from<2>(momentum, energy, pv.size());
              std::vector<PairV<2>> out(pv.size());
              for (std::size_t b = 0; b < pv.size(); ++b)
                out[b] = op.quantize(pv[b], nv[b], inv ? &(*inv)[b] : nullptr);
-             return pairs_to(out, batched);
+             return pairs_to(out, rows);
            },
            py::arg("velocities"), py::arg("normal"), py::kw_only(), py::arg("momentum") = py::none(),
            py::arg("energy") = py::none(),
            "The pre state as reversal restores it: exact mode decodes its chart cell at the centre.")
       .def("chart",
            [](const Pair2D& op, const Array& v, const Array& n) {
-             bool batched = false;
-             std::vector<PairV<2>> pv = pairs_from(v, batched);
+             Rows rows{};
+             std::vector<PairV<2>> pv = pairs_from(v, rows);
              const auto nv = normals_from(n, pv.size());
              py::array_t<double> out(static_cast<py::ssize_t>(pv.size()));
              for (std::size_t b = 0; b < pv.size(); ++b) out.mutable_data()[b] = op.chart(pv[b], nv[b]);

@@ -7,6 +7,7 @@
 
 #include <cstring>
 #include <limits>
+#include <type_traits>
 #include <memory>
 #include <optional>
 
@@ -67,7 +68,7 @@ en::Config make_config(int dim, const std::vector<double>& box, const std::vecto
     c.boundary[k] = en::parse_boundary(boundary.size() == 1 ? boundary[0] : boundary[k]);
   }
   c.diameter = diameter;
-  c.mode = parse_mode(mode);
+  c.mode = en::parse_engine_mode(mode);
   c.law = parse_law(law);
   require(seed <= 0xFFFFFFFFull, "seed must be < 2^32");
   c.seed = static_cast<std::uint32_t>(seed);
@@ -81,20 +82,14 @@ en::Config make_config(int dim, const std::vector<double>& box, const std::vecto
 
 py::dict counters_dict(const en::Counters& c) {
   py::dict d;
-  d["events"] = c.events;
-  d["pair_collisions"] = c.pair_collisions;
-  d["group_collisions"] = c.group_collisions;
-  d["group_particles"] = c.group_particles;
-  d["group_fallbacks"] = c.group_fallbacks;
-  d["wall_events"] = c.wall_events;
-  d["cell_crossings"] = c.cell_crossings;
-  d["invalid_events"] = c.invalid_events;
-  d["grazing_skipped"] = c.grazing_skipped;
-  d["reverse_failures"] = c.reverse_failures;
-  d["forward_collisions"] = c.forward_collisions;
-  d["reverse_collisions"] = c.reverse_collisions;
+  c.visit([&](const char* name, std::uint64_t q) { d[name] = q; });
   return d;
 }
+
+template <class T>
+struct is_vector : std::false_type {};
+template <class T>
+struct is_vector<std::vector<T>> : std::true_type {};
 
 py::dict run_dict(const en::RunResult& r) {
   py::dict d;
@@ -155,7 +150,8 @@ class PyEngine {
     d["dim"] = c.dim;
     d["box"] = vec_array(std::vector<double>(c.box.begin(), c.box.begin() + c.dim));
     std::vector<std::int64_t> bnd;
-    for (int k = 0; k < c.dim; ++k) bnd.push_back(c.boundary[k] == en::Boundary::periodic ? 1 : 0);
+    // the Boundary value per axis (0 wall, 1 periodic: the same as a periodic flag)
+    for (int k = 0; k < c.dim; ++k) bnd.push_back(static_cast<std::int64_t>(c.boundary[k]));
     d["periodic"] = vec_array(bnd);
     d["diameter"] = c.diameter;
     d["mode"] = std::string(to_string(c.mode));
@@ -166,43 +162,14 @@ class PyEngine {
     d["bits"] = c.bits;
     d["groups"] = c.groups;
     d["group_tol"] = c.group_tol;
-    d["n"] = s.n;
-    d["time"] = s.time;
-    d["start_time"] = s.start_time;
-    d["net_collisions"] = s.net_collisions;
-    d["x"] = vec_array(s.x);
-    d["v"] = vec_array(s.v);
-    d["t_local"] = vec_array(s.t_local);
-    d["cell"] = vec_array(s.cell);
-    d["centre"] = vec_array(s.centre);
-    d["stamp"] = vec_array(s.stamp);
-    d["ncoll"] = vec_array(s.ncoll);
-    d["rng"] = vec_array(s.rng);
-    d["ev_t"] = vec_array(s.ev_t);
-    d["ev_kind"] = vec_array(s.ev_kind);
-    d["ev_partner"] = vec_array(s.ev_partner);
-    d["ev_stamp"] = vec_array(s.ev_stamp);
-    d["second"] = vec_array(s.second);
-    d["touching"] = vec_array(s.touching);
-    d["log_cells"] = vec_array(s.log_cells);
-    d["log_pushed"] = s.log_pushed;
-    d["netc"] = vec_array(s.netc);
-    d["wall_keys"] = vec_array(s.wall_keys);
-    d["wall_sizes"] = vec_array(s.wall_sizes);
-    d["wall_masks"] = vec_array(s.wall_masks);
-    d["wall_ids"] = vec_array(s.wall_ids);
-    d["wall_netc"] = vec_array(s.wall_netc);
-    d["wall_times"] = vec_array(s.wall_times);
-    d["pre_keys"] = vec_array(s.pre_keys);
-    d["pre_sizes"] = vec_array(s.pre_sizes);
-    d["pre_vals"] = vec_array(s.pre_vals);
-    d["pre_pushed"] = s.pre_pushed;
-    const en::Counters& k = s.counters;
-    d["counters"] = vec_array(std::vector<std::uint64_t>{
-        k.events, k.pair_collisions, k.group_collisions, k.group_particles, k.group_fallbacks, k.wall_events,
-        k.cell_crossings, k.invalid_events, k.grazing_skipped, k.reverse_failures, k.forward_collisions,
-        k.reverse_collisions});
-    d["energy0"] = s.energy0;
+    s.visit([&](const char* key, const auto& field) {
+      using T = std::decay_t<decltype(field)>;
+      if constexpr (is_vector<T>::value) d[key] = vec_array(field);
+      else d[key] = field;
+    });
+    std::vector<std::uint64_t> counters;
+    s.counters.visit([&](const char*, std::uint64_t q) { counters.push_back(q); });
+    d["counters"] = vec_array(counters);
     d["momentum0"] = vec_array(std::vector<double>(s.momentum0.begin(), s.momentum0.end()));
     return d;
   }
@@ -223,10 +190,11 @@ class PyEngine {
             "checkpoint: box and periodic need one entry per axis");
     for (int k = 0; k < c.dim; ++k) {
       c.box[k] = box[k];
-      c.boundary[k] = per[k] ? en::Boundary::periodic : en::Boundary::wall;
+      require(per[k] == 0 || per[k] == 1, "checkpoint: periodic holds 0 (wall) or 1 (periodic) per axis");
+      c.boundary[k] = static_cast<en::Boundary>(per[k]);
     }
     c.diameter = py::cast<double>(get("diameter"));
-    c.mode = parse_mode(py::cast<std::string>(get("mode")));
+    c.mode = en::parse_engine_mode(py::cast<std::string>(get("mode")));
     c.law = parse_law(py::cast<std::string>(get("law")));
     c.seed = py::cast<std::uint32_t>(get("seed"));
     // absent in checkpoints written before the generator choice existed: Philox per particle
@@ -237,54 +205,19 @@ class PyEngine {
     c.bits = py::cast<int>(get("bits"));
     c.groups = py::cast<bool>(get("groups"));
     c.group_tol = py::cast<double>(get("group_tol"));
-    s.n = py::cast<std::size_t>(get("n"));
-    s.time = py::cast<double>(get("time"));
-    s.start_time = py::cast<double>(get("start_time"));
-    s.net_collisions = py::cast<std::int64_t>(get("net_collisions"));
-    s.x = array_vec<double>(d, "x");
-    s.v = array_vec<double>(d, "v");
-    s.t_local = array_vec<double>(d, "t_local");
-    s.cell = array_vec<std::int64_t>(d, "cell");
-    // absent in checkpoints written before the neighbour lists: centres from x, events predicted anew
-    if (d.contains("centre")) s.centre = array_vec<double>(d, "centre");
-    s.stamp = array_vec<std::uint64_t>(d, "stamp");
-    s.ncoll = array_vec<std::uint64_t>(d, "ncoll");
-    s.rng = array_vec<std::uint64_t>(d, "rng");
-    s.ev_t = array_vec<double>(d, "ev_t");
-    s.ev_kind = array_vec<std::int64_t>(d, "ev_kind");
-    s.ev_partner = array_vec<std::int64_t>(d, "ev_partner");
-    s.ev_stamp = array_vec<std::uint64_t>(d, "ev_stamp");
-    s.second = array_vec<double>(d, "second");
-    s.touching = array_vec<std::int64_t>(d, "touching");
-    s.log_cells = array_vec<std::uint64_t>(d, "log_cells");
-    s.log_pushed = py::cast<std::uint64_t>(get("log_pushed"));
-    s.netc = array_vec<std::int64_t>(d, "netc");
-    s.wall_keys = array_vec<std::uint64_t>(d, "wall_keys");
-    s.wall_sizes = array_vec<std::uint64_t>(d, "wall_sizes");
-    s.wall_masks = array_vec<std::uint64_t>(d, "wall_masks");
-    s.wall_ids = array_vec<std::uint64_t>(d, "wall_ids");
-    s.wall_netc = array_vec<std::int64_t>(d, "wall_netc");
-    s.wall_times = array_vec<double>(d, "wall_times");
-    s.pre_keys = array_vec<std::uint64_t>(d, "pre_keys");
-    s.pre_sizes = array_vec<std::uint64_t>(d, "pre_sizes");
-    s.pre_vals = array_vec<double>(d, "pre_vals");
-    s.pre_pushed = py::cast<std::uint64_t>(get("pre_pushed"));
+    s.visit([&](const char* key, auto& field) {
+      using T = std::decay_t<decltype(field)>;
+      // absent in checkpoints written before the neighbour lists: centres from x, events predicted anew
+      if (std::strcmp(key, "centre") == 0 && !d.contains(key)) return;
+      if constexpr (is_vector<T>::value) field = array_vec<typename T::value_type>(d, key);
+      else field = py::cast<T>(get(key));
+    });
     const auto k = array_vec<std::uint64_t>(d, "counters");
-    require(k.size() == 12, "checkpoint: counters must have 12 entries");
-    en::Counters& q = s.counters;
-    q.events = k[0];
-    q.pair_collisions = k[1];
-    q.group_collisions = k[2];
-    q.group_particles = k[3];
-    q.group_fallbacks = k[4];
-    q.wall_events = k[5];
-    q.cell_crossings = k[6];
-    q.invalid_events = k[7];
-    q.grazing_skipped = k[8];
-    q.reverse_failures = k[9];
-    q.forward_collisions = k[10];
-    q.reverse_collisions = k[11];
-    s.energy0 = py::cast<double>(get("energy0"));
+    std::size_t nk = 0;
+    s.counters.visit([&](const char*, std::uint64_t) { ++nk; });
+    require(k.size() == nk, "checkpoint: counters must have " + std::to_string(nk) + " entries");
+    std::size_t u = 0;
+    s.counters.visit([&](const char*, std::uint64_t& q) { q = k[u++]; });
     const auto p0 = array_vec<double>(d, "momentum0");
     require(p0.size() == 3, "checkpoint: momentum0 must have 3 entries");
     for (int k2 = 0; k2 < 3; ++k2) s.momentum0[k2] = p0[k2];
@@ -329,6 +262,18 @@ void register_engine(py::module_& m) {
       .def_property_readonly("start_time", [](const PyEngine& e) { return e.sim().start_time(); })
       .def_property_readonly("n", [](const PyEngine& e) { return e.sim().size(); })
       .def_property_readonly("dim", [](const PyEngine& e) { return e.sim().config().dim; })
+      .def_property_readonly("box",
+                             [](const PyEngine& e) {
+                               const auto& c = e.sim().config();
+                               return std::vector<double>(c.box.begin(), c.box.begin() + c.dim);
+                             })
+      .def_property_readonly("periodic",
+                             [](const PyEngine& e) {
+                               const auto& c = e.sim().config();
+                               std::vector<bool> p;
+                               for (int k = 0; k < c.dim; ++k) p.push_back(c.boundary[k] == en::Boundary::periodic);
+                               return p;
+                             })
       .def("diagnostics", &PyEngine::diagnostics)
       .def("snapshot", &PyEngine::snapshot);
 

@@ -5,25 +5,17 @@
 #include <pybind11/stl.h>
 
 #include <optional>
+#include <type_traits>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "revcol/collide/cases.hpp"
 #include "revcol/collide/collision.hpp"
-#include "revcol/rng/clcg4.hpp"
-#include "revcol/rng/philox.hpp"
 
 namespace py = pybind11;
 
 namespace revcol::bind {
 namespace {
-
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-std::string shape_of(const Array& a) {
-  std::string s = "(";
-  for (py::ssize_t k = 0; k < a.ndim(); ++k) s += (k ? ", " : "") + std::to_string(a.shape(k));
-  return s + (a.ndim() == 1 ? ",)" : ")");
-}
 
 std::vector<Contact> contacts_from(const std::vector<std::pair<int, int>>& pairs) {
   std::vector<Contact> out;
@@ -31,73 +23,40 @@ std::vector<Contact> contacts_from(const std::vector<std::pair<int, int>>& pairs
   return out;
 }
 
-// (n, d) or (B, n, d) -> B
-std::size_t batch_of(const ExactCollision& op, const Array& v, const char* what) {
-  const int n = op.particles(), d = op.dim();
-  const bool one = v.ndim() == 2 && v.shape(0) == n && v.shape(1) == d;
-  const bool many = v.ndim() == 3 && v.shape(1) == n && v.shape(2) == d;
-  require(one || many, [&] {
-    return std::string(what) + " must have shape (" + std::to_string(n) + ", " + std::to_string(d) +
-           ") or (B, " + std::to_string(n) + ", " + std::to_string(d) + "), got " + shape_of(v);
-  });
-  return one ? 1 : static_cast<std::size_t>(v.shape(0));
+// (n, d) or (B, n, d)
+Rows rows_for(const ExactCollision& op, const Array& v) {
+  return rows_of(v, {op.particles(), op.dim()}, "velocities");
 }
 
-struct HeldArrays {
-  std::vector<Held> held;
-  Array m;  // keeps the data alive
-};
-
-std::optional<HeldArrays> held_from(const ExactCollision& op, std::optional<Array> momentum,
-                                    std::optional<Array> energy, std::size_t B, bool batched) {
-  require(momentum.has_value() == energy.has_value(),
-          "give both momentum and energy (held invariants), or neither");
-  if (!momentum) return std::nullopt;
-  const int d = op.dim();
-  const Array& m = *momentum;
-  const Array& e = *energy;
-  const bool one = !batched && m.ndim() == 1 && m.shape(0) == d && e.ndim() == 0;
-  const bool many = batched && m.ndim() == 2 && static_cast<std::size_t>(m.shape(0)) == B &&
-                    m.shape(1) == d && e.ndim() == 1 && static_cast<std::size_t>(e.shape(0)) == B;
-  require(one || many, [&] {
-    return "momentum/energy must have shapes (d,)/() for one state or (B, d)/(B,) for a batch, got " +
-           shape_of(m) + "/" + shape_of(e);
-  });
-  HeldArrays h{{}, m};
-  for (std::size_t b = 0; b < B; ++b) h.held.push_back(Held{m.data() + b * d, e.data()[b]});
-  return h;
+// momentum= and energy= as ExactCollision's Held, or none.
+std::optional<std::vector<Held>> held_for(const ExactCollision& op, const std::optional<Array>& momentum,
+                                          const std::optional<Array>& energy, std::size_t B) {
+  const auto h = held_from(momentum, energy, B, op.dim());
+  if (!h) return std::nullopt;
+  std::vector<Held> out;
+  for (std::size_t b = 0; b < B; ++b) out.push_back(Held{h->momentum[b], h->energy[b]});
+  return out;
 }
 
-Array run(Collision& c, const Array& v, py::object rng, std::optional<Array> g,
-          std::optional<Array> momentum, std::optional<Array> energy, int dir) {
+Array run(Collision& c, const Array& v, const py::object& rng, const std::optional<Array>& g,
+          const std::optional<Array>& momentum, const std::optional<Array>& energy, batch::Dir dir) {
   const ExactCollision& op = c.op();
-  const std::size_t B = batch_of(op, v, "velocities");
-  const bool batched = v.ndim() == 3;
-  const auto held = held_from(op, std::move(momentum), std::move(energy), B, batched);
-  const Held* hp = held ? held->held.data() : nullptr;
-  Array out(std::vector<py::ssize_t>(v.shape(), v.shape() + v.ndim()));
+  const Rows rows = rows_for(op, v);
+  const auto held = held_for(op, momentum, energy, rows.count);
+  const Held* hp = held ? held->data() : nullptr;
+  Array out(shape(v));
   double* o = out.mutable_data();
-  require(rng.is_none() != !g.has_value(), "give exactly one of rng= (a generator) or g= (draws)");
-  const std::size_t k = op.draws();
-  if (g) {
-    const Array& ga = *g;
-    require(static_cast<std::size_t>(ga.size()) == B * k &&
-                (batched ? ga.ndim() == 2 : ga.ndim() <= 1),
-            [&] {
-              return "g must have shape (" + std::to_string(k) + ",) or (B, " + std::to_string(k) +
-                     "), got " + shape_of(ga);
-            });
-    if (dir > 0) c.forward(v.data(), B, ga.data(), o, hp);
-    else c.reverse(v.data(), B, ga.data(), o, hp);
-  } else if (py::isinstance<rng::CLCG4>(rng)) {
-    auto& gen = rng.cast<rng::CLCG4&>();
-    if (dir > 0) c.forward(v.data(), B, gen, o, hp); else c.reverse(v.data(), B, gen, o, hp);
-  } else if (py::isinstance<rng::Philox>(rng)) {
-    auto& gen = rng.cast<rng::Philox&>();
-    if (dir > 0) c.forward(v.data(), B, gen, o, hp); else c.reverse(v.data(), B, gen, o, hp);
-  } else {
-    throw InvalidArgument("rng must be a revcol.CLCG4 or revcol.Philox");
-  }
+  const bool fwd = dir == batch::Dir::forward;
+  with_draws(rng, g.has_value(), [&](auto gen) {
+    if constexpr (std::is_null_pointer_v<decltype(gen)>) {
+      const std::vector<double> gv = draws_from(*g, rows, op.draws());
+      if (fwd) c.forward(v.data(), rows.count, gv.data(), o, hp);
+      else c.reverse(v.data(), rows.count, gv.data(), o, hp);
+    } else {
+      if (fwd) c.forward(v.data(), rows.count, *gen, o, hp);
+      else c.reverse(v.data(), rows.count, *gen, o, hp);
+    }
+  });
   return out;
 }
 
@@ -156,23 +115,22 @@ void register_exact(py::module_& m) {
                   "The operator of a named case (see revcol.named_cases()).")
       .def("forward",
            [](Collision& c, const Array& v, py::object rng, std::optional<Array> g,
-              std::optional<Array> mo, std::optional<Array> en) { return run(c, v, std::move(rng), std::move(g), std::move(mo), std::move(en), +1); },
+              std::optional<Array> mo, std::optional<Array> en) { return run(c, v, rng, g, mo, en, batch::Dir::forward); },
            py::arg("velocities"), py::kw_only(), py::arg("rng") = py::none(), py::arg("g") = py::none(),
            py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
            "Pre -> post. velocities (n, d) or (B, n, d); exactly one of rng or g ((d_n,) or (B, d_n)).")
       .def("reverse",
            [](Collision& c, const Array& v, py::object rng, std::optional<Array> g,
-              std::optional<Array> mo, std::optional<Array> en) { return run(c, v, std::move(rng), std::move(g), std::move(mo), std::move(en), -1); },
+              std::optional<Array> mo, std::optional<Array> en) { return run(c, v, rng, g, mo, en, batch::Dir::reverse); },
            py::arg("velocities"), py::kw_only(), py::arg("rng") = py::none(), py::arg("g") = py::none(),
            py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
            "Post -> pre with the draws forward used (rng steps back).")
       .def("chart",
            [](const Collision& c, const Array& v) {
              const ExactCollision& op = c.op();
-             const std::size_t B = batch_of(op, v, "velocities");
-             const std::size_t nd = op.particles() * op.dim(), k = op.draws();
-             Array out = v.ndim() == 3 ? Array({static_cast<py::ssize_t>(B), static_cast<py::ssize_t>(k)})
-                                       : Array({static_cast<py::ssize_t>(k)});
+             const Rows rows = rows_for(op, v);
+             const std::size_t B = rows.count, nd = op.particles() * op.dim(), k = op.draws();
+             Array out(rows.batched ? batched({op.draws()}, B) : Shape{op.draws()});
              for (std::size_t b = 0; b < B; ++b) {
                const std::vector<double> cb = op.chart(v.data() + b * nd);
                std::copy(cb.begin(), cb.end(), out.mutable_data() + b * k);
@@ -183,12 +141,11 @@ void register_exact(py::module_& m) {
       .def("quantize",
            [](const Collision& c, const Array& v, std::optional<Array> mo, std::optional<Array> en) {
              const ExactCollision& op = c.op();
-             const std::size_t B = batch_of(op, v, "velocities");
-             const std::size_t nd = op.particles() * op.dim();
-             const auto held = held_from(op, std::move(mo), std::move(en), B, v.ndim() == 3);
-             Array out(std::vector<py::ssize_t>(v.shape(), v.shape() + v.ndim()));
+             const std::size_t B = rows_for(op, v).count, nd = op.particles() * op.dim();
+             const auto held = held_for(op, mo, en, B);
+             Array out(shape(v));
              for (std::size_t b = 0; b < B; ++b)
-               op.quantize(v.data() + b * nd, out.mutable_data() + b * nd, held ? &held->held[b] : nullptr);
+               op.quantize(v.data() + b * nd, out.mutable_data() + b * nd, held ? &(*held)[b] : nullptr);
              return out;
            },
            py::arg("velocities"), py::kw_only(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
@@ -196,7 +153,7 @@ void register_exact(py::module_& m) {
       .def("normal_speeds",
            [](const Collision& c, const Array& v) {
              const ExactCollision& op = c.op();
-             require(batch_of(op, v, "velocities") == 1 && v.ndim() == 2, "one state of shape (n, d)");
+             require(!rows_for(op, v).batched, "one state of shape (n, d)");
              return op.normal_speeds(v.data());
            },
            py::arg("velocities"), "r_k . (v_i - v_j) for each contact (< 0 approaching).")

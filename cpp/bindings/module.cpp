@@ -13,7 +13,9 @@ PYBIND11_MODULE(_core, m) {
   revcol::bind::register_verify(m);
   revcol::bind::register_exact(m);
   revcol::bind::register_paper(m);
+  revcol::bind::register_paper_study(m);
   revcol::bind::register_statesave(m);
   revcol::bind::register_engine(m);
   revcol::bind::register_engine_init(m);
+  revcol::bind::register_lattice(m);
 }

@@ -1,6 +1,6 @@
 // Binding of the paper-mode operators of §4.3-4.5 (Pair3DPaper, Triple1DPaper,
-// Triple2DPaper) and of the paper-mode measurements: numpy arrays in and out, nothing else.
-// A single collision is a batch of one; the shape of the input is kept in the output.
+// Triple2DPaper): numpy arrays in and out, nothing else. A single collision is a batch of
+// one; the shape of the input is kept in the output. The measurements are paper_study.cpp.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -8,68 +8,21 @@
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
-#include "revcol/collide/calotte.hpp"
-#include "revcol/collide/ellipse_arc.hpp"
+#include "revcol/collide/batch.hpp"
 #include "revcol/collide/pair3d_paper.hpp"
-#include "revcol/collide/paper_batch.hpp"
 #include "revcol/collide/paper_study.hpp"
 #include "revcol/collide/triple1d_paper.hpp"
 #include "revcol/collide/triple2d_paper.hpp"
-#include "revcol/rng/clcg4.hpp"
-#include "revcol/rng/philox.hpp"
 
 namespace py = pybind11;
 
 namespace revcol::bind {
 namespace {
-
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using Shape = std::vector<py::ssize_t>;
-
-std::string shape_str(const Shape& s) {
-  std::string out = "(";
-  for (std::size_t k = 0; k < s.size(); ++k) out += (k ? ", " : "") + std::to_string(s[k]);
-  return out + (s.size() == 1 ? ",)" : ")");
-}
-std::string shape_of(const Array& a) { return shape_str(Shape(a.shape(), a.shape() + a.ndim())); }
-
-// Whether `a` has shape `inner` (one entry) or (B, *inner) (B entries).
-struct Rows {
-  std::size_t count;
-  bool batched;
-};
-std::optional<Rows> match(const Array& a, const Shape& inner) {
-  const auto n = static_cast<py::ssize_t>(inner.size());
-  auto tail = [&](py::ssize_t off) {
-    for (py::ssize_t k = 0; k < n; ++k)
-      if (a.shape(off + k) != inner[k]) return false;
-    return true;
-  };
-  if (a.ndim() == n && tail(0)) return Rows{1, false};
-  if (a.ndim() == n + 1 && tail(1)) return Rows{static_cast<std::size_t>(a.shape(0)), true};
-  return std::nullopt;
-}
-std::size_t entry_size(const Shape& inner) {
-  std::size_t s = 1;
-  for (py::ssize_t k : inner) s *= static_cast<std::size_t>(k);
-  return s;
-}
-// `a` for B entries: shape inner (broadcast) or (B, *inner); returns each entry's data pointer.
-std::vector<const double*> per_entry(const Array& a, const Shape& inner, std::size_t B, const char* name) {
-  const auto m = match(a, inner);
-  require(m && (!m->batched || m->count == B), [&] {
-    Shape many{static_cast<py::ssize_t>(B)};
-    many.insert(many.end(), inner.begin(), inner.end());
-    return std::string(name) + " must have shape " + shape_str(inner) + " or " + shape_str(many) +
-           ", got " + shape_of(a);
-  });
-  std::vector<const double*> out(B);
-  for (std::size_t b = 0; b < B; ++b) out[b] = a.data() + (m->batched ? b * entry_size(inner) : 0);
-  return out;
-}
 
 // Per-operator type conversions.
 template <class Op> struct Conv;
@@ -116,13 +69,7 @@ struct Holder {
 
 template <class Op>
 std::vector<typename Op::State> states_from(const Array& v, Rows& rows) {
-  const auto m = match(v, Conv<Op>::vshape());
-  require(m.has_value(), [&] {
-    std::string many = "(B";
-    for (py::ssize_t k : Conv<Op>::vshape()) many += ", " + std::to_string(k);
-    return "velocities must have shape " + shape_str(Conv<Op>::vshape()) + " or " + many + "), got " + shape_of(v);
-  });
-  rows = *m;
+  rows = rows_of(v, Conv<Op>::vshape(), "velocities");
   std::vector<typename Op::State> out(rows.count);
   const std::size_t es = entry_size(Conv<Op>::vshape());
   for (std::size_t b = 0; b < rows.count; ++b) out[b] = Conv<Op>::state(v.data() + b * es);
@@ -131,9 +78,7 @@ std::vector<typename Op::State> states_from(const Array& v, Rows& rows) {
 
 template <class Op>
 Array states_to(const std::vector<typename Op::State>& s, const Rows& rows) {
-  Shape shape = Conv<Op>::vshape();
-  if (rows.batched) shape.insert(shape.begin(), static_cast<py::ssize_t>(s.size()));
-  Array out(shape);
+  Array out(rows.batched ? batched(Conv<Op>::vshape(), s.size()) : Conv<Op>::vshape());
   const std::size_t es = entry_size(Conv<Op>::vshape());
   for (std::size_t b = 0; b < s.size(); ++b) Conv<Op>::put(s[b], out.mutable_data() + b * es);
   return out;
@@ -147,69 +92,28 @@ std::vector<typename Op::Geometry> geometries_from(const Array& x, std::size_t B
   return out;
 }
 
+// forward or reverse with exactly one source of random numbers.
 template <class Op>
-std::vector<typename Op::Draws> draws_from(const Array& g, const Rows& rows) {
-  constexpr int d = Op::draws;
-  const std::size_t B = rows.count;
-  // (d,) for one entry, (B, d) for a batch; with one draw also () and (B,)
-  const bool one = !rows.batched && ((g.ndim() == 1 && g.shape(0) == d) || (d == 1 && g.ndim() == 0));
-  const bool many = rows.batched && ((g.ndim() == 2 && static_cast<std::size_t>(g.shape(0)) == B && g.shape(1) == d) ||
-                                     (d == 1 && g.ndim() == 1 && static_cast<std::size_t>(g.shape(0)) == B));
-  require(one || many, [&] {
-    return std::string("g must have shape ") + (rows.batched ? "(" + std::to_string(B) + ", " + std::to_string(d) + ")"
-                                                            : "(" + std::to_string(d) + ",)") +
-           (d == 1 ? (rows.batched ? " or (" + std::to_string(B) + ",)" : " or ()") : "") + ", got " + shape_of(g);
-  });
-  std::vector<typename Op::Draws> out(B);
-  for (std::size_t b = 0; b < B; ++b)
-    for (int k = 0; k < d; ++k) out[b][k] = g.data()[b * d + k];
-  return out;
-}
-
-template <class Op>
-std::optional<std::vector<typename Op::Inv>> invariants_from(const std::optional<Array>& momentum,
-                                                             const std::optional<Array>& energy,
-                                                             std::size_t B) {
-  require(momentum.has_value() == energy.has_value(),
-          "give both momentum and energy (held invariants), or neither");
-  if (!momentum) return std::nullopt;
-  constexpr int d = Op::dim;
-  const auto m = per_entry(*momentum, {d}, B, "momentum");
-  const auto e = per_entry(*energy, {}, B, "energy");
-  std::vector<typename Op::Inv> out(B);
-  for (std::size_t b = 0; b < B; ++b) {
-    for (int k = 0; k < d; ++k) out[b].momentum[k] = m[b][k];
-    out[b].energy = *e[b];
-  }
-  return out;
-}
-
-// forward (dir = +1) or reverse (dir = -1) with exactly one source of random numbers.
-template <class Op>
-Array run(Holder<Op>& h, const Array& velocities, const Array& geometry, py::object rng,
-          std::optional<Array> g, std::optional<Array> momentum, std::optional<Array> energy, int dir) {
+Array run(Holder<Op>& h, const Array& velocities, const Array& geometry, const py::object& rng,
+          const std::optional<Array>& g, const std::optional<Array>& momentum,
+          const std::optional<Array>& energy, batch::Dir dir) {
   Rows rows{};
   std::vector<typename Op::State> v = states_from<Op>(velocities, rows);
   const auto x = geometries_from<Op>(geometry, v.size());
-  const auto inv = invariants_from<Op>(momentum, energy, v.size());
+  const auto inv = invariants_from<Op::dim>(momentum, energy, v.size());
   const typename Op::Inv* ip = inv ? inv->data() : nullptr;
-  require(rng.is_none() != !g.has_value(), "give exactly one of rng= (a generator) or g= (draws)");
   const std::size_t B = v.size();
-  if (g) {
-    const auto gv = draws_from<Op>(*g, rows);
-    if (dir > 0) paper::forward_batch(h.op, v.data(), x.data(), B, gv.data(), h.log, ip);
-    else paper::reverse_batch(h.op, v.data(), x.data(), B, gv.data(), h.log, ip);
-  } else if (py::isinstance<rng::CLCG4>(rng)) {
-    auto& gen = rng.cast<rng::CLCG4&>();
-    if (dir > 0) paper::forward_batch(h.op, v.data(), x.data(), B, gen, h.log, ip);
-    else paper::reverse_batch(h.op, v.data(), x.data(), B, gen, h.log, ip);
-  } else if (py::isinstance<rng::Philox>(rng)) {
-    auto& gen = rng.cast<rng::Philox&>();
-    if (dir > 0) paper::forward_batch(h.op, v.data(), x.data(), B, gen, h.log, ip);
-    else paper::reverse_batch(h.op, v.data(), x.data(), B, gen, h.log, ip);
-  } else {
-    throw InvalidArgument("rng must be a revcol.CLCG4 or revcol.Philox");
-  }
+  const bool fwd = dir == batch::Dir::forward;
+  with_draws(rng, g.has_value(), [&](auto gen) {
+    if constexpr (std::is_null_pointer_v<decltype(gen)>) {
+      const std::vector<double> gv = draws_from(*g, rows, Op::draws);
+      if (fwd) forward_batch(h.op, v.data(), x.data(), B, gv.data(), h.log, ip);
+      else reverse_batch(h.op, v.data(), x.data(), B, gv.data(), h.log, ip);
+    } else {
+      if (fwd) forward_batch(h.op, v.data(), x.data(), B, *gen, h.log, ip);
+      else reverse_batch(h.op, v.data(), x.data(), B, *gen, h.log, ip);
+    }
+  });
   return states_to<Op>(v, rows);
 }
 
@@ -219,7 +123,7 @@ void common_methods(Cls& cls, const char* geometry_name) {
   cls.def("forward",
           [](Holder<Op>& h, const Array& v, const Array& x, py::object rng, std::optional<Array> g,
              std::optional<Array> momentum, std::optional<Array> energy) {
-            return run<Op>(h, v, x, std::move(rng), std::move(g), std::move(momentum), std::move(energy), +1);
+            return run<Op>(h, v, x, rng, g, momentum, energy, batch::Dir::forward);
           },
           py::arg("velocities"), py::arg(geometry_name), py::kw_only(), py::arg("rng") = py::none(),
           py::arg("g") = py::none(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
@@ -229,7 +133,7 @@ void common_methods(Cls& cls, const char* geometry_name) {
       .def("reverse",
            [](Holder<Op>& h, const Array& v, const Array& x, py::object rng, std::optional<Array> g,
               std::optional<Array> momentum, std::optional<Array> energy) {
-             return run<Op>(h, v, x, std::move(rng), std::move(g), std::move(momentum), std::move(energy), -1);
+             return run<Op>(h, v, x, rng, g, momentum, energy, batch::Dir::reverse);
            },
            py::arg("velocities"), py::arg(geometry_name), py::kw_only(), py::arg("rng") = py::none(),
            py::arg("g") = py::none(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
@@ -249,35 +153,13 @@ template <class F>
 Array map_entries(const Array& a, const Shape& inner, const char* name, int out_per_entry, F f) {
   const auto m = match(a, inner);
   require(m.has_value(), [&] { return std::string(name) + " has the wrong shape " + shape_of(a); });
-  Shape shape;
-  if (m->batched) shape.push_back(static_cast<py::ssize_t>(m->count));
-  if (out_per_entry > 1) shape.push_back(out_per_entry);
-  Array out(shape);
+  Shape out_shape;
+  if (m->batched) out_shape.push_back(static_cast<py::ssize_t>(m->count));
+  if (out_per_entry > 1) out_shape.push_back(out_per_entry);
+  Array out(out_shape);
   const std::size_t es = entry_size(inner);
   for (std::size_t b = 0; b < m->count; ++b) f(a.data() + b * es, out.mutable_data() + b * out_per_entry);
   return out;
-}
-
-py::dict study_dict(const paper::StudyResult& r) {
-  py::dict d;
-  d["case"] = r.config.case_name;
-  d["pre"] = r.config.pre;
-  d["seed"] = r.config.seed;
-  d["printed_reverse"] = r.config.printed_reverse;
-  d["cos_tol"] = r.config.cos_tol;
-  d["arc"] = paper::to_string(r.config.arc);
-  d["angle"] = paper::to_string(r.config.angle);
-  d["collisions"] = r.collisions;
-  d["ok"] = r.ok;
-  d["invalid_post"] = r.invalid_post;
-  d["reverse_threw"] = r.reverse_threw;
-  d["wrong"] = r.wrong;
-  d["restarts"] = r.restarts;
-  d["logged"] = r.logged;
-  d["failure_rate"] = r.failure_rate;
-  d["max_ok_error"] = r.max_ok_error;
-  d["first_failure"] = r.first_failure;
-  return d;
 }
 
 const char* kPair3DDoc = R"(Paper mode: 2 particles in 3 dimensions (Perumalla & Protopopescu 2013, §4.3), as printed.
@@ -462,60 +344,6 @@ void register_paper(py::module_& m) {
            py::arg("g"), "G-to-Psi (Procedure 5): (psi1, psi2, psi3) per entry of g (3,) or (B, 3).")
       .def("__repr__", [](const Holder<Triple2DPaper>&) { return std::string("revcol.Triple2DPaper()"); });
 
-  // --- measurements and tables
-  m.def(
-      "paper_study",
-      [](const std::string& case_name, std::uint64_t collisions, std::uint64_t seed, const std::string& pre,
-         bool printed_reverse, double cos_tol, const std::string& arc, const std::string& angle) {
-        paper::StudyConfig c;
-        c.case_name = case_name;
-        c.collisions = collisions;
-        c.seed = seed;
-        c.pre = pre;
-        c.printed_reverse = printed_reverse;
-        c.cos_tol = cos_tol;
-        c.arc = paper::parse_arc_method(arc);
-        c.angle = paper::parse_arc_angle(angle);
-        paper::StudyResult r;
-        {
-          py::gil_scoped_release release;
-          r = paper::study(c);
-        }
-        return study_dict(r);
-      },
-      py::kw_only(), py::arg("case"), py::arg("collisions") = 1000000, py::arg("seed") = 0,
-      py::arg("pre") = "chain", py::arg("printed_reverse") = false, py::arg("cos_tol") = 1e-8,
-      py::arg("arc") = "simpson", py::arg("angle") = "parametric",
-      "Reversal failure rate of a paper-mode case (see revcol.paper.failure_rate).");
-  m.def("paper_cases", [] {
-    py::list out;
-    for (const paper::PaperCase& c : paper::paper_cases()) {
-      py::dict d;
-      d["name"] = c.name;
-      d["n"] = c.n;
-      d["d"] = c.d;
-      d["geometry"] = c.geometry;
-      d["velocities"] = c.velocities;
-      d["description"] = c.description;
-      out.append(d);
-    }
-    return out;
-  }, "The paper-mode cases: name, n, d, geometry, default velocities, description.");
-  m.def("arc_reference",
-        [](double g, double aspect) {
-          require(g >= 0.0 && g <= 1.0, "random number must be in [0,1]");
-          return static_cast<double>(paper::EllipseArc::reference_parametric(g, aspect));
-        },
-        py::arg("g"), py::arg("aspect") = paper::kPaperAspect,
-        "High-precision parametric angle at arc length g L(2 pi) (long double; slow).");
-  m.def("calotte_fraction",
-        [](int s, double psi, bool direct) {
-          if (direct) return paper::CalotteTable::fraction_direct(s, psi);
-          require(s == 3 || s == 4, "calotte tables exist for s = 3 and s = 4");
-          return (s == 4 ? paper::CalotteTable::h4() : paper::CalotteTable::h3()).fraction(psi);
-        },
-        py::arg("s"), py::arg("psi"), py::arg("direct") = false,
-        "Calotte-area fraction F(psi) of the paper's H_4 (s = 4) or H_3 (s = 3) shape.");
 }
 
 }  // namespace revcol::bind

@@ -1,9 +1,7 @@
 #include "revcol/verify.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <sstream>
 
 #include "revcol/collide/pair1d.hpp"
@@ -14,20 +12,11 @@
 namespace revcol {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 template <int Dim>
 std::vector<double> flat(const PairV<Dim>& v) {
   std::vector<double> out(v.i.begin(), v.i.end());
   out.insert(out.end(), v.j.begin(), v.j.end());
   return out;
-}
-template <int Dim>
-void negate(PairV<Dim>& v) {
-  for (int k = 0; k < Dim; ++k) { v.i[k] = -v.i[k]; v.j[k] = -v.j[k]; }
 }
 
 double max_rel_error(const std::vector<double>& a, const std::vector<double>& b) {
@@ -39,12 +28,41 @@ double max_rel_error(const std::vector<double>& a, const std::vector<double>& b)
   return scale > 0.0 ? err / scale : err;
 }
 
+// Velocities of a pair, negated and flattened (v_i then v_j): the chain's state in 1D and 2D.
+template <int Dim>
+struct PairChain {
+  using State = PairV<Dim>;
+  void negate(State& v) const {
+    for (int k = 0; k < Dim; ++k) { v.i[k] = -v.i[k]; v.j[k] = -v.j[k]; }
+  }
+  std::vector<double> flat(const State& v) const { return revcol::flat(v); }
+};
+
 // The 2-particle 2D illustration (the paper's Procedure for "Reversal Illustration for
-// 2-Particle Collisions in 2 Dimensions") for any 2D pair operator and generator.
-template <class Op, class Gen>
-void run_pair2d(const Op& op, Gen& gen, const VerifyConfig& c, VerifyResult& r,
-                const std::function<PairV<2>(const PairV<2>&, const std::array<double, 2>&,
-                                             const Invariants<2>&)>& reference) {
+// 2-Particle Collisions in 2 Dimensions") for either 2D pair operator, momentum and energy held.
+template <class Op>
+struct Pair2DChain : PairChain<2> {
+  static constexpr bool stops_early = false;
+  const Op& op;
+  std::array<double, 2> n;
+  Invariants<2> inv;
+  std::size_t draws() const { return 1; }
+  void forward(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.forward(v, n, g[0], log, &inv); }
+  void reverse(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.reverse(v, n, g[0], log, &inv); }
+};
+
+// The 1D pair: no free parameter and no random number, the exchange is exact in floating point.
+struct Pair1DChain : PairChain<1> {
+  static constexpr bool stops_early = false;
+  Pair1D op;
+  double n;
+  std::size_t draws() const { return 0; }
+  void forward(State& v, const double*, RareLog&, std::uint64_t) const { v = op.forward(v, n); }
+  void reverse(State& v, const double*, RareLog&, std::uint64_t) const { v = op.reverse(v, n); }
+};
+
+template <class Op, class Gen, class Reference>
+void run_pair2d(const Op& op, Gen& gen, const VerifyConfig& c, VerifyResult& r, Reference reference) {
   PairV<2> v{{0.25, -0.5}, {1.0, 0.75}};  // default start: approaches along (1, 1)
   if (!c.velocities.empty()) {
     require(c.velocities.size() == 4, "pair2d needs 4 initial velocity components");
@@ -59,45 +77,13 @@ void run_pair2d(const Op& op, Gen& gen, const VerifyConfig& c, VerifyResult& r,
   const Invariants<2> inv{{v.i[0] + v.j[0], v.i[1] + v.j[1]},
                           v.i[0] * v.i[0] + v.i[1] * v.i[1] + v.j[0] * v.j[0] + v.j[1] * v.j[1]};
   op.check_pre(v, n, &inv);  // a bad start throws here, before anything runs
-  const auto start_state = gen;
   r.initial = flat(v);
   r.reference = flat(reference(v, n, inv));
-  RareLog log;
-
-  auto t0 = Clock::now();
-  for (std::uint64_t k = 0; k < c.collisions; ++k) {
-    v = op.forward(v, n, gen.next(), log, &inv);
-    negate(v);  // reverse the velocities to create the next collision
-  }
-  r.forward_s = seconds_since(t0);
-  r.log_bytes = log.bytes();
-  r.log_entries = log.size();
-  r.random_numbers_drawn = c.collisions;
-
-  t0 = Clock::now();
-  std::uint64_t undone = 0;
-  try {
-    for (; undone < c.collisions; ++undone) {
-      negate(v);
-      const double g = gen.prev();
-      v = op.reverse(v, n, g, log, &inv);
-    }
-  } catch (const InvalidArgument& e) {
-    // a wrong reversal (the printed Procedure 2) hands the next step an invalid state
-    r.error = "reverse step " + std::to_string(undone + 1) + " of " +
-              std::to_string(c.collisions) + ": " + e.what();
-    ++undone;  // its number was stepped back
-  }
-  r.reverse_s = seconds_since(t0);
-  r.random_numbers_undone = undone;
-  r.final_velocities = flat(v);
-  r.rng_restored = gen == start_state;
-  r.passed = log.size() == 0;
+  detail::reversal_chain(Pair2DChain<Op>{{}, op, n, inv}, v, gen, c, r);
 }
 
 template <class Gen>
-void run_case(const VerifyConfig& c, VerifyResult& r) {
-  Gen gen = rng::make_generator<Gen>(0, c.seed, 1);
+bool run_pair_case(const VerifyConfig& c, Gen& gen, VerifyResult& r) {
   if (c.case_name == "pair2d") {
     if (c.mode == Mode::exact) {
       const Pair2DExact op(c.law, c.bits);
@@ -108,36 +94,37 @@ void run_case(const VerifyConfig& c, VerifyResult& r) {
       run_pair2d(op, gen, c, r, [](const PairV<2>& v, const std::array<double, 2>&,
                                    const Invariants<2>&) { return v; });
     }
-  } else if (c.case_name == "pair1d") {
-    // no free parameter and no random number: the exchange is exact in floating point
-    const Pair1D op;
-    PairV<1> v{{0.25}, {1.5}};
-    if (!c.velocities.empty()) {
-      require(c.velocities.size() == 2, "pair1d needs 2 initial velocity components");
-      v = {{c.velocities[0]}, {c.velocities[1]}};
-    }
-    const double n = c.normal.empty() ? 1.0 : c.normal.at(0);
-    r.initial = r.reference = flat(v);
-    (void)op.forward(v, n);  // validates the start
-    auto t0 = Clock::now();
-    for (std::uint64_t k = 0; k < c.collisions; ++k) { v = op.forward(v, n); negate(v); }
-    r.forward_s = seconds_since(t0);
-    t0 = Clock::now();
-    for (std::uint64_t k = 0; k < c.collisions; ++k) { negate(v); v = op.reverse(v, n); }
-    r.reverse_s = seconds_since(t0);
-    r.final_velocities = flat(v);
-    r.rng_restored = true;
-    r.passed = true;
-  } else {
-    if (detail::run_exact_case(c, r) || detail::run_paper_case(c, r)) return;
-    std::string known;
-    for (const std::string& name : verify_cases(c.mode)) known += (known.empty() ? "" : ", ") + name;
-    throw InvalidArgument("unknown verify case '" + c.case_name + "' for mode " +
-                          to_string(c.mode) + " (known: " + known + ")");
+    return true;
   }
+  if (c.case_name != "pair1d") return false;
+  PairV<1> v{{0.25}, {1.5}};
+  if (!c.velocities.empty()) {
+    require(c.velocities.size() == 2, "pair1d needs 2 initial velocity components");
+    v = {{c.velocities[0]}, {c.velocities[1]}};
+  }
+  const Pair1DChain chain{{}, Pair1D{}, c.normal.empty() ? 1.0 : c.normal.at(0)};
+  r.initial = r.reference = flat(v);
+  (void)chain.op.forward(v, chain.n);  // validates the start
+  detail::reversal_chain(chain, v, gen, c, r);
+  return true;
 }
 
 }  // namespace
+
+detail::Generator detail::make_generator(const VerifyConfig& c) {
+  if (c.rng == "clcg4") return rng::make_generator<rng::CLCG4>(0, c.seed, 1);
+  if (c.rng == "philox") return rng::make_generator<rng::Philox>(0, c.seed, 1);
+  throw InvalidArgument("rng must be 'clcg4' or 'philox', got '" + c.rng + "'");
+}
+
+bool detail::run_exact_case(const VerifyConfig& c, VerifyResult& r) {
+  Generator gen = make_generator(c);
+  return run_exact_case(c, gen, r);
+}
+bool detail::run_paper_case(const VerifyConfig& c, VerifyResult& r) {
+  Generator gen = make_generator(c);
+  return run_paper_case(c, gen, r);
+}
 
 VerifyResult verify(const VerifyConfig& c) {
   require(c.collisions >= 1, "collisions must be >= 1");
@@ -145,10 +132,16 @@ VerifyResult verify(const VerifyConfig& c) {
   (void)check_bits;
   VerifyResult r;
   r.config = c;
-  r.collisions = c.collisions;  // a case runner lowers it when its chain stops early
-  if (c.rng == "clcg4") run_case<rng::CLCG4>(c, r);
-  else if (c.rng == "philox") run_case<rng::Philox>(c, r);
-  else throw InvalidArgument("rng must be 'clcg4' or 'philox', got '" + c.rng + "'");
+  r.collisions = c.collisions;
+  detail::Generator gen = detail::make_generator(c);
+  const bool known = std::visit([&](auto& g) { return run_pair_case(c, g, r); }, gen) ||
+                     detail::run_exact_case(c, gen, r) || detail::run_paper_case(c, gen, r);
+  if (!known) {
+    std::string names;
+    for (const std::string& name : verify_cases(c.mode)) names += (names.empty() ? "" : ", ") + name;
+    throw InvalidArgument("unknown verify case '" + c.case_name + "' for mode " +
+                          to_string(c.mode) + " (known: " + names + ")");
+  }
   r.max_rel_error = max_rel_error(r.final_velocities, r.initial);
   r.bit_exact = r.final_velocities == r.reference;
   r.forward_per_s = r.forward_s > 0 ? static_cast<double>(r.collisions) / r.forward_s : 0.0;

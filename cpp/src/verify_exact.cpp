@@ -4,21 +4,43 @@
 // paper's literal fixed momentum hands the reverse step -cm + h where forward produced
 // cm + h: for two particles the exchange symmetry makes those the same bits, for three or
 // more it does not.
-#include <chrono>
+#include <algorithm>
+#include <variant>
 
 #include "revcol/collide/cases.hpp"
-#include "revcol/rng/streams.hpp"
 #include "revcol/verify.hpp"
 
 namespace revcol::detail {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+// ExactCollision in the chain: flat velocities, the held momentum's sign following the
+// negation (collision t holds +M when t is even, -M when odd).
+struct ExactChain {
+  using State = std::vector<double>;
+  static constexpr bool stops_early = false;
+  const ExactCollision& op;
+  Held hp, hn;
+  mutable std::vector<double> tmp;  // the operator writes out of place
+  std::size_t draws() const { return static_cast<std::size_t>(op.draws()); }
+  const Held* held(std::uint64_t t) const { return t % 2 ? &hn : &hp; }
+  void forward(State& v, const double* g, RareLog& log, std::uint64_t t) const {
+    op.forward(v.data(), g, tmp.data(), log, held(t));
+    v.swap(tmp);
+  }
+  void reverse(State& v, const double* g, RareLog& log, std::uint64_t t) const {
+    op.reverse(v.data(), g, tmp.data(), log, held(t));
+    v.swap(tmp);
+  }
+  void negate(State& v) const {
+    for (double& x : v) x = -x;
+  }
+  std::vector<double> flat(const State& v) const { return v; }
+};
 
 template <class Gen>
-void run(const VerifyConfig& c, const NamedCase& nc, VerifyResult& r) {
+void run(const VerifyConfig& c, const NamedCase& nc, Gen& gen, VerifyResult& r) {
   const ExactCollision op = exact_operator(nc, c.law, c.bits);
-  const int nd = nc.n * nc.d, k = op.draws();
+  const int nd = nc.n * nc.d;
   std::vector<double> v;
   if (!c.velocities.empty()) {
     require(static_cast<int>(c.velocities.size()) == nd, [&] {
@@ -40,57 +62,23 @@ void run(const VerifyConfig& c, const NamedCase& nc, VerifyResult& r) {
       e += v[i * nc.d + a] * v[i * nc.d + a];
     }
   for (int a = 0; a < nc.d; ++a) mn[a] = -mp[a];
-  const Held hp{mp.data(), e}, hn{mn.data(), e};
-  op.check_pre(v.data(), &hp);  // a bad start throws here, before anything runs
-
-  Gen gen = rng::make_generator<Gen>(0, c.seed, 1);
-  const Gen start = gen;
+  const ExactChain chain{op, Held{mp.data(), e}, Held{mn.data(), e}, std::vector<double>(nd)};
+  op.check_pre(v.data(), &chain.hp);  // a bad start throws here, before anything runs
   r.initial = v;
   r.reference.assign(nd, 0.0);
-  op.quantize(v.data(), r.reference.data(), &hp);
-  RareLog log;
-  std::vector<double> g(std::max(k, 1)), tmp(nd);
-
-  auto t0 = Clock::now();
-  for (std::uint64_t t = 0; t < c.collisions; ++t) {
-    for (int j = 0; j < k; ++j) g[j] = gen.next();
-    op.forward(v.data(), g.data(), tmp.data(), log, t % 2 ? &hn : &hp);
-    for (int i = 0; i < nd; ++i) v[i] = -tmp[i];  // reverse the velocities: the next collision
-  }
-  r.forward_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  r.log_bytes = log.bytes();
-  r.log_entries = log.size();
-  r.random_numbers_drawn = c.collisions * k;
-
-  t0 = Clock::now();
-  std::uint64_t undone = 0;
-  try {
-    for (std::uint64_t t = c.collisions; t-- > 0;) {
-      for (int i = 0; i < nd; ++i) v[i] = -v[i];
-      for (int j = k - 1; j >= 0; --j) { g[j] = gen.prev(); ++undone; }
-      op.reverse(v.data(), g.data(), tmp.data(), log, t % 2 ? &hn : &hp);
-      v = tmp;
-    }
-  } catch (const InvalidArgument& e) {
-    r.error = std::string("reverse step failed: ") + e.what();
-  }
-  r.reverse_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  r.random_numbers_undone = undone;
-  r.final_velocities = v;
-  r.rng_restored = gen == start;
-  r.passed = log.size() == 0;
+  op.quantize(v.data(), r.reference.data(), &chain.hp);
+  reversal_chain(chain, v, gen, c, r);
 }
 
 }  // namespace
 
-bool run_exact_case(const VerifyConfig& c, VerifyResult& r) {
+bool run_exact_case(const VerifyConfig& c, Generator& gen, VerifyResult& r) {
   if (c.mode != Mode::exact) return false;
   bool known = false;
   for (const NamedCase& nc : named_cases()) known = known || nc.name == c.case_name;
   if (!known) return false;
   const NamedCase nc = named_case(c.case_name);
-  if (c.rng == "philox") run<rng::Philox>(c, nc, r);
-  else run<rng::CLCG4>(c, nc, r);
+  std::visit([&](auto& g) { run(c, nc, g, r); }, gen);
   return true;
 }
 

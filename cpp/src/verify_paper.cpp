@@ -20,19 +20,35 @@
 // back (its pre state kept, its draws stepped back), the steps before it are reversed, and
 // `error` says where it stopped. The chain cannot go on: the paper's illustration has no
 // valid next collision. Failure rates over 10^6 collisions: paper_study.hpp.
-#include <chrono>
+#include <variant>
 
 #include "paper_adapt.hpp"
-#include "revcol/rng/streams.hpp"
 #include "revcol/verify.hpp"
 
 namespace revcol::detail {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+// A paper-mode operator in the chain, momentum and energy held; its forward step may refuse
+// the state the previous one left (§4.5), which stops the chain.
+template <class Op>
+struct PaperChain {
+  using A = paper::adapt::Adapter<Op>;
+  using State = typename Op::State;
+  static constexpr bool stops_early = true;
+  const Op& op;
+  typename Op::Geometry x;
+  typename Op::Inv inv;
+  std::size_t draws() const { return static_cast<std::size_t>(Op::draws); }
+  void forward(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.forward(v, x, draws_of(g), log, &inv); }
+  void reverse(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.reverse(v, x, draws_of(g), log, &inv); }
+  void negate(State& v) const { A::negate(v); }
+  std::vector<double> flat(const State& v) const { return A::flat(v); }
+  static typename Op::Draws draws_of(const double* g) {
+    typename Op::Draws d;
+    for (std::size_t k = 0; k < d.size(); ++k) d[k] = g[k];
+    return d;
+  }
+};
 
 template <class Op, class Gen>
 void run_chain(const Op& op, Gen& gen, const paper::PaperCase& pc, const VerifyConfig& c,
@@ -44,76 +60,16 @@ void run_chain(const Op& op, Gen& gen, const paper::PaperCase& pc, const VerifyC
     require(pc.name == "pair3d", "only pair3d takes a contact normal; the triples keep their positions");
     geom = c.normal;
   }
-  const typename Op::Geometry x = A::geometry(geom);
-  const typename Op::Inv inv = A::invariants(v);
-  op.check_pre(v, x, &inv);  // a bad start throws here, before anything runs
-  const Gen start_state = gen;
+  const PaperChain<Op> chain{op, A::geometry(geom), A::invariants(v)};
+  op.check_pre(v, chain.x, &chain.inv);  // a bad start throws here, before anything runs
   r.initial = A::flat(v);
   r.reference = r.initial;  // paper mode promises the start itself (to 1e-9)
-  RareLog log;
-  typename Op::Draws g;
-
-  auto t0 = Clock::now();
-  std::uint64_t done = 0;
-  typename Op::State last_pre = v;  // the pre state of the last step (to take it back)
-  try {
-    for (; done < c.collisions; ++done) {
-      for (double& gk : g) gk = gen.next();
-      try {
-        const typename Op::State next = op.forward(v, x, g, log, &inv);
-        last_pre = v;
-        v = next;
-      } catch (...) {
-        for (std::size_t k = 0; k < g.size(); ++k) (void)gen.prev();  // this collision did not happen
-        throw;
-      }
-      A::negate(v);  // reverse the velocities to create the next collision
-    }
-  } catch (const InvalidArgument& e) {
-    // step `done + 1` refused the state that step `done` left: that step's post state does not
-    // separate (the printed procedures of §4.5 produce such states). Take step `done` back too
-    // (its pre state was kept, its draws are stepped back) and reverse the steps before it.
-    r.error = "forward step " + std::to_string(done) + " of " + std::to_string(c.collisions) +
-              " produced a post-collision state that the next step refuses (" + e.what() +
-              "); stopped, that step taken back, the " + std::to_string(done - 1) +
-              " steps before it reversed";
-    if (done > 0) {
-      for (std::size_t k = 0; k < g.size(); ++k) (void)gen.prev();
-      v = last_pre;
-      --done;
-    }
-  }
-  r.forward_s = seconds_since(t0);
-  r.collisions = done;  // the rates are per collision actually taken
-  r.log_bytes = log.bytes();
-  r.log_entries = log.size();
-  r.random_numbers_drawn = done * Op::draws;
-
-  t0 = Clock::now();
-  std::uint64_t undone = 0;
-  try {
-    for (; undone < done; ++undone) {
-      A::negate(v);
-      for (std::size_t k = g.size(); k-- > 0;) g[k] = gen.prev();
-      v = op.reverse(v, x, g, log, &inv);
-    }
-  } catch (const InvalidArgument& e) {
-    // a wrong reversal hands the next step an invalid state
-    r.error += (r.error.empty() ? "" : "; ") + std::string("reverse step ") +
-               std::to_string(undone + 1) + " of " + std::to_string(done) + ": " + e.what();
-    ++undone;  // its numbers were stepped back
-  }
-  r.reverse_s = seconds_since(t0);
-  r.random_numbers_undone = undone * Op::draws;
-  r.final_velocities = A::flat(v);
-  r.rng_restored = gen == start_state;
-  r.passed = log.size() == 0 && done == c.collisions;
+  reversal_chain(chain, v, gen, c, r);
 }
 
 template <class Gen>
-bool run_case(const VerifyConfig& c, VerifyResult& r) {
+void run_case(const VerifyConfig& c, Gen& gen, VerifyResult& r) {
   const paper::PaperCase& pc = paper::paper_case(c.case_name);
-  Gen gen = rng::make_generator<Gen>(0, c.seed, 1);
   paper::StudyConfig sc;
   sc.printed_reverse = c.printed_reverse;
   if (pc.name == "pair3d") {
@@ -123,19 +79,17 @@ bool run_case(const VerifyConfig& c, VerifyResult& r) {
   } else {
     run_chain(paper::adapt::Adapter<Triple2DPaper>::make(sc), gen, pc, c, r);
   }
-  return true;
 }
 
 }  // namespace
 
-bool run_paper_case(const VerifyConfig& config, VerifyResult& r) {
+bool run_paper_case(const VerifyConfig& config, Generator& gen, VerifyResult& r) {
   if (config.mode != Mode::paper) return false;
   bool known = false;
   for (const std::string& n : paper_case_names()) known = known || n == config.case_name;
   if (!known) return false;
-  if (config.rng == "clcg4") return run_case<rng::CLCG4>(config, r);
-  if (config.rng == "philox") return run_case<rng::Philox>(config, r);
-  throw InvalidArgument("rng must be 'clcg4' or 'philox', got '" + config.rng + "'");
+  std::visit([&](auto& g) { run_case(config, g, r); }, gen);
+  return true;
 }
 
 std::vector<std::string> paper_case_names() {

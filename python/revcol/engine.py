@@ -4,7 +4,9 @@ per-collision memory.
 Particles of one diameter D and unit mass move freely between elastic collisions in a box
 [0, L_k] per axis (reflecting walls or periodic); each collision's outcome is drawn over all
 permitted post-collision states by a reversible operator (exact mode, ``flux`` law by
-default; ``uniform``; or ``mode="paper"``, the paper's Procedures 1-2, in 2D). ``run`` goes
+default; ``uniform``; ``mode="paper"``, the paper's Procedures 1-2, in 2D; or
+``mode="specular"``, the deterministic elastic reflection: no random number, a baseline for
+benchmarks and physics checks; groups still go through the exact operator). ``run`` goes
 forward; ``run_back`` negates every velocity, runs the same event search applying
 ``v -> -reverse(-v)`` with the generators stepping back, and negates again, so the state
 returns to an earlier time without any stored history (the rare log aside, usually empty).
@@ -30,6 +32,7 @@ particle (docs/engine.md).
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
@@ -150,6 +153,16 @@ class Simulation:
         """Dimension d."""
         return self._e.dim
 
+    @property
+    def box(self) -> np.ndarray:
+        """Box lengths L_k, shape (dim,): the box is [0, L_k] per axis."""
+        return np.asarray(self._e.box, dtype=float)
+
+    @property
+    def periodic(self) -> tuple:
+        """Per axis, whether it is periodic (else reflecting walls at 0 and L_k)."""
+        return tuple(bool(p) for p in self._e.periodic)
+
     def diagnostics(self) -> dict:
         """Energy and momentum (and their drift from the start), rare-log bytes, collisions
         per particle, events by type."""
@@ -157,19 +170,32 @@ class Simulation:
 
     # --- checkpoints ---------------------------------------------------------------------
 
-    def state(self) -> dict:
-        """The full state (positions, velocities, local times, cells, stamps, per-particle
-        generator counters, scheduled events, rare log, counters) as numpy arrays."""
+    def snapshot(self) -> dict:
+        """The full state (positions, velocities, local times, list centres, stamps,
+        per-stream generator counters, scheduled events, keyed logs, counters) as numpy
+        arrays and scalars: ``Simulation.from_snapshot`` resumes it bit for bit."""
         return self._e.snapshot()
 
     @classmethod
+    def from_snapshot(cls, snapshot: dict) -> "Simulation":
+        """Rebuilds from ``snapshot()``; the run resumes bit for bit."""
+        return cls(None, None, None, _engine=_core.Engine.from_snapshot(dict(snapshot)))
+
+    def state(self) -> dict:
+        """Deprecated name of ``snapshot()``."""
+        warnings.warn("Simulation.state() is now Simulation.snapshot()", DeprecationWarning, stacklevel=2)
+        return self.snapshot()
+
+    @classmethod
     def from_state(cls, state: dict) -> "Simulation":
-        """Rebuilds from ``state()``; the run resumes bit for bit."""
-        return cls(None, None, None, _engine=_core.Engine.from_snapshot(dict(state)))
+        """Deprecated name of ``from_snapshot()``."""
+        warnings.warn("Simulation.from_state() is now Simulation.from_snapshot()", DeprecationWarning,
+                      stacklevel=2)
+        return cls.from_snapshot(state)
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the full state to ``path`` (numpy ``.npz``)."""
-        st = self.state()
+        st = self.snapshot()
         arrays = {k: np.asarray(v) for k, v in st.items()}
         with open(path, "wb") as f:
             np.savez(f, **arrays)
@@ -182,7 +208,7 @@ class Simulation:
             for k in z.files:
                 a = z[k]
                 st[k] = a.item() if a.ndim == 0 else a
-        return cls.from_state(st)
+        return cls.from_snapshot(st)
 
     def __repr__(self) -> str:
         return f"Simulation(n={self.n}, dim={self.dim}, time={self.time:.6g})"

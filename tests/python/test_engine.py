@@ -9,9 +9,9 @@ from revcol import Simulation
 
 def _err(sim, x0, v0):
     x, v = sim.positions, sim.velocities
-    box = sim.state()["box"]
+    box = sim.box
     dx = np.abs(x - x0)
-    per = sim.state()["periodic"].astype(bool)
+    per = np.array(sim.periodic, dtype=bool)
     dx[:, per] = np.minimum(dx[:, per], np.abs(dx[:, per] - box[per]))
     return (dx / box).max(), np.abs(v - v0).max() / np.abs(v0).max()
 
@@ -64,7 +64,7 @@ def test_conservation_and_diagnostics():
 
 def test_checkpoint_resume_is_bit_identical(tmp_path):
     a = Simulation.random(n=100, dim=2, phi=0.4, boundary="wall", seed=7)
-    b = Simulation.from_state(a.state())
+    b = Simulation.from_snapshot(a.snapshot())
     a.run(collisions=3000)
     b.run(collisions=1234)
     path = tmp_path / "ck.npz"
@@ -84,19 +84,19 @@ def test_clcg4_streams_round_trip_and_npz_resume(tmp_path, streams):
     kw = dict(boundary="wall", seed=9, generator="clcg4", streams=streams)
     a = Simulation.random(n=200, dim=2, phi=0.3, **kw)
     x0, v0 = a.positions, a.velocities
-    b = Simulation.from_state(a.state())
+    b = Simulation.from_snapshot(a.snapshot())
     a.run(collisions=300)
     b.run(collisions=120)
     b.save(tmp_path / "ck.npz")
     c = Simulation.load(tmp_path / "ck.npz")
-    assert c.state()["generator"] == "clcg4"
-    assert c.state()["rng"].shape == ((1,) if streams == "single" else (200,))
+    assert c.snapshot()["generator"] == "clcg4"
+    assert c.snapshot()["rng"].shape == ((1,) if streams == "single" else (200,))
     c.run(collisions=180)
     assert np.array_equal(a.velocities, c.velocities) and np.array_equal(a.positions, c.positions)
     c.run_back()
     ex, ev = _err(c, x0, v0)
     assert ex < 1e-9 and ev < 1e-9
-    assert not c.state()["rng"].any()  # every stream back at its start
+    assert not c.snapshot()["rng"].any()  # every stream back at its start
 
 
 def test_generator_and_streams_rejected():
@@ -191,12 +191,40 @@ def test_1d_lists_the_rods_beside_no_renewals(boundary):
     sim = revcol.Simulation.random(n=300, dim=1, phi=0.3, boundary=boundary, seed=3)
     x0, v0 = sim.positions, sim.velocities
     sim.run(collisions=6000)
-    renewals = sim.diagnostics()["events"]["cell_crossings"]
+    renewals = sim.diagnostics()["events"]["list_renewals"]
     if boundary == "wall":
         assert renewals == 0
     else:
         assert renewals < 6000 / 20
-        assert sim.positions.min() >= -0.25 and sim.positions.max() <= sim.state()["box"][0] + 0.25
+        assert sim.positions.min() >= -0.25 and sim.positions.max() <= sim.box[0] + 0.25
     sim.run_back()
     assert np.array_equal(sim.velocities, v0)
     assert np.max(np.abs(sim.positions - x0)) < 1e-9
+
+
+def test_box_periodic_and_snapshot_names():
+    sim = Simulation.random(n=60, dim=2, phi=0.3, boundary=["wall", "periodic"], seed=2)
+    snap = sim.snapshot()
+    assert np.array_equal(sim.box, snap["box"]) and sim.box.shape == (2,)
+    assert sim.periodic == (False, True)
+    assert list(snap["periodic"]) == [0, 1]
+    # the old names still work, with a deprecation warning
+    with pytest.warns(DeprecationWarning):
+        st = sim.state()
+    with pytest.warns(DeprecationWarning):
+        b = Simulation.from_state(st)
+    assert np.array_equal(b.positions, sim.positions)
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_specular_mode_draws_nothing_and_round_trips(dim):
+    sim = Simulation.random(n=120, dim=dim, phi=0.3, seed=3, mode="specular", groups=False)
+    x0, v0 = sim.positions, sim.velocities
+    sim.run(collisions=120)
+    assert not sim.snapshot()["rng"].any()  # deterministic: no stream moved
+    assert sim.snapshot()["mode"] == "specular"
+    sim.run_back()
+    ex, ev = _err(sim, x0, v0)
+    assert ex < 1e-9 and ev < 1e-9
+    with pytest.raises(ValueError, match="mode"):
+        Simulation.random(n=10, dim=2, phi=0.1, mode="specularr")

@@ -188,3 +188,24 @@ def test_named_verify_cases_exact():
     for c in revcol.named_cases():
         r = revcol.verify(c["name"], collisions=2000, mode="exact", seed=1)
         assert r["passed"] and r["bit_exact"], (c["name"], r["error"])
+
+
+def test_batch_validates_every_entry_and_its_draws_before_anything_moves():
+    """The one batch template (batch.hpp): entry and draw checks name the entry, and a bad
+    batch moves no generator and writes no log; a good one draws d_n per entry and back."""
+    op = revcol.Collision.named("triple1d")
+    v = np.array([[[1.0], [0.0], [0.0]], [[1.0], [0.0], [0.0]]])
+    assert op.draws == 1
+    with pytest.raises(ValueError, match=r"^entry 1: random number must be in \[0,1\]$"):
+        op.forward(v, g=[[0.5], [1.5]])
+    bad = v.copy()
+    bad[1] = [[0.0], [0.0], [1.0]]  # entry 1 separates: not a pre state
+    gen = revcol.Philox()
+    with pytest.raises(ValueError, match="^entry 1: "):
+        op.forward(bad, rng=gen)
+    assert gen.counter == 0 and op.log_size == 0 and op.log_pushed == 0
+    post = op.forward(v, rng=gen)
+    assert gen.counter == 2 * op.draws
+    back = op.reverse(post, rng=gen)
+    assert gen.counter == 0
+    assert np.allclose(back, v)

@@ -1,5 +1,6 @@
 """The paper's reversal illustration through revcol.verify and the CLI."""
 import json
+import pathlib
 import subprocess
 import sys
 
@@ -62,3 +63,25 @@ def test_cli_reports_failure_and_bad_arguments():
     usage = subprocess.run([sys.executable, "-m", "revcol", "verify", "pair2d", "--collisions", "-3"],
                            capture_output=True, text=True)
     assert usage.returncode == 2 and "positive integer" in usage.stderr
+
+
+# Known answers: every case, both modes, both laws (exact mode), both generators, the
+# printed reverse (paper mode), 2000 collisions at seed 3, as verify reported them before
+# its three reversal loops became one (cpp/include/revcol/verify.hpp, reversal_chain). The
+# timings are left out; every other field must be the same, bit for bit.
+_KNOWN = [json.loads(line) for line in
+          (pathlib.Path(__file__).with_name("verify_known_answers.jsonl")).read_text().splitlines()]
+_TIMINGS = {"forward_per_s", "reverse_per_s", "forward_s", "reverse_s"}
+
+
+@pytest.mark.parametrize("known", _KNOWN, ids=lambda k: f"{k['case']}-{k['mode']}-{k['law']}-{k['rng']}-{k['printed_reverse']}")
+def test_known_answers(known):
+    args = dict(collisions=2000, mode=known["mode"], law=known["law"], rng=known["rng"], seed=known["seed"],
+                printed_reverse=known["printed_reverse"])
+    if "throws" in known:
+        with pytest.raises(ValueError) as e:
+            revcol.verify(known["case"], **args)
+        assert str(e.value) == known["throws"]
+        return
+    r = revcol.verify(known["case"], **args)
+    assert {k: v for k, v in r.items() if k not in _TIMINGS} == known

@@ -9,15 +9,19 @@
 
 namespace revcol {
 
-/// paper: the paper's procedures as printed (with its typos fixed); exact: DESIGN.md §3.
-enum class Mode { paper, exact };
+/// paper: the paper's procedures as printed (with its typos fixed); exact: DESIGN.md §3;
+/// specular: the deterministic elastic reflection (collide/specular.hpp; the engine only:
+/// parse_mode refuses it, revcol::engine::parse_engine_mode accepts it).
+enum class Mode { paper, exact, specular };
 /// The target law of the exact operator on the permitted set P (DESIGN.md "Which law").
 /// flux: density proportional to the separation rate a.x (the default: keeps an
 /// event-driven gas in equilibrium); uniform: uniform over P (the paper's requirement).
 enum class Law { flux, uniform };
 
 /// "paper" / "exact".
-inline const char* to_string(Mode m) { return m == Mode::paper ? "paper" : "exact"; }
+inline const char* to_string(Mode m) {
+  return m == Mode::paper ? "paper" : m == Mode::specular ? "specular" : "exact";
+}
 /// "flux" / "uniform".
 inline const char* to_string(Law l) { return l == Law::flux ? "flux" : "uniform"; }
 /// Parses "paper" / "exact"; throws InvalidArgument naming the allowed values.

@@ -36,6 +36,23 @@ class Wall {
                                        double tol = 1e-9) {
     return flip(box, x, v, radius, tol, /*approaching=*/true);
   }
+  /// One axis of the reflection, as the event-driven engine applies it: flips v when the
+  /// centre x is within tol of, or past, the wall it approaches (lo + radius when v < 0,
+  /// hi - radius when v > 0); returns whether it flipped. One-sided on purpose: a centre
+  /// that round-off put a hair beyond the wall still reflects. Self-inverse on the flipped
+  /// component, so the engine undoes a flip by flipping again (its wall-mask log says which).
+  static bool reflect_axis(double lo, double hi, double x, double& v, double radius, double tol) {
+    if ((v < 0.0 && x - (lo + radius) <= tol) || (v > 0.0 && (hi - radius) - x <= tol)) {
+      v = -v;
+      return true;
+    }
+    return false;
+  }
+  /// Whether the centre x touches (within tol, or is past) either wall of the axis.
+  static bool touches_axis(double lo, double hi, double x, double radius, double tol) {
+    return x - (lo + radius) <= tol || (hi - radius) - x <= tol;
+  }
+
   /// Post -> pre: flips the components receding from touched walls.
   static std::array<double, 3> reverse(const Box& box, const std::array<double, 3>& x,
                                        const std::array<double, 3>& v, double radius,

@@ -86,18 +86,22 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "revcol/collide/common.hpp"
+#include "revcol/error.hpp"
 #include "revcol/rng/streams.hpp"
 
 namespace revcol::engine {
 
-/// Boundary condition of one axis: reflecting walls at 0 and L, or periodic.
-enum class Boundary { wall, periodic };
+/// Boundary condition of one axis: reflecting walls at 0 and L, or periodic (the axis
+/// types are in engine/boundary.hpp). The values are the checkpoint's per-axis entries.
+enum class Boundary { wall = 0, periodic = 1 };
 
 /// "wall" / "periodic".
 inline const char* to_string(Boundary b) { return b == Boundary::wall ? "wall" : "periodic"; }
@@ -111,6 +115,9 @@ enum class Generator { philox, clcg4 };
 inline const char* to_string(Generator g) { return g == Generator::philox ? "philox" : "clcg4"; }
 /// Parses "philox" / "clcg4"; throws InvalidArgument otherwise.
 Generator parse_generator(const std::string& s);
+/// Parses a mode the engine runs: "exact", "paper", and the engine-only modes of
+/// cpp/src/engine_operators.hpp; throws InvalidArgument otherwise.
+Mode parse_engine_mode(const std::string& s);
 /// Parses "per_particle" (or "per-particle") / "single"; throws InvalidArgument otherwise
 /// (the engine has no per-draw policy: a collision's draw count depends on its size).
 rng::StreamPolicy parse_engine_streams(const std::string& s);
@@ -121,7 +128,7 @@ struct Config {
   std::array<double, 3> box{1.0, 1.0, 1.0};      ///< box lengths L_k: the box is [0, L_k] per axis
   std::array<Boundary, 3> boundary{Boundary::periodic, Boundary::periodic, Boundary::periodic};  ///< per axis
   double diameter = 1.0;                         ///< D
-  Mode mode = Mode::exact;                       ///< exact (default) or paper (2D pairs: Pair2DPaper)
+  Mode mode = Mode::exact;                       ///< the pair operator: exact (default), paper, ... (engine_operators.hpp)
   Law law = Law::flux;                           ///< exact mode's target law
   std::uint32_t seed = 1;                        ///< the generator family (rng/streams.hpp)
   Generator generator = Generator::philox;       ///< Philox (key {stream, seed}) or CLCG4 (stream seed * count + i)
@@ -135,20 +142,54 @@ struct Config {
                        ///< chooses it from the packing fraction (not saved in snapshots)
 };
 
+/// visit(f): calls f(name, field) for each field of a struct that lists them in a static
+/// visit_fields(self, f) (Counters, Snapshot); const and non-const alike.
+template <class Derived>
+struct Visitable {
+  /// Every field, writable.
+  template <class F>
+  void visit(F&& f) {
+    Derived::visit_fields(static_cast<Derived&>(*this), f);
+  }
+  /// Every field, read-only.
+  template <class F>
+  void visit(F&& f) const {
+    Derived::visit_fields(static_cast<const Derived&>(*this), f);
+  }
+};
+
 /// Event counts (cumulative over both directions).
-struct Counters {
+struct Counters : Visitable<Counters> {
   std::uint64_t events = 0;            ///< events popped from the heap
   std::uint64_t pair_collisions = 0;   ///< two-particle collisions
   std::uint64_t group_collisions = 0;  ///< collisions of three or more particles
   std::uint64_t group_particles = 0;   ///< particles taking part in those
   std::uint64_t group_fallbacks = 0;   ///< groups the operator refused (processed as a pair)
   std::uint64_t wall_events = 0;       ///< wall reflections
-  std::uint64_t cell_crossings = 0;    ///< neighbour-list renewals (named when they were cell crossings)
+  std::uint64_t list_renewals = 0;     ///< neighbour-list renewals (1D ring: wraps); formerly cell_crossings
   std::uint64_t invalid_events = 0;    ///< predictions whose partner had changed
   std::uint64_t grazing_skipped = 0;   ///< predicted contacts found not approaching at contact
   std::uint64_t reverse_failures = 0;  ///< reversed collisions the operator refused (beyond the horizon)
   std::uint64_t forward_collisions = 0;  ///< collisions processed forward
   std::uint64_t reverse_collisions = 0;  ///< collisions processed in reverse
+
+  /// Calls f(name, count) for every counter of c, in the checkpoint format's order (its
+  /// `counters` array) and with the names of the diagnostics (visit(f) on an object).
+  template <class S, class F>
+  static void visit_fields(S& c, F& f) {
+    f("events", c.events);
+    f("pair_collisions", c.pair_collisions);
+    f("group_collisions", c.group_collisions);
+    f("group_particles", c.group_particles);
+    f("group_fallbacks", c.group_fallbacks);
+    f("wall_events", c.wall_events);
+    f("list_renewals", c.list_renewals);
+    f("invalid_events", c.invalid_events);
+    f("grazing_skipped", c.grazing_skipped);
+    f("reverse_failures", c.reverse_failures);
+    f("forward_collisions", c.forward_collisions);
+    f("reverse_collisions", c.reverse_collisions);
+  }
 };
 
 /// What one run or run_back call did.
@@ -160,7 +201,7 @@ struct RunResult {
 };
 
 /// The full state, for checkpoints: restoring it resumes bit for bit.
-struct Snapshot {
+struct Snapshot : Visitable<Snapshot> {
   Config config;
   std::size_t n = 0;
   double time = 0.0, start_time = 0.0;
@@ -192,6 +233,74 @@ struct Snapshot {
   Counters counters;
   double energy0 = 0.0;                        ///< kinetic energy at construction
   std::array<double, 3> momentum0{};           ///< momentum at construction
+
+  /// Copies the field `name` into out (its type must match; throws InvalidArgument if no
+  /// field of that name and type exists).
+  template <class T>
+  void field(const char* name, T& out) const {
+    bool found = false;
+    visit([&](const char* key, const auto& v) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(v)>, T>)
+        if (!found && std::strcmp(key, name) == 0) {
+          out = v;
+          found = true;
+        }
+    });
+    require(found, std::string("snapshot has no field '") + name + "' of this type");
+  }
+  /// Sets the field `name` from value (same rules).
+  template <class T>
+  void field(const char* name, const T& value) {
+    bool found = false;
+    visit([&](const char* key, auto& v) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(v)>, T>)
+        if (!found && std::strcmp(key, name) == 0) {
+          v = value;
+          found = true;
+        }
+    });
+    require(found, std::string("snapshot has no field '") + name + "' of this type");
+  }
+
+  /// Calls f(name, field) for every field of s but `config`, `counters` and `momentum0`, in
+  /// the checkpoint format's order and with its names: a binding or an archive loops over
+  /// this instead of naming each field (`centre` may be empty: a checkpoint written before
+  /// the lists). visit(f) on an object.
+  template <class S, class F>
+  static void visit_fields(S& s, F& f) {
+    f("n", s.n);
+    f("time", s.time);
+    f("start_time", s.start_time);
+    f("net_collisions", s.net_collisions);
+    f("x", s.x);
+    f("v", s.v);
+    f("t_local", s.t_local);
+    f("cell", s.cell);
+    f("centre", s.centre);
+    f("stamp", s.stamp);
+    f("ncoll", s.ncoll);
+    f("rng", s.rng);
+    f("ev_t", s.ev_t);
+    f("ev_kind", s.ev_kind);
+    f("ev_partner", s.ev_partner);
+    f("ev_stamp", s.ev_stamp);
+    f("second", s.second);
+    f("touching", s.touching);
+    f("log_cells", s.log_cells);
+    f("log_pushed", s.log_pushed);
+    f("netc", s.netc);
+    f("wall_keys", s.wall_keys);
+    f("wall_sizes", s.wall_sizes);
+    f("wall_masks", s.wall_masks);
+    f("wall_ids", s.wall_ids);
+    f("wall_netc", s.wall_netc);
+    f("wall_times", s.wall_times);
+    f("pre_keys", s.pre_keys);
+    f("pre_sizes", s.pre_sizes);
+    f("pre_vals", s.pre_vals);
+    f("pre_pushed", s.pre_pushed);
+    f("energy0", s.energy0);
+  }
 };
 
 /// Conservation and activity diagnostics.

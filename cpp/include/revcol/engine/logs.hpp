@@ -1,0 +1,193 @@
+// The engine's keyed logs: the little it must remember for a reversed run, each entry
+// keyed by something both directions recover exactly, pushed forward and popped in reverse
+// (LIFO). Both are empty in a gas almost always.
+//
+// WallLog (walls at a collision's instant). A particle of a collision that touches a wall
+// (within group_tol D) and approaches it reflects before the collision operator (W1), and
+// again after it if the operator sends it into a touched wall (W2). Which components W1
+// and W2 flipped cannot be read off the post state (the wall operator's two-to-one case),
+// so the forward run keeps the flip masks of a collision at a wall, keyed by (smallest id,
+// that particle's net collision count before the collision), with its members, their net
+// counts and its time. The reversed collision pops them: undoes W2, reverses the operator,
+// undoes W1. A reversed run schedules no standalone wall event for a particle touching a
+// wall unless the entry of its next reversed collision says W2 flipped it at this instant
+// (`entry`).
+//
+// ExactPreLog. At singular points of a chart (a 3D pair almost head-on, groups with resting
+// contacts) a pre state's K-bit cell spans up to ~2^(-K/2); when its centre is off by more
+// than 1e-10 (relative), the forward run keeps the pre velocities, keyed by (stream,
+// generator counter before the collision's draws), which names the collision uniquely, and
+// the reversed collision restores them when the key on top matches.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace revcol::engine {
+
+/// The wall-mask log (see above). Masks: bit k = axis k flipped; W1 | W2 << 8 per member.
+class WallLog {
+ public:
+  /// Forward: keeps the masks of a collision at a wall: its smallest id, that id's net
+  /// count before (key), its time, and per member (in the collision's order) the id, its
+  /// net count before (netc[id]) and the masks.
+  void push(int id, std::int64_t key, double t, int n, const int* ids, const std::int64_t* netc, const unsigned* w1,
+            const unsigned* w2) {
+    keys_.push_back(static_cast<std::uint64_t>(id));
+    keys_.push_back(static_cast<std::uint64_t>(key));
+    times_.push_back(t);
+    sizes_.push_back(static_cast<std::uint64_t>(n));
+    for (int u = 0; u < n; ++u) {
+      ids_.push_back(static_cast<std::uint64_t>(ids[u]));
+      netc_.push_back(netc[ids[u]]);
+      masks_.push_back(w1[u] | (w2[u] << 8));
+    }
+  }
+  /// Reverse: the masks of the collision keyed (id, key) with n members, popped; zeros
+  /// (nothing popped) when the top entry is another collision's.
+  void pop(int id, std::int64_t key, int n, unsigned* w1, unsigned* w2) {
+    for (int u = 0; u < n; ++u) w1[u] = w2[u] = 0;
+    if (sizes_.empty()) return;
+    const std::size_t e = sizes_.size() - 1;
+    if (keys_[2 * e] != static_cast<std::uint64_t>(id) || keys_[2 * e + 1] != static_cast<std::uint64_t>(key) ||
+        sizes_[e] != static_cast<std::uint64_t>(n))
+      return;
+    const std::size_t at = masks_.size() - n;
+    for (int u = 0; u < n; ++u) {
+      w1[u] = static_cast<unsigned>(masks_[at + u] & 0xffu);
+      w2[u] = static_cast<unsigned>(masks_[at + u] >> 8);
+    }
+    masks_.resize(at);
+    ids_.resize(at);
+    netc_.resize(at);
+    sizes_.pop_back();
+    times_.pop_back();
+    keys_.resize(keys_.size() - 2);
+  }
+  /// Reverse: the member slot of particle i (net count netc_i now) in the entry of its next
+  /// reversed collision if that collision is at time tnow (relative 1e-9), else -1. The
+  /// log is short: at most 64 entries are searched.
+  long entry(int i, std::int64_t netc_i, double tnow) const {
+    if (sizes_.empty()) return -1;
+    std::size_t off = masks_.size();
+    std::size_t e = sizes_.size();
+    for (int seen = 0; e > 0 && seen < 64; ++seen) {
+      --e;
+      off -= sizes_[e];
+      for (std::size_t u = off; u < off + sizes_[e]; ++u) {
+        if (ids_[u] != static_cast<std::uint64_t>(i)) continue;
+        if (netc_[u] != netc_i - 1) return -1;
+        return std::fabs(times_[e] - tnow) <= 1e-9 * (std::fabs(tnow) + 1.0) ? static_cast<long>(u) : -1;
+      }
+    }
+    return -1;
+  }
+  /// The masks (W1 | W2 << 8) of member slot m.
+  std::uint64_t mask(long m) const { return masks_[m]; }
+  /// Clears bits of member slot m's masks (a W2 flip undone by a standalone wall event).
+  void clear(long m, std::uint64_t bits) { masks_[m] &= ~bits; }
+  /// Entries now held.
+  std::size_t entries() const { return sizes_.size(); }
+  /// Bytes now held.
+  std::size_t bytes() const {
+    return (keys_.size() + 2 * sizes_.size() + 3 * masks_.size()) * sizeof(std::uint64_t);
+  }
+
+  /// The log's arrays, for snapshots: (smallest id, key) per entry, members per entry, masks,
+  /// member ids and net counts per member, time per entry.
+  template <class Self, class F>
+  static void fields(Self& s, F&& f) {
+    f("wall_keys", s.keys_);
+    f("wall_sizes", s.sizes_);
+    f("wall_masks", s.masks_);
+    f("wall_ids", s.ids_);
+    f("wall_netc", s.netc_);
+    f("wall_times", s.times_);
+  }
+  /// Whether the arrays fit together (sizes add up, ids below n).
+  bool consistent(std::size_t n) const {
+    std::uint64_t m = 0;
+    for (auto q : sizes_) m += q;
+    if (keys_.size() != 2 * sizes_.size() || times_.size() != sizes_.size()) return false;
+    if (m != masks_.size() || m != ids_.size() || m != netc_.size()) return false;
+    return std::all_of(ids_.begin(), ids_.end(), [&](std::uint64_t q) { return q < n; });
+  }
+
+ private:
+  std::vector<std::uint64_t> keys_, sizes_, masks_, ids_;
+  std::vector<std::int64_t> netc_;
+  std::vector<double> times_;
+};
+
+/// The exact-pre log (see above).
+class ExactPreLog {
+ public:
+  /// Whether b differs from a by more than 1e-10 of a's largest component (n values).
+  static bool off_by(const double* a, const double* b, int n) {
+    double amax = 0.0, d = 0.0;
+    for (int k = 0; k < n; ++k) {
+      amax = std::fmax(amax, std::fabs(a[k]));
+      d = std::fmax(d, std::fabs(a[k] - b[k]));
+    }
+    return d > 1e-10 * amax;
+  }
+  /// Forward: keeps the pre velocities a (n values; and b, n more, for a pair) under the
+  /// key (stream, generator counter before the draws).
+  void push(int stream, std::uint64_t key, const double* a, const double* b, int n) {
+    keys_.push_back(static_cast<std::uint64_t>(stream));
+    keys_.push_back(key);
+    sizes_.push_back(static_cast<std::uint64_t>(b ? 2 * n : n));
+    vals_.insert(vals_.end(), a, a + n);
+    if (b) vals_.insert(vals_.end(), b, b + n);
+    ++pushed_;
+  }
+  /// Reverse: a (and b, the second half of a pair) are the pre velocities the reverse
+  /// computed; replaced by the kept ones, popped, when the top entry is this key's.
+  void pop(int stream, std::uint64_t key, double* a, double* b) {
+    if (sizes_.empty()) return;
+    const std::size_t e = sizes_.size() - 1;
+    if (keys_[2 * e] != static_cast<std::uint64_t>(stream) || keys_[2 * e + 1] != key) return;
+    const std::size_t n = sizes_[e];
+    const double* src = vals_.data() + (vals_.size() - n);
+    if (b) {
+      std::copy(src, src + n / 2, a);
+      std::copy(src + n / 2, src + n, b);
+    } else {
+      std::copy(src, src + n, a);
+    }
+    vals_.resize(vals_.size() - n);
+    sizes_.pop_back();
+    keys_.resize(keys_.size() - 2);
+  }
+  /// Entries now held.
+  std::size_t entries() const { return sizes_.size(); }
+  /// Entries ever pushed.
+  std::uint64_t pushed() const { return pushed_; }
+  /// Bytes now held.
+  std::size_t bytes() const {
+    return vals_.size() * sizeof(double) + (keys_.size() + sizes_.size()) * sizeof(std::uint64_t);
+  }
+  /// The log's arrays and counter, for snapshots.
+  template <class Self, class F>
+  static void fields(Self& s, F&& f) {
+    f("pre_keys", s.keys_);
+    f("pre_sizes", s.sizes_);
+    f("pre_vals", s.vals_);
+    f("pre_pushed", s.pushed_);
+  }
+  /// Whether the arrays fit together (2 keys per entry, sizes add up to the values).
+  bool consistent() const {
+    std::uint64_t total = 0;
+    for (auto q : sizes_) total += q;
+    return keys_.size() == 2 * sizes_.size() && total == vals_.size();
+  }
+
+ private:
+  std::vector<std::uint64_t> keys_, sizes_;
+  std::vector<double> vals_;
+  std::uint64_t pushed_ = 0;
+};
+
+}  // namespace revcol::engine

@@ -1,0 +1,451 @@
+// Neighbour lists with a shell, built from a cell grid of list centres.
+//
+// Each particle i keeps a list centre c_i (where it was at its last list renewal) and the
+// ids of the particles whose centres lie within D + shell of c_i, each with its periodic
+// image: the lists are symmetric (j on i's iff i on j's, with mirrored image codes) and a
+// pure function of the centres (a snapshot keeps the centres, a restore rebuilds the lists).
+// The engine renews i's list when i is h = (shell - 1e-3 D) / 2 from its centre, so a pair
+// off each other's lists is more than D (1 + 1e-3) apart and a prediction scans the list
+// alone. The cell grid (cells at least D + shell wide) holds the centres and is read by
+// the renewals only. Ids on a list are sorted: a canonical order, the same after a restore.
+//
+// Image codes: 2 bits per axis, 0: x_j, 1: x_j + L, 2: x_j - L (the nearest image of j's
+// centre seen from i's; Boundaries::image). With L >= 2 (D + shell) each listed pair has one
+// nearest image (the engine keeps the shell below L / 2 - D).
+//
+// 1D (walls, or a periodic ring of 3 rods or more): rods keep their order, so each lists
+// the rods beside it for the whole run ("adjacent" mode: no cell grid, no renewals; on a
+// ring the engine's wrap event recodes the images of the rods beside a wrapped rod).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "revcol/engine/boundary.hpp"
+
+namespace revcol::engine {
+
+/// Symmetric neighbour lists over list centres, per dimension d.
+template <int Dim>
+class NeighbourLists {
+ public:
+  using Vec = std::array<double, Dim>;  ///< a d-vector
+
+  /// A renewal's new list on the stack. Listed centres are within D + shell of c_i, so their
+  /// particles (disjoint spheres) are within D + shell + h of it: at most ((1.5 D + shell +
+  /// h) / (D / 2))^d of them: 74 in 3D at the smallest shell (0.4 D), 45 in 2D at the shell
+  /// of phi 0.3 (1.1 D). A sparse gas takes a wider shell, and a dense cluster in it can
+  /// overflow: the slower path for more is the safety net.
+  static constexpr int kMaxList = 128;
+
+  /// Sets the geometry: n particles, the box, and the list reach D + shell; `adjacent`
+  /// chooses the 1D mode. Lists are empty until build().
+  void setup(std::size_t n, const Boundaries<Dim>& box, double reach, bool adjacent) {
+    n_ = n;
+    box_ = box;
+    list_r2_ = reach * reach;
+    adj_ = Dim == 1 && adjacent;
+    total_cells_ = 1;
+    for (int k = 0; k < Dim; ++k) {
+      const double L = box.length(k);
+      nc_[k] = std::max(1, static_cast<int>(std::floor(L / reach)));
+      cw_[k] = L / nc_[k];
+      stride_[k] = total_cells_;
+      total_cells_ *= nc_[k];
+      shift_tab_[k][0] = 0.0;
+      shift_tab_[k][1] = L;
+      shift_tab_[k][2] = -L;
+      shift_tab_[k][3] = 0.0;
+    }
+  }
+
+  /// Whether the lists are 1D's rods-beside-each-other (a constant false in 2D and 3D).
+  bool adjacent() const { return Dim == 1 && adj_; }
+  /// The list centres (n x dim).
+  void set_centres(const std::vector<double>& c) {
+    cn_.assign(n_, Centre{});
+    for (std::size_t i = 0; i < n_; ++i)
+      for (int k = 0; k < Dim; ++k) cn_[i].c[k] = c[i * Dim + k];
+  }
+  /// i's list centre.
+  const double* centre(int i) const { return cn_[i].c; }
+  /// i's list centre, to move (then renew(i)).
+  double* centre(int i) { return cn_[i].c; }
+  /// Cell coordinates of every centre (n x dim; zeros in 1D's adjacent mode).
+  const std::vector<int>& cells() const { return cell_; }
+
+  /// Every list from the centres (construction, restore). pos(j): rod j's position now
+  /// (1D's adjacent mode only).
+  template <class Pos>
+  void build(Pos&& pos) {
+    cell_.assign(n_ * Dim, 0);
+    if (adjacent()) {
+      build_adjacent(pos);
+      return;
+    }
+    for (std::size_t i = 0; i < n_; ++i) place(static_cast<int>(i));
+    link_all();
+    nbcap_ = 16;
+    nb_.assign(n_ * nbcap_, 0);
+    nbc_.assign(n_ * nbcap_, 0);
+    nbn_.assign(n_, 0);
+    for (std::size_t i = 0; i < n_; ++i)
+      for_cells(static_cast<int>(i), [&](int j) {
+        unsigned code;
+        if (near(static_cast<int>(i), j, code)) list_insert(static_cast<int>(i), j, code);
+      });
+  }
+
+  /// i's centre has moved: i goes to its new cell and its list is rebuilt from there, with
+  /// i on the lists of its old and new neighbours (cell-grid mode).
+  void renew(int i) {
+    unlink(i);  // from the cell it was linked in (cell_ still holds it)
+    place(i);
+    link(i);
+    rebuild_list(i);
+  }
+
+  /// Calls f(j, shift) for every particle j on i's list; shift is the image offset to add to
+  /// x_j. prefetch(j) is called for every j first: the scan's branches (approaching or not)
+  /// are unpredictable, and a mispredicted one would otherwise serialize the cache misses.
+  /// This is the engine's inner loop: measure before changing.
+  template <class F, class Prefetch>
+  void for_neighbours(int i, F&& f, Prefetch&& prefetch) const {
+    const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
+    const int* ids = nb_.data() + base;
+    const unsigned char* codes = nbc_.data() + base;
+    const int m = nbn_[i];
+    for (int u = 0; u < m; ++u) prefetch(ids[u]);
+    for (int u = 0; u < m; ++u) f(ids[u], shift_of(codes[u]));
+  }
+
+  /// Image shift s of the pair (a, b), with r = x_a - x_b - s, from the centres (or, in 1D's
+  /// adjacent mode, from a's list).
+  Vec pair_shift(int a, int b) const {
+    if (adjacent()) {
+      const std::size_t base = static_cast<std::size_t>(a) * nbcap_;
+      for (int u = 0; u < nbn_[a]; ++u)
+        if (nb_[base + u] == b) return shift_of(nbc_[base + u]);
+    }
+    unsigned code;
+    near(a, b, code);
+    return shift_of(code);
+  }
+
+  /// 1D ring: i has gone past an end of the box and been moved by L: the images of its
+  /// pairs with the rods beside it are recoded. pos(j): rod j's position now.
+  template <class Pos>
+  void recode_beside(int i, Pos&& pos) {
+    const int r = right_[i], l = left_[i];
+    const unsigned cr = right_code(i, r, pos), cl = right_code(l, i, pos);
+    list_recode(i, r, cr);
+    list_recode(r, i, mirror(cr));
+    list_recode(l, i, cl);
+    list_recode(i, l, mirror(cl));
+  }
+
+  /// Whether j's centre is within D + shell of i's, with j's nearest image code seen from i.
+  /// Symmetric to the bit: near(j, i) gives the same answer and the mirrored code.
+  bool near(int i, int j, unsigned& code) const {
+    code = 0;
+    double d2 = 0.0;
+    for (int k = 0; k < Dim; ++k) {
+      unsigned ck;
+      const double d = box_.image(k, cn_[i].c[k] - cn_[j].c[k], ck);
+      code |= ck << (2 * k);
+      d2 += d * d;
+    }
+    return d2 < list_r2_;
+  }
+  /// The code of the mirrored pair (1 <-> 2 on every axis).
+  static unsigned mirror(unsigned code) { return ((code & 0x15u) << 1) | ((code >> 1) & 0x15u); }
+  /// The image offset of a code.
+  Vec shift_of(unsigned code) const {
+    Vec s;
+    for (int k = 0; k < Dim; ++k) s[k] = shift_tab_[k][(code >> (2 * k)) & 3u];
+    return s;
+  }
+
+  /// Number of particles on i's list.
+  int count(int i) const { return nbn_[i]; }
+  /// Bytes held.
+  std::size_t memory_bytes() const {
+    return cell_.capacity() * sizeof(int) + head_.capacity() * sizeof(int) + cn_.capacity() * sizeof(Centre) +
+           nbn_.capacity() * sizeof(int) + nb_.capacity() * (sizeof(int) + 1) +
+           (left_.capacity() + right_.capacity()) * sizeof(int);
+  }
+
+  /// Checks the lists against their definition: symmetric with mirrored codes, sorted, and
+  /// (cell-grid mode) exactly the pairs whose centres are within reach, by brute force.
+  /// O(n^2): for tests and REVCOL_VALIDATE builds on small systems.
+  bool valid() const {
+    for (std::size_t i = 0; i < n_; ++i) {
+      const std::size_t base = i * nbcap_;
+      for (int u = 0; u < nbn_[i]; ++u) {
+        const int j = nb_[base + u];
+        if (u > 0 && nb_[base + u - 1] >= j) return false;
+        const std::size_t bj = static_cast<std::size_t>(j) * nbcap_;
+        int w = 0;
+        while (w < nbn_[j] && nb_[bj + w] != static_cast<int>(i)) ++w;
+        if (w == nbn_[j] || nbc_[bj + w] != mirror(nbc_[base + u])) return false;
+      }
+      if (adjacent()) continue;
+      int listed = 0;
+      for (std::size_t j = 0; j < n_; ++j) {
+        if (j == i) continue;
+        unsigned code;
+        if (!near(static_cast<int>(i), static_cast<int>(j), code)) continue;
+        ++listed;
+        int u = 0;
+        while (u < nbn_[i] && nb_[base + u] != static_cast<int>(j)) ++u;
+        if (u == nbn_[i] || nbc_[base + u] != code) return false;
+      }
+      if (listed != nbn_[i]) return false;
+    }
+    return true;
+  }
+
+ private:
+  // A list centre with the links of its cell's chain: the renewal's scan reads one line each.
+  struct alignas(Dim == 3 ? 32 : 8) Centre {
+    double c[Dim] = {};
+    int next = -1, prev = -1;
+  };
+
+  int cell_of(double x, int k) const {
+    int c = static_cast<int>(std::floor(x / cw_[k]));
+    return std::clamp(c, 0, nc_[k] - 1);
+  }
+  int cell_index(std::size_t i) const {
+    int c = 0;
+    for (int k = 0; k < Dim; ++k) c += cell_[i * Dim + k] * stride_[k];
+    return c;
+  }
+  void place(int i) {
+    for (int k = 0; k < Dim; ++k) cell_[i * Dim + k] = cell_of(cn_[i].c[k], k);
+  }
+  void link_all() {
+    head_.assign(total_cells_, -1);
+    for (std::size_t i = 0; i < n_; ++i) link(static_cast<int>(i));
+  }
+  void link(int i) {
+    const int c = cell_index(i);
+    cn_[i].next = head_[c];
+    cn_[i].prev = -1;
+    if (head_[c] >= 0) cn_[head_[c]].prev = i;
+    head_[c] = i;
+  }
+  void unlink(int i) {
+    if (cn_[i].prev >= 0) cn_[cn_[i].prev].next = cn_[i].next;
+    else head_[cell_index(i)] = cn_[i].next;
+    if (cn_[i].next >= 0) cn_[cn_[i].next].prev = cn_[i].prev;
+  }
+
+  // Calls f(j) for every particle j != i whose centre is in the 3^d cells around i's
+  // (every cell of a periodic axis with fewer than 3, each once).
+  template <class F>
+  void for_cells(int i, F&& f) const {
+    int idx[3][3];
+    int cnt[3] = {1, 1, 1};
+    idx[1][0] = idx[2][0] = 0;
+    for (int k = 0; k < Dim; ++k) {
+      const int c0 = cell_[i * Dim + k];
+      const bool per = box_.periodic(k);
+      cnt[k] = 0;
+      if (per && nc_[k] < 3) {
+        for (int c = 0; c < nc_[k]; ++c) idx[k][cnt[k]++] = c * stride_[k];
+        continue;
+      }
+      for (int off = -1; off <= 1; ++off) {
+        int ck = c0 + off;
+        if (ck < 0 || ck >= nc_[k]) {
+          if (!per) continue;
+          ck += ck < 0 ? nc_[k] : -nc_[k];
+        }
+        idx[k][cnt[k]++] = ck * stride_[k];
+      }
+    }
+    // the chains are walked side by side, one link of each per round: their loads are
+    // independent, so the cache misses overlap (measured faster than one chain at a time)
+    int cur[27];
+    int m = 0;
+    for (int c = 0; c < cnt[2]; ++c)
+      for (int b = 0; b < cnt[1]; ++b) {
+        const int base = idx[1][b] + idx[2][c];
+        for (int a = 0; a < cnt[0]; ++a) {
+          const int h = head_[idx[0][a] + base];
+          if (h >= 0) cur[m++] = h;
+        }
+      }
+    while (m > 0) {
+      int live = 0;
+      for (int q = 0; q < m; ++q) {
+        const int j = cur[q];
+        if (j != i) f(j);
+        const int nx = cn_[j].next;
+        if (nx >= 0) cur[live++] = nx;
+      }
+      m = live;
+    }
+  }
+
+  void list_insert(int i, int j, unsigned code) {
+    if (nbn_[i] == nbcap_) grow_lists();
+    const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
+    int m = nbn_[i]++;
+    while (m > 0 && nb_[base + m - 1] > j) {
+      nb_[base + m] = nb_[base + m - 1];
+      nbc_[base + m] = nbc_[base + m - 1];
+      --m;
+    }
+    nb_[base + m] = j;
+    nbc_[base + m] = static_cast<unsigned char>(code);
+  }
+  void list_recode(int i, int j, unsigned code) {
+    const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
+    int u = 0;
+    while (nb_[base + u] != j) ++u;
+    nbc_[base + u] = static_cast<unsigned char>(code);
+  }
+  void list_erase(int i, int j) {
+    const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
+    const int m = nbn_[i];
+    int u = 0;
+    while (u < m && nb_[base + u] != j) ++u;
+    for (; u + 1 < m; ++u) {
+      nb_[base + u] = nb_[base + u + 1];
+      nbc_[base + u] = nbc_[base + u + 1];
+    }
+    --nbn_[i];
+  }
+  void grow_lists(int least = 0) {
+    int cap = 2 * nbcap_;
+    while (cap < least) cap *= 2;
+    std::vector<int> nb(n_ * cap);
+    std::vector<unsigned char> nbc(n_ * cap);
+    for (std::size_t i = 0; i < n_; ++i)
+      for (int u = 0; u < nbn_[i]; ++u) {
+        nb[i * cap + u] = nb_[i * nbcap_ + u];
+        nbc[i * cap + u] = nbc_[i * nbcap_ + u];
+      }
+    nb_.swap(nb);
+    nbc_.swap(nbc);
+    nbcap_ = cap;
+  }
+
+  // 1D: the rods in order of position (a rotation of the ring's order on a periodic axis),
+  // each listed with the rods beside it.
+  template <class Pos>
+  void build_adjacent(Pos& pos) {
+    nbcap_ = 2;
+    nb_.assign(n_ * nbcap_, 0);
+    nbc_.assign(n_ * nbcap_, 0);
+    nbn_.assign(n_, 0);
+    left_.assign(n_, -1);
+    right_.assign(n_, -1);
+    std::vector<int> order(n_);
+    std::vector<double> x(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      order[i] = static_cast<int>(i);
+      x[i] = pos(static_cast<int>(i));
+    }
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return x[a] < x[b] || (x[a] == x[b] && a < b); });
+    const std::size_t pairs = box_.periodic(0) ? n_ : (n_ > 0 ? n_ - 1 : 0);
+    for (std::size_t u = 0; u < pairs; ++u) {
+      const int a = order[u], b = order[(u + 1) % n_];  // b is the rod to the right of a
+      right_[a] = b;
+      left_[b] = a;
+      const unsigned code = right_code(a, b, pos);
+      list_insert(a, b, code);
+      list_insert(b, a, mirror(code));
+    }
+  }
+  // The image of b, the rod to the right of a, seen from a: b itself (code 0) when it lies
+  // to the right, else b + L (code 1). Unambiguous: stored positions are within a quarter
+  // diameter of the box, and b lies between D and L - 2 D to the right of a on the ring.
+  template <class Pos>
+  unsigned right_code(int a, int b, Pos& pos) const {
+    if (!box_.periodic(0)) return 0u;
+    return pos(b) > pos(a) ? 0u : 1u;
+  }
+
+  // i's list from its (new) centre, and i on the lists of its old and new neighbours: a
+  // merge of the old and new sorted lists, so that only the lists whose entry for i changes
+  // are touched (most neighbours stay, and keep their image unless i was wrapped).
+  void rebuild_list(int i) {
+    int fresh[kMaxList];
+    unsigned char fcode[kMaxList];
+    int nf = 0;
+    bool spill = false;
+    for_cells(i, [&](int j) {
+      unsigned code;
+      if (!near(i, j, code)) return;
+      if (nf == kMaxList) {
+        spill = true;
+        return;
+      }
+      int m = nf++;
+      while (m > 0 && fresh[m - 1] > j) {
+        fresh[m] = fresh[m - 1];
+        fcode[m] = fcode[m - 1];
+        --m;
+      }
+      fresh[m] = j;
+      fcode[m] = static_cast<unsigned char>(code);
+    });
+    if (spill) {  // beyond kMaxList (not reached, see there): the slow way
+      for (int u = 0; u < nbn_[i]; ++u) list_erase(nb_[static_cast<std::size_t>(i) * nbcap_ + u], i);
+      nbn_[i] = 0;
+      for_cells(i, [&](int j) {
+        unsigned code;
+        if (!near(i, j, code)) return;
+        list_insert(i, j, code);
+        list_insert(j, i, mirror(code));
+      });
+      return;
+    }
+    int u = 0, w = 0;
+    const int no = nbn_[i];
+    while (u < no || w < nf) {
+      const std::size_t base = static_cast<std::size_t>(i) * nbcap_;  // list_insert may grow the lists
+      const int jo = u < no ? nb_[base + u] : std::numeric_limits<int>::max();
+      const int jn = w < nf ? fresh[w] : std::numeric_limits<int>::max();
+      if (jo < jn) {
+        list_erase(jo, i);
+        ++u;
+      } else if (jn < jo) {
+        list_insert(jn, i, mirror(fcode[w]));
+        ++w;
+      } else {
+        if (nbc_[base + u] != fcode[w]) list_recode(jn, i, mirror(fcode[w]));
+        ++u;
+        ++w;
+      }
+    }
+    if (nf > nbcap_) grow_lists(nf);
+    const std::size_t b2 = static_cast<std::size_t>(i) * nbcap_;
+    std::copy(fresh, fresh + nf, nb_.begin() + b2);
+    std::copy(fcode, fcode + nf, nbc_.begin() + b2);
+    nbn_[i] = nf;
+  }
+
+  std::size_t n_ = 0;
+  Boundaries<Dim> box_;
+  double list_r2_ = 0.0;
+  std::array<double, Dim> cw_{};
+  std::array<int, Dim> nc_{}, stride_{};
+  int total_cells_ = 1;
+  double shift_tab_[Dim][4] = {};        // image code -> shift
+  std::vector<int> cell_, head_;         // cells of the list centres, heads of their chains
+  std::vector<Centre> cn_;
+  bool adj_ = false;                     // 1D: rods beside each other, no cell grid
+  std::vector<int> left_, right_;        // 1D: the rods beside, -1 at a wall
+  std::vector<int> nb_, nbn_;            // lists (nbcap_ slots each), lengths
+  std::vector<unsigned char> nbc_;       // their image codes
+  int nbcap_ = 16;
+};
+
+}  // namespace revcol::engine

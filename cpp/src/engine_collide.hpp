@@ -1,0 +1,419 @@
+// EngineImpl's collisions: a pair through the operator Op, a group through ExactCollision,
+// the walls a colliding particle touches (the wall-mask log, revcol/engine/logs.hpp), and
+// the random numbers they draw.
+// The protocol (ties, groups, walls at a collision, the exact-pre log) is described in
+// revcol/engine/engine.hpp. Private to cpp/src, included after engine_impl.hpp.
+#pragma once
+#include <stdexcept>
+
+#include "engine_impl.hpp"
+
+namespace revcol::engine::detail {
+
+template <int Dim, PairOperator Op>
+struct EngineImpl<Dim, Op>::Group {
+  int n = 0;
+  int id[kMaxGroup];
+  Vec off[kMaxGroup];
+  int ne = 0;
+  int ea[3 * kMaxGroup], eb[3 * kMaxGroup];  // edges as member indices, ids ea < eb by id
+  bool overflow = false;
+};
+
+// Members of the contact component of (a, b) at time t, each with its image offset: every
+// particle whose contact with a member is closed within group_tol and approaching or at
+// rest, found through the members' lists.
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::gather(int a, int b, const Vec& s, double t, Group& g) const {
+  g.n = 2;
+  g.id[0] = a;
+  g.off[0] = Vec{};
+  g.id[1] = b;
+  g.off[1] = s;  // x_b + s is b's image next to a
+  g.ne = 1;
+  g.ea[0] = 0;
+  g.eb[0] = 1;
+  for (int m = 0; m < g.n && !g.overflow; ++m) {
+    const int im = g.id[m];
+    Vec pm;
+    for (int k = 0; k < Dim; ++k) pm[k] = pos_at(im, k, t);
+    for_neighbours(im, [&](int j, const Vec& sh) {
+      if (g.overflow) return;
+      double r2 = 0.0, rw = 0.0;
+      double r[Dim];
+      for (int k = 0; k < Dim; ++k) {
+        r[k] = pm[k] - (pos_at(j, k, t) + sh[k]);
+        r2 += r[k] * r[k];
+      }
+      if (!(r2 - sigma2_ <= contact_tol_)) return;
+      for (int k = 0; k < Dim; ++k) rw += r[k] * (p_[im].v[k] - p_[j].v[k]);
+      if (!(rw <= 0.0)) return;
+      int q = -1;
+      for (int u = 0; u < g.n; ++u)
+        if (g.id[u] == j) q = u;
+      if (q < 0) {
+        if (g.n == kMaxGroup) {
+          g.overflow = true;
+          return;
+        }
+        q = g.n++;
+        g.id[q] = j;
+        for (int k = 0; k < Dim; ++k) g.off[q][k] = g.off[m][k] + sh[k];
+      } else {
+        // the same image? (a component wrapping around the box is not one contact set)
+        for (int k = 0; k < Dim; ++k)
+          if (g.off[q][k] != g.off[m][k] + sh[k]) return;
+      }
+      for (int e = 0; e < g.ne; ++e)
+        if ((g.ea[e] == m && g.eb[e] == q) || (g.ea[e] == q && g.eb[e] == m)) return;
+      if (g.ne == 3 * kMaxGroup) {
+        g.overflow = true;
+        return;
+      }
+      g.ea[g.ne] = m;
+      g.eb[g.ne] = q;
+      ++g.ne;
+    });
+  }
+}
+
+// ---- random numbers ------------------------------------------------------------------------
+
+// CLCG4 only: each stream's state, from the family and the draws taken (rng_): a
+// modular power of the multipliers per stream.
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::make_generators() {
+  clcg_.clear();
+  if (cfg_.generator != Generator::clcg4) return;
+  clcg_ = rng::generator_traits<rng::CLCG4>::family(cfg_.seed, stream_count());
+  for (std::size_t i = 0; i < clcg_.size(); ++i) {
+    if (rng_[i] == 0) continue;
+    rng::CLCG4::State st = clcg_[i].state();
+    for (int j = 0; j < 4; ++j)
+      st[j] = rng::clcg4_detail::mulmod(
+          st[j], rng::clcg4_detail::powmod(rng::CLCG4::multiplier[j], rng_[i], rng::CLCG4::modulus[j]),
+          rng::CLCG4::modulus[j]);
+    clcg_[i].set_state(st);
+  }
+}
+
+// One number from a stream: Philox at the stream's counter, or CLCG4 next / prev.
+template <int Dim, PairOperator Op>
+double EngineImpl<Dim, Op>::draw(int stream, bool reversed) {
+  if (cfg_.generator == Generator::clcg4) {
+    if (reversed) {
+      --rng_[stream];
+      return clcg_[stream].prev();
+    }
+    ++rng_[stream];
+    return clcg_[stream].next();
+  }
+  const rng::Philox p({static_cast<std::uint32_t>(stream), cfg_.seed}, 0);
+  if (reversed) return p.at(--rng_[stream]);
+  return p.at(rng_[stream]++);
+}
+
+// ---- walls at a collision's instant (the wall-mask log) -----------------------------------
+
+// Reflects i on every wall it touches and approaches (Boundaries::reflect, the wall
+// operator's per-axis form); returns the mask of flipped axes.
+template <int Dim, PairOperator Op>
+unsigned EngineImpl<Dim, Op>::touch_walls(int i) {
+  unsigned mask = 0;
+  for (int k = 0; k < Dim; ++k)
+    if (box_.reflect(k, p_[i].x[k], p_[i].v[k])) {
+      mask |= 1u << k;
+      ++counters_.wall_events;
+    }
+  return mask;
+}
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::flip_mask(int i, unsigned mask) {
+  for (int k = 0; k < Dim; ++k)
+    if (mask >> k & 1u) {
+      p_[i].v[k] = -p_[i].v[k];
+      ++counters_.wall_events;
+    }
+}
+template <int Dim, PairOperator Op>
+bool EngineImpl<Dim, Op>::touches_wall(int i) const {
+  for (int k = 0; k < Dim; ++k)
+    if (box_.touches(k, p_[i].x[k])) return true;
+  return false;
+}
+
+// ---- pairs --------------------------------------------------------------------------------
+
+// A collision of a and b predicted at t (stamps checked). Returns whether one happened.
+template <int Dim, PairOperator Op>
+bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
+  if (a > b) std::swap(a, b);
+  const Vec s = nl_.pair_shift(a, b);
+  // The gather scans two neighbourhoods; it runs only when a group is possible: a
+  // neighbour was within the contact tolerance at a prediction (resting contacts), or a
+  // second collision of a or b was predicted within a relative 1e-9 of t (ties).
+  const double window = t + 1e-9 * (std::fabs(t) + 1.0);
+  const bool maybe = cfg_.force_group_search || touching_[a] || touching_[b] || second_[a] <= window ||
+                     second_[b] <= window;
+  if (cfg_.groups && maybe) {
+    Group g;
+    gather(a, b, s, t, g);
+    if (g.n > 2 || g.overflow) {
+      if (!g.overflow && group_collide(g, t, reversed)) return true;
+      ++counters_.group_fallbacks;
+    }
+  }
+  advance(a, t);
+  advance(b, t);
+  const std::int64_t wkey = reversed ? netc_[a] - 1 : netc_[a];
+  unsigned w1[2] = {0, 0}, w2[2] = {0, 0};
+  if (reversed) {
+    wlog_.pop(a, wkey, 2, w1, w2);
+    flip_mask(a, w2[0]);
+    flip_mask(b, w2[1]);
+  } else {
+    w1[0] = touch_walls(a);
+    w1[1] = touch_walls(b);
+  }
+  Vec r;
+  double rw = 0.0;
+  for (int k = 0; k < Dim; ++k) {
+    r[k] = (p_[a].x[k] - p_[b].x[k]) - s[k];
+    rw += r[k] * (p_[a].v[k] - p_[b].v[k]);
+  }
+  if (!(rw < 0.0)) {  // grazing: round-off left no approach at contact
+    ++counters_.grazing_skipped;
+    repredict(a);
+    repredict(b);
+    return false;
+  }
+  PairV<Dim> in;
+  for (int k = 0; k < Dim; ++k) {
+    in.i[k] = p_[a].v[k];
+    in.j[k] = p_[b].v[k];
+  }
+  PairV<Dim> out;
+  try {
+    out = apply_pair(in, r, stream_of(a), reversed);
+  } catch (const InvalidArgument&) {
+    // Only a reversed run can get here: a post state this operator cannot reverse (the
+    // rare log is empty, or the state fails validation) means the reversed trajectory has
+    // left the forward one (beyond the round-off horizon). The pair reflects specularly,
+    // drawing nothing, and the failure is counted: the restored state is not the start.
+    if (!reversed) throw;
+    ++counters_.reverse_failures;
+    out = Specular<Dim>::reflect(in, r);
+  }
+  for (int k = 0; k < Dim; ++k) {
+    p_[a].v[k] = out.i[k];
+    p_[b].v[k] = out.j[k];
+  }
+  if (reversed) {
+    flip_mask(a, w1[0]);
+    flip_mask(b, w1[1]);
+  } else {
+    w2[0] = touch_walls(a);
+    w2[1] = touch_walls(b);
+    if (w1[0] | w1[1] | w2[0] | w2[1] || touches_wall(a) || touches_wall(b)) {
+      const int ids[2] = {a, b};
+      wlog_.push(a, wkey, t, 2, ids, netc_.data(), w1, w2);
+    }
+  }
+  finish_collision(a, reversed);
+  finish_collision(b, reversed);
+  ++counters_.pair_collisions;
+  const int ids[2] = {a, b};
+  validate_collision(ids, 2);
+  repredict(a);
+  repredict(b);
+  return true;
+}
+
+// Forward: Op's forward; reversed (velocities negated): -Op.reverse(-v), its draws stepped
+// back in the opposite order. An operator that needs the exact-pre log keeps a singular pre
+// state whose cell centre is off by more than 1e-10, keyed by (stream, counter before the
+// draws), and the reversed collision restores it.
+template <int Dim, PairOperator Op>
+PairV<Dim> EngineImpl<Dim, Op>::apply_pair(const PairV<Dim>& in, const Vec& r, int stream, bool reversed) {
+  PairV<Dim> arg = in;
+  if (reversed)
+    for (int k = 0; k < Dim; ++k) {
+      arg.i[k] = -arg.i[k];
+      arg.j[k] = -arg.j[k];
+    }
+  std::array<double, (Op::draws > 0 ? Op::draws : 1)> g{};
+  if (reversed)
+    for (int k = Op::draws - 1; k >= 0; --k) g[k] = draw(stream, true);
+  else
+    for (int k = 0; k < Op::draws; ++k) g[k] = draw(stream, false);
+  PairV<Dim> out;
+  if (reversed) {
+    out = op_.reverse(arg, r, g.data(), log_);
+    if constexpr (Op::needs_exact_pre_log) pre_.pop(stream, rng_[stream], out.i.data(), out.j.data());
+    for (int k = 0; k < Dim; ++k) {
+      out.i[k] = -out.i[k];
+      out.j[k] = -out.j[k];
+    }
+  } else {
+    out = op_.forward(arg, r, g.data(), log_);
+    if constexpr (Op::needs_exact_pre_log) {
+      static_assert(ExactPreLogged<Op>, "an operator that needs the exact-pre log gives singular() and quantize()");
+      if (op_.singular(arg, r)) {
+        const PairV<Dim> q = op_.quantize(arg, r);
+        if (ExactPreLog::off_by(arg.i.data(), q.i.data(), Dim) || ExactPreLog::off_by(arg.j.data(), q.j.data(), Dim))
+          pre_.push(stream, rng_[stream] - Op::draws, arg.i.data(), arg.j.data(), Dim);
+      }
+    }
+  }
+  return out;
+}
+
+// ---- groups -------------------------------------------------------------------------------
+
+// A group of n > 2 particles: members sorted by id, contacts oriented from the larger id to
+// the smaller, ExactCollision drawing (n-1)d-1 numbers from the stream of the smallest id.
+// Returns false (nothing changed) when the operator refuses the group.
+template <int Dim, PairOperator Op>
+bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
+  int order[kMaxGroup] = {};
+  for (int u = 0; u < g.n; ++u) order[u] = u;
+  for (int u = 1; u < g.n; ++u)  // insertion sort by id (n <= 8)
+    for (int w = u; w > 0 && g.id[order[w]] < g.id[order[w - 1]]; --w) std::swap(order[w], order[w - 1]);
+  const int n = g.n;
+  const int first = g.id[order[0]];
+  const std::int64_t wkey = reversed ? netc_[first] - 1 : netc_[first];
+  unsigned w1[kMaxGroup], w2[kMaxGroup];
+  for (int u = 0; u < n; ++u) advance(g.id[order[u]], t);
+  if (reversed) {
+    wlog_.pop(first, wkey, n, w1, w2);
+    for (int u = 0; u < n; ++u) flip_mask(g.id[order[u]], w2[u]);
+  } else {
+    for (int u = 0; u < n; ++u) w1[u] = touch_walls(g.id[order[u]]);
+  }
+  int ids[kMaxGroup];
+  for (int u = 0; u < n; ++u) ids[u] = g.id[order[u]];
+  if (!group_operator(g, order, t, reversed)) {
+    // refused before any draw was consumed (validation comes first): undo the walls
+    for (int u = 0; u < n; ++u) flip_mask(ids[u], reversed ? w2[u] : w1[u]);
+    if (reversed && (std::any_of(w1, w1 + n, [](unsigned q) { return q != 0; }) ||
+                     std::any_of(w2, w2 + n, [](unsigned q) { return q != 0; })))
+      wlog_.push(first, wkey, t, n, ids, netc_.data(), w1, w2);  // put the masks back
+    return false;
+  }
+  for (int u = 0; u < n; ++u) {
+    if (reversed) flip_mask(ids[u], w1[u]);
+    else w2[u] = touch_walls(ids[u]);
+    finish_collision(ids[u], reversed);
+  }
+  if (!reversed) {
+    bool any = false;
+    for (int u = 0; u < n; ++u) any = any || w1[u] != 0 || w2[u] != 0 || touches_wall(ids[u]);
+    if (any) {
+      // the keys must be the counts before this collision: undo finish_collision's step
+      for (int u = 0; u < n; ++u) --netc_[ids[u]];
+      wlog_.push(first, wkey, t, n, ids, netc_.data(), w1, w2);
+      for (int u = 0; u < n; ++u) ++netc_[ids[u]];
+    }
+  }
+  ++counters_.group_collisions;
+  counters_.group_particles += static_cast<std::uint64_t>(n);
+  validate_collision(ids, n);
+  for (int u = 0; u < n; ++u) repredict(g.id[u]);
+  return true;
+}
+
+// The group's velocities through ExactCollision (members in id order): forward, or
+// -reverse(-v) with the draws stepped back; the exact-pre log for resting contacts. Sets
+// the members' velocities; returns false, nothing changed, when the operator refuses.
+template <int Dim, PairOperator Op>
+bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, bool reversed) {
+  const int n = g.n;
+  int rank[kMaxGroup];
+  for (int u = 0; u < n; ++u) rank[order[u]] = u;
+  struct E {
+    int i, j, mi, mj;
+  };
+  std::vector<E> edges;
+  edges.reserve(g.ne);
+  for (int e = 0; e < g.ne; ++e) {
+    int p = g.ea[e], q = g.eb[e];
+    if (g.id[p] > g.id[q]) std::swap(p, q);
+    edges.push_back({rank[p], rank[q], p, q});
+  }
+  std::sort(edges.begin(), edges.end(), [](const E& x, const E& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
+  std::vector<Contact> contacts;
+  std::vector<double> normals;
+  for (const E& e : edges) {
+    contacts.push_back({e.i, e.j});
+    for (int k = 0; k < Dim; ++k) {
+      const double xi = pos_at(g.id[e.mi], k, t) + g.off[e.mi][k];
+      const double xj = pos_at(g.id[e.mj], k, t) + g.off[e.mj][k];
+      normals.push_back(xi - xj);
+    }
+  }
+  std::vector<double> pre(n * Dim), post(n * Dim);
+  for (int u = 0; u < n; ++u)
+    for (int k = 0; k < Dim; ++k) {
+      const double vk = p_[g.id[order[u]]].v[k];
+      pre[u * Dim + k] = reversed ? -vk : vk;
+    }
+  const int stream = stream_of(g.id[order[0]]);
+  try {
+    const ExactCollision op(n, Dim, contacts, normals, cfg_.law, cfg_.bits);
+    const int m = op.draws();
+    std::vector<double> gs(m);
+    if (reversed) {
+      op.check_post(pre.data());
+      for (int k = m - 1; k >= 0; --k) gs[k] = draw(stream, true);
+      op.reverse(pre.data(), gs.data(), post.data(), log_);
+      pre_.pop(stream, rng_[stream], post.data(), nullptr);
+    } else {
+      op.check_pre(pre.data());
+      const std::uint64_t key = rng_[stream];
+      for (int k = 0; k < m; ++k) gs[k] = draw(stream, false);
+      op.forward(pre.data(), gs.data(), post.data(), log_);
+      // resting contacts and aligned velocities put the pre state on a singular set of
+      // the chart (a vertex of T, eta = 0), where its cell spans ~2^-K/2: keep it exactly
+      std::vector<double> q(n * Dim);
+      op.quantize(pre.data(), q.data());
+      if (ExactPreLog::off_by(pre.data(), q.data(), n * Dim)) pre_.push(stream, key, pre.data(), nullptr, n * Dim);
+    }
+  } catch (const InvalidArgument&) {
+    return false;
+  }
+  for (int u = 0; u < n; ++u) {
+    const int id = g.id[order[u]];
+    for (int k = 0; k < Dim; ++k) p_[id].v[k] = reversed ? -post[u * Dim + k] : post[u * Dim + k];
+  }
+  return true;
+}
+
+// REVCOL_VALIDATE builds: after a collision, the members are not overlapping any listed
+// neighbour (beyond round-off), every list is symmetric (small systems) and the queue
+// keeps its invariants. Throws std::logic_error on a violation. A no-op otherwise.
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::validate_collision(const int* ids, int n) const {
+#ifdef REVCOL_VALIDATE
+  for (int u = 0; u < n; ++u) {
+    const int i = ids[u];
+    for_neighbours(i, [&](int j, const Vec& sh) {
+      double r2 = 0.0;
+      for (int k = 0; k < Dim; ++k) {
+        const double d = pos_at(i, k, clock_) - (pos_at(j, k, clock_) + sh[k]);
+        r2 += d * d;
+      }
+      if (!(r2 >= sigma2_ * (1.0 - 1e-6)))
+        throw std::logic_error("REVCOL_VALIDATE: particles " + std::to_string(i) + " and " + std::to_string(j) +
+                               " overlap after a collision: |r| / D = " + std::to_string(std::sqrt(r2 / sigma2_)) +
+                               (rev_ ? " (reversed run)" : " (forward run)") + " at t = " + std::to_string(clock_));
+    });
+  }
+  if (!queue_.valid()) throw std::logic_error("REVCOL_VALIDATE: event queue invariants broken");
+  if (n_ <= 2000 && !nl_.valid()) throw std::logic_error("REVCOL_VALIDATE: neighbour lists not symmetric");
+#else
+  (void)ids;
+  (void)n;
+#endif
+}
+
+}  // namespace revcol::engine::detail

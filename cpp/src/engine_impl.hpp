@@ -1,0 +1,581 @@
+// The event-driven engine for one dimension and one pair operator: EngineImpl<Dim, Op>,
+// behind revcol::engine::Simulation. The physics and the reversal protocol are in
+// revcol/engine/engine.hpp; the parts it is made of in revcol/engine/ (event queue,
+// neighbour lists, boundaries, keyed logs, kinematics) and the operator concept in
+// revcol/collide/operator.hpp. This header holds the class, its state and its event loop;
+// engine_collide.hpp the collisions (pairs, groups, walls at a collision).
+// Private to cpp/src: included by the per-dimension engine_<d>d.cpp files only.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "revcol/collide/exact.hpp"
+#include "revcol/collide/operator.hpp"
+#include "revcol/collide/specular.hpp"
+#include "revcol/engine/boundary.hpp"
+#include "revcol/engine/engine.hpp"
+#include "revcol/engine/event_queue.hpp"
+#include "revcol/engine/kinematics.hpp"
+#include "revcol/engine/logs.hpp"
+#include "revcol/engine/neighbours.hpp"
+#include "revcol/error.hpp"
+#include "revcol/rng/clcg4.hpp"
+#include "revcol/rng/philox.hpp"
+#include "revcol/rng/streams.hpp"
+
+namespace revcol::engine::detail {
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+inline constexpr int kMaxGroup = 8;  // particles in one group collision
+
+enum Kind : std::int32_t { kWall = 0, kRenew = 1, kColl = 2, kNone = 3 };  // kRenew: neighbour-list renewal
+
+/// One particle's scheduled event (the queue holds its key (t, kind, id)).
+struct Ev {
+  double t = kInf;              ///< time
+  std::int32_t kind = kNone;    ///< Kind
+  std::int32_t partner = -1;    ///< particle (collision), 2 axis + (v > 0) (wall) or 0 (renewal)
+  std::uint64_t stamp = 0;      ///< the partner's stamp at prediction
+};
+
+/// Lexicographic (t, kind, partner): a canonical earliest candidate whatever the scan order.
+inline bool earlier(double t, std::int32_t kind, std::int32_t partner, const Ev& e) {
+  if (t != e.t) return t < e.t;
+  if (kind != e.kind) return kind < e.kind;
+  return partner < e.partner;
+}
+
+/// The shell in diameters, from the packing fraction phi (see setup_geometry).
+double auto_shell(int dim, double phi);
+
+/// Builds the engine for config.mode in dimension Dim (engine_<d>d.cpp).
+template <int Dim>
+std::unique_ptr<Simulation> make_engine(const Config& c, const std::vector<double>& x, const std::vector<double>& v,
+                                        double t0);
+/// Restores the engine for s.config.mode in dimension Dim (engine_<d>d.cpp).
+template <int Dim>
+std::unique_ptr<Simulation> restore_engine(const Snapshot& s);
+
+template <int Dim, PairOperator Op>
+class EngineImpl final : public Simulation {
+  static_assert(Op::dim == Dim, "the operator's dimension must be the engine's");
+
+ public:
+  using Vec = std::array<double, Dim>;
+  using Kin = FloatKinematics<Dim>;
+
+  EngineImpl(const Config& c, const std::vector<double>& x, const std::vector<double>& v, double t0, Op op)
+      : cfg_(c), n_(x.size() / Dim), op_(std::move(op)) {
+    setup_geometry();
+    p_.assign(n_, Particle<Dim>{});
+    for (std::size_t i = 0; i < n_; ++i) {
+      for (int k = 0; k < Dim; ++k) {
+        p_[i].x[k] = x[i * Dim + k];
+        p_[i].v[k] = v[i * Dim + k];
+      }
+      p_[i].t = t0;
+    }
+    clock_ = t0;
+    start_ = t0;
+    ncoll_.assign(n_, 0);
+    rng_.assign(stream_count(), 0);
+    make_generators();
+    nl_.set_centres(x);  // list centres: where the particles start
+    ev_.assign(n_, Ev{});
+    netc_.assign(n_, 0);
+    second_.assign(n_, kInf);
+    touching_.assign(n_, 0);
+    build_lists();
+    const Diagnostics d = diagnostics();
+    e0_ = d.energy;
+    p0_ = d.momentum;
+    rebuild_events();
+  }
+
+  EngineImpl(const Snapshot& s, Op op) : cfg_(s.config), n_(s.n), op_(std::move(op)) {
+    setup_geometry();
+    p_.assign(n_, Particle<Dim>{});
+    for (std::size_t i = 0; i < n_; ++i) {
+      for (int k = 0; k < Dim; ++k) {
+        p_[i].x[k] = s.x[i * Dim + k];
+        p_[i].v[k] = s.v[i * Dim + k];
+      }
+      p_[i].t = s.t_local[i];
+      p_[i].stamp = s.stamp[i];
+    }
+    clock_ = s.time;
+    start_ = s.start_time;
+    net_ = s.net_collisions;
+    ncoll_ = s.ncoll;
+    require(s.rng.size() == stream_count(), "snapshot: rng must hold one draw count per stream");
+    rng_ = s.rng;
+    make_generators();
+    // list centres (cells and lists follow from them); a checkpoint without them (written
+    // before the neighbour lists) starts them where the particles are and predicts anew
+    const bool old_format = s.centre.empty();
+    nl_.set_centres(old_format ? positions() : s.centre);
+    ev_.resize(n_);
+    netc_ = s.netc;
+    WallLog::fields(wlog_, [&](const char* key, auto& field) { s.field(key, field); });
+    ExactPreLog::fields(pre_, [&](const char* key, auto& field) { s.field(key, field); });
+    second_.assign(n_, kInf);
+    touching_.assign(n_, 0);
+    for (std::size_t i = 0; i < n_; ++i) {
+      require(s.ev_kind[i] >= kWall && s.ev_kind[i] <= kNone, "snapshot: bad event kind");
+      require(s.ev_kind[i] != kColl || (s.ev_partner[i] >= 0 && static_cast<std::size_t>(s.ev_partner[i]) < n_),
+              "snapshot: event partner outside [0, n)");
+      ev_[i] = Ev{s.ev_t[i], static_cast<std::int32_t>(s.ev_kind[i]), static_cast<std::int32_t>(s.ev_partner[i]),
+                  s.ev_stamp[i]};
+      second_[i] = s.second[i];
+      touching_[i] = s.touching[i] != 0;
+    }
+    for (std::uint64_t c : s.log_cells) log_.push(c);
+    log_offset_ = s.log_pushed - log_.pushed();
+    counters_ = s.counters;
+    e0_ = s.energy0;
+    p0_ = s.momentum0;
+    build_lists();
+    if (old_format) rebuild_events();
+    else build_queue();
+  }
+
+  // ---- the Simulation interface -------------------------------------------------------
+
+  RunResult run(std::uint64_t max_collisions, double t_end, const Progress& cb, std::uint64_t every) override {
+    require(!std::isnan(t_end), "end time must not be NaN");
+    return loop(max_collisions, t_end, cb, every, /*reversed=*/false);
+  }
+
+  RunResult run_back(std::uint64_t max_collisions, double t_target) override {
+    require(!std::isnan(t_target), "target time must not be NaN");
+    require(t_target <= clock_, [&] {
+      return "run_back: target time " + std::to_string(t_target) + " is later than the current time " +
+             std::to_string(clock_);
+    });
+    flip();
+    RunResult r;
+    try {
+      r = loop(max_collisions, -t_target, {}, 0, /*reversed=*/true);
+    } catch (...) {
+      flip();
+      throw;
+    }
+    flip();
+    if (clock_ == 0.0) clock_ = 0.0;  // -0 from the negations reads as 0
+    r.time = clock_;
+    return r;
+  }
+
+  std::vector<double> positions() const override {
+    std::vector<double> out(n_ * Dim);
+    for (std::size_t i = 0; i < n_; ++i)
+      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = Kin::pos_at(p_[i], k, clock_);
+    return out;
+  }
+  std::vector<double> velocities() const override {
+    std::vector<double> out(n_ * Dim);
+    for (std::size_t i = 0; i < n_; ++i)
+      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = p_[i].v[k];
+    return out;
+  }
+  std::vector<std::uint64_t> collision_counts() const override { return ncoll_; }
+  double time() const override { return clock_; }
+  double start_time() const override { return start_; }
+  std::size_t size() const override { return n_; }
+  const Config& config() const override { return cfg_; }
+
+  Diagnostics diagnostics() const override {
+    Diagnostics d;
+    double e = 0.0;
+    for (std::size_t i = 0; i < n_; ++i)
+      for (int k = 0; k < Dim; ++k) {
+        const double vk = p_[i].v[k];
+        e += 0.5 * vk * vk;
+        d.momentum[k] += vk;
+      }
+    d.energy = e;
+    d.energy_drift = e0_ > 0 ? (e - e0_) / e0_ : 0.0;
+    double dp = 0.0;
+    for (int k = 0; k < Dim; ++k) dp += (d.momentum[k] - p0_[k]) * (d.momentum[k] - p0_[k]);
+    d.momentum_drift = e0_ > 0 ? std::sqrt(dp) / std::sqrt(2.0 * e0_ * static_cast<double>(n_)) : 0.0;
+    d.log_bytes = log_.bytes() + pre_.bytes() + wlog_.bytes();
+    d.wall_log_entries = wlog_.entries();
+    d.log_pushed = log_.pushed() + log_offset_;
+    d.exact_pre_pushed = pre_.pushed();
+    d.exact_pre_entries = pre_.entries();
+    std::uint64_t parts = 0;
+    for (auto c : ncoll_) parts += c;
+    d.collisions_per_particle = static_cast<double>(parts) / static_cast<double>(n_);
+    d.net_collisions = net_;
+    d.counters = counters_;
+    return d;
+  }
+
+  Snapshot snapshot() const override {
+    Snapshot s;
+    s.config = cfg_;
+    s.n = n_;
+    s.time = clock_;
+    s.start_time = start_;
+    s.net_collisions = net_;
+    s.x.resize(n_ * Dim);
+    s.v.resize(n_ * Dim);
+    s.centre.resize(n_ * Dim);
+    s.t_local.resize(n_);
+    s.stamp.resize(n_);
+    s.ev_t.resize(n_);
+    s.ev_kind.resize(n_);
+    s.ev_partner.resize(n_);
+    s.ev_stamp.resize(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      for (int k = 0; k < Dim; ++k) {
+        s.x[i * Dim + k] = p_[i].x[k];
+        s.v[i * Dim + k] = p_[i].v[k];
+        s.centre[i * Dim + k] = nl_.centre(static_cast<int>(i))[k];
+      }
+      s.t_local[i] = p_[i].t;
+      s.stamp[i] = p_[i].stamp;
+      s.ev_t[i] = ev_[i].t;
+      s.ev_kind[i] = ev_[i].kind;
+      s.ev_partner[i] = ev_[i].partner;
+      s.ev_stamp[i] = ev_[i].stamp;
+    }
+    s.cell.assign(nl_.cells().begin(), nl_.cells().end());
+    s.ncoll = ncoll_;
+    s.rng = rng_;
+    s.second = second_;
+    s.touching.assign(touching_.begin(), touching_.end());
+    s.log_cells = log_.cells();
+    s.log_pushed = log_.pushed() + log_offset_;
+    s.netc = netc_;
+    WallLog::fields(wlog_, [&](const char* key, const auto& field) { s.field(key, field); });
+    ExactPreLog::fields(pre_, [&](const char* key, const auto& field) { s.field(key, field); });
+    s.counters = counters_;
+    s.energy0 = e0_;
+    s.momentum0 = p0_;
+    return s;
+  }
+
+  std::size_t memory_bytes() const override {
+    return n_ * (sizeof(Particle<Dim>) + sizeof(Ev) + sizeof(double) + 1 + 3 * sizeof(std::uint64_t)) +
+           nl_.memory_bytes() + queue_.memory_bytes() + log_.bytes() + pre_.bytes() + wlog_.bytes() +
+           clcg_.size() * sizeof(rng::CLCG4);
+  }
+
+ private:
+  // ---- geometry ------------------------------------------------------------------------
+  // Listed centres must be within D + shell < L / 2, so that each listed pair has one
+  // nearest image: a small periodic box (L >= 3 D) takes a thinner shell. A particle stays
+  // within h = (shell - 1e-3 D) / 2 of its list centre (revcol/engine/neighbours.hpp).
+  void setup_geometry() {
+    sigma2_ = cfg_.diameter * cfg_.diameter;
+    contact_tol_ = 2.0 * cfg_.group_tol * sigma2_;
+    box_ = Boundaries<Dim>(cfg_);
+    double vol = 1.0;  // in diameters^d
+    for (int k = 0; k < Dim; ++k) vol *= cfg_.box[k] / cfg_.diameter;
+    const double phi = static_cast<double>(n_) * particle_volume(Dim, 1.0) / vol;
+    shell_ = (cfg_.shell > 0.0 ? cfg_.shell : auto_shell(Dim, phi)) * cfg_.diameter;
+    for (int k = 0; k < Dim; ++k)
+      if (box_.periodic(k)) shell_ = std::min(shell_, 0.9 * (0.5 * cfg_.box[k] - cfg_.diameter));
+    renew_h_ = 0.5 * (shell_ - 1e-3 * cfg_.diameter);
+    renew_h2_ = renew_h_ * renew_h_;
+    nl_.setup(n_, box_, cfg_.diameter + shell_, Dim == 1 && (!box_.periodic(0) || n_ >= 3));
+  }
+  bool adjacent() const { return nl_.adjacent(); }  // a constant false in 2D and 3D
+  void build_lists() {
+    nl_.build([&](int j) { return pos_at(j, 0, clock_); });
+  }
+  double pos_at(int j, int k, double t) const { return Kin::pos_at(p_[j], k, t); }
+  template <class F>
+  void for_neighbours(int i, F&& f) const {
+    nl_.for_neighbours(i, f, [&](int j) { __builtin_prefetch(&p_[j]); });
+  }
+  static constexpr double kWrap = 0.25;  // 1D ring: a rod is wrapped kWrap D past the box's end
+
+  // ---- prediction ---------------------------------------------------------------------
+
+  // i's earliest event: a wall, its list renewal (in 1D on a ring: its wrap), or a
+  // collision with a listed particle; also its second earliest collision time and whether
+  // a neighbour touches it (the group gate).
+  void predict(int i) {
+    Ev best;
+    const double ti = p_[i].t;
+    for (int k = 0; k < Dim; ++k) {
+      const double vk = p_[i].v[k];
+      if (vk == 0.0 || !box_.walls(k)) continue;
+      const int up = vk > 0.0 ? 1 : 0;
+      bool wall_ok = true;
+      if (rev_ && box_.touches_ahead(k, p_[i].x[k] + vk * (clock_ - ti), up)) {
+        // touching and approaching in a reversed run: a flip of a collision's W2 at this
+        // instant is undone now; any other touched wall waits for the collision
+        const long m = wall_entry(i);
+        wall_ok = m >= 0 && (wlog_.mask(m) >> (8 + k) & 1u);
+      }
+      if (wall_ok) {
+        double t = Kin::plane_time(p_[i], k, box_.wall_at(k, up));
+        if (t < clock_) t = clock_;
+        if (earlier(t, kWall, 2 * k + up, best)) best = Ev{t, kWall, 2 * k + up, 0};
+      }
+    }
+    if (adjacent()) {
+      // 1D: no renewal; on a periodic axis the wrap, kWrap D past either end of the box
+      const double vk = p_[i].v[0];
+      if (box_.periodic(0) && vk != 0.0) {
+        const double edge = vk > 0.0 ? box_.length(0) + kWrap * cfg_.diameter : -kWrap * cfg_.diameter;
+        double t = Kin::plane_time(p_[i], 0, edge);
+        if (t < clock_) t = clock_;
+        if (earlier(t, kRenew, 0, best)) best = Ev{t, kRenew, 0, 0};
+      }
+    } else {
+      double tau;
+      if (Kin::renewal_time(p_[i], nl_.centre(i), renew_h2_, tau)) {
+        double t = ti + tau;
+        if (t < clock_) t = clock_;
+        if (earlier(t, kRenew, 0, best)) best = Ev{t, kRenew, 0, 0};
+      }
+    }
+    double first = kInf, second = kInf;  // the two earliest collision times (the group gate)
+    bool touch = false;
+    for_neighbours(i, [&](int j, const Vec& sh) {
+      double t;
+      bool hit, tj = false;
+      if (i < j) {
+        hit = Kin::pair_time(p_[i], p_[j], sh, sigma2_, contact_tol_, t, tj);
+      } else {
+        Vec s;
+        for (int k = 0; k < Dim; ++k) s[k] = -sh[k];
+        hit = Kin::pair_time(p_[j], p_[i], s, sigma2_, contact_tol_, t, tj);
+      }
+      if (tj) {
+        touch = true;
+        touching_[j] = 1;
+      }
+      if (!hit) return;
+      if (t < clock_) t = clock_;
+      if (t < first) {
+        second = first;
+        first = t;
+      } else if (t < second) {
+        second = t;
+      }
+      if (earlier(t, kColl, j, best)) best = Ev{t, kColl, j, p_[j].stamp};
+    });
+    ev_[i] = best;
+    second_[i] = second;
+    touching_[i] = touch ? 1 : 0;
+  }
+
+  // ---- the event queue (revcol/engine/event_queue.hpp), key (t, kind, id) ----------------
+
+  // Every event into the queue (construction, restore, reversal): the window starts at the
+  // clock, ~8 events per bucket from the median distance of the events ahead.
+  void build_queue() {
+    std::vector<double> ahead;
+    ahead.reserve(n_);
+    for (std::size_t i = 0; i < n_; ++i)
+      if (ev_[i].t < kInf) ahead.push_back(ev_[i].t - clock_);
+    double width = 0.0;
+    if (!ahead.empty()) {
+      auto mid = ahead.begin() + ahead.size() / 2;
+      std::nth_element(ahead.begin(), mid, ahead.end());
+      width = 8.0 * 2.0 * *mid / static_cast<double>(ahead.size());
+    }
+    if (!(width > 0.0) || !std::isfinite(width)) width = 1.0;
+    queue_.reset(n_, clock_, width);
+    for (std::size_t i = 0; i < n_; ++i) update(static_cast<int>(i));
+  }
+  void update(int i) { queue_.set(i, ev_[i].t, ev_[i].kind); }
+  void rebuild_events() {
+    for (std::size_t i = 0; i < n_; ++i) predict(static_cast<int>(i));
+    build_queue();
+  }
+  void repredict(int i) {
+    predict(i);
+    update(i);
+  }
+
+  // ---- state changes ------------------------------------------------------------------
+
+  void advance(int i, double t) { Kin::advance(p_[i], t); }
+
+  // Negates velocities, local times and the clock; rebuilds every prediction.
+  void flip() {
+    for (auto& q : p_) {
+      for (int k = 0; k < Dim; ++k) q.v[k] = -q.v[k];
+      q.t = -q.t;
+    }
+    clock_ = -clock_;
+    rev_ = !rev_;
+    for (auto& q : p_) ++q.stamp;
+    rebuild_events();
+  }
+
+  void wall_event(int i, const Ev& e) {
+    advance(i, e.t);
+    if (rev_) {
+      // arriving at a wall at the instant of a logged collision: only W2's flips are
+      // undone here; a wall that collision left untouched waits for it
+      const long m = wall_entry(i);
+      if (m >= 0) {
+        const std::uint64_t bit = 1ull << (8 + e.partner / 2);
+        if (!(wlog_.mask(m) & bit)) {
+          repredict(i);
+          return;
+        }
+        wlog_.clear(m, bit);
+      }
+    }
+    const int k = e.partner / 2;
+    p_[i].v[k] = -p_[i].v[k];
+    ++counters_.wall_events;
+    repredict(i);
+  }
+
+  // The list renewal: the centre moves to where i is now (wrapped into the box on periodic
+  // axes, moving the stored position by L: its line, and so every prediction, is unchanged),
+  // i's list is rebuilt (in 1D, the images of the rods beside it recoded: this is then the
+  // wrap) and i is predicted again. Nothing physical changes: no stamp.
+  void renew_event(int i, const Ev& e) {
+    move_centre(i, e.t);
+    if (adjacent()) nl_.recode_beside(i, [&](int j) { return pos_at(j, 0, clock_); });
+    else nl_.renew(i);
+    ++counters_.list_renewals;
+    repredict(i);
+  }
+
+  // i's centre to where i is at t; on a periodic axis a position outside the box is first
+  // moved by L (its line, and so every prediction, is unchanged).
+  void move_centre(int i, double t) {
+    const double dt = t - p_[i].t;
+    double* c = nl_.centre(i);
+    for (int k = 0; k < Dim; ++k) {
+      double ck = p_[i].x[k] + p_[i].v[k] * dt;
+      if (box_.wrap(k, p_[i].x[k], ck)) ck = p_[i].x[k] + p_[i].v[k] * dt;
+      c[k] = ck;
+    }
+  }
+
+  // ---- random numbers -----------------------------------------------------------------
+
+  std::size_t stream_count() const { return cfg_.streams == rng::StreamPolicy::single ? 1 : n_; }
+  // The stream a collision whose smallest particle id is `id` draws from.
+  int stream_of(int id) const { return cfg_.streams == rng::StreamPolicy::single ? 0 : id; }
+
+  // CLCG4 only: each stream's state, from the family and the draws taken (rng_).
+  void make_generators();
+  // One number from a stream, forward (the next) or reversed (the last one, stepped back).
+  double draw(int stream, bool reversed);
+
+  // ---- collisions (engine_collide.hpp) --------------------------------------------------
+
+  struct Group;  // members of a contact component, with image offsets and edges
+  void gather(int a, int b, const Vec& s, double t, Group& g) const;
+  bool collide(int a, int b, double t, bool reversed);
+  PairV<Dim> apply_pair(const PairV<Dim>& in, const Vec& r, int stream, bool reversed);
+  bool group_collide(Group& g, double t, bool reversed);
+  bool group_operator(Group& g, const int* order, double t, bool reversed);
+  unsigned touch_walls(int i);
+  void flip_mask(int i, unsigned mask);
+  bool touches_wall(int i) const;
+  long wall_entry(int i) const { return wlog_.entry(i, netc_[i], rev_ ? -clock_ : clock_); }
+  void finish_collision(int i, bool reversed) {
+    ++ncoll_[i];
+    ++p_[i].stamp;
+    netc_[i] += reversed ? -1 : 1;
+  }
+  void validate_collision(const int* ids, int n) const;
+
+  // ---- the event loop -----------------------------------------------------------------
+
+  RunResult loop(std::uint64_t max_collisions, double t_end, const Progress& cb, std::uint64_t every,
+                 bool reversed) {
+    RunResult res;
+    double t_last = clock_;
+    bool done_count = max_collisions == 0;
+    while (true) {
+      const int i = queue_.top();
+      if (i < 0) break;  // nothing scheduled (never: every particle has an event, maybe at infinity)
+      const Ev e = ev_[i];
+      if (done_count) {
+        // finish the instant of the last collision, then stop half way to the next event
+        if (e.t > t_last || e.t == kInf) {
+          double te = e.t == kInf ? t_last : t_last + 0.5 * (e.t - t_last);
+          if (te > t_end) te = t_end;
+          if (te > clock_) clock_ = te;
+          break;
+        }
+      } else if (e.t > t_end || e.t == kInf) {
+        if (t_end != kInf && t_end > clock_) clock_ = t_end;
+        break;
+      }
+      clock_ = e.t;
+      ++res.events;
+      ++counters_.events;
+      if (e.kind == kWall) {
+        wall_event(i, e);
+      } else if (e.kind == kRenew) {
+        renew_event(i, e);
+      } else if (e.kind == kColl) {
+        if (p_[e.partner].stamp != e.stamp) {
+          ++counters_.invalid_events;
+          repredict(i);
+          continue;
+        }
+        if (!collide(i, e.partner, e.t, reversed)) continue;
+        ++res.collisions;
+        if (reversed) {
+          --net_;
+          ++counters_.reverse_collisions;
+        } else {
+          ++net_;
+          ++counters_.forward_collisions;
+        }
+        t_last = e.t;
+        if (res.collisions >= max_collisions) done_count = true;
+        if (cb && every > 0 && res.collisions % every == 0 && !cb(res.collisions)) {
+          res.interrupted = true;
+          done_count = true;
+        }
+      } else {
+        break;
+      }
+    }
+    res.time = clock_;
+    return res;
+  }
+
+  Config cfg_;
+  std::size_t n_;
+  Op op_;                                  // the pair operator, chosen once (make_engine)
+  Boundaries<Dim> box_;
+  double sigma2_ = 1.0, contact_tol_ = 0.0;
+  double shell_ = 0.0, renew_h_ = 0.0, renew_h2_ = 0.0;  // the neighbour lists
+  std::vector<Particle<Dim>> p_;
+  NeighbourLists<Dim> nl_;
+  EventQueue<double> queue_;               // one event per particle, key (t, kind, id)
+  std::vector<Ev> ev_;
+  std::vector<std::uint64_t> ncoll_, rng_;  // rng_: draws taken, per stream
+  std::vector<rng::CLCG4> clcg_;             // CLCG4 only: one generator per stream
+  mutable std::vector<double> second_;           // second earliest collision time per particle
+  mutable std::vector<unsigned char> touching_;  // a neighbour within the contact tolerance
+  double clock_ = 0.0, start_ = 0.0;
+  std::int64_t net_ = 0;
+  RareLog log_;
+  std::uint64_t log_offset_ = 0;
+  ExactPreLog pre_;
+  WallLog wlog_;
+  std::vector<std::int64_t> netc_;  // net collisions per particle (wall-log keys)
+  bool rev_ = false;                // inside a reversed run
+  Counters counters_;
+  double e0_ = 0.0;
+  std::array<double, 3> p0_{};
+};
+
+}  // namespace revcol::engine::detail

@@ -1,0 +1,93 @@
+// The boundary seam (revcol/engine/boundary.hpp): the periodic axis's nearest image and
+// wrap, the wall axis's contact, reflection (agreeing with the wall operator,
+// collide/wall.hpp) and wall position, and Boundaries dispatching per axis in a mixed box.
+#include "revcol/engine/boundary.hpp"
+
+#include <array>
+#include <cmath>
+#include <random>
+
+#include "check.hpp"
+#include "revcol/collide/wall.hpp"
+
+using namespace revcol;
+using namespace revcol::engine;
+
+TEST_CASE("periodic axis: nearest image with its code, and the wrap by L") {
+  unsigned code = 9;
+  CHECK(PeriodicAxis::image(3.0, 10.0, code) == 3.0 && code == 0u);
+  CHECK(PeriodicAxis::image(6.0, 10.0, code) == -4.0 && code == 1u);   // x_j + L is nearer
+  CHECK(PeriodicAxis::image(-7.5, 10.0, code) == 2.5 && code == 2u);   // x_j - L is nearer
+  CHECK(PeriodicAxis::image(5.0, 10.0, code) == 5.0 && code == 0u);    // a tie keeps d
+  double x = 9.9;
+  CHECK(PeriodicAxis::wrap(x, 10.2, 10.0) && std::fabs(x + 0.1) < 1e-12);
+  x = 0.3;
+  CHECK(PeriodicAxis::wrap(x, -0.05, 10.0) && x == 10.3);
+  x = 4.0;
+  CHECK(!PeriodicAxis::wrap(x, 4.0, 10.0) && x == 4.0);
+  double v = 1.0;
+  CHECK(!PeriodicAxis::reflect(0.0, v, 10.0, 0.5, 1e-9) && v == 1.0);  // no walls
+}
+
+TEST_CASE("wall axis: reflects exactly what the wall operator reflects, on one axis") {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double L = 6.0, r = 0.5, tol = 1e-9;
+  Box box;
+  box.dim = 1;
+  box.lo = {0.0, 0.0, 0.0};
+  box.hi = {L, 0.0, 0.0};
+  int flipped = 0;
+  for (int s = 0; s < 2000; ++s) {
+    // a centre at a wall (within tol), approaching it, or elsewhere
+    const int where = s % 3;
+    const double x = where == 0 ? r + 0.5 * tol * u(rng) : where == 1 ? (L - r) + 0.5 * tol * u(rng) : 3.0 + u(rng);
+    double v = u(rng);
+    const double v0 = v;
+    const bool f = WallAxis::reflect(x, v, L, r, tol);
+    CHECK(f == (v == -v0));
+    CHECK(f == WallAxis::touches_ahead(x, v0 > 0.0 ? 1 : 0, L, r, tol));
+    if (f) {
+      ++flipped;
+      // the wall operator gives the same post velocity, and its reverse gives back v0
+      const auto post = Wall::forward(box, {x, 0, 0}, {v0, 0, 0}, r, tol);
+      CHECK(post[0] == v);
+      CHECK(Wall::reverse(box, {x, 0, 0}, post, r, tol)[0] == v0);
+    }
+    CHECK(WallAxis::touches(x, L, r, tol) == (where != 2));
+  }
+  CHECK(flipped > 400);  // about half of the 1333 at a wall approach it
+  CHECK(WallAxis::wall_at(1, L, r) == L - r);
+  CHECK(WallAxis::wall_at(0, L, r) == r);
+  unsigned code = 7;
+  CHECK(WallAxis::image(5.5, L, code) == 5.5 && code == 0u);  // no images through walls
+}
+
+TEST_CASE("a mixed box: each axis answers by its own kind") {
+  Config c;
+  c.dim = 3;
+  c.box = {10.0, 8.0, 6.0};
+  c.boundary = {Boundary::wall, Boundary::periodic, Boundary::wall};
+  c.diameter = 1.0;
+  c.group_tol = 1e-9;
+  const Boundaries<3> b(c);
+  CHECK(b.walls(0) && b.periodic(1) && b.walls(2) && b.any_walls());
+  CHECK(b.length(1) == 8.0);
+  unsigned code;
+  CHECK(b.image(0, 7.0, code) == 7.0 && code == 0u);
+  CHECK(b.image(1, 7.0, code) == -1.0 && code == 1u);
+  CHECK(b.shift(1, 1u) == 8.0 && b.shift(1, 2u) == -8.0 && b.shift(1, 0u) == 0.0);
+  double v = -2.0;
+  CHECK(b.reflect(0, 0.5, v) && v == 2.0);
+  v = -2.0;
+  CHECK(!b.reflect(1, 0.5, v) && v == -2.0);  // periodic: no wall at 0.5
+  CHECK(b.touches(2, 5.5) && !b.touches(1, 7.5));
+  double x = 7.9;
+  CHECK(b.wrap(1, x, 8.1) && std::fabs(x + 0.1) < 1e-12);
+  x = 9.9;
+  CHECK(!b.wrap(0, x, 10.1) && x == 9.9);  // walls never wrap
+  CHECK(b.wall_at(2, 1) == 5.5);
+  CHECK(b.touches_ahead(2, 5.5, 1) && !b.touches_ahead(2, 5.5, 0));
+}
+
+CHECK_MAIN()

@@ -1,0 +1,111 @@
+// Double-double arithmetic: the error-free transformations must be exact, checked in
+// exact integer arithmetic (__int128) on integer-valued doubles, where every partial
+// result is an integer too; the derived operations (add, square, div, sqrt, norm2) must
+// reach about 2^-100 relative accuracy, checked against long double (64-bit mantissa)
+// where it is enough and against exact identities where it is not.
+#include "revcol/double_double.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+
+#include "check.hpp"
+
+using namespace revcol;
+
+namespace {
+using i128 = __int128;
+
+// A random integer-valued double with `bits` significant bits and a random sign.
+double random_int(std::mt19937_64& rng, int bits) {
+  const std::uint64_t m = (rng() >> (64 - bits)) | (std::uint64_t{1} << (bits - 1));
+  return (rng() & 1) ? -static_cast<double>(m) : static_cast<double>(m);
+}
+i128 as_int(double x) { return static_cast<i128>(x); }  // exact for integer-valued |x| < 2^127
+// Half an ulp of x (for |x| >= 2^52 this is an integer or 1/2).
+double half_ulp(double x) { return 0.5 * (std::nextafter(std::fabs(x), INFINITY) - std::fabs(x)); }
+}  // namespace
+
+TEST_CASE("two_sum is exact: s + e == a + b, |e| <= ulp(s)/2") {
+  std::mt19937_64 rng(1);
+  for (int t = 0; t < 20000; ++t) {
+    // integers of up to 53 bits at shifts up to 2^60: the sum needs more than 53 bits
+    const double a = std::ldexp(random_int(rng, 53), static_cast<int>(rng() % 8));
+    const double b = random_int(rng, 1 + static_cast<int>(rng() % 53));
+    const dd::DD s = dd::two_sum(a, b);
+    CHECK(s.hi == a + b);
+    CHECK(as_int(s.hi) + as_int(s.lo) == as_int(a) + as_int(b));
+    CHECK(std::fabs(s.lo) <= half_ulp(s.hi));
+    const dd::DD r = dd::two_sum(b, a);  // order does not matter
+    CHECK(r.hi == s.hi);
+    CHECK(r.lo == s.lo);
+  }
+  // a lost low part is recovered whole
+  const dd::DD big = dd::two_sum(1.0, std::ldexp(1.0, -80));
+  CHECK(big.hi == 1.0);
+  CHECK(big.lo == std::ldexp(1.0, -80));
+}
+
+TEST_CASE("quick_two_sum is exact when |a| >= |b|") {
+  std::mt19937_64 rng(2);
+  for (int t = 0; t < 20000; ++t) {
+    const double a = std::ldexp(random_int(rng, 53), 10);
+    const double b = random_int(rng, 1 + static_cast<int>(rng() % 53));
+    const dd::DD s = dd::quick_two_sum(a, b);
+    CHECK(as_int(s.hi) + as_int(s.lo) == as_int(a) + as_int(b));
+    CHECK(std::fabs(s.lo) <= half_ulp(s.hi));
+  }
+}
+
+TEST_CASE("two_prod is exact: p + e == a * b to the last of 106 bits") {
+  std::mt19937_64 rng(3);
+  for (int t = 0; t < 20000; ++t) {
+    const double a = random_int(rng, 1 + static_cast<int>(rng() % 53));
+    const double b = random_int(rng, 1 + static_cast<int>(rng() % 53));
+    const dd::DD p = dd::two_prod(a, b);
+    CHECK(p.hi == a * b);
+    CHECK(as_int(p.hi) + as_int(p.lo) == as_int(a) * as_int(b));
+    CHECK(std::fabs(p.lo) <= half_ulp(p.hi));
+    // scaling by powers of two keeps it exact (away from overflow and underflow)
+    const int ea = static_cast<int>(rng() % 200) - 100, eb = static_cast<int>(rng() % 200) - 100;
+    const dd::DD q = dd::two_prod(std::ldexp(a, ea), std::ldexp(b, eb));
+    CHECK(std::ldexp(q.hi, -ea - eb) == p.hi);
+    CHECK(std::ldexp(q.lo, -ea - eb) == p.lo);
+  }
+  // the classic: (1 + 2^-30)^2 = 1 + 2^-29 + 2^-60, whose last bit a double loses
+  const dd::DD sq = dd::two_prod(1.0 + std::ldexp(1.0, -30), 1.0 + std::ldexp(1.0, -30));
+  CHECK(sq.hi == 1.0 + std::ldexp(1.0, -29));
+  CHECK(sq.lo == std::ldexp(1.0, -60));
+}
+
+TEST_CASE("add, square, div, sqrt and norm2 reach double-double accuracy") {
+  // references in long double (2^-64 relative; a sum of three rounded products is within
+  // 2^-62): each result must beat a double's 2^-53 by far, so the check is at 2^-60
+  const long double tol = std::ldexp(1.0L, -60);
+  // x - y in double-double, for identities that must hold beyond long double's reach
+  auto diff = [](dd::DD x, double y) { return dd::add(x, {-y, 0.0}).hi; };
+  auto val = [](dd::DD x) { return static_cast<long double>(x.hi) + static_cast<long double>(x.lo); };
+  auto rel = [](long double a, long double b) { return std::fabs(a - b) / std::fabs(b); };
+  const dd::DD third = dd::div({1.0, 0.0}, {3.0, 0.0});
+  CHECK(rel(val(third), 1.0L / 3.0L) <= tol);
+  CHECK(third.lo != 0.0);  // a plain double quotient would leave it 0
+  const dd::DD root2 = dd::sqrt({2.0, 0.0});
+  CHECK(rel(val(root2), std::sqrt(2.0L)) <= tol);
+  // sqrt(x)^2 = x and (a / b) b = a to double-double accuracy
+  CHECK(std::fabs(diff(dd::square(root2), 2.0)) <= std::ldexp(2.0, -100));
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> unif(0.5, 2.0);
+  for (int t = 0; t < 2000; ++t) {
+    const dd::DD x{unif(rng), 0.0}, y{unif(rng), 0.0};
+    const dd::DD s = dd::add(x, dd::div(x, y));
+    CHECK(rel(val(s), static_cast<long double>(x.hi) + static_cast<long double>(x.hi) / y.hi) <= tol);
+    const dd::DD q = dd::square(dd::sqrt(x));
+    CHECK(std::fabs(diff(q, x.hi)) <= std::ldexp(x.hi, -100));
+    const double u[3] = {unif(rng), -unif(rng), unif(rng)};
+    const long double n2 = static_cast<long double>(u[0]) * u[0] +
+                           static_cast<long double>(u[1]) * u[1] + static_cast<long double>(u[2]) * u[2];
+    CHECK(rel(val(dd::norm2<3>(u)), n2) <= tol);
+  }
+}
+
+CHECK_MAIN()

@@ -1,0 +1,230 @@
+// Known-answer determinism test (box2d's test_determinism): for a set of configurations
+// covering 1D/2D/3D, walls/periodic/mixed, flux/uniform/paper, Philox/CLCG4 and
+// per-particle/single streams, plus constructed group and wall-log cases, run N collisions
+// forward, hash the full Snapshot (FNV-1a 64 over the exact bits of every field), run back
+// to the start, hash again. The constants were recorded from the engine as it was before
+// the issue-12 refactoring (tag baseline-issue12); a refactoring must leave them unchanged.
+// Only a deliberate, explained behaviour change may update one (say so in the commit).
+//
+// The hash lists the Snapshot's fields by hand, on purpose: it is an independent check of
+// Snapshot::visit, not a use of it.
+#include <cinttypes>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "check.hpp"
+#include "revcol/engine/engine.hpp"
+
+using namespace revcol;
+using namespace revcol::engine;
+
+namespace {
+
+constexpr std::uint64_t kAll = std::numeric_limits<std::uint64_t>::max();
+
+struct Fnv {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  void bytes(const void* p, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) {
+      h ^= b[i];
+      h *= 0x100000001b3ull;
+    }
+  }
+  template <class T>
+  void pod(const T& x) {
+    bytes(&x, sizeof(T));
+  }
+  template <class T>
+  void vec(const std::vector<T>& v) {
+    pod(static_cast<std::uint64_t>(v.size()));
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+};
+
+std::uint64_t hash_snapshot(const Snapshot& s) {
+  Fnv f;
+  const Config& c = s.config;
+  f.pod(c.dim);
+  for (double L : c.box) f.pod(L);
+  for (Boundary b : c.boundary) f.pod(static_cast<int>(b));
+  f.pod(c.diameter);
+  f.pod(static_cast<int>(c.mode));
+  f.pod(static_cast<int>(c.law));
+  f.pod(c.seed);
+  f.pod(static_cast<int>(c.generator));
+  f.pod(static_cast<int>(c.streams));
+  f.pod(c.bits);
+  f.pod(static_cast<int>(c.groups));
+  f.pod(c.group_tol);
+  f.pod(static_cast<std::uint64_t>(s.n));
+  f.pod(s.time);
+  f.pod(s.start_time);
+  f.pod(s.net_collisions);
+  f.vec(s.x);
+  f.vec(s.v);
+  f.vec(s.t_local);
+  f.vec(s.cell);
+  f.vec(s.centre);
+  f.vec(s.stamp);
+  f.vec(s.ncoll);
+  f.vec(s.rng);
+  f.vec(s.ev_t);
+  f.vec(s.ev_kind);
+  f.vec(s.ev_partner);
+  f.vec(s.ev_stamp);
+  f.vec(s.second);
+  f.vec(s.touching);
+  f.vec(s.log_cells);
+  f.pod(s.log_pushed);
+  f.vec(s.netc);
+  f.vec(s.wall_keys);
+  f.vec(s.wall_sizes);
+  f.vec(s.wall_masks);
+  f.vec(s.wall_ids);
+  f.vec(s.wall_netc);
+  f.vec(s.wall_times);
+  f.vec(s.pre_keys);
+  f.vec(s.pre_sizes);
+  f.vec(s.pre_vals);
+  f.pod(s.pre_pushed);
+  const Counters& k = s.counters;
+  for (std::uint64_t q : {k.events, k.pair_collisions, k.group_collisions, k.group_particles, k.group_fallbacks,
+                          k.wall_events, k.list_renewals, k.invalid_events, k.grazing_skipped, k.reverse_failures,
+                          k.forward_collisions, k.reverse_collisions})
+    f.pod(q);
+  f.pod(s.energy0);
+  for (double p : s.momentum0) f.pod(p);
+  return f.h;
+}
+
+struct Case {
+  const char* name;
+  Config config;
+  std::vector<double> x, v;
+  std::uint64_t collisions;  // forward, then all the way back
+  std::uint64_t mid, back;   // the known answers
+  bool groups_expected;
+};
+
+Config config(int d, Boundary b0, Boundary b1, Boundary b2, Mode mode, Law law, Generator g, rng::StreamPolicy sp,
+              std::uint32_t seed) {
+  Config c;
+  c.dim = d;
+  c.boundary = {b0, b1, b2};
+  c.mode = mode;
+  c.law = law;
+  c.generator = g;
+  c.streams = sp;
+  c.seed = seed;
+  return c;
+}
+
+Case gas(const char* name, const Config& c, std::size_t n, double phi, std::uint64_t seed, std::uint64_t coll,
+         std::uint64_t mid, std::uint64_t back, bool groups = false) {
+  const InitialState st = random_state(c, n, phi, seed);
+  return Case{name, st.config, st.x, st.v, coll, mid, back, groups};
+}
+
+std::vector<Case> cases() {
+  const auto W = Boundary::wall, P = Boundary::periodic;
+  const auto pp = rng::StreamPolicy::per_particle, single = rng::StreamPolicy::single;
+  const auto ph = Generator::philox, cl = Generator::clcg4;
+  std::vector<Case> cs;
+  cs.push_back(gas("1D walls, exact, philox, per particle",
+                   config(1, W, W, W, Mode::exact, Law::flux, ph, pp, 7), 32, 0.4, 11, 2000,
+                   0x1b3cba27daa6fb35ull, 0x9d4ead7234f3281bull));
+  cs.push_back(gas("1D periodic ring, paper, clcg4, single",
+                   config(1, P, P, P, Mode::paper, Law::flux, cl, single, 3), 40, 0.5, 12, 2000,
+                   0x185b203e9c163ac0ull, 0xd2e80f5d1f7507bcull));
+  cs.push_back(gas("2D periodic, exact flux, philox, per particle",
+                   config(2, P, P, P, Mode::exact, Law::flux, ph, pp, 5), 200, 0.3, 13, 1000,
+                   0x3f19892999459855ull, 0xadf3eed4b2139546ull));
+  cs.push_back(gas("2D walls, paper, philox, single",
+                   config(2, W, W, W, Mode::paper, Law::flux, ph, single, 9), 100, 0.2, 14, 600,
+                   0x1056f7dba37673d5ull, 0xe0396f4b680770e7ull));
+  cs.push_back(gas("2D mixed (wall x, periodic y), exact uniform, clcg4, per particle",
+                   config(2, W, P, P, Mode::exact, Law::uniform, cl, pp, 2), 150, 0.4, 15, 800,
+                   0x5d041871e6deae6dull, 0xf2e37bb5fb22f7a9ull));
+  {  // dense, with a contact tolerance wide enough (9e-4 D) that near-simultaneous contacts group
+    Config c = config(2, P, P, P, Mode::exact, Law::flux, ph, pp, 1);
+    c.group_tol = 9e-4;
+    cs.push_back(gas("2D periodic dense (phi 0.6, group_tol 9e-4: groups), exact flux, philox", c, 200, 0.6, 16,
+                     3000, 0x4e3e13fdfce25bd3ull, 0x35bfe634d87bf303ull, true));
+    Config c3 = config(3, P, P, P, Mode::exact, Law::flux, ph, pp, 4);
+    c3.group_tol = 9e-4;
+    cs.push_back(gas("3D periodic dense (phi 0.5, group_tol 9e-4: groups, a fallback), exact flux", c3, 200, 0.5, 16,
+                     3000, 0x3bb23751788f6704ull, 0x309a4f5b1ab9dd93ull, true));
+  }
+  cs.push_back(gas("3D periodic, exact flux, philox, per particle",
+                   config(3, P, P, P, Mode::exact, Law::flux, ph, pp, 6), 200, 0.3, 17, 600,
+                   0xe5d46a6d610f4f25ull, 0x1de88da1bfd5efcfull));
+  cs.push_back(gas("3D mixed (periodic, wall, periodic), exact uniform, clcg4, single",
+                   config(3, P, W, P, Mode::exact, Law::uniform, cl, single, 8), 256, 0.45, 18, 600,
+                   0x156c5d3fa4dfedf8ull, 0x8896e818a71519deull));
+  {  // Newton's cradle in 2D: a group collision and the exact-pre log
+    Config c = config(2, W, W, W, Mode::exact, Law::flux, ph, pp, 1);
+    c.box = {30, 30, 1};
+    cs.push_back(Case{"2D Newton's cradle (group, exact-pre log)", c, {5, 15, 10, 15, 11, 15, 12, 15},
+                      {1, 0, 0, 0, 0, 0, 0, 0}, 40, 0xef7a9e36580987e1ull, 0x554fb80190ad7c19ull, true});
+  }
+  {  // a particle hit while resting in a 3D corner: the wall-mask log
+    Config c = config(3, W, W, W, Mode::exact, Law::flux, ph, pp, 5);
+    c.box = {10, 10, 10};
+    const double s3 = 1.0 / std::sqrt(3.0);
+    cs.push_back(Case{"3D corner hit (wall-mask log)", c, {0.5, 0.5, 0.5, 0.5 + 3 * s3, 0.5 + 3 * s3, 0.5 + 3 * s3},
+                      {0, 0, 0, -s3, -s3, -s3}, 40, 0x60c7c549bf69b130ull, 0x4ae8884551ce427full, false});
+  }
+  return cs;
+}
+
+TEST_CASE("state hash after N collisions forward and N back matches the baseline") {
+  for (const Case& k : cases()) {
+    auto s = make_simulation(k.config, k.x, k.v);
+    s->run(k.collisions, std::numeric_limits<double>::infinity());
+    const Snapshot mid = s->snapshot();
+    const std::uint64_t hm = hash_snapshot(mid);
+    s->run_back(kAll, s->start_time());
+    const std::uint64_t hb = hash_snapshot(s->snapshot());
+    std::printf("  %-72s mid 0x%016" PRIx64 "ull back 0x%016" PRIx64 "ull (%" PRIu64 " groups, %" PRIu64
+                " wall-log, %" PRIu64 " pre-log)\n",
+                k.name, hm, hb, mid.counters.group_collisions, static_cast<std::uint64_t>(mid.wall_sizes.size()),
+                static_cast<std::uint64_t>(mid.pre_sizes.size()));
+    CHECK(hm == k.mid);
+    CHECK(hb == k.back);
+    if (k.groups_expected) CHECK(mid.counters.group_collisions > 0);
+  }
+}
+
+TEST_CASE("the hash sees a one-bit change of any kind of field") {
+  const Case k = cases()[2];
+  auto s = make_simulation(k.config, k.x, k.v);
+  s->run(100, std::numeric_limits<double>::infinity());
+  const Snapshot a = s->snapshot();
+  const std::uint64_t h = hash_snapshot(a);
+  CHECK(hash_snapshot(s->snapshot()) == h);  // the snapshot itself is deterministic
+  Snapshot b = a;
+  std::uint64_t bits;
+  std::memcpy(&bits, &b.v[5], 8);
+  bits ^= 1u;
+  std::memcpy(&b.v[5], &bits, 8);
+  CHECK(hash_snapshot(b) != h);
+  b = a;
+  ++b.rng[3];
+  CHECK(hash_snapshot(b) != h);
+  b = a;
+  ++b.counters.events;
+  CHECK(hash_snapshot(b) != h);
+  b = a;
+  b.pre_pushed += 1;
+  CHECK(hash_snapshot(b) != h);
+}
+
+}  // namespace
+
+CHECK_MAIN()

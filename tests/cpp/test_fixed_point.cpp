@@ -1,0 +1,104 @@
+// FixedPoint: K-bit cells of [0,1), decoded at their centres, and the exact torus shift.
+// Known answers at the edges (cells 0 and 2^K - 1, c = 0 and c = 1), centres re-encoding
+// to their own cell, and the shift wrapping both ways, for the smallest, default and
+// largest K.
+#include "revcol/fixed_point.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+
+#include "check.hpp"
+
+using namespace revcol;
+
+namespace {
+const int kBits[] = {FixedPoint::min_bits, 20, FixedPoint::default_bits, FixedPoint::max_bits};
+}
+
+TEST_CASE("K outside [min_bits, max_bits] is refused") {
+  CHECK_THROWS_AS(FixedPoint(FixedPoint::min_bits - 1), InvalidArgument);
+  CHECK_THROWS_AS(FixedPoint(FixedPoint::max_bits + 1), InvalidArgument);
+  CHECK_THROWS_AS(FixedPoint(0), InvalidArgument);
+  CHECK(FixedPoint(FixedPoint::min_bits).bits() == FixedPoint::min_bits);
+  CHECK(FixedPoint(FixedPoint::max_bits).bits() == FixedPoint::max_bits);
+  CHECK(FixedPoint().bits() == 40);
+}
+
+TEST_CASE("encode at the edges: cell 0, cell 2^K - 1, clamping and NaN") {
+  for (int K : kBits) {
+    const FixedPoint fp(K);
+    const std::uint64_t last = (std::uint64_t{1} << K) - 1;
+    const double cell = std::ldexp(1.0, -K);
+    CHECK(fp.cells() == std::ldexp(1.0, K));
+    CHECK(fp.encode(0.0) == 0);
+    CHECK(fp.encode(-0.0) == 0);
+    CHECK(fp.encode(-1e-300) == 0);                      // below 0 clamps to cell 0
+    CHECK(fp.encode(std::numeric_limits<double>::quiet_NaN()) == 0);
+    CHECK(fp.encode(cell) == 1);                         // the first edge belongs to cell 1
+    CHECK(fp.encode(std::nextafter(cell, 0.0)) == 0);    // just below it: cell 0
+    CHECK(fp.encode(1.0) == last);                       // c = 1 (rounding) clamps to the last cell
+    CHECK(fp.encode(std::nextafter(1.0, 0.0)) == last);
+    CHECK(fp.encode(1.0 - cell) == last);                // the last edge opens the last cell
+    CHECK(fp.encode(std::nextafter(1.0 - cell, 0.0)) == last - 1);
+    CHECK(fp.encode(2.0) == last);
+  }
+}
+
+TEST_CASE("decode gives exact cell centres that re-encode to their cell") {
+  for (int K : kBits) {
+    const FixedPoint fp(K);
+    const std::uint64_t last = (std::uint64_t{1} << K) - 1;
+    const double half = std::ldexp(1.0, -K - 1);
+    CHECK(fp.decode(0) == half);                  // (0 + 1/2) 2^-K, exact
+    CHECK(fp.decode(last) == 1.0 - half);         // (2^K - 1/2) 2^-K, exact for K <= 52
+    CHECK(fp.decode(last) < 1.0);
+    CHECK(fp.offset_in_cell(fp.decode(0)) == 0.5);
+    CHECK(fp.offset_in_cell(fp.decode(last)) == 0.5);
+    std::mt19937_64 rng(static_cast<unsigned>(K));
+    for (int t = 0; t < 10000; ++t) {
+      const std::uint64_t u = rng() & last;
+      const double c = fp.decode(u);
+      CHECK(fp.encode(c) == u);
+      CHECK(fp.offset_in_cell(c) == 0.5);
+      CHECK(c > 0.0);
+      CHECK(c < 1.0);
+    }
+    for (std::uint64_t u : {std::uint64_t{0}, std::uint64_t{1}, last - 1, last})
+      CHECK(fp.encode(fp.decode(u)) == u);
+  }
+}
+
+TEST_CASE("the torus shift wraps at 2^K and is undone exactly by sub") {
+  for (int K : kBits) {
+    const FixedPoint fp(K);
+    const std::uint64_t last = (std::uint64_t{1} << K) - 1;
+    CHECK(fp.add(last, 1) == 0);
+    CHECK(fp.add(last, last) == last - 1);
+    CHECK(fp.sub(0, 1) == last);
+    CHECK(fp.sub(0, last) == 1);
+    CHECK(fp.add(0, 0) == 0);
+    CHECK(fp.sub(last, last) == 0);
+    // a shift of G = 1/2 moves every cell by half the torus
+    const std::uint64_t halfway = fp.shift(0.5);
+    CHECK(halfway == (std::uint64_t{1} << (K - 1)));
+    CHECK(fp.add(halfway, halfway) == 0);
+    // G = 1 (CLCG4 can return it) is the last cell, one short of a full turn
+    CHECK(fp.shift(1.0) == last);
+    CHECK(fp.add(5, fp.shift(1.0)) == 4);
+    std::mt19937_64 rng(static_cast<unsigned>(1000 + K));
+    std::uniform_real_distribution<double> unif(0.0, 1.0);
+    for (int t = 0; t < 10000; ++t) {
+      const std::uint64_t u = rng() & last;
+      const std::uint64_t g = fp.shift(unif(rng));
+      const std::uint64_t v = fp.add(u, g);
+      CHECK(v <= last);
+      CHECK(fp.sub(v, g) == u);
+      CHECK(fp.add(fp.sub(u, g), g) == u);
+      CHECK(v == (u + g) % (last + 1));
+    }
+  }
+}
+
+CHECK_MAIN()
