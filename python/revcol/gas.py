@@ -180,7 +180,7 @@ class _GasRun:
         if finished:
             return True
         if (done in self.plot_c) or (self.plot_t and sim.time in self.plot_t):
-            clone = Simulation.from_state(sim.state())
+            clone = Simulation.from_snapshot(sim.snapshot())
             clone.run_back()
             ex, ev = round_trip_errors(clone.positions, clone.velocities, self.x0, self.v0, self.box, self.periodic)
             self.curve.append({"collisions": done, "time": sim.time, "error_x": ex, "error_v": ev})

@@ -31,7 +31,7 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
 
     For each of ``seeds`` seeds (the scene's seed, then the next ones), one forward run
     stops at each grid point (:data:`HORIZON_GRID`, up to ``max_collisions``); a clone of the
-    state (``state()`` / ``from_state``) runs back to the start and gives both errors. A seed
+    state (``snapshot()`` / ``from_snapshot``) runs back to the start and gives both errors. A seed
     stops once its error reaches ``o1`` (O(1): the reversed trajectory has left the forward
     one). Each grid point reports the worst error over the seeds (a seed that stopped counts
     as O(1)); the horizon is the largest N_c before the first grid point whose worst error
@@ -64,7 +64,7 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
                 errs, done = [], 0
                 for nc in grid:
                     done += int(sim.run(collisions=nc - done)["collisions"])
-                    clone = Simulation.from_state(sim.state())
+                    clone = Simulation.from_snapshot(sim.snapshot())
                     clone.run_back()
                     ex, ev = round_trip_errors(clone.positions, clone.velocities, x0, v0, box, periodic)
                     errs.append((ex, ev))
