@@ -9,7 +9,7 @@ the forward run between events; the run then goes back from where it stopped. Ct
 the reversal stops it at the next chunk (the round trip is then incomplete).
 
     >>> from revcol.scene import load_scene
-    >>> r = run_gas(load_scene(None), progress=False)   # the built-in default scene
+    >>> r = run_gas(load_scene("scenes/paper-mode-2d.toml"), progress=False)
     >>> r["passed"], r["collisions_forward"] == r["collisions_back"]
     (True, True)
 """
@@ -32,15 +32,20 @@ from .report import version
 from .roundtrip import BAR, ERROR_DEFINITIONS, geometry, round_trip_errors
 from .scene import Scene, SceneError, engine_options, read_initial
 
-__all__ = ["build_simulation", "run_gas", "list_renewals"]
+__all__ = ["build_simulation", "run_gas", "round_trip", "list_renewals"]
 
 
 def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
     """The engine for a gas scene: from its initial state, or from the engine's random start
     in its box (``[system] start``: auto, random or lattice). ``seed`` overrides the
-    scene's. A state the engine refuses raises :class:`SceneError` naming the field."""
+    scene's. A state the engine refuses raises :class:`SceneError` naming the field. A
+    lattice scene gets a :class:`revcol.lattice.LatticeSimulation` (:mod:`revcol.lattice_gas`)."""
     if scene.kind != "gas":
         raise SceneError(f"{scene.source}: [scene] kind: {scene.kind!r} scenes build no particles")
+    if scene.engine == "lattice":
+        from .lattice_gas import build_lattice
+
+        return build_lattice(scene, seed)
     opts = engine_options(scene)
     if seed is not None:
         opts["seed"] = int(seed)
@@ -175,7 +180,7 @@ class _GasRun:
         if finished:
             return True
         if (done in self.plot_c) or (self.plot_t and sim.time in self.plot_t):
-            clone = Simulation.from_state(sim.state())
+            clone = Simulation.from_snapshot(sim.snapshot())
             clone.run_back()
             ex, ev = round_trip_errors(clone.positions, clone.velocities, self.x0, self.v0, self.box, self.periodic)
             self.curve.append({"collisions": done, "time": sim.time, "error_x": ex, "error_v": ev})
@@ -267,7 +272,8 @@ class _GasRun:
 def run_gas(scene: Scene, *, plot: str | os.PathLike | None = None,
             trajectory: str | os.PathLike | None = None, progress: bool | None = None,
             checkpoints: bool = True) -> dict:
-    """Runs a gas scene forward and back; returns the report (a dict, see :mod:`revcol.run`).
+    """Runs a gas scene forward and back; returns the report (a dict, see :mod:`revcol.run`;
+    a lattice scene's: :mod:`revcol.lattice_gas`).
 
     ``plot``: a directory for the PNG figures (round-trip error and energy drift against
     collisions, snapshots at the start, the turn and the end); ``trajectory``: a ``.xyz`` or
@@ -290,16 +296,26 @@ def run_gas(scene: Scene, *, plot: str | os.PathLike | None = None,
         require_matplotlib()
     if progress is None:
         progress = sys.stdout.isatty()
-    run = _GasRun(scene, plot, trajectory, progress, checkpoints)
+    if scene.engine == "lattice":
+        from .lattice_gas import run_lattice_gas
+
+        return run_lattice_gas(scene, plot=plot, trajectory=trajectory, progress=progress, checkpoints=checkpoints)
+    return round_trip(_GasRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_gas")
+
+
+def round_trip(run, plot, figures: str) -> dict:
+    """Forward, turn, back (Ctrl-C counted throughout), the report, and with ``plot`` the
+    figures drawn by ``revcol.plots.<figures>``. ``run`` is a gas run (this module's, or the
+    lattice engine's in :mod:`revcol.lattice_gas`)."""
     with Interrupt() as stop:
         run.forward(stop)
         run.turn()
         run.reverse(stop, stop.presses)
     report = run.report()
     if plot is not None:
-        from .plots import plot_gas
+        from . import plots
 
         sim = run.sim
-        report["written"] += plot_gas(report, Path(plot), (run.x0, run.v0), run.shot_turn,
-                                      (sim.positions, sim.velocities))
+        report["written"] += getattr(plots, figures)(report, Path(plot), (run.x0, run.v0), run.shot_turn,
+                                                     (sim.positions, sim.velocities))
     return report

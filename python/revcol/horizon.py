@@ -31,16 +31,21 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
 
     For each of ``seeds`` seeds (the scene's seed, then the next ones), one forward run
     stops at each grid point (:data:`HORIZON_GRID`, up to ``max_collisions``); a clone of the
-    state (``state()`` / ``from_state``) runs back to the start and gives both errors. A seed
+    state (``snapshot()`` / ``from_snapshot``) runs back to the start and gives both errors. A seed
     stops once its error reaches ``o1`` (O(1): the reversed trajectory has left the forward
     one). Each grid point reports the worst error over the seeds (a seed that stopped counts
     as O(1)); the horizon is the largest N_c before the first grid point whose worst error
-    exceeds 1e-9."""
+    exceeds 1e-9. A lattice scene has none: :func:`revcol.lattice_gas.lattice_horizon` checks
+    its round trip bit for bit at a few N_c."""
     if scene.kind != "gas":
         raise SceneError(f"{scene.source}: [scene] kind: --horizon measures gas scenes, not {scene.kind!r}")
     if scene.seed + seeds > 2**32:
         raise SceneError(f"{scene.source}: [rng] seed: seeds {scene.seed} .. {scene.seed + seeds - 1} "
                          "pass 2^32 - 1")
+    if scene.engine == "lattice":  # no horizon: checked bit for bit at a few N_c instead
+        from .lattice_gas import lattice_horizon
+
+        return lattice_horizon(scene, seeds=seeds, max_collisions=max_collisions, progress=progress)
     if progress is None:
         progress = sys.stdout.isatty()
     n = scene.particles
@@ -59,7 +64,7 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
                 errs, done = [], 0
                 for nc in grid:
                     done += int(sim.run(collisions=nc - done)["collisions"])
-                    clone = Simulation.from_state(sim.state())
+                    clone = Simulation.from_snapshot(sim.snapshot())
                     clone.run_back()
                     ex, ev = round_trip_errors(clone.positions, clone.velocities, x0, v0, box, periodic)
                     errs.append((ex, ev))

@@ -1,5 +1,6 @@
 """The PNG figures of ``revcol run --plot``: a gas run's round-trip error, energy drift and
-snapshots (start, turn, end), and the horizon's error against collisions per particle.
+snapshots (start, turn, end), a lattice run's energy drift, bits-back size and snapshots, and
+the horizon's error against collisions per particle.
 
 matplotlib is imported only here and only when a figure is drawn (Agg backend unless pyplot
 is already in use); :func:`require_matplotlib` checks for it before a run starts.
@@ -15,7 +16,7 @@ import numpy as np
 from .roundtrip import BAR
 from .scene import SceneError
 
-__all__ = ["require_matplotlib", "plot_gas", "plot_horizon"]
+__all__ = ["require_matplotlib", "plot_gas", "plot_lattice_gas", "plot_horizon"]
 
 
 def require_matplotlib() -> None:
@@ -57,6 +58,35 @@ def plot_gas(r: dict, out: Path, start, turn, end) -> list[str]:
     fig.tight_layout()
     written.append(_save(fig, out / "roundtrip_error.png", plt))
 
+    written.append(_energy_figure(r, out, plt, title))
+    written.append(_snapshots_figure(r, out, plt, title, start, turn, end))
+    return written
+
+
+def plot_lattice_gas(r: dict, out: Path, start, turn, end) -> list[str]:
+    """A lattice run's figures in ``out``: energy drift and the bits-back integer's size against
+    collisions (sampled after each chunk of the forward run), and snapshots; ``start``,
+    ``turn``, ``end`` are (positions, velocities). There is no round-trip error curve: every
+    round trip is bit for bit. Returns the paths."""
+    plt = _pyplot()
+    out.mkdir(parents=True, exist_ok=True)
+    title = textwrap.fill(r["summary"], 110)
+    written = [_energy_figure(r, out, plt, title)]
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    bs = np.array(r["bits_series"], dtype=float).reshape(-1, 2)
+    ax.plot(bs[:, 0], bs[:, 1], "-", lw=1)
+    ax.set_xlabel("collisions forward")
+    ax.set_ylabel("bits-back integer X: bit length")
+    ax.set_title(title, fontsize=7)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    written.append(_save(fig, out / "bits_back.png", plt))
+    written.append(_snapshots_figure(r, out, plt, title, start, turn, end))
+    return written
+
+
+def _energy_figure(r: dict, out: Path, plt, title: str) -> str:
     fig, ax = plt.subplots(figsize=(7, 4.5))
     es = np.array(r["energy_series"], dtype=float).reshape(-1, 2)
     ax.plot(es[:, 0], es[:, 1], "-", lw=1)
@@ -66,8 +96,10 @@ def plot_gas(r: dict, out: Path, start, turn, end) -> list[str]:
     ax.set_title(title, fontsize=7)
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
-    written.append(_save(fig, out / "energy_drift.png", plt))
+    return _save(fig, out / "energy_drift.png", plt)
 
+
+def _snapshots_figure(r: dict, out: Path, plt, title: str, start, turn, end) -> str:
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.6))
     shots = [("start", *start), (f"after {r['collisions_forward']:,} collisions forward", *turn),
              ("after reversal", *end)]
@@ -77,8 +109,7 @@ def plot_gas(r: dict, out: Path, start, turn, end) -> list[str]:
     fig.suptitle(title + ("  (x-y projection, colour: speed)" if r["dimension"] == 3 else "  (colour: speed)"),
                  fontsize=7)
     fig.tight_layout()
-    written.append(_save(fig, out / "snapshots.png", plt))
-    return written
+    return _save(fig, out / "snapshots.png", plt)
 
 
 def _draw_particles(ax, x, v, box, sigma) -> None:

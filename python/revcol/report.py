@@ -53,40 +53,106 @@ def format_report(r: dict) -> str:
         if r["interrupted"]:
             lines.append(f"  interrupted (Ctrl-C): the table covers the runs done; {r.get('not_run', 0)} not run")
     else:
-        drift_p = ("n/a (walls on every axis)" if r["momentum_drift_turn"] is None else
-                   f"{r['momentum_drift_turn']:+.2g} at the turn, {_si(r['momentum_drift_end'])} after reversal "
-                   "(periodic axes)")
-        fwd_end = f"t = {r['time_turn']:.6g}"
-        lines = [
-            head,
-            f"  scene            {r['summary']}",
-            f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:.3g} per particle) to "
-            f"{fwd_end} in {_duration(r['forward_s'])}: {_si(r['forward_per_s'])} collisions/s",
-            f"  reverse          {r['collisions_back']:,} collisions back to t = {r['time_end']:.6g} in "
-            f"{_duration(r['reverse_s'])}: {_si(r['reverse_per_s'])} collisions/s",
-            f"  positions error  {r['error_x']:.3g}   {ERROR_DEFINITIONS['error_x']}",
-            f"  velocity error   {r['error_v']:.3g}   {ERROR_DEFINITIONS['error_v']}",
-            f"  bar              {BAR:g} (both)",
-            f"  energy drift     {r['energy_drift_turn']:+.2g} at the turn, {r['energy_drift_end']:+.2g} after "
-            "reversal   ((E - E0) / E0)",
-            f"  momentum drift   {drift_p}",
-            f"  log bytes        {r['log_bytes_turn']} at the turn, {r['log_bytes_end']} after reversal",
-            f"  peak RSS         {_mib(r['peak_rss_bytes'])}",
-        ]
-        if r["reverse_failures"]:
-            lines.append(f"  reverse failures {r['reverse_failures']} (the reversed run left the forward one)")
-        if r["checkpoints"]:
-            lines.append(f"  checkpoints      {len(r['checkpoints'])} in {Path(r['checkpoints'][0]).parent}")
-        if r["trajectory"]:
-            lines.append(f"  trajectory       {r['trajectory_frames']} frames in {r['trajectory']}")
-        if r["interrupted"]:
-            lines.append(f"  interrupted      during the {r['interrupted']} run (Ctrl-C)"
-                         + ("; the round trip is incomplete" if not r["round_trip_complete"] else
-                            "; went back from where it stopped"))
-        lines.append(f"  result           {'PASSED' if r['passed'] else 'FAILED'}")
+        body = _lattice_lines(r) if r.get("engine") == "lattice" else _float_lines(r)
+        lines = [head, f"  scene            {r['summary']}"] + body + _gas_tail(r)
     if r.get("written"):
         lines.append("  written          " + " ".join(r["written"]))
     return "\n".join(lines)
+
+
+def _float_lines(r: dict) -> list[str]:
+    """A float-engine gas round trip: rates, errors against the bar, drifts, log, memory."""
+    drift_p = ("n/a (walls on every axis)" if r["momentum_drift_turn"] is None else
+               f"{r['momentum_drift_turn']:+.2g} at the turn, {_si(r['momentum_drift_end'])} after reversal "
+               "(periodic axes)")
+    lines = [
+        f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:.3g} per particle) to "
+        f"t = {r['time_turn']:.6g} in {_duration(r['forward_s'])}: {_si(r['forward_per_s'])} collisions/s",
+        f"  reverse          {r['collisions_back']:,} collisions back to t = {r['time_end']:.6g} in "
+        f"{_duration(r['reverse_s'])}: {_si(r['reverse_per_s'])} collisions/s",
+        f"  positions error  {r['error_x']:.3g}   {ERROR_DEFINITIONS['error_x']}",
+        f"  velocity error   {r['error_v']:.3g}   {ERROR_DEFINITIONS['error_v']}",
+        f"  bar              {BAR:g} (both)",
+        f"  energy drift     {r['energy_drift_turn']:+.2g} at the turn, {r['energy_drift_end']:+.2g} after "
+        "reversal   ((E - E0) / E0)",
+        f"  momentum drift   {drift_p}",
+        f"  log bytes        {r['log_bytes_turn']} at the turn, {r['log_bytes_end']} after reversal",
+        f"  peak RSS         {_mib(r['peak_rss_bytes'])}",
+    ]
+    if r["reverse_failures"]:
+        lines.append(f"  reverse failures {r['reverse_failures']} (the reversed run left the forward one)")
+    return lines
+
+
+def _err(e: float, unit: str) -> str:
+    return f"{e:.2g} {unit}" if e > 0 else "0 (the float values lie on the lattice)"
+
+
+def _n(count: int, one: str, many: str | None = None) -> str:
+    return f"{count:,} {one if count == 1 else (many or one + 's')}"
+
+
+_PARTS = {"positions": "positions", "velocities": "velocities", "rng_counters": "RNG counters",
+          "bits_back": "bits-back integer", "clock": "clock", "collision_count": "collision count",
+          "rare_log": "rare log"}
+
+
+def _lattice_lines(r: dict) -> list[str]:
+    """A lattice-engine round trip: what came back bit for bit, X's size, the rare log,
+    redraws, multi-body ticks, drifts, rates and memory."""
+    u, q, x, n = r["units"], r["quantization"], r["bits_back"], max(r["collisions_forward"], 1)
+    ok = r["restored"]
+    same = ", ".join(f"{_PARTS[k]} {'yes' if v else 'NO'}" for k, v in ok.items())
+    redraws = ", ".join(f"{k} {c}" for k, c in r["redraws"].items())
+    mom = r["momentum_drift_turn"]
+    drift_p = ("n/a (walls on every axis)" if mom is None else
+               f"({', '.join(f'{p:+.0f}' for p in mom['lattice_units'])}) lattice units at the turn "
+               f"({mom['relative']:.2g} of sqrt(2 E0 N)), "
+               f"({', '.join(f'{p:+.0f}' for p in r['momentum_drift_end']['lattice_units'])}) after reversal")
+    lines = [
+        f"  engine           lattice: sigma = 2^{u['S']} lattice units per diameter, a tick = {u['tick']:.3g} time "
+        "units (a typical particle moves 2^-20 sigma per tick)",
+        f"  start            quantized once: positions within {_err(q['max_position_error'], 'diameters')}, "
+        f"velocities within {_err(q['max_velocity_error'], 'v_rms')}; exact from there on",
+        f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:,.4g} per particle) to "
+        f"t = {r['time_turn']:.6g} (tick {r['clock_turn']:,}) in {_duration(r['forward_s'])}: "
+        f"{_si(r['forward_per_s'])} collisions/s ({_si(r['forward_per_cpu_s'])} per CPU second)",
+        f"  reverse          {r['collisions_back']:,} collisions back to t = {r['time_end']:.6g} (tick "
+        f"{r['clock_end']:,}) in {_duration(r['reverse_s'])}: {_si(r['reverse_per_s'])} collisions/s "
+        f"({_si(r['reverse_per_cpu_s'])} per CPU second)",
+        f"  restored         {'bit for bit' if r['bit_for_bit'] else 'NOT bit for bit'}: {same}",
+        f"  bits-back X      {x['start']} bits at the start, {x['turn']} at the turn, {x['end']} after reversal; "
+        f"max {x['max']} (sampled every {x['sampled_every']:,} collisions)",
+        f"  rare log         {_n(r['log_entries_turn'], 'entry', 'entries')} ({r['log_bytes_turn']} bytes) at the "
+        f"turn, {r['log_entries_per_collision']:.2g} per collision ({_n(r['group_bounces'], 'group bounce')}); "
+        f"{_n(r['log_entries_end'], 'entry', 'entries')} ({r['log_bytes_end']} bytes) after reversal",
+        f"  redraws          {r['redraws_total']:,} ({r['redraws_total'] / n:.2g} per collision): {redraws}",
+        f"  multi-body       {_n(r['multi_body'], 'tick')} with three bodies ({r['multi_body'] / n:.2g} per "
+        f"collision), {r['wall_body']} with a wall and a body ({r['wall_body'] / n:.2g} per collision)",
+        f"  energy drift     {r['energy_drift_turn']:+.2g} at the turn, {r['energy_drift_end']:+.2g} after reversal   "
+        "((E - E0) / E0, exact integers)",
+        f"  momentum drift   {drift_p}",
+        f"  memory           engine {r['engine_memory_bytes'] / 2**10:.0f} KiB; peak RSS {_mib(r['peak_rss_bytes'])}",
+    ]
+    if r["engine_error"]:
+        lines.append(f"  engine error     {r['engine_error']}")
+    return lines
+
+
+def _gas_tail(r: dict) -> list[str]:
+    """Outputs written, an interruption, and the result line of a gas round trip."""
+    lines = []
+    if r["checkpoints"]:
+        lines.append(f"  checkpoints      {len(r['checkpoints'])} in {Path(r['checkpoints'][0]).parent}")
+    if r["trajectory"]:
+        lines.append(f"  trajectory       {r['trajectory_frames']} frames in {r['trajectory']}")
+    if r["interrupted"]:
+        lines.append(f"  interrupted      during the {r['interrupted']} run (Ctrl-C)"
+                     + ("; the round trip is incomplete" if not r["round_trip_complete"] else
+                        "; went back from where it stopped"))
+    how = ": restored bit for bit" if r.get("engine") == "lattice" and r["passed"] else ""
+    lines.append(f"  result           {'PASSED' if r['passed'] else 'FAILED'}{how}")
+    return lines
 
 
 def verify_lines(r: dict) -> list[str]:
@@ -105,6 +171,8 @@ def verify_lines(r: dict) -> list[str]:
 
 def format_horizon(r: dict) -> str:
     """The horizon table as text."""
+    if r.get("engine") == "lattice":
+        return _lattice_horizon(r)
     lines = [f"revcol run --horizon {r['scene']['name']}  ({r['scene']['source']})",
              f"  scene  {r['summary']}",
              f"  worst round-trip error over {r['seeds']} seed(s) from {r['seed_first']}; "
@@ -122,6 +190,28 @@ def format_horizon(r: dict) -> str:
     else:
         lines.append(f"  horizon: not reached up to N_c = {r['rows'][-1]['collisions']:,} "
                      f"(--max-collisions {r['max_collisions']:,})")
+    if r["interrupted"]:
+        lines.append("  interrupted (Ctrl-C): the table covers what ran")
+    if r.get("written"):
+        lines.append("  written  " + " ".join(r["written"]))
+    return "\n".join(lines)
+
+
+def _lattice_horizon(r: dict) -> str:
+    """``--horizon`` on a lattice scene: the bit-for-bit checks and why there is no horizon."""
+    lines = [f"revcol run --horizon {r['scene']['name']}  ({r['scene']['source']})",
+             f"  scene  {r['summary']}",
+             f"  round trips of {r['seeds']} seed(s) from {r['seed_first']}, each compared exactly with its start",
+             f"  {'N_c':>10}  {'per particle':>12}  bit for bit"]
+    for row in r["rows"]:
+        lines.append(f"  {row['collisions']:>10,}  {row['per_particle']:>12.4g}  {row['bit_for_bit']}/{row['seeds']}")
+        lines += [f"      engine error: {e}" for e in row["errors"]]
+    if r["passed"]:
+        lines.append("  horizon: none. The lattice engine's state is integers and each collision an exact "
+                     "bijection, so the round trip is exact at every N_c (checked above bit for bit); the float "
+                     "engine's horizon for this gas: --horizon --engine float")
+    else:
+        lines.append("  FAILED: a lattice round trip did not come back bit for bit (above)")
     if r["interrupted"]:
         lines.append("  interrupted (Ctrl-C): the table covers what ran")
     if r.get("written"):

@@ -1,7 +1,11 @@
 """``revcol run``: run a scene forward, back to its start, and report the round trip.
 
 A *gas* scene (``revcol.scene``) builds N hard spheres, runs N_c collisions forward (or to an
-end time), then ``run_back`` to the start time, and compares with the start:
+end time), then ``run_back`` to the start time, and compares with the start. On the lattice
+engine (``[collisions] engine = "lattice"``, the default scene's; :mod:`revcol.lattice_gas`)
+every part of the integer state is compared exactly: positions, velocities, stream counters,
+the bits-back integer, the rare log and the clock; the round trip passes when all come back
+bit for bit, for any N_c. On the float engine:
 
 - ``error_x`` = max over particles and axes of |x - x0| / L_axis (periodic images folded);
 - ``error_v`` = max over particles of |v - v0| / max over particles of |v0| (Euclidean norms);
@@ -10,16 +14,17 @@ end time), then ``run_back`` to the start time, and compares with the start:
 The report also has forward and reverse collisions/s (engine calls only), energy drift
 (E - E0) / E0 and momentum drift |P - P0| / sqrt(2 E0 N) along the periodic axes (walls
 exchange momentum, so there is none to conserve along a walled axis), the rare-log bytes,
-and the process's peak RSS. A real gas is chaotic: round-off grows by about an order of
-magnitude per collision per particle, so a round trip passes only within a *horizon* of a
-few collisions per particle; :func:`horizon` measures it (``revcol run --horizon``).
+and the process's peak RSS. A real gas is chaotic: on the float engine round-off grows by
+about an order of magnitude per collision per particle, so a round trip passes only within a
+*horizon* of a few collisions per particle; :func:`horizon` measures it (``revcol run
+--horizon``; on a lattice scene it checks a few N_c bit for bit instead: there is none).
 
 *Reversal* scenes run the paper's illustration (:func:`revcol.verify`; velocities only, no
 positions are built), *statesave* scenes the paper's §6 study (:func:`revcol.statesave.study`).
 
 This module is the entry point, :func:`run_scene`; the parts live in small modules, each
-re-exported here: :mod:`revcol.gas` (the gas run), :mod:`revcol.horizon`,
-:mod:`revcol.paper_scenes` (reversal and statesave scenes), :mod:`revcol.report` (text and
+re-exported here: :mod:`revcol.gas` (the gas run), :mod:`revcol.lattice_gas` (on the lattice
+engine), :mod:`revcol.horizon`, :mod:`revcol.paper_scenes` (reversal and statesave scenes), :mod:`revcol.report` (text and
 JSON), :mod:`revcol.plots`, :mod:`revcol.roundtrip` (the bar and the errors) and
 :mod:`revcol.progress` (Ctrl-C, progress bar, peak RSS).
 
@@ -31,10 +36,9 @@ stopped and writes everything asked for, marked interrupted. Ctrl-C during the r
 stops it at the next chunk of collisions (the report then says the round trip is
 incomplete); a third Ctrl-C ends the process.
 
-    >>> from revcol.scene import load_scene
-    >>> r = run_scene(load_scene(None), progress=False)   # the built-in default scene
-    >>> r["passed"], r["collisions_forward"] == r["collisions_back"]
-    (True, True)
+    >>> r = run_scene(None, collisions=20_000, progress=False)   # the default scene, shorter
+    >>> r["passed"], r["bit_for_bit"], r["collisions_forward"] == r["collisions_back"]
+    (True, True, True)
 """
 from __future__ import annotations
 
@@ -49,7 +53,7 @@ from .paper_scenes import run_reversal, run_statesave
 from .progress import Bar as _Bar, Interrupt as _Interrupt, peak_rss as _peak_rss  # noqa: F401
 from .report import format_horizon, format_report, write_json
 from .roundtrip import BAR, ERROR_DEFINITIONS, round_trip_errors  # noqa: F401
-from .scene import Scene, SceneError, load_scene
+from .scene import Scene, SceneError, load_scene, with_engine
 
 __all__ = ["BAR", "build_simulation", "run_gas", "run_reversal", "run_statesave", "horizon", "run_scene",
            "format_report", "format_horizon", "write_json", "round_trip_errors"]
@@ -58,14 +62,18 @@ __all__ = ["BAR", "build_simulation", "run_gas", "run_reversal", "run_statesave"
 def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str | os.PathLike | None = None,
               plot: str | os.PathLike | None = None, trajectory: str | os.PathLike | None = None,
               horizon_seeds: int | None = None, max_collisions: int = 1_000_000,
-              collisions: int | None = None, seed: int | None = None, progress: bool | None = None) -> dict:
+              collisions: int | None = None, seed: int | None = None, engine: str | None = None,
+              progress: bool | None = None) -> dict:
     """Runs any scene (a :class:`Scene`, a path, or None for the built-in default) and writes
     the outputs asked for (arguments here, else the scene's ``[output]``). ``collisions``
     overrides N_c (a gas's end time included); ``horizon_seeds`` measures the horizon over
-    that many seeds instead of one round trip. Returns the report; every output is checked
+    that many seeds instead of one round trip; ``engine`` (``"float"`` or ``"lattice"``) runs a
+    gas scene on that engine instead of its own. Returns the report; every output is checked
     before anything runs, and a bad one raises :class:`SceneError`."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
+    if engine is not None:
+        scene = with_engine(scene, engine)
     if collisions is not None:
         if scene.kind == "gas" and scene.particles == 1:
             raise SceneError(f"{scene.source}: [run] collisions: a single particle never collides")
@@ -84,6 +92,9 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
     if scene.kind == "reversal" and plot is not None:
         raise SceneError(f"{scene.source}: --plot has no figures for a 'reversal' scene (velocities only; "
                          "see revcol verify)")
+    if horizon_seeds is not None and plot is not None and scene.engine == "lattice":
+        raise SceneError(f"{scene.source}: --horizon --plot: a lattice scene has no horizon to plot "
+                         "(every round trip is bit for bit); add --engine float for the float engine's")
     if plot is not None:
         from .plots import require_matplotlib
 

@@ -3,7 +3,10 @@
 A scene is one of three kinds (``[scene] kind``):
 
 - ``"gas"`` (the default): N hard spheres in a box, run forward N_c collisions (or to an
-  end time) with the event-driven engine, then back to the start (``revcol run``);
+  end time) with the event-driven engine, then back to the start (``revcol run``); the
+  float engine (``revcol.Simulation``, 1-3D, exact within a horizon) unless ``[collisions]
+  engine = "lattice"`` (``revcol.lattice.LatticeSimulation``: 2D, integer state, exact for
+  any number of collisions; exact mode, flux or uniform law, Philox per-particle streams);
 - ``"reversal"``: the paper's reversal illustration for a named case (2 or 3 particles,
   momentum and energy held, velocities only: no positions are built), ``revcol verify``'s
   machinery;
@@ -43,9 +46,11 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
 
     [collisions]
+    engine = "float"              # gas only: "float" | "lattice" (2D, exact mode, Philox
+                                  # per_particle; its default generator is then "philox")
     mode = "exact"                # "exact" | "paper" (gas: 1D and 2D, the engine's limit)
     law = "flux"                  # exact mode: "flux" | "uniform"
-    bits = 40                     # K, bits per chart coordinate, 8..52 (not statesave)
+    bits = 40                     # K, bits per chart coordinate, 8..52 (not statesave, not lattice)
 
     [rng]
     generator = "clcg4"           # "clcg4" | "philox"
@@ -85,10 +90,14 @@ from typing import Any
 
 from . import _core
 
-__all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "engine_options", "DEFAULT_SCENE", "KINDS"]
+__all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "engine_options", "lattice_options", "with_engine",
+           "DEFAULT_SCENE", "KINDS", "ENGINES"]
 
 #: the kinds of scene
 KINDS = ("gas", "reversal", "statesave")
+
+#: the engines a gas scene can run on (``[collisions] engine``)
+ENGINES = ("float", "lattice")
 
 
 class SceneError(ValueError):
@@ -114,6 +123,7 @@ class Scene:
     start: str = "auto"
     kinetic_energy: float | None = None
     initial_state: Path | None = None
+    engine: str = "float"
     mode: str = "exact"
     law: str = "flux"
     bits: int = 40
@@ -152,8 +162,9 @@ class Scene:
                     f"{self.mode}{law}, {self.generator} seed {self.seed}")
         box = " x ".join(f"{b:g}" for b in self.box)
         end = f"{self.collisions:,} collisions" if self.collisions is not None else f"t = {self.time:g}"
+        engine = "lattice engine, " if self.engine == "lattice" else ""
         return (f"{self.name}: {self.particles} particles in {self.dimension}D, sigma = {self.diameter:g}, "
-                f"box {box} ({', '.join(self.boundaries)}), {self.mode}{law}, {self.generator} "
+                f"box {box} ({', '.join(self.boundaries)}), {engine}{self.mode}{law}, {self.generator} "
                 f"{self.streams} seed {self.seed}, {end}")
 
     def to_dict(self) -> dict[str, Any]:
@@ -192,6 +203,7 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "initial_state": ("str", None),
     },
     "collisions": {
+        "engine": ("str", ENGINES),
         "mode": ("str", ("exact", "paper")),
         "law": ("str", ("flux", "uniform")),
         "bits": ("int", tuple(LIMITS["bits"])),
@@ -227,29 +239,31 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
 _USES: dict[str, dict[str, Any]] = {
     "gas": {"scene": {"name", "description", "kind"}, "system": "*", "collisions": "*", "rng": "*",
             "run": "*", "output": "*"},
-    "reversal": {"scene": {"name", "description", "kind", "case"}, "collisions": "*",
+    "reversal": {"scene": {"name", "description", "kind", "case"}, "collisions": {"mode", "law", "bits"},
                  "rng": {"generator", "seed"}, "run": {"collisions"}, "output": {"json"}},
     "statesave": {"scene": {"name", "description", "kind"}, "statesave": "*", "collisions": {"mode", "law"},
                   "rng": {"generator", "seed"}, "run": {"collisions"}, "output": {"json", "plot"}},
 }
 
-# N_c when a gas scene gives neither collisions nor time: 2 collisions per particle. A gas is
-# chaotic and round-off grows by about an order of magnitude per collision per particle, so
-# a round trip restores the start to 1e-9 only within a horizon of 4-10 collisions per
-# particle in 2D/3D (docs/engine.md); 2 per particle sits well inside it (docs/run.md).
+# N_c when a float-engine gas scene gives neither collisions nor time: 2 collisions per
+# particle. A gas is chaotic and round-off grows by about an order of magnitude per collision
+# per particle, so a round trip restores the start to 1e-9 only within a horizon of 4-10
+# collisions per particle in 2D/3D (docs/engine.md); 2 per particle sits well inside it
+# (docs/run.md). The lattice engine has no horizon: its default is a real length, 10^6.
 _DEFAULT_PER_PARTICLE = 2
+_LATTICE_DEFAULT_COLLISIONS = 1_000_000
 
 DEFAULT_SCENE: dict[str, Any] = {
-    "scene": {"name": "default", "description": "2D hard-disk gas, N = 1000, area fraction 0.3, walls"},
+    "scene": {"name": "default",
+              "description": "2D hard-disk gas on the lattice engine, N = 1000, area fraction 0.3, walls"},
     "system": {"dimension": 2, "particles": 1000, "diameter": 1.0, "packing_fraction": 0.3,
                "boundaries": "wall"},
-    "collisions": {"mode": "exact", "law": "flux"},
-    "rng": {"generator": "clcg4", "streams": "per_particle", "seed": 0},
-    # N_c = 1000 (2 collisions per particle), measured with
-    #   revcol run --horizon --seeds 200 (docs/run.md): over seeds 0..199 the worst round-trip
-    #   error at N_c = 1000 is 3.6e-10 (99th percentile 2.2e-10, median 1.4e-11); at N_c = 2000
-    #   4 seeds of 200 fail the 1e-9 bar.
-    "run": {"collisions": 1000},
+    "collisions": {"engine": "lattice", "mode": "exact", "law": "flux"},
+    "rng": {"generator": "philox", "streams": "per_particle", "seed": 0},
+    # 10^6 collisions (2000 per particle, 2 N_c / N) forward and back, restored bit for bit;
+    # about 3 s of CPU each way (docs/run.md). The float engine's horizon for this gas is
+    # 3 collisions per particle (revcol run --horizon --engine float).
+    "run": {"collisions": 1_000_000},
 }
 
 
@@ -406,6 +420,12 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
 
     start = get("system", "start", "auto")
 
+    engine = get("collisions", "engine", "float")
+    if engine == "lattice":
+        _check_lattice(source, d, mode, get("rng", "generator", "philox"), get("rng", "streams", "per_particle"),
+                       ("collisions", "bits") in values)
+        common = {**common, "generator": get("rng", "generator", "philox")}
+
     paper_dims = tuple(LIMITS["paper_mode_dimensions"])
     if mode == "paper" and d not in paper_dims:
         raise _fail(source, "[collisions] mode", f"'paper' runs gases in {' and '.join(f'{k}D' for k in paper_dims)} "
@@ -415,7 +435,7 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
     if nc is not None and t_end is not None:
         raise _fail(source, "[run] time", "give either collisions or time, not both")
     if nc is None and t_end is None:
-        nc = max(1, _DEFAULT_PER_PARTICLE * n // 2)
+        nc = _LATTICE_DEFAULT_COLLISIONS if engine == "lattice" else max(1, _DEFAULT_PER_PARTICLE * n // 2)
     if nc is not None and n == 1:
         raise _fail(source, "[run] collisions", "a single particle never collides; give [run] time instead")
     checkpoint_interval = get("run", "checkpoint_interval", 0)
@@ -430,7 +450,7 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
 
     scene = Scene(
         dimension=d, particles=n, diameter=sigma, box=tuple(box), packing_fraction=phi,
-        boundaries=tuple(bounds), start=start,
+        boundaries=tuple(bounds), start=start, engine=engine,
         kinetic_energy=get("system", "kinetic_energy"), initial_state=initial_path,
         mode=mode, law=law, bits=get("collisions", "bits", 40),
         streams=get("rng", "streams", "per_particle"), collisions=nc, time=t_end,
@@ -440,6 +460,47 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
     if arrays is not None:
         _check_initial(source, scene, *arrays)
     return scene
+
+
+def _check_lattice(source: str, d: int, mode: str, generator: str, streams: str, bits_given: bool) -> None:
+    """The combinations the lattice engine runs: 2D, exact mode (flux or uniform law), Philox
+    per-particle streams, no chart bits; anything else is a SceneError naming the field."""
+    why = "engine = 'lattice'"
+    if d != 2:
+        raise _fail(source, "[system] dimension", f"{why} runs 2D gases only, got dimension {d}")
+    if mode != "exact":
+        raise _fail(source, "[collisions] mode", f"{why} runs exact mode only (flux or uniform law), got {mode!r}")
+    if generator != "philox":
+        raise _fail(source, "[rng] generator", f"{why} draws from Philox per-particle streams, got {generator!r}")
+    if streams != "per_particle":
+        raise _fail(source, "[rng] streams", f"{why} draws from one Philox stream per particle, got {streams!r}")
+    if bits_given:
+        raise _fail(source, "[collisions] bits", f"does not apply to {why} (its collisions are exact integer "
+                    "bijections, no K-bit chart)")
+
+
+def with_engine(scene: Scene, engine: str) -> Scene:
+    """``scene`` on another engine (``revcol run --engine``), checked as a scene file saying
+    ``[collisions] engine = ...`` would be: a scene that names no generator gets the engine's
+    default one (Philox on the lattice); a lattice scene moved to the float engine keeps its
+    Philox streams and gets the float engine's default chart bits, 40."""
+    if engine not in ENGINES:
+        raise SceneError(f"{scene.source}: --engine must be one of {', '.join(map(repr, ENGINES))}, got {engine!r}")
+    if scene.kind != "gas":
+        raise SceneError(f"{scene.source}: --engine applies to 'gas' scenes, not {scene.kind!r}")
+    fields = scene.extra.get("fields", ())
+    out = dataclasses.replace(scene, engine=engine)
+    if engine == "lattice":
+        if "rng.generator" not in fields:  # the lattice's default generator, as in a scene file
+            out = dataclasses.replace(out, generator="philox")
+        try:
+            _check_lattice(scene.source, scene.dimension, scene.mode, out.generator, scene.streams,
+                           "collisions.bits" in fields)
+        except SceneError as e:
+            raise SceneError(f"{e} (--engine lattice)") from None
+    if scene.initial_state is not None:
+        _check_initial(scene.source, out, *read_initial(scene.source, scene.initial_state, scene.dimension))
+    return out
 
 
 def _reversal(source, get, common, mode, law, out) -> Scene:
@@ -495,11 +556,16 @@ def read_initial(source: str, path: Path, d: int):
 
 def _check_initial(source: str, scene: Scene, x, v) -> None:
     """Builds the engine once from the explicit state: its validation (finite values, inside
-    the box, no overlap, non-zero kinetic energy) is the one the run will meet."""
+    the box, no overlap, non-zero kinetic energy; on the lattice also the quantization: a box or
+    speed range it cannot hold, an overlap after rounding) is the one the run will meet."""
     from .engine import Simulation
+    from .lattice import LatticeSimulation
 
     try:
-        Simulation(x, v, scene.box, **engine_options(scene))
+        if scene.engine == "lattice":
+            LatticeSimulation(x, v, scene.box, **lattice_options(scene))
+        else:
+            Simulation(x, v, scene.box, **engine_options(scene))
     except ValueError as e:
         raise _fail(source, "[system] initial_state", f"{scene.initial_state.name}: {e}") from None
 
@@ -527,6 +593,11 @@ def engine_options(scene: Scene) -> dict[str, Any]:
     return dict(boundary=list(scene.boundaries),
                 diameter=scene.diameter, mode=scene.mode, law=scene.law, seed=scene.seed,
                 bits=scene.bits, generator=scene.generator, streams=scene.streams)
+
+
+def lattice_options(scene: Scene) -> dict[str, Any]:
+    """The keyword arguments of :class:`revcol.lattice.LatticeSimulation` that a gas scene sets."""
+    return dict(boundary=list(scene.boundaries), diameter=scene.diameter, law=scene.law, seed=scene.seed)
 
 
 def load_scene(path: str | Path | None = None) -> Scene:

@@ -68,18 +68,32 @@ def test_example_scenes_round_trip_reduced(path, tmp_path):
 
 
 def test_default_report_cli(tmp_path, capsys):
+    # the default scene (lattice engine) at 2*10^4 collisions; its full length is the main job
     out = tmp_path / "r.json"
-    assert cli_main(["run", "--json", str(out), "--no-progress"]) == 0
+    assert cli_main(["run", "--json", str(out), "--no-progress", "--collisions", "20000"]) == 0
     text = capsys.readouterr().out
-    for needle in ("revcol run default", "1000 particles in 2D", "collisions/s", "positions error",
-                   "velocity error", "energy drift", "momentum drift   n/a (walls on every axis)",
-                   "log bytes", "peak RSS", "result           PASSED"):
+    for needle in ("revcol run default", "1000 particles in 2D", "lattice engine", "collisions/s",
+                   "restored         bit for bit", "bits-back X", "rare log", "redraws", "multi-body",
+                   "energy drift", "momentum drift   n/a (walls on every axis)", "peak RSS",
+                   "result           PASSED: restored bit for bit"):
         assert needle in text, needle
     assert "\r" not in text  # no progress bar when stdout is not a terminal
     r = json.loads(out.read_text())
-    assert r["passed"] and r["collisions_forward"] == r["collisions_back"] == 1000
-    assert r["scene"]["generator"] == "clcg4" and r["scene"]["streams"] == "per_particle"
+    assert r["passed"] and r["bit_for_bit"] and r["collisions_forward"] == r["collisions_back"] == 20000
+    assert r["scene"]["generator"] == "philox" and r["scene"]["streams"] == "per_particle"
     assert r["forward_per_s"] > 0 and r["reverse_per_s"] > 0 and r["peak_rss_bytes"] > 0
+
+
+def test_default_gas_on_the_float_engine_cli(tmp_path, capsys):
+    # the same gas on the float engine, 2 collisions per particle (inside its horizon)
+    out = tmp_path / "r.json"
+    assert cli_main(["run", "--engine", "float", "--collisions", "1000", "--json", str(out), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    for needle in ("revcol run default", "1000 particles in 2D", "positions error", "velocity error",
+                   "log bytes", "result           PASSED"):
+        assert needle in text, needle
+    r = json.loads(out.read_text())
+    assert r["passed"] and r.get("engine") is None and r["scene"]["engine"] == "float"
     assert set(r["error_definitions"]) == {"error_x", "error_v"}
 
 
@@ -281,12 +295,10 @@ def test_horizon(tmp_path, capsys):
     assert all(a["error_v"] <= b["error_v"] for a, b in zip(one["rows"], rows[:len(one["rows"])]))
 
 
-def test_ctrl_c_stops_forward_and_still_reverses_and_writes(tmp_path, capsys, monkeypatch):
-    import revcol.run as run
-
-    # a 1D gas reverses exactly however long it runs: 1e8 collisions would take a minute.
-    # The SIGINT is sent 0.3 s after the run's handler is installed (never before it).
-    enter = run._Interrupt.__enter__
+def sigint_once_running(monkeypatch, interrupt_class) -> list:
+    """Sends SIGINT 0.3 s after a run's Ctrl-C handler (``interrupt_class``) is installed
+    (never before it); returns the timers, to cancel when the run is over."""
+    enter = interrupt_class.__enter__
     timers = []
 
     def enter_then_interrupt(self):
@@ -294,7 +306,15 @@ def test_ctrl_c_stops_forward_and_still_reverses_and_writes(tmp_path, capsys, mo
         timers.append(threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT)))
         timers[-1].start()
         return out
-    monkeypatch.setattr(run._Interrupt, "__enter__", enter_then_interrupt)
+    monkeypatch.setattr(interrupt_class, "__enter__", enter_then_interrupt)
+    return timers
+
+
+def test_ctrl_c_stops_forward_and_still_reverses_and_writes(tmp_path, capsys, monkeypatch):
+    import revcol.run as run
+
+    # a 1D gas reverses exactly however long it runs: 1e8 collisions would take a minute.
+    timers = sigint_once_running(monkeypatch, run._Interrupt)
     before = signal.getsignal(signal.SIGINT)
     p = tmp_path / "long.toml"
     p.write_text("[system]\ndimension = 1\nparticles = 1000\npacking_fraction = 0.3\n[run]\ncollisions = 100000000\n")
@@ -344,7 +364,7 @@ def test_reversal_builds_no_particles(monkeypatch):
 
 
 def test_imports_only_what_a_run_uses():
-    code = ("import sys, revcol.run as r; rep = r.run_scene(None, progress=False); "
+    code = ("import sys, revcol.run as r; rep = r.run_scene(None, collisions=20000, progress=False); "
             "print(rep['passed'], *[m in sys.modules for m in ('matplotlib', 'revcol.trajectory', 'tqdm', 'gsd')])")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout

@@ -15,7 +15,8 @@ def write(tmp_path: Path, text: str) -> Path:
 
 def test_default_scene():
     s = load_scene(None)
-    assert (s.dimension, s.particles, s.mode, s.law, s.generator) == (2, 1000, "exact", "flux", "clcg4")
+    assert (s.dimension, s.particles, s.mode, s.law, s.generator) == (2, 1000, "exact", "flux", "philox")
+    assert s.engine == "lattice" and s.collisions == 10**6
     assert s.boundaries == ("wall", "wall") and s.packing_fraction == 0.3 and s.streams == "per_particle"
     # area fraction 0.3 of 1000 unit disks: side^2 = 1000 pi / 4 / 0.3
     assert s.box[0] == pytest.approx((1000 * np.pi / 4 / 0.3) ** 0.5, rel=1e-15)
@@ -252,3 +253,15 @@ def test_random_start_in_an_explicit_box():
     s = scene_from_dict({"system": {"dimension": 2, "particles": 20, "box": [30.0, 6.0], "start": "random"}},
                         "s.toml")
     assert s.start == "random" and s.packing_fraction is None
+
+
+def test_engine_field_and_the_lattice_defaults():
+    gas = {"system": {"dimension": 2, "particles": 50, "packing_fraction": 0.2}}
+    f = scene_from_dict(gas)
+    assert (f.engine, f.generator, f.collisions) == ("float", "clcg4", 50)  # 2 collisions per particle
+    lat = scene_from_dict({**gas, "collisions": {"engine": "lattice", "law": "uniform"}})
+    assert (lat.engine, lat.generator, lat.streams, lat.law, lat.collisions) == \
+        ("lattice", "philox", "per_particle", "uniform", 10**6)
+    assert "lattice engine, exact/uniform" in lat.summary() and lat.to_dict()["engine"] == "lattice"
+    with pytest.raises(SceneError, match=r"\[collisions\] engine: does not apply to kind = 'statesave'"):
+        scene_from_dict({"scene": {"kind": "statesave"}, "collisions": {"engine": "lattice"}})
