@@ -49,7 +49,7 @@ def roundtrip(dim, n, phi, nc, seed=1, mode="exact", law="flux", boundary="perio
     revcol = _revcol()
     sim = revcol.Simulation.random(n=n, dim=dim, phi=phi, seed=seed, mode=mode, law=law, boundary=boundary)
     x0, v0 = sim.positions, sim.velocities
-    st = sim.state()
+    st = sim.snapshot() if hasattr(sim, "snapshot") else sim.state()  # builds before the rename (bench/ab_compare.py)
     box, per = st["box"], st["periodic"].astype(bool)
     t0 = time.perf_counter()
     sim.run(collisions=nc)

@@ -75,7 +75,7 @@ def roundtrip(args) -> dict:
     for boundary in (("periodic", "wall") if args.boundary == "both" else (args.boundary,)):
         sim = LatticeSimulation.random(n=args.n, phi=args.phi, boundary=boundary, seed=args.seed,
                                        init="lattice" if args.phi > 0.35 else "auto", law=args.law)
-        s0 = sim.state()
+        s0 = sim.snapshot()
         nc = args.n * 10
         while nc <= float(args.max):
             t0 = time.perf_counter()
@@ -84,7 +84,7 @@ def roundtrip(args) -> dict:
             d = sim.diagnostics()
             sim.run_back()
             t2 = time.perf_counter()
-            ok = _same(sim.state(), s0)
+            ok = _same(sim.snapshot(), s0)
             row = {"boundary": boundary, "law": args.law, "n": args.n, "phi": args.phi, "collisions": nc,
                    "per_particle": 2 * nc / args.n, "bit_for_bit": bool(ok),
                    "forward_s": t1 - t0, "reverse_s": t2 - t1,

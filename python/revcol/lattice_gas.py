@@ -40,7 +40,7 @@ from .scene import Scene, SceneError, lattice_options, read_initial
 __all__ = ["build_lattice", "run_lattice_gas", "lattice_horizon", "restored", "RESTORED_PARTS",
            "LATTICE_HORIZON_GRID"]
 
-#: the parts of the state compared exactly after the round trip: report name -> state() keys
+#: the parts of the state compared exactly after the round trip: report name -> snapshot() keys
 RESTORED_PARTS: dict[str, tuple[str, ...]] = {
     "positions": ("x",),
     "velocities": ("v",),
@@ -116,7 +116,7 @@ class _LatticeRun:
         self.sim = sim = build_lattice(scene)
         self.n = sim.n
         self.box, self.periodic = geometry(sim)
-        self.s0 = sim.state()
+        self.s0 = sim.snapshot()
         self.x0, self.v0 = sim.positions, sim.velocities
         self.bits0 = self.bits_max = int(sim.diagnostics()["bits_length"])
         self.nc = scene.collisions
@@ -200,7 +200,7 @@ class _LatticeRun:
     def turn(self) -> None:
         sim = self.sim
         self.diag_turn = sim.diagnostics()
-        self.state_turn = sim.state()
+        self.state_turn = sim.snapshot()
         self.t_turn, self.clock_turn = sim.time, sim.clock
         self.shot_turn = (sim.positions, sim.velocities)
         if self.writer is not None and self.frames[-1] != self.done:
@@ -250,7 +250,7 @@ class _LatticeRun:
 def lattice_report(run: _LatticeRun) -> dict[str, Any]:
     """The report of a lattice round trip (see :mod:`revcol.report` for its text)."""
     sim, scene, done, n = run.sim, run.scene, run.done, run.n
-    end, d_turn, d_end = sim.state(), run.diag_turn, sim.diagnostics()
+    end, d_turn, d_end = sim.snapshot(), run.diag_turn, sim.diagnostics()
     same = restored(run.s0, end)
     complete = sim.collisions == 0 and run.interrupted != "reverse" and run.engine_error is None
     ex, ev = round_trip_errors(sim.positions, sim.velocities, run.x0, run.v0, run.box, run.periodic)
@@ -324,7 +324,7 @@ def lattice_horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000
                     progress: bool | None = None) -> dict:
     """``--horizon`` on a lattice scene: there is none. For each seed, one forward run stops at
     each N_c of :data:`LATTICE_HORIZON_GRID` (up to ``max_collisions``); a copy of the state
-    (``state()`` / ``from_state``) runs back to the start and is compared with it exactly.
+    (``snapshot()`` / ``from_snapshot``) runs back to the start and is compared with it exactly.
     ``passed`` when every round trip is bit for bit."""
     if progress is None:
         progress = sys.stdout.isatty()
@@ -353,13 +353,13 @@ def _horizon_seeds(scene: Scene, seeds: int, grid: list[int], rows: dict, bar: B
     """The round trips of :func:`lattice_horizon`, counted into ``rows``."""
     for s in range(seeds):
         sim = build_lattice(scene, scene.seed + s)
-        s0, done = sim.state(), 0
+        s0, done = sim.snapshot(), 0
         for nc in grid:
             try:
                 done += int(sim.run(collisions=nc - done)["collisions"])
-                clone = LatticeSimulation.from_state(sim.state())
+                clone = LatticeSimulation.from_snapshot(sim.snapshot())
                 clone.run_back()
-                ok = all(restored(s0, clone.state()).values())
+                ok = all(restored(s0, clone.snapshot()).values())
             except RuntimeError as e:
                 ok = False
                 rows[nc]["errors"].append(f"seed {scene.seed + s}: {e}")

@@ -35,11 +35,5 @@ def round_trip_errors(x, v, x0, v0, box, periodic) -> tuple[float, float]:
 
 def geometry(sim) -> tuple[np.ndarray, np.ndarray]:
     """(box lengths, periodic flags) per axis of a :class:`revcol.Simulation`, the inputs of
-    :func:`round_trip_errors`: ``Simulation.box`` / ``.periodic`` where the engine has
-    them, else read from its state."""
-    if hasattr(sim, "box") and hasattr(sim, "periodic"):
-        box, per = sim.box, sim.periodic
-    else:
-        st = sim.state()
-        box, per = st["box"], st["periodic"]
-    return np.asarray(box, dtype=float)[: sim.dim], np.asarray(per, dtype=bool)[: sim.dim]
+    :func:`round_trip_errors`."""
+    return np.asarray(sim.box, dtype=float)[: sim.dim], np.asarray(sim.periodic, dtype=bool)[: sim.dim]
