@@ -1,0 +1,85 @@
+// The lattice family of revcol-bench: the 2D lattice engine's collisions per second forward and
+// reverse (periodic, N = 10^4, area fractions 0.3 and 0.5; walls at 0.3), with the round trip's
+// bit-exactness and the rare counts. Run it beside engine/d2/... in one invocation to compare
+// with the float engine (the machine is shared: never compare across runs).
+//
+//   revcol-bench --bench lattice/ --collisions 200000
+//
+// Metrics: forward_per_s, reverse_per_s, bit_exact (1 when positions, velocities, streams, X and
+// clock are restored bit for bit), events_per_collision, log_entries, redraws_per_collision,
+// multi_body, wall_body, bits_length (X after the forward run), energy_drift (relative, after the
+// forward run), engine_bytes, n, phi.
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bench.hpp"
+#include "revcol/lattice/engine.hpp"
+
+namespace revcol::bench {
+namespace {
+
+namespace la = revcol::lattice;
+
+struct LatticeCase {
+  std::size_t n = 10000;
+  double phi = 0.3;
+  bool walls = false;
+  std::uint64_t seed = 1;
+};
+
+std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
+  la::LatticeConfig cfg;
+  cfg.wall = {c.walls, c.walls};
+  cfg.seed = static_cast<std::uint32_t>(c.seed);
+  const la::LatticeStart st = la::random_start(cfg, c.n, c.phi, c.seed, c.phi > 0.35 ? "lattice" : "auto");
+  la::LatticeEngine e(st.units, st.x, st.v, cfg.seed, la::LatticePair2D(st.units.sigma));
+  // warm up a collision per particle from the initialiser's lattice, then start the clock
+  e.run(c.n, la::tick_limit - 1);
+  const la::Snapshot s0 = e.snapshot();
+  const la::Counters k0 = e.counters();
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  const std::uint64_t done = e.run(nc, la::tick_limit - 1);
+  const auto t1 = clock::now();
+  const la::Diagnostics d1 = la::diagnostics(e);
+  const la::Counters k1 = e.counters();
+  e.run_back(s0.collisions, s0.origin);
+  const auto t2 = clock::now();
+  const bool exact = la::same_state(e.snapshot(), s0);
+  double redraws = 0.0;
+  for (int k = 1; k < 8; ++k) redraws += static_cast<double>(k1.redraws[k] - k0.redraws[k]);
+  const double coll = static_cast<double>(done);
+  return {{"forward_per_s", coll / std::chrono::duration<double>(t1 - t0).count()},
+          {"reverse_per_s", coll / std::chrono::duration<double>(t2 - t1).count()},
+          {"bit_exact", exact ? 1.0 : 0.0},
+          {"events_per_collision", static_cast<double>(k1.events - k0.events) / coll},
+          {"log_entries", static_cast<double>(k1.log_entries - k0.log_entries)},
+          {"redraws_per_collision", redraws / coll},
+          {"multi_body", static_cast<double>(k1.multi_body - k0.multi_body)},
+          {"wall_body", static_cast<double>(k1.wall_body - k0.wall_body)},
+          {"bits_length", static_cast<double>(d1.bits_length)},
+          {"energy_drift", d1.energy_drift},
+          {"engine_bytes", static_cast<double>(e.memory_bytes())},
+          {"n", static_cast<double>(c.n)},
+          {"phi", c.phi}};
+}
+
+}  // namespace
+
+void add_lattice_benches(std::vector<Bench>& out) {
+  struct Named {
+    const char* name;
+    LatticeCase c;
+  };
+  static const Named named[] = {{"lattice/periodic/n10000/phi0.3", {10000, 0.3, false, 1}},
+                                {"lattice/periodic/n10000/phi0.5", {10000, 0.5, false, 1}},
+                                {"lattice/walls/n10000/phi0.3", {10000, 0.3, true, 1}}};
+  for (const Named& m : named) {
+    const LatticeCase c = m.c;
+    out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice(c, n); }});
+  }
+}
+
+}  // namespace revcol::bench

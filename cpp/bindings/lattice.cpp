@@ -1,0 +1,278 @@
+// Binding of the 2D lattice engine: numpy int64 arrays in and out, dicts for starts,
+// diagnostics and checkpoints. No physics here (revcol/lattice/engine.hpp).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "bindings.hpp"
+#include "revcol/error.hpp"
+#include "revcol/lattice/engine.hpp"
+
+namespace py = pybind11;
+
+namespace revcol::bind {
+namespace {
+
+namespace la = revcol::lattice;
+using IArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+using FArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+std::vector<la::Vec2> vecs(const IArray& a, const char* what) {
+  require(a.ndim() == 2 && a.shape(1) == 2, [&] { return std::string(what) + " must be an (n, 2) integer array"; });
+  std::vector<la::Vec2> out(static_cast<std::size_t>(a.shape(0)));
+  if (!out.empty()) std::memcpy(out.data(), a.data(), out.size() * sizeof(la::Vec2));
+  return out;
+}
+py::array_t<std::int64_t> vec_array(const std::vector<la::Vec2>& v) {
+  py::array_t<std::int64_t> out({static_cast<py::ssize_t>(v.size()), py::ssize_t{2}});
+  if (!v.empty()) std::memcpy(out.mutable_data(), v.data(), v.size() * sizeof(la::Vec2));
+  return out;
+}
+template <class T>
+py::array_t<T> flat_array(const T* p, std::size_t n) {
+  py::array_t<T> out(static_cast<py::ssize_t>(n));
+  if (n > 0) std::memcpy(out.mutable_data(), p, n * sizeof(T));
+  return out;
+}
+template <class T>
+std::vector<T> get_flat(const py::dict& d, const char* key) {
+  require(d.contains(key), [&] { return std::string("lattice checkpoint is missing '") + key + "'"; });
+  auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(d[key]);
+  require(static_cast<bool>(a), [&] { return std::string("lattice checkpoint entry '") + key + "' is not an array"; });
+  return std::vector<T>(a.data(), a.data() + a.size());
+}
+template <class T>
+T get(const py::dict& d, const char* key) {
+  require(d.contains(key), [&] { return std::string("lattice checkpoint is missing '") + key + "'"; });
+  return py::cast<T>(d[key]);
+}
+
+py::dict units_dict(const la::Units& u) {
+  py::dict d;
+  d["S"] = u.S;
+  d["sigma"] = u.sigma;
+  d["L"] = py::make_tuple(u.L[0], u.L[1]);
+  d["wall"] = py::make_tuple(u.wall[0], u.wall[1]);
+  d["vmax"] = u.vmax;
+  d["length_unit"] = u.length_unit;
+  d["tick"] = u.tick;
+  return d;
+}
+la::Units units_from(const py::dict& d) {
+  la::Units u;
+  u.S = get<int>(d, "S");
+  u.sigma = get<std::int64_t>(d, "sigma");
+  const auto L = get<std::vector<std::int64_t>>(d, "L");
+  const auto w = get<std::vector<bool>>(d, "wall");
+  require(L.size() == 2 && w.size() == 2, "lattice units: L and wall need two entries");
+  u.L = {L[0], L[1]};
+  u.wall = {w[0], w[1]};
+  u.vmax = get<std::int64_t>(d, "vmax");
+  u.length_unit = get<double>(d, "length_unit");
+  u.tick = get<double>(d, "tick");
+  la::validate(u);
+  return u;
+}
+
+py::dict start_dict(const la::LatticeStart& s) {
+  py::dict d;
+  d["units"] = units_dict(s.units);
+  d["x"] = vec_array(s.x);
+  d["v"] = vec_array(s.v);
+  d["max_position_error"] = s.max_position_error;
+  d["max_velocity_error"] = s.max_velocity_error;
+  return d;
+}
+
+py::dict counters_dict(const la::Counters& c) {
+  py::dict d;
+  d["events"] = c.events;
+  d["collisions_applied"] = c.collisions;
+  d["walls"] = c.walls;
+  d["crossings"] = c.crossings;
+  d["stale"] = c.stale;
+  py::dict r;
+  for (int k = 1; k < 8; ++k) r[la::redraw_names[k]] = c.redraws[k];
+  d["redraws"] = r;
+  d["log_entries_written"] = c.log_entries;
+  d["multi_body"] = c.multi_body;
+  d["wall_body"] = c.wall_body;
+  d["group_bounces"] = c.group_bounces;
+  return d;
+}
+
+py::dict snapshot_dict(const la::Snapshot& s, revcol::Law law) {
+  py::dict d;
+  d["engine"] = "lattice";
+  d["units"] = units_dict(s.units);
+  d["law"] = to_string(law);
+  d["seed"] = s.seed;
+  d["clock"] = s.clock;
+  d["origin"] = s.origin;
+  d["collisions"] = s.collisions;
+  d["x"] = vec_array(s.x);
+  d["v"] = vec_array(s.v);
+  d["streams"] = flat_array(s.streams.data(), s.streams.size());
+  d["bits"] = flat_array(s.bits.data(), s.bits.size());
+  std::vector<std::uint64_t> li, lr;
+  for (const auto& e : s.log) {
+    li.push_back(e.first);
+    lr.push_back(e.second);
+  }
+  d["log_index"] = flat_array(li.data(), li.size());
+  d["log_redraws"] = flat_array(lr.data(), lr.size());
+  std::vector<std::uint64_t> gi;
+  std::vector<std::int64_t> gd, gs, gm;
+  for (const auto& [k, g] : s.groups) {
+    gi.push_back(k);
+    gd.push_back(g.first);
+    gs.push_back(static_cast<std::int64_t>(g.second.size()));
+    for (int m : g.second) gm.push_back(m);
+  }
+  d["group_index"] = flat_array(gi.data(), gi.size());
+  d["group_drawer"] = flat_array(gd.data(), gd.size());
+  d["group_size"] = flat_array(gs.data(), gs.size());
+  d["group_members"] = flat_array(gm.data(), gm.size());
+  d["energy0"] = flat_array(s.energy0.data(), 2);
+  d["momentum0"] = flat_array(s.momentum0.data(), 4);
+  return d;
+}
+
+la::Snapshot snapshot_from(const py::dict& d) {
+  la::Snapshot s;
+  s.units = units_from(get<py::dict>(d, "units"));
+  s.seed = get<std::uint32_t>(d, "seed");
+  s.clock = get<std::int64_t>(d, "clock");
+  s.origin = get<std::int64_t>(d, "origin");
+  s.collisions = get<std::uint64_t>(d, "collisions");
+  s.x = vecs(IArray::ensure(d["x"]), "x");
+  s.v = vecs(IArray::ensure(d["v"]), "v");
+  s.streams = get_flat<std::uint64_t>(d, "streams");
+  s.bits = get_flat<std::uint64_t>(d, "bits");
+  const auto li = get_flat<std::uint64_t>(d, "log_index");
+  const auto lr = get_flat<std::uint64_t>(d, "log_redraws");
+  require(li.size() == lr.size(), "lattice checkpoint: log_index and log_redraws differ in length");
+  for (std::size_t k = 0; k < li.size(); ++k) s.log.emplace_back(li[k], static_cast<std::uint32_t>(lr[k]));
+  const auto gi = get_flat<std::uint64_t>(d, "group_index");
+  const auto gd = get_flat<std::int64_t>(d, "group_drawer");
+  const auto gs = get_flat<std::int64_t>(d, "group_size");
+  const auto gm = get_flat<std::int64_t>(d, "group_members");
+  require(gi.size() == gd.size() && gi.size() == gs.size(), "lattice checkpoint: group arrays differ in length");
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < gi.size(); ++k) {
+    require(gs[k] >= 2 && at + static_cast<std::size_t>(gs[k]) <= gm.size(), "lattice checkpoint: group_members too short");
+    std::vector<int> members(gm.begin() + static_cast<std::ptrdiff_t>(at), gm.begin() + static_cast<std::ptrdiff_t>(at + gs[k]));
+    at += static_cast<std::size_t>(gs[k]);
+    s.groups.push_back({gi[k], {static_cast<int>(gd[k]), members}});
+  }
+  const auto e0 = get_flat<std::uint64_t>(d, "energy0");
+  const auto p0 = get_flat<std::int64_t>(d, "momentum0");
+  require(e0.size() == 2 && p0.size() == 4, "lattice checkpoint: energy0 needs 2 words and momentum0 4");
+  s.energy0 = {e0[0], e0[1]};
+  s.momentum0 = {p0[0], p0[1], p0[2], p0[3]};
+  return s;
+}
+
+/// The engine with the law it was made with (the operator's law is not in the snapshot struct).
+struct PyLattice {
+  revcol::Law law;
+  la::LatticeEngine e;
+};
+
+}  // namespace
+
+void register_lattice(py::module_& m) {
+  m.def(
+      "lattice_random_start",
+      [](std::size_t n, double phi, std::vector<bool> wall, double diameter, std::uint64_t seed, const std::string& init) {
+        require(wall.size() == 2, "lattice: walls need one flag per axis (2D)");
+        require(seed <= 0xFFFFFFFFull, "seed must be < 2^32");
+        la::LatticeConfig c;
+        c.wall = {wall[0], wall[1]};
+        c.diameter = diameter;
+        c.seed = static_cast<std::uint32_t>(seed);
+        return start_dict(la::random_start(c, n, phi, seed, init));
+      },
+      py::arg("n"), py::arg("phi"), py::arg("wall"), py::arg("diameter"), py::arg("seed"), py::arg("init"),
+      "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
+  m.def(
+      "lattice_quantize",
+      [](const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, double diameter) {
+        require(box.size() == 2 && wall.size() == 2, "lattice: box and walls need two entries (2D)");
+        require(x.ndim() == 2 && x.shape(1) == 2 && v.ndim() == 2 && v.shape(1) == 2, "lattice: positions and velocities must be (n, 2)");
+        la::LatticeConfig c;
+        c.box = {box[0], box[1]};
+        c.wall = {wall[0], wall[1]};
+        c.diameter = diameter;
+        return start_dict(la::quantize_start(c, std::vector<double>(x.data(), x.data() + x.size()),
+                                             std::vector<double>(v.data(), v.data() + v.size())));
+      },
+      py::arg("x"), py::arg("v"), py::arg("box"), py::arg("wall"), py::arg("diameter"),
+      "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
+
+  py::class_<PyLattice>(m, "LatticeEngine", "The 2D lattice engine (revcol/lattice/engine.hpp).")
+      .def(py::init([](const py::dict& units, const IArray& x, const IArray& v, std::uint64_t seed, const std::string& law,
+                       std::int64_t clock) {
+             require(seed <= 0xFFFFFFFFull, "seed must be < 2^32");
+             const la::Units u = units_from(units);
+             const revcol::Law lw = parse_law(law);
+             return PyLattice{lw, la::LatticeEngine(u, vecs(x, "x"), vecs(v, "v"), static_cast<std::uint32_t>(seed),
+                                                    la::LatticePair2D(u.sigma, lw), clock)};
+           }),
+           py::arg("units"), py::arg("x"), py::arg("v"), py::arg("seed"), py::arg("law"), py::arg("clock") = 0)
+      .def_static(
+          "from_snapshot",
+          [](const py::dict& d) {
+            const la::Snapshot s = snapshot_from(d);
+            const revcol::Law lw = parse_law(get<std::string>(d, "law"));
+            return PyLattice{lw, la::LatticeEngine(s, la::LatticePair2D(s.units.sigma, lw))};
+          },
+          "Rebuilds an engine from snapshot(); it resumes bit for bit.")
+      .def(
+          "run",
+          [](PyLattice& p, std::optional<std::uint64_t> collisions, std::optional<std::int64_t> until) {
+            const std::uint64_t done = p.e.run(collisions.value_or(std::numeric_limits<std::uint64_t>::max()),
+                                               until.value_or(la::tick_limit - 1));
+            return done;
+          },
+          py::arg("collisions") = py::none(), py::arg("until") = py::none(),
+          "Forward: until that many more collisions or the tick `until`; returns the collisions done.")
+      .def(
+          "run_back",
+          [](PyLattice& p, std::optional<std::uint64_t> to_collisions, std::optional<std::int64_t> to_tick) {
+            p.e.run_back(to_collisions.value_or(0), to_tick.value_or(p.e.origin()));
+          },
+          py::arg("to_collisions") = py::none(), py::arg("to_tick") = py::none(),
+          "Back to collision count `to_collisions` or tick `to_tick` (default: the start).")
+      .def("snapshot", [](const PyLattice& p) { return snapshot_dict(p.e.snapshot(), p.law); })
+      .def_property_readonly("positions", [](const PyLattice& p) { return vec_array(p.e.positions()); })
+      .def_property_readonly("velocities", [](const PyLattice& p) { return vec_array(p.e.velocities()); })
+      .def_property_readonly("clock", [](const PyLattice& p) { return p.e.clock(); })
+      .def_property_readonly("origin", [](const PyLattice& p) { return p.e.origin(); })
+      .def_property_readonly("collisions", [](const PyLattice& p) { return p.e.collisions(); })
+      .def_property_readonly("units", [](const PyLattice& p) { return units_dict(p.e.units()); })
+      .def_property_readonly("n", [](const PyLattice& p) { return p.e.size(); })
+      .def_property_readonly("law", [](const PyLattice& p) { return std::string(to_string(p.law)); })
+      .def("diagnostics", [](const PyLattice& p) {
+        const la::Diagnostics g = la::diagnostics(p.e);
+        py::dict d = counters_dict(p.e.counters());
+        d["energy_drift"] = g.energy_drift;
+        d["energy_drift_units"] = g.energy_drift_units;
+        d["momentum_drift"] = py::make_tuple(g.momentum_drift[0], g.momentum_drift[1]);
+        d["bits_length"] = g.bits_length;
+        d["log_entries"] = g.log_entries;
+        d["group_log_entries"] = p.e.group_log_size();
+        d["collisions"] = g.collisions;
+        d["clock"] = g.clock;
+        d["time"] = g.time;
+        d["memory_bytes"] = g.memory_bytes;
+        return d;
+      });
+}
+
+}  // namespace revcol::bind

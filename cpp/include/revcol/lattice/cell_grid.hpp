@@ -1,0 +1,97 @@
+// The integer cell grid of the 2D lattice engine and its flat walls (LATTICE.md §6).
+//
+// Cells. Per axis, nc cells with integer boundaries b(c) = floor(c L / nc); a particle belongs to
+// the cell holding its position at its last event, and leaves it at an exact integer tick (the
+// first tick at which x_a + v (t - t_a) is outside [b(c), b(c+1))), a neutral event. Pair
+// predictions look at the 3 x 3 neighbouring cells: a pair that overlaps at tick a is at distance
+// < sigma + |w| <= sigma + 2 vmax at tick a-1, so with a cell width >= w_min = sigma + 2 vmax + 2
+// it is in neighbouring cells at a-1 and was predicted at the later of its two last events.
+// On a periodic axis the grid needs nc >= 5, so that a neighbouring cell's image is the minimum
+// image; a smaller periodic axis uses 8 cells for the crossings (rechecks every L/8) and takes every
+// cell as a neighbour (the minimum image between rechecks then moves by < L/4; L >= 4.5 sigma).
+//
+// Walls. On a wall axis the centres live in [h, H] = [sigma/2, L - sigma/2]. A flat wall reflects the
+// normal component on a tick transition, exactly and as a bijection: the pre phases at tick a-1
+// toward the lower wall, {x >= h, x + v < h}, are |v| integers, and so are the post phases at tick
+// a, {x' >= h, x' - v' < h} with v' = -v; the mirror x' = h + (|v| - 1 - (x - h)) maps one onto
+// the other, and read backwards (velocities negated) it is the same map. The upper wall is the
+// mirror image. Two walls within one tick (a corner) are the two axes' mirrors at once.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "revcol/lattice/units.hpp"
+
+namespace revcol::lattice {
+
+/// Wall mirror on one axis: pre phase x at tick a-1 (x + v beyond the wall) -> post x' at tick a;
+/// returns false (nothing changed) when x + v stays inside [h, H].
+inline bool wall_mirror(std::int64_t& x, std::int64_t& v, std::int64_t h, std::int64_t H) noexcept {
+  if (v < 0 && x + v < h) {
+    x = h + (-v - 1 - (x - h));
+    v = -v;
+    return true;
+  }
+  if (v > 0 && x + v > H) {
+    x = H - (v - 1 - (H - x));
+    v = -v;
+    return true;
+  }
+  return false;
+}
+
+/// Ticks from an anchor x0 in [h, H] until the line x0 + v dt first leaves [h, H]; -1 if never.
+inline std::int64_t wall_ticks(std::int64_t x0, std::int64_t v, std::int64_t h, std::int64_t H) noexcept {
+  if (v < 0) return (x0 - h) / -v + 1;
+  if (v > 0) return (H - x0) / v + 1;
+  return -1;
+}
+
+/// The cell grid: geometry per axis and the members of each cell.
+class CellGrid {
+ public:
+  /// A grid for these units (cell width >= sigma + 2 vmax + 2) over n particles.
+  void build(const Units& u, std::size_t n);
+  /// Number of cells along axis k.
+  int count(int k) const noexcept { return nc_[k]; }
+  /// Lower boundary of cell c (0 <= c <= nc) on axis k: floor(c L / nc).
+  std::int64_t boundary(int k, int c) const noexcept { return bounds_[k][static_cast<std::size_t>(c)]; }
+  /// The cell index on axis k of a position in [0, L).
+  int cell_of(int k, std::int64_t x) const noexcept;
+  /// Ticks from an anchor x0 in cell c of axis k until the line x0 + v dt leaves the cell; -1 if never.
+  std::int64_t exit_ticks(int k, int c, std::int64_t x0, std::int64_t v) const noexcept;
+  /// Flat cell id of a particle at position x.
+  int cell_id(const Vec2& x) const noexcept { return cell_of(0, x[0]) * nc_[1] + cell_of(1, x[1]); }
+  /// Calls f(member) for every particle in the cells neighbouring (and including) flat cell id.
+  template <class F>
+  void for_neighbours(int id, F&& f) const {
+    const int c0 = id / nc_[1], c1 = id % nc_[1];
+    int a0[8], a1[8];
+    const int n0 = axis_range(0, c0, a0), n1 = axis_range(1, c1, a1);
+    for (int i = 0; i < n0; ++i)
+      for (int j = 0; j < n1; ++j)
+        for (int m : members_[a0[i] * nc_[1] + a1[j]]) f(m);
+  }
+  /// Puts particle p into flat cell id.
+  void insert(int p, int id);
+  /// Removes particle p from its cell.
+  void remove(int p);
+  /// The flat cell of particle p.
+  int cell_of_particle(int p) const noexcept { return where_[p]; }
+  /// Bytes held by the grid.
+  std::size_t memory_bytes() const noexcept;
+
+ private:
+  // the distinct neighbour cells of c on axis k into out[8] (returns their count)
+  int axis_range(int k, int c, int* out) const noexcept;
+  std::array<std::int64_t, 2> L_{};
+  std::array<int, 2> nc_{1, 1};
+  std::array<std::vector<std::int64_t>, 2> bounds_;  // b(c) = floor(c L / nc), c = 0..nc
+  std::array<bool, 2> all_{false, false};  // small periodic axis: every cell is a neighbour
+  std::array<bool, 2> wall_{false, false};
+  std::vector<std::vector<int>> members_;
+  std::vector<int> where_, slot_;
+};
+
+}  // namespace revcol::lattice

@@ -1,0 +1,731 @@
+// The event machinery of the 2D lattice engine, generic over the exact pair operator
+// (LATTICE.md §2, §4; the concrete engine is lattice/engine.hpp).
+//
+// State: per particle an anchor position (integer, wrapped into the box) at an anchor tick, an
+// integer velocity, a line version (bumped when the line changes) and a Philox stream counter; the
+// clock; the bits-back integer X; the rare log; the collision count. Free flight is exact:
+// x(t) = x_a + v (t - t_a), wrapped on periodic axes.
+//
+// Event rule. Invariant: no pair overlaps at any integer tick, and every centre is inside [h, H] on
+// wall axes. A pair collides on the transition a-1 -> a where a is the first tick at which its
+// incoming lines overlap; a wall reflects on the transition into the first tick beyond it
+// (cell_grid.hpp); a cell crossing is neutral. One event per particle in the queue (its earliest:
+// crossing, wall, or collision with a neighbour); a collision found by p with q is also written into
+// q's slot when it is earlier there, so a pair's collision sits in both slots; an event whose versions
+// are stale is recomputed when it comes up.
+//
+// Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
+// collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
+// lo descending (kind 1 + (N - 1 - lo)), then walls (kind N + 1). So the reverse undoes each tick's
+// state changes in exactly the opposite order: the bits-back X and the streams are stacks.
+//
+// Reverse (the prototype's engine.py): negate velocities, anchor ticks and the clock, run the same
+// search, apply v -> -reverse(-v) at each collision with the streams stepping back, negate again.
+//
+// Forward acceptance (LATTICE.md §4): a candidate post state is redrawn (the drawing stream steps on)
+// when the operator refuses it, when a post centre is outside the walls or faster than vmax, when it
+// overlaps a third body at tick a, or when its new lines overlap a third body at tick a-1 (a false tie:
+// the reverse would meet that body first). The rare log maps the collision index to its redraw count;
+// the reverse reads and erases it. Detected and resolved by the rule, counted: three bodies within one
+// tick (a third body's line overlapping a pre line at tick a: the pre line belongs to the past of the
+// reverse) and a wall and a body within one tick (a collision right after a reflection on the same
+// tick). Not resolved, an error naming it (never a silent approximation): a reflected line whose tick
+// a-1 point overlaps a body (the reverse would meet the body first), and more than max_redraws redraws.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "revcol/engine/event_queue.hpp"
+#include "revcol/error.hpp"
+#include "revcol/lattice/cell_grid.hpp"
+#include "revcol/lattice/geometry.hpp"
+#include "revcol/lattice/units.hpp"
+#include "revcol/rng/philox.hpp"
+
+namespace revcol::lattice {
+
+/// Redraw reasons counted by the engine (index into Counters::redraws).
+enum RedrawReason : int {
+  redraw_cell_readback = 1,    ///< operator: the lifting round-off changes the read-back cell
+  redraw_not_approaching = 2,  ///< operator: pre not approaching about the quantized normal
+  redraw_empty_post = 3,       ///< operator: empty post phase set
+  redraw_out_of_domain = 4,    ///< operator: phases not an interval
+  redraw_overlap_after = 5,    ///< post state overlaps a third body at tick a
+  redraw_ghost_tie = 6,        ///< new lines overlap a third body at tick a-1
+  redraw_outside = 7,          ///< post centre beyond a wall or speed beyond vmax
+};
+/// Names of the redraw reasons, index 0 unused.
+inline constexpr const char* redraw_names[8] = {"",           "cell_readback", "not_approaching", "empty_post",
+                                                 "out_of_domain", "overlap_after", "ghost_tie",   "outside"};
+
+/// Event and rare-case counts, cumulative over both directions (not part of the physical state).
+struct Counters {
+  std::uint64_t events = 0;              ///< queue pops
+  std::uint64_t collisions = 0;          ///< collisions applied (forward and reverse)
+  std::uint64_t walls = 0;               ///< wall reflections applied (both directions)
+  std::uint64_t crossings = 0;           ///< cell crossings
+  std::uint64_t stale = 0;               ///< stale events recomputed
+  std::array<std::uint64_t, 8> redraws{};  ///< forward redraws by RedrawReason
+  std::uint64_t log_entries = 0;         ///< rare-log entries written (forward)
+  std::uint64_t multi_body = 0;          ///< three bodies within one tick (resolved by the rule)
+  std::uint64_t wall_body = 0;           ///< a wall and a body within one tick (resolved by the rule)
+  std::uint64_t group_bounces = 0;       ///< three or more bodies resolved by a group bounce (a log entry)
+};
+
+/// Everything that defines a lattice state, in the forward frame, positions at the clock.
+struct Snapshot {
+  Units units;                                 ///< units and box
+  std::uint32_t seed = 1;                      ///< Philox key {particle, seed}
+  std::int64_t clock = 0;                      ///< the current tick
+  std::int64_t origin = 0;                     ///< the tick of the initial state (no run back past it)
+  std::uint64_t collisions = 0;                ///< collisions since the initial state
+  std::vector<Vec2> x;                         ///< positions at the clock
+  std::vector<Vec2> v;                         ///< velocities
+  std::vector<std::uint64_t> streams;          ///< per-particle Philox counters
+  std::vector<std::uint64_t> bits;             ///< the bits-back integer X, 64-bit words, low first
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> log;  ///< rare log: collision index -> redraws
+  /// rare log: collision index -> (drawing particle, members) of a group bounce
+  std::vector<std::pair<std::uint64_t, std::pair<int, std::vector<int>>>> groups;
+  std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
+  std::array<std::int64_t, 4> momentum0{};     ///< initial momentum per axis (128 bits: low, high)
+  Counters counters;                           ///< statistics (not compared by same_state)
+};
+
+/// True when two snapshots hold the same physical state bit for bit (everything but counters).
+bool same_state(const Snapshot& a, const Snapshot& b);
+
+/// The 48-bit draw k of particle p's stream: Philox4x32-10 block (lo32(k), hi32(k), 0, 0) under
+/// key {p, seed}, bits w0 (32) and the top 16 of w1.
+inline std::uint64_t draw48(std::uint32_t p, std::uint32_t seed, std::uint64_t k) noexcept {
+  const auto w = rng::philox4x32_10({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k >> 32), 0U, 0U}, {p, seed});
+  return (std::uint64_t{w[0]} << 16) | (w[1] >> 16);
+}
+/// The 256 initial bits of X for a seed: four words from stream key {2^32 - 1, seed}.
+std::vector<std::uint64_t> initial_bits(std::uint32_t seed);
+
+/// The lattice engine's event machinery over a pair operator Op (pair_forward / pair_reverse as
+/// LatticePair2D) and a bits-back integer Bits (BitsBack).
+template <class Op, class Bits, class Queue = engine::EventQueue<std::int64_t>>
+class BasicEngine {
+ public:
+  /// An engine on a validated integer state at tick clock, X from initial_bits(seed).
+  BasicEngine(const Units& u, std::vector<Vec2> x, std::vector<Vec2> v, std::uint32_t seed, Op op,
+              std::int64_t clock = 0)
+      : op_(std::move(op)) {
+    validate_state(u, x, v);
+    require(clock > -tick_limit / 2 && clock < tick_limit / 2, "lattice: the start tick must be within +-2^60");
+    Snapshot s;
+    s.units = u;
+    s.seed = seed;
+    s.clock = s.origin = clock;
+    s.x = std::move(x);
+    s.v = std::move(v);
+    s.streams.assign(s.x.size(), 0);
+    s.bits = initial_bits(seed);
+    const u128 e = kinetic2(s.v);
+    s.energy0 = {static_cast<std::uint64_t>(e), static_cast<std::uint64_t>(e >> 64)};
+    const auto p = momentum_of(s.v);
+    for (int k = 0; k < 2; ++k) {
+      s.momentum0[2 * k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(static_cast<u128>(p[k])));
+      s.momentum0[2 * k + 1] = static_cast<std::int64_t>(p[k] >> 64);
+    }
+    load(s);
+  }
+  /// An engine resuming a snapshot bit for bit.
+  BasicEngine(const Snapshot& s, Op op) : op_(std::move(op)) { restore(s); }
+
+  /// Replaces the state by a snapshot (validated first: on bad input nothing changes).
+  void restore(const Snapshot& s) {
+    validate_state(s.units, s.x, s.v);
+    require(s.streams.size() == s.x.size(), "lattice snapshot: one stream counter per particle");
+    for (const auto& e : s.groups) {
+      const auto& [drawer, members] = e.second;
+      require(e.first >= 1 && e.first <= s.collisions && members.size() >= 2 &&
+                  drawer >= 0 && static_cast<std::size_t>(drawer) < s.x.size(),
+              "lattice snapshot: a group entry out of range");
+      for (int m : members) require(m >= 0 && static_cast<std::size_t>(m) < s.x.size(), "lattice snapshot: a group member out of range");
+    }
+    require(s.origin <= s.clock && s.clock < tick_limit / 2 && s.origin > -tick_limit / 2,
+            "lattice snapshot: origin <= clock within +-2^60 required");
+    require(op_.sigma() == s.units.sigma, "lattice snapshot: the operator's sigma differs from the units'");
+    load(s);
+  }
+
+  /// Runs forward until `collisions` more collisions (clock = the last one's tick) or up to tick
+  /// `until` (clock = until), whichever comes first. Returns the collisions done.
+  std::uint64_t run(std::uint64_t collisions, std::int64_t until) {
+    require(until >= clock_, "lattice run: the end tick is before the clock");
+    require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
+    if (collisions == 0) return 0;
+    return loop(collisions, until, false, 0);
+  }
+  /// Runs back to collision count `to_collisions` (the state the forward run had right after it,
+  /// clock = its tick) or to tick `to_tick` (clock = to_tick), whichever comes first in reverse.
+  void run_back(std::uint64_t to_collisions, std::int64_t to_tick) {
+    require(to_collisions <= ncoll_, "lattice run_back: the target collision count is ahead of the state");
+    require(to_tick >= origin_ && to_tick <= clock_, "lattice run_back: the target tick must be in [origin, clock]");
+    flip();
+    try {
+      loop(0, -to_tick, true, to_collisions);
+    } catch (...) {
+      flip();
+      throw;
+    }
+    flip();
+  }
+
+  /// The state (forward frame, positions at the clock).
+  Snapshot snapshot() const {
+    Snapshot s;
+    s.units = u_;
+    s.seed = seed_;
+    s.clock = clock_;
+    s.origin = origin_;
+    s.collisions = ncoll_;
+    s.x = positions();
+    s.v = velocities();
+    s.streams = ctr_;
+    s.bits = X_.words();
+    s.log.assign(log_.begin(), log_.end());
+    for (const auto& [k, g] : groups_) s.groups.push_back({k, {g.drawer, g.members}});
+    s.energy0 = energy0_;
+    s.momentum0 = momentum0_;
+    s.counters = cnt_;
+    return s;
+  }
+  /// Positions at the clock, wrapped.
+  std::vector<Vec2> positions() const {
+    std::vector<Vec2> out(ln_.size());
+    for (std::size_t p = 0; p < ln_.size(); ++p) out[p] = pos(static_cast<int>(p), clock_);
+    return out;
+  }
+  /// Velocities (a copy).
+  std::vector<Vec2> velocities() const {
+    std::vector<Vec2> out(ln_.size());
+    for (std::size_t p = 0; p < ln_.size(); ++p) out[p] = ln_[p].v;
+    return out;
+  }
+  std::int64_t clock() const noexcept { return clock_; }                ///< the current tick
+  std::int64_t origin() const noexcept { return origin_; }              ///< the initial tick
+  std::uint64_t collisions() const noexcept { return ncoll_; }          ///< collisions since the start
+  const Bits& bits() const noexcept { return X_; }                      ///< the bits-back integer
+  const Counters& counters() const noexcept { return cnt_; }            ///< statistics
+  std::size_t log_size() const noexcept { return log_.size(); }         ///< rare-log entries held (redraws)
+  std::size_t group_log_size() const noexcept { return groups_.size(); }  ///< group bounces held in the log
+  const Units& units() const noexcept { return u_; }                    ///< units and box
+  std::size_t size() const noexcept { return ln_.size(); }               ///< N
+  std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
+  const std::vector<std::uint64_t>& streams() const noexcept { return ctr_; }  ///< stream counters
+  const Op& op() const noexcept { return op_; }                         ///< the pair operator
+  /// Redraws tried before a collision is resolved as a group bounce (group_bounce); -1 (tests
+  /// only) resolves every collision so.
+  int max_redraws = 256;
+  /// When set, every forward collision appends (tick, i, j), i < j (tests, studies).
+  std::vector<std::array<std::int64_t, 3>>* trace = nullptr;
+  /// Bytes held by the engine's arrays, queue, grid and log.
+  std::size_t memory_bytes() const noexcept {
+    const std::size_t n = ln_.size();
+    return n * (2 * sizeof(Vec2) + 4 * 8 + 3 * 8 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
+           log_.size() * 48 + X_.words().size() * 8;
+  }
+  /// Momentum sum v per axis, 128 bits.
+  static std::array<i128, 2> momentum_of(const std::vector<Vec2>& v) noexcept {
+    std::array<i128, 2> p{};
+    for (const Vec2& a : v) p = {p[0] + a[0], p[1] + a[1]};
+    return p;
+  }
+  /// Initial energy (sum |v|^2) and momentum, as recorded at construction.
+  u128 energy0() const noexcept { return (static_cast<u128>(energy0_[1]) << 64) | energy0_[0]; }
+  /// Initial momentum along axis k.
+  i128 momentum0(int k) const noexcept {
+    return static_cast<i128>((static_cast<u128>(static_cast<std::uint64_t>(momentum0_[2 * k + 1])) << 64) |
+                             static_cast<std::uint64_t>(momentum0_[2 * k]));
+  }
+
+ private:
+  enum Type : std::uint8_t { none = 0, cross = 1, wall = 2, coll = 3 };
+
+  void load(const Snapshot& s) {
+    u_ = s.units;
+    seed_ = s.seed;
+    const std::size_t n = s.x.size();
+    ln_.resize(n);
+    for (std::size_t p = 0; p < n; ++p) ln_[p] = Line{s.x[p], s.v[p], s.clock};
+    ver_.assign(n, 0);
+    ctr_ = s.streams;
+    X_ = Bits(s.bits);
+    log_.clear();
+    for (const auto& e : s.log) log_[e.first] = e.second;
+    groups_.clear();
+    for (const auto& e : s.groups) groups_[e.first] = Group{e.second.first, e.second.second};
+    clock_ = s.clock;
+    origin_ = s.origin;
+    ncoll_ = s.collisions;
+    energy0_ = s.energy0;
+    momentum0_ = s.momentum0;
+    cnt_ = s.counters;
+    wall_tick_.assign(n, std::numeric_limits<std::int64_t>::min());
+    reversed_ = false;
+    sigma2_ = static_cast<u128>(u_.sigma) * static_cast<u128>(u_.sigma);
+    sigma2d_ = static_cast<double>(sigma2_);
+    hlo_ = u_.sigma / 2;
+    rebuild();
+  }
+
+  // ---- geometry of the lines ----
+  Vec2 pos(int p, std::int64_t t) const noexcept {
+    Vec2 out;
+    const std::int64_t dt = t - ln_[p].ta;
+    for (int k = 0; k < 2; ++k) {
+      std::int64_t m, y;
+      // fast path (measure before changing): the displacement fits int64 and at most one wrap
+      if (!__builtin_mul_overflow(ln_[p].v[k], dt, &m) && !__builtin_add_overflow(ln_[p].x[k], m, &y)) {
+        if (u_.wall[k]) {
+          out[k] = y;
+          continue;
+        }
+        if (y >= u_.L[k]) y -= u_.L[k];
+        else if (y < 0) y += u_.L[k];
+        if (y >= 0 && y < u_.L[k]) {
+          out[k] = y;
+          continue;
+        }
+      }
+      const i128 z = static_cast<i128>(ln_[p].x[k]) + static_cast<i128>(ln_[p].v[k]) * dt;
+      out[k] = u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
+    }
+    return out;
+  }
+  Vec2 diff(const Vec2& a, const Vec2& b) const noexcept {
+    Vec2 r;
+    for (int k = 0; k < 2; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
+    return r;
+  }
+  bool overlap(const Vec2& a, const Vec2& b) const noexcept {
+    const Vec2 r = diff(a, b);
+    return norm2(r[0], r[1]) < sigma2_;
+  }
+  std::int64_t hhi(int k) const noexcept { return u_.L[k] - hlo_; }
+
+  // ---- keys ----
+  std::int32_t n32() const noexcept { return static_cast<std::int32_t>(ln_.size()); }
+  std::int32_t coll_kind(int a, int b) const noexcept {
+    const int lo = std::min(a, b);
+    return reversed_ ? 1 + (n32() - 1 - lo) : 2 + lo;
+  }
+  std::int32_t wall_kind() const noexcept { return reversed_ ? n32() + 1 : 1; }
+
+  // ---- prediction ----
+  void reanchor(int p, std::int64_t t) {
+    ln_[p].x = pos(p, t);
+    ln_[p].ta = t;
+    const int id = grid_.cell_id(ln_[p].x);
+    if (grid_.cell_of_particle(p) != id) {
+      grid_.remove(p);
+      grid_.insert(p, id);
+    }
+  }
+  void schedule(int p, Type type, std::int64_t t, std::int32_t kind, int partner) {
+    type_[p] = type;
+    partner_[p] = partner;
+    vself_[p] = ver_[p];
+    vpart_[p] = partner >= 0 ? ver_[partner] : 0;
+    if (type == none) queue_.erase(p); else queue_.set(p, t, kind);
+  }
+  void predict(int p, std::int64_t lo) {
+    reanchor(p, lo);
+    constexpr std::int64_t inf = std::numeric_limits<std::int64_t>::max();
+    std::int64_t bt = inf;
+    std::int32_t bk = 0;
+    Type btype = none;
+    int bq = -1;
+    auto offer = [&](std::int64_t t, std::int32_t k, Type ty, int q) {
+      if (t >= tick_limit) return;
+      if (std::tie(t, k, q) < std::tie(bt, bk, bq) || btype == none) {
+        bt = t, bk = k, btype = ty, bq = q;
+      }
+    };
+    const int cell = grid_.cell_of_particle(p);
+    const int c[2] = {cell / grid_.count(1), cell % grid_.count(1)};
+    for (int k = 0; k < 2; ++k) {
+      const std::int64_t dt = grid_.exit_ticks(k, c[k], ln_[p].x[k], ln_[p].v[k]);
+      if (dt > 0) offer(lo + dt, 0, cross, -1);
+      if (u_.wall[k]) {
+        const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(k));
+        if (dw > 0) offer(lo + dw, wall_kind(), wall, -1);
+      }
+    }
+    grid_.for_neighbours(cell, [&](int q) {
+      if (q == p) return;
+      const Vec2 r = diff(ln_[p].x, pos(q, lo));
+      const Vec2 w{ln_[p].v[0] - ln_[q].v[0], ln_[p].v[1] - ln_[q].v[1]};
+      // cheap exits before the exact search (measure before changing): separating and outside
+      // (exact), or a closest approach beyond sigma by far more than double round-off
+      const i128 B = static_cast<i128>(r[0]) * w[0] + static_cast<i128>(r[1]) * w[1];
+      const u128 r2 = norm2(r[0], r[1]);
+      if (B >= 0 && r2 >= sigma2_) return;
+      const double rr = static_cast<double>(r2), bb = static_cast<double>(B);
+      const double aa = static_cast<double>(w[0]) * w[0] + static_cast<double>(w[1]) * w[1];
+      if (rr - bb * (bb / aa) > sigma2d_ * (1.0 + 1e-9) + rr * 1e-12) return;
+      const std::int64_t tau = first_overlap(r, w, sigma2_);
+      if (tau >= 0) offer(lo + tau, coll_kind(p, q), coll, q);
+    });
+    schedule(p, btype, bt, bk, bq);
+    if (btype == coll) {  // write it into the partner's slot when earlier there
+      if (!queue_.scheduled(bq) || std::make_pair(bt, bk) < std::make_pair(queue_.time(bq), queue_.kind(bq))) {
+        schedule(bq, coll, bt, bk, p);
+      }
+    }
+  }
+  void rebuild() {
+    const std::size_t n = ln_.size();
+    type_.assign(n, none);
+    partner_.assign(n, -1);
+    vself_.assign(n, 0);
+    vpart_.assign(n, 0);
+    grid_.build(u_, n);
+    for (std::size_t p = 0; p < n; ++p) {
+      ln_[p].x = pos(static_cast<int>(p), clock_);
+      ln_[p].ta = clock_;
+      grid_.insert(static_cast<int>(p), grid_.cell_id(ln_[p].x));
+    }
+    // first bucket width: ~2^20 ticks per mean free time per particle, over N particles (the
+    // queue adapts it; a speed setting only)
+    queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << 20) / static_cast<std::int64_t>(n)));
+    // forward: events at the clock may still be pending (a run stopped after a collision);
+    // reverse: the clock's tick is done (see run_back), the search starts one tick later
+    const std::int64_t lo = reversed_ ? clock_ + 1 : clock_;
+    for (std::size_t p = 0; p < n; ++p) predict(static_cast<int>(p), lo);
+    last_key_ = {std::numeric_limits<std::int64_t>::min(), 0};
+  }
+  void flip() {
+    for (Line& l : ln_) {
+      l.v = {-l.v[0], -l.v[1]};
+      l.ta = -l.ta;
+    }
+    clock_ = -clock_;
+    for (auto& t : wall_tick_) t = std::numeric_limits<std::int64_t>::min();
+    reversed_ = !reversed_;
+    rebuild();
+  }
+
+  // ---- the loop ----
+  bool valid(int p) const noexcept {
+    if (ver_[p] != vself_[p]) return false;
+    return type_[p] != coll || ver_[partner_[p]] == vpart_[p];
+  }
+  void check_order(std::int64_t t, std::int32_t k) {
+    if (std::make_pair(t, k) < last_key_) throw std::logic_error("lattice engine: events out of order (a bug)");
+    last_key_ = {t, k};
+  }
+  std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target) {
+    std::uint64_t done = 0;
+    for (;;) {
+      const int p = queue_.top();
+      if (p < 0 || queue_.time(p) > until) {
+        clock_ = until;
+        return done;
+      }
+      const std::int64_t t = queue_.time(p);
+      ++cnt_.events;
+      if (!valid(p)) {
+        ++cnt_.stale;
+        predict(p, t);
+        continue;
+      }
+      if (type_[p] == cross) {
+        ++cnt_.crossings;
+        predict(p, t);
+        continue;
+      }
+      check_order(t, queue_.kind(p));
+      if (type_[p] == wall) {
+        reflect(p, t);
+        continue;
+      }
+      const int i = std::min(p, partner_[p]), j = std::max(p, partner_[p]);
+      if (back) {
+        if (ncoll_ == target) {
+          clock_ = t - 1;
+          return done;
+        }
+        collide_back(i, j, t);
+      } else {
+        collide_forward(i, j, t);
+      }
+      ++done;
+      if (!back && done == want) {
+        clock_ = t;
+        return done;
+      }
+    }
+  }
+
+  // ---- walls ----
+  void reflect(int p, std::int64_t a) {
+    Vec2 x = pos(p, a - 1), v = ln_[p].v;
+    Vec2 old_line_at_a = pos(p, a);
+    for (int k = 0; k < 2; ++k) {
+      if (!(u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(k)))) x[k] += v[k];
+      if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
+    }
+    const Vec2 ghost = wrapped(Vec2{x[0] - v[0], x[1] - v[1]});
+    const int cell = grid_.cell_of_particle(p);
+    grid_.for_neighbours(cell, [&](int q) {
+      if (q == p) return;
+      if (overlap(ghost, pos(q, a - 1))) {
+        throw std::runtime_error("lattice engine: a wall and a body within one tick that the rule cannot resolve (particle " +
+                                 std::to_string(p) + ", tick " + std::to_string(a) + "); not supported yet");
+      }
+      if (overlap(old_line_at_a, pos(q, a))) ++cnt_.wall_body;
+    });
+    ln_[p].x = x;
+    ln_[p].v = v;
+    ln_[p].ta = a;
+    ++ver_[p];
+    wall_tick_[p] = a;
+    ++cnt_.walls;
+    predict(p, a);
+  }
+
+  // ---- collisions ----
+  // origin + d, wrapped on periodic axes (128-bit sum: no overflow whatever the box)
+  Vec2 shifted(const Vec2& origin, const Vec2& d) const noexcept {
+    Vec2 o;
+    for (int k = 0; k < 2; ++k) {
+      const i128 y = static_cast<i128>(origin[k]) + d[k];
+      o[k] = u_.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u_.L[k]);
+    }
+    return o;
+  }
+  Vec2 wrapped(const Vec2& x) const noexcept {
+    Vec2 o = x;
+    for (int k = 0; k < 2; ++k)
+      if (!u_.wall[k]) o[k] = wrap(x[k], u_.L[k]);
+    return o;
+  }
+  // why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none
+  // why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none.
+  // The same scan flags `multi` when a pre line (pre_a: i's and j's pre lines at tick a) overlaps
+  // a third body at a: complete whenever 0 is returned (every neighbour was looked at).
+  int post_reason(int i, int j, const Vec2& xi, const Vec2& xj, const Vec2& vi, const Vec2& vj, std::int64_t a,
+                  const Vec2 (&pre_a)[2], bool& multi) const {
+    for (int k = 0; k < 2; ++k) {
+      for (const Vec2* vv : {&vi, &vj})
+        if ((*vv)[k] > u_.vmax || (*vv)[k] < -u_.vmax) return redraw_outside;
+      if (!u_.wall[k]) continue;
+      for (const Vec2* xx : {&xi, &xj})
+        if ((*xx)[k] < hlo_ || (*xx)[k] > hhi(k)) return redraw_outside;
+    }
+    int why = 0;
+    multi = false;
+    for (int s = 0; s < 2 && why == 0; ++s) {
+      const Vec2& x = s == 0 ? xi : xj;
+      const Vec2& v = s == 0 ? vi : vj;
+      const Vec2 ghost = wrapped(Vec2{x[0] - v[0], x[1] - v[1]});
+      grid_.for_neighbours(grid_.cell_id(x), [&](int q) {
+        if (why != 0 || q == i || q == j) return;
+        const Vec2 qa = pos(q, a);
+        if (overlap(x, qa)) why = redraw_overlap_after;
+        else if (overlap(ghost, pos(q, a - 1))) why = redraw_ghost_tie;
+        if (overlap(pre_a[0], qa) || overlap(pre_a[1], qa)) multi = true;
+      });
+    }
+    return why;
+  }
+  void apply(int i, int j, const Vec2& xi, const Vec2& xj, const Vec2& vi, const Vec2& vj, std::int64_t a) {
+    ln_[i].x = xi;
+    ln_[j].x = xj;
+    ln_[i].v = vi;
+    ln_[j].v = vj;
+    ln_[i].ta = ln_[j].ta = a;
+    ++ver_[i];
+    ++ver_[j];
+    ++cnt_.collisions;
+    predict(i, a);
+    predict(j, a);
+  }
+  void collide_forward(int i, int j, std::int64_t a) {
+    if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
+    const Vec2 pre_a[2] = {pos(i, a), pos(j, a)};
+    bool multi = false;
+    const std::uint64_t ctr0 = ctr_[i];
+    std::array<std::uint64_t, 8> reasons{};
+    // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
+    // values stay within a few sigma of 0 whatever the box
+    const Vec2 xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{0, 0};
+    Vec2 xi2, xj2, vi2, vj2;
+    Bits out;
+    std::uint32_t redraws = 0;
+    for (;;) {
+      if (static_cast<std::int64_t>(redraws) > max_redraws) {
+        group_bounce(i, j, a, ctr0, reasons);
+        return;
+      }
+      const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
+      const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_, xi2, xj2, vi2, vj2, out);
+      int why = static_cast<int>(rf);
+      if (why == 0) {
+        xi2 = shifted(xj, xi2);
+        xj2 = shifted(xj, xj2);
+        why = post_reason(i, j, xi2, xj2, vi2, vj2, a, pre_a, multi);
+      }
+      if (why == 0) break;
+      ++cnt_.redraws[std::min(why, 7)];
+      ++reasons[std::min(why, 7)];
+      ++redraws;
+    }
+    if (multi) ++cnt_.multi_body;
+    if (redraws > 0) {
+      log_[ncoll_ + 1] = redraws;
+      ++cnt_.log_entries;
+    }
+    X_ = std::move(out);
+    ++ncoll_;
+    if (trace != nullptr) trace->push_back({a, i, j});
+    apply(i, j, xi2, xj2, vi2, vj2, a);
+  }
+  void collide_back(int i, int j, std::int64_t a) {
+    if (const auto g = groups_.find(ncoll_); g != groups_.end()) {
+      group_back(i, j, a, g);
+      return;
+    }
+    const Vec2 xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{0, 0};
+    std::uint32_t redraws = 0;
+    const auto it = log_.find(ncoll_);
+    if (it != log_.end()) redraws = it->second;
+    if (ctr_[i] < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+    const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i] - 1);
+    Vec2 xi0, xj0, vi0, vj0;
+    op_.pair_reverse(xi, zero, Vec2{-ln_[i].v[0], -ln_[i].v[1]}, Vec2{-ln_[j].v[0], -ln_[j].v[1]}, g, X_, xi0, xj0, vi0, vj0);
+    xi0 = shifted(xj, xi0);
+    xj0 = shifted(xj, xj0);
+    ctr_[i] -= 1 + redraws;
+    if (it != log_.end()) log_.erase(it);
+    --ncoll_;
+    apply(i, j, xi0, xj0, Vec2{-vi0[0], -vi0[1]}, Vec2{-vj0[0], -vj0[1]}, a);
+  }
+
+  // ---- three or more bodies within one tick: the group bounce (an exact involution) ----
+  // When no draw is acceptable (a third body k is met within the tick, so every post state of the
+  // pair overlaps it), the group G = {i, j} closed under "a member's pre line overlaps a body at
+  // tick a" bounces back: each member's post state at tick a is its pre position at a-1 with its
+  // velocity negated. Read backwards (velocities negated) the post lines overlap exactly where the
+  // pre lines did, so the reverse meets the group at the same tick, finds the entry in the log, and
+  // applies the same map (position at the event tick - 1, velocity negated). The post state must
+  // meet the invariants against bodies outside G (no overlap at a, no false tie at a-1) and the
+  // walls; otherwise the collision is an error, nothing changed. The draws tried are logged.
+  void group_bounce(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
+    std::vector<int> g{i, j};
+    for (std::size_t m = 0; m < g.size(); ++m) {
+      const Vec2 xa = pos(g[m], a);
+      grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
+        if (std::find(g.begin(), g.end(), q) == g.end() && overlap(xa, pos(q, a))) g.push_back(q);
+      });
+    }
+    std::sort(g.begin(), g.end());
+    std::vector<Vec2> post(g.size());
+    bool ok = true;
+    for (std::size_t m = 0; m < g.size() && ok; ++m) {
+      post[m] = pos(g[m], a - 1);
+      const Vec2 ghost = pos(g[m], a);  // the new line at a-1 is the pre line at a
+      for (int k = 0; k < 2; ++k)
+        if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(k))) ok = false;
+      grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
+        if (!ok || std::find(g.begin(), g.end(), q) != g.end()) return;
+        if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) ok = false;
+      });
+    }
+    if (!ok) {
+      ctr_[i] = ctr0;  // nothing changed
+      std::string why = "lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
+                        std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
+                        " found no acceptable post state in " + std::to_string(max_redraws) +
+                        " redraws, and its group of " + std::to_string(g.size()) + " cannot bounce back (";
+      for (int k = 1; k < 8; ++k) why += std::string(redraw_names[k]) + " " + std::to_string(reasons[k]) + (k < 7 ? ", " : ")");
+      throw std::runtime_error(why);
+    }
+    ++ncoll_;
+    log_[ncoll_] = static_cast<std::uint32_t>(ctr_[i] - ctr0);
+    ++cnt_.log_entries;
+    groups_[ncoll_] = Group{i, g};
+    ++cnt_.multi_body;
+    ++cnt_.group_bounces;
+    if (trace != nullptr) trace->push_back({a, i, j});
+    for (std::size_t m = 0; m < g.size(); ++m) {
+      Line& l = ln_[g[m]];
+      l = Line{post[m], Vec2{-l.v[0], -l.v[1]}, a};
+      ++ver_[g[m]];
+    }
+    ++cnt_.collisions;
+    for (int q : g) predict(q, a);
+  }
+  template <class It>
+  void group_back(int i, int j, std::int64_t a, It entry) {
+    const std::vector<int> g = entry->second.members;
+    if (std::find(g.begin(), g.end(), i) == g.end() || std::find(g.begin(), g.end(), j) == g.end()) {
+      throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
+    }
+    const auto it = log_.find(ncoll_);
+    const std::uint32_t draws = it == log_.end() ? 0 : it->second;
+    const int drawer = entry->second.drawer;
+    if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+    std::vector<Vec2> pre(g.size());
+    for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
+    for (std::size_t m = 0; m < g.size(); ++m) {
+      Line& l = ln_[g[m]];
+      l = Line{pre[m], Vec2{-l.v[0], -l.v[1]}, a};
+      ++ver_[g[m]];
+    }
+    ctr_[drawer] -= draws;
+    if (it != log_.end()) log_.erase(it);
+    groups_.erase(entry);
+    --ncoll_;
+    ++cnt_.collisions;
+    for (int q : g) predict(q, a);
+  }
+
+  Op op_;
+  Units u_;
+  std::uint32_t seed_ = 1;
+  // one particle's line, together in memory (the prediction loop reads all three)
+  struct Line {
+    Vec2 x;              // anchor position (wrapped)
+    Vec2 v;              // velocity
+    std::int64_t ta;     // anchor tick
+  };
+  std::vector<Line> ln_;
+  std::vector<std::int64_t> wall_tick_;
+  std::vector<std::uint64_t> ver_, ctr_, vself_, vpart_;
+  std::vector<Type> type_;
+  std::vector<int> partner_;
+  Bits X_;
+  std::map<std::uint64_t, std::uint32_t> log_;
+  struct Group {
+    int drawer;                 // whose stream the tried draws came from
+    std::vector<int> members;   // ascending
+  };
+  std::map<std::uint64_t, Group> groups_;  // collision index -> group bounce
+  std::int64_t clock_ = 0, origin_ = 0;
+  std::uint64_t ncoll_ = 0;
+  std::array<std::uint64_t, 2> energy0_{};
+  std::array<std::int64_t, 4> momentum0_{};
+  Counters cnt_;
+  bool reversed_ = false;
+  u128 sigma2_ = 0;
+  double sigma2d_ = 0.0;
+  std::int64_t hlo_ = 0;
+  CellGrid grid_;
+  Queue queue_;
+  std::pair<std::int64_t, std::int32_t> last_key_{};
+};
+
+}  // namespace revcol::lattice

@@ -1,0 +1,61 @@
+// Integer geometry of the 2D lattice engine (../../../../docs: /work/shared/LATTICE.md §1-2).
+//
+// Lengths are integers in lattice units (sigma = 2^S of them per diameter), time is an integer
+// tick count, velocities are lattice units per tick. Free flight x(t) = x_a + v (t - t_a) is then
+// exact and the same whether computed from either end of a segment, so every event decision
+// reads identical geometry forward and backward.
+//
+// Bounds (enforced by the units, units.hpp): a box length L < 2^63 - 2^56 lattice units, so a
+// wrapped position is in [0, L), a minimum-image difference in [-L/2, L/2] (|r| < 2^62), and
+// |r|^2 + |r'|^2 < 2^125 fits an unsigned 128-bit integer; |v| <= 2^53 per axis, so v * dt with |dt| < 2^62 is below
+// 2^115 in 128 bits. A pair overlaps at a tick when |r|^2 < sigma^2 (strictly: touching is outside).
+//
+// The first overlap tick of a pair (first_overlap) is decided exactly: with r the relative vector
+// at the search's first tick and w the relative velocity, f(tau) = |r + w tau|^2 - sigma^2 is a convex
+// quadratic in tau. Double precision gives only a first guess of the root; the answer is then decided by
+// evaluating the exact integer predicate f(tau) < 0 at the guess and its neighbours (a bisection on
+// integers when the guess is off, as near grazing). The full discriminant B^2 - A C (~2^230) is never
+// formed in integers.
+#pragma once
+#include <array>
+#include <cstdint>
+
+#include "revcol/lattice/int128.hpp"
+
+namespace revcol::lattice {
+
+/// A 2D integer vector (a lattice position, velocity or relative vector).
+using Vec2 = std::array<std::int64_t, 2>;
+
+/// x mod L in [0, L) for L > 0 (x any 128-bit value).
+inline std::int64_t wrap(i128 x, std::int64_t L) noexcept {
+  if (x >= 0 && x < L) return static_cast<std::int64_t>(x);
+  i128 r = x % L;
+  if (r < 0) r += L;
+  return static_cast<std::int64_t>(r);
+}
+
+/// The minimum image of a difference d in (-L, L): r = d mod L, minus L when r >= (L + 1) / 2
+/// (so |result| <= L/2). The same integer function in both directions of time.
+inline std::int64_t min_image(std::int64_t d, std::int64_t L) noexcept {
+  if (d < 0) d += L;
+  if (d >= L) d -= L;
+  return d >= (L + 1) / 2 ? d - L : d;
+}
+
+/// |r|^2 in 128 bits (|r_k| < 2^62).
+inline u128 norm2(std::int64_t rx, std::int64_t ry) noexcept {
+  const u128 ax = static_cast<u128>(rx < 0 ? -static_cast<i128>(rx) : static_cast<i128>(rx));
+  const u128 ay = static_cast<u128>(ry < 0 ? -static_cast<i128>(ry) : static_cast<i128>(ry));
+  return ax * ax + ay * ay;
+}
+
+/// True when the relative vector r + w tau is strictly inside the contact circle: |.|^2 < sigma2.
+/// Exact; components beyond 2^61 count as outside (sigma < 2^61).
+bool overlaps_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) noexcept;
+
+/// The smallest integer tau >= 0 with |r + w tau|^2 < sigma2, or -1 if there is none. Exact
+/// (see the header comment); |r_k| < 2^62, |w_k| < 2^54.
+std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept;
+
+}  // namespace revcol::lattice

@@ -1,0 +1,71 @@
+// Units of the 2D lattice engine, chosen once from the box and the particles, and the one-time
+// quantization of a float state (LATTICE.md §1, §6).
+//
+// Length: sigma = 2^S lattice units per diameter D. choose_units takes the largest S <= 60 with
+// every box length below 2^61 lattice units; any box below max_box (~2^63) is valid (minimum-image
+// differences are then below 2^62 and their squares fit 128-bit integers, geometry.hpp). S < 40 (a box longer than 2^22 diameters) is refused: the
+// velocity resolution would fall below ~2^20 units.
+// Velocity: the root-mean-square speed v_rms of the float state is mapped to 2^(S-20) units per
+// tick, so a tick moves a typical particle 2^-20 sigma (the prototype's choice). One tick is then
+// D 2^-20 / v_rms in the float state's time unit. Speeds are bounded by vmax = 2^(S-8) units per
+// tick per axis (1/256 sigma per tick): a relative move per tick below sigma/128, which the cell
+// grid (cell_grid.hpp) relies on. Because no particle can be faster than sqrt(total kinetic energy),
+// a state with sqrt(sum |v|^2) > vmax is refused (N > ~2^24 at the default scale).
+// Ticks: the clock and per-particle anchor ticks are int64; every event tick is kept below
+// tick_limit = 2^61 (about 2^41 mean free times of a typical particle); a run that would pass it
+// stops with an error, nothing changed past the last event.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "revcol/lattice/geometry.hpp"
+
+namespace revcol::lattice {
+
+/// Largest allowed clock or event tick (both directions): |t| < 2^61.
+inline constexpr std::int64_t tick_limit = std::int64_t{1} << 61;
+/// Largest allowed box length in lattice units (positions, their differences and a position
+/// plus or minus a velocity stay inside int64).
+inline constexpr std::int64_t max_box = INT64_MAX - (std::int64_t{1} << 56);
+
+/// The lattice's units and box: what integer state means physically.
+struct Units {
+  int S = 60;                                ///< sigma = 2^S lattice units per diameter
+  std::int64_t sigma = std::int64_t{1} << 60;  ///< lattice units per diameter
+  std::array<std::int64_t, 2> L{};           ///< box lengths in lattice units, per axis
+  std::array<bool, 2> wall{false, false};    ///< per axis: flat walls at 0 and L (else periodic)
+  std::int64_t vmax = std::int64_t{1} << 52;  ///< largest |v| per axis, units per tick
+  double length_unit = 0.0;                  ///< float length of one lattice unit (D / sigma)
+  double tick = 0.0;                         ///< float time of one tick
+};
+
+/// Checks a Units value (box lengths, sigma, vmax); throws InvalidArgument naming the problem.
+void validate(const Units& u);
+
+/// Units for a float box of lengths box (per axis) and diameter D holding particles whose
+/// root-mean-square speed is v_rms; throws InvalidArgument if the lattice cannot hold it.
+Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall);
+
+/// A float state quantized to the lattice: integer positions and velocities, and the errors.
+struct Quantized {
+  std::vector<Vec2> x;         ///< positions, wrapped into [0, L) (periodic) or clamped inside walls
+  std::vector<Vec2> v;         ///< velocities
+  double max_position_error = 0.0;  ///< max |x_float - x_lattice * length_unit| / D
+  double max_velocity_error = 0.0;  ///< max |v_float - v_lattice * length_unit / tick| / v_rms
+};
+
+/// Quantizes n x 2 float positions and velocities (row-major) once. Refuses (InvalidArgument) a
+/// speed beyond vmax, a position outside the walls, or a pair overlapping after quantization.
+Quantized quantize(const Units& u, const std::vector<double>& x, const std::vector<double>& v);
+
+/// Checks an integer state: positions inside [0, L) (and inside the walls), |v| <= vmax per axis,
+/// sqrt(sum |v|^2) <= vmax, and no pair overlapping (|r|^2 < sigma^2); throws InvalidArgument
+/// naming the first problem. O(N) with a hash grid.
+void validate_state(const Units& u, const std::vector<Vec2>& x, const std::vector<Vec2>& v);
+
+/// Kinetic energy sum |v|^2 in 128 bits (lattice units).
+u128 kinetic2(const std::vector<Vec2>& v) noexcept;
+
+}  // namespace revcol::lattice

@@ -1,0 +1,290 @@
+// Exact predicates, units, quantization and the cell grid of the 2D lattice engine
+// (lattice/geometry.hpp, units.hpp, cell_grid.hpp).
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <unordered_map>
+
+#include "revcol/error.hpp"
+#include "revcol/lattice/cell_grid.hpp"
+#include "revcol/lattice/geometry.hpp"
+#include "revcol/lattice/units.hpp"
+
+namespace revcol::lattice {
+
+bool overlaps_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) noexcept {
+  constexpr i128 big = i128{1} << 61;
+  const i128 dx = static_cast<i128>(r[0]) + static_cast<i128>(w[0]) * tau;
+  const i128 dy = static_cast<i128>(r[1]) + static_cast<i128>(w[1]) * tau;
+  if (dx >= big || dx <= -big || dy >= big || dy <= -big) return false;
+  return norm2(static_cast<std::int64_t>(dx), static_cast<std::int64_t>(dy)) < sigma2;
+}
+
+std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept {
+  if (norm2(r[0], r[1]) < sigma2) return 0;
+  const i128 B = static_cast<i128>(r[0]) * w[0] + static_cast<i128>(r[1]) * w[1];
+  if (B >= 0) return -1;  // not approaching: f increases from f(0) >= 0
+  const i128 A = static_cast<i128>(w[0]) * w[0] + static_cast<i128>(w[1]) * w[1];
+  // f is convex with its real minimum in [tv, tv + 1); the integer minimum is at tv or tv + 1.
+  const std::int64_t tv = static_cast<std::int64_t>(-B / A);
+  const bool at_v = overlaps_at(r, w, tv, sigma2);
+  if (!at_v) return overlaps_at(r, w, tv + 1, sigma2) ? tv + 1 : -1;
+  // f decreases on [0, tv]: the answer is the first tau in (0, tv] with f < 0 (f(0) >= 0).
+  // First guess in double: the smaller root of A t^2 + 2 B t + C.
+  const double a = static_cast<double>(A), b = static_cast<double>(B);
+  const double c = static_cast<double>(static_cast<i128>(norm2(r[0], r[1])) - static_cast<i128>(sigma2));
+  const double disc = std::max(0.0, b * b - a * c);
+  double g = c / (-b + std::sqrt(disc));  // cancellation-free form of (-b - sqrt(disc)) / a
+  std::int64_t lo = 0, hi = tv;            // invariant: f(lo) >= 0, f(hi) < 0
+  if (std::isfinite(g) && g > 0.0 && g < static_cast<double>(tv)) {
+    const std::int64_t t = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::ceil(g)), 1, tv);
+    // the guess and its neighbours decide it in the common case
+    for (std::int64_t s : {t, t - 1, t + 1}) {
+      if (s <= lo || s >= hi) continue;
+      if (overlaps_at(r, w, s, sigma2)) hi = s; else lo = s;
+    }
+    if (hi - lo == 1) return hi;
+    for (std::int64_t s : {t - 2, t + 2}) {
+      if (s <= lo || s >= hi) continue;
+      if (overlaps_at(r, w, s, sigma2)) hi = s; else lo = s;
+    }
+  }
+  while (hi - lo > 1) {  // exact bisection on integers (a far guess, e.g. near grazing)
+    const std::int64_t mid = lo + (hi - lo) / 2;
+    if (overlaps_at(r, w, mid, sigma2)) hi = mid; else lo = mid;
+  }
+  return hi;
+}
+
+void validate(const Units& u) {
+  require(u.S >= 8 && u.S <= 60, "lattice units: S must be in [8, 60]");
+  require(u.sigma == (std::int64_t{1} << u.S), "lattice units: sigma must be 2^S");
+  for (int k = 0; k < 2; ++k) {
+    require(u.L[k] > 0 && u.L[k] < max_box, "lattice units: a box length must be in (0, 2^63 - 2^56) lattice units");
+    if (u.wall[k]) {
+      require(u.L[k] > u.sigma + 2, "lattice units: a walled axis must be longer than one diameter");
+    } else {
+      require(static_cast<double>(u.L[k]) >= 4.5 * static_cast<double>(u.sigma),
+              "lattice units: a periodic axis must be at least 4.5 diameters long");
+    }
+  }
+  require(u.vmax >= 1 && u.vmax <= u.sigma / 256, "lattice units: vmax must be in [1, sigma / 256]");
+}
+
+Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall) {
+  require(std::isfinite(D) && D > 0.0, "lattice: the diameter must be positive and finite");
+  require(std::isfinite(v_rms) && v_rms > 0.0, "lattice: the rms speed must be positive and finite (a gas at rest has no dynamics)");
+  double longest = 0.0;
+  for (double b : box) {
+    require(std::isfinite(b) && b > 0.0, "lattice: box lengths must be positive and finite");
+    longest = std::max(longest, b / D);
+  }
+  int S = 60;
+  while (S >= 40 && std::ldexp(longest, S) >= 0x1p61) --S;
+  require(S >= 40, [&] {
+    return "lattice: a box of " + std::to_string(longest) +
+           " diameters is too long for the lattice (at most 2^21 diameters per axis)";
+  });
+  Units u;
+  u.S = S;
+  u.sigma = std::int64_t{1} << S;
+  u.wall = wall;
+  for (int k = 0; k < 2; ++k) u.L[k] = std::llround(std::ldexp(box[k] / D, S));
+  u.vmax = std::int64_t{1} << (S - 8);
+  u.length_unit = std::ldexp(D, -S);
+  u.tick = std::ldexp(D, -20) / v_rms;
+  validate(u);
+  return u;
+}
+
+u128 kinetic2(const std::vector<Vec2>& v) noexcept {
+  u128 e = 0;
+  for (const Vec2& a : v) e += norm2(a[0], a[1]);
+  return e;
+}
+
+void validate_state(const Units& u, const std::vector<Vec2>& x, const std::vector<Vec2>& v) {
+  validate(u);
+  require(x.size() == v.size(), "lattice: positions and velocities differ in length");
+  require(!x.empty(), "lattice: no particles");
+  require(x.size() < (std::size_t{1} << 30), "lattice: at most 2^30 particles");
+  const std::int64_t h = u.sigma / 2;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    for (int k = 0; k < 2; ++k) {
+      require(x[i][k] >= 0 && x[i][k] < u.L[k], [&] {
+        return "lattice: particle " + std::to_string(i) + " is outside the box [0, L)";
+      });
+      if (u.wall[k]) {
+        require(x[i][k] >= h && x[i][k] <= u.L[k] - h, [&] {
+          return "lattice: particle " + std::to_string(i) + " overlaps a wall";
+        });
+      }
+      require(v[i][k] >= -u.vmax && v[i][k] <= u.vmax, [&] {
+        return "lattice: particle " + std::to_string(i) + " is faster than the lattice allows (vmax = 2^(S-8) per axis)";
+      });
+    }
+  }
+  const u128 e = kinetic2(v);
+  require(e <= static_cast<u128>(u.vmax) * static_cast<u128>(u.vmax),
+          "lattice: the total kinetic energy allows a speed beyond vmax (too many particles for the velocity scale)");
+  // overlaps, with a hash grid of cells of one diameter
+  const u128 s2 = static_cast<u128>(u.sigma) * static_cast<u128>(u.sigma);
+  std::array<std::int64_t, 2> nc{};
+  for (int k = 0; k < 2; ++k) nc[k] = std::max<std::int64_t>(1, u.L[k] / u.sigma);
+  auto key = [&](std::int64_t a, std::int64_t b) { return a * nc[1] + b; };
+  std::unordered_map<std::int64_t, std::vector<int>> grid;
+  auto cell = [&](int k, std::int64_t p) { return std::min<std::int64_t>(nc[k] - 1, static_cast<std::int64_t>(static_cast<i128>(p) * nc[k] / u.L[k])); };
+  for (std::size_t i = 0; i < x.size(); ++i) grid[key(cell(0, x[i][0]), cell(1, x[i][1]))].push_back(static_cast<int>(i));
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const std::int64_t c0 = cell(0, x[i][0]), c1 = cell(1, x[i][1]);
+    for (std::int64_t d0 = -1; d0 <= 1; ++d0) {
+      for (std::int64_t d1 = -1; d1 <= 1; ++d1) {
+        std::int64_t a = c0 + d0, b = c1 + d1;
+        if (a < 0 || a >= nc[0]) { if (u.wall[0]) continue; a = (a + nc[0]) % nc[0]; }
+        if (b < 0 || b >= nc[1]) { if (u.wall[1]) continue; b = (b + nc[1]) % nc[1]; }
+        auto it = grid.find(key(a, b));
+        if (it == grid.end()) continue;
+        for (int j : it->second) {
+          if (j <= static_cast<int>(i)) continue;
+          std::int64_t r[2];
+          for (int k = 0; k < 2; ++k) {
+            const std::int64_t d = x[i][k] - x[j][k];
+            r[k] = u.wall[k] ? d : min_image(d, u.L[k]);
+          }
+          require(norm2(r[0], r[1]) >= s2, [&] {
+            return "lattice: particles " + std::to_string(i) + " and " + std::to_string(j) + " overlap";
+          });
+        }
+      }
+    }
+  }
+}
+
+Quantized quantize(const Units& u, const std::vector<double>& x, const std::vector<double>& v) {
+  validate(u);
+  require(x.size() == v.size() && x.size() % 2 == 0, "lattice: positions and velocities must both be n x 2");
+  const std::size_t n = x.size() / 2;
+  Quantized q;
+  q.x.resize(n);
+  q.v.resize(n);
+  const double vunit = u.length_unit / u.tick;  // float velocity of one lattice unit per tick
+  double vr = 0.0;
+  for (double a : v) vr += a * a;
+  vr = std::sqrt(vr / std::max<std::size_t>(n, 1));
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 2; ++k) {
+      const double xf = x[2 * i + k], vf = v[2 * i + k];
+      require(std::isfinite(xf) && std::isfinite(vf), "lattice: a position or velocity is not finite");
+      const double xl = xf / u.length_unit, vl = vf / vunit;
+      require(std::fabs(vl) <= static_cast<double>(u.vmax), [&] {
+        return "lattice: particle " + std::to_string(i) + " is faster than the lattice allows (vmax = 2^(S-8) per axis)";
+      });
+      require(std::fabs(xl) < 0x1p62 && (u.wall[k] || std::fabs(xl) < static_cast<double>(u.L[k]) * 4.0), "lattice: a position is far outside the box");
+      std::int64_t xi = std::llround(xl);
+      xi = u.wall[k] ? xi : wrap(xi, u.L[k]);
+      q.x[i][k] = xi;
+      q.v[i][k] = std::llround(vl);
+      const double ex = std::fabs(std::nearbyint(xl) - xl);  // the rounding, before the wrap
+      q.max_position_error = std::max(q.max_position_error, ex / static_cast<double>(u.sigma));
+      if (vr > 0.0) {
+        q.max_velocity_error = std::max(q.max_velocity_error, std::fabs(static_cast<double>(q.v[i][k]) * vunit - vf) / vr);
+      }
+    }
+  }
+  validate_state(u, q.x, q.v);
+  return q;
+}
+
+// ---- cells ----
+
+void CellGrid::build(const Units& u, std::size_t n) {
+  const std::int64_t wmin = u.sigma + 2 * u.vmax + 2;
+  std::array<std::int64_t, 2> ncl{};
+  for (int k = 0; k < 2; ++k) {
+    L_[k] = u.L[k];
+    wall_[k] = u.wall[k];
+    ncl[k] = std::max<std::int64_t>(1, u.L[k] / wmin);
+  }
+  // at most ~4 cells per particle: a sparse gas takes wider cells (any width >= wmin works)
+  const double cap = 4.0 * static_cast<double>(n) + 64.0;
+  const double total = static_cast<double>(ncl[0]) * static_cast<double>(ncl[1]);
+  if (total > cap) {
+    const double f = std::sqrt(total / cap);
+    for (int k = 0; k < 2; ++k) ncl[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(static_cast<double>(ncl[k]) / f));
+  }
+  for (int k = 0; k < 2; ++k) {
+    all_[k] = !u.wall[k] && ncl[k] < 5;
+    nc_[k] = static_cast<int>(all_[k] ? 8 : ncl[k]);
+    bounds_[k].resize(static_cast<std::size_t>(nc_[k]) + 1);
+    for (int c = 0; c <= nc_[k]; ++c) bounds_[k][c] = static_cast<std::int64_t>(static_cast<i128>(c) * L_[k] / nc_[k]);
+  }
+  members_.assign(static_cast<std::size_t>(nc_[0]) * nc_[1], {});
+  where_.assign(n, -1);
+  slot_.assign(n, -1);
+}
+
+int CellGrid::cell_of(int k, std::int64_t x) const noexcept {
+  // a double guess, corrected exactly against the integer boundaries
+  int c = static_cast<int>(static_cast<double>(x) / static_cast<double>(L_[k]) * nc_[k]);
+  c = std::clamp(c, 0, nc_[k] - 1);
+  while (c > 0 && x < boundary(k, c)) --c;
+  while (c + 1 < nc_[k] && x >= boundary(k, c + 1)) ++c;
+  return c;
+}
+
+std::int64_t CellGrid::exit_ticks(int k, int c, std::int64_t x0, std::int64_t v) const noexcept {
+  if (v > 0) {
+    if (wall_[k] && c + 1 == nc_[k]) return -1;  // the wall comes first
+    return (boundary(k, c + 1) - x0 + v - 1) / v;
+  }
+  if (v < 0) {
+    if (wall_[k] && c == 0) return -1;
+    return (x0 - boundary(k, c)) / -v + 1;
+  }
+  return -1;
+}
+
+int CellGrid::axis_range(int k, int c, int* out) const noexcept {
+  const int nc = nc_[k];
+  if (all_[k]) {
+    for (int i = 0; i < nc; ++i) out[i] = i;
+    return nc;
+  }
+  int n = 0;
+  for (int d = -1; d <= 1; ++d) {
+    int a = c + d;
+    if (a < 0 || a >= nc) {
+      if (wall_[k]) continue;
+      a = (a + nc) % nc;
+    }
+    bool seen = false;
+    for (int i = 0; i < n; ++i) seen = seen || out[i] == a;
+    if (!seen) out[n++] = a;
+  }
+  return n;
+}
+
+void CellGrid::insert(int p, int id) {
+  auto& m = members_[id];
+  where_[p] = id;
+  slot_[p] = static_cast<int>(m.size());
+  m.push_back(p);
+}
+
+void CellGrid::remove(int p) {
+  auto& m = members_[where_[p]];
+  const int s = slot_[p];
+  const int last = m.back();
+  m[s] = last;
+  slot_[last] = s;
+  m.pop_back();
+  where_[p] = -1;
+}
+
+std::size_t CellGrid::memory_bytes() const noexcept {
+  std::size_t b = members_.capacity() * sizeof(std::vector<int>) + (where_.capacity() + slot_.capacity()) * sizeof(int);
+  for (const auto& m : members_) b += m.capacity() * sizeof(int);
+  return b;
+}
+
+}  // namespace revcol::lattice

@@ -1,0 +1,240 @@
+"""The 2D lattice engine: a randomized hard-disk gas reversed bit for bit, for any number of
+collisions, with memory that does not grow with them (revcol/lattice/engine.hpp, LATTICE.md).
+
+Positions and velocities are integers: sigma = 2^S lattice units per diameter D, a tick moves a
+typical particle 2^-20 sigma. Free flight is exact; a pair collides on the transition into the
+first tick at which its incoming lines overlap, through an exact integer bijection (the lattice
+pair operator, with a bits-back integer X carrying the sub-tick phase and the torus shift
+``u = u' + G``), drawing 48-bit numbers from per-particle Philox streams. ``run_back`` negates the
+velocities, runs the same event search with the inverse operator and the streams stepping back, and
+negates again: positions, velocities, streams, X and clock come back **bit for bit**, to the start
+or to any earlier collision count or time.
+
+A float start (``random`` or arrays) is quantized once; ``quantization`` reports the error. The
+round trip is exact from the quantized state on. Times in floats are ``clock * tick``.
+
+    >>> from revcol.lattice import LatticeSimulation
+    >>> sim = LatticeSimulation.random(n=100, phi=0.3, seed=1)
+    >>> x0, v0 = sim.lattice_positions, sim.lattice_velocities
+    >>> _ = sim.run(collisions=2000)
+    >>> _ = sim.run_back()                       # back to the start
+    >>> bool((sim.lattice_positions == x0).all() and (sim.lattice_velocities == v0).all())
+    True
+"""
+from __future__ import annotations
+
+import os
+from typing import Optional, Sequence, Union
+
+import numpy as np
+
+from . import _core
+
+__all__ = ["LatticeSimulation"]
+
+_Boundary = Union[str, Sequence[str]]
+
+
+def _walls(boundary: _Boundary) -> list:
+    names = [boundary, boundary] if isinstance(boundary, str) else [str(b) for b in boundary]
+    if len(names) != 2:
+        raise ValueError("the lattice engine is 2D: boundary must be one name or two")
+    out = []
+    for b in names:
+        if b in ("wall", "walls"):
+            out.append(True)
+        elif b == "periodic":
+            out.append(False)
+        else:
+            raise ValueError(f"boundary must be 'wall' or 'periodic', got {b!r}")
+    return out
+
+
+class LatticeSimulation:
+    """N hard disks on the integer lattice, run forward and back bit for bit (2D only).
+
+    Build from float arrays (``LatticeSimulation(positions, velocities, box)``, quantized once)
+    or at random (``LatticeSimulation.random(n, phi=...)``, the float engine's initialiser then
+    quantized). ``boundary``: ``"periodic"`` or ``"wall"`` (one or per axis). ``law``: ``"flux"``
+    (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and X's
+    first 256 bits. Bad input raises ``ValueError`` naming the problem.
+    """
+
+    def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
+                 diameter: float = 1.0, law: str = "flux", seed: int = 1, _engine=None,
+                 _quantization: Optional[dict] = None):
+        if _engine is not None:
+            self._e = _engine
+            self._q = dict(_quantization or {})
+            return
+        x = np.asarray(positions, dtype=float)
+        v = np.asarray(velocities, dtype=float)
+        start = _core.lattice_quantize(x, v, [float(b) for b in np.broadcast_to(box, (2,))],
+                                       _walls(boundary), float(diameter))
+        self._init_from_start(start, law, seed)
+
+    def _init_from_start(self, start: dict, law: str, seed: int) -> None:
+        self._e = _core.LatticeEngine(start["units"], start["x"], start["v"], int(seed), str(law))
+        self._q = {"max_position_error": start["max_position_error"],
+                   "max_velocity_error": start["max_velocity_error"]}
+
+    @classmethod
+    def random(cls, n: int, dim: int = 2, phi: float = 0.3, *, boundary: _Boundary = "periodic",
+               diameter: float = 1.0, seed: int = 1, init: str = "auto", law: str = "flux") -> "LatticeSimulation":
+        """n disks at area fraction phi in a square box (the float engine's ``random_state``:
+        random sequential addition or a jittered lattice, Gaussian velocities with zero momentum,
+        kT = 1), quantized once. The same ``seed`` keys the streams."""
+        if dim != 2:
+            raise ValueError(f"the lattice engine is 2D, got dim={dim}")
+        start = _core.lattice_random_start(int(n), float(phi), _walls(boundary), float(diameter), int(seed), str(init))
+        sim = cls.__new__(cls)
+        sim._init_from_start(start, law, seed)
+        return sim
+
+    # --- running ---------------------------------------------------------------------------
+
+    def _tick(self, time: float) -> int:
+        return int(round(float(time) / self._e.units["tick"]))
+
+    def run(self, collisions: Optional[int] = None, time: Optional[float] = None) -> dict:
+        """Forward until ``collisions`` more collisions (the clock then at the last one's tick)
+        or the clock reaches ``time`` (rounded to a tick), whichever comes first. Returns
+        collisions done, clock and time."""
+        if collisions is None and time is None:
+            raise ValueError("run needs collisions= or time=")
+        until = None if time is None else self._tick(time)
+        done = self._e.run(None if collisions is None else int(collisions), until)
+        return {"collisions": int(done), "clock": self.clock, "time": self.time}
+
+    def run_back(self, collisions: Optional[int] = None, time: Optional[float] = None,
+                 to_collision: Optional[int] = None) -> dict:
+        """Backwards until ``collisions`` collisions are undone (or the count is back at
+        ``to_collision``: the state the forward run had right after it, bit for bit), or the
+        clock is back at ``time``, whichever comes first; with none of them, to the start."""
+        target = None
+        if collisions is not None:
+            target = self._e.collisions - int(collisions)
+            if target < 0:
+                raise ValueError(f"cannot undo {collisions} collisions: only {self._e.collisions} were run")
+        if to_collision is not None:
+            target = int(to_collision) if target is None else max(target, int(to_collision))
+        tick = None if time is None else self._tick(time)
+        before = self._e.collisions
+        self._e.run_back(target, tick)
+        return {"collisions": int(before - self._e.collisions), "clock": self.clock, "time": self.time}
+
+    # --- state -----------------------------------------------------------------------------
+
+    @property
+    def lattice_positions(self) -> np.ndarray:
+        """Integer positions at the clock, shape (n, 2), lattice units (a copy)."""
+        return self._e.positions
+
+    @property
+    def lattice_velocities(self) -> np.ndarray:
+        """Integer velocities, shape (n, 2), lattice units per tick (a copy)."""
+        return self._e.velocities
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Positions at the clock in float units, shape (n, 2)."""
+        return self._e.positions.astype(float) * self._e.units["length_unit"]
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """Velocities in float units, shape (n, 2)."""
+        u = self._e.units
+        return self._e.velocities.astype(float) * (u["length_unit"] / u["tick"])
+
+    @property
+    def clock(self) -> int:
+        """The integer tick."""
+        return int(self._e.clock)
+
+    @property
+    def time(self) -> float:
+        """The clock in float time units (clock * tick)."""
+        return self._e.clock * self._e.units["tick"]
+
+    @property
+    def collisions(self) -> int:
+        """Collisions since the start (forward minus undone)."""
+        return int(self._e.collisions)
+
+    @property
+    def n(self) -> int:
+        """Number of particles."""
+        return int(self._e.n)
+
+    @property
+    def dim(self) -> int:
+        """Dimension: 2."""
+        return 2
+
+    @property
+    def units(self) -> dict:
+        """S, sigma, L, wall, vmax, length_unit, tick."""
+        return dict(self._e.units)
+
+    @property
+    def quantization(self) -> dict:
+        """Max position error (in diameters) and velocity error (relative to the rms speed) of
+        the one quantization of the float start."""
+        return dict(self._q)
+
+    def diagnostics(self) -> dict:
+        """Energy drift (relative and in lattice units), momentum drift per axis (lattice
+        units), X's bit length, rare-log entries (redraw counts, and group bounces: three or more
+        bodies within one tick), redraws by reason, multi-body and wall-body ticks, events by type,
+        memory, and the quantization errors."""
+        d = dict(self._e.diagnostics())
+        d.update(self._q)
+        return d
+
+    # --- checkpoints -----------------------------------------------------------------------
+
+    def state(self) -> dict:
+        """The full state (units, positions at the clock, velocities, stream counters, X's
+        words, rare log, clock, collision count) as numpy arrays and numbers."""
+        s = dict(self._e.snapshot())
+        s["quantization"] = dict(self._q)
+        return s
+
+    @classmethod
+    def from_state(cls, state: dict) -> "LatticeSimulation":
+        """Rebuilds from ``state()``; the run resumes bit for bit."""
+        st = dict(state)
+        q = st.pop("quantization", None)
+        return cls(None, None, None, _engine=_core.LatticeEngine.from_snapshot(st), _quantization=q)
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the full state to ``path`` (numpy ``.npz``; nested dicts as ``a.b`` keys)."""
+        flat = {}
+        for k, v in self.state().items():
+            if isinstance(v, dict):
+                for k2, v2 in v.items():
+                    flat[f"{k}.{k2}"] = np.asarray(v2)
+            else:
+                flat[k] = np.asarray(v)
+        with open(path, "wb") as f:
+            np.savez(f, **flat)
+
+    @classmethod
+    def load(cls, path: Union[str, os.PathLike]) -> "LatticeSimulation":
+        """Reads a state written by ``save``."""
+        st: dict = {}
+        with np.load(path, allow_pickle=False) as z:
+            for k in z.files:
+                a = z[k]
+                val = a.item() if a.ndim == 0 else a
+                if "." in k:
+                    outer, inner = k.split(".", 1)
+                    if isinstance(val, np.ndarray) and outer == "units":
+                        val = tuple(val.tolist())
+                    st.setdefault(outer, {})[inner] = val
+                else:
+                    st[k] = val
+        return cls.from_state(st)
+
+    def __repr__(self) -> str:
+        return f"LatticeSimulation(n={self.n}, collisions={self.collisions}, clock={self.clock})"

@@ -1,0 +1,181 @@
+// The event queue (revcol/engine/event_queue.hpp) against a brute-force reference: random
+// set / erase / top sequences with ties in time and kind, events at never(), empty queues,
+// negative and huge times, for double times and std::int64_t ticks; the queue's own
+// invariants checked along the way.
+#include "revcol/engine/event_queue.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "check.hpp"
+
+using revcol::engine::EventQueue;
+
+namespace {
+
+// The reference: a flat array, top() by a full scan.
+template <class Time>
+struct Brute {
+  std::vector<Time> t;
+  std::vector<std::int32_t> k;
+  std::vector<bool> on;
+  explicit Brute(std::size_t n) : t(n), k(n), on(n, false) {}
+  int top() const {
+    int best = -1;
+    for (int i = 0; i < static_cast<int>(t.size()); ++i) {
+      if (!on[i]) continue;
+      if (best < 0 || t[i] < t[best] || (t[i] == t[best] && (k[i] < k[best] || (k[i] == k[best] && i < best))))
+        best = i;
+    }
+    return best;
+  }
+};
+
+// An event-driven pattern: pop the top, reschedule it (and a few others) later than now,
+// sometimes at exactly now or at the same time as another (ties), sometimes at never(), and
+// sometimes erase; times drawn by `draw(now, rng)`.
+template <class Time, class Draw>
+int run_pattern(std::size_t n, Time now, Time width, int steps, std::uint32_t seed, Draw draw) {
+  std::mt19937_64 rng(seed);
+  EventQueue<Time> q;
+  Brute<Time> b(n);
+  q.reset(n, now, width);
+  int bad = 0;
+  auto set = [&](int id, Time t, std::int32_t kind) {
+    q.set(id, t, kind);
+    b.t[id] = t;
+    b.k[id] = kind;
+    b.on[id] = true;
+  };
+  for (std::size_t i = 0; i < n; ++i) set(static_cast<int>(i), draw(now, rng), static_cast<std::int32_t>(rng() % 3));
+  for (int s = 0; s < steps; ++s) {
+    const int want = b.top();
+    const int got = q.top();
+    if (got != want) ++bad;
+    if (want < 0) {  // empty: refill a few
+      for (int r = 0; r < 3; ++r) set(static_cast<int>(rng() % n), draw(now, rng), static_cast<std::int32_t>(rng() % 3));
+      continue;
+    }
+    if (b.t[want] != EventQueue<Time>::never()) now = b.t[want];
+    if (q.time(want) != b.t[want] || q.kind(want) != b.k[want] || !q.scheduled(want)) ++bad;
+    const auto r = rng() % 16;
+    if (r == 0) {
+      q.erase(want);
+      b.on[want] = false;
+      if (q.scheduled(want)) ++bad;
+    } else if (r == 1) {
+      set(want, EventQueue<Time>::never(), 3);
+    } else if (r == 2) {
+      set(want, now, static_cast<std::int32_t>(rng() % 3));  // at the same instant: a tie in time
+    } else {
+      set(want, draw(now, rng), static_cast<std::int32_t>(rng() % 3));
+    }
+    // others rescheduled (a collision's partner), erased, or tied with the top
+    const int other = static_cast<int>(rng() % n);
+    const auto r2 = rng() % 8;
+    if (r2 == 0) {
+      q.erase(other);
+      b.on[other] = false;
+    } else if (r2 == 1 && b.on[want]) {
+      set(other, b.t[want], b.k[want]);  // the same (time, kind): only the id decides
+    } else if (r2 < 5) {
+      set(other, draw(now, rng), static_cast<std::int32_t>(rng() % 3));
+    }
+    if (s % 97 == 0 && !q.valid()) ++bad;
+  }
+  // drain: everything comes out in key order
+  for (;;) {
+    const int want = b.top();
+    const int got = q.top();
+    if (got != want) ++bad;
+    if (want < 0) break;
+    q.erase(want);
+    b.on[want] = false;
+  }
+  if (!q.valid()) ++bad;
+  return bad;
+}
+
+}  // namespace
+
+TEST_CASE("double times: random event-driven sequences match the brute-force reference") {
+  for (std::uint32_t seed = 1; seed <= 6; ++seed)
+    for (std::size_t n : {1u, 2u, 7u, 100u, 1000u}) {
+      // exponential gaps (a gas), quantized to 1/8 so that exact ties in time happen
+      auto draw = [](double now, std::mt19937_64& rng) {
+        std::exponential_distribution<double> e(1.0);
+        return now + std::floor(e(rng) * 8.0) / 8.0;
+      };
+      CHECK(run_pattern<double>(n, 0.0, 0.05, 4000, seed, draw) == 0);
+      // a bucket width far too small and far too large: order does not depend on it
+      CHECK(run_pattern<double>(n, 0.0, 1e-9, 2000, seed, draw) == 0);
+      CHECK(run_pattern<double>(n, 0.0, 1e9, 2000, seed, draw) == 0);
+    }
+}
+
+TEST_CASE("double times: negative clock (a reversed run), arbitrary earlier times") {
+  for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+    auto draw = [](double now, std::mt19937_64& rng) {
+      std::uniform_real_distribution<double> u(-1.0, 20.0);  // some earlier than now
+      return now + u(rng);
+    };
+    CHECK(run_pattern<double>(300, -1e3, 0.1, 5000, seed, draw) == 0);
+  }
+}
+
+TEST_CASE("int64 ticks: random sequences, ties, huge and negative ticks") {
+  for (std::uint32_t seed = 1; seed <= 6; ++seed)
+    for (std::size_t n : {1u, 3u, 64u, 500u}) {
+      auto small = [](std::int64_t now, std::mt19937_64& rng) {
+        return now + static_cast<std::int64_t>(rng() % 50);
+      };
+      CHECK(run_pattern<std::int64_t>(n, 0, 1, 3000, seed, small) == 0);
+      CHECK(run_pattern<std::int64_t>(n, -123456789, 7, 3000, seed, small) == 0);
+      auto huge = [](std::int64_t now, std::mt19937_64& rng) {
+        const std::int64_t room = std::numeric_limits<std::int64_t>::max() - 1 - now;
+        const std::int64_t step = static_cast<std::int64_t>(rng() >> 2) % (room / 4 + 1);
+        return now + step;
+      };
+      CHECK(run_pattern<std::int64_t>(n, std::numeric_limits<std::int64_t>::min() / 2, 1000, 2000, seed, huge) == 0);
+      CHECK(run_pattern<std::int64_t>(n, 0, std::numeric_limits<std::int64_t>::max() / 4, 2000, seed, small) == 0);
+    }
+}
+
+TEST_CASE("an empty queue returns -1, takes events again, and unscheduled ids report so") {
+  EventQueue<double> q;
+  q.reset(5, 0.0, 1.0);
+  CHECK(q.top() == -1);
+  CHECK(!q.scheduled(2));
+  CHECK(q.time(2) == EventQueue<double>::never());
+  q.set(3, 1e6, 2);
+  q.set(1, 1e6, 2);
+  q.set(4, 1e6, 1);
+  CHECK(q.top() == 4);  // smaller kind first at equal time
+  q.erase(4);
+  CHECK(q.top() == 1);  // then the smaller id
+  q.erase(1);
+  q.erase(3);
+  CHECK(q.top() == -1);
+  q.set(0, -5.0, 0);  // earlier than the window's start
+  CHECK(q.top() == 0);
+  q.set(2, EventQueue<double>::never(), 3);
+  q.erase(0);
+  CHECK(q.top() == 2);  // an event at never() is kept and comes out last
+  CHECK(q.valid());
+  CHECK(q.memory_bytes() > 0);
+
+  EventQueue<std::int64_t> t;
+  t.reset(3, 0, 0);  // a width of 0 is taken as 1
+  CHECK(t.top() == -1);
+  t.set(1, 10, 0);
+  t.set(0, 10, 0);
+  CHECK(t.top() == 0);
+  t.set(0, 11, 0);
+  CHECK(t.top() == 1);
+  CHECK(t.valid());
+}
+
+CHECK_MAIN()
