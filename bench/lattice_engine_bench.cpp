@@ -1,26 +1,39 @@
 // The lattice family of revcol-bench: the 2D lattice engine's collisions per second forward and
 // reverse (periodic, N = 10^4, area fractions 0.3 and 0.5; walls at 0.3), with the round trip's
 // bit-exactness and the rare counts. Run it beside engine/d2/... in one invocation to compare
-// with the float engine (the machine is shared: never compare across runs).
+// with the float engine (the machine is shared: never compare across runs). lattice/float/...
+// runs the float engine (2D, exact mode, flux law, periodic) with the same timing, so that one
+// invocation of --bench lattice/ carries both; the *_cpu_per_s metrics divide by the process's CPU
+// time, which a loaded machine distorts less than the wall clock.
 //
 //   revcol-bench --bench lattice/ --collisions 200000
 //
-// Metrics: forward_per_s, reverse_per_s, bit_exact (1 when positions, velocities, streams, X and
+// Metrics: forward_per_s, reverse_per_s, forward_cpu_per_s, reverse_cpu_per_s, bit_exact (1 when positions, velocities, streams, X and
 // clock are restored bit for bit), events_per_collision, log_entries, redraws_per_collision,
 // multi_body, wall_body, bits_length (X after the forward run), energy_drift (relative, after the
 // forward run), engine_bytes, n, phi.
 #include <chrono>
 #include <cstdint>
+#include <ctime>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "bench.hpp"
+#include "revcol/engine/engine.hpp"
 #include "revcol/lattice/engine.hpp"
 
 namespace revcol::bench {
 namespace {
 
 namespace la = revcol::lattice;
+namespace en = revcol::engine;
+
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 struct LatticeCase {
   std::size_t n = 10000;
@@ -41,18 +54,23 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
   const la::Counters k0 = e.counters();
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
+  const double c0 = cpu_seconds();
   const std::uint64_t done = e.run(nc, la::tick_limit - 1);
   const auto t1 = clock::now();
+  const double c1 = cpu_seconds();
   const la::Diagnostics d1 = la::diagnostics(e);
   const la::Counters k1 = e.counters();
   e.run_back(s0.collisions, s0.origin);
   const auto t2 = clock::now();
+  const double c2 = cpu_seconds();
   const bool exact = la::same_state(e.snapshot(), s0);
   double redraws = 0.0;
   for (int k = 1; k < 8; ++k) redraws += static_cast<double>(k1.redraws[k] - k0.redraws[k]);
   const double coll = static_cast<double>(done);
   return {{"forward_per_s", coll / std::chrono::duration<double>(t1 - t0).count()},
           {"reverse_per_s", coll / std::chrono::duration<double>(t2 - t1).count()},
+          {"forward_cpu_per_s", coll / (c1 - c0)},
+          {"reverse_cpu_per_s", coll / (c2 - c1)},
           {"bit_exact", exact ? 1.0 : 0.0},
           {"events_per_collision", static_cast<double>(k1.events - k0.events) / coll},
           {"log_entries", static_cast<double>(k1.log_entries - k0.log_entries)},
@@ -62,6 +80,33 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
           {"bits_length", static_cast<double>(d1.bits_length)},
           {"energy_drift", d1.energy_drift},
           {"engine_bytes", static_cast<double>(e.memory_bytes())},
+          {"n", static_cast<double>(c.n)},
+          {"phi", c.phi}};
+}
+
+// the float engine on the same kind of gas, timed the same way (its own family is engine/...)
+std::vector<Metric> run_float(const LatticeCase& c, std::uint64_t nc) {
+  en::Config cfg;
+  cfg.dim = 2;
+  cfg.seed = static_cast<std::uint32_t>(c.seed);
+  const en::InitialState st = en::random_state(cfg, c.n, c.phi, c.seed, 0.0, c.phi > 0.35 ? "lattice" : "auto");
+  auto sim = en::make_simulation(st.config, st.x, st.v);
+  const double inf = std::numeric_limits<double>::infinity();
+  sim->run(c.n, inf);
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  const double c0 = cpu_seconds();
+  const en::RunResult f = sim->run(nc, inf);
+  const auto t1 = clock::now();
+  const double c1 = cpu_seconds();
+  const en::RunResult b = sim->run_back(nc, -inf);
+  const auto t2 = clock::now();
+  const double c2 = cpu_seconds();
+  const double fc = static_cast<double>(f.collisions), bc = static_cast<double>(b.collisions);
+  return {{"forward_per_s", fc / std::chrono::duration<double>(t1 - t0).count()},
+          {"reverse_per_s", bc / std::chrono::duration<double>(t2 - t1).count()},
+          {"forward_cpu_per_s", fc / (c1 - c0)},
+          {"reverse_cpu_per_s", bc / (c2 - c1)},
           {"n", static_cast<double>(c.n)},
           {"phi", c.phi}};
 }
@@ -79,6 +124,11 @@ void add_lattice_benches(std::vector<Bench>& out) {
   for (const Named& m : named) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice(c, n); }});
+  }
+  for (const double phi : {0.3, 0.5}) {
+    const LatticeCase c{10000, phi, false, 1};
+    out.push_back({phi < 0.4 ? "lattice/float/n10000/phi0.3" : "lattice/float/n10000/phi0.5", "collisions/s",
+                   [c](std::uint64_t n) { return run_float(c, n); }});
   }
 }
 

@@ -6,10 +6,11 @@ bench/results/lattice_*.json.
     python3 bench/lattice_study.py all
 
 throughput: one revcol-bench invocation running the lattice family (periodic N = 1e4 at area
-fractions 0.3 and 0.5, walls at 0.3) beside the float engine's 2D case engine/d2/n10000/phi0.5,
-so the two are measured side by side on the same (shared) machine; collisions per second forward
-and reverse, bit-exactness of the round trip, redraws and log entries per collision. Writes
-lattice_throughput.json.
+fractions 0.3 and 0.5, walls at 0.3) and, timed the same way, the float engine on the same
+periodic gases (lattice/float/...), so the two are measured side by side on the same (shared)
+machine; collisions per second forward and reverse (wall clock and CPU time), bit-exactness of the
+round trip, redraws and log entries per collision. Writes lattice_throughput.json and prints the
+lattice / float ratios.
 
 roundtrip: one gas (N, area fraction, periodic and walls) run forward in steps of 10x collisions up
 to --max and back to the start after each step, from Python: bit-for-bit restoration of positions,
@@ -37,13 +38,24 @@ RESULTS = os.path.join(HERE, "results")
 def throughput(args) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "b.json")
-        cmd = [args.bin, "--bench", "lattice/", "--bench", "engine/d2/n10000/phi0.5",
+        cmd = [args.bin, "--bench", "lattice/",
                "--collisions", str(int(float(args.collisions))), "--repeats", str(args.repeats), "--json", out]
         t0 = time.time()
         subprocess.run(cmd, check=True)
         with open(out) as f:
             res = json.load(f)
     res = {"command": " ".join(cmd), "wall_seconds": time.time() - t0, "results": res}
+    rates: dict = {}
+    for row in res["results"]["results"]:  # revcol-bench rows: bench, metric, median, values
+        rates.setdefault(row["bench"], {})[row["metric"]] = row["median"]
+    ratios = {}
+    for phi in ("0.3", "0.5"):
+        lat, flo = rates.get(f"lattice/periodic/n10000/phi{phi}"), rates.get(f"lattice/float/n10000/phi{phi}")
+        if lat and flo:
+            ratios[phi] = {m: lat[m] / flo[m] for m in ("forward_per_s", "reverse_per_s",
+                                                        "forward_cpu_per_s", "reverse_cpu_per_s")}
+    res["lattice_over_float"] = ratios
+    print(json.dumps(ratios, indent=1))
     path = os.path.join(RESULTS, "lattice_throughput.json")
     with open(path, "w") as f:
         json.dump(res, f, indent=1)

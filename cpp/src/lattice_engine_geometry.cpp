@@ -2,6 +2,7 @@
 // (lattice/geometry.hpp, units.hpp, cell_grid.hpp).
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 
@@ -218,7 +219,13 @@ void CellGrid::build(const Units& u, std::size_t n) {
     bounds_[k].resize(static_cast<std::size_t>(nc_[k]) + 1);
     for (int c = 0; c <= nc_[k]; ++c) bounds_[k][c] = static_cast<std::int64_t>(static_cast<i128>(c) * L_[k] / nc_[k]);
   }
-  members_.assign(static_cast<std::size_t>(nc_[0]) * nc_[1], {});
+  // disks with centres in a w0 x w1 cell, pairwise >= sigma apart: at most (ceil(w/sigma) + 1)^2
+  std::int64_t per = 1;
+  for (int k = 0; k < 2; ++k) per *= (L_[k] / nc_[k] + u.sigma) / u.sigma + 1;
+  cap_ = static_cast<std::size_t>(std::min<std::int64_t>(per + 2, 8));
+  const std::size_t cells = static_cast<std::size_t>(nc_[0]) * nc_[1];
+  slots_.assign(cells * static_cast<std::size_t>(cap_), -1);
+  count_.assign(cells, 0);
   where_.assign(n, -1);
   slot_.assign(n, -1);
 }
@@ -264,27 +271,33 @@ int CellGrid::axis_range(int k, int c, int* out) const noexcept {
   return n;
 }
 
+void CellGrid::grow() {
+  const std::size_t cap = 2 * cap_;
+  std::vector<int> wider(count_.size() * cap, -1);
+  for (std::size_t id = 0; id < count_.size(); ++id)
+    for (std::int32_t k = 0; k < count_[id]; ++k) wider[id * cap + k] = slots_[id * cap_ + k];
+  slots_.swap(wider);
+  cap_ = cap;
+}
+
 void CellGrid::insert(int p, int id) {
-  auto& m = members_[id];
+  if (static_cast<std::size_t>(count_[id]) >= cap_) grow();
   where_[p] = id;
-  slot_[p] = static_cast<int>(m.size());
-  m.push_back(p);
+  slot_[p] = count_[id];
+  slots_[static_cast<std::size_t>(id) * cap_ + count_[id]++] = p;
 }
 
 void CellGrid::remove(int p) {
-  auto& m = members_[where_[p]];
+  const int id = where_[p];
   const int s = slot_[p];
-  const int last = m.back();
-  m[s] = last;
+  const int last = slots_[static_cast<std::size_t>(id) * cap_ + --count_[id]];
+  slots_[static_cast<std::size_t>(id) * cap_ + s] = last;
   slot_[last] = s;
-  m.pop_back();
   where_[p] = -1;
 }
 
 std::size_t CellGrid::memory_bytes() const noexcept {
-  std::size_t b = members_.capacity() * sizeof(std::vector<int>) + (where_.capacity() + slot_.capacity()) * sizeof(int);
-  for (const auto& m : members_) b += m.capacity() * sizeof(int);
-  return b;
+  return (slots_.capacity() + where_.capacity() + slot_.capacity()) * sizeof(int) + count_.capacity() * 4;
 }
 
 }  // namespace revcol::lattice

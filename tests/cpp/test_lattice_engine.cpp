@@ -213,6 +213,34 @@ TEST_CASE("units: a box too long or too fast for the lattice is refused with a c
   CHECK(threw);
 }
 
+TEST_CASE("cell grid: flat cells grow past their first capacity, neighbours enumerated once each") {
+  Units u = choose_units({200.0, 200.0}, 1.0, 1.0, {false, true});
+  CellGrid g;
+  g.build(u, 100);
+  CHECK(g.count(0) >= 5);
+  const int id = g.cell_id(Vec2{u.L[0] / 2, u.L[1] / 2});
+  for (int p = 0; p < 40; ++p) g.insert(p, id);  // more than any first capacity
+  for (int p = 40; p < 100; ++p) g.insert(p, (id + 7 * p) % (g.count(0) * g.count(1)));
+  g.remove(3);
+  g.remove(17);
+  std::vector<int> seen(100, 0);
+  g.for_neighbours(id, [&](int q) { ++seen[q]; });
+  int in_cell = 0;
+  for (int p = 0; p < 40; ++p) in_cell += seen[p];
+  CHECK(in_cell == 38);
+  CHECK(seen[3] == 0 && seen[17] == 0);
+  for (int c : seen) CHECK(c <= 1);
+  // boundaries: b(0) = 0, b(nc) = L, and cell_of agrees with them
+  for (int k = 0; k < 2; ++k) {
+    CHECK(g.boundary(k, 0) == 0);
+    CHECK(g.boundary(k, g.count(k)) == u.L[k]);
+    for (int c = 0; c < g.count(k); ++c) {
+      CHECK(g.cell_of(k, g.boundary(k, c)) == c);
+      CHECK(g.cell_of(k, g.boundary(k, c + 1) - 1) == c);
+    }
+  }
+}
+
 TEST_CASE("test operator, periodic: 100 collisions per particle forward and back bit for bit") {
   LatticeStart s = start(100, 0.3, false, 3);
   BounceEngine e(s.units, s.x, s.v, 3, BounceOp{s.units.sigma});

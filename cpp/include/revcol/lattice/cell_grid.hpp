@@ -71,7 +71,8 @@ class CellGrid {
     const int n0 = axis_range(0, c0, a0), n1 = axis_range(1, c1, a1);
     for (int i = 0; i < n0; ++i)
       for (int j = 0; j < n1; ++j)
-        for (int m : members_[a0[i] * nc_[1] + a1[j]]) f(m);
+        for (std::size_t id2 = static_cast<std::size_t>(a0[i]) * nc_[1] + a1[j], k = 0, e = count_[id2]; k < e; ++k)
+          f(slots_[id2 * cap_ + k]);
   }
   /// Puts particle p into flat cell id.
   void insert(int p, int id);
@@ -90,7 +91,13 @@ class CellGrid {
   std::array<std::vector<std::int64_t>, 2> bounds_;  // b(c) = floor(c L / nc), c = 0..nc
   std::array<bool, 2> all_{false, false};  // small periodic axis: every cell is a neighbour
   std::array<bool, 2> wall_{false, false};
-  std::vector<std::vector<int>> members_;
+  // members stored flat (measure before changing: the neighbour scan is bound by memory loads):
+  // cell id's members are slots_[id * cap_ .. + count_[id]]; cap_ starts at min(8, the most disks
+  // whose centres fit one cell without overlapping, plus 2) and doubles when a cell is full
+  void grow();
+  std::size_t cap_ = 6;
+  std::vector<int> slots_;
+  std::vector<std::int32_t> count_;
   std::vector<int> where_, slot_;
 };
 

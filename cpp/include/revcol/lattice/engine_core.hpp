@@ -276,6 +276,8 @@ class BasicEngine {
     reversed_ = false;
     sigma2_ = static_cast<u128>(u_.sigma) * static_cast<u128>(u_.sigma);
     sigma2d_ = static_cast<double>(sigma2_);
+    const double far = static_cast<double>(u_.sigma) + 4.0 * static_cast<double>(u_.vmax);
+    far2_ = far * far * (1.0 + 1e-9);
     hlo_ = u_.sigma / 2;
     rebuild();
   }
@@ -372,8 +374,9 @@ class BasicEngine {
       const i128 B = static_cast<i128>(r[0]) * w[0] + static_cast<i128>(r[1]) * w[1];
       const u128 r2 = norm2(r[0], r[1]);
       if (B >= 0 && r2 >= sigma2_) return;
-      const double rr = static_cast<double>(r2), bb = static_cast<double>(B);
-      const double aa = static_cast<double>(w[0]) * w[0] + static_cast<double>(w[1]) * w[1];
+      const double r0 = static_cast<double>(r[0]), r1 = static_cast<double>(r[1]);
+      const double w0 = static_cast<double>(w[0]), w1 = static_cast<double>(w[1]);
+      const double rr = r0 * r0 + r1 * r1, bb = r0 * w0 + r1 * w1, aa = w0 * w0 + w1 * w1;
       if (rr - bb * (bb / aa) > sigma2d_ * (1.0 + 1e-9) + rr * 1e-12) return;
       const std::int64_t tau = first_overlap(r, w, sigma2_);
       if (tau >= 0) offer(lo + tau, coll_kind(p, q), coll, q);
@@ -534,9 +537,14 @@ class BasicEngine {
       grid_.for_neighbours(grid_.cell_id(x), [&](int q) {
         if (why != 0 || q == i || q == j) return;
         const Vec2 qa = pos(q, a);
+        // exit (measure before changing): farther than sigma + 4 vmax, none of the three can hold
+        // (the ghost and the pre point are within 2 vmax of x, q moves at most vmax per tick)
+        const Vec2 d = diff(x, qa);
+        const double dd = static_cast<double>(d[0]) * d[0] + static_cast<double>(d[1]) * d[1];
+        if (dd > far2_) return;
         if (overlap(x, qa)) why = redraw_overlap_after;
-        else if (overlap(ghost, pos(q, a - 1))) why = redraw_ghost_tie;
-        if (overlap(pre_a[0], qa) || overlap(pre_a[1], qa)) multi = true;
+        else if (overlap(ghost, wrapped(Vec2{qa[0] - ln_[q].v[0], qa[1] - ln_[q].v[1]}))) why = redraw_ghost_tie;
+        if (overlap(pre_a[s], qa)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
       });
     }
     return why;
@@ -721,7 +729,7 @@ class BasicEngine {
   Counters cnt_;
   bool reversed_ = false;
   u128 sigma2_ = 0;
-  double sigma2d_ = 0.0;
+  double sigma2d_ = 0.0, far2_ = 0.0;
   std::int64_t hlo_ = 0;
   CellGrid grid_;
   Queue queue_;
