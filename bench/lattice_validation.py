@@ -253,8 +253,8 @@ def matrix(args) -> dict:
     res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
            "build": _build_info(), "collisions": c, "law": "flux", "seed": args.seed,
            "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "rows": []}
-    for n in args.n:
-        for phi in args.phi:
+    for phi in args.phi:  # in the order given: a run cut short still covers both N
+        for n in args.n:
             for b in args.boundary:
                 row = run_child(n, phi, b, c, args.seed)
                 res["rows"].append(row)
