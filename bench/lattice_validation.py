@@ -90,9 +90,16 @@ def _git_commit() -> str:
 
 
 def _build_info() -> dict:
+    """The module the run imports, and any uncommitted change to tracked files (the build may
+    carry a local line, e.g. module.cpp's registration of the lattice binding)."""
     from revcol import _core
     path = _core.__file__
-    return {"core": path, "core_mtime": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(os.path.getmtime(path)))}
+    try:
+        diff = subprocess.run(["git", "diff", "HEAD"], cwd=HERE, capture_output=True, text=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        diff = "unknown"
+    return {"core": path, "core_mtime": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(os.path.getmtime(path))),
+            "uncommitted_diff": diff}
 
 
 def _write_atomic(path: str, obj) -> None:
