@@ -17,7 +17,10 @@ ticks, X's bit length (start, end, min and max sampled along the forward run; th
 passes through the same states), energy drift (relative, relative / sqrt(C), and per collision in
 units of 2^-40 of a pair's mean energy), momentum drift (lattice units per periodic axis, per
 collision and / sqrt(C); a wall axis does not conserve momentum), the child's peak RSS (VmHWM)
-at 10^5, 10^6, ... collisions and C, and the child's ru_maxrss from wait4. Rows are written
+at 10^5, 10^6, ... collisions and C, and the child's ru_maxrss from wait4. If the engine throws
+on the way forward, the row records the error and the collisions done (``completed`` false), whether
+running back from the failed state works, and checks bit for bit from the latest snapshot before
+the failure (taken every C/100 collisions) back to an earlier one and to 0. Rows are written
 after each gas (atomically: a temporary file renamed), with the commit of the build and the load
 average before and after.
 
@@ -148,12 +151,67 @@ def _drift_figures(d: dict, d0_energy: float, c: int, n: int, wall: list) -> dic
     }
 
 
+def _forward(sim, c: int, samples: int) -> dict:
+    """C collisions forward in chunks: X's bit length sampled after each, RSS and drift at the
+    checkpoints, a snapshot at C/2 and after the latest chunk. An engine error stops the run
+    where the engine left it (at its last completed collision) and is recorded."""
+    marks = _checkpoints(c)
+    step = max(1, c // samples)
+    f = {"rss": [], "mid": None, "last": None, "prev": None, "wall": 0.0, "cpu": 0.0, "error": None, "samples": 0,
+         "bmin": sim.diagnostics()["bits_length"], "bmax": sim.diagnostics()["bits_length"]}
+    done = 0
+    while done < c:
+        nxt = min([m for m in marks if m > done] + [(done // step + 1) * step])
+        t0, p0 = time.perf_counter(), time.process_time()
+        try:
+            sim.run(collisions=nxt - done)
+        except RuntimeError as e:
+            f["error"] = str(e)
+        f["wall"] += time.perf_counter() - t0
+        f["cpu"] += time.process_time() - p0
+        if f["error"] is not None or sim.collisions != nxt:
+            f["error"] = f["error"] or f"forward run stopped after {sim.collisions} of {c} collisions"
+            break
+        done = nxt
+        d = sim.diagnostics()
+        f["samples"] += 1
+        f["bmin"], f["bmax"] = min(f["bmin"], d["bits_length"]), max(f["bmax"], d["bits_length"])
+        if done in marks:
+            st = _proc_status()
+            f["rss"].append({"collisions": done, "vmhwm_bytes": st["VmHWM"], "vmrss_bytes": st["VmRSS"],
+                             "engine_memory_bytes": d["memory_bytes"], "bits_length": d["bits_length"],
+                             "log_entries": d["log_entries"], "energy_drift_relative": d["energy_drift"]})
+        if done == c // 2:
+            f["mid"] = (done, sim.state())
+        elif done < c:
+            f["prev"], f["last"] = f["last"], (done, sim.state())
+    return f
+
+
+def _after_failure(sim, f: dict):
+    """The engine failed on the way forward: try running back from where it stopped (recorded),
+    then resume from the latest snapshot, whose midpoint is the C/2 snapshot if taken, else the
+    one before. Returns the simulation to run back from."""
+    from revcol.lattice import LatticeSimulation
+    try:
+        sim.run_back()
+        f["run_back_from_failure"] = "ok"
+    except (RuntimeError, ValueError) as e:
+        f["run_back_from_failure"] = f"{type(e).__name__}: {e}"
+    if f["last"] is None:
+        return None
+    if f["mid"] is None or f["mid"][0] >= f["last"][0]:
+        f["mid"] = f.get("prev")
+    return LatticeSimulation.from_state(f["last"][1])
+
+
 def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, samples: int = 100,
             law: str = "flux") -> dict:
     """One gas: C collisions forward (snapshot at C/2), back to C/2 (compared), back to 0
-    (compared). Returns the row (see the module doc)."""
+    (compared). Returns the row (see the module doc). If the engine fails on the way forward, the
+    row says so (``completed`` false, ``forward_error``) and the checks run on the collisions done,
+    the midpoint being the latest snapshot before the failure."""
     from revcol.lattice import LatticeSimulation
-    c = int(collisions)
     load0 = os.getloadavg()
     sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi), law=law)
     s0 = sim.state()
@@ -161,67 +219,53 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     wall = [bool(w) for w in units["wall"]]
     e0 = float(np.sum(sim.lattice_velocities.astype(float) ** 2))
     bits0 = sim.diagnostics()["bits_length"]
-    bmin = bmax = bits0
-    marks = _checkpoints(c)
-    step = max(1, c // samples)
-    rss, smid, d_end = [], None, None
-    wall_f = cpu_f = 0.0
-    done = 0
-    while done < c:
-        nxt = min([m for m in marks if m > done] + [(done // step + 1) * step])
-        t0, p0 = time.perf_counter(), time.process_time()
-        got = sim.run(collisions=nxt - done)["collisions"]
-        wall_f += time.perf_counter() - t0
-        cpu_f += time.process_time() - p0
-        if got != nxt - done:
-            raise RuntimeError(f"forward run stopped after {done + got} of {c} collisions")
-        done = nxt
-        d = sim.diagnostics()
-        bmin, bmax = min(bmin, d["bits_length"]), max(bmax, d["bits_length"])
-        if done in marks:
-            st = _proc_status()
-            rss.append({"collisions": done, "vmhwm_bytes": st["VmHWM"], "vmrss_bytes": st["VmRSS"],
-                        "engine_memory_bytes": d["memory_bytes"], "bits_length": d["bits_length"],
-                        "log_entries": d["log_entries"],
-                        "energy_drift_relative": d["energy_drift"]})
-        if done == c // 2:
-            smid = sim.state()
-        if done == c:
-            d_end = d
+    f = _forward(sim, int(collisions), samples)
+    c = sim.collisions  # collisions done (= collisions unless the engine failed)
+    d_end = sim.diagnostics()
+    if f["error"] is not None:
+        sim = _after_failure(sim, f)
     t0, p0 = time.perf_counter(), time.process_time()
-    sim.run_back(to_collision=c // 2)
-    mid = compare_states(sim.state(), smid)
-    sim.run_back()
+    mid, back, d_back, checked = {"all": None}, {"all": None}, {"bits_length": None}, None
+    if sim is not None:
+        checked = sim.collisions
+        if f["mid"] is not None:
+            sim.run_back(to_collision=f["mid"][0])
+            mid = compare_states(sim.state(), f["mid"][1])
+        sim.run_back()
+        back = compare_states(sim.state(), s0)
+        d_back = sim.diagnostics()
     wall_r, cpu_r = time.perf_counter() - t0, time.process_time() - p0
-    back = compare_states(sim.state(), s0)
-    d_back = sim.diagnostics()
     log_held = d_end["log_entries"]  # every entry, group bounces included (they are keyed in the same log)
+    cc = max(c, 1)
     row = {
-        "n": n, "phi": phi, "boundary": boundary, "law": law, "seed": seed, "collisions": c,
+        "n": n, "phi": phi, "boundary": boundary, "law": law, "seed": seed, "collisions_asked": int(collisions),
+        "collisions": c, "completed": f["error"] is None, "forward_error": f["error"],
+        "run_back_from_failure": f.get("run_back_from_failure"), "collisions_checked_back": checked,
         "collisions_per_particle": 2.0 * c / n,
-        "bit_for_bit": back["all"] and mid["all"], "roundtrip": back, "midpoint": mid,
-        "midpoint_collision": c // 2,
-        "forward_collisions_per_s_wall": c / wall_f, "reverse_collisions_per_s_wall": c / wall_r,
-        "forward_collisions_per_s_cpu": c / cpu_f, "reverse_collisions_per_s_cpu": c / cpu_r,
-        "forward_s_wall": wall_f, "reverse_s_wall": wall_r, "forward_s_cpu": cpu_f, "reverse_s_cpu": cpu_r,
+        "bit_for_bit": bool(back["all"] and mid["all"]), "roundtrip": back, "midpoint": mid,
+        "midpoint_collision": None if f["mid"] is None else f["mid"][0],
+        "forward_collisions_per_s_wall": c / f["wall"], "reverse_collisions_per_s_wall": (checked or 0) / wall_r,
+        "forward_collisions_per_s_cpu": c / f["cpu"], "reverse_collisions_per_s_cpu": (checked or 0) / max(cpu_r, 1e-9),
+        "forward_s_wall": f["wall"], "reverse_s_wall": wall_r, "forward_s_cpu": f["cpu"], "reverse_s_cpu": cpu_r,
         "log_entries": log_held, "log_entries_redraw_only": log_held - d_end["group_log_entries"],
-        "log_entries_group_bounce": d_end["group_log_entries"], "log_entries_per_collision": log_held / c,
-        "log_bar_met": log_held / c <= 1e-5,
+        "log_entries_group_bounce": d_end["group_log_entries"], "log_entries_per_collision": log_held / cc,
+        "log_bar_met": log_held / cc <= 1e-5,
         "redraws": dict(d_end["redraws"]),
-        "redraws_per_collision": {k: v / c for k, v in d_end["redraws"].items()},
-        "redraws_total_per_collision": sum(d_end["redraws"].values()) / c,
+        "redraws_per_collision": {k: v / cc for k, v in d_end["redraws"].items()},
+        "redraws_total_per_collision": sum(d_end["redraws"].values()) / cc,
         "multi_body_ticks": d_end["multi_body"], "wall_body_ticks": d_end["wall_body"],
         "group_bounces": d_end["group_bounces"],
         "events_forward": d_end["events"], "wall_reflections_forward": d_end["walls"],
-        "bits_X": {"start": bits0, "end": d_end["bits_length"], "min": bmin, "max": bmax,
-                   "after_reverse": d_back["bits_length"], "samples": c // step},
-        "drift_after_c": _drift_figures(d_end, e0, c, n, wall),
-        "rss": rss,
+        "bits_X": {"start": bits0, "end": d_end["bits_length"], "min": f["bmin"], "max": f["bmax"],
+                   "after_reverse": d_back["bits_length"], "samples": f["samples"]},
+        "drift_after_c": _drift_figures(d_end, e0, cc, n, wall),
+        "rss": f["rss"],
         "units": {k: (list(v) if isinstance(v, tuple) else v) for k, v in units.items()},
         "quantization": sim.quantization,
         "loadavg_start": list(load0), "loadavg_end": list(os.getloadavg()),
+        "commit": _git_commit(),
     }
-    hwm = [r["vmhwm_bytes"] for r in rss if r["collisions"] >= 100000]
+    hwm = [r["vmhwm_bytes"] for r in f["rss"] if r["collisions"] >= 100000]
     row["vmhwm_growth_from_1e5_bytes"] = (hwm[-1] - hwm[0]) if hwm else None
     return row
 
@@ -267,7 +311,7 @@ def matrix(args) -> dict:
                 res["rows"].append(row)
                 res["updated_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
                 _write_atomic(path, res)
-                print(json.dumps({k: row.get(k) for k in ("n", "phi", "boundary", "collisions", "bit_for_bit",
+                print(json.dumps({k: row.get(k) for k in ("n", "phi", "boundary", "collisions", "completed", "bit_for_bit",
                                                           "log_entries", "child_wall_s")}), flush=True)
     res["finished_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
     _write_atomic(path, res)

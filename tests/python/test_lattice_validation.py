@@ -19,8 +19,10 @@ N, C = 200, 20000
 def _check_row(row, boundary):
     assert row["roundtrip"] == {k: True for k in row["roundtrip"]}, row["roundtrip"]
     assert row["midpoint"] == {k: True for k in row["midpoint"]}, row["midpoint"]
+    assert row["completed"] and row["forward_error"] is None
     assert row["bit_for_bit"]
     assert row["collisions"] == C and row["midpoint_collision"] == C // 2
+    assert row["collisions_checked_back"] == C
     assert row["log_entries_per_collision"] <= 1e-5  # here: no entry at all in 2e4 collisions
     assert row["bits_X"]["after_reverse"] == row["bits_X"]["start"]
     # flux law: X stays bounded (its size changes by O(1) bits per collision, no drift)
