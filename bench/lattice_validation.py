@@ -24,6 +24,10 @@ the failure (taken every C/100 collisions) back to an earlier one and to 0. Rows
 after each gas (atomically: a temporary file renamed), with the commit of the build and the load
 average before and after.
 
+failures: forward only, several seeds, up to --collisions: the first engine error and, rebuilt
+from the snapshot before it, the bodies within 3 ticks' travel of the failing pair. Writes
+lattice_validation_<out>.json.
+
 equilibrium: a dense periodic lattice gas from equal speeds (not Maxwellian) relaxed for
 --relax collisions per particle, then speed samples pooled over snapshots --gap collisions per
 particle apart, KS against the 2D Maxwell-Boltzmann (Rayleigh) law with the measured kT; and the
@@ -40,6 +44,7 @@ import argparse
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -441,9 +446,85 @@ def equilibrium(args) -> dict:
     return res
 
 
+# --- failures -----------------------------------------------------------------------------------
+
+_FAIL = re.compile(r"collision (\d+) of particles (\d+), (\d+) at tick (-?\d+)")
+
+
+def _third_bodies(sim, i: int, j: int, a: int) -> list:
+    """At the state just before the failed collision: every body other than i and j whose gap to
+    i or j at ticks a-1, a, a+1 is below 3 ticks' travel of the pair (free flight from the clock;
+    a wall reflection in between is not modelled), in units of the pair's largest travel per tick."""
+    u = sim.units
+    sig = int(u["sigma"])
+    box = [int(v) for v in u["L"]]
+    x = sim.lattice_positions.astype(object)
+    v = sim.lattice_velocities.astype(object)
+    step = max(math.isqrt(int(v[p][0]) ** 2 + int(v[p][1]) ** 2) for p in (i, j))
+
+    def gap(p, q, t):
+        r = [int(x[p][k] - x[q][k] + (v[p][k] - v[q][k]) * (t - sim.clock)) for k in range(2)]
+        r = [rk if u["wall"][k] else (rk + box[k] // 2) % box[k] - box[k] // 2 for k, rk in enumerate(r)]
+        return (math.isqrt(r[0] ** 2 + r[1] ** 2) - sig) / step
+
+    out = []
+    for q in range(sim.n):
+        for p in (i, j):
+            if q not in (i, j):
+                g = [gap(p, q, t) for t in (a - 1, a, a + 1)]
+                if min(g) < 3:
+                    out.append({"body": q, "near": p, "gap_ticks_at_a-1_a_a+1": g})
+    return out
+
+
+def failure_scan(n: int, phi: float, boundary: str, seed: int, collisions: int, chunk: int = 100000) -> dict:
+    """Forward only, up to `collisions`, in chunks with a snapshot before each: the first engine
+    error (collision index, message) and, rebuilt from the snapshot just before it, the third
+    bodies near the failing pair."""
+    from revcol.lattice import LatticeSimulation
+    sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi))
+    row = {"n": n, "phi": phi, "boundary": boundary, "seed": seed, "collisions_asked": collisions,
+           "failed_at": None, "error": None}
+    while sim.collisions < collisions:
+        snap = sim.state()
+        try:
+            sim.run(collisions=min(chunk, collisions - sim.collisions))
+        except RuntimeError as e:
+            row["error"] = str(e)
+            break
+    row["collisions"] = sim.collisions
+    d = sim.diagnostics()
+    row.update(log_entries=d["log_entries"], group_bounces=d["group_bounces"], multi_body=d["multi_body"],
+               redraws=dict(d["redraws"]))
+    m = _FAIL.search(row["error"] or "")
+    if m:
+        k, i, j, a = (int(g) for g in m.groups())
+        row["failed_at"] = k
+        sim = LatticeSimulation.from_state(snap)
+        sim.run(collisions=k - 1 - sim.collisions)
+        row["third_bodies"] = _third_bodies(sim, i, j, a)
+    return row
+
+
+def failures(args) -> dict:
+    c = int(float(args.collisions))
+    path = os.path.join(RESULTS, f"lattice_validation_{args.out}.json")
+    res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
+           "build": _build_info(), "rows": []}
+    for phi in args.phi:
+        for b in args.boundary:
+            for s in range(args.seed, args.seed + args.seeds):
+                res["rows"].append(failure_scan(args.n[0], phi, b, s, c))
+                _write_atomic(path, res)
+                r = res["rows"][-1]
+                print(json.dumps({k: r[k] for k in ("phi", "boundary", "seed", "collisions", "failed_at")}), flush=True)
+    print("wrote", path)
+    return res
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=["matrix", "equilibrium", "gas"])
+    ap.add_argument("what", choices=["matrix", "equilibrium", "gas", "failures"])
     ap.add_argument("--collisions", default="1e7")
     ap.add_argument("--n", type=int, nargs="+", default=None, help="matrix default 1000 10000; equilibrium 1000")
     ap.add_argument("--phi", type=float, nargs="+", default=None, help="matrix default 0.1 0.3 0.5 0.7; equilibrium 0.5")
@@ -467,6 +548,8 @@ def main(argv=None) -> int:
     os.makedirs(RESULTS, exist_ok=True)
     if a.what == "matrix":
         matrix(a)
+    elif a.what == "failures":
+        failures(a)
     else:
         a.n, a.phi = a.n[0], a.phi[0]
         equilibrium(a)

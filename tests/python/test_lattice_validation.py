@@ -98,3 +98,17 @@ def test_dense_lattice_gas_relaxes_to_maxwell_with_the_float_collision_rate():
     # same collision rate as the float engine's flux law within 4 standard errors, and within 5%
     assert abs(s["rate_difference"]) <= 4 * s["rate_difference_se"], s
     assert abs(s["rate_relative_difference"]) < 0.05, s
+
+
+def test_third_bodies_measures_a_gap_in_ticks_of_travel():
+    v_rms = math.sqrt(2.0 / 3.0)
+    tick = 2.0 ** -20 / v_rms  # units.hpp: a tick moves a particle of rms speed 2^-20 D
+    x = np.array([[5.0, 5.0], [6.5, 5.0], [5.0, 6.0 + 2.0 * tick]])  # body 2 two ticks' travel above 0
+    v = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 0.0]])
+    sim = lattice.LatticeSimulation(x, v, 10.0, boundary="periodic")
+    assert abs(sim.units["tick"] / tick - 1.0) < 1e-6
+    got = lv._third_bodies(sim, 0, 1, sim.clock)
+    assert [(g["body"], g["near"]) for g in got] == [(2, 0)]
+    assert np.allclose(got[0]["gap_ticks_at_a-1_a_a+1"], [2.0, 2.0, 2.0], atol=1e-3)
+    m = lv._FAIL.search("lattice engine: collision 6617 of particles 603, 635 at tick 250525 found no ...")
+    assert [int(g) for g in m.groups()] == [6617, 603, 635, 250525]
