@@ -4,6 +4,7 @@ bench/results/lattice_validation_*.json.
     PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py matrix [--collisions 1e7]
         [--n 1000 10000] [--phi 0.1 0.3 0.5 0.7] [--boundary wall periodic] [--out matrix]
     PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py equilibrium [--n 1000] [--phi 0.5]
+    PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py failures [--phi 0.5 0.7] [--seeds 4] [--collisions 2e6] --out failures
     PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py gas --n 1000 --phi 0.3 --boundary wall --collisions 1e5
 
 matrix: every gas (N x area fraction x boundary, flux law) in its own subprocess (``gas``), one
