@@ -2,7 +2,7 @@
 bench/results/lattice_*.json.
 
     python3 bench/lattice_study.py throughput [--bin build-dev/revcol-bench] [--collisions 2e5]
-    PYTHONPATH=build-dev/pkg python3 bench/lattice_study.py roundtrip [--n 1000] [--phi 0.3] [--max 1e6] [--law flux]
+    PYTHONPATH=build-dev/pkg python3 bench/lattice_study.py roundtrip [--n 1000] [--phi 0.3] [--max 1e6] [--law flux] [--boundary both]
     python3 bench/lattice_study.py all
 
 throughput: one revcol-bench invocation running the lattice family (periodic N = 1e4 at area
@@ -17,7 +17,7 @@ to --max and back to the start after each step, from Python: bit-for-bit restora
 velocities, stream counters, X and clock; X's bit length, rare-log entries, redraws, multi-body and
 wall-body ticks, energy drift (relative) and momentum drift (lattice units) after the forward run.
 Under the uniform law X grows (the entropy the non-equilibrium law produces): its bit length after
-each forward run is the measurement. Writes lattice_roundtrip_<law>.json.
+each forward run is the measurement. Writes lattice_roundtrip_<law>_n<N>_phi<phi>.json.
 """
 from __future__ import annotations
 
@@ -72,7 +72,7 @@ def _same(a: dict, b: dict) -> bool:
 def roundtrip(args) -> dict:
     from revcol.lattice import LatticeSimulation
     rows = []
-    for boundary in ("periodic", "wall"):
+    for boundary in (("periodic", "wall") if args.boundary == "both" else (args.boundary,)):
         sim = LatticeSimulation.random(n=args.n, phi=args.phi, boundary=boundary, seed=args.seed,
                                        init="lattice" if args.phi > 0.35 else "auto", law=args.law)
         s0 = sim.state()
@@ -99,7 +99,8 @@ def roundtrip(args) -> dict:
             if not ok:
                 break
             nc *= 10
-    path = os.path.join(RESULTS, f"lattice_roundtrip_{args.law}.json")
+    tag = "" if args.boundary == "both" else f"_{args.boundary}"
+    path = os.path.join(RESULTS, f"lattice_roundtrip_{args.law}_n{args.n}_phi{args.phi}{tag}.json")
     with open(path, "w") as f:
         json.dump({"rows": rows}, f, indent=1)
     print("wrote", path)
@@ -117,6 +118,7 @@ def main(argv=None) -> int:
     ap.add_argument("--max", default="1e5")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--law", default="flux", choices=["flux", "uniform"])
+    ap.add_argument("--boundary", default="both", choices=["both", "periodic", "wall"])
     a = ap.parse_args(argv)
     os.makedirs(RESULTS, exist_ok=True)
     if a.what in ("throughput", "all"):

@@ -628,29 +628,56 @@ class BasicEngine {
   // tick a" bounces back: each member's post state at tick a is its pre position at a-1 with its
   // velocity negated. Read backwards (velocities negated) the post lines overlap exactly where the
   // pre lines did, so the reverse meets the group at the same tick, finds the entry in the log, and
-  // applies the same map (position at the event tick - 1, velocity negated). The post state must
-  // meet the invariants against bodies outside G (no overlap at a, no false tie at a-1) and the
-  // walls; otherwise the collision is an error, nothing changed. The draws tried are logged.
+  // applies the same map (position at the event tick - 1, velocity negated). A body that the bounced
+  // post state would overlap at a, or whose point at a-1 the new lines would overlap, joins G (up to
+  // 16 members); the post state must then meet the invariants against bodies outside G and the
+  // walls, otherwise the collision is an error, nothing changed. The draws tried are logged. Energy
+  // is kept exactly; the group's total momentum is reversed (a rare, counted departure).
   void group_bounce(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
     std::vector<int> g{i, j};
+    auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
     for (std::size_t m = 0; m < g.size(); ++m) {
       const Vec2 xa = pos(g[m], a);
       grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
-        if (std::find(g.begin(), g.end(), q) == g.end() && overlap(xa, pos(q, a))) g.push_back(q);
+        if (!member(q) && overlap(xa, pos(q, a))) g.push_back(q);
       });
     }
-    std::sort(g.begin(), g.end());
-    std::vector<Vec2> post(g.size());
-    bool ok = true;
-    for (std::size_t m = 0; m < g.size() && ok; ++m) {
-      post[m] = pos(g[m], a - 1);
-      const Vec2 ghost = pos(g[m], a);  // the new line at a-1 is the pre line at a
-      for (int k = 0; k < 2; ++k)
-        if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(k))) ok = false;
-      grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
-        if (!ok || std::find(g.begin(), g.end(), q) != g.end()) return;
-        if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) ok = false;
-      });
+    // a body that the bounced post state would overlap at a (or its new lines at a-1) joins the
+    // group too; repeat until none does (or the group grows past 16: an error below)
+    std::vector<Vec2> post;
+    bool ok = false, grew = true;
+    while (grew && g.size() <= 16) {
+      grew = false;
+      ok = true;
+      post.assign(g.size(), Vec2{});
+      for (std::size_t m = 0; m < g.size(); ++m) {
+        post[m] = pos(g[m], a - 1);
+        const Vec2 ghost = pos(g[m], a);  // the new line at a-1 is the pre line at a
+        for (int k = 0; k < 2; ++k)
+          if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(k))) ok = false;
+        grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
+          if (grew || member(q)) return;
+          if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) {
+            g.push_back(q);
+            grew = true;
+          }
+        });
+        if (grew) break;
+      }
+    }
+    ok = ok && !grew;
+    std::vector<std::size_t> order(g.size());
+    for (std::size_t m = 0; m < g.size(); ++m) order[m] = m;
+    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return g[x] < g[y]; });
+    {
+      std::vector<int> gs(g.size());
+      std::vector<Vec2> ps(g.size());
+      for (std::size_t m = 0; m < g.size(); ++m) {
+        gs[m] = g[order[m]];
+        if (ok) ps[m] = post[order[m]];
+      }
+      g.swap(gs);
+      post.swap(ps);
     }
     if (!ok) {
       ctr_[i] = ctr0;  // nothing changed
