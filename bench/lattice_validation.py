@@ -26,7 +26,8 @@ after each gas (atomically: a temporary file renamed), with the commit of the bu
 average before and after.
 
 failures: forward only, several seeds, up to --collisions: the first engine error and, rebuilt
-from the snapshot before it, the bodies within 3 ticks' travel of the failing pair. Writes
+from the snapshot before it, the bodies within 3 ticks' travel of the failing pair; and a census
+of the group bounces in the rare log (the same members bouncing again and again is a trap). Writes
 lattice_validation_<out>.json.
 
 equilibrium: a dense periodic lattice gas from equal speeds (not Maxwellian) relaxed for
@@ -478,6 +479,24 @@ def _third_bodies(sim, i: int, j: int, a: int) -> list:
     return out
 
 
+def group_census(state: dict, top: int = 3) -> dict:
+    """The group bounces held in a state's rare log: how often the same members bounced (the
+    most frequent groups, the collision indices of their first and last bounce), and the most
+    bounces within any 10^5 consecutive collisions."""
+    idx = np.asarray(state["group_index"], dtype=np.int64)
+    sizes = np.asarray(state["group_size"], dtype=np.int64)
+    members = np.asarray(state["group_members"], dtype=np.int64)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    by = {}
+    for k, s0, m in zip(idx.tolist(), starts.tolist(), sizes.tolist()):
+        by.setdefault(tuple(members[s0:s0 + m].tolist()), []).append(k)
+    common = sorted(by.items(), key=lambda kv: -len(kv[1]))[:top]
+    window = int(np.max(np.searchsorted(idx, idx + 100000) - np.arange(idx.size))) if idx.size else 0
+    return {"bounces": int(idx.size), "distinct_groups": len(by), "most_bounces_in_1e5_collisions": window,
+            "most_frequent": [{"members": list(g), "bounces": len(ks), "first": ks[0], "last": ks[-1]}
+                              for g, ks in common]}
+
+
 def failure_scan(n: int, phi: float, boundary: str, seed: int, collisions: int, chunk: int = 100000) -> dict:
     """Forward only, up to `collisions`, in chunks with a snapshot before each: the first engine
     error (collision index, message) and, rebuilt from the snapshot just before it, the third
@@ -496,7 +515,7 @@ def failure_scan(n: int, phi: float, boundary: str, seed: int, collisions: int, 
     row["collisions"] = sim.collisions
     d = sim.diagnostics()
     row.update(log_entries=d["log_entries"], group_bounces=d["group_bounces"], multi_body=d["multi_body"],
-               redraws=dict(d["redraws"]))
+               redraws=dict(d["redraws"]), groups=group_census(sim.state()))
     m = _FAIL.search(row["error"] or "")
     if m:
         k, i, j, a = (int(g) for g in m.groups())

@@ -112,3 +112,13 @@ def test_third_bodies_measures_a_gap_in_ticks_of_travel():
     assert np.allclose(got[0]["gap_ticks_at_a-1_a_a+1"], [2.0, 2.0, 2.0], atol=1e-3)
     m = lv._FAIL.search("lattice engine: collision 6617 of particles 603, 635 at tick 250525 found no ...")
     assert [int(g) for g in m.groups()] == [6617, 603, 635, 250525]
+
+
+def test_group_census_finds_the_same_members_bouncing_again():
+    state = {"group_index": np.array([5, 7, 200007, 200009, 200011]),
+             "group_size": np.array([2, 3, 3, 3, 3]),
+             "group_members": np.array([1, 2, 4, 5, 6, 7, 8, 9, 7, 8, 9, 7, 8, 9])}
+    c = lv.group_census(state)
+    assert c["bounces"] == 5 and c["distinct_groups"] == 3
+    assert c["most_frequent"][0] == {"members": [7, 8, 9], "bounces": 3, "first": 200007, "last": 200011}
+    assert c["most_bounces_in_1e5_collisions"] == 3
