@@ -226,10 +226,8 @@ Example:
     'C1'
 )";
 
-}  // namespace
-
-void register_paper(py::module_& m) {
-  // --- 2 particles, 3D
+// --- 2 particles, 3D
+void register_pair3d(py::module_& m) {
   py::class_<Holder<Pair3DPaper>> p3(m, "Pair3DPaper", kPair3DDoc);
   p3.def(py::init([](bool printed) { return Holder<Pair3DPaper>{Pair3DPaper(printed), {}}; }),
          py::kw_only(), py::arg("printed_reverse") = false);
@@ -256,8 +254,10 @@ void register_paper(py::module_& m) {
       .def("__repr__", [](const Holder<Pair3DPaper>& h) {
         return std::string("revcol.Pair3DPaper(printed_reverse=") + (h.op.printed_reverse() ? "True" : "False") + ")";
       });
+}
 
-  // --- 3 particles, 1D
+// --- 3 particles, 1D
+void register_triple1d(py::module_& m) {
   py::class_<Holder<Triple1DPaper>> t1(m, "Triple1DPaper", kTriple1DDoc);
   t1.def(py::init([](const std::string& arc, double cos_tol, bool printed, const std::string& angle) {
            return Holder<Triple1DPaper>{
@@ -296,8 +296,10 @@ void register_paper(py::module_& m) {
                "', cos_tol=" + tol + ", printed_reverse=" +
                (h.op.printed_reverse() ? "True" : "False") + ", angle='" + paper::to_string(h.op.arc().angle()) + "')";
       });
+}
 
-  // --- 3 particles, 2D
+// --- 3 particles, 2D
+void register_triple2d(py::module_& m) {
   py::class_<Holder<Triple2DPaper>> t2(m, "Triple2DPaper", kTriple2DDoc);
   t2.def(py::init([]() { return Holder<Triple2DPaper>{Triple2DPaper(), {}}; }));
   common_methods<Triple2DPaper>(t2, "positions");
@@ -343,7 +345,14 @@ void register_paper(py::module_& m) {
            },
            py::arg("g"), "G-to-Psi (Procedure 5): (psi1, psi2, psi3) per entry of g (3,) or (B, 3).")
       .def("__repr__", [](const Holder<Triple2DPaper>&) { return std::string("revcol.Triple2DPaper()"); });
+}
 
+}  // namespace
+
+void register_paper(py::module_& m) {
+  register_pair3d(m);
+  register_triple1d(m);
+  register_triple2d(m);
 }
 
 }  // namespace revcol::bind
