@@ -192,17 +192,18 @@ void register_collide(py::module_& m) {
            py::arg("velocities"), py::arg("normal"), "Post -> pre (the pair must separate).")
       .def_property_readonly_static("draws", [](py::object) { return Pair1D::draws; });
 
-  auto wall = [](const Box& box, const Array& x, const Array& v, double radius, double tol, int dir) {
+  auto wall = [](const Wall& w, const Array& x, const Array& v, double radius, double tol, int dir) {
+    const Box& box = w.box();
     require(x.ndim() == 1 && v.ndim() == 1 && x.shape(0) == box.dim && v.shape(0) == box.dim,
             [&] { return "position and velocity must have shape (" + std::to_string(box.dim) + ",)"; });
     std::array<double, 3> xa{}, va{};
     for (int k = 0; k < box.dim; ++k) { xa[k] = x.data()[k]; va[k] = v.data()[k]; }
-    const auto out = dir > 0 ? Wall::forward(box, xa, va, radius, tol) : Wall::reverse(box, xa, va, radius, tol);
+    const auto out = dir > 0 ? w.forward(xa, va, radius, tol) : w.reverse(xa, va, radius, tol);
     Array res(box.dim);
     for (int k = 0; k < box.dim; ++k) res.mutable_data()[k] = out[k];
     return res;
   };
-  py::class_<Box>(m, "Wall",
+  py::class_<Wall>(m, "Wall",
                   "Reflection on the walls of the box [lo, hi] (d = 1..3): every wall the particle\n"
                   "touches (within tol) and approaches flips its normal velocity component. A particle\n"
                   "leaving a touched wall is refused (not one reversible event).")
@@ -218,12 +219,12 @@ void register_collide(py::module_& m) {
                b.lo[k] = lo.data()[k];
                b.hi[k] = hi.data()[k];
              }
-             return b;
+             return Wall(b);
            }),
            py::arg("lo"), py::arg("hi"))
-      .def("forward", [wall](const Box& b, const Array& x, const Array& v, double r, double tol) { return wall(b, x, v, r, tol, +1); },
+      .def("forward", [wall](const Wall& w, const Array& x, const Array& v, double r, double tol) { return wall(w, x, v, r, tol, +1); },
            py::arg("position"), py::arg("velocity"), py::arg("radius"), py::arg("tol") = 1e-9)
-      .def("reverse", [wall](const Box& b, const Array& x, const Array& v, double r, double tol) { return wall(b, x, v, r, tol, -1); },
+      .def("reverse", [wall](const Wall& w, const Array& x, const Array& v, double r, double tol) { return wall(w, x, v, r, tol, -1); },
            py::arg("position"), py::arg("velocity"), py::arg("radius"), py::arg("tol") = 1e-9)
       .def_property_readonly_static("draws", [](py::object) { return Wall::draws; });
 }

@@ -57,4 +57,14 @@ TEST_CASE("pair1d exchanges velocities and is its own inverse") {
   CHECK_THROWS_AS(op.forward(PairV<1>{{1.0}, {1.0}}, 1.0), InvalidArgument);
 }
 
+TEST_CASE("a Wall holds its box: its members give the static forms' results") {
+  Box b; b.dim = 3; b.lo = {0, 0, 0}; b.hi = {4, 4, 4};
+  const Wall w(b);
+  const std::array<double, 3> x{0.5, 3.5, 0.5}, pre{-1.0, 2.0, -3.0};
+  CHECK(w.box().hi[1] == 4.0);
+  CHECK(w.forward(x, pre, 0.5) == Wall::forward(b, x, pre, 0.5));
+  CHECK(w.reverse(x, w.forward(x, pre, 0.5), 0.5) == pre);
+  CHECK_THROWS_AS(w.forward({2.0, 2.0, 2.0}, pre, 0.5), InvalidArgument);  // touches no wall
+}
+
 CHECK_MAIN()

@@ -23,10 +23,26 @@ struct Box {
   std::array<double, 3> hi{};     ///< upper walls
 };
 
-/// Wall reflection of one particle.
+/// Wall reflection of one particle. A Wall holds its box (what Python's revcol.Wall is); the
+/// static forms take the box as an argument, for callers that keep boxes of their own.
 class Wall {
  public:
   static constexpr int draws = 0;  ///< random numbers per collision
+
+  /// The walls of `box`.
+  explicit Wall(const Box& box) : box_(box) {}
+  /// The box whose walls these are.
+  const Box& box() const noexcept { return box_; }
+  /// forward(box(), x, v, radius, tol).
+  std::array<double, 3> forward(const std::array<double, 3>& x, const std::array<double, 3>& v, double radius,
+                                double tol = 1e-9) const {
+    return forward(box_, x, v, radius, tol);
+  }
+  /// reverse(box(), x, v, radius, tol).
+  std::array<double, 3> reverse(const std::array<double, 3>& x, const std::array<double, 3>& v, double radius,
+                                double tol = 1e-9) const {
+    return reverse(box_, x, v, radius, tol);
+  }
 
   /// Reflects v on every wall the particle (centre x, radius) touches, within tol, and
   /// approaches. Returns the new velocity; throws InvalidArgument when it touches no wall
@@ -61,6 +77,8 @@ class Wall {
   }
 
  private:
+  Box box_;
+
   static std::array<double, 3> flip(const Box& box, const std::array<double, 3>& x,
                                     const std::array<double, 3>& v, double radius, double tol,
                                     bool approaching) {
