@@ -70,7 +70,7 @@ STATE_PARTS = {
 
 
 def compare_states(a: dict, b: dict) -> dict:
-    """Bit-for-bit equality of two ``LatticeSimulation.state()`` dicts, per part, and overall."""
+    """Bit-for-bit equality of two ``LatticeSimulation.snapshot()`` dicts, per part, and overall."""
     out = {part: all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in keys)
            for part, keys in STATE_PARTS.items()}
     out["all"] = all(out.values())
@@ -189,9 +189,9 @@ def _forward(sim, c: int, samples: int) -> dict:
                              "engine_memory_bytes": d["memory_bytes"], "bits_length": d["bits_length"],
                              "log_entries": d["log_entries"], "energy_drift_relative": d["energy_drift"]})
         if done == c // 2:
-            f["mid"] = (done, sim.state())
+            f["mid"] = (done, sim.snapshot())
         elif done < c:
-            f["prev"], f["last"] = f["last"], (done, sim.state())
+            f["prev"], f["last"] = f["last"], (done, sim.snapshot())
     return f
 
 
@@ -209,7 +209,7 @@ def _after_failure(sim, f: dict):
         return None
     if f["mid"] is None or f["mid"][0] >= f["last"][0]:
         f["mid"] = f.get("prev")
-    return LatticeSimulation.from_state(f["last"][1])
+    return LatticeSimulation.from_snapshot(f["last"][1])
 
 
 def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, samples: int = 100,
@@ -221,7 +221,7 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     from revcol.lattice import LatticeSimulation
     load0 = os.getloadavg()
     sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi), law=law)
-    s0 = sim.state()
+    s0 = sim.snapshot()
     units = sim.units
     wall = [bool(w) for w in units["wall"]]
     e0 = float(np.sum(sim.lattice_velocities.astype(float) ** 2))
@@ -237,9 +237,9 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
         checked = sim.collisions
         if f["mid"] is not None:
             sim.run_back(to_collision=f["mid"][0])
-            mid = compare_states(sim.state(), f["mid"][1])
+            mid = compare_states(sim.snapshot(), f["mid"][1])
         sim.run_back()
-        back = compare_states(sim.state(), s0)
+        back = compare_states(sim.snapshot(), s0)
         d_back = sim.diagnostics()
     wall_r, cpu_r = time.perf_counter() - t0, time.process_time() - p0
     log_held = d_end["log_entries"]  # every entry, group bounces included (they are keyed in the same log)
@@ -506,7 +506,7 @@ def failure_scan(n: int, phi: float, boundary: str, seed: int, collisions: int, 
     row = {"n": n, "phi": phi, "boundary": boundary, "seed": seed, "collisions_asked": collisions,
            "failed_at": None, "error": None}
     while sim.collisions < collisions:
-        snap = sim.state()
+        snap = sim.snapshot()
         try:
             sim.run(collisions=min(chunk, collisions - sim.collisions))
         except RuntimeError as e:
@@ -515,12 +515,12 @@ def failure_scan(n: int, phi: float, boundary: str, seed: int, collisions: int, 
     row["collisions"] = sim.collisions
     d = sim.diagnostics()
     row.update(log_entries=d["log_entries"], group_bounces=d["group_bounces"], multi_body=d["multi_body"],
-               redraws=dict(d["redraws"]), groups=group_census(sim.state()))
+               redraws=dict(d["redraws"]), groups=group_census(sim.snapshot()))
     m = _FAIL.search(row["error"] or "")
     if m:
         k, i, j, a = (int(g) for g in m.groups())
         row["failed_at"] = k
-        sim = LatticeSimulation.from_state(snap)
+        sim = LatticeSimulation.from_snapshot(snap)
         sim.run(collisions=k - 1 - sim.collisions)
         row["third_bodies"] = _third_bodies(sim, i, j, a)
     return row

@@ -56,8 +56,8 @@ def test_wall_gas_round_trip_and_midpoint_in_a_subprocess():
 def test_compare_states_sees_one_bit_in_each_part():
     sim = lattice.LatticeSimulation.random(n=50, phi=0.3, seed=4)
     sim.run(collisions=200)
-    a = sim.state()
-    assert lv.compare_states(a, sim.state())["all"]
+    a = sim.snapshot()
+    assert lv.compare_states(a, sim.snapshot())["all"]
     for part, keys in lv.STATE_PARTS.items():
         b = dict(a)
         k = keys[0]
