@@ -106,10 +106,10 @@ def test_a_broken_round_trip_fails_and_names_the_part(tmp_path, capsys, monkeypa
     def run_back_then_nudge(self, *a, **k):
         out = real(self, *a, **k)
         if self.collisions == 0:
-            st = self.state()
+            st = self.snapshot()
             st["v"] = st["v"].copy()
             st["v"][7, 1] += 1
-            self._e = LatticeSimulation.from_state(st)._e
+            self._e = LatticeSimulation.from_snapshot(st)._e
         return out
     monkeypatch.setattr(LatticeSimulation, "run_back", run_back_then_nudge)
     assert cli_main(["run", str(small(tmp_path)), "--json", str(tmp_path / "r.json"), "--no-progress"]) == 1
@@ -126,10 +126,10 @@ def test_a_velocity_perturbed_at_the_turn_does_not_come_back(tmp_path, capsys, m
 
     def turn_then_nudge(self):
         real(self)
-        st = self.sim.state()
+        st = self.sim.snapshot()
         st["v"] = st["v"].copy()
         st["v"][0, 0] += 1
-        self.sim._e = LatticeSimulation.from_state(st)._e
+        self.sim._e = LatticeSimulation.from_snapshot(st)._e
     monkeypatch.setattr(lg._LatticeRun, "turn", turn_then_nudge)
     assert cli_main(["run", str(small(tmp_path)), "--no-progress"]) == 1
     assert "result           FAILED" in capsys.readouterr().out
@@ -298,7 +298,7 @@ def test_lattice_trajectory_replays_the_forward_frames_exactly(tmp_path):
     assert sim.collisions == 800
     start = lg.build_lattice(load_scene(small(tmp_path, collisions=1000)))
     sim.run_back()
-    assert all(lg.restored(start.state(), sim.state()).values())
+    assert all(lg.restored(start.snapshot(), sim.snapshot()).values())
 
 
 def test_lattice_plot(tmp_path):
