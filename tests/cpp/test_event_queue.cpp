@@ -135,7 +135,9 @@ TEST_CASE("int64 ticks: random sequences, ties, huge and negative ticks") {
       CHECK(run_pattern<std::int64_t>(n, 0, 1, 3000, seed, small) == 0);
       CHECK(run_pattern<std::int64_t>(n, -123456789, 7, 3000, seed, small) == 0);
       auto huge = [](std::int64_t now, std::mt19937_64& rng) {
-        const std::int64_t room = std::numeric_limits<std::int64_t>::max() - 1 - now;
+        // room up to max - 1, computed without overflow for negative now (UBSan)
+        const std::int64_t top = std::numeric_limits<std::int64_t>::max() - 1;
+        const std::int64_t room = now < 0 ? top / 2 : top - now;
         const std::int64_t step = static_cast<std::int64_t>(rng() >> 2) % (room / 4 + 1);
         return now + step;
       };
