@@ -119,17 +119,25 @@ void add_lattice_benches(std::vector<Bench>& out) {
     const char* name;
     LatticeCase c;
   };
+  // the lattice engine (periodic at N = 1e4 and 1e5, area fractions 0.3 and 0.5; walls at 1e4)
+  // and the float engine on the same periodic gases (lattice/float/...), for the table
   static const Named named[] = {{"lattice/periodic/n10000/phi0.3", {10000, 0.3, false, 1}},
                                 {"lattice/periodic/n10000/phi0.5", {10000, 0.5, false, 1}},
-                                {"lattice/walls/n10000/phi0.3", {10000, 0.3, true, 1}}};
+                                {"lattice/periodic/n100000/phi0.3", {100000, 0.3, false, 1}},
+                                {"lattice/periodic/n100000/phi0.5", {100000, 0.5, false, 1}},
+                                {"lattice/walls/n10000/phi0.3", {10000, 0.3, true, 1}},
+                                {"lattice/walls/n10000/phi0.5", {10000, 0.5, true, 1}}};
   for (const Named& m : named) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice(c, n); }});
   }
-  for (const double phi : {0.3, 0.5}) {
-    const LatticeCase c{10000, phi, false, 1};
-    out.push_back({phi < 0.4 ? "lattice/float/n10000/phi0.3" : "lattice/float/n10000/phi0.5", "collisions/s",
-                   [c](std::uint64_t n) { return run_float(c, n); }});
+  static const Named floats[] = {{"lattice/float/n10000/phi0.3", {10000, 0.3, false, 1}},
+                                 {"lattice/float/n10000/phi0.5", {10000, 0.5, false, 1}},
+                                 {"lattice/float/n100000/phi0.3", {100000, 0.3, false, 1}},
+                                 {"lattice/float/n100000/phi0.5", {100000, 0.5, false, 1}}};
+  for (const Named& m : floats) {
+    const LatticeCase c = m.c;
+    out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_float(c, n); }});
   }
 }
 

@@ -1,16 +1,16 @@
 """Studies of the 2D lattice engine (revcol/lattice/engine.hpp, LATTICE.md). Writes
 bench/results/lattice_*.json.
 
-    python3 bench/lattice_study.py throughput [--bin build-dev/revcol-bench] [--collisions 2e5]
+    python3 bench/lattice_study.py throughput [--bin build-dev/revcol-bench] [--collisions 2e5] [--rounds 5] [--cpu 1]
     PYTHONPATH=build-dev/pkg python3 bench/lattice_study.py roundtrip [--n 1000] [--phi 0.3] [--max 1e6] [--law flux] [--boundary both]
     python3 bench/lattice_study.py all
 
-throughput: one revcol-bench invocation running the lattice family (periodic N = 1e4 at area
-fractions 0.3 and 0.5, walls at 0.3) and, timed the same way, the float engine on the same
-periodic gases (lattice/float/...), so the two are measured side by side on the same (shared)
-machine; collisions per second forward and reverse (wall clock and CPU time), bit-exactness of the
-round trip, redraws and log entries per collision. Writes lattice_throughput.json and prints the
-lattice / float ratios.
+throughput: the lattice engine and, timed the same way, the float engine on the same periodic
+gases (N = 1e4 and 1e5, area fractions 0.3 and 0.5; revcol-bench lattice/periodic/... and
+lattice/float/...), interleaved: every round runs each case once per engine, alternating which goes
+first, one process per run pinned to one core, the load average recorded before each run.
+Collisions per second forward and reverse (wall clock and CPU time), medians and ranges over
+rounds, and the lattice / float ratios of the medians. Writes lattice_throughput.json.
 
 roundtrip: one gas (N, area fraction, periodic and walls) run forward in steps of 10x collisions up
 to --max and back to the start after each step, from Python: bit-for-bit restoration of positions,
@@ -35,37 +35,71 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
 
 
-def throughput(args) -> dict:
+#: the gases of the issue's table: (N, area fraction); periodic, lattice and float side by side
+THROUGHPUT_CASES = [(10000, "0.3"), (10000, "0.5"), (100000, "0.3"), (100000, "0.5")]
+METRICS = ("forward_per_s", "reverse_per_s", "forward_cpu_per_s", "reverse_cpu_per_s")
+
+
+def _bench_once(args, name: str, collisions: int) -> dict:
+    """One revcol-bench process for one case (pinned to --cpu unless -1): its metrics."""
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "b.json")
-        cmd = [args.bin, "--bench", "lattice/",
-               "--collisions", str(int(float(args.collisions))), "--repeats", str(args.repeats), "--json", out]
-        t0 = time.time()
-        subprocess.run(cmd, check=True)
+        cmd = [args.bin, "--bench", name, "--collisions", str(collisions), "--repeats", "1", "--json", out]
+        if args.cpu >= 0:
+            cmd = ["taskset", "-c", str(args.cpu)] + cmd
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
         with open(out) as f:
             res = json.load(f)
-    res = {"command": " ".join(cmd), "wall_seconds": time.time() - t0, "results": res}
-    rates: dict = {}
-    for row in res["results"]["results"]:  # revcol-bench rows: bench, metric, median, values
-        rates.setdefault(row["bench"], {})[row["metric"]] = row["median"]
-    ratios = {}
-    for phi in ("0.3", "0.5"):
-        lat, flo = rates.get(f"lattice/periodic/n10000/phi{phi}"), rates.get(f"lattice/float/n10000/phi{phi}")
-        if lat and flo:
-            ratios[phi] = {m: lat[m] / flo[m] for m in ("forward_per_s", "reverse_per_s",
-                                                        "forward_cpu_per_s", "reverse_cpu_per_s")}
-    res["lattice_over_float"] = ratios
+    return {row["metric"]: row["median"] for row in res["results"] if row["bench"] == name}
+
+
+def throughput(args) -> dict:
+    """Lattice and float engines on the same periodic gases, interleaved: each round runs every
+    case once per engine, alternating which engine goes first, one process per run pinned to one
+    core, with the load average before each run; the medians and ranges over rounds and the
+    lattice / float ratios of the medians."""
+    base = int(float(args.collisions))
+    raw: dict = {}
+    loads = []
+    t0 = time.time()
+    for r in range(args.rounds):
+        for n, phi in THROUGHPUT_CASES:
+            engines = ["lattice", "float"] if r % 2 == 0 else ["float", "lattice"]
+            for eng in engines:
+                name = f"lattice/{'periodic' if eng == 'lattice' else 'float'}/n{n}/phi{phi}"
+                loads.append(os.getloadavg()[0])
+                m = _bench_once(args, name, base if n <= 10000 else 2 * base)
+                raw.setdefault(name, []).append(m)
+                print(f"round {r} {name:34s} forward {m['forward_per_s']:.3g}/s reverse {m['reverse_per_s']:.3g}/s "
+                      f"(load {loads[-1]:.2f})", flush=True)
+    summary, ratios = {}, {}
+    for name, runs in raw.items():
+        summary[name] = {m: {"median": float(np.median([x[m] for x in runs])), "min": min(x[m] for x in runs),
+                             "max": max(x[m] for x in runs)} for m in METRICS}
+        for m in ("bit_exact", "log_entries", "redraws_per_collision", "multi_body", "events_per_collision"):
+            if m in runs[0]:
+                summary[name][m] = [x[m] for x in runs]
+    for n, phi in THROUGHPUT_CASES:
+        lat, flo = summary[f"lattice/periodic/n{n}/phi{phi}"], summary[f"lattice/float/n{n}/phi{phi}"]
+        ratios[f"n{n}/phi{phi}"] = {m: lat[m]["median"] / flo[m]["median"] for m in METRICS}
+    res = {"command": " ".join(sys.argv), "rounds": args.rounds, "collisions_per_run": base,
+           "collisions_per_run_n100000": 2 * base, "cpu": args.cpu, "wall_seconds": time.time() - t0,
+           "load_before_runs": {"min": min(loads), "median": float(np.median(loads)), "max": max(loads)},
+           "summary": summary, "lattice_over_float": ratios, "raw": raw,
+           "commit": subprocess.run(["git", "-C", HERE, "rev-parse", "HEAD"], capture_output=True,
+                                    text=True).stdout.strip()}
     print(json.dumps(ratios, indent=1))
     path = os.path.join(RESULTS, "lattice_throughput.json")
-    with open(path, "w") as f:
+    with open(path + ".tmp", "w") as f:
         json.dump(res, f, indent=1)
+    os.replace(path + ".tmp", path)
     print("wrote", path)
     return res
 
 
 def _same(a: dict, b: dict) -> bool:
     keys = ["clock", "origin", "collisions", "x", "v", "streams", "bits", "log_index", "log_redraws",
-            "group_index", "group_drawer", "group_size", "group_members"]
+            "group_index", "group_drawer", "group_size", "group_members", "group_kind", "group_v"]
     return all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in keys)
 
 
@@ -91,7 +125,7 @@ def roundtrip(args) -> dict:
                    "bits_length": d["bits_length"], "log_entries": d["log_entries"],
                    "log_entries_written": d["log_entries_written"],
                    "redraws": d["redraws"], "multi_body": d["multi_body"], "wall_body": d["wall_body"],
-                   "group_bounces": d["group_bounces"],
+                   "group_resolves": d["group_resolves"], "group_bounces": d["group_bounces"],
                    "energy_drift": d["energy_drift"], "momentum_drift": list(d["momentum_drift"]),
                    "quantization": sim.quantization}
             print(json.dumps(row))
@@ -112,7 +146,8 @@ def main(argv=None) -> int:
     ap.add_argument("what", choices=["throughput", "roundtrip", "all"])
     ap.add_argument("--bin", default=os.path.join(HERE, "..", "build-dev", "revcol-bench"))
     ap.add_argument("--collisions", default="2e5")
-    ap.add_argument("--repeats", type=int, default=1)
+    ap.add_argument("--rounds", type=int, default=5, help="throughput: interleaved rounds")
+    ap.add_argument("--cpu", type=int, default=1, help="throughput: core to pin each run to (-1: none)")
     ap.add_argument("--n", type=int, default=1000)
     ap.add_argument("--phi", type=float, default=0.3)
     ap.add_argument("--max", default="1e5")

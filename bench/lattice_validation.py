@@ -255,13 +255,13 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
         "forward_collisions_per_s_cpu": c / f["cpu"], "reverse_collisions_per_s_cpu": (checked or 0) / max(cpu_r, 1e-9),
         "forward_s_wall": f["wall"], "reverse_s_wall": wall_r, "forward_s_cpu": f["cpu"], "reverse_s_cpu": cpu_r,
         "log_entries": log_held, "log_entries_redraw_only": log_held - d_end["group_log_entries"],
-        "log_entries_group_bounce": d_end["group_log_entries"], "log_entries_per_collision": log_held / cc,
+        "log_entries_group": d_end["group_log_entries"], "log_entries_per_collision": log_held / cc,
         "log_bar_met": log_held / cc <= 1e-5,
         "redraws": dict(d_end["redraws"]),
         "redraws_per_collision": {k: v / cc for k, v in d_end["redraws"].items()},
         "redraws_total_per_collision": sum(d_end["redraws"].values()) / cc,
         "multi_body_ticks": d_end["multi_body"], "wall_body_ticks": d_end["wall_body"],
-        "group_bounces": d_end["group_bounces"],
+        "group_resolves": d_end["group_resolves"], "group_bounces": d_end["group_bounces"],
         "events_forward": d_end["events"], "wall_reflections_forward": d_end["walls"],
         "bits_X": {"start": bits0, "end": d_end["bits_length"], "min": f["bmin"], "max": f["bmax"],
                    "after_reverse": d_back["bits_length"], "samples": f["samples"]},
@@ -480,9 +480,10 @@ def _third_bodies(sim, i: int, j: int, a: int) -> list:
 
 
 def group_census(state: dict, top: int = 3) -> dict:
-    """The group bounces held in a state's rare log: how often the same members bounced (the
-    most frequent groups, the collision indices of their first and last bounce), and the most
-    bounces within any 10^5 consecutive collisions."""
+    """The group collisions held in a state's rare log (resolves and bounces): how often the same
+    members met as a group (the most frequent groups, the collision indices of their first and
+    last), and the most group collisions within any 10^5 consecutive collisions (the same
+    members again and again is a trap)."""
     idx = np.asarray(state["group_index"], dtype=np.int64)
     sizes = np.asarray(state["group_size"], dtype=np.int64)
     members = np.asarray(state["group_members"], dtype=np.int64)
@@ -492,8 +493,10 @@ def group_census(state: dict, top: int = 3) -> dict:
         by.setdefault(tuple(members[s0:s0 + m].tolist()), []).append(k)
     common = sorted(by.items(), key=lambda kv: -len(kv[1]))[:top]
     window = int(np.max(np.searchsorted(idx, idx + 100000) - np.arange(idx.size))) if idx.size else 0
-    return {"bounces": int(idx.size), "distinct_groups": len(by), "most_bounces_in_1e5_collisions": window,
-            "most_frequent": [{"members": list(g), "bounces": len(ks), "first": ks[0], "last": ks[-1]}
+    kind = np.asarray(state.get("group_kind", np.zeros(idx.size)), dtype=np.int64)
+    return {"groups": int(idx.size), "resolves": int(np.sum(kind == 1)), "bounces": int(np.sum(kind == 0)),
+            "distinct_groups": len(by), "most_groups_in_1e5_collisions": window,
+            "most_frequent": [{"members": list(g), "times": len(ks), "first": ks[0], "last": ks[-1]}
                               for g, ks in common]}
 
 
@@ -514,7 +517,8 @@ def failure_scan(n: int, phi: float, boundary: str, seed: int, collisions: int, 
             break
     row["collisions"] = sim.collisions
     d = sim.diagnostics()
-    row.update(log_entries=d["log_entries"], group_bounces=d["group_bounces"], multi_body=d["multi_body"],
+    row.update(log_entries=d["log_entries"], group_resolves=d["group_resolves"], group_bounces=d["group_bounces"],
+               multi_body=d["multi_body"],
                redraws=dict(d["redraws"]), groups=group_census(sim.snapshot()))
     m = _FAIL.search(row["error"] or "")
     if m:

@@ -102,6 +102,7 @@ py::dict counters_dict(const la::Counters& c) {
   d["log_entries_written"] = c.log_entries;
   d["multi_body"] = c.multi_body;
   d["wall_body"] = c.wall_body;
+  d["group_resolves"] = c.group_resolves;
   d["group_bounces"] = c.group_bounces;
   return d;
 }
@@ -127,17 +128,22 @@ py::dict snapshot_dict(const la::Snapshot& s, revcol::Law law) {
   d["log_index"] = flat_array(li.data(), li.size());
   d["log_redraws"] = flat_array(lr.data(), lr.size());
   std::vector<std::uint64_t> gi;
-  std::vector<std::int64_t> gd, gs, gm;
-  for (const auto& [k, g] : s.groups) {
-    gi.push_back(k);
-    gd.push_back(g.first);
-    gs.push_back(static_cast<std::int64_t>(g.second.size()));
-    for (int m : g.second) gm.push_back(m);
+  std::vector<std::int64_t> gd, gs, gm, gk;
+  std::vector<la::Vec2> gv;
+  for (const auto& g : s.groups) {
+    gi.push_back(g.index);
+    gd.push_back(g.drawer);
+    gs.push_back(static_cast<std::int64_t>(g.members.size()));
+    gk.push_back(g.pre_v.empty() ? 0 : 1);
+    for (int m : g.members) gm.push_back(m);
+    gv.insert(gv.end(), g.pre_v.begin(), g.pre_v.end());
   }
   d["group_index"] = flat_array(gi.data(), gi.size());
   d["group_drawer"] = flat_array(gd.data(), gd.size());
   d["group_size"] = flat_array(gs.data(), gs.size());
   d["group_members"] = flat_array(gm.data(), gm.size());
+  d["group_kind"] = flat_array(gk.data(), gk.size());  // 0 bounce, 1 resolve (pre velocities in group_v)
+  d["group_v"] = vec_array(gv);
   d["energy0"] = flat_array(s.energy0.data(), 2);
   d["momentum0"] = flat_array(s.momentum0.data(), 4);
   return d;
@@ -163,13 +169,27 @@ la::Snapshot snapshot_from(const py::dict& d) {
   const auto gs = get_flat<std::int64_t>(d, "group_size");
   const auto gm = get_flat<std::int64_t>(d, "group_members");
   require(gi.size() == gd.size() && gi.size() == gs.size(), "lattice checkpoint: group arrays differ in length");
-  std::size_t at = 0;
+  // group_kind and group_v arrived with the group resolve; a checkpoint without them holds bounces only
+  const auto gk = d.contains("group_kind") ? get_flat<std::int64_t>(d, "group_kind") : std::vector<std::int64_t>(gi.size(), 0);
+  const auto gv = d.contains("group_v") ? vecs(IArray::ensure(d["group_v"]), "group_v") : std::vector<la::Vec2>{};
+  require(gk.size() == gi.size(), "lattice checkpoint: group_kind and group_index differ in length");
+  std::size_t at = 0, atv = 0;
   for (std::size_t k = 0; k < gi.size(); ++k) {
     require(gs[k] >= 2 && at + static_cast<std::size_t>(gs[k]) <= gm.size(), "lattice checkpoint: group_members too short");
-    std::vector<int> members(gm.begin() + static_cast<std::ptrdiff_t>(at), gm.begin() + static_cast<std::ptrdiff_t>(at + gs[k]));
+    require(gk[k] == 0 || gk[k] == 1, "lattice checkpoint: group_kind must be 0 (bounce) or 1 (resolve)");
+    la::GroupEntry e;
+    e.index = gi[k];
+    e.drawer = static_cast<int>(gd[k]);
+    e.members.assign(gm.begin() + static_cast<std::ptrdiff_t>(at), gm.begin() + static_cast<std::ptrdiff_t>(at + gs[k]));
+    if (gk[k] == 1) {
+      require(atv + static_cast<std::size_t>(gs[k]) <= gv.size(), "lattice checkpoint: group_v too short");
+      e.pre_v.assign(gv.begin() + static_cast<std::ptrdiff_t>(atv), gv.begin() + static_cast<std::ptrdiff_t>(atv + gs[k]));
+      atv += static_cast<std::size_t>(gs[k]);
+    }
     at += static_cast<std::size_t>(gs[k]);
-    s.groups.push_back({gi[k], {static_cast<int>(gd[k]), members}});
+    s.groups.push_back(std::move(e));
   }
+  require(at == gm.size() && atv == gv.size(), "lattice checkpoint: group_members or group_v longer than the groups");
   const auto e0 = get_flat<std::uint64_t>(d, "energy0");
   const auto p0 = get_flat<std::int64_t>(d, "momentum0");
   require(e0.size() == 2 && p0.size() == 4, "lattice checkpoint: energy0 needs 2 words and momentum0 4");

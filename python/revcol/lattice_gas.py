@@ -48,7 +48,8 @@ RESTORED_PARTS: dict[str, tuple[str, ...]] = {
     "bits_back": ("bits",),
     "clock": ("clock", "origin"),
     "collision_count": ("collisions",),
-    "rare_log": ("log_index", "log_redraws", "group_index", "group_drawer", "group_size", "group_members"),
+    "rare_log": ("log_index", "log_redraws", "group_index", "group_drawer", "group_size", "group_members",
+                 "group_kind", "group_v"),
 }
 
 _LOG_KEYS = RESTORED_PARTS["rare_log"]
@@ -96,7 +97,7 @@ def restored(start: dict, end: dict) -> dict[str, bool]:
 
 
 def log_size(state: dict) -> tuple[int, int]:
-    """(entries, bytes) of the rare log in a state: redraw entries plus group bounces, and the
+    """(entries, bytes) of the rare log in a state: redraw entries plus group collisions, and the
     bytes its arrays take in a checkpoint."""
     entries = len(state["log_index"]) + len(state["group_index"])
     return entries, int(sum(np.asarray(state[k]).nbytes for k in _LOG_KEYS))
@@ -291,7 +292,8 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
                       "max": run.bits_max, "sampled_every": run.every},
         "log_entries_turn": entries_turn, "log_bytes_turn": bytes_turn,
         "log_entries_end": entries_end, "log_bytes_end": bytes_end,
-        "group_bounces": int(d_turn["group_bounces"]), "log_entries_per_collision": per(entries_turn),
+        "group_resolves": int(d_turn["group_resolves"]), "group_bounces": int(d_turn["group_bounces"]),
+        "log_entries_per_collision": per(entries_turn),
         "redraws": redraws, "redraws_total": sum(redraws.values()), "redraws_per_collision": per(sum(redraws.values())),
         "multi_body": int(d_turn["multi_body"]), "wall_body": int(d_turn["wall_body"]),
         "energy_drift_turn": float(d_turn["energy_drift"]), "energy_drift_end": float(d_end["energy_drift"]),

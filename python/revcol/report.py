@@ -124,7 +124,8 @@ def _lattice_lines(r: dict) -> list[str]:
         f"  bits-back X      {x['start']} bits at the start, {x['turn']} at the turn, {x['end']} after reversal; "
         f"max {x['max']} (sampled every {x['sampled_every']:,} collisions)",
         f"  rare log         {_n(r['log_entries_turn'], 'entry', 'entries')} ({r['log_bytes_turn']} bytes) at the "
-        f"turn, {r['log_entries_per_collision']:.2g} per collision ({_n(r['group_bounces'], 'group bounce')}); "
+        f"turn, {r['log_entries_per_collision']:.2g} per collision ({_n(r['group_resolves'], 'group collision')} "
+        f"resolved, {_n(r['group_bounces'], 'group bounce')}); "
         f"{_n(r['log_entries_end'], 'entry', 'entries')} ({r['log_bytes_end']} bytes) after reversal",
         f"  redraws          {r['redraws_total']:,} ({r['redraws_total'] / n:.2g} per collision): {redraws}",
         f"  multi-body       {_n(r['multi_body'], 'tick')} with three bodies ({r['multi_body'] / n:.2g} per "

@@ -34,6 +34,7 @@
 #pragma once
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -77,7 +78,21 @@ struct Counters {
   std::uint64_t log_entries = 0;         ///< rare-log entries written (forward)
   std::uint64_t multi_body = 0;          ///< three bodies within one tick (resolved by the rule)
   std::uint64_t wall_body = 0;           ///< a wall and a body within one tick (resolved by the rule)
-  std::uint64_t group_bounces = 0;       ///< three or more bodies resolved by a group bounce (a log entry)
+  std::uint64_t group_resolves = 0;      ///< groups resolved specularly, pre velocities logged (a log entry)
+  std::uint64_t group_bounces = 0;       ///< groups that bounced back (the fallback; a log entry)
+};
+
+/// A group collision in the rare log: a pair that no draw could resolve because a third body (or
+/// more) is met within the same tick. Its members stay at their tick a-1 positions ("stall") and
+/// either take the velocities of a specular resolution (pre_v holds their exact pre velocities,
+/// so the reverse restores them) or, when that post state would break the event rule, bounce
+/// back (every velocity negated, an involution: pre_v empty).
+struct GroupEntry {
+  std::uint64_t index = 0;    ///< collision index (1-based)
+  int drawer = 0;             ///< whose stream the tried draws came from
+  std::vector<int> members;   ///< ascending
+  std::vector<Vec2> pre_v;    ///< members' exact pre velocities (a resolve); empty: a bounce
+  bool operator==(const GroupEntry&) const = default;
 };
 
 /// Everything that defines a lattice state, in the forward frame, positions at the clock.
@@ -92,8 +107,7 @@ struct Snapshot {
   std::vector<std::uint64_t> streams;          ///< per-particle Philox counters
   std::vector<std::uint64_t> bits;             ///< the bits-back integer X, 64-bit words, low first
   std::vector<std::pair<std::uint64_t, std::uint32_t>> log;  ///< rare log: collision index -> redraws
-  /// rare log: collision index -> (drawing particle, members) of a group bounce
-  std::vector<std::pair<std::uint64_t, std::pair<int, std::vector<int>>>> groups;
+  std::vector<GroupEntry> groups;              ///< rare log: group collisions (resolves and bounces)
   std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
   std::array<std::int64_t, 4> momentum0{};     ///< initial momentum per axis (128 bits: low, high)
   Counters counters;                           ///< statistics (not compared by same_state)
@@ -147,11 +161,15 @@ class BasicEngine {
     validate_state(s.units, s.x, s.v);
     require(s.streams.size() == s.x.size(), "lattice snapshot: one stream counter per particle");
     for (const auto& e : s.groups) {
-      const auto& [drawer, members] = e.second;
-      require(e.first >= 1 && e.first <= s.collisions && members.size() >= 2 &&
-                  drawer >= 0 && static_cast<std::size_t>(drawer) < s.x.size(),
+      require(e.index >= 1 && e.index <= s.collisions && e.members.size() >= 2 && e.drawer >= 0 &&
+                  static_cast<std::size_t>(e.drawer) < s.x.size(),
               "lattice snapshot: a group entry out of range");
-      for (int m : members) require(m >= 0 && static_cast<std::size_t>(m) < s.x.size(), "lattice snapshot: a group member out of range");
+      require(e.pre_v.empty() || e.pre_v.size() == e.members.size(),
+              "lattice snapshot: a group entry needs one pre velocity per member (or none: a bounce)");
+      for (int m : e.members) require(m >= 0 && static_cast<std::size_t>(m) < s.x.size(), "lattice snapshot: a group member out of range");
+      for (const Vec2& w : e.pre_v)
+        require(w[0] >= -s.units.vmax && w[0] <= s.units.vmax && w[1] >= -s.units.vmax && w[1] <= s.units.vmax,
+                "lattice snapshot: a group entry's pre velocity is faster than vmax");
     }
     require(s.origin <= s.clock && s.clock < tick_limit / 2 && s.origin > -tick_limit / 2,
             "lattice snapshot: origin <= clock within +-2^60 required");
@@ -195,7 +213,7 @@ class BasicEngine {
     s.streams = ctr_;
     s.bits = X_.words();
     s.log.assign(log_.begin(), log_.end());
-    for (const auto& [k, g] : groups_) s.groups.push_back({k, {g.drawer, g.members}});
+    for (const auto& [k, g] : groups_) s.groups.push_back(GroupEntry{k, g.drawer, g.members, g.pre_v});
     s.energy0 = energy0_;
     s.momentum0 = momentum0_;
     s.counters = cnt_;
@@ -219,7 +237,7 @@ class BasicEngine {
   const Bits& bits() const noexcept { return X_; }                      ///< the bits-back integer
   const Counters& counters() const noexcept { return cnt_; }            ///< statistics
   std::size_t log_size() const noexcept { return log_.size(); }         ///< rare-log entries held (redraws)
-  std::size_t group_log_size() const noexcept { return groups_.size(); }  ///< group bounces held in the log
+  std::size_t group_log_size() const noexcept { return groups_.size(); }  ///< group collisions held in the log
   const Units& units() const noexcept { return u_; }                    ///< units and box
   std::size_t size() const noexcept { return ln_.size(); }               ///< N
   std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
@@ -228,13 +246,21 @@ class BasicEngine {
   /// Redraws tried before a collision is resolved as a group bounce (group_bounce); -1 (tests
   /// only) resolves every collision so.
   int max_redraws = 256;
+  /// When false (tests only), every group collision bounces back instead of resolving.
+  bool group_resolve = true;
   /// When set, every forward collision appends (tick, i, j), i < j (tests, studies).
   std::vector<std::array<std::int64_t, 3>>* trace = nullptr;
   /// Bytes held by the engine's arrays, queue, grid and log.
   std::size_t memory_bytes() const noexcept {
     const std::size_t n = ln_.size();
     return n * (2 * sizeof(Vec2) + 4 * 8 + 3 * 8 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
-           log_.size() * 48 + X_.words().size() * 8;
+           log_.size() * 48 + group_bytes() + X_.words().size() * 8;
+  }
+  /// Bytes held by the group entries of the rare log (map node, members, pre velocities).
+  std::size_t group_bytes() const noexcept {
+    std::size_t b = 0;
+    for (const auto& [k, g] : groups_) b += 80 + g.members.size() * sizeof(int) + g.pre_v.size() * sizeof(Vec2);
+    return b;
   }
   /// Momentum sum v per axis, 128 bits.
   static std::array<i128, 2> momentum_of(const std::vector<Vec2>& v) noexcept {
@@ -265,7 +291,7 @@ class BasicEngine {
     log_.clear();
     for (const auto& e : s.log) log_[e.first] = e.second;
     groups_.clear();
-    for (const auto& e : s.groups) groups_[e.first] = Group{e.second.first, e.second.second};
+    for (const auto& e : s.groups) groups_[e.index] = Group{e.drawer, e.members, e.pre_v};
     clock_ = s.clock;
     origin_ = s.origin;
     ncoll_ = s.collisions;
@@ -575,7 +601,7 @@ class BasicEngine {
     std::uint32_t redraws = 0;
     for (;;) {
       if (static_cast<std::int64_t>(redraws) > max_redraws) {
-        group_bounce(i, j, a, ctr0, reasons);
+        group_collide(i, j, a, ctr0, reasons);
         return;
       }
       const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
@@ -622,18 +648,25 @@ class BasicEngine {
     apply(i, j, xi0, xj0, Vec2{-vi0[0], -vi0[1]}, Vec2{-vj0[0], -vj0[1]}, a);
   }
 
-  // ---- three or more bodies within one tick: the group bounce (an exact involution) ----
+  // ---- a third body within one tick: group collisions (LATTICE.md §4, docs/lattice.md) ----
   // When no draw is acceptable (a third body k is met within the tick, so every post state of the
-  // pair overlaps it), the group G = {i, j} closed under "a member's pre line overlaps a body at
-  // tick a" bounces back: each member's post state at tick a is its pre position at a-1 with its
-  // velocity negated. Read backwards (velocities negated) the post lines overlap exactly where the
-  // pre lines did, so the reverse meets the group at the same tick, finds the entry in the log, and
-  // applies the same map (position at the event tick - 1, velocity negated). A body that the bounced
-  // post state would overlap at a, or whose point at a-1 the new lines would overlap, joins G (up to
-  // 16 members); the post state must then meet the invariants against bodies outside G and the
-  // walls, otherwise the collision is an error, nothing changed. The draws tried are logged. Energy
-  // is kept exactly; the group's total momentum is reversed (a rare, counted departure).
-  void group_bounce(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
+  // pair overlaps it or ties with it), the group G = {i, j}, closed under "a member's pre line
+  // overlaps a body at tick a", collides as one. Every member stays at its tick a-1 position at
+  // tick a (a stall of one tick), so the members' positions at a never overlap each other.
+  //   Resolve (first choice): the members' velocities go through sequential specular collisions
+  //   of the touching pairs (normal along the centres at a-1) until no touching pair approaches,
+  //   rounded to integers with the momentum kept exactly; the exact pre velocities go to the log.
+  //   For one pair this is the specular collision, and its reversed lines overlap at a-1 exactly
+  //   where the pre lines did at a, so the reverse meets the group at the same tick.
+  //   Bounce (fallback): every member's velocity negated (an involution: nothing but the members
+  //   is logged); the group's momentum is reversed.
+  // Either way a body that the post state would overlap at a, or whose point at a-1 the new lines
+  // would overlap, joins G (up to 16 members); a resolve whose reversed lines meet no member pair
+  // at a-1 (the reverse would not see it) or that breaks vmax falls back to the bounce. The post
+  // state must meet the invariants against bodies outside G and the walls, otherwise the collision
+  // is an error, nothing changed. The draws tried are logged with the entry.
+  // The group closed under "a member's pre line at a overlaps a body at a", ascending.
+  std::vector<int> group_of(int i, int j, std::int64_t a) const {
     std::vector<int> g{i, j};
     auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
     for (std::size_t m = 0; m < g.size(); ++m) {
@@ -642,19 +675,76 @@ class BasicEngine {
         if (!member(q) && overlap(xa, pos(q, a))) g.push_back(q);
       });
     }
-    // a body that the bounced post state would overlap at a (or its new lines at a-1) joins the
-    // group too; repeat until none does (or the group grows past 16: an error below)
-    std::vector<Vec2> post;
-    bool ok = false, grew = true;
-    while (grew && g.size() <= 16) {
-      grew = false;
-      ok = true;
+    return g;
+  }
+  // Post velocities of a resolve for the members g (positions at a-1: x): sequential specular
+  // collisions of the pairs whose pre lines overlap at a, then integer rounding with the sum kept.
+  std::vector<Vec2> resolve_velocities(const std::vector<int>& g, const std::vector<Vec2>& x, std::int64_t a) const {
+    const std::size_t n = g.size();
+    std::vector<std::array<double, 2>> v(n);
+    for (std::size_t m = 0; m < n; ++m) v[m] = {static_cast<double>(ln_[g[m]].v[0]), static_cast<double>(ln_[g[m]].v[1])};
+    struct Touch {
+      std::size_t p, q;
+      double n0, n1;
+    };
+    std::vector<Touch> touch;
+    for (std::size_t p = 0; p < n; ++p)
+      for (std::size_t q = p + 1; q < n; ++q) {
+        if (!overlap(pos(g[p], a), pos(g[q], a))) continue;
+        const Vec2 r = diff(x[p], x[q]);
+        const double r0 = static_cast<double>(r[0]), r1 = static_cast<double>(r[1]), len = std::sqrt(r0 * r0 + r1 * r1);
+        if (len > 0.0) touch.push_back({p, q, r0 / len, r1 / len});
+      }
+    const double eps = 1e-12 * static_cast<double>(u_.vmax);
+    for (int sweep = 0; sweep < 64; ++sweep) {
+      bool any = false;
+      for (const Touch& t : touch) {
+        const double wn = (v[t.p][0] - v[t.q][0]) * t.n0 + (v[t.p][1] - v[t.q][1]) * t.n1;
+        if (wn >= -eps) continue;  // not approaching along the normal
+        v[t.p] = {v[t.p][0] - wn * t.n0, v[t.p][1] - wn * t.n1};
+        v[t.q] = {v[t.q][0] + wn * t.n0, v[t.q][1] + wn * t.n1};
+        any = true;
+      }
+      if (!any) break;
+    }
+    std::vector<Vec2> out(n);
+    for (int k = 0; k < 2; ++k) {
+      i128 before = 0, after = 0;
+      std::size_t big = 0;
+      for (std::size_t m = 0; m < n; ++m) {
+        const double c = std::clamp(v[m][k], -static_cast<double>(tick_limit), static_cast<double>(tick_limit));
+        out[m][k] = static_cast<std::int64_t>(std::llround(c));
+        before += ln_[g[m]].v[k];
+        after += out[m][k];
+        if (std::abs(out[m][k]) > std::abs(out[big][k])) big = m;
+      }
+      out[big][k] += static_cast<std::int64_t>(before - after);  // momentum kept exactly
+    }
+    return out;
+  }
+  // The post state of a group collision: positions at a (the a-1 points) and velocities, the
+  // group grown by every body the post state would meet. False when it breaks the walls, vmax,
+  // the 16-member cap or (a resolve) the reverse's view of it.
+  bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec2>& post, std::vector<Vec2>& vel) const {
+    auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
+    for (;;) {
+      if (g.size() > 16) return false;
+      std::sort(g.begin(), g.end());
       post.assign(g.size(), Vec2{});
-      for (std::size_t m = 0; m < g.size(); ++m) {
-        post[m] = pos(g[m], a - 1);
-        const Vec2 ghost = pos(g[m], a);  // the new line at a-1 is the pre line at a
-        for (int k = 0; k < 2; ++k)
-          if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(k))) ok = false;
+      for (std::size_t m = 0; m < g.size(); ++m) post[m] = pos(g[m], a - 1);
+      if (resolve) {
+        vel = resolve_velocities(g, post, a);
+      } else {
+        vel.assign(g.size(), Vec2{});
+        for (std::size_t m = 0; m < g.size(); ++m) vel[m] = Vec2{-ln_[g[m]].v[0], -ln_[g[m]].v[1]};
+      }
+      bool grew = false;
+      for (std::size_t m = 0; m < g.size() && !grew; ++m) {
+        for (int k = 0; k < 2; ++k) {
+          if (vel[m][k] > u_.vmax || vel[m][k] < -u_.vmax) return false;
+          if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(k))) return false;
+        }
+        const Vec2 ghost = wrapped(Vec2{post[m][0] - vel[m][0], post[m][1] - vel[m][1]});  // the new line at a-1
         grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
           if (grew || member(q)) return;
           if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) {
@@ -662,42 +752,49 @@ class BasicEngine {
             grew = true;
           }
         });
-        if (grew) break;
       }
+      if (grew) continue;
+      if (!resolve) return true;  // a bounce's new lines at a-1 are the pre lines at a
+      for (std::size_t p = 0; p < g.size(); ++p)
+        for (std::size_t q = p + 1; q < g.size(); ++q) {
+          const Vec2 gp = wrapped(Vec2{post[p][0] - vel[p][0], post[p][1] - vel[p][1]});
+          const Vec2 gq = wrapped(Vec2{post[q][0] - vel[q][0], post[q][1] - vel[q][1]});
+          if (overlap(gp, gq)) return true;  // the reverse meets this pair at a-1
+        }
+      return false;
     }
-    ok = ok && !grew;
-    std::vector<std::size_t> order(g.size());
-    for (std::size_t m = 0; m < g.size(); ++m) order[m] = m;
-    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return g[x] < g[y]; });
-    {
-      std::vector<int> gs(g.size());
-      std::vector<Vec2> ps(g.size());
-      for (std::size_t m = 0; m < g.size(); ++m) {
-        gs[m] = g[order[m]];
-        if (ok) ps[m] = post[order[m]];
-      }
-      g.swap(gs);
-      post.swap(ps);
+  }
+  void group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
+    const std::vector<int> g0 = group_of(i, j, a);
+    std::vector<int> g = g0;
+    std::vector<Vec2> post, vel;
+    bool resolve = group_resolve, ok = resolve && group_post(g, a, true, post, vel);
+    if (!ok) {
+      resolve = false;
+      g = g0;
+      ok = group_post(g, a, false, post, vel);
     }
     if (!ok) {
       ctr_[i] = ctr0;  // nothing changed
       std::string why = "lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
                         std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
                         " found no acceptable post state in " + std::to_string(max_redraws) +
-                        " redraws, and its group of " + std::to_string(g.size()) + " cannot bounce back (";
+                        " redraws, and its group of " + std::to_string(g.size()) + " can neither resolve nor bounce back (";
       for (int k = 1; k < 8; ++k) why += std::string(redraw_names[k]) + " " + std::to_string(reasons[k]) + (k < 7 ? ", " : ")");
       throw std::runtime_error(why);
     }
+    std::vector<Vec2> pre_v;
+    if (resolve)
+      for (int q : g) pre_v.push_back(ln_[q].v);
     ++ncoll_;
     log_[ncoll_] = static_cast<std::uint32_t>(ctr_[i] - ctr0);
     ++cnt_.log_entries;
-    groups_[ncoll_] = Group{i, g};
+    groups_[ncoll_] = Group{i, g, std::move(pre_v)};
     ++cnt_.multi_body;
-    ++cnt_.group_bounces;
+    ++(resolve ? cnt_.group_resolves : cnt_.group_bounces);
     if (trace != nullptr) trace->push_back({a, i, j});
     for (std::size_t m = 0; m < g.size(); ++m) {
-      Line& l = ln_[g[m]];
-      l = Line{post[m], Vec2{-l.v[0], -l.v[1]}, a};
+      ln_[g[m]] = Line{post[m], vel[m], a};
       ++ver_[g[m]];
     }
     ++cnt_.collisions;
@@ -713,11 +810,13 @@ class BasicEngine {
     const std::uint32_t draws = it == log_.end() ? 0 : it->second;
     const int drawer = entry->second.drawer;
     if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+    const std::vector<Vec2>& pre_v = entry->second.pre_v;  // forward frame; empty: a bounce
     std::vector<Vec2> pre(g.size());
     for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
     for (std::size_t m = 0; m < g.size(); ++m) {
       Line& l = ln_[g[m]];
-      l = Line{pre[m], Vec2{-l.v[0], -l.v[1]}, a};
+      const Vec2 v = pre_v.empty() ? Vec2{-l.v[0], -l.v[1]} : Vec2{-pre_v[m][0], -pre_v[m][1]};
+      l = Line{pre[m], v, a};
       ++ver_[g[m]];
     }
     ctr_[drawer] -= draws;
@@ -747,8 +846,9 @@ class BasicEngine {
   struct Group {
     int drawer;                 // whose stream the tried draws came from
     std::vector<int> members;   // ascending
+    std::vector<Vec2> pre_v;    // exact pre velocities (a resolve) or empty (a bounce)
   };
-  std::map<std::uint64_t, Group> groups_;  // collision index -> group bounce
+  std::map<std::uint64_t, Group> groups_;  // collision index -> group collision
   std::int64_t clock_ = 0, origin_ = 0;
   std::uint64_t ncoll_ = 0;
   std::array<std::uint64_t, 2> energy0_{};
