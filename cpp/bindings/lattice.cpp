@@ -61,6 +61,7 @@ py::dict units_dict(const la::Units& u) {
   d["vmax"] = u.vmax;
   d["length_unit"] = u.length_unit;
   d["tick"] = u.tick;
+  d["tick_bits"] = u.tick_bits;
   return d;
 }
 la::Units units_from(const py::dict& d) {
@@ -75,6 +76,8 @@ la::Units units_from(const py::dict& d) {
   u.vmax = get<std::int64_t>(d, "vmax");
   u.length_unit = get<double>(d, "length_unit");
   u.tick = get<double>(d, "tick");
+  // tick_bits arrived with the finer-tick option; units without it are the default 20
+  u.tick_bits = d.contains("tick_bits") ? get<int>(d, "tick_bits") : la::default_tick_bits;
   la::validate(u);
   return u;
 }
@@ -104,6 +107,7 @@ py::dict counters_dict(const la::Counters& c) {
   d["wall_body"] = c.wall_body;
   d["group_resolves"] = c.group_resolves;
   d["group_bounces"] = c.group_bounces;
+  d["wall_groups"] = c.wall_groups;
   return d;
 }
 
@@ -209,30 +213,35 @@ struct PyLattice {
 void register_lattice(py::module_& m) {
   m.def(
       "lattice_random_start",
-      [](std::size_t n, double phi, std::vector<bool> wall, double diameter, std::uint64_t seed, const std::string& init) {
+      [](std::size_t n, double phi, std::vector<bool> wall, double diameter, std::uint64_t seed, const std::string& init,
+         int tick_bits) {
         require(wall.size() == 2, "lattice: walls need one flag per axis (2D)");
         require(seed <= 0xFFFFFFFFull, "seed must be < 2^32");
         la::LatticeConfig c;
         c.wall = {wall[0], wall[1]};
         c.diameter = diameter;
         c.seed = static_cast<std::uint32_t>(seed);
+        c.tick_bits = tick_bits;
         return start_dict(la::random_start(c, n, phi, seed, init));
       },
       py::arg("n"), py::arg("phi"), py::arg("wall"), py::arg("diameter"), py::arg("seed"), py::arg("init"),
+      py::arg("tick_bits") = la::default_tick_bits,
       "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
   m.def(
       "lattice_quantize",
-      [](const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, double diameter) {
+      [](const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, double diameter, int tick_bits) {
         require(box.size() == 2 && wall.size() == 2, "lattice: box and walls need two entries (2D)");
         require(x.ndim() == 2 && x.shape(1) == 2 && v.ndim() == 2 && v.shape(1) == 2, "lattice: positions and velocities must be (n, 2)");
         la::LatticeConfig c;
         c.box = {box[0], box[1]};
         c.wall = {wall[0], wall[1]};
         c.diameter = diameter;
+        c.tick_bits = tick_bits;
         return start_dict(la::quantize_start(c, std::vector<double>(x.data(), x.data() + x.size()),
                                              std::vector<double>(v.data(), v.data() + v.size())));
       },
       py::arg("x"), py::arg("v"), py::arg("box"), py::arg("wall"), py::arg("diameter"),
+      py::arg("tick_bits") = la::default_tick_bits,
       "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
 
   py::class_<PyLattice>(m, "LatticeEngine", "The 2D lattice engine (revcol/lattice/engine.hpp).")

@@ -70,9 +70,13 @@ void validate(const Units& u) {
     }
   }
   require(u.vmax >= 1 && u.vmax <= u.sigma / 256, "lattice units: vmax must be in [1, sigma / 256]");
+  require(u.tick_bits >= min_tick_bits && u.tick_bits <= max_tick_bits, "lattice units: tick_bits must be in [16, 26]");
 }
 
-Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall) {
+Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
+                   int tick_bits) {
+  require(tick_bits >= min_tick_bits && tick_bits <= max_tick_bits,
+          "lattice: tick_bits must be in [16, 26] (a typical particle moves 2^-tick_bits diameters per tick)");
   require(std::isfinite(D) && D > 0.0, "lattice: the diameter must be positive and finite");
   require(std::isfinite(v_rms) && v_rms > 0.0, "lattice: the rms speed must be positive and finite (a gas at rest has no dynamics)");
   double longest = 0.0;
@@ -93,7 +97,8 @@ Units choose_units(const std::array<double, 2>& box, double D, double v_rms, con
   for (int k = 0; k < 2; ++k) u.L[k] = std::llround(std::ldexp(box[k] / D, S));
   u.vmax = std::int64_t{1} << (S - 8);
   u.length_unit = std::ldexp(D, -S);
-  u.tick = std::ldexp(D, -20) / v_rms;
+  u.tick = std::ldexp(D, -tick_bits) / v_rms;
+  u.tick_bits = tick_bits;
   validate(u);
   return u;
 }

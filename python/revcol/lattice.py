@@ -59,11 +59,14 @@ class LatticeSimulation:
     or at random (``LatticeSimulation.random(n, phi=...)``, the float engine's initialiser then
     quantized). ``boundary``: ``"periodic"`` or ``"wall"`` (one or per axis). ``law``: ``"flux"``
     (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and X's
-    first 256 bits. Bad input raises ``ValueError`` naming the problem.
+    first 256 bits. ``tick_bits`` T (16..26, default 20): a particle of rms speed moves 2^-T
+    diameters per tick; a finer tick (larger T) makes redraws and group collisions (a third body
+    within one tick) rarer, in proportion to the tick, at the cost of T - 20 fewer bits of
+    velocity resolution (docs/lattice.md). Bad input raises ``ValueError`` naming the problem.
     """
 
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
-                 diameter: float = 1.0, law: str = "flux", seed: int = 1, _engine=None,
+                 diameter: float = 1.0, law: str = "flux", seed: int = 1, tick_bits: int = 20, _engine=None,
                  _quantization: Optional[dict] = None):
         if _engine is not None:
             self._e = _engine
@@ -72,7 +75,7 @@ class LatticeSimulation:
         x = np.asarray(positions, dtype=float)
         v = np.asarray(velocities, dtype=float)
         start = _core.lattice_quantize(x, v, [float(b) for b in np.broadcast_to(box, (2,))],
-                                       _walls(boundary), float(diameter))
+                                       _walls(boundary), float(diameter), int(tick_bits))
         self._init_from_start(start, law, seed)
 
     def _init_from_start(self, start: dict, law: str, seed: int) -> None:
@@ -82,13 +85,15 @@ class LatticeSimulation:
 
     @classmethod
     def random(cls, n: int, dim: int = 2, phi: float = 0.3, *, boundary: _Boundary = "periodic",
-               diameter: float = 1.0, seed: int = 1, init: str = "auto", law: str = "flux") -> "LatticeSimulation":
+               diameter: float = 1.0, seed: int = 1, init: str = "auto", law: str = "flux",
+               tick_bits: int = 20) -> "LatticeSimulation":
         """n disks at area fraction phi in a square box (the float engine's ``random_state``:
         random sequential addition or a jittered lattice, Gaussian velocities with zero momentum,
         kT = 1), quantized once. The same ``seed`` keys the streams."""
         if dim != 2:
             raise ValueError(f"the lattice engine is 2D, got dim={dim}")
-        start = _core.lattice_random_start(int(n), float(phi), _walls(boundary), float(diameter), int(seed), str(init))
+        start = _core.lattice_random_start(int(n), float(phi), _walls(boundary), float(diameter), int(seed), str(init),
+                                           int(tick_bits))
         sim = cls.__new__(cls)
         sim._init_from_start(start, law, seed)
         return sim

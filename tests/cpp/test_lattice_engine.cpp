@@ -186,6 +186,31 @@ TEST_CASE("wall mirror: a bijection of the pre phases onto the post phases, its 
   }
 }
 
+TEST_CASE("units: tick_bits sets the tick (a typical particle moves 2^-T sigma per tick) and is range-checked") {
+  const Units u20 = choose_units({20.0, 20.0}, 1.0, 2.0, {false, false});
+  const Units u22 = choose_units({20.0, 20.0}, 1.0, 2.0, {false, false}, 22);
+  CHECK(u20.tick_bits == 20);
+  CHECK(u22.tick_bits == 22);
+  CHECK(u20.tick == std::ldexp(1.0, -20) / 2.0);
+  CHECK(u22.tick == std::ldexp(1.0, -22) / 2.0);
+  CHECK(u22.S == u20.S);
+  // v_rms maps to 2^(S - T) units per tick
+  const Quantized q = quantize(u22, {1.0, 1.0, 5.0, 5.0}, {2.0, 0.0, 0.0, 0.0});
+  CHECK(q.v[0][0] == std::int64_t{1} << (u22.S - 22));
+  for (int bad : {15, 27}) {
+    bool threw = false;
+    try {
+      choose_units({20.0, 20.0}, 1.0, 1.0, {false, false}, bad);
+    } catch (const revcol::InvalidArgument& e) {
+      threw = std::string(e.what()).find("tick_bits") != std::string::npos;
+    }
+    CHECK(threw);
+  }
+  Units bad = u22;
+  bad.tick_bits = 30;
+  CHECK_THROWS_AS(validate(bad), revcol::InvalidArgument);
+}
+
 TEST_CASE("units: a box too long or too fast for the lattice is refused with a clear error") {
   bool threw = false;
   try {
@@ -345,6 +370,36 @@ TEST_CASE("bad input: a clear error, and the state is unchanged") {
   CHECK(same_state(e.snapshot(), s));
   e.run_back(0, e.origin());
   CHECK(e.collisions() == 0);
+}
+
+TEST_CASE("an engine error mid-run (forward or back) leaves the state as it was, and the run can go on") {
+  auto throws = [](auto&& f, const char* word) {
+    try {
+      f();
+    } catch (const std::runtime_error& ex) {
+      return std::string(ex.what()).find(word) != std::string::npos;
+    }
+    return false;
+  };
+  for (bool walls : {false, true}) {
+    LatticeEngine e = make(120, 0.4, walls, 9);
+    const Snapshot s0 = e.snapshot();
+    e.run(500, tick_limit - 1);
+    const Snapshot s1 = e.snapshot();
+    e.throw_at_collision = 800;
+    CHECK(throws([&] { e.run(1000, tick_limit - 1); }, "test hook"));
+    CHECK(same_state(e.snapshot(), s1));
+    CHECK(e.collisions() == 500);
+    e.throw_at_collision = 0;
+    e.run(1000, tick_limit - 1);
+    const Snapshot s2 = e.snapshot();
+    e.throw_at_collision = 900;  // undoing collision 900 of 1500
+    CHECK(throws([&] { e.run_back(0, e.origin()); }, "test hook"));
+    CHECK(same_state(e.snapshot(), s2));
+    e.throw_at_collision = 0;
+    e.run_back(0, e.origin());
+    CHECK(same_state(e.snapshot(), s0));
+  }
 }
 
 TEST_CASE("group collisions (a third body within one tick): forced on every collision, forward and back bit for bit") {

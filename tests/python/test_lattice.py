@@ -8,7 +8,7 @@ from revcol.lattice import LatticeSimulation
 
 def _same(a: dict, b: dict) -> bool:
     keys = ["clock", "origin", "collisions", "x", "v", "streams", "bits", "log_index", "log_redraws",
-            "group_index", "group_drawer", "group_size", "group_members", "seed", "law"]
+            "group_index", "group_drawer", "group_size", "group_members", "group_kind", "group_v", "seed", "law"]
     return all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in keys)
 
 
@@ -42,6 +42,27 @@ def test_midpoint_and_time_reversal_equal_the_forward_states():
     assert np.array_equal(sim.lattice_velocities, mid["v"])
     sim.run_back(collisions=1000)
     assert sim.collisions == 2000
+
+
+def test_tick_bits_finer_tick_round_trip_and_checkpoint(tmp_path):
+    coarse = LatticeSimulation.random(n=120, phi=0.5, boundary="wall", seed=4)
+    fine = LatticeSimulation.random(n=120, phi=0.5, boundary="wall", seed=4, tick_bits=22)
+    assert coarse.units["tick_bits"] == 20 and fine.units["tick_bits"] == 22
+    assert fine.units["tick"] == pytest.approx(coarse.units["tick"] / 4, rel=1e-12)
+    # the same float start: positions identical, velocities carry 2 bits less (v_rms -> 2^(S-22))
+    assert np.array_equal(fine.lattice_positions, coarse.lattice_positions)
+    assert np.allclose(fine.velocities, coarse.velocities, rtol=0, atol=1e-9)
+    s0 = fine.snapshot()
+    fine.run(collisions=6000)
+    path = tmp_path / "fine.npz"
+    fine.save(path)
+    other = LatticeSimulation.load(path)
+    assert other.units["tick_bits"] == 22 and _same(other.snapshot(), fine.snapshot())
+    other.run_back()
+    assert _same(other.snapshot(), s0)
+    for bad in (15, 27):
+        with pytest.raises(ValueError, match="tick_bits"):
+            LatticeSimulation.random(n=50, phi=0.3, tick_bits=bad)
 
 
 def test_save_load_resumes_bit_for_bit(tmp_path):
@@ -115,3 +136,21 @@ def test_simulation_routes_engine_lattice():
         revcol.Simulation.random(n=20, dim=2, phi=0.2, engine="cuda")
     with pytest.raises(ValueError, match="engine"):
         revcol.Simulation([[1.0, 1.0]], [[1.0, 0.0]], 5.0, engine="cuda")
+
+
+def test_a_reflection_and_a_pair_within_one_tick_resolve_as_a_group():
+    # N = 1000, area fraction 0.7, walls, seed 1, stopped before collision 4 018 558: particle 471
+    # reflects on a wall at the tick where it meets 470, and every draw of the pair put a post
+    # centre beyond the wall; the engine raised an error there before the group took the
+    # reflection in (bench/results/lattice_validation_matrix_n1000.json of commit 94a9260)
+    import os
+    path = os.path.join(os.path.dirname(__file__), "..", "data", "lattice", "wall_body_group_n1000_phi0.7.npz")
+    sim = LatticeSimulation.load(path)
+    s0 = sim.snapshot()
+    assert sim.collisions == 4018557
+    sim.run(collisions=1)
+    d = sim.diagnostics()
+    assert d["wall_groups"] == 1 and d["group_resolves"] + d["group_bounces"] == 1  # counters start at the load
+    sim.run(collisions=20000)
+    sim.run_back(to_collision=4018557)
+    assert _same(sim.snapshot(), s0)

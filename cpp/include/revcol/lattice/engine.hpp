@@ -33,6 +33,7 @@ struct LatticeConfig {
   double diameter = 1.0;                   ///< D
   Law law = Law::flux;                     ///< the operator's post-direction law
   std::uint32_t seed = 1;                  ///< stream seed (Philox key {particle, seed}) and X's first bits
+  int tick_bits = default_tick_bits;       ///< a particle of rms speed moves 2^-tick_bits D per tick (units.hpp)
 };
 
 /// A quantized start and what the quantization cost.

@@ -80,6 +80,7 @@ struct Counters {
   std::uint64_t wall_body = 0;           ///< a wall and a body within one tick (resolved by the rule)
   std::uint64_t group_resolves = 0;      ///< groups resolved specularly, pre velocities logged (a log entry)
   std::uint64_t group_bounces = 0;       ///< groups that bounced back (the fallback; a log entry)
+  std::uint64_t wall_groups = 0;         ///< group members whose reflection at the same tick the group took in
 };
 
 /// A group collision in the rare log: a pair that no draw could resolve because a third body (or
@@ -183,18 +184,25 @@ class BasicEngine {
     require(until >= clock_, "lattice run: the end tick is before the clock");
     require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
     if (collisions == 0) return 0;
-    return loop(collisions, until, false, 0);
+    const Snapshot before = snapshot();  // an engine error mid-run leaves the state as it was
+    try {
+      return loop(collisions, until, false, 0);
+    } catch (...) {
+      restore(before);
+      throw;
+    }
   }
   /// Runs back to collision count `to_collisions` (the state the forward run had right after it,
   /// clock = its tick) or to tick `to_tick` (clock = to_tick), whichever comes first in reverse.
   void run_back(std::uint64_t to_collisions, std::int64_t to_tick) {
     require(to_collisions <= ncoll_, "lattice run_back: the target collision count is ahead of the state");
     require(to_tick >= origin_ && to_tick <= clock_, "lattice run_back: the target tick must be in [origin, clock]");
+    const Snapshot before = snapshot();  // an engine error mid-run leaves the state as it was
     flip();
     try {
       loop(0, -to_tick, true, to_collisions);
     } catch (...) {
-      flip();
+      restore(before);
       throw;
     }
     flip();
@@ -248,12 +256,15 @@ class BasicEngine {
   int max_redraws = 256;
   /// When false (tests only), every group collision bounces back instead of resolving.
   bool group_resolve = true;
+  /// Tests only: when nonzero, applying collision index k (forward: the k-th; reverse: undoing
+  /// the k-th) throws, to check that an engine error leaves the state as it was.
+  std::uint64_t throw_at_collision = 0;
   /// When set, every forward collision appends (tick, i, j), i < j (tests, studies).
   std::vector<std::array<std::int64_t, 3>>* trace = nullptr;
   /// Bytes held by the engine's arrays, queue, grid and log.
   std::size_t memory_bytes() const noexcept {
     const std::size_t n = ln_.size();
-    return n * (2 * sizeof(Vec2) + 4 * 8 + 3 * 8 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
+    return n * (2 * sizeof(Vec2) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec2) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
            log_.size() * 48 + group_bytes() + X_.words().size() * 8;
   }
   /// Bytes held by the group entries of the rare log (map node, members, pre velocities).
@@ -299,6 +310,7 @@ class BasicEngine {
     momentum0_ = s.momentum0;
     cnt_ = s.counters;
     wall_tick_.assign(n, std::numeric_limits<std::int64_t>::min());
+    pre_wall_.assign(n, Line{});
     reversed_ = false;
     sigma2_ = static_cast<u128>(u_.sigma) * static_cast<u128>(u_.sigma);
     sigma2d_ = static_cast<double>(sigma2_);
@@ -426,9 +438,9 @@ class BasicEngine {
       ln_[p].ta = clock_;
       grid_.insert(static_cast<int>(p), grid_.cell_id(ln_[p].x));
     }
-    // first bucket width: ~2^20 ticks per mean free time per particle, over N particles (the
-    // queue adapts it; a speed setting only)
-    queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << 20) / static_cast<std::int64_t>(n)));
+    // first bucket width: ~2^tick_bits ticks per mean free time per particle, over N particles
+    // (the queue adapts it; a speed setting only)
+    queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << u_.tick_bits) / static_cast<std::int64_t>(n)));
     // forward: events at the clock may still be pending (a run stopped after a collision);
     // reverse: the clock's tick is done (see run_back), the search starts one tick later
     const std::int64_t lo = reversed_ ? clock_ + 1 : clock_;
@@ -481,6 +493,8 @@ class BasicEngine {
         continue;
       }
       const int i = std::min(p, partner_[p]), j = std::max(p, partner_[p]);
+      if (throw_at_collision != 0 && (back ? ncoll_ : ncoll_ + 1) == throw_at_collision)
+        throw std::runtime_error("lattice engine: test hook at collision " + std::to_string(throw_at_collision));
       if (back) {
         if (ncoll_ == target) {
           clock_ = t - 1;
@@ -516,6 +530,7 @@ class BasicEngine {
       }
       if (overlap(old_line_at_a, pos(q, a))) ++cnt_.wall_body;
     });
+    pre_wall_[p] = Line{pos(p, a - 1), ln_[p].v, a - 1};  // a group collision at a may take it back
     ln_[p].x = x;
     ln_[p].v = v;
     ln_[p].ta = a;
@@ -690,14 +705,29 @@ class BasicEngine {
     std::vector<Touch> touch;
     for (std::size_t p = 0; p < n; ++p)
       for (std::size_t q = p + 1; q < n; ++q) {
-        if (!overlap(pos(g[p], a), pos(g[q], a))) continue;
         const Vec2 r = diff(x[p], x[q]);
         const double r0 = static_cast<double>(r[0]), r1 = static_cast<double>(r[1]), len = std::sqrt(r0 * r0 + r1 * r1);
-        if (len > 0.0) touch.push_back({p, q, r0 / len, r1 / len});
+        const double w0 = v[p][0] - v[q][0], w1 = v[p][1] - v[q][1];
+        // touching: the pre lines overlap at a, or the pair is within one tick's relative travel at a-1
+        const bool near = len < static_cast<double>(u_.sigma) + std::sqrt(w0 * w0 + w1 * w1);
+        if (len > 0.0 && (near || overlap(pos(g[p], a), pos(g[q], a)))) touch.push_back({p, q, r0 / len, r1 / len});
       }
+    // a wall is met within the tick by a member whose line is beyond it at a: -1 lower, +1 upper
+    std::vector<std::array<int, 2>> wall(n, {0, 0});
+    for (std::size_t m = 0; m < n; ++m) {
+      const Vec2 xa = pos(g[m], a);
+      for (int k = 0; k < 2; ++k)
+        if (u_.wall[k]) wall[m][k] = xa[k] < hlo_ ? -1 : xa[k] > hhi(k) ? 1 : 0;
+    }
     const double eps = 1e-12 * static_cast<double>(u_.vmax);
     for (int sweep = 0; sweep < 64; ++sweep) {
       bool any = false;
+      for (std::size_t m = 0; m < n; ++m)
+        for (int k = 0; k < 2; ++k)
+          if (wall[m][k] * v[m][k] > 0.0) {  // approaching a wall it meets: specular, exact
+            v[m][k] = -v[m][k];
+            any = true;
+          }
       for (const Touch& t : touch) {
         const double wn = (v[t.p][0] - v[t.q][0]) * t.n0 + (v[t.p][1] - v[t.q][1]) * t.n1;
         if (wn >= -eps) continue;  // not approaching along the normal
@@ -754,7 +784,9 @@ class BasicEngine {
         });
       }
       if (grew) continue;
-      if (!resolve) return true;  // a bounce's new lines at a-1 are the pre lines at a
+      // the reverse must meet the group at this tick: some member pair's new lines overlap at a-1
+      // (a bounce's new lines at a-1 are its pre lines at a, so it holds unless a member's line
+      // was taken back from a reflection at a)
       for (std::size_t p = 0; p < g.size(); ++p)
         for (std::size_t q = p + 1; q < g.size(); ++q) {
           const Vec2 gp = wrapped(Vec2{post[p][0] - vel[p][0], post[p][1] - vel[p][1]});
@@ -765,6 +797,18 @@ class BasicEngine {
     }
   }
   void group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
+    // a member reflected at this very tick takes its line from before the reflection, and the
+    // wall joins the group as a contact (resolve_velocities): the stall point is then a real point
+    // inside the box, and the log's pre velocity is the one before the reflection
+    const Line keep[2] = {ln_[i], ln_[j]};
+    bool unreflected[2] = {false, false};
+    for (int s = 0; s < 2; ++s) {
+      const int m = s == 0 ? i : j;
+      if (wall_tick_[m] == a) {
+        ln_[m] = pre_wall_[m];
+        unreflected[s] = true;
+      }
+    }
     const std::vector<int> g0 = group_of(i, j, a);
     std::vector<int> g = g0;
     std::vector<Vec2> post, vel;
@@ -776,6 +820,8 @@ class BasicEngine {
     }
     if (!ok) {
       ctr_[i] = ctr0;  // nothing changed
+      ln_[i] = keep[0];
+      ln_[j] = keep[1];
       std::string why = "lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
                         std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
                         " found no acceptable post state in " + std::to_string(max_redraws) +
@@ -792,6 +838,11 @@ class BasicEngine {
     groups_[ncoll_] = Group{i, g, std::move(pre_v)};
     ++cnt_.multi_body;
     ++(resolve ? cnt_.group_resolves : cnt_.group_bounces);
+    for (int s = 0; s < 2; ++s)
+      if (unreflected[s]) {
+        wall_tick_[s == 0 ? i : j] = std::numeric_limits<std::int64_t>::min();  // the group took the reflection in
+        ++cnt_.wall_groups;
+      }
     if (trace != nullptr) trace->push_back({a, i, j});
     for (std::size_t m = 0; m < g.size(); ++m) {
       ln_[g[m]] = Line{post[m], vel[m], a};
@@ -838,6 +889,7 @@ class BasicEngine {
   };
   std::vector<Line> ln_;
   std::vector<std::int64_t> wall_tick_;
+  std::vector<Line> pre_wall_;  // a particle's line before its reflection at wall_tick_ (that tick only)
   std::vector<std::uint64_t> ver_, ctr_, vself_, vpart_;
   std::vector<Type> type_;
   std::vector<int> partner_;

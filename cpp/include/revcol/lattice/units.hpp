@@ -5,9 +5,12 @@
 // every box length below 2^61 lattice units; any box below max_box (~2^63) is valid (minimum-image
 // differences are then below 2^62 and their squares fit 128-bit integers, geometry.hpp). S < 40 (a box longer than 2^22 diameters) is refused: the
 // velocity resolution would fall below ~2^20 units.
-// Velocity: the root-mean-square speed v_rms of the float state is mapped to 2^(S-20) units per
-// tick, so a tick moves a typical particle 2^-20 sigma (the prototype's choice). One tick is then
-// D 2^-20 / v_rms in the float state's time unit. Speeds are bounded by vmax = 2^(S-8) units per
+// Velocity: the root-mean-square speed v_rms of the float state is mapped to 2^(S-T) units per
+// tick, so a tick moves a typical particle 2^-T sigma; T = tick_bits, 20 by default (the
+// prototype's choice), 16..26 allowed. One tick is then D 2^-T / v_rms in the float state's time
+// unit. A finer tick (larger T) makes third bodies within one tick, and so redraws and group
+// collisions, rarer (their rate is proportional to the tick) at the cost of T - 20 fewer bits of
+// velocity resolution (2^(S-T) units for v_rms); N is bounded by 2^(2 (T - 8)) (vmax below). Speeds are bounded by vmax = 2^(S-8) units per
 // tick per axis (1/256 sigma per tick): a relative move per tick below sigma/128, which the cell
 // grid (cell_grid.hpp) relies on. Because no particle can be faster than sqrt(total kinetic energy),
 // a state with sqrt(sum |v|^2) > vmax is refused (N > ~2^24 at the default scale).
@@ -39,14 +42,19 @@ struct Units {
   std::int64_t vmax = std::int64_t{1} << 52;  ///< largest |v| per axis, units per tick
   double length_unit = 0.0;                  ///< float length of one lattice unit (D / sigma)
   double tick = 0.0;                         ///< float time of one tick
+  int tick_bits = 20;                        ///< T: a particle of rms speed moves 2^-T sigma per tick
 };
+
+/// Default and allowed range of tick_bits.
+inline constexpr int default_tick_bits = 20, min_tick_bits = 16, max_tick_bits = 26;
 
 /// Checks a Units value (box lengths, sigma, vmax); throws InvalidArgument naming the problem.
 void validate(const Units& u);
 
 /// Units for a float box of lengths box (per axis) and diameter D holding particles whose
 /// root-mean-square speed is v_rms; throws InvalidArgument if the lattice cannot hold it.
-Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall);
+Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
+                   int tick_bits = default_tick_bits);
 
 /// A float state quantized to the lattice: integer positions and velocities, and the errors.
 struct Quantized {
