@@ -106,8 +106,24 @@ class EventQueue {
   /// The id with the smallest (time, kind, id), or -1 when nothing is scheduled; not removed.
   /// Moves on to the next non-empty bucket, and to the next window, while the current
   /// bucket is empty.
-  int top() {
+  [[gnu::always_inline]] int top() {
     ++tops_;
+    if (!heap_.empty()) return heap_[0].id;  // the common case, inlined into the event loops
+    return refill_top();
+  }
+
+  /// id's scheduled time (never() when unscheduled).
+  Time time(int id) const { return time_[id]; }
+  /// id's scheduled kind (0 when unscheduled).
+  std::int32_t kind(int id) const { return kind_[id]; }
+  /// Whether id has an event in the queue.
+  bool scheduled(int id) const { return loc_[id] != kUnscheduled; }
+  /// Number of ids.
+  std::size_t size() const { return time_.size(); }
+
+ private:
+  // top() when the current bucket's heap is empty: the next non-empty bucket, or the next window
+  int refill_top() {
     while (heap_.empty()) {
       if (++cur_ < nbuckets_) {
         for (int i = bhead_[cur_]; i >= 0;) {
@@ -126,15 +142,7 @@ class EventQueue {
     return heap_[0].id;
   }
 
-  /// id's scheduled time (never() when unscheduled).
-  Time time(int id) const { return time_[id]; }
-  /// id's scheduled kind (0 when unscheduled).
-  std::int32_t kind(int id) const { return kind_[id]; }
-  /// Whether id has an event in the queue.
-  bool scheduled(int id) const { return loc_[id] != kUnscheduled; }
-  /// Number of ids.
-  std::size_t size() const { return time_.size(); }
-
+ public:
   /// Bytes held by the queue's arrays.
   std::size_t memory_bytes() const {
     return time_.capacity() * sizeof(Time) + kind_.capacity() * sizeof(std::int32_t) +

@@ -54,7 +54,7 @@ struct FloatKinematics {
   /// time; false when the pair does not approach or misses. `touching`: within contact_tol
   /// (r^2 - D^2 <= contact_tol) and not separating. (Measured: skipping candidates by the
   /// lower bound c / (-2 b) before the square root was not faster.)
-  static bool pair_time(const Particle<Dim>& a, const Particle<Dim>& b, const Vec& s, double sigma2,
+  [[gnu::always_inline]] static bool pair_time(const Particle<Dim>& a, const Particle<Dim>& b, const Vec& s, double sigma2,
                         double contact_tol, double& t, bool& touching) {
     const double ta = a.t, tb = b.t;
     const double tr = ta > tb ? ta : tb;
