@@ -13,12 +13,19 @@
 
 namespace revcol::lattice {
 
-bool overlaps_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) noexcept {
+namespace {
+// overlaps_at, inlined into first_overlap's search (it runs up to five times per prediction)
+[[gnu::always_inline]] inline bool overlap_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) noexcept {
   constexpr i128 big = i128{1} << 61;
   const i128 dx = static_cast<i128>(r[0]) + static_cast<i128>(w[0]) * tau;
   const i128 dy = static_cast<i128>(r[1]) + static_cast<i128>(w[1]) * tau;
   if (dx >= big || dx <= -big || dy >= big || dy <= -big) return false;
   return norm2(static_cast<std::int64_t>(dx), static_cast<std::int64_t>(dy)) < sigma2;
+}
+}  // namespace
+
+bool overlaps_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) noexcept {
+  return overlap_at(r, w, tau, sigma2);
 }
 
 std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept {
@@ -27,12 +34,18 @@ std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept {
   if (B >= 0) return -1;  // not approaching: f increases from f(0) >= 0
   const i128 A = static_cast<i128>(w[0]) * w[0] + static_cast<i128>(w[1]) * w[1];
   // f is convex with its real minimum in [tv, tv + 1); the integer minimum is at tv or tv + 1.
-  const std::int64_t tv = static_cast<std::int64_t>(-B / A);
-  const bool at_v = overlaps_at(r, w, tv, sigma2);
-  if (!at_v) return overlaps_at(r, w, tv + 1, sigma2) ? tv + 1 : -1;
+  // tv = floor(-B / A): a double guess (from the 64-bit components: no 128-bit division or
+  // conversion), made exact by A tv <= -B < A (tv + 1) in 128 bits (|B| < 2^106, |tv| < 2^62)
+  const double r0 = static_cast<double>(r[0]), r1 = static_cast<double>(r[1]);
+  const double w0 = static_cast<double>(w[0]), w1 = static_cast<double>(w[1]);
+  const double a = w0 * w0 + w1 * w1, b = r0 * w0 + r1 * w1;
+  std::int64_t tv = static_cast<std::int64_t>(std::clamp(std::floor(-b / a), 0.0, 0x1p61));
+  while (tv > 0 && A * tv > -B) --tv;
+  while (A * (tv + 1) <= -B) ++tv;
+  const bool at_v = overlap_at(r, w, tv, sigma2);
+  if (!at_v) return overlap_at(r, w, tv + 1, sigma2) ? tv + 1 : -1;
   // f decreases on [0, tv]: the answer is the first tau in (0, tv] with f < 0 (f(0) >= 0).
-  // First guess in double: the smaller root of A t^2 + 2 B t + C.
-  const double a = static_cast<double>(A), b = static_cast<double>(B);
+  // First guess in double: the smaller root of A t^2 + 2 B t + C (C exact, then rounded once).
   const double c = static_cast<double>(static_cast<i128>(norm2(r[0], r[1])) - static_cast<i128>(sigma2));
   const double disc = std::max(0.0, b * b - a * c);
   double g = c / (-b + std::sqrt(disc));  // cancellation-free form of (-b - sqrt(disc)) / a
@@ -42,17 +55,17 @@ std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept {
     // the guess and its neighbours decide it in the common case
     for (std::int64_t s : {t, t - 1, t + 1}) {
       if (s <= lo || s >= hi) continue;
-      if (overlaps_at(r, w, s, sigma2)) hi = s; else lo = s;
+      if (overlap_at(r, w, s, sigma2)) hi = s; else lo = s;
     }
     if (hi - lo == 1) return hi;
     for (std::int64_t s : {t - 2, t + 2}) {
       if (s <= lo || s >= hi) continue;
-      if (overlaps_at(r, w, s, sigma2)) hi = s; else lo = s;
+      if (overlap_at(r, w, s, sigma2)) hi = s; else lo = s;
     }
   }
   while (hi - lo > 1) {  // exact bisection on integers (a far guess, e.g. near grazing)
     const std::int64_t mid = lo + (hi - lo) / 2;
-    if (overlaps_at(r, w, mid, sigma2)) hi = mid; else lo = mid;
+    if (overlap_at(r, w, mid, sigma2)) hi = mid; else lo = mid;
   }
   return hi;
 }
@@ -223,6 +236,11 @@ void CellGrid::build(const Units& u, std::size_t n) {
     nc_[k] = static_cast<int>(all_[k] ? 8 : ncl[k]);
     bounds_[k].resize(static_cast<std::size_t>(nc_[k]) + 1);
     for (int c = 0; c <= nc_[k]; ++c) bounds_[k][c] = static_cast<std::int64_t>(static_cast<i128>(c) * L_[k] / nc_[k]);
+    scale_[k] = static_cast<double>(nc_[k]) / static_cast<double>(L_[k]);
+    nbr_[k].assign(static_cast<std::size_t>(nc_[k]) * 8, 0);
+    nbrn_[k].assign(static_cast<std::size_t>(nc_[k]), 0);
+    for (int c = 0; c < nc_[k]; ++c)
+      nbrn_[k][static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(axis_range(k, c, &nbr_[k][static_cast<std::size_t>(c) * 8]));
   }
   // disks with centres in a w0 x w1 cell, pairwise >= sigma apart: at most (ceil(w/sigma) + 1)^2
   std::int64_t per = 1;
@@ -233,15 +251,6 @@ void CellGrid::build(const Units& u, std::size_t n) {
   count_.assign(cells, 0);
   where_.assign(n, -1);
   slot_.assign(n, -1);
-}
-
-int CellGrid::cell_of(int k, std::int64_t x) const noexcept {
-  // a double guess, corrected exactly against the integer boundaries
-  int c = static_cast<int>(static_cast<double>(x) / static_cast<double>(L_[k]) * nc_[k]);
-  c = std::clamp(c, 0, nc_[k] - 1);
-  while (c > 0 && x < boundary(k, c)) --c;
-  while (c + 1 < nc_[k] && x >= boundary(k, c + 1)) ++c;
-  return c;
 }
 
 std::int64_t CellGrid::exit_ticks(int k, int c, std::int64_t x0, std::int64_t v) const noexcept {
@@ -302,7 +311,8 @@ void CellGrid::remove(int p) {
 }
 
 std::size_t CellGrid::memory_bytes() const noexcept {
-  return (slots_.capacity() + where_.capacity() + slot_.capacity()) * sizeof(int) + count_.capacity() * 4;
+  return (slots_.capacity() + where_.capacity() + slot_.capacity() + nbr_[0].capacity() + nbr_[1].capacity()) * sizeof(int) +
+         count_.capacity() * 4 + nbrn_[0].capacity() + nbrn_[1].capacity();
 }
 
 }  // namespace revcol::lattice

@@ -57,8 +57,15 @@ class CellGrid {
   int count(int k) const noexcept { return nc_[k]; }
   /// Lower boundary of cell c (0 <= c <= nc) on axis k: floor(c L / nc).
   std::int64_t boundary(int k, int c) const noexcept { return bounds_[k][static_cast<std::size_t>(c)]; }
-  /// The cell index on axis k of a position in [0, L).
-  int cell_of(int k, std::int64_t x) const noexcept;
+  /// The cell index on axis k of a position in [0, L): a double guess, corrected exactly against
+  /// the integer boundaries.
+  int cell_of(int k, std::int64_t x) const noexcept {
+    int c = static_cast<int>(static_cast<double>(x) * scale_[k]);
+    c = c < 0 ? 0 : c >= nc_[k] ? nc_[k] - 1 : c;
+    while (c > 0 && x < boundary(k, c)) --c;
+    while (c + 1 < nc_[k] && x >= boundary(k, c + 1)) ++c;
+    return c;
+  }
   /// Ticks from an anchor x0 in cell c of axis k until the line x0 + v dt leaves the cell; -1 if never.
   std::int64_t exit_ticks(int k, int c, std::int64_t x0, std::int64_t v) const noexcept;
   /// Flat cell id of a particle at position x.
@@ -67,8 +74,10 @@ class CellGrid {
   template <class F>
   void for_neighbours(int id, F&& f) const {
     const int c0 = id / nc_[1], c1 = id % nc_[1];
-    int a0[8], a1[8];
-    const int n0 = axis_range(0, c0, a0), n1 = axis_range(1, c1, a1);
+    // the distinct neighbour cells per axis, tabulated by build (axis_range)
+    const int* a0 = &nbr_[0][static_cast<std::size_t>(c0) * 8];
+    const int* a1 = &nbr_[1][static_cast<std::size_t>(c1) * 8];
+    const int n0 = nbrn_[0][static_cast<std::size_t>(c0)], n1 = nbrn_[1][static_cast<std::size_t>(c1)];
     for (int i = 0; i < n0; ++i)
       for (int j = 0; j < n1; ++j)
         for (std::size_t id2 = static_cast<std::size_t>(a0[i]) * nc_[1] + a1[j], k = 0, e = count_[id2]; k < e; ++k)
@@ -89,6 +98,9 @@ class CellGrid {
   std::array<std::int64_t, 2> L_{};
   std::array<int, 2> nc_{1, 1};
   std::array<std::vector<std::int64_t>, 2> bounds_;  // b(c) = floor(c L / nc), c = 0..nc
+  std::array<double, 2> scale_{0.0, 0.0};             // nc / L: cell_of's first guess
+  std::array<std::vector<int>, 2> nbr_;               // per axis and cell: its neighbour cells (8 slots)
+  std::array<std::vector<std::uint8_t>, 2> nbrn_;     // per axis and cell: how many
   std::array<bool, 2> all_{false, false};  // small periodic axis: every cell is a neighbour
   std::array<bool, 2> wall_{false, false};
   // members stored flat (measure before changing: the neighbour scan is bound by memory loads):
