@@ -321,7 +321,7 @@ class BasicEngine {
   }
 
   // ---- geometry of the lines ----
-  Vec2 pos(int p, std::int64_t t) const noexcept {
+  [[gnu::always_inline]] Vec2 pos(int p, std::int64_t t) const noexcept {
     Vec2 out;
     const std::int64_t dt = t - ln_[p].ta;
     for (int k = 0; k < 2; ++k) {
