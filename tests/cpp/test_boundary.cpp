@@ -25,8 +25,9 @@ TEST_CASE("periodic axis: nearest image with its code, and the wrap by L") {
   CHECK(PeriodicAxis::wrap(x, -0.05, 10.0) && x == 10.3);
   x = 4.0;
   CHECK(!PeriodicAxis::wrap(x, 4.0, 10.0) && x == 4.0);
-  double v = 1.0;
-  CHECK(!PeriodicAxis::reflect(0.0, v, 10.0, 0.5, 1e-9) && v == 1.0);  // no walls
+  std::array<double, 2> v = {1.0, -2.0};
+  CHECK(!PeriodicAxis::meets(0.0, -1.0, 10.0, 0.5, 1e-9));  // no walls
+  CHECK(PeriodicAxis::reflect<2>(0, v) == 0u && v[0] == 1.0 && v[1] == -2.0);
 }
 
 TEST_CASE("wall axis: reflects exactly what the wall operator reflects, on one axis") {
@@ -42,16 +43,17 @@ TEST_CASE("wall axis: reflects exactly what the wall operator reflects, on one a
     // a centre at a wall (within tol), approaching it, or elsewhere
     const int where = s % 3;
     const double x = where == 0 ? r + 0.5 * tol * u(rng) : where == 1 ? (L - r) + 0.5 * tol * u(rng) : 3.0 + u(rng);
-    double v = u(rng);
-    const double v0 = v;
-    const bool f = WallAxis::reflect(x, v, L, r, tol);
-    CHECK(f == (v == -v0));
+    const double v0 = u(rng);
+    const bool f = WallAxis::meets(x, v0, L, r, tol);
     CHECK(f == WallAxis::touches_ahead(x, v0 > 0.0 ? 1 : 0, L, r, tol));
     if (f) {
       ++flipped;
+      std::array<double, 2> v = {v0, 0.25};
+      CHECK(WallAxis::reflect<2>(0, v) == 1u);  // its own component only
+      CHECK(v[0] == -v0 && v[1] == 0.25);
       // the wall operator gives the same post velocity, and its reverse gives back v0
       const auto post = Wall::forward(box, {x, 0, 0}, {v0, 0, 0}, r, tol);
-      CHECK(post[0] == v);
+      CHECK(post[0] == v[0]);
       CHECK(Wall::reverse(box, {x, 0, 0}, post, r, tol)[0] == v0);
     }
     CHECK(WallAxis::touches(x, L, r, tol) == (where != 2));
@@ -77,10 +79,16 @@ TEST_CASE("a mixed box: each axis answers by its own kind") {
   CHECK(b.image(0, 7.0, code) == 7.0 && code == 0u);
   CHECK(b.image(1, 7.0, code) == -1.0 && code == 1u);
   CHECK(b.shift(1, 1u) == 8.0 && b.shift(1, 2u) == -8.0 && b.shift(1, 0u) == 0.0);
-  double v = -2.0;
-  CHECK(b.reflect(0, 0.5, v) && v == 2.0);
-  v = -2.0;
-  CHECK(!b.reflect(1, 0.5, v) && v == -2.0);  // periodic: no wall at 0.5
+  CHECK(b.meets(0, 0.5, -2.0) && !b.meets(0, 0.5, 2.0));  // receding: not met
+  CHECK(!b.meets(1, 0.5, -2.0));                           // periodic: no wall at 0.5
+  // a corner (x low, z high): every met wall flips its own component, the periodic axis none
+  std::array<double, 3> v = {-2.0, -1.0, 3.0};
+  CHECK(b.reflect({0.5, 0.5, 5.5}, v) == 5u);
+  CHECK(v == std::array<double, 3>({2.0, -1.0, -3.0}));
+  CHECK(b.reflect({0.5, 0.5, 5.5}, v) == 0u);  // now receding from both: nothing met
+  v = {-2.0, -1.0, 3.0};
+  CHECK(b.reflect_at(0, v) == 1u);  // a wall event: its own axis; z waits for its own
+  CHECK(v == std::array<double, 3>({2.0, -1.0, 3.0}));
   CHECK(b.touches(2, 5.5) && !b.touches(1, 7.5));
   double x = 7.9;
   CHECK(b.wrap(1, x, 8.1) && std::fabs(x + 0.1) < 1e-12);
@@ -88,6 +96,18 @@ TEST_CASE("a mixed box: each axis answers by its own kind") {
   CHECK(!b.wrap(0, x, 10.1) && x == 9.9);  // walls never wrap
   CHECK(b.wall_at(2, 1) == 5.5);
   CHECK(b.touches_ahead(2, 5.5, 1) && !b.touches_ahead(2, 5.5, 0));
+}
+
+TEST_CASE("reflection masks: each is its own inverse, counted per wall") {
+  const std::array<double, 3> v0 = {1.5, -2.0, 0.25};
+  for (Reflection m : {0u, 1u, 2u, 5u, 7u, kReversed}) {
+    std::array<double, 3> v = v0;
+    apply<3>(m, v);
+    for (int k = 0; k < 3; ++k) CHECK(v[k] == ((m & kReversed) || (m >> k & 1u) ? -v0[k] : v0[k]));
+    apply<3>(m, v);
+    CHECK(v == v0);
+  }
+  CHECK(reflections(0u) == 0 && reflections(5u) == 2 && reflections(kReversed) == 1);
 }
 
 CHECK_MAIN()
