@@ -314,10 +314,12 @@ class EngineImpl final : public Simulation {
       const int up = vk > 0.0 ? 1 : 0;
       bool wall_ok = true;
       if (rev_ && box_.touches_ahead(k, p_[i].x[k] + vk * (clock_ - ti), up)) {
-        // touching and approaching in a reversed run: a reflection of a collision's W2 at
-        // this instant is undone now; any other touched wall waits for the collision
+        // touching and approaching in a reversed run at the instant of a logged collision
+        // of i: a reflection of its W2 is undone now; any other touched wall waits for the
+        // collision. With no such collision (m < 0) the wall is met on its own, as forward
+        // (the second wall of an exact corner)
         const long m = wall_entry(i);
-        wall_ok = m >= 0 && w2_covers(m, wall_mask(i, k));
+        wall_ok = m < 0 || w2_covers(m, wall_mask(i, k));
       }
       if (wall_ok) {
         double t = Kin::plane_time(p_[i], k, box_.wall_at(k, up));
