@@ -17,7 +17,10 @@
 //   reflect(k, v)       what the axis's wall does to the velocity v (all its components) of
 //                       a particle that meets it; returns the Reflection applied.
 // WallAxis: reflecting walls at 0 and L (the paper §2.2): v_k -> -v_k. PeriodicAxis: the
-// axis wraps, no walls.
+// axis wraps, no walls. BounceAxis: bounce-back (no-slip) walls at 0 and L, Maxwell's
+// rough wall of kinetic theory and lattice Boltzmann: v -> -v, the whole velocity. It keeps
+// the energy, draws nothing, and takes away the tangential momentum (a channel with
+// periodic x and bounce y walls relaxes its x momentum towards 0; specular y walls keep it).
 //
 // A Reflection is what a wall did to a velocity, as a mask: bit k, component k flipped; or
 // kReversed, every component negated (v -> -v). The engine's wall-mask log keeps these
@@ -104,6 +107,20 @@ struct WallAxis {
   }
 };
 
+/// Bounce-back walls at 0 and L on one axis: the walls of WallAxis (position, contact),
+/// but a particle that meets one reverses its whole velocity. Under time reversal T(v) = -v
+/// it is its own inverse: T(-v) = v meets the same wall again, and -T(-v) = -v = T(v). At a
+/// corner it takes precedence (whole): the particle reverses once, whatever else it meets.
+struct BounceAxis : WallAxis {
+  static constexpr bool whole = true;  ///< reflects the whole velocity
+  /// The reflection of a bounce-back wall: v -> -v (kReversed).
+  template <int Dim>
+  static Reflection reflect(int /*k*/, std::array<double, Dim>& v) {
+    for (int j = 0; j < Dim; ++j) v[j] = -v[j];
+    return kReversed;
+  }
+};
+
 /// A periodic axis of length L.
 struct PeriodicAxis {
   static constexpr bool periodic = true;  ///< pairs see images across the axis
@@ -162,6 +179,7 @@ class Boundaries {
   decltype(auto) visit(int k, F&& f) const {
     switch (kind_[k]) {
       case Boundary::wall: return f(WallAxis{});
+      case Boundary::bounce: return f(BounceAxis{});
       case Boundary::periodic: break;
     }
     return f(PeriodicAxis{});
