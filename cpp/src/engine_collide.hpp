@@ -144,13 +144,16 @@ void EngineImpl<Dim, Op>::set_velocity(int i, const Vec& v, Reflection mask) {
   for (int k = 0; k < Dim; ++k) p_[i].v[k] = v[k];
   counters_.wall_events += static_cast<std::uint64_t>(reflections(mask));
 }
-// The mask a standalone wall event of i on axis k applies: Boundaries::reflect_at,
-// computed on a copy of the velocity.
+// The mask a standalone wall event of i on axis k applies at time t (i's position then):
+// Boundaries::reflect_at, computed on a copy of the velocity.
 template <int Dim, PairOperator Op>
-Reflection EngineImpl<Dim, Op>::wall_mask(int i, int k) const {
-  Vec v;
-  for (int j = 0; j < Dim; ++j) v[j] = p_[i].v[j];
-  return box_.reflect_at(k, v);
+Reflection EngineImpl<Dim, Op>::wall_mask(int i, int k, double t) const {
+  Vec x, v;
+  for (int j = 0; j < Dim; ++j) {
+    x[j] = pos_at(i, j, t);
+    v[j] = p_[i].v[j];
+  }
+  return box_.reflect_at(k, x, v);
 }
 // Whether the W2 mask of wall-log member slot m holds every reflection of `mask`.
 template <int Dim, PairOperator Op>

@@ -319,7 +319,7 @@ class EngineImpl final : public Simulation {
         // collision. With no such collision (m < 0) the wall is met on its own, as forward
         // (the second wall of an exact corner)
         const long m = wall_entry(i);
-        wall_ok = m < 0 || w2_covers(m, wall_mask(i, k));
+        wall_ok = m < 0 || w2_covers(m, wall_mask(i, k, clock_));
       }
       if (wall_ok) {
         double t = Kin::plane_time(p_[i], k, box_.wall_at(k, up));
@@ -423,7 +423,7 @@ class EngineImpl final : public Simulation {
   // A wall event on axis k: axis k's own reflection (Boundaries::reflect_at).
   void wall_event(int i, const Ev& e) {
     advance(i, e.t);
-    const Reflection mask = wall_mask(i, e.partner / 2);
+    const Reflection mask = wall_mask(i, e.partner / 2, e.t);
     if (rev_) {
       // arriving at a wall at the instant of a logged collision: only W2's reflections are
       // undone here; a wall that collision left untouched waits for it
@@ -486,7 +486,7 @@ class EngineImpl final : public Simulation {
   Reflection touch_walls(int i);
   void flip_mask(int i, Reflection mask);
   void set_velocity(int i, const Vec& v, Reflection mask);
-  Reflection wall_mask(int i, int k) const;
+  Reflection wall_mask(int i, int k, double t) const;
   bool w2_covers(long m, Reflection mask) const;
   bool touches_wall(int i) const;
   long wall_entry(int i) const { return wlog_.entry(i, netc_[i], rev_ ? -clock_ : clock_); }

@@ -88,7 +88,7 @@ TEST_CASE("a mixed box: each axis answers by its own kind") {
   CHECK(v == std::array<double, 3>({2.0, -1.0, -3.0}));
   CHECK(b.reflect({0.5, 0.5, 5.5}, v) == 0u);  // now receding from both: nothing met
   v = {-2.0, -1.0, 3.0};
-  CHECK(b.reflect_at(0, v) == 1u);  // a wall event: its own axis; z waits for its own
+  CHECK(b.reflect_at(0, {0.5, 0.5, 5.5}, v) == 1u);  // a wall event: its own axis; z waits for its own
   CHECK(v == std::array<double, 3>({2.0, -1.0, 3.0}));
   CHECK(b.touches(2, 5.5) && !b.touches(1, 7.5));
   double x = 7.9;
@@ -176,9 +176,15 @@ TEST_CASE("corners: a bounce wall among the walls met reverses v once; otherwise
   CHECK(b.reflect({0.5, 0.5, 3.0}, v) == 0u);
   // a standalone wall event: its own wall's reflection, whatever else it touches
   v = v0;
-  CHECK(b.reflect_at(0, v) == 1u && v == std::array<double, 3>({2.0, -1.0, 3.0}));
+  CHECK(b.reflect_at(0, corner, v) == 1u && v == std::array<double, 3>({2.0, -1.0, 3.0}));
   v = v0;
-  CHECK(b.reflect_at(2, v) == kReversed && v == std::array<double, 3>({2.0, 1.0, -3.0}));
+  CHECK(b.reflect_at(2, corner, v) == kReversed && v == std::array<double, 3>({2.0, 1.0, -3.0}));
+  // at a corner exactly, receding from the bounce wall at y: -v would approach it at this
+  // very instant, so its component flips too (else y and z hand the particle back and forth)
+  v = {-2.0, 1.0, 3.0};
+  CHECK(b.reflect_at(2, corner, v) == 5u && v == std::array<double, 3>({2.0, 1.0, -3.0}));
+  v = {-2.0, 1.0, 3.0};  // a hair inside y's contact: y's own event comes later, nothing more
+  CHECK(b.reflect_at(2, {0.5, 0.5 + 1e-12, 5.5}, v) == kReversed && v == std::array<double, 3>({2.0, -1.0, -3.0}));
   // the corner rule is reversible through its mask: applying it again restores v
   for (const auto& x : {corner, std::array<double, 3>{0.5, 0.5, 3.0}})
     for (const auto& w0 : {v0, std::array<double, 3>{1.0, -1.0, -3.0}, std::array<double, 3>{-2.0, 1.0, -3.0}}) {

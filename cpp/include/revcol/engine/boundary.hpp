@@ -33,7 +33,10 @@
 // (R_k turned v's approach into a retreat; T turns it back) and R_k(T(R_k(v))) = T(v), so
 // the reversed run's event at the same wall restores the state, one event at a time. At an
 // exact corner the events of one instant (lowest axis first) compose to the corner rule
-// below. The walls a particle meets at a collision's instant (W1, W2: Boundaries::reflect)
+// below. One guard (reflect_at): after v -> -v a wall the particle is at or past and now
+// approaches flips its component at once, or two bounce walls of an exact corner would hand
+// a particle back and forth at one instant forever (a state only a collision in the corner
+// makes; it is not reversed exactly: docs/engine.md, "Not done"). The walls a particle meets at a collision's instant (W1, W2: Boundaries::reflect)
 // are the corner rule itself: the walls it meets (touches within tol, or is past, and
 // approaches) are found first; if one of them acts on the whole velocity, the first such
 // (lowest axis) applies alone, once; otherwise every met wall applies (each flips its own
@@ -258,11 +261,27 @@ class Boundaries {
       }
     return again == 0 ? kReversed : ((1u << Dim) - 1u) & ~again;
   }
-  /// A standalone wall event on axis k: axis k's own reflection (see above). Changes v;
-  /// returns the mask applied.
-  Reflection reflect_at(int k, Vec& v) const { return axis_reflect(k, v); }
+  /// A standalone wall event on axis k of a particle at x: axis k's own reflection (see
+  /// above). After a whole-velocity reflection, a wall the particle is at or past (tol 0)
+  /// and now approaches flips its own component too: its event would come at this very
+  /// instant, and at an exact corner two bounce walls would hand the particle back and forth
+  /// forever. Changes v; returns the mask applied.
+  Reflection reflect_at(int k, const Vec& x, Vec& v) const {
+    const Reflection applied = axis_reflect(k, v);
+    if (!(applied & kReversed)) return applied;
+    unsigned again = 0;
+    for (int j = 0; j < Dim; ++j)
+      if (j != k && v[j] != 0.0 && walls(j) && touches_ahead_within(j, x[j], v[j] > 0.0 ? 1 : 0, 0.0)) {
+        v[j] = -v[j];
+        again |= 1u << j;
+      }
+    return again == 0 ? kReversed : ((1u << Dim) - 1u) & ~again;
+  }
 
  private:
+  bool touches_ahead_within(int k, double x, int up, double tol) const {
+    return visit(k, [&](auto a) { return decltype(a)::touches_ahead(x, up, L_[k], radius_, tol); });
+  }
   Reflection axis_reflect(int k, Vec& v) const {
     return visit(k, [&](auto a) { return decltype(a)::template reflect<Dim>(k, v); });
   }
