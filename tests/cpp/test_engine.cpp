@@ -352,21 +352,30 @@ TEST_CASE("Newton's cradle in 2D (a row of 3 at rest, hit along the row): one gr
   CHECK(e.v < 1e-9);
 }
 
+namespace {
+
+// Particle 0 at rest in the lower corner of a box of 10 with walls of kind b, particle 1
+// arriving along the diagonal (contact at t = 2).
+Built corner_hit(int d, std::uint32_t seed, Boundary b) {
+  Config c = config(d, b);
+  c.seed = seed;
+  c.box = {10, 10, 10};
+  std::vector<double> x(2 * d), v(2 * d, 0.0);
+  const double s = 1.0 / std::sqrt(static_cast<double>(d));
+  for (int k = 0; k < d; ++k) {
+    x[k] = 0.5;
+    x[d + k] = 0.5 + 3.0 * s;
+    v[d + k] = -s;
+  }
+  return build(c, x, v);
+}
+
+}  // namespace
+
 TEST_CASE("a particle hit while touching a corner: walls and collision reversed in order") {
   for (int d : {2, 3})
   for (std::uint32_t seed = 1; seed <= 12; ++seed) {  // the draws decide how often it chatters
-    Config c = config(d, Boundary::wall);
-    c.seed = seed;
-    c.box = {10, 10, 10};
-    // particle 0 at rest in the lower corner, particle 1 arriving along the diagonal
-    std::vector<double> x(2 * d), v(2 * d, 0.0);
-    const double s = 1.0 / std::sqrt(static_cast<double>(d));
-    for (int k = 0; k < d; ++k) {
-      x[k] = 0.5;
-      x[d + k] = 0.5 + 3.0 * s;
-      v[d + k] = -s;
-    }
-    Built b = build(c, x, v);
+    Built b = corner_hit(d, seed, Boundary::wall);
     Counters f;
     const Err e = there_and_back(b, 6.0, f);
     CHECK(f.pair_collisions >= 1);
@@ -769,17 +778,7 @@ TEST_CASE("bounce walls: a particle hit while resting in a corner; 2D reversed, 
   // walls handed the particle back and forth at one instant forever
   for (int d : {2, 3})
     for (std::uint32_t seed = 1; seed <= 12; ++seed) {
-      Config c = config(d, Boundary::bounce);
-      c.seed = seed;
-      c.box = {10, 10, 10};
-      std::vector<double> x(2 * d), v(2 * d, 0.0);
-      const double s = 1.0 / std::sqrt(static_cast<double>(d));
-      for (int k = 0; k < d; ++k) {
-        x[k] = 0.5;
-        x[d + k] = 0.5 + 3.0 * s;
-        v[d + k] = -s;
-      }
-      Built b = build(c, x, v);
+      Built b = corner_hit(d, seed, Boundary::bounce);
       b.s->run(kAll, 6.0);
       CHECK(b.s->diagnostics().counters.pair_collisions >= 1u);
       CHECK(std::fabs(b.s->diagnostics().energy - 0.5) < 1e-12);
