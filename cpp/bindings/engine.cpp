@@ -151,7 +151,8 @@ class PyEngine {
     d["dim"] = c.dim;
     d["box"] = vec_array(std::vector<double>(c.box.begin(), c.box.begin() + c.dim));
     std::vector<std::int64_t> bnd;
-    // the Boundary value per axis (0 wall, 1 periodic: the same as a periodic flag)
+    // the Boundary value per axis (0 wall, 1 periodic: the same as a periodic flag; other
+    // kinds by their values, engine.hpp)
     for (int k = 0; k < c.dim; ++k) bnd.push_back(static_cast<std::int64_t>(c.boundary[k]));
     d["periodic"] = vec_array(bnd);
     d["diameter"] = c.diameter;
@@ -191,8 +192,7 @@ class PyEngine {
             "checkpoint: box and periodic need one entry per axis");
     for (int k = 0; k < c.dim; ++k) {
       c.box[k] = box[k];
-      require(per[k] == 0 || per[k] == 1, "checkpoint: periodic holds 0 (wall) or 1 (periodic) per axis");
-      c.boundary[k] = static_cast<en::Boundary>(per[k]);
+      c.boundary[k] = en::boundary_from_value(per[k]);  // every kind of en::kBoundaries, by value
     }
     c.diameter = py::cast<double>(get("diameter"));
     c.mode = en::parse_engine_mode(py::cast<std::string>(get("mode")));

@@ -17,10 +17,25 @@
 
 namespace revcol::engine {
 
+namespace {
+// "'wall', 'periodic'": the names of kBoundaries, for messages.
+std::string boundary_names() {
+  std::string names;
+  for (Boundary b : kBoundaries) names += std::string(names.empty() ? "'" : ", '") + to_string(b) + "'";
+  return names;
+}
+}  // namespace
+
 Boundary parse_boundary(const std::string& s) {
-  if (s == "wall") return Boundary::wall;
-  if (s == "periodic") return Boundary::periodic;
-  throw InvalidArgument("boundary must be 'wall' or 'periodic', got '" + s + "'");
+  for (Boundary b : kBoundaries)
+    if (s == to_string(b)) return b;
+  throw InvalidArgument("boundary must be one of " + boundary_names() + ", got '" + s + "'");
+}
+
+Boundary boundary_from_value(std::int64_t v) {
+  for (Boundary b : kBoundaries)
+    if (v == static_cast<std::int64_t>(b)) return b;
+  throw InvalidArgument("boundary value " + std::to_string(v) + " names no kind (" + boundary_names() + ": 0, 1, ...)");
 }
 
 Generator parse_generator(const std::string& s) {
@@ -63,7 +78,7 @@ void validate_config(const Config& c) {
   for (int k = 0; k < c.dim; ++k) {
     const double L = c.box[k];
     require(std::isfinite(L) && L > 0.0, [&] { return "box length on axis " + std::to_string(k) + " must be finite and > 0"; });
-    if (c.boundary[k] == Boundary::wall) {
+    if (has_walls(c.boundary[k])) {
       require(limits::wall_axis_fits(L, c.diameter), [&] {
         return "diameter " + std::to_string(c.diameter) + " is too large for the box: axis " + std::to_string(k) +
                " has length " + std::to_string(L) + " (walls need L > D)";
@@ -94,7 +109,7 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
       const double xk = x[i * d + k], vk = v[i * d + k];
       require(std::isfinite(xk), [&] { return "position of particle " + std::to_string(i) + " is not finite"; });
       require(std::isfinite(vk), [&] { return "velocity of particle " + std::to_string(i) + " is not finite"; });
-      if (c.boundary[k] == Boundary::wall)
+      if (has_walls(c.boundary[k]))
         require(xk >= r && xk <= c.box[k] - r, [&] {
           return "particle " + std::to_string(i) + " is outside the box on axis " + std::to_string(k) + ": x = " +
                  std::to_string(xk) + ", allowed [" + std::to_string(r) + ", " + std::to_string(c.box[k] - r) +
@@ -143,7 +158,7 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
         int ck = cc[i][k] + rem % 3 - 1;
         rem /= 3;
         if (ck < 0 || ck >= nc[k]) {
-          if (c.boundary[k] == Boundary::wall || nc[k] < 3) { ok = false; break; }
+          if (has_walls(c.boundary[k]) || nc[k] < 3) { ok = false; break; }
           if (ck < 0) { ck += nc[k]; sh[k] = -c.box[k]; } else { ck -= nc[k]; sh[k] = c.box[k]; }
         }
         q[k] = ck;

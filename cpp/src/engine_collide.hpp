@@ -115,25 +115,51 @@ double EngineImpl<Dim, Op>::draw(int stream, bool reversed) {
 
 // ---- walls at a collision's instant (the wall-mask log) -----------------------------------
 
-// Reflects i on every wall it touches and approaches (Boundaries::reflect, the wall
-// operator's per-axis form); returns the mask of flipped axes.
+// Reflects i on the walls it meets (touches and approaches) at this instant, by the corner
+// rule of Boundaries::reflect (each wall's own reflection, revcol/engine/boundary.hpp);
+// returns the mask applied, which the wall-mask log keeps.
 template <int Dim, PairOperator Op>
-unsigned EngineImpl<Dim, Op>::touch_walls(int i) {
-  unsigned mask = 0;
-  for (int k = 0; k < Dim; ++k)
-    if (box_.reflect(k, p_[i].x[k], p_[i].v[k])) {
-      mask |= 1u << k;
-      ++counters_.wall_events;
-    }
+Reflection EngineImpl<Dim, Op>::touch_walls(int i) {
+  Vec x, v;
+  for (int k = 0; k < Dim; ++k) {
+    x[k] = p_[i].x[k];
+    v[k] = p_[i].v[k];
+  }
+  const Reflection mask = box_.reflect(x, v);
+  if (mask != 0) set_velocity(i, v, mask);
   return mask;
 }
+// Re-applies a logged mask to i (each reflection is its own inverse).
 template <int Dim, PairOperator Op>
-void EngineImpl<Dim, Op>::flip_mask(int i, unsigned mask) {
-  for (int k = 0; k < Dim; ++k)
-    if (mask >> k & 1u) {
-      p_[i].v[k] = -p_[i].v[k];
-      ++counters_.wall_events;
-    }
+void EngineImpl<Dim, Op>::flip_mask(int i, Reflection mask) {
+  if (mask == 0) return;
+  Vec v;
+  for (int k = 0; k < Dim; ++k) v[k] = p_[i].v[k];
+  apply<Dim>(mask, v);
+  set_velocity(i, v, mask);
+}
+// Sets i's velocity to v, the result of the reflection `mask`, and counts it (reflections()).
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::set_velocity(int i, const Vec& v, Reflection mask) {
+  for (int k = 0; k < Dim; ++k) p_[i].v[k] = v[k];
+  counters_.wall_events += static_cast<std::uint64_t>(reflections(mask));
+}
+// The mask a standalone wall event of i on axis k applies at time t (i's position then):
+// Boundaries::reflect_at, computed on a copy of the velocity.
+template <int Dim, PairOperator Op>
+Reflection EngineImpl<Dim, Op>::wall_mask(int i, int k, double t) const {
+  Vec x, v;
+  for (int j = 0; j < Dim; ++j) {
+    x[j] = pos_at(i, j, t);
+    v[j] = p_[i].v[j];
+  }
+  return box_.reflect_at(k, x, v);
+}
+// Whether the W2 mask of wall-log member slot m holds every reflection of `mask`.
+template <int Dim, PairOperator Op>
+bool EngineImpl<Dim, Op>::w2_covers(long m, Reflection mask) const {
+  const std::uint64_t bits = std::uint64_t{mask} << 8;
+  return (wlog_.mask(m) & bits) == bits;
 }
 template <int Dim, PairOperator Op>
 bool EngineImpl<Dim, Op>::touches_wall(int i) const {
@@ -166,7 +192,7 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
   advance(a, t);
   advance(b, t);
   const std::int64_t wkey = reversed ? netc_[a] - 1 : netc_[a];
-  unsigned w1[2] = {0, 0}, w2[2] = {0, 0};
+  Reflection w1[2] = {0, 0}, w2[2] = {0, 0};
   if (reversed) {
     wlog_.pop(a, wkey, 2, w1, w2);
     flip_mask(a, w2[0]);
@@ -282,7 +308,7 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
   const int n = g.n;
   const int first = g.id[order[0]];
   const std::int64_t wkey = reversed ? netc_[first] - 1 : netc_[first];
-  unsigned w1[kMaxGroup], w2[kMaxGroup];
+  Reflection w1[kMaxGroup], w2[kMaxGroup];
   for (int u = 0; u < n; ++u) advance(g.id[order[u]], t);
   if (reversed) {
     wlog_.pop(first, wkey, n, w1, w2);
@@ -295,8 +321,8 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
   if (!group_operator(g, order, t, reversed)) {
     // refused before any draw was consumed (validation comes first): undo the walls
     for (int u = 0; u < n; ++u) flip_mask(ids[u], reversed ? w2[u] : w1[u]);
-    if (reversed && (std::any_of(w1, w1 + n, [](unsigned q) { return q != 0; }) ||
-                     std::any_of(w2, w2 + n, [](unsigned q) { return q != 0; })))
+    if (reversed && (std::any_of(w1, w1 + n, [](Reflection q) { return q != 0; }) ||
+                     std::any_of(w2, w2 + n, [](Reflection q) { return q != 0; })))
       wlog_.push(first, wkey, t, n, ids, netc_.data(), w1, w2);  // put the masks back
     return false;
   }

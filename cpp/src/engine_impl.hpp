@@ -314,10 +314,12 @@ class EngineImpl final : public Simulation {
       const int up = vk > 0.0 ? 1 : 0;
       bool wall_ok = true;
       if (rev_ && box_.touches_ahead(k, p_[i].x[k] + vk * (clock_ - ti), up)) {
-        // touching and approaching in a reversed run: a flip of a collision's W2 at this
-        // instant is undone now; any other touched wall waits for the collision
+        // touching and approaching in a reversed run at the instant of a logged collision
+        // of i: a reflection of its W2 is undone now; any other touched wall waits for the
+        // collision. With no such collision (m < 0) the wall is met on its own, as forward
+        // (the second wall of an exact corner)
         const long m = wall_entry(i);
-        wall_ok = m >= 0 && (wlog_.mask(m) >> (8 + k) & 1u);
+        wall_ok = m < 0 || w2_covers(m, wall_mask(i, k, clock_));
       }
       if (wall_ok) {
         double t = Kin::plane_time(p_[i], k, box_.wall_at(k, up));
@@ -418,24 +420,23 @@ class EngineImpl final : public Simulation {
     rebuild_events();
   }
 
+  // A wall event on axis k: axis k's own reflection (Boundaries::reflect_at).
   void wall_event(int i, const Ev& e) {
     advance(i, e.t);
+    const Reflection mask = wall_mask(i, e.partner / 2, e.t);
     if (rev_) {
-      // arriving at a wall at the instant of a logged collision: only W2's flips are
+      // arriving at a wall at the instant of a logged collision: only W2's reflections are
       // undone here; a wall that collision left untouched waits for it
       const long m = wall_entry(i);
       if (m >= 0) {
-        const std::uint64_t bit = 1ull << (8 + e.partner / 2);
-        if (!(wlog_.mask(m) & bit)) {
+        if (!w2_covers(m, mask)) {
           repredict(i);
           return;
         }
-        wlog_.clear(m, bit);
+        wlog_.clear(m, std::uint64_t{mask} << 8);
       }
     }
-    const int k = e.partner / 2;
-    p_[i].v[k] = -p_[i].v[k];
-    ++counters_.wall_events;
+    flip_mask(i, mask);
     repredict(i);
   }
 
@@ -482,8 +483,11 @@ class EngineImpl final : public Simulation {
   PairV<Dim> apply_pair(const PairV<Dim>& in, const Vec& r, int stream, bool reversed);
   bool group_collide(Group& g, double t, bool reversed);
   bool group_operator(Group& g, const int* order, double t, bool reversed);
-  unsigned touch_walls(int i);
-  void flip_mask(int i, unsigned mask);
+  Reflection touch_walls(int i);
+  void flip_mask(int i, Reflection mask);
+  void set_velocity(int i, const Vec& v, Reflection mask);
+  Reflection wall_mask(int i, int k, double t) const;
+  bool w2_covers(long m, Reflection mask) const;
   bool touches_wall(int i) const;
   long wall_entry(int i) const { return wlog_.entry(i, netc_[i], rev_ ? -clock_ : clock_); }
   void finish_collision(int i, bool reversed) {

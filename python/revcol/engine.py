@@ -2,7 +2,10 @@
 per-collision memory.
 
 Particles of one diameter D and unit mass move freely between elastic collisions in a box
-[0, L_k] per axis (reflecting walls or periodic); each collision's outcome is drawn over all
+[0, L_k] per axis (``boundary``, one name or one per axis: ``"periodic"``; ``"wall"``,
+specular walls, v_n -> -v_n; or ``"bounce"``, bounce-back no-slip walls, v -> -v, which keep
+the energy and reverse like ``"wall"`` but not the tangential momentum, e.g. a channel
+``["periodic", "bounce"]``); each collision's outcome is drawn over all
 permitted post-collision states by a reversible operator (exact mode, ``flux`` law by
 default; ``uniform``; ``mode="paper"``, the paper's Procedures 1-2, in 2D; or
 ``mode="specular"``, the deterministic elastic reflection: no random number, a baseline for
@@ -181,7 +184,7 @@ class Simulation:
 
     @property
     def periodic(self) -> tuple:
-        """Per axis, whether it is periodic (else reflecting walls at 0 and L_k)."""
+        """Per axis, whether it is periodic (else walls at 0 and L_k: ``"wall"`` or ``"bounce"``)."""
         return tuple(bool(p) for p in self._e.periodic)
 
     def diagnostics(self) -> dict:

@@ -228,3 +228,30 @@ def test_specular_mode_draws_nothing_and_round_trips(dim):
     assert ex < 1e-9 and ev < 1e-9
     with pytest.raises(ValueError, match="mode"):
         Simulation.random(n=10, dim=2, phi=0.1, mode="specularr")
+
+
+def test_bounce_boundary_end_to_end():
+    # (5, 5) moving (1, 0.5) meets x = 9.5 at t = 4.5: a bounce wall sends it back along
+    # its line (exactly -v), a specular wall keeps the tangent
+    b = Simulation([[5.0, 5.0]], [[1.0, 0.5]], [10.0, 10.0], boundary="bounce")
+    w = Simulation([[5.0, 5.0]], [[1.0, 0.5]], [10.0, 10.0], boundary="wall")
+    b.run(time=8.0)
+    w.run(time=8.0)
+    assert np.array_equal(b.velocities, [[-1.0, -0.5]])
+    assert np.array_equal(b.positions, [[6.0, 5.5]])
+    assert np.array_equal(w.velocities, [[-1.0, 0.5]])
+    assert b.periodic == (False, False)
+    # a channel, one name per axis; the kind survives a snapshot (value 2) and run_back
+    c = Simulation([[2.0, 2.0], [6.0, 3.0]], [[1.0, -1.5], [-0.5, 1.0]], [9.0, 6.0],
+                   boundary=["periodic", "bounce"])
+    snap = c.snapshot()
+    assert list(snap["periodic"]) == [1, 2]
+    c.run(time=20.0)
+    d = Simulation.from_snapshot(c.snapshot())
+    c.run(time=30.0)
+    d.run(time=30.0)
+    assert np.array_equal(c.velocities, d.velocities)
+    c.run_back(time=0.0)
+    assert np.max(np.abs(c.velocities - np.array([[1.0, -1.5], [-0.5, 1.0]]))) < 1e-9
+    with pytest.raises(ValueError, match="boundary"):
+        Simulation([[5.0, 5.0]], [[1.0, 0.5]], [10.0, 10.0], boundary="noslip")

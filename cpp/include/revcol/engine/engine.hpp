@@ -25,7 +25,7 @@
 //
 // Reverse. Negate every velocity and every time (local times and the clock), run the same
 // event search, and at each collision apply v -> -reverse(-v) with the generator stepping
-// back; wall events are their own inverse (a reflection of the approached component), and
+// back; wall events are their own inverse (a reflection, engine/boundary.hpp), and
 // so are list renewals (no physical change: a reversed run renews where its own trajectory
 // leaves its spheres). Negating again at the end returns the state to the forward
 // orientation. Negation is exact, so free flight is bit-identical both ways; what is not is
@@ -66,12 +66,12 @@
 //
 // Walls at a collision. A particle of a collision that touches a wall (within group_tol D)
 // and approaches it reflects before the operator (W1), and again after it if the operator
-// sends it into a touched wall (W2). Which components W1 and W2 flipped cannot be read off
-// the post state (the wall operator's two-to-one case), so the forward run keeps them, in a
+// sends it into a touched wall (W2). What W1 and W2 did (their Reflection masks) cannot be
+// read off the post state (the wall operator's two-to-one case), so the forward run keeps them, in a
 // small log keyed by (smallest id, its net collision count), for collisions at a wall only;
 // the reversed collision undoes W2, reverses the operator, undoes W1, and a reversed run
 // schedules no standalone wall event for a particle already touching a wall unless that
-// log says W2 flipped it at this instant.
+// log says W2 applied that wall's reflection at this instant.
 //
 // The exact-pre log. At singular points of a chart (a 3D pair almost head-on, groups with
 // resting contacts such as Newton's cradle) a pre state's K-bit cell spans up to
@@ -99,14 +99,28 @@
 
 namespace revcol::engine {
 
-/// Boundary condition of one axis: reflecting walls at 0 and L, or periodic (the axis
-/// types are in engine/boundary.hpp). The values are the checkpoint's per-axis entries.
-enum class Boundary { wall = 0, periodic = 1 };
+/// Boundary condition of one axis: reflecting (specular) walls at 0 and L, periodic, or
+/// bounce-back (no-slip) walls at 0 and L, which reverse the whole velocity (the axis types
+/// are in engine/boundary.hpp). The values are the checkpoint's per-axis entries.
+enum class Boundary { wall = 0, periodic = 1, bounce = 2 };
 
-/// "wall" / "periodic".
-inline const char* to_string(Boundary b) { return b == Boundary::wall ? "wall" : "periodic"; }
-/// Parses "wall" / "periodic"; throws InvalidArgument otherwise.
+/// Every boundary kind, in the order of their values (parsing and checkpoints read it).
+inline constexpr std::array<Boundary, 3> kBoundaries{Boundary::wall, Boundary::periodic, Boundary::bounce};
+/// "wall" / "periodic" / "bounce".
+inline const char* to_string(Boundary b) {
+  switch (b) {
+    case Boundary::wall: return "wall";
+    case Boundary::periodic: return "periodic";
+    case Boundary::bounce: return "bounce";
+  }
+  return "?";
+}
+/// Whether an axis of kind b has walls at 0 and L (every kind but periodic).
+inline bool has_walls(Boundary b) { return b != Boundary::periodic; }
+/// Parses a name of kBoundaries ("wall", "periodic", "bounce"); throws InvalidArgument otherwise.
 Boundary parse_boundary(const std::string& s);
+/// The kind whose value (a checkpoint's per-axis entry) is v; throws InvalidArgument otherwise.
+Boundary boundary_from_value(std::int64_t v);
 
 /// The reversible generator behind the collisions' random numbers.
 enum class Generator { philox, clcg4 };

@@ -4,14 +4,15 @@
 //
 // WallLog (walls at a collision's instant). A particle of a collision that touches a wall
 // (within group_tol D) and approaches it reflects before the collision operator (W1), and
-// again after it if the operator sends it into a touched wall (W2). Which components W1
-// and W2 flipped cannot be read off the post state (the wall operator's two-to-one case),
-// so the forward run keeps the flip masks of a collision at a wall, keyed by (smallest id,
+// again after it if the operator sends it into a touched wall (W2). What W1 and W2 did
+// (a Reflection: the components flipped, or v -> -v; revcol/engine/boundary.hpp) cannot be
+// read off the post state (the wall operator's two-to-one case), so the forward run keeps
+// the masks of a collision at a wall, keyed by (smallest id,
 // that particle's net collision count before the collision), with its members, their net
 // counts and its time. The reversed collision pops them: undoes W2, reverses the operator,
 // undoes W1. A reversed run schedules no standalone wall event for a particle touching a
-// wall unless the entry of its next reversed collision says W2 flipped it at this instant
-// (`entry`).
+// wall unless the entry of its next reversed collision says W2 applied that wall's
+// reflection at this instant (`entry`).
 //
 // ExactPreLog. At singular points of a chart (a 3D pair almost head-on, groups with resting
 // contacts) a pre state's K-bit cell spans up to ~2^(-K/2); when its centre is off by more
@@ -27,7 +28,8 @@
 
 namespace revcol::engine {
 
-/// The wall-mask log (see above). Masks: bit k = axis k flipped; W1 | W2 << 8 per member.
+/// The wall-mask log (see above). Masks: W1 | W2 << 8 per member, each a Reflection of
+/// revcol/engine/boundary.hpp (bit k: component k flipped; 1 << 7: v -> -v).
 class WallLog {
  public:
   /// Forward: keeps the masks of a collision at a wall: its smallest id, that id's net
