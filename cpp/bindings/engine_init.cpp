@@ -48,7 +48,9 @@ py::dict engine_limits() {
   d["max_group_tol"] = lim::kMaxGroupTol;
   d["wall_margin"] = lim::kWallMargin;
   d["paper_mode_dimensions"] = py::tuple(paper);
-  d["boundaries"] = py::make_tuple(en::to_string(en::Boundary::wall), en::to_string(en::Boundary::periodic));
+  py::list boundaries;
+  for (const en::Boundary b : en::kBoundaries) boundaries.append(en::to_string(b));
+  d["boundaries"] = py::tuple(boundaries);
   d["generators"] = py::make_tuple(en::to_string(en::Generator::philox), en::to_string(en::Generator::clcg4));
   d["streams"] = py::make_tuple(std::string(rng::to_string(rng::StreamPolicy::per_particle)),
                                 std::string(rng::to_string(rng::StreamPolicy::single)));

@@ -39,7 +39,7 @@ struct Geometry {
   Geometry(const Config& c) : d(c.dim), D(c.diameter) {
     for (int k = 0; k < d; ++k) {
       L[k] = c.box[k];
-      wall[k] = c.boundary[k] == Boundary::wall;
+      wall[k] = has_walls(c.boundary[k]);  // reflecting or bounce-back walls
       // a margin of 1e-6 D from the walls: a particle touching a wall at the start would be
       // at an event at t0, which a reversed run cannot tell from a departure (engine.hpp)
       lo[k] = wall[k] ? 0.5 * D * (1.0 + limits::kWallMargin) : 0.0;
@@ -281,7 +281,7 @@ InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, do
     const double L = c.box[k];
     const std::string axis = "axis " + std::to_string(k) + " has length " + std::to_string(L);
     require(std::isfinite(L) && L > 0.0, "box length on " + axis + ": must be finite and > 0");
-    if (c.boundary[k] == Boundary::wall)
+    if (has_walls(c.boundary[k]))
       require(L > D * (1.0 + limits::kWallMargin),
               "diameter " + std::to_string(D) + " is too large for the box: " + axis + " (walls need L > D)");
     else

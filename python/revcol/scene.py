@@ -39,7 +39,7 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     particles = 1000              # N >= 1 (required unless initial_state gives it)
     diameter = 1.0                # sigma > 0
     packing_fraction = 0.3        # sets a cubic box; or give box = [Lx, Ly]
-    boundaries = "wall"           # "wall" | "periodic", or one per axis ("walls": deprecated)
+    boundaries = "wall"           # "wall" | "periodic" | "bounce" (float engine), or one per axis ("walls": deprecated)
     start = "auto"                # "auto" | "random" (sequential addition) | "lattice";
                                   # auto: random up to the engine's rsa_fraction, else lattice
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)

@@ -226,7 +226,7 @@ def test_limits_are_the_engines(monkeypatch):
 
     lim = _core.engine_limits()
     assert lim["max_fraction"] == {1: 0.95, 2: 0.75, 3: 0.7} and lim["min_periodic_cells"] == 3
-    assert tuple(lim["paper_mode_dimensions"]) == (1, 2) and tuple(lim["boundaries"]) == ("wall", "periodic")
+    assert tuple(lim["paper_mode_dimensions"]) == (1, 2) and tuple(lim["boundaries"]) == ("wall", "periodic", "bounce")
     assert tuple(lim["streams"]) == ("per_particle", "single") and tuple(lim["bits"]) == (8, 52)
     assert _core.engine_particle_volume(2, 2.0) == pytest.approx(np.pi)
     # a scene follows whatever the engine says
