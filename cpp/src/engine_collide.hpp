@@ -120,6 +120,7 @@ double EngineImpl<Dim, Op>::draw(int stream, bool reversed) {
 // returns the mask applied, which the wall-mask log keeps.
 template <int Dim, PairOperator Op>
 Reflection EngineImpl<Dim, Op>::touch_walls(int i) {
+  if (!box_.any_walls()) return 0;  // periodic on every axis: nothing to touch (the common gas)
   Vec x, v;
   for (int k = 0; k < Dim; ++k) {
     x[k] = p_[i].x[k];
