@@ -2,9 +2,13 @@
 // bench/<family>_bench.cpp and appends to the list in add_<family>_benches().
 #pragma once
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "revcol/error.hpp"
 
 namespace revcol::bench {
 
@@ -30,5 +34,35 @@ void add_engine_benches(std::vector<Bench>& out);     ///< engine_bench.cpp: the
 void add_skip_benches(std::vector<Bench>& out);       ///< skip_bench.cpp: what a pair-only scene does not pay for
 void add_lattice_op_benches(std::vector<Bench>& out);  ///< lattice_op_bench.cpp: the exact lattice pair operator
 void add_lattice_benches(std::vector<Bench>& out);     ///< lattice_engine_bench.cpp: the 2D lattice engine
+
+/// Applies the environment variable `var`'s comma-separated key=value list: set(key, value)
+/// for each entry (it returns false for an unknown key). A malformed entry, an unknown key
+/// (`known` lists them) or a value set() cannot parse (std::stoi and the like throw) raises
+/// InvalidArgument naming the variable and the entry.
+template <class Set>
+void apply_settings(const char* var, const char* known, Set&& set) {
+  const char* env = std::getenv(var);
+  if (env == nullptr) return;
+  const std::string all = env, name = var;
+  std::size_t at = 0;
+  while (at < all.size()) {
+    std::size_t end = all.find(',', at);
+    if (end == std::string::npos) end = all.size();
+    const std::string item = all.substr(at, end - at);
+    at = end + 1;
+    if (item.empty()) continue;
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos) throw InvalidArgument(name + ": expected key=value, got '" + item + "'");
+    const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+    bool known_key = false;
+    try {
+      known_key = set(key, value);
+    } catch (const std::logic_error& e) {  // stoi/stod failures and InvalidArgument
+      if (dynamic_cast<const InvalidArgument*>(&e)) throw;
+      throw InvalidArgument(name + ": bad value for " + key + ": '" + value + "'");
+    }
+    if (!known_key) throw InvalidArgument(name + ": unknown key '" + key + "' (known: " + known + ")");
+  }
+}
 
 }  // namespace revcol::bench

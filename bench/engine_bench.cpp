@@ -49,37 +49,21 @@ struct Case {
 };
 
 void apply_environment(Case& c) {
-  const char* env = std::getenv("REVCOL_ENGINE");
-  if (env == nullptr) return;
-  const std::string all = env;
-  std::size_t at = 0;
-  while (at < all.size()) {
-    std::size_t end = all.find(',', at);
-    if (end == std::string::npos) end = all.size();
-    const std::string item = all.substr(at, end - at);
-    at = end + 1;
-    if (item.empty()) continue;
-    const std::size_t eq = item.find('=');
-    require(eq != std::string::npos, [&] { return "REVCOL_ENGINE: expected key=value, got '" + item + "'"; });
-    const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
-    try {
-      if (key == "d") c.d = std::stoi(value);
-      else if (key == "n") c.n = std::stoull(value);
-      else if (key == "phi") c.phi = std::stod(value);
-      else if (key == "boundary") c.boundary = value;
-      else if (key == "law") c.law = parse_law(value);
-      else if (key == "mode") c.mode = revcol::engine::parse_engine_mode(value);
-      else if (key == "seed") c.seed = std::stoull(value);
-      else if (key == "warm") c.warm = std::stod(value);
-      else if (key == "groups") c.groups = value != "0";
-      else if (key == "shell") c.shell = std::stod(value);
-      else throw InvalidArgument("REVCOL_ENGINE: unknown key '" + key +
-                                 "' (known: d, n, phi, boundary, law, mode, seed, warm, groups, shell)");
-    } catch (const std::logic_error& e) {
-      if (dynamic_cast<const InvalidArgument*>(&e)) throw;
-      throw InvalidArgument("REVCOL_ENGINE: bad value for " + key + ": '" + value + "'");
-    }
-  }
+  apply_settings("REVCOL_ENGINE", "d, n, phi, boundary, law, mode, seed, warm, groups, shell",
+                 [&](const std::string& key, const std::string& value) {
+                   if (key == "d") c.d = std::stoi(value);
+                   else if (key == "n") c.n = std::stoull(value);
+                   else if (key == "phi") c.phi = std::stod(value);
+                   else if (key == "boundary") c.boundary = value;
+                   else if (key == "law") c.law = parse_law(value);
+                   else if (key == "mode") c.mode = revcol::engine::parse_engine_mode(value);
+                   else if (key == "seed") c.seed = std::stoull(value);
+                   else if (key == "warm") c.warm = std::stod(value);
+                   else if (key == "groups") c.groups = value != "0";
+                   else if (key == "shell") c.shell = std::stod(value);
+                   else return false;
+                   return true;
+                 });
 }
 
 double peak_rss_bytes() {

@@ -27,36 +27,20 @@ namespace ss = revcol::statesave;
 
 // REVCOL_STATESAVE's key=value list applied to c; throws InvalidArgument naming a bad entry.
 void apply_environment(ss::Config& c) {
-  const char* env = std::getenv("REVCOL_STATESAVE");
-  if (env == nullptr) return;
-  const std::string all = env;
-  std::size_t at = 0;
-  while (at < all.size()) {
-    std::size_t end = all.find(',', at);
-    if (end == std::string::npos) end = all.size();
-    const std::string item = all.substr(at, end - at);
-    at = end + 1;
-    if (item.empty()) continue;
-    const std::size_t eq = item.find('=');
-    require(eq != std::string::npos, [&] { return "REVCOL_STATESAVE: expected key=value, got '" + item + "'"; });
-    const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
-    try {
-      if (key == "n") c.particles = std::stoull(value);
-      else if (key == "seed") c.seed = std::stoull(value);
-      else if (key == "rng") c.rng = value;
-      else if (key == "law") c.law = parse_law(value);
-      else if (key == "bits") c.bits = std::stoi(value);
-      else if (key == "budget") c.budget_bytes = std::stoull(value);
-      else if (key == "prefault") c.prefault = value != "0";
-      else if (key == "mean_dt") c.mean_dt = std::stod(value);
-      else if (key == "grazing_tol") c.grazing_tol = std::stod(value);
-      else throw InvalidArgument("REVCOL_STATESAVE: unknown key '" + key +
-                                 "' (known: n, seed, rng, law, bits, budget, prefault, mean_dt, grazing_tol)");
-    } catch (const std::logic_error& e) {  // stoull/stod failures and InvalidArgument
-      if (dynamic_cast<const InvalidArgument*>(&e)) throw;
-      throw InvalidArgument("REVCOL_STATESAVE: bad value for " + key + ": '" + value + "'");
-    }
-  }
+  apply_settings("REVCOL_STATESAVE", "n, seed, rng, law, bits, budget, prefault, mean_dt, grazing_tol",
+                 [&](const std::string& key, const std::string& value) {
+                   if (key == "n") c.particles = std::stoull(value);
+                   else if (key == "seed") c.seed = std::stoull(value);
+                   else if (key == "rng") c.rng = value;
+                   else if (key == "law") c.law = parse_law(value);
+                   else if (key == "bits") c.bits = std::stoi(value);
+                   else if (key == "budget") c.budget_bytes = std::stoull(value);
+                   else if (key == "prefault") c.prefault = value != "0";
+                   else if (key == "mean_dt") c.mean_dt = std::stod(value);
+                   else if (key == "grazing_tol") c.grazing_tol = std::stod(value);
+                   else return false;
+                   return true;
+                 });
 }
 
 // JSON has no inf or NaN: a non-finite error (a rollback gone wrong) is reported as 1e300.
