@@ -184,11 +184,13 @@ class BasicEngine {
     require(until >= clock_, "lattice run: the end tick is before the clock");
     require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
     if (collisions == 0) return 0;
-    const Snapshot before = snapshot();  // an engine error mid-run leaves the state as it was
+    // an engine error mid-run leaves the state as it was: an undo journal of the particles the
+    // run changes (O(changes), so that run(collisions=1) stays O(1) at any N)
+    begin_undo();
     try {
       return loop(collisions, until, false, 0);
     } catch (...) {
-      restore(before);
+      undo();
       throw;
     }
   }
@@ -265,7 +267,8 @@ class BasicEngine {
   std::size_t memory_bytes() const noexcept {
     const std::size_t n = ln_.size();
     return n * (2 * sizeof(Vec2) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec2) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
-           log_.size() * 48 + group_bytes() + X_.words().size() * 8;
+           log_.size() * 48 + group_bytes() + X_.words().size() * 8 + undo_.capacity() * sizeof(Saved) +
+           undo_epoch_.capacity() * sizeof(std::uint32_t);
   }
   /// Bytes held by the group entries of the rare log (map node, members, pre velocities).
   std::size_t group_bytes() const noexcept {
@@ -514,6 +517,7 @@ class BasicEngine {
 
   // ---- walls ----
   void reflect(int p, std::int64_t a) {
+    journal(p);
     Vec2 x = pos(p, a - 1), v = ln_[p].v;
     Vec2 old_line_at_a = pos(p, a);
     for (int k = 0; k < 2; ++k) {
@@ -603,6 +607,8 @@ class BasicEngine {
     predict(j, a);
   }
   void collide_forward(int i, int j, std::int64_t a) {
+    journal(i);
+    journal(j);
     if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
     const Vec2 pre_a[2] = {pos(i, a), pos(j, a)};
     bool multi = false;
@@ -830,6 +836,7 @@ class BasicEngine {
       throw std::runtime_error(why);
     }
     std::vector<Vec2> pre_v;
+    for (int q : g) journal(q);
     if (resolve)
       for (int q : g) pre_v.push_back(ln_[q].v);
     ++ncoll_;
@@ -890,6 +897,54 @@ class BasicEngine {
   std::vector<Line> ln_;
   std::vector<std::int64_t> wall_tick_;
   std::vector<Line> pre_wall_;  // a particle's line before its reflection at wall_tick_ (that tick only)
+  // ---- the forward run's undo journal (run(): an engine error restores the state) ----
+  struct Saved {
+    int p;
+    Line line, pre_wall;
+    std::uint64_t ctr;
+    std::int64_t wall_tick;
+  };
+  std::vector<Saved> undo_;
+  std::vector<std::uint32_t> undo_epoch_;  // per particle: the run() that journaled it
+  std::uint32_t epoch_ = 0;
+  Bits undo_X_;
+  Counters undo_cnt_;
+  std::int64_t undo_clock_ = 0;
+  std::uint64_t undo_ncoll_ = 0;
+  void begin_undo() {
+    if (undo_epoch_.size() != ln_.size() || ++epoch_ == 0) {  // new size, or the epoch wrapped
+      undo_epoch_.assign(ln_.size(), 0);
+      epoch_ = 1;
+    }
+    undo_.clear();
+    undo_X_ = X_;
+    undo_cnt_ = cnt_;
+    undo_clock_ = clock_;
+    undo_ncoll_ = ncoll_;
+  }
+  // keeps p's state as it was when this run() began (first change only)
+  void journal(int p) {
+    if (undo_epoch_.empty() || undo_epoch_[p] == epoch_) return;
+    undo_epoch_[p] = epoch_;
+    undo_.push_back(Saved{p, ln_[p], pre_wall_[p], ctr_[p], wall_tick_[p]});
+  }
+  void undo() {
+    for (const Saved& sv : undo_) {
+      ln_[sv.p] = sv.line;
+      pre_wall_[sv.p] = sv.pre_wall;
+      ctr_[sv.p] = sv.ctr;
+      wall_tick_[sv.p] = sv.wall_tick;
+      ++ver_[sv.p];
+    }
+    undo_.clear();
+    X_ = undo_X_;
+    cnt_ = undo_cnt_;
+    clock_ = undo_clock_;
+    log_.erase(log_.upper_bound(undo_ncoll_), log_.end());  // the forward run only adds keys
+    groups_.erase(groups_.upper_bound(undo_ncoll_), groups_.end());
+    ncoll_ = undo_ncoll_;
+    rebuild();
+  }
   std::vector<std::uint64_t> ver_, ctr_, vself_, vpart_;
   std::vector<Type> type_;
   std::vector<int> partner_;
