@@ -191,9 +191,9 @@ class LatticeSimulation:
 
     def diagnostics(self) -> dict:
         """Energy drift (relative and in lattice units), momentum drift per axis (lattice
-        units), X's bit length, rare-log entries (redraw counts, and group bounces: three or more
-        bodies within one tick), redraws by reason, multi-body and wall-body ticks, events by type,
-        memory, and the quantization errors."""
+        units), X's bit length, rare-log entries (redraw counts, and group collisions: a third body
+        within one tick; ``group_resolves``, ``group_bounces``, ``wall_groups``), redraws by reason,
+        multi-body and wall-body ticks, events by type, memory, and the quantization errors."""
         d = dict(self._e.diagnostics())
         d.update(self._q)
         return d
