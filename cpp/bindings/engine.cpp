@@ -117,7 +117,10 @@ class PyEngine {
   }
   py::dict run_back(std::optional<std::uint64_t> collisions, std::optional<double> time) {
     const std::uint64_t nc = collisions.value_or(std::numeric_limits<std::uint64_t>::max());
-    const double tt = time.value_or(collisions ? -std::numeric_limits<double>::infinity() : s_->start_time());
+    // collisions alone: never past the start (the reversed dynamics goes on forever before it);
+    // pass a time to go earlier
+    const double tt = time.value_or(s_->start_time());
+    require(!time || std::isfinite(*time), "run_back: time must be finite");
     return run_dict(s_->run_back(nc, tt));
   }
   py::array_t<double> positions() const { return to_array(s_->positions(), s_->size(), s_->config().dim); }

@@ -78,6 +78,10 @@ void validate_config(const Config& c) {
   for (int k = 0; k < c.dim; ++k) {
     const double L = c.box[k];
     require(std::isfinite(L) && L > 0.0, [&] { return "box length on axis " + std::to_string(k) + " must be finite and > 0"; });
+    require(limits::box_ratio_fits(L, c.diameter), [&] {
+      return "box length on axis " + std::to_string(k) + " is " + std::to_string(L / c.diameter) +
+             " diameters: at most 2^30 (a smaller box or a larger diameter)";
+    });
     if (has_walls(c.boundary[k])) {
       require(limits::wall_axis_fits(L, c.diameter), [&] {
         return "diameter " + std::to_string(c.diameter) + " is too large for the box: axis " + std::to_string(k) +

@@ -132,6 +132,12 @@ class EngineImpl final : public Simulation {
       require(s.ev_kind[i] >= kWall && s.ev_kind[i] <= kNone, "snapshot: bad event kind");
       require(s.ev_kind[i] != kColl || (s.ev_partner[i] >= 0 && static_cast<std::size_t>(s.ev_partner[i]) < n_),
               "snapshot: event partner outside [0, n)");
+      // a wall event's partner is 2 axis + (upper wall), on an axis with walls (issue 17: a forged
+      // partner wrote out of bounds)
+      require(s.ev_kind[i] != kWall || (s.ev_partner[i] >= 0 && s.ev_partner[i] < 2 * Dim &&
+                                        has_walls(cfg_.boundary[static_cast<std::size_t>(s.ev_partner[i] / 2)])),
+              "snapshot: wall event on an axis without walls (partner must be 2 axis + upper)");
+      require(!std::isnan(s.ev_t[i]), "snapshot: event time is NaN");
       ev_[i] = Ev{s.ev_t[i], static_cast<std::int32_t>(s.ev_kind[i]), static_cast<std::int32_t>(s.ev_partner[i]),
                   s.ev_stamp[i]};
       second_[i] = s.second[i];
@@ -151,11 +157,15 @@ class EngineImpl final : public Simulation {
 
   RunResult run(std::uint64_t max_collisions, double t_end, const Progress& cb, std::uint64_t every) override {
     require(!std::isnan(t_end), "end time must not be NaN");
+    require(std::isfinite(t_end) || max_collisions != std::numeric_limits<std::uint64_t>::max(),
+            "run: give a finite end time or a collision count (an infinite run never returns)");
     return loop(max_collisions, t_end, cb, every, /*reversed=*/false);
   }
 
   RunResult run_back(std::uint64_t max_collisions, double t_target) override {
     require(!std::isnan(t_target), "target time must not be NaN");
+    require(std::isfinite(t_target) || max_collisions != std::numeric_limits<std::uint64_t>::max(),
+            "run_back: give a finite target time or a collision count (an infinite run back never returns)");
     require(t_target <= clock_, [&] {
       return "run_back: target time " + std::to_string(t_target) + " is later than the current time " +
              std::to_string(clock_);

@@ -281,6 +281,7 @@ InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, do
     const double L = c.box[k];
     const std::string axis = "axis " + std::to_string(k) + " has length " + std::to_string(L);
     require(std::isfinite(L) && L > 0.0, "box length on " + axis + ": must be finite and > 0");
+    require(limits::box_ratio_fits(L, D), "box length on " + axis + ": more than 2^30 diameters of " + std::to_string(D));
     if (has_walls(c.boundary[k]))
       require(L > D * (1.0 + limits::kWallMargin),
               "diameter " + std::to_string(D) + " is too large for the box: " + axis + " (walls need L > D)");
@@ -309,6 +310,12 @@ InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t see
   require(phi <= maxphi, "packing fraction " + std::to_string(phi) + " above what the initialiser reaches (" +
                              std::to_string(maxphi) + " in " + std::to_string(d) + "D)");
   const double L = std::pow(static_cast<double>(n) * limits::particle_volume(d, c.diameter) / phi, 1.0 / d);
+  // a tiny diameter underflows the particle volume and the box to 0 (issue 17)
+  require(std::isfinite(L) && L > 0.0 && limits::box_ratio_fits(L, c.diameter), [&] {
+    return "the box for " + std::to_string(n) + " particles of diameter " + std::to_string(c.diameter) +
+           " at packing fraction " + std::to_string(phi) + " is not representable (length " + std::to_string(L) +
+           "): choose a diameter between 1e-100 and 1e100";
+  });
   for (int k = 0; k < 3; ++k) c.box[k] = k < d ? L : 1.0;
   // "auto" decides on the phi asked for, not on the cube's (which differs in the last bits)
   const bool rsa = how == Placement::rsa || (how == Placement::automatic && phi <= limits::rsa_fraction(d));

@@ -136,7 +136,8 @@ class Simulation:
 
     def run_back(self, collisions: Optional[int] = None, time: Optional[float] = None) -> dict:
         """Backwards: until ``collisions`` collisions are undone or the clock is back at
-        ``time``; with neither, back to the start time."""
+        ``time`` (finite; it may be before the start); without ``time``, never past the start
+        time."""
         return self._e.run_back(None if collisions is None else int(collisions),
                                 None if time is None else float(time))
 

@@ -55,6 +55,12 @@ constexpr double particle_volume(int d, double D) {
   return d == 1 ? D : d == 2 ? kPi * D * D / 4.0 : kPi * D * D * D / 6.0;
 }
 
+/// Largest box length in diameters per axis: cell and list indices stay within int, and a
+/// position keeps ~1e-7 D of resolution (issue 17: L / D past int made the cell count overflow).
+inline constexpr double kMaxBoxDiameters = 1073741824.0;  // 2^30
+/// True when an axis of length L is at most kMaxBoxDiameters diameters D long.
+constexpr bool box_ratio_fits(double L, double D) { return L / D <= kMaxBoxDiameters; }
+
 /// True when a walled axis of length L holds a particle of diameter D (L > D).
 constexpr bool wall_axis_fits(double L, double D) { return L > D; }
 
