@@ -223,6 +223,13 @@ std::unique_ptr<Simulation> make_simulation(const Config& c, const std::vector<d
                                             const std::vector<double>& v, double t0) {
   require(std::isfinite(t0), "start time must be finite");
   validate_state(c, x, v);
+  double vmax = 0.0;
+  for (double q : v) vmax = std::max(vmax, std::fabs(q));
+  require(limits::clock_fits(t0, c.diameter, vmax), [&] {
+    return "start time " + std::to_string(t0) + " is too large for the clock to resolve flights of one diameter (at most " +
+           std::to_string(limits::kMaxClockFlights) + " D / v_max = " + std::to_string(limits::kMaxClockFlights * c.diameter / vmax) +
+           "); shift the time origin";
+  });
   if (c.dim == 1) return detail::make_engine<1>(c, x, v, t0);
   if (c.dim == 2) return detail::make_engine<2>(c, x, v, t0);
   return detail::make_engine<3>(c, x, v, t0);
@@ -243,6 +250,12 @@ std::unique_ptr<Simulation> restore_simulation(const Snapshot& s) {
   require(s.rng.size() == (s.config.streams == rng::StreamPolicy::single ? 1 : n),
           "snapshot: rng must hold one draw count per stream (n, or 1 for a single stream)");
   require(std::isfinite(s.time) && std::isfinite(s.start_time), "snapshot: times must be finite");
+  {
+    double vmax = 0.0;
+    for (double q : s.v) vmax = std::max(vmax, std::fabs(q));
+    require(limits::clock_fits(s.time, s.config.diameter, vmax) && limits::clock_fits(s.start_time, s.config.diameter, vmax),
+            "snapshot: a time too large for the clock to resolve flights of one diameter (|t| v_max / D > 4.5e9)");
+  }
   for (double t : s.t_local) require(std::isfinite(t), "snapshot: local times must be finite");
   for (double q : s.x) require(std::isfinite(q), "snapshot: positions must be finite");
   for (double q : s.v) require(std::isfinite(q), "snapshot: velocities must be finite");

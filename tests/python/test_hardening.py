@@ -52,3 +52,15 @@ def test_unbounded_runs_are_refused_and_change_nothing():
     s.run(collisions=10)
     s.run_back(time=s.start_time - 0.5)  # a finite time before the start is still allowed
     assert s.time == s.start_time - 0.5
+
+
+def test_a_start_time_the_clock_cannot_resolve_is_refused():
+    # was a hang: at t0 = 1e16 the clock's ulp (2) outgrew the flight times, events shared one time
+    with pytest.raises(ValueError, match="shift the time origin"):
+        Simulation.random(100, 2, 0.3, boundary="wall", time=1e16)
+    s = Simulation.random(100, 2, 0.3, boundary="wall", time=1e6)  # allowed (round trips degrade: docs)
+    s.run(collisions=50)
+    st = s.snapshot()
+    st["time"] = 1e16
+    with pytest.raises(ValueError, match="too large for the clock"):
+        Simulation.from_snapshot(st)

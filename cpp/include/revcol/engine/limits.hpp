@@ -61,6 +61,16 @@ inline constexpr double kMaxBoxDiameters = 1073741824.0;  // 2^30
 /// True when an axis of length L is at most kMaxBoxDiameters diameters D long.
 constexpr bool box_ratio_fits(double L, double D) { return L / D <= kMaxBoxDiameters; }
 
+/// Largest |clock| in units of D / v_max: past it the clock's ulp (2^-52 |t|) exceeds 1e-6 of
+/// the time a particle takes to cross its own diameter, and events begin to share one clock
+/// value (issue 17: a start time of 1e16 never returned). Round trips degrade well before:
+/// the position error grows like ulp(t) v / D (a start at t = 1e6 D / v gave 2e-8).
+inline constexpr double kMaxClockFlights = 4.5e9;
+/// True when a clock t resolves flight times D / vmax (|t| <= kMaxClockFlights D / vmax).
+inline bool clock_fits(double t, double D, double vmax) {
+  return vmax <= 0.0 || (t < 0.0 ? -t : t) * vmax <= kMaxClockFlights * D;
+}
+
 /// True when a walled axis of length L holds a particle of diameter D (L > D).
 constexpr bool wall_axis_fits(double L, double D) { return L > D; }
 
