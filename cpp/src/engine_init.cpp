@@ -247,6 +247,12 @@ InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, do
   return s;
 }
 
+void check_energy(double energy) {
+  // 0 asks for the default (kT = 1); NaN or a negative energy was taken as the default silently (issue 17)
+  require(std::isfinite(energy) && energy >= 0.0,
+          "kinetic energy must be finite and > 0 (or omitted for kT = 1), got " + std::to_string(energy));
+}
+
 void check_common(const Config& c, std::size_t n, std::uint64_t seed) {
   require(c.dim >= limits::kMinDim && c.dim <= limits::kMaxDim, "dim must be 1, 2 or 3");
   require(n > 0, "no particles (N = 0)");
@@ -274,6 +280,7 @@ double box_fraction(const Config& c, std::size_t n) {
 InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, double energy,
                           const std::string& init, bool equal_speeds) {
   check_common(c, n, seed);
+  check_energy(energy);
   const Placement how = parse_placement(init);
   const int d = c.dim;
   const double D = c.diameter;
@@ -303,6 +310,7 @@ InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, do
 InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t seed, double energy,
                           const std::string& init, bool equal_speeds) {
   check_common(c, n, seed);
+  check_energy(energy);
   require(std::isfinite(phi) && phi > 0.0, "packing fraction must be finite and > 0");
   const Placement how = parse_placement(init);
   const int d = c.dim;

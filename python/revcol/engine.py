@@ -128,6 +128,11 @@ class Simulation:
         whichever comes first, ending between events. ``callback(done)`` is called every
         ``every`` collisions; returning False stops the run. Returns collisions, events,
         time, interrupted."""
+        # checked before the first event: a bad argument must not leave collisions done (issue 17)
+        if callback is not None and not callable(callback):
+            raise TypeError(f"callback must be callable, got {type(callback).__name__}")
+        if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
+            raise ValueError(f"every must be an integer >= 1, got {every!r}")
         cb = None
         if callback is not None:
             cb = lambda k: bool(callback(k) is not False)  # None means go on

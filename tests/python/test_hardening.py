@@ -64,3 +64,22 @@ def test_a_start_time_the_clock_cannot_resolve_is_refused():
     st["time"] = 1e16
     with pytest.raises(ValueError, match="too large for the clock"):
         Simulation.from_snapshot(st)
+
+
+@pytest.mark.parametrize("energy", [float("nan"), -1.0, float("inf")])
+def test_a_bad_start_energy_is_refused(energy):
+    # was silently replaced by the default (kT = 1)
+    with pytest.raises(ValueError, match="kinetic energy"):
+        Simulation.random(100, 2, 0.3, energy=energy)
+
+
+def test_run_checks_its_arguments_before_the_first_event():
+    # callback=5 ran 10 collisions before the TypeError
+    s = Simulation.random(50, 2, 0.3, seed=2)
+    before = s.snapshot()
+    with pytest.raises(TypeError, match="callable"):
+        s.run(collisions=100, callback=5, every=10)
+    with pytest.raises(ValueError, match="every"):
+        s.run(collisions=100, callback=lambda k: None, every=0)
+    after = s.snapshot()
+    assert all(np.array_equal(np.asarray(before[k]), np.asarray(after[k])) for k in ("x", "v", "time", "rng"))
