@@ -128,6 +128,13 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
     }
   require(std::isfinite(e), "kinetic energy overflows");
   require(e > 0.0, "zero kinetic energy: nothing would ever move");
+  double vmax = 0.0;
+  for (double q : v) vmax = std::max(vmax, std::fabs(q));
+  require(vmax >= limits::kMinGasSpeed && vmax <= limits::max_gas_speed(static_cast<double>(n), d), [&] {
+    return "largest velocity component " + num(vmax) + " is outside the speeds the operators resolve: [2^-420, 2^450 / sqrt(N d)] = [" +
+           num(limits::kMinGasSpeed) + ", " + num(limits::max_gas_speed(static_cast<double>(n), d)) + "] (rescale velocities and time)";
+  });
+  require(std::isfinite(c.diameter / vmax), "diameter / speed overflows: rescale lengths or velocities");
   // overlaps through a cell grid (cells >= D)
   std::array<int, 3> nc{1, 1, 1};
   std::array<double, 3> cw{1, 1, 1};

@@ -224,6 +224,10 @@ ExactCollision::Energy ExactCollision::relative_energy(const double* v, const do
 
 void ExactCollision::check_common(const double* v, const Held* held) const {
   for (int k = 0; k < n_ * d_; ++k) require(std::isfinite(v[k]), "velocities must be finite (got a NaN or infinity)");
+  double rel = 0.0;  // the largest relative component over the contacts: the collision's speed scale
+  for (const auto& c : contacts_)
+    for (int a = 0; a < d_; ++a) rel = std::fmax(rel, std::fabs(v[c.i * d_ + a] - v[c.j * d_ + a]));
+  check_speed_range(max_abs(v, n_ * d_), rel);
   if (held) {
     require(std::isfinite(held->energy), "energy must be finite");
     for (int a = 0; a < d_; ++a) require(std::isfinite(held->momentum[a]), "momentum must be finite");

@@ -171,6 +171,7 @@ std::array<double, 3> Triple2DPaper::normal_speeds(const State& v, const paper::
 Triple2DPaper::Parts Triple2DPaper::parts(const State& v, const paper::Canonical& cf,
                                           const Inv* inv, bool post, const Draws& g) const {
   paper::require_finite(v);
+  paper::require_speed_range(v);
   require(g[0] >= 0.0 && g[0] <= 1.0 && g[1] >= 0.0 && g[1] <= 1.0 && g[2] >= 0.0 && g[2] <= 1.0,
           "random numbers must be in [0,1]");
   const Frame3 f = frame_velocities(cf, v);

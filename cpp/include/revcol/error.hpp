@@ -1,5 +1,6 @@
 // Error types of the core. The binding translates InvalidArgument to Python's ValueError.
 #pragma once
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -26,6 +27,14 @@ template <class F>
   requires std::is_invocable_r_v<std::string, F>
 inline void require(bool cond, F&& make_msg) {
   if (!cond) [[unlikely]] throw InvalidArgument(make_msg());
+}
+
+/// A double for a message: 6 significant digits in %g form (1e-130 stays 1e-130, where
+/// std::to_string prints 0.000000).
+inline std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
 }
 
 }  // namespace revcol

@@ -19,6 +19,7 @@
 #include <array>
 #include <concepts>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -94,12 +95,19 @@ void run(A& a, const double* g, RareLog& log, Dir dir) {
   apply_all(a, g, log, dir);
 }
 
-/// Validates everything, then draws B x d_n numbers from gen (reverse: steps it back, last
-/// entry and last draw first) and runs the batch.
+/// Validates everything (a reverse batch: also that a counter generator can step back all its
+/// draws), then draws B x d_n numbers from gen (reverse: steps it back, last entry and last
+/// draw first) and runs the batch.
 template <Entries A, Generator Gen>
 void run(A& a, Gen& gen, RareLog& log, Dir dir) {
   check_all(a, nullptr, false, log, dir);
   std::vector<double> g(a.size() * a.draws());
+  if constexpr (requires { { gen.counter() } -> std::convertible_to<std::uint64_t>; })
+    if (dir == Dir::reverse)  // a counter generator cannot step back before draw 0: say so first
+      require(gen.counter() >= g.size(), [&] {
+        return "rng counter is " + std::to_string(gen.counter()) + " but reversing this batch steps back " +
+               std::to_string(g.size()) + " draws (the generator cannot go before draw 0)";
+      });
   if (dir == Dir::forward)
     for (double& x : g) x = gen.next();
   else

@@ -37,6 +37,33 @@ inline Law parse_law(const std::string& s) {
   throw InvalidArgument("law must be 'flux' or 'uniform', got '" + s + "'");
 }
 
+/// The speed range of the operators (issue 17). A collision's relative speed |w| must lie in
+/// [kMinRelativeSpeed, kMaxSpeed] and every velocity component in [-kMaxSpeed, kMaxSpeed]:
+/// below, squares and the chart's products of |w| underflow (a round trip of 1e-5 at 1e-160,
+/// NaN at 1e-170); above, energies and the chart's products overflow (NaN at 1e150 for 9 of the
+/// 15 named cases). Inside, every named case's round trip is the same as at speed 1
+/// (tests/python/test_hardening.py: at the limits and just outside them).
+inline constexpr double kMinRelativeSpeed = 0x1.0p-480;  // about 1.0e-144
+/// Upper end of the speed range (see kMinRelativeSpeed).
+inline constexpr double kMaxSpeed = 0x1.0p+450;  // about 2.9e135
+
+/// Throws InvalidArgument unless the largest |velocity component| and the relative speed's scale
+/// (its largest |component|, which never underflows as |w|^2 does) lie in the operators' speed
+/// range [kMinRelativeSpeed, kMaxSpeed]; a zero relative speed has its own message.
+inline void check_speed_range(double max_component, double relative_scale) {
+  require(max_component <= kMaxSpeed, "velocities too large: a component exceeds 2^450 (about 2.9e135)");
+  require(relative_scale > 0.0, "zero relative speed: the particles cannot collide");
+  require(relative_scale >= kMinRelativeSpeed,
+          "relative speed too small: below 2^-480 (about 1.0e-144), where the chart underflows");
+}
+
+/// The largest |x_k| of n values (0 for n = 0).
+inline double max_abs(const double* x, int n) {
+  double m = 0.0;
+  for (int k = 0; k < n; ++k) m = std::fmax(m, std::fabs(x[k]));
+  return m;
+}
+
 /// The rare log (DESIGN.md §4): a stack of pre-collision chart cells that the post state
 /// cannot give back to half a cell. Forward pushes, reverse pops, in LIFO order.
 class RareLog {

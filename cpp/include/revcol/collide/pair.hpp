@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 #include "revcol/collide/common.hpp"
 
@@ -32,6 +33,12 @@ template <int Dim>
 inline void require_finite(const PairV<Dim>& v) {
   require(all_finite(v.i.data(), Dim) && all_finite(v.j.data(), Dim),
           "velocities must be finite (got a NaN or infinity)");
+}
+
+/// Throws InvalidArgument unless the pair's speeds lie in the operators' range (check_speed_range).
+template <int Dim>
+inline void require_speed_range(const PairV<Dim>& v, const std::type_identity_t<std::array<double, Dim>>& w) {
+  check_speed_range(std::fmax(max_abs(v.i.data(), Dim), max_abs(v.j.data(), Dim)), max_abs(w.data(), Dim));
 }
 
 /// Unit contact normal a and, in 2D, its tangent t = (-a_y, a_x): an orthonormal frame

@@ -176,9 +176,8 @@ class Pair2DExact {
     Split s;
     s.p = f.normal_part(w);
     s.q = f.tangent_part(w);
+    require_speed_range(v, w);
     s.norm = std::sqrt(w[0] * w[0] + w[1] * w[1]);
-    require(s.norm > 0.0, "zero relative speed: the particles cannot collide");
-    require(std::isfinite(s.norm), "velocities too large (relative speed overflows)");
     if (post) {
       require(s.p > 0.0 || logged, [&] { return std::string("post-collision state does not separate along the contact normal "
               "(normal relative velocity " + std::to_string(s.p) + " <= 0)"); });

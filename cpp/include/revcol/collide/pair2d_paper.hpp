@@ -100,9 +100,8 @@ class Pair2DPaper {
     require_finite(v);
     require(g >= 0.0 && g <= 1.0, "random number must be in [0,1]");
     const std::array<double, 2> w = relative(v);
+    require_speed_range(v, w);
     const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1]);
-    require(norm > 0.0, "zero relative speed: the particles cannot collide");
-    require(std::isfinite(norm), "velocities too large (relative speed overflows)");
     const double p = f.normal_part(w);
     if (post)
       require(p > 0.0, [&] { return std::string("post-collision state does not separate along the contact normal "

@@ -142,9 +142,8 @@ class Pair3DPaper {
     require(g[0] >= 0.0 && g[0] <= 1.0 && g[1] >= 0.0 && g[1] <= 1.0,
             "random numbers must be in [0,1]");
     const std::array<double, 3> w = relative(v);
+    require_speed_range(v, w);
     const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    require(norm > 0.0, "zero relative speed: the particles cannot collide");
-    require(std::isfinite(norm), "velocities too large (relative speed overflows)");
     const double p = n.a[0] * w[0] + n.a[1] * w[1] + n.a[2] * w[2];
     if (post)
       require(p > 0.0, [&] { return std::string("post-collision state does not separate along the contact normal "

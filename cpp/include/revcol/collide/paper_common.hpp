@@ -33,6 +33,19 @@ inline void require_finite(const TripleT& v) {
   require(ok, "velocities must be finite (got a NaN or infinity)");
 }
 
+/// Throws InvalidArgument unless the triple's speeds lie in the operators' range
+/// (check_speed_range): every |component| and the largest pairwise relative component.
+template <class TripleT>
+inline void require_speed_range(const TripleT& v) {
+  double top = 0.0, rel = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (std::size_t k = 0; k < v[i].size(); ++k) {
+      top = std::fmax(top, std::fabs(v[i][k]));
+      for (std::size_t j = i + 1; j < v.size(); ++j) rel = std::fmax(rel, std::fabs(v[i][k] - v[j][k]));
+    }
+  check_speed_range(top, rel);
+}
+
 /// Radius rho of the relative-velocity sphere of a triple from held invariants,
 /// rho^2 = E - |M|^2 / 3, checked against the velocities' own |x| = `x_norm` within 1e-8
 /// relative plus the rounding of that difference.

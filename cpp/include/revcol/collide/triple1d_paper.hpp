@@ -164,6 +164,7 @@ class Triple1DPaper {
 
   Parts parts(const State& v, const Geometry& x, const Inv* inv, bool post, const Draws& g) const {
     paper::require_finite(v);
+    paper::require_speed_range(v);
     require(g[0] >= 0.0 && g[0] <= 1.0, "random number must be in [0,1]");
     Parts s;
     s.o = order(x);

@@ -21,6 +21,7 @@
 // Collisions. Paper mode has pair operators in 1D (the exchange) and 2D (Procedures 1-2);
 // its 3D pair operator is not a bijection, so the engine refuses paper mode in 3D.
 #pragma once
+#include <cmath>
 #include <cstdint>
 
 #include "revcol/fixed_point.hpp"
@@ -70,6 +71,15 @@ inline constexpr double kMaxClockFlights = 4.5e9;
 inline bool clock_fits(double t, double D, double vmax) {
   return vmax <= 0.0 || (t < 0.0 ? -t : t) * vmax <= kMaxClockFlights * D;
 }
+
+/// Speeds a gas may start with (issue 17): the largest |velocity component| v_max must be at
+/// least kMinGasSpeed and sqrt(N d) v_max (a bound on every speed the gas can ever reach, from
+/// its energy) at most the operators' kMaxSpeed (2^450). Below 2^-420, a colliding pair's
+/// relative speed could fall under the operators' 2^-480 (two distinct components >= 2^-420
+/// differ by at least 2^-472); a gas at 1e-161 hung, one at 1e154 overflowed.
+inline constexpr double kMinGasSpeed = 0x1.0p-420;  // about 3.7e-127
+/// Largest v_max for N particles in d dimensions: 2^450 / sqrt(N d).
+inline double max_gas_speed(double n, int d) { return 0x1.0p+450 / std::sqrt(n * d); }
 
 /// True when a walled axis of length L holds a particle of diameter D (L > D).
 constexpr bool wall_axis_fits(double L, double D) { return L > D; }
