@@ -8,6 +8,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "args.hpp"
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "revcol/collide/pair1d.hpp"
@@ -91,8 +92,9 @@ Example:
 
 void register_collide(py::module_& m) {
   py::class_<Pair2D>(m, "Pair2D", kPair2DDoc)
-      .def(py::init([](const std::string& mode, const std::string& law, int bits, bool printed) {
-             return Pair2D(parse_mode(mode), parse_law(law), bits, printed);
+      .def(py::init([](const std::string& mode, const std::string& law, PyInt bits, bool printed) {
+             return Pair2D(parse_mode(mode), parse_law(law),
+                           to_int<int>(bits, "bits", FixedPoint::min_bits, FixedPoint::max_bits), printed);
            }),
            py::kw_only(), py::arg("mode") = "exact", py::arg("law") = "flux",
            py::arg("bits") = FixedPoint::default_bits, py::arg("printed_reverse") = false)

@@ -12,8 +12,10 @@
 #include <optional>
 
 #include "bindings.hpp"
+#include "args.hpp"
 #include "revcol/engine/engine.hpp"
 #include "revcol/engine/init.hpp"
+#include "revcol/engine/limits.hpp"
 #include "revcol/error.hpp"
 
 namespace py = pybind11;
@@ -105,23 +107,32 @@ class PyEngine {
  public:
   explicit PyEngine(std::unique_ptr<en::Simulation> s) : s_(std::move(s)) {}
 
-  py::dict run(std::optional<std::uint64_t> collisions, std::optional<double> time,
-               std::optional<std::function<bool(std::uint64_t)>> cb, std::uint64_t every) {
+  py::dict run(std::optional<PyInt> collisions_arg, std::optional<PyReal> time_arg,
+               std::optional<std::function<bool(std::uint64_t)>> cb, PyInt every_arg) {
+    const auto collisions = to_int<std::uint64_t>(collisions_arg, "collisions");
+    const auto every = to_int<std::uint64_t>(every_arg, "every", 1);
+    const auto time = to_real(time_arg, "time");
     require(collisions.has_value() || time.has_value(), "give collisions, time, or both");
     const std::uint64_t nc = collisions.value_or(std::numeric_limits<std::uint64_t>::max());
     const double te = time.value_or(std::numeric_limits<double>::infinity());
     require(!time || *time >= s_->time(), "run: end time is earlier than the current time (use run_back)");
     en::Progress p;
     if (cb) p = *cb;
-    return run_dict(s_->run(nc, te, p, cb ? every : 0));
+    const en::RunResult r = s_->run(nc, te, p, cb ? every : 0, poll_signals);
+    if (PyErr_Occurred()) throw py::error_already_set();  // Ctrl-C: the run stopped between events
+    return run_dict(r);
   }
-  py::dict run_back(std::optional<std::uint64_t> collisions, std::optional<double> time) {
+  py::dict run_back(std::optional<PyInt> collisions_arg, std::optional<PyReal> time_arg) {
+    const auto collisions = to_int<std::uint64_t>(collisions_arg, "collisions");
+    const auto time = to_real(time_arg, "time");
     const std::uint64_t nc = collisions.value_or(std::numeric_limits<std::uint64_t>::max());
     // collisions alone: never past the start (the reversed dynamics goes on forever before it);
     // pass a time to go earlier
     const double tt = time.value_or(s_->start_time());
     require(!time || std::isfinite(*time), "run_back: time must be finite");
-    return run_dict(s_->run_back(nc, tt));
+    const en::RunResult r = s_->run_back(nc, tt, poll_signals);
+    if (PyErr_Occurred()) throw py::error_already_set();
+    return run_dict(r);
   }
   py::array_t<double> positions() const { return to_array(s_->positions(), s_->size(), s_->config().dim); }
   py::array_t<double> velocities() const { return to_array(s_->velocities(), s_->size(), s_->config().dim); }
@@ -240,9 +251,13 @@ class PyEngine {
 void register_engine(py::module_& m) {
   py::class_<PyEngine>(m, "Engine", "The event-driven engine (revcol/engine/engine.hpp); use revcol.Simulation.")
       .def(py::init([](const Array& x, const Array& v, const std::vector<double>& box,
-                       const std::vector<std::string>& boundary, double diameter, const std::string& mode,
-                       const std::string& law, std::uint64_t seed, int bits, bool groups, double group_tol,
-                       double time, const std::string& generator, const std::string& streams) {
+                       const std::vector<std::string>& boundary, PyReal diameter_arg, const std::string& mode,
+                       const std::string& law, PyInt seed_arg, PyInt bits_arg, bool groups, PyReal group_tol_arg,
+                       PyReal time_arg, const std::string& generator, const std::string& streams) {
+             const double diameter = to_real(diameter_arg, "diameter"), group_tol = to_real(group_tol_arg, "group_tol");
+             const double time = to_real(time_arg, "time");
+             const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, en::limits::kMaxSeed);
+             const auto bits = to_int<int>(bits_arg, "bits", en::limits::kMinBits, en::limits::kMaxBits);
              int n = 0, d = 0, nv = 0, dv = 0;
              auto xs = flat(x, "positions", n, d);
              auto vs = flat(v, "velocities", nv, dv);
@@ -283,8 +298,13 @@ void register_engine(py::module_& m) {
 
   m.def(
       "engine_random_state",
-      [](int dim, std::size_t n, double phi, const std::vector<std::string>& boundary, double diameter,
-         std::uint64_t seed, double energy, const std::string& init, bool equal_speeds) {
+      [](PyInt dim_arg, PyInt n_arg, PyReal phi_arg, const std::vector<std::string>& boundary, PyReal diameter_arg,
+         PyInt seed_arg, PyReal energy_arg, const std::string& init, bool equal_speeds) {
+        const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
+        const double energy = to_real(energy_arg, "energy");
+        const int dim = to_int<int>(dim_arg, "dim", en::limits::kMinDim, en::limits::kMaxDim);
+        const auto n = to_int<std::size_t>(n_arg, "n", 1, std::size_t{1} << 31);
+        const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, en::limits::kMaxSeed);
         en::Config c;
         c.dim = dim;
         require(dim >= 1 && dim <= 3, [&] { return "dim must be 1, 2 or 3, got " + std::to_string(dim); });

@@ -7,6 +7,7 @@
 #include <optional>
 #include <type_traits>
 
+#include "args.hpp"
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "revcol/collide/cases.hpp"
@@ -85,9 +86,12 @@ recovers the pre state exactly (after its first quantization) with the same numb
 
 void register_exact(py::module_& m) {
   py::class_<Collision>(m, "Collision", kDoc)
-      .def(py::init([](int n, int d, const std::vector<std::pair<int, int>>& contacts,
+      .def(py::init([](PyInt n_arg, PyInt d_arg, const std::vector<std::pair<int, int>>& contacts,
                        std::optional<Array> normals, std::optional<Array> positions,
-                       double diameter, const std::string& law, int bits, double tol) {
+                       PyReal diameter_arg, const std::string& law, PyInt bits_arg, PyReal tol_arg) {
+             const int n = to_int<int>(n_arg, "n"), d = to_int<int>(d_arg, "d");
+             const int bits = to_int<int>(bits_arg, "bits", FixedPoint::min_bits, FixedPoint::max_bits);
+             const double diameter = to_real(diameter_arg, "diameter"), tol = to_real(tol_arg, "tol");
              require(normals.has_value() != positions.has_value(),
                      "give exactly one of normals= (m x d) or positions= (n x d)");
              if (positions) {
@@ -108,8 +112,9 @@ void register_exact(py::module_& m) {
            py::arg("diameter") = 1.0, py::arg("law") = "flux", py::arg("bits") = 40,
            py::arg("tol") = 1e-9)
       .def_static("named",
-                  [](const std::string& name, const std::string& law, int bits) {
-                    return Collision(exact_operator(named_case(name), parse_law(law), bits));
+                  [](const std::string& name, const std::string& law, PyInt bits) {
+                    return Collision(exact_operator(named_case(name), parse_law(law),
+                                                    to_int<int>(bits, "bits", FixedPoint::min_bits, FixedPoint::max_bits)));
                   },
                   py::arg("name"), py::kw_only(), py::arg("law") = "flux", py::arg("bits") = 40,
                   "The operator of a named case (see revcol.named_cases()).")

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "args.hpp"
 #include "bindings.hpp"
 #include "revcol/error.hpp"
 #include "revcol/lattice/engine.hpp"
@@ -213,10 +214,13 @@ struct PyLattice {
 void register_lattice(py::module_& m) {
   m.def(
       "lattice_random_start",
-      [](std::size_t n, double phi, std::vector<bool> wall, double diameter, std::uint64_t seed, const std::string& init,
-         int tick_bits) {
+      [](PyInt n_arg, PyReal phi_arg, std::vector<bool> wall, PyReal diameter_arg, PyInt seed_arg, const std::string& init,
+         PyInt tick_bits_arg) {
+        const auto n = to_int<std::size_t>(n_arg, "n");
+        const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
+        const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
+        const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
         require(wall.size() == 2, "lattice: walls need one flag per axis (2D)");
-        require(seed <= 0xFFFFFFFFull, "seed must be < 2^32");
         la::LatticeConfig c;
         c.wall = {wall[0], wall[1]};
         c.diameter = diameter;
@@ -229,7 +233,10 @@ void register_lattice(py::module_& m) {
       "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
   m.def(
       "lattice_quantize",
-      [](const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, double diameter, int tick_bits) {
+      [](const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, PyReal diameter_arg,
+         PyInt tick_bits_arg) {
+        const double diameter = to_real(diameter_arg, "diameter");
+        const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
         require(box.size() == 2 && wall.size() == 2, "lattice: box and walls need two entries (2D)");
         require(x.ndim() == 2 && x.shape(1) == 2 && v.ndim() == 2 && v.shape(1) == 2, "lattice: positions and velocities must be (n, 2)");
         la::LatticeConfig c;
@@ -245,9 +252,10 @@ void register_lattice(py::module_& m) {
       "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
 
   py::class_<PyLattice>(m, "LatticeEngine", "The 2D lattice engine (revcol/lattice/engine.hpp).")
-      .def(py::init([](const py::dict& units, const IArray& x, const IArray& v, std::uint64_t seed, const std::string& law,
-                       std::int64_t clock) {
-             require(seed <= 0xFFFFFFFFull, "seed must be < 2^32");
+      .def(py::init([](const py::dict& units, const IArray& x, const IArray& v, PyInt seed_arg, const std::string& law,
+                       PyInt clock_arg) {
+             const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
+             const auto clock = to_int<std::int64_t>(clock_arg, "clock");
              const la::Units u = units_from(units);
              const revcol::Law lw = parse_law(law);
              return PyLattice{lw, la::LatticeEngine(u, vecs(x, "x"), vecs(v, "v"), static_cast<std::uint32_t>(seed),
@@ -264,17 +272,23 @@ void register_lattice(py::module_& m) {
           py::arg("snapshot"), "Rebuilds an engine from snapshot(); it resumes bit for bit.")
       .def(
           "run",
-          [](PyLattice& p, std::optional<std::uint64_t> collisions, std::optional<std::int64_t> until) {
+          [](PyLattice& p, std::optional<PyInt> collisions_arg, std::optional<PyInt> until_arg) {
+            const auto collisions = to_int<std::uint64_t>(collisions_arg, "collisions");
+            const auto until = to_int<std::int64_t>(until_arg, "until");
             const std::uint64_t done = p.e.run(collisions.value_or(std::numeric_limits<std::uint64_t>::max()),
-                                               until.value_or(la::tick_limit - 1));
+                                               until.value_or(la::tick_limit - 1), poll_signals);
+            if (PyErr_Occurred()) throw py::error_already_set();  // Ctrl-C: stopped at a valid tick
             return done;
           },
           py::arg("collisions") = py::none(), py::arg("until") = py::none(),
           "Forward: until that many more collisions or the tick `until`; returns the collisions done.")
       .def(
           "run_back",
-          [](PyLattice& p, std::optional<std::uint64_t> to_collisions, std::optional<std::int64_t> to_tick) {
-            p.e.run_back(to_collisions.value_or(0), to_tick.value_or(p.e.origin()));
+          [](PyLattice& p, std::optional<PyInt> to_collisions_arg, std::optional<PyInt> to_tick_arg) {
+            const auto to_collisions = to_int<std::uint64_t>(to_collisions_arg, "to_collisions");
+            const auto to_tick = to_int<std::int64_t>(to_tick_arg, "to_tick");
+            p.e.run_back(to_collisions.value_or(0), to_tick.value_or(p.e.origin()), poll_signals);
+            if (PyErr_Occurred()) throw py::error_already_set();
           },
           py::arg("to_collisions") = py::none(), py::arg("to_tick") = py::none(),
           "Back to collision count `to_collisions` or tick `to_tick` (default: the start).")

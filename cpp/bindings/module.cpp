@@ -5,9 +5,20 @@
 #include "bindings.hpp"
 #include "revcol/error.hpp"
 
+#define REVCOL_STR2(x) #x
+#define REVCOL_STR(x) REVCOL_STR2(x)
+
 PYBIND11_MODULE(_core, m) {
   m.doc() = "revcol core (private): use the revcol package";
   pybind11::register_exception<revcol::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
+  // what built this module, stamped into checkpoints (python/revcol/_io.py)
+  m.attr("build") = "gcc " __VERSION__ ", pybind11 " REVCOL_STR(PYBIND11_VERSION_MAJOR) "." REVCOL_STR(
+      PYBIND11_VERSION_MINOR) "." REVCOL_STR(PYBIND11_VERSION_PATCH)
+#ifdef NDEBUG
+      ", release";
+#else
+      ", debug";
+#endif
   revcol::bind::register_rng(m);
   revcol::bind::register_collide(m);
   revcol::bind::register_verify(m);

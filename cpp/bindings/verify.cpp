@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "args.hpp"
 #include "bindings.hpp"
 #include "revcol/verify.hpp"
 
@@ -13,8 +14,11 @@ void register_verify(py::module_& m) {
   m.def(
       "verify",
       [](const std::string& case_name, const std::string& mode, const std::string& law,
-         const std::string& rng, std::uint64_t seed, std::uint64_t collisions, int bits,
+         const std::string& rng, PyInt seed_arg, PyInt collisions_arg, PyInt bits_arg,
          bool printed_reverse, std::vector<double> velocities, std::vector<double> normal) {
+        const auto seed = to_int<std::uint64_t>(seed_arg, "seed");
+        const auto collisions = to_int<std::uint64_t>(collisions_arg, "collisions");
+        const int bits = to_int<int>(bits_arg, "bits");
         VerifyConfig c;
         c.case_name = case_name;
         c.mode = parse_mode(mode);

@@ -155,14 +155,15 @@ class EngineImpl final : public Simulation {
 
   // ---- the Simulation interface -------------------------------------------------------
 
-  RunResult run(std::uint64_t max_collisions, double t_end, const Progress& cb, std::uint64_t every) override {
+  RunResult run(std::uint64_t max_collisions, double t_end, const Progress& cb, std::uint64_t every,
+                const Poll& poll) override {
     require(!std::isnan(t_end), "end time must not be NaN");
     require(std::isfinite(t_end) || max_collisions != std::numeric_limits<std::uint64_t>::max(),
             "run: give a finite end time or a collision count (an infinite run never returns)");
-    return loop(max_collisions, t_end, cb, every, /*reversed=*/false);
+    return loop(max_collisions, t_end, cb, every, poll, /*reversed=*/false);
   }
 
-  RunResult run_back(std::uint64_t max_collisions, double t_target) override {
+  RunResult run_back(std::uint64_t max_collisions, double t_target, const Poll& poll) override {
     require(!std::isnan(t_target), "target time must not be NaN");
     require(std::isfinite(t_target) || max_collisions != std::numeric_limits<std::uint64_t>::max(),
             "run_back: give a finite target time or a collision count (an infinite run back never returns)");
@@ -173,7 +174,7 @@ class EngineImpl final : public Simulation {
     flip();
     RunResult r;
     try {
-      r = loop(max_collisions, -t_target, {}, 0, /*reversed=*/true);
+      r = loop(max_collisions, -t_target, {}, 0, poll, /*reversed=*/true);
     } catch (...) {
       flip();
       throw;
@@ -510,11 +511,19 @@ class EngineImpl final : public Simulation {
   // ---- the event loop -----------------------------------------------------------------
 
   RunResult loop(std::uint64_t max_collisions, double t_end, const Progress& cb, std::uint64_t every,
-                 bool reversed) {
+                 const Poll& poll, bool reversed) {
     RunResult res;
     double t_last = clock_;
     bool done_count = max_collisions == 0;
+    std::uint32_t since_poll = 0;
     while (true) {
+      if (poll && ++since_poll == kPollEvents) {  // Ctrl-C: stop as a collision count would
+        since_poll = 0;
+        if (!done_count && !poll()) {
+          res.interrupted = true;
+          done_count = true;
+        }
+      }
       const int i = queue_.top();
       if (i < 0) break;  // nothing scheduled (never: every particle has an event, maybe at infinity)
       const Ev e = ev_[i];

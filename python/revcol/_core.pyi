@@ -33,6 +33,9 @@ class _Logged(metaclass=_pybind11_type):
 class InvalidArgument(ValueError):
     """Bad input to the core (revcol::InvalidArgument); nothing was changed."""
 
+#: what built the module: compiler, pybind11, release/debug (stamped into checkpoints)
+build: str
+
 
 # ---- cpp/bindings/rng.cpp: the reversible generators.
 

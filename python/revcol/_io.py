@@ -8,21 +8,84 @@ from typing import Mapping, Union
 
 import numpy as np
 
-__all__ = ["write_npz_atomic"]
+__all__ = ["write_npz_atomic", "read_checkpoint", "STAMP_KEYS"]
+
+#: keys a checkpoint file carries besides the snapshot: what wrote it
+STAMP_KEYS = ("revcol_version", "revcol_build", "revcol_engine")
+
+
+def _fsync_folder(folder: str) -> None:
+    """Makes a rename durable (POSIX: fsync the folder); a no-op where folders cannot be opened."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
 
 
 def write_npz_atomic(path: Union[str, os.PathLike], arrays: Mapping[str, np.ndarray]) -> None:
-    """Writes ``arrays`` as an ``.npz`` to ``path`` atomically (temporary file, then ``os.replace``)."""
+    """Writes ``arrays`` as an ``.npz`` to ``path`` atomically (temporary file in the same folder,
+    fsync, then ``os.replace``): a failed save leaves any previous file at ``path`` whole."""
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".revcol-", suffix=".npz.tmp", dir=folder)
     try:
         with os.fdopen(fd, "wb") as f:
             np.savez(f, **arrays)
+            f.flush()
+            os.fsync(f.fileno())  # the data is on disk before the name points at it
         os.replace(tmp, path)
+        _fsync_folder(folder)
     except BaseException:
         try:
             os.unlink(tmp)
         except OSError:
             pass
         raise
+
+
+def stamped(arrays: Mapping[str, np.ndarray], engine: str) -> dict:
+    """``arrays`` with the stamp of this revcol (version, build: compiler and flags) and ``engine``."""
+    from . import __version__, _core
+    out = dict(arrays)
+    out.update(revcol_version=np.asarray(__version__), revcol_build=np.asarray(_core.build),
+               revcol_engine=np.asarray(engine))
+    return out
+
+
+def read_checkpoint(path: Union[str, os.PathLike], engine: str) -> dict:
+    """The arrays of a checkpoint written by ``save`` (no pickles), its stamp checked: a file that is
+    not an ``.npz``, or whose stamp names another engine, raises ValueError naming the problem; one
+    written by another revcol version or build loads with a RuntimeWarning (it resumes, but bit-for-bit
+    agreement with the other build's run is not promised). Files from before stamps load silently."""
+    import warnings
+    import zipfile
+
+    from . import __version__, _core
+    try:
+        z = np.load(path, allow_pickle=False)
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as e:
+        raise ValueError(f"{os.fspath(path)!r} is not a readable revcol checkpoint ({e})") from None
+    if not isinstance(z, np.lib.npyio.NpzFile):
+        raise ValueError(f"{os.fspath(path)!r} is not a revcol checkpoint (.npz), it holds one array")
+    out = {}
+    with z:
+        try:
+            for k in z.files:
+                out[k] = z[k]
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as e:
+            raise ValueError(f"{os.fspath(path)!r}: entry {k!r} is damaged ({e})") from None
+    stamp = {k: out.pop(k) for k in STAMP_KEYS if k in out}
+    if "revcol_engine" in stamp and str(stamp["revcol_engine"]) != engine:
+        raise ValueError(f"{os.fspath(path)!r} is a {stamp['revcol_engine']} engine checkpoint, not {engine}")
+    ver, build = str(stamp.get("revcol_version", __version__)), str(stamp.get("revcol_build", _core.build))
+    if ver != __version__ or build != _core.build:
+        warnings.warn(f"{os.fspath(path)!r} was written by revcol {ver} ({build}); this is {__version__} "
+                      f"({_core.build}): the run resumes, but bit-for-bit agreement across builds is not promised",
+                      RuntimeWarning, stacklevel=3)
+    return out

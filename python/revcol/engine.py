@@ -41,7 +41,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._io import write_npz_atomic
+from ._io import read_checkpoint, stamped, write_npz_atomic
 
 __all__ = ["Simulation"]
 
@@ -52,6 +52,14 @@ def _boundary_list(boundary: _Boundary) -> list:
     if isinstance(boundary, str):
         return [boundary]
     return [str(b) for b in boundary]
+
+
+def _real_array(a, name: str) -> np.ndarray:
+    """``a`` as a float64 array; a TypeError naming ``name`` when it is not one (issue 17)."""
+    try:
+        return np.asarray(a, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name} must be an array of real numbers ({e})") from None
 
 
 class Simulation:
@@ -84,15 +92,16 @@ class Simulation:
         if _engine is not None:
             self._e = _engine
             return
-        x = np.asarray(positions, dtype=float)
-        v = np.asarray(velocities, dtype=float)
+        x = _real_array(positions, "positions")
+        v = _real_array(velocities, "velocities")
         if x.ndim == 1:
             x = x[:, None]
         if v.ndim == 1:
             v = v[:, None]
-        box = np.atleast_1d(np.asarray(box, dtype=float)).tolist()
-        self._e = _core.Engine(x, v, box, _boundary_list(boundary), float(diameter), mode, law,
-                               int(seed), int(bits), bool(groups), float(group_tol), float(time),
+        box = np.atleast_1d(_real_array(box, "box")).tolist()
+        # scalars go through as given: the engine names a wrong type or range (issue 17)
+        self._e = _core.Engine(x, v, box, _boundary_list(boundary), diameter, mode, law,
+                               seed, bits, bool(groups), group_tol, time,
                                str(generator), str(streams))
 
     @classmethod
@@ -114,9 +123,8 @@ class Simulation:
                                             init=init, **kwargs)
         if engine != "float":
             raise ValueError(f"engine must be 'float' or 'lattice', got {engine!r}")
-        x, v, box = _core.engine_random_state(int(dim), int(n), float(phi), _boundary_list(boundary),
-                                              float(diameter), int(seed),
-                                              float(energy) if energy is not None else 0.0, init,
+        x, v, box = _core.engine_random_state(dim, n, phi, _boundary_list(boundary), diameter, seed,
+                                              energy if energy is not None else 0.0, init,
                                               bool(equal_speeds))
         return cls(x, v, box, boundary=boundary, diameter=diameter, seed=seed, **kwargs)
 
@@ -131,20 +139,16 @@ class Simulation:
         # checked before the first event: a bad argument must not leave collisions done (issue 17)
         if callback is not None and not callable(callback):
             raise TypeError(f"callback must be callable, got {type(callback).__name__}")
-        if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
-            raise ValueError(f"every must be an integer >= 1, got {every!r}")
         cb = None
         if callback is not None:
             cb = lambda k: bool(callback(k) is not False)  # None means go on
-        return self._e.run(None if collisions is None else int(collisions),
-                           None if time is None else float(time), cb, int(every))
+        return self._e.run(collisions, time, cb, every)
 
     def run_back(self, collisions: Optional[int] = None, time: Optional[float] = None) -> dict:
         """Backwards: until ``collisions`` collisions are undone or the clock is back at
         ``time`` (finite; it may be before the start); without ``time``, never past the start
         time."""
-        return self._e.run_back(None if collisions is None else int(collisions),
-                                None if time is None else float(time))
+        return self._e.run_back(collisions, time)
 
     # --- state ---------------------------------------------------------------------------
 
@@ -226,16 +230,12 @@ class Simulation:
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the full state to ``path`` (numpy ``.npz``)."""
         st = self.snapshot()
-        write_npz_atomic(path, {k: np.asarray(v) for k, v in st.items()})
+        write_npz_atomic(path, stamped({k: np.asarray(v) for k, v in st.items()}, "float"))
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "Simulation":
         """Reads a state written by ``save``."""
-        with np.load(path, allow_pickle=False) as z:
-            st = {}
-            for k in z.files:
-                a = z[k]
-                st[k] = a.item() if a.ndim == 0 else a
+        st = {k: (a.item() if a.ndim == 0 else a) for k, a in read_checkpoint(path, "float").items()}
         return cls.from_snapshot(st)
 
     def __repr__(self) -> str:

@@ -30,7 +30,9 @@ from typing import Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._io import write_npz_atomic
+from ._args import integer, real
+from ._io import read_checkpoint, stamped, write_npz_atomic
+from .engine import _real_array
 
 __all__ = ["LatticeSimulation"]
 
@@ -72,14 +74,17 @@ class LatticeSimulation:
             self._e = _engine
             self._q = dict(_quantization or {})
             return
-        x = np.asarray(positions, dtype=float)
-        v = np.asarray(velocities, dtype=float)
+        x = _real_array(positions, "positions")
+        v = _real_array(velocities, "velocities")
+        box = _real_array(box, "box")
+        if box.ndim > 1 or box.size not in (1, 2):
+            raise ValueError(f"box must be one length or two (2D), got shape {box.shape}")
         start = _core.lattice_quantize(x, v, [float(b) for b in np.broadcast_to(box, (2,))],
-                                       _walls(boundary), float(diameter), int(tick_bits))
+                                       _walls(boundary), diameter, tick_bits)
         self._init_from_start(start, law, seed)
 
     def _init_from_start(self, start: dict, law: str, seed: int) -> None:
-        self._e = _core.LatticeEngine(start["units"], start["x"], start["v"], int(seed), str(law))
+        self._e = _core.LatticeEngine(start["units"], start["x"], start["v"], seed, str(law))
         self._q = {"max_position_error": start["max_position_error"],
                    "max_velocity_error": start["max_velocity_error"]}
 
@@ -92,8 +97,7 @@ class LatticeSimulation:
         kT = 1), quantized once. The same ``seed`` keys the streams."""
         if dim != 2:
             raise ValueError(f"the lattice engine is 2D, got dim={dim}")
-        start = _core.lattice_random_start(int(n), float(phi), _walls(boundary), float(diameter), int(seed), str(init),
-                                           int(tick_bits))
+        start = _core.lattice_random_start(n, phi, _walls(boundary), diameter, seed, str(init), tick_bits)
         sim = cls.__new__(cls)
         sim._init_from_start(start, law, seed)
         return sim
@@ -101,7 +105,10 @@ class LatticeSimulation:
     # --- running ---------------------------------------------------------------------------
 
     def _tick(self, time: float) -> int:
-        return int(round(float(time) / self._e.units["tick"]))
+        ticks = round(real(time, "time") / self._e.units["tick"])
+        if not -2**62 <= ticks <= 2**62:
+            raise ValueError(f"time = {time} is outside the lattice clock (|ticks| <= 2^62)")
+        return int(ticks)
 
     def run(self, collisions: Optional[int] = None, time: Optional[float] = None) -> dict:
         """Forward until ``collisions`` more collisions (the clock then at the last one's tick)
@@ -110,7 +117,7 @@ class LatticeSimulation:
         if collisions is None and time is None:
             raise ValueError("run needs collisions= or time=")
         until = None if time is None else self._tick(time)
-        done = self._e.run(None if collisions is None else int(collisions), until)
+        done = self._e.run(None if collisions is None else integer(collisions, "collisions", 0), until)
         return {"collisions": int(done), "clock": self.clock, "time": self.time}
 
     def run_back(self, collisions: Optional[int] = None, time: Optional[float] = None,
@@ -120,11 +127,12 @@ class LatticeSimulation:
         clock is back at ``time``, whichever comes first; with none of them, to the start."""
         target = None
         if collisions is not None:
-            target = self._e.collisions - int(collisions)
+            target = self._e.collisions - integer(collisions, "collisions", 0)
             if target < 0:
                 raise ValueError(f"cannot undo {collisions} collisions: only {self._e.collisions} were run")
         if to_collision is not None:
-            target = int(to_collision) if target is None else max(target, int(to_collision))
+            to_collision = integer(to_collision, "to_collision", 0)
+            target = to_collision if target is None else max(target, to_collision)
         tick = None if time is None else self._tick(time)
         before = self._e.collisions
         self._e.run_back(target, tick)
@@ -234,23 +242,21 @@ class LatticeSimulation:
                     flat[f"{k}.{k2}"] = np.asarray(v2)
             else:
                 flat[k] = np.asarray(v)
-        write_npz_atomic(path, flat)
+        write_npz_atomic(path, stamped(flat, "lattice"))
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "LatticeSimulation":
         """Reads a state written by ``save``."""
         st: dict = {}
-        with np.load(path, allow_pickle=False) as z:
-            for k in z.files:
-                a = z[k]
-                val = a.item() if a.ndim == 0 else a
-                if "." in k:
-                    outer, inner = k.split(".", 1)
-                    if isinstance(val, np.ndarray) and outer == "units":
-                        val = tuple(val.tolist())
-                    st.setdefault(outer, {})[inner] = val
-                else:
-                    st[k] = val
+        for k, a in read_checkpoint(path, "lattice").items():
+            val = a.item() if a.ndim == 0 else a
+            if "." in k:
+                outer, inner = k.split(".", 1)
+                if isinstance(val, np.ndarray) and outer == "units":
+                    val = tuple(val.tolist())
+                st.setdefault(outer, {})[inner] = val
+            else:
+                st[k] = val
         return cls.from_snapshot(st)
 
     def __repr__(self) -> str:

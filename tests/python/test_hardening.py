@@ -83,3 +83,168 @@ def test_run_checks_its_arguments_before_the_first_event():
         s.run(collisions=100, callback=lambda k: None, every=0)
     after = s.snapshot()
     assert all(np.array_equal(np.asarray(before[k]), np.asarray(after[k])) for k in ("x", "v", "time", "rng"))
+
+
+# --- operators: errors move no generator; speeds outside the chart's range are refused ----
+
+
+def _approaching(c, rng):
+    """A pre state of named case c (a dict of revcol.named_cases()) that its operator accepts."""
+    op = revcol.Collision.named(c["name"])
+    for _ in range(1000):
+        v = rng.normal(size=(c["n"], c["d"]))
+        try:
+            op.forward(v, g=np.full(op.draws, 0.5))
+            return op, v
+        except ValueError:
+            pass
+    raise AssertionError(f"no pre state found for {c['name']}")
+
+
+@pytest.mark.parametrize("make", [lambda: revcol.Pair2D(), lambda: revcol.Pair2D(mode="paper")])
+def test_a_reverse_batch_the_counter_cannot_serve_moves_nothing(make):
+    # was: the generator stepped back one draw before the error (issue 17)
+    op = make()
+    v = np.array([[[-1.0, 0.2], [1.0, 0.1]]] * 3)
+    n = np.array([[1.0, 0.0]] * 3)
+    post = op.forward(v, n, rng=revcol.Philox())
+    for counter in (0, 1, 2):
+        p = revcol.Philox(counter=counter)
+        with pytest.raises(ValueError, match="steps back 3 draws"):
+            op.reverse(post, n, rng=p)
+        assert p.counter == counter
+    back = op.reverse(post, n, rng=revcol.Philox(counter=3))
+    assert np.abs(back - v).max() < 1e-12
+
+
+def test_a_collision_reverse_the_counter_cannot_serve_moves_nothing():
+    op = revcol.Collision.named("triple2d-c1")
+    _, v = _approaching(revcol.named_cases()[4], np.random.default_rng(3))
+    post = op.forward(np.stack([v, v]), rng=revcol.Philox())  # 2 x 3 draws
+    p = revcol.Philox(counter=5)
+    with pytest.raises(ValueError, match="counter is 5 but reversing this batch steps back 6"):
+        op.reverse(post, rng=p)
+    assert p.counter == 5 and op.log_size == 0
+
+
+@pytest.mark.parametrize("case", revcol.named_cases(), ids=lambda c: c["name"])
+def test_every_named_case_works_up_to_its_speed_limits_and_refuses_beyond(case):
+    # was: NaN, silently, at 1e-170 and at >= 1e150 (issue 17); the limits are 2^-480 for the
+    # relative speed's largest component and 2^450 for any component (collide/common.hpp)
+    op, v = _approaching(case, np.random.default_rng(7))
+    g = np.full(op.draws, 0.37)
+
+    def round_trip(u):
+        back = op.reverse(op.forward(u, g=g), g=g)
+        assert np.isfinite(back).all()
+        return np.abs(back - u).max() / np.abs(u).max()
+
+    base = round_trip(v)
+    rel = max(np.abs(v[i] - v[j]).max() for i, j in case["contacts"])
+    for scale in (2.0**-479 / rel, 2.0**449 / np.abs(v).max()):  # inside, at the edges
+        assert round_trip(v * scale) <= max(4 * base, 1e-13)
+    with pytest.raises(ValueError, match="relative speed too small"):
+        op.forward(v * (2.0**-481 / rel), g=g)
+    with pytest.raises(ValueError, match="velocities too large"):
+        op.forward(v * (2.0**451 / np.abs(v).max()), g=g)
+
+
+@pytest.mark.parametrize("scale", [1e-161, 1e-130, 1e136, 1.2e154])
+def test_a_gas_too_slow_or_too_fast_for_the_operators_is_refused(scale):
+    # was: a hang at 1e-161 and an overflow at 1.2e154 (issue 17)
+    s = Simulation.random(100, 2, 0.3, seed=1)
+    with pytest.raises(ValueError, match="velocity|kinetic energy overflows"):
+        Simulation(s.positions, s.velocities * scale, s.box)
+    Simulation(s.positions, s.velocities * 1e-120, s.box).run(collisions=50)  # inside: runs
+
+
+# --- integer and real arguments are named -------------------------------------------------
+
+
+@pytest.mark.parametrize("call, exc, text", [
+    (lambda: revcol.Pair2D(bits=2**40), ValueError, "bits = 1099511627776 is outside"),
+    (lambda: revcol.Pair2D(bits="40"), TypeError, "bits must be an integer, got str"),
+    (lambda: revcol.Collision.named("pair2d", bits=-1), ValueError, "bits"),
+    (lambda: revcol.Collision(2, 2.0, [(0, 1)], normals=[[1.0, 0.0]]), TypeError, "d must be an integer"),
+    (lambda: Simulation.random(100, 2, "0.3"), TypeError, "phi must be a real number, got str"),
+    (lambda: Simulation.random(100, 2, 0.3, seed=-1), ValueError, "seed = -1 is outside"),
+    (lambda: Simulation.random(10**12, 2, 0.3), ValueError, "n = 1000000000000 is outside"),
+    (lambda: Simulation([[1.0, 1.0]], [[1.0, 0.0]], ["a", "b"]), TypeError, "box must be an array of real"),
+    (lambda: Simulation.random(50, 2, 0.3, diameter=None), TypeError, "diameter must be a real number"),
+])
+def test_bad_scalar_arguments_are_named(call, exc, text):
+    with pytest.raises(exc, match=text):
+        call()
+
+
+@pytest.mark.parametrize("engine", ["float", "lattice"])
+@pytest.mark.parametrize("kw, exc, text", [
+    (dict(collisions=-1), ValueError, "collisions = -1 is outside"),
+    (dict(collisions=2**64), (ValueError, OverflowError), "collisions"),
+    (dict(collisions=1e6), TypeError, "collisions must be an integer, got float \\(1000000.0; write"),
+    (dict(collisions=[3]), TypeError, "collisions must be an integer, got list"),
+    (dict(time="soon"), TypeError, "time must be a real number, got str"),
+])
+def test_bad_run_arguments_are_named_and_change_nothing(engine, kw, exc, text):
+    s = Simulation.random(50, 2, 0.3, seed=1, engine=engine)
+    s.run(collisions=20)
+    before = s.snapshot()
+    with pytest.raises(exc, match=text):
+        s.run(**kw)
+    with pytest.raises(exc, match=text):
+        s.run_back(**kw)
+    after = s.snapshot()
+    assert before.keys() == after.keys()
+    for k in before:
+        if isinstance(before[k], dict):
+            assert before[k] == after[k], k
+        else:
+            assert np.array_equal(np.asarray(before[k]), np.asarray(after[k])), k
+
+
+# --- checkpoints: stamped, checked, written atomically ------------------------------------
+
+
+@pytest.mark.parametrize("engine", ["float", "lattice"])
+def test_a_checkpoint_carries_its_stamp_and_is_checked(engine, tmp_path):
+    s = Simulation.random(50, 2, 0.3, seed=1, engine=engine)
+    s.run(collisions=30)
+    path = tmp_path / "a.npz"
+    s.save(path)
+    with np.load(path) as z:
+        assert str(z["revcol_version"]) == revcol.__version__ and str(z["revcol_engine"]) == engine
+        assert str(z["revcol_build"]) == revcol._core.build
+        data = {k: z[k] for k in z.files}
+    cls = type(s)
+    assert np.array_equal(cls.load(path).positions, s.positions)
+    other = {"float": "lattice", "lattice": "float"}[engine]
+    np.savez(tmp_path / "b.npz", **{**data, "revcol_engine": np.asarray(other)})
+    with pytest.raises(ValueError, match=f"is a {other} engine checkpoint"):
+        cls.load(tmp_path / "b.npz")
+    np.savez(tmp_path / "c.npz", **{**data, "revcol_version": np.asarray("0.0.1")})
+    with pytest.warns(RuntimeWarning, match="written by revcol 0.0.1"):
+        cls.load(tmp_path / "c.npz")
+    (tmp_path / "d.npz").write_bytes(b"not a zip file at all")
+    with pytest.raises(ValueError, match="not a readable revcol checkpoint"):
+        cls.load(tmp_path / "d.npz")
+    np.save(tmp_path / "e.npy", np.zeros(3))
+    with pytest.raises(ValueError, match="holds one array"):
+        cls.load(tmp_path / "e.npy")
+
+
+def test_a_failed_save_keeps_the_previous_checkpoint(tmp_path, monkeypatch):
+    s = Simulation.random(50, 2, 0.3, seed=1)
+    path = tmp_path / "ck.npz"
+    s.save(path)
+    good = path.read_bytes()
+    s.run(collisions=10)
+
+    def broken(f, **arrays):
+        f.write(b"half a file")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savez", broken)
+    with pytest.raises(OSError, match="disk full"):
+        s.save(path)
+    assert path.read_bytes() == good
+    assert [p.name for p in tmp_path.iterdir()] == ["ck.npz"]  # no temporary left behind

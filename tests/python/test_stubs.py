@@ -95,6 +95,8 @@ def test_every_name_is_in_both():
     for node in _stub().body:
         if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
             stub_names.add(node.name)
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            stub_names.add(node.target.id)  # module attributes (build)
     runtime = {n for n in dir(_core) if not n.startswith("__")}
     assert _public(stub_names) == _public(runtime)
 

@@ -211,7 +211,7 @@ struct RunResult {
   std::uint64_t collisions = 0;  ///< collisions processed (pairs and groups)
   std::uint64_t events = 0;      ///< events popped
   double time = 0.0;             ///< the clock at the end
-  bool interrupted = false;      ///< the progress callback asked to stop
+  bool interrupted = false;      ///< the progress callback (or the poll) asked to stop
 };
 
 /// The full state, for checkpoints: restoring it resumes bit for bit.
@@ -336,6 +336,11 @@ struct Diagnostics {
 /// Called every `every` collisions with the collisions done so far in this call;
 /// returning false stops the run between events.
 using Progress = std::function<bool(std::uint64_t)>;
+/// Called every kPollEvents events whatever happens (collisions or not); returning false stops
+/// the run between events, at a state as valid as any other stop (the binding checks Ctrl-C).
+using Poll = std::function<bool()>;
+/// Events between two polls: about 10 ms of events (a poll is one flag check in Python).
+inline constexpr std::uint32_t kPollEvents = 1u << 14;
 
 /// The engine for any d (runtime); one implementation per d behind it.
 class Simulation {
@@ -344,10 +349,10 @@ class Simulation {
   /// Runs forward until `max_collisions` more collisions or the clock reaches t_end,
   /// whichever first, ending between events.
   virtual RunResult run(std::uint64_t max_collisions, double t_end, const Progress& cb = {},
-                        std::uint64_t every = 0) = 0;
+                        std::uint64_t every = 0, const Poll& poll = {}) = 0;
   /// Runs backwards until `max_collisions` collisions are undone or the clock is back at
-  /// t_target (<= time()), whichever first, ending between events.
-  virtual RunResult run_back(std::uint64_t max_collisions, double t_target) = 0;
+  /// t_target (<= time()), whichever first, ending between events (or when poll says stop).
+  virtual RunResult run_back(std::uint64_t max_collisions, double t_target, const Poll& poll = {}) = 0;
   /// Positions at the current time (n x dim, row-major).
   virtual std::vector<double> positions() const = 0;
   /// Velocities (n x dim).

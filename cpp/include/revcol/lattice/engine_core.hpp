@@ -36,6 +36,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -180,7 +181,7 @@ class BasicEngine {
 
   /// Runs forward until `collisions` more collisions (clock = the last one's tick) or up to tick
   /// `until` (clock = until), whichever comes first. Returns the collisions done.
-  std::uint64_t run(std::uint64_t collisions, std::int64_t until) {
+  std::uint64_t run(std::uint64_t collisions, std::int64_t until, const std::function<bool()>& poll = {}) {
     require(until >= clock_, "lattice run: the end tick is before the clock");
     require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
     if (collisions == 0) return 0;
@@ -188,7 +189,7 @@ class BasicEngine {
     // run changes (O(changes), so that run(collisions=1) stays O(1) at any N)
     begin_undo();
     try {
-      return loop(collisions, until, false, 0);
+      return loop(collisions, until, false, 0, poll);
     } catch (...) {
       undo();
       throw;
@@ -196,13 +197,13 @@ class BasicEngine {
   }
   /// Runs back to collision count `to_collisions` (the state the forward run had right after it,
   /// clock = its tick) or to tick `to_tick` (clock = to_tick), whichever comes first in reverse.
-  void run_back(std::uint64_t to_collisions, std::int64_t to_tick) {
+  void run_back(std::uint64_t to_collisions, std::int64_t to_tick, const std::function<bool()>& poll = {}) {
     require(to_collisions <= ncoll_, "lattice run_back: the target collision count is ahead of the state");
     require(to_tick >= origin_ && to_tick <= clock_, "lattice run_back: the target tick must be in [origin, clock]");
     const Snapshot before = snapshot();  // an engine error mid-run leaves the state as it was
     flip();
     try {
-      loop(0, -to_tick, true, to_collisions);
+      loop(0, -to_tick, true, to_collisions, poll);
     } catch (...) {
       restore(before);
       throw;
@@ -470,10 +471,17 @@ class BasicEngine {
     if (std::make_pair(t, k) < last_key_) throw std::logic_error("lattice engine: events out of order (a bug)");
     last_key_ = {t, k};
   }
-  std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target) {
+  std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target,
+                     const std::function<bool()>& poll) {
     std::uint64_t done = 0;
+    std::uint32_t since_poll = 0;
     for (;;) {
       const int p = queue_.top();
+      if (poll && ++since_poll == kPollEvents && p >= 0) {
+        // Ctrl-C: end at the tick before the next event, as run(until = that tick) would
+        since_poll = 0;
+        if (!poll()) until = std::max(clock_, std::min(until, queue_.time(p) - 1));
+      }
       if (p < 0 || queue_.time(p) > until) {
         clock_ = until;
         return done;

@@ -29,6 +29,8 @@ namespace revcol::lattice {
 
 /// Largest allowed clock or event tick (both directions): |t| < 2^61.
 inline constexpr std::int64_t tick_limit = std::int64_t{1} << 61;
+/// Events between two polls of a run's stop request (Ctrl-C through the binding).
+inline constexpr std::uint32_t kPollEvents = 1u << 14;
 /// Largest allowed box length in lattice units (positions, their differences and a position
 /// plus or minus a velocity stay inside int64).
 inline constexpr std::int64_t max_box = INT64_MAX - (std::int64_t{1} << 56);

@@ -1,0 +1,38 @@
+"""Argument checks of the Python wrappers, with messages that name the argument (issue 17).
+
+The compiled module names its own scalar arguments (``cpp/bindings/args.hpp``); these are for
+wrappers that compute with an argument before it reaches C++ (``collisions - done``,
+``time / tick``). ``bool`` is refused as an integer: ``run(collisions=True)`` is a mistake.
+"""
+from __future__ import annotations
+
+import math
+import operator
+from typing import Optional
+
+
+def integer(x, name: str, lo: Optional[int] = None, hi: Optional[int] = None) -> int:
+    """``x`` as an int (anything with ``__index__`` but bool); TypeError / ValueError naming ``name``."""
+    if isinstance(x, bool):
+        raise TypeError(f"{name} must be an integer, got bool")
+    try:
+        v = operator.index(x)
+    except TypeError:
+        hint = f" ({x!r}; write int(...) or 1_000_000)" if isinstance(x, float) else ""
+        raise TypeError(f"{name} must be an integer, got {type(x).__name__}{hint}") from None
+    if (lo is not None and v < lo) or (hi is not None and v > hi):
+        raise ValueError(f"{name} = {v} is outside [{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}]")
+    return v
+
+
+def real(x, name: str, *, finite: bool = True) -> float:
+    """``x`` as a float (a real number, not a string or bool); TypeError / ValueError naming ``name``."""
+    if isinstance(x, (bool, str, bytes)):
+        raise TypeError(f"{name} must be a real number, got {type(x).__name__}")
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a real number, got {type(x).__name__}") from None
+    if finite and not math.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {v}")
+    return v
