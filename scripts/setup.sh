@@ -27,7 +27,7 @@ fi
 py=.venv/bin/python
 $py -m pip install -q --disable-pip-version-check --upgrade pip >/dev/null
 $py -m pip install -q --disable-pip-version-check \
-  "scikit-build-core>=0.10" "pybind11>=2.12" "cmake>=3.20" ninja numpy "scipy>=1.8" "pytest>=7" "matplotlib>=3.5" "tqdm>=4.60" "gsd>=3" "mypy>=1.10"
+  "scikit-build-core>=0.10" "pybind11>=2.12" "cmake>=3.20" ninja numpy "scipy>=1.8" "pytest>=7" "matplotlib>=3.5" "tqdm>=4.60" "gsd>=3" "mypy>=1.10" "hypothesis>=6.80"
 # no build isolation: the tools above are in .venv, and build/ is reused between runs
 $py -m pip install -q --disable-pip-version-check --no-build-isolation --no-deps .
 echo "setup: ok ($($py -c 'import revcol, sys; print("revcol", revcol.__version__, "python", sys.version.split()[0])'))"

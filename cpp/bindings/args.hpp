@@ -12,6 +12,7 @@
 // "typing.SupportsInt | typing.SupportsIndex" and "typing.SupportsFloat | typing.SupportsIndex",
 // as for pybind11's int and float.
 #pragma once
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
@@ -98,6 +99,69 @@ inline std::optional<double> to_real(const std::optional<PyReal>& x, const std::
   return to_real(*x, what);
 }
 
+/// A Python object standing for a string argument, converted in the function body.
+struct PyStr {
+  pybind11::object o;  ///< the argument as given
+};
+
+/// x as a std::string (a Python str only); a TypeError naming `what` otherwise.
+inline std::string to_str(const PyStr& x, const std::string& what) {
+  if (!pybind11::isinstance<pybind11::str>(x.o))
+    throw pybind11::type_error(what + " must be a string, got " +
+                               std::string(pybind11::str(pybind11::type::handle_of(x.o).attr("__name__"))));
+  return x.o.cast<std::string>();
+}
+
+/// A Python object standing for a float64 array argument, converted in the function body.
+struct ArrayArg {
+  pybind11::object o;  ///< the argument as given
+};
+
+/// x as a C-contiguous float64 array (numpy's conversion: any array, nested sequence or number);
+/// a TypeError naming `what` when numpy cannot convert it.
+inline pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast> to_array(
+    const ArrayArg& x, const std::string& what) {
+  using A = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
+  A a = A::ensure(x.o);  // empty (error cleared) when numpy cannot convert
+  if (!a)
+    throw pybind11::type_error(what + " must be an array of real numbers, got " +
+                               std::string(pybind11::str(pybind11::type::handle_of(x.o).attr("__name__"))));
+  return a;
+}
+
+/// As to_array, for an optional argument (None gives nullopt).
+inline std::optional<pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>> to_array(
+    const std::optional<ArrayArg>& x, const std::string& what) {
+  if (!x) return std::nullopt;
+  return to_array(*x, what);
+}
+
+/// f() (the reading of checkpoint entry `key`), with any conversion failure (pybind11's
+/// "Unable to cast", a numpy TypeError/ValueError) turned into an InvalidArgument naming the entry.
+template <class F>
+auto checkpoint_entry(const std::string& key, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const pybind11::cast_error&) {
+    throw InvalidArgument("checkpoint entry '" + key + "' has the wrong type or range for its field");
+  } catch (pybind11::error_already_set& e) {
+    if (!e.matches(PyExc_TypeError) && !e.matches(PyExc_ValueError) && !e.matches(PyExc_OverflowError)) throw;
+    throw InvalidArgument("checkpoint entry '" + key + "' has the wrong type or range (" + e.what() + ")");
+  }
+}
+
+/// A checkpoint entry converted to T; an InvalidArgument naming the entry when it does not fit.
+template <class T>
+T checkpoint_field(pybind11::handle obj, const std::string& key) {
+  try {
+    return checkpoint_entry(key, [&] { return pybind11::cast<T>(obj); });
+  } catch (const InvalidArgument& e) {  // say what was there
+    throw InvalidArgument(std::string(e.what()) + ": got " +
+                          std::string(pybind11::str(pybind11::type::handle_of(obj).attr("__name__"))) + " " +
+                          std::string(pybind11::repr(obj)).substr(0, 60));
+  }
+}
+
 /// A long run's poll (engine::Poll): false once a signal handler (Ctrl-C) left a Python
 /// exception pending; the run stops at a valid point and the caller raises it.
 inline bool poll_signals() { return PyErr_CheckSignals() == 0; }
@@ -116,6 +180,30 @@ struct type_caster<revcol::bind::PyInt> {
     return true;
   }
   static handle cast(const revcol::bind::PyInt& x, return_value_policy, handle) { return x.o.inc_ref(); }
+};
+/// Loads any object into PyStr; signatures show str.
+template <>
+struct type_caster<revcol::bind::PyStr> {
+  PYBIND11_TYPE_CASTER(revcol::bind::PyStr, const_name("str"));
+  bool load(handle src, bool) {
+    if (!src) return false;
+    value.o = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const revcol::bind::PyStr& x, return_value_policy, handle) { return x.o.inc_ref(); }
+};
+/// Loads any object into ArrayArg; signatures show pybind11's float64 array type text.
+template <>
+struct type_caster<revcol::bind::ArrayArg> {
+  PYBIND11_TYPE_CASTER(revcol::bind::ArrayArg,
+                       io_name("typing.Annotated[numpy.typing.ArrayLike, numpy.float64]",
+                               "numpy.typing.NDArray[numpy.float64]"));
+  bool load(handle src, bool) {
+    if (!src) return false;
+    value.o = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const revcol::bind::ArrayArg& x, return_value_policy, handle) { return x.o.inc_ref(); }
 };
 /// Loads any object into PyReal; signatures show pybind11's float type text.
 template <>

@@ -92,15 +92,20 @@ Example:
 
 void register_collide(py::module_& m) {
   py::class_<Pair2D>(m, "Pair2D", kPair2DDoc)
-      .def(py::init([](const std::string& mode, const std::string& law, PyInt bits, bool printed) {
-             return Pair2D(parse_mode(mode), parse_law(law),
+      .def(py::init([](PyStr mode, PyStr law, PyInt bits, bool printed) {
+             return Pair2D(parse_mode(to_str(mode, "mode")), parse_law(to_str(law, "law")),
                            to_int<int>(bits, "bits", FixedPoint::min_bits, FixedPoint::max_bits), printed);
            }),
            py::kw_only(), py::arg("mode") = "exact", py::arg("law") = "flux",
            py::arg("bits") = FixedPoint::default_bits, py::arg("printed_reverse") = false)
       .def("forward",
-           [](Pair2D& op, const Array& v, const Array& n, py::object rng, std::optional<Array> g,
-              std::optional<Array> momentum, std::optional<Array> energy) {
+           [](Pair2D& op, const ArrayArg& v_arg, const ArrayArg& n_arg, py::object rng, std::optional<ArrayArg> g_arg,
+              std::optional<ArrayArg> momentum_arg, std::optional<ArrayArg> energy_arg) {
+             const auto v = to_array(v_arg, "velocities");
+             const auto n = to_array(n_arg, "normal");
+             const auto g = to_array(g_arg, "g");
+             const auto momentum = to_array(momentum_arg, "momentum");
+             const auto energy = to_array(energy_arg, "energy");
              return run_pair2d(op, v, n, rng, g, momentum, energy, batch::Dir::forward);
            },
            py::arg("velocities"), py::arg("normal"), py::kw_only(), py::arg("rng") = py::none(),
@@ -109,16 +114,25 @@ void register_collide(py::module_& m) {
            "(B, 2) from j to i; exactly one of rng (drawn in entry order) or g (draws in [0,1]).\n"
            "Every entry is validated first; on error nothing changes.")
       .def("reverse",
-           [](Pair2D& op, const Array& v, const Array& n, py::object rng, std::optional<Array> g,
-              std::optional<Array> momentum, std::optional<Array> energy) {
+           [](Pair2D& op, const ArrayArg& v_arg, const ArrayArg& n_arg, py::object rng, std::optional<ArrayArg> g_arg,
+              std::optional<ArrayArg> momentum_arg, std::optional<ArrayArg> energy_arg) {
+             const auto v = to_array(v_arg, "velocities");
+             const auto n = to_array(n_arg, "normal");
+             const auto g = to_array(g_arg, "g");
+             const auto momentum = to_array(momentum_arg, "momentum");
+             const auto energy = to_array(energy_arg, "energy");
              return run_pair2d(op, v, n, rng, g, momentum, energy, batch::Dir::reverse);
            },
            py::arg("velocities"), py::arg("normal"), py::kw_only(), py::arg("rng") = py::none(),
            py::arg("g") = py::none(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
            "Post -> pre with the draws forward used (rng steps back, last entry first).")
       .def("quantize",
-           [](const Pair2D& op, const Array& v, const Array& n, std::optional<Array> momentum,
-              std::optional<Array> energy) {
+           [](const Pair2D& op, const ArrayArg& v_arg, const ArrayArg& n_arg, std::optional<ArrayArg> momentum_arg,
+              std::optional<ArrayArg> energy_arg) {
+             const auto v = to_array(v_arg, "velocities");
+             const auto n = to_array(n_arg, "normal");
+             const auto momentum = to_array(momentum_arg, "momentum");
+             const auto energy = to_array(energy_arg, "energy");
              Rows rows{};
              std::vector<PairV<2>> pv = pairs_from(v, rows);
              const auto nv = normals_from(n, pv.size());
@@ -132,7 +146,9 @@ void register_collide(py::module_& m) {
            py::arg("energy") = py::none(),
            "The pre state as reversal restores it: exact mode decodes its chart cell at the centre.")
       .def("chart",
-           [](const Pair2D& op, const Array& v, const Array& n) {
+           [](const Pair2D& op, const ArrayArg& v_arg, const ArrayArg& n_arg) {
+             const auto v = to_array(v_arg, "velocities");
+             const auto n = to_array(n_arg, "normal");
              Rows rows{};
              std::vector<PairV<2>> pv = pairs_from(v, rows);
              const auto nv = normals_from(n, pv.size());
@@ -188,9 +204,13 @@ void register_collide(py::module_& m) {
                      "Pair collisions in 1 dimension: the velocities are exchanged (no random number).\n"
                      "velocities (2,) or (B, 2) = (v_i, v_j); normal = sign of x_i - x_j.")
       .def(py::init<>())
-      .def("forward", [pair1d](const Pair1D&, const Array& v, const Array& n) { return pair1d(v, n, +1); },
+      .def("forward", [pair1d](const Pair1D&, const ArrayArg& v_arg, const ArrayArg& n_arg) {
+        const auto v = to_array(v_arg, "velocities");
+        const auto n = to_array(n_arg, "normal"); return pair1d(v, n, +1); },
            py::arg("velocities"), py::arg("normal"), "Pre -> post (the pair must approach).")
-      .def("reverse", [pair1d](const Pair1D&, const Array& v, const Array& n) { return pair1d(v, n, -1); },
+      .def("reverse", [pair1d](const Pair1D&, const ArrayArg& v_arg, const ArrayArg& n_arg) {
+        const auto v = to_array(v_arg, "velocities");
+        const auto n = to_array(n_arg, "normal"); return pair1d(v, n, -1); },
            py::arg("velocities"), py::arg("normal"), "Post -> pre (the pair must separate).")
       .def_property_readonly_static("draws", [](py::object) { return Pair1D::draws; });
 
@@ -209,7 +229,9 @@ void register_collide(py::module_& m) {
                   "Reflection on the walls of the box [lo, hi] (d = 1..3): every wall the particle\n"
                   "touches (within tol) and approaches flips its normal velocity component. A particle\n"
                   "leaving a touched wall is refused (not one reversible event).")
-      .def(py::init([](const Array& lo, const Array& hi) {
+      .def(py::init([](const ArrayArg& lo_arg, const ArrayArg& hi_arg) {
+        const auto lo = to_array(lo_arg, "lo");
+        const auto hi = to_array(hi_arg, "hi");
              require(lo.ndim() == 1 && hi.ndim() == 1 && lo.shape(0) == hi.shape(0) &&
                          lo.shape(0) >= 1 && lo.shape(0) <= 3,
                      "lo and hi must have the same shape (d,), d = 1, 2 or 3");
@@ -224,9 +246,13 @@ void register_collide(py::module_& m) {
              return Wall(b);
            }),
            py::arg("lo"), py::arg("hi"))
-      .def("forward", [wall](const Wall& w, const Array& x, const Array& v, double r, double tol) { return wall(w, x, v, r, tol, +1); },
+      .def("forward", [wall](const Wall& w, const ArrayArg& x_arg, const ArrayArg& v_arg, double r, double tol) {
+        const auto x = to_array(x_arg, "positions");
+        const auto v = to_array(v_arg, "velocities"); return wall(w, x, v, r, tol, +1); },
            py::arg("position"), py::arg("velocity"), py::arg("radius"), py::arg("tol") = 1e-9)
-      .def("reverse", [wall](const Wall& w, const Array& x, const Array& v, double r, double tol) { return wall(w, x, v, r, tol, -1); },
+      .def("reverse", [wall](const Wall& w, const ArrayArg& x_arg, const ArrayArg& v_arg, double r, double tol) {
+        const auto x = to_array(x_arg, "positions");
+        const auto v = to_array(v_arg, "velocities"); return wall(w, x, v, r, tol, -1); },
            py::arg("position"), py::arg("velocity"), py::arg("radius"), py::arg("tol") = 1e-9)
       .def_property_readonly_static("draws", [](py::object) { return Wall::draws; });
 }

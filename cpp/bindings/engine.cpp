@@ -49,9 +49,11 @@ py::array_t<T> vec_array(const std::vector<T>& v) {
 template <class T>
 std::vector<T> array_vec(const py::dict& d, const char* key) {
   require(d.contains(key), [&] { return std::string("checkpoint is missing '") + key + "'"; });
-  auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(d[key]);
-  require(static_cast<bool>(a), [&] { return std::string("checkpoint entry '") + key + "' is not an array"; });
-  return std::vector<T>(a.data(), a.data() + a.size());
+  return checkpoint_entry(key, [&] {
+    auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(d[key]);
+    require(static_cast<bool>(a), [&] { return std::string("checkpoint entry '") + key + "' is not an array"; });
+    return std::vector<T>(a.data(), a.data() + a.size());
+  });
 }
 
 en::Config make_config(int dim, const std::vector<double>& box, const std::vector<std::string>& boundary,
@@ -195,10 +197,10 @@ class PyEngine {
       require(d.contains(key), [&] { return std::string("checkpoint is missing '") + key + "'"; });
       return d[key];
     };
-    require(py::cast<int>(get("format")) == 1, "checkpoint format must be 1");
+    require(checkpoint_field<int>(get("format"), "format") == 1, "checkpoint format must be 1");
     en::Snapshot s;
     en::Config& c = s.config;
-    c.dim = py::cast<int>(get("dim"));
+    c.dim = checkpoint_field<int>(get("dim"), "dim");
     require(c.dim >= 1 && c.dim <= 3, "checkpoint: dim must be 1, 2 or 3");
     const auto box = array_vec<double>(d, "box");
     const auto per = array_vec<std::int64_t>(d, "periodic");
@@ -208,24 +210,24 @@ class PyEngine {
       c.box[k] = box[k];
       c.boundary[k] = en::boundary_from_value(per[k]);  // every kind of en::kBoundaries, by value
     }
-    c.diameter = py::cast<double>(get("diameter"));
-    c.mode = en::parse_engine_mode(py::cast<std::string>(get("mode")));
-    c.law = parse_law(py::cast<std::string>(get("law")));
-    c.seed = py::cast<std::uint32_t>(get("seed"));
+    c.diameter = checkpoint_field<double>(get("diameter"), "diameter");
+    c.mode = en::parse_engine_mode(checkpoint_field<std::string>(get("mode"), "mode"));
+    c.law = parse_law(checkpoint_field<std::string>(get("law"), "law"));
+    c.seed = checkpoint_field<std::uint32_t>(get("seed"), "seed");
     // absent in checkpoints written before the generator choice existed: Philox per particle
-    c.generator = d.contains("generator") ? en::parse_generator(py::cast<std::string>(d["generator"]))
+    c.generator = d.contains("generator") ? en::parse_generator(checkpoint_field<std::string>(d["generator"], "generator"))
                                           : en::Generator::philox;
-    c.streams = d.contains("streams") ? en::parse_engine_streams(py::cast<std::string>(d["streams"]))
+    c.streams = d.contains("streams") ? en::parse_engine_streams(checkpoint_field<std::string>(d["streams"], "streams"))
                                       : rng::StreamPolicy::per_particle;
-    c.bits = py::cast<int>(get("bits"));
-    c.groups = py::cast<bool>(get("groups"));
-    c.group_tol = py::cast<double>(get("group_tol"));
+    c.bits = checkpoint_field<int>(get("bits"), "bits");
+    c.groups = checkpoint_field<bool>(get("groups"), "groups");
+    c.group_tol = checkpoint_field<double>(get("group_tol"), "group_tol");
     s.visit([&](const char* key, auto& field) {
       using T = std::decay_t<decltype(field)>;
       // absent in checkpoints written before the neighbour lists: centres from x, events predicted anew
       if (std::strcmp(key, "centre") == 0 && !d.contains(key)) return;
       if constexpr (is_vector<T>::value) field = array_vec<typename T::value_type>(d, key);
-      else field = py::cast<T>(get(key));
+      else field = checkpoint_field<T>(get(key), key);
     });
     const auto k = array_vec<std::uint64_t>(d, "counters");
     std::size_t nk = 0;
@@ -251,9 +253,11 @@ class PyEngine {
 void register_engine(py::module_& m) {
   py::class_<PyEngine>(m, "Engine", "The event-driven engine (revcol/engine/engine.hpp); use revcol.Simulation.")
       .def(py::init([](const Array& x, const Array& v, const std::vector<double>& box,
-                       const std::vector<std::string>& boundary, PyReal diameter_arg, const std::string& mode,
-                       const std::string& law, PyInt seed_arg, PyInt bits_arg, bool groups, PyReal group_tol_arg,
-                       PyReal time_arg, const std::string& generator, const std::string& streams) {
+                       const std::vector<std::string>& boundary, PyReal diameter_arg, PyStr mode_arg,
+                       PyStr law_arg, PyInt seed_arg, PyInt bits_arg, bool groups, PyReal group_tol_arg,
+                       PyReal time_arg, PyStr generator_arg, PyStr streams_arg) {
+             const std::string mode = to_str(mode_arg, "mode"), law = to_str(law_arg, "law");
+             const std::string generator = to_str(generator_arg, "generator"), streams = to_str(streams_arg, "streams");
              const double diameter = to_real(diameter_arg, "diameter"), group_tol = to_real(group_tol_arg, "group_tol");
              const double time = to_real(time_arg, "time");
              const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, en::limits::kMaxSeed);
@@ -299,7 +303,8 @@ void register_engine(py::module_& m) {
   m.def(
       "engine_random_state",
       [](PyInt dim_arg, PyInt n_arg, PyReal phi_arg, const std::vector<std::string>& boundary, PyReal diameter_arg,
-         PyInt seed_arg, PyReal energy_arg, const std::string& init, bool equal_speeds) {
+         PyInt seed_arg, PyReal energy_arg, PyStr init_arg, bool equal_speeds) {
+        const std::string init = to_str(init_arg, "init");
         const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
         const double energy = to_real(energy_arg, "energy");
         const int dim = to_int<int>(dim_arg, "dim", en::limits::kMinDim, en::limits::kMaxDim);

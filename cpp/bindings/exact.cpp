@@ -87,8 +87,11 @@ recovers the pre state exactly (after its first quantization) with the same numb
 void register_exact(py::module_& m) {
   py::class_<Collision>(m, "Collision", kDoc)
       .def(py::init([](PyInt n_arg, PyInt d_arg, const std::vector<std::pair<int, int>>& contacts,
-                       std::optional<Array> normals, std::optional<Array> positions,
-                       PyReal diameter_arg, const std::string& law, PyInt bits_arg, PyReal tol_arg) {
+                       std::optional<ArrayArg> normals_arg, std::optional<ArrayArg> positions_arg,
+                       PyReal diameter_arg, PyStr law_arg, PyInt bits_arg, PyReal tol_arg) {
+             const std::string law = to_str(law_arg, "law");
+        const auto normals = to_array(normals_arg, "normals");
+        const auto positions = to_array(positions_arg, "positions");
              const int n = to_int<int>(n_arg, "n"), d = to_int<int>(d_arg, "d");
              const int bits = to_int<int>(bits_arg, "bits", FixedPoint::min_bits, FixedPoint::max_bits);
              const double diameter = to_real(diameter_arg, "diameter"), tol = to_real(tol_arg, "tol");
@@ -112,26 +115,35 @@ void register_exact(py::module_& m) {
            py::arg("diameter") = 1.0, py::arg("law") = "flux", py::arg("bits") = 40,
            py::arg("tol") = 1e-9)
       .def_static("named",
-                  [](const std::string& name, const std::string& law, PyInt bits) {
-                    return Collision(exact_operator(named_case(name), parse_law(law),
+                  [](PyStr name, PyStr law, PyInt bits) {
+                    return Collision(exact_operator(named_case(to_str(name, "name")), parse_law(to_str(law, "law")),
                                                     to_int<int>(bits, "bits", FixedPoint::min_bits, FixedPoint::max_bits)));
                   },
                   py::arg("name"), py::kw_only(), py::arg("law") = "flux", py::arg("bits") = 40,
                   "The operator of a named case (see revcol.named_cases()).")
       .def("forward",
-           [](Collision& c, const Array& v, py::object rng, std::optional<Array> g,
-              std::optional<Array> mo, std::optional<Array> en) { return run(c, v, rng, g, mo, en, batch::Dir::forward); },
+           [](Collision& c, const ArrayArg& v_arg, py::object rng, std::optional<ArrayArg> g_arg,
+              std::optional<ArrayArg> mo_arg, std::optional<ArrayArg> en_arg) {
+             const auto v = to_array(v_arg, "velocities");
+             const auto g = to_array(g_arg, "g");
+             const auto mo = to_array(mo_arg, "momentum");
+             const auto en = to_array(en_arg, "energy"); return run(c, v, rng, g, mo, en, batch::Dir::forward); },
            py::arg("velocities"), py::kw_only(), py::arg("rng") = py::none(), py::arg("g") = py::none(),
            py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
            "Pre -> post. velocities (n, d) or (B, n, d); exactly one of rng or g ((d_n,) or (B, d_n)).")
       .def("reverse",
-           [](Collision& c, const Array& v, py::object rng, std::optional<Array> g,
-              std::optional<Array> mo, std::optional<Array> en) { return run(c, v, rng, g, mo, en, batch::Dir::reverse); },
+           [](Collision& c, const ArrayArg& v_arg, py::object rng, std::optional<ArrayArg> g_arg,
+              std::optional<ArrayArg> mo_arg, std::optional<ArrayArg> en_arg) {
+             const auto v = to_array(v_arg, "velocities");
+             const auto g = to_array(g_arg, "g");
+             const auto mo = to_array(mo_arg, "momentum");
+             const auto en = to_array(en_arg, "energy"); return run(c, v, rng, g, mo, en, batch::Dir::reverse); },
            py::arg("velocities"), py::kw_only(), py::arg("rng") = py::none(), py::arg("g") = py::none(),
            py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
            "Post -> pre with the draws forward used (rng steps back).")
       .def("chart",
-           [](const Collision& c, const Array& v) {
+           [](const Collision& c, const ArrayArg& v_arg) {
+             const auto v = to_array(v_arg, "velocities");
              const ExactCollision& op = c.op();
              const Rows rows = rows_for(op, v);
              const std::size_t B = rows.count, nd = op.particles() * op.dim(), k = op.draws();
@@ -144,7 +156,10 @@ void register_exact(py::module_& m) {
            },
            py::arg("velocities"), "Chart coordinates in [0, 1] of post states: uniform under the law.")
       .def("quantize",
-           [](const Collision& c, const Array& v, std::optional<Array> mo, std::optional<Array> en) {
+           [](const Collision& c, const ArrayArg& v_arg, std::optional<ArrayArg> mo_arg, std::optional<ArrayArg> en_arg) {
+             const auto v = to_array(v_arg, "velocities");
+             const auto mo = to_array(mo_arg, "momentum");
+             const auto en = to_array(en_arg, "energy");
              const ExactCollision& op = c.op();
              const std::size_t B = rows_for(op, v).count, nd = op.particles() * op.dim();
              const auto held = held_for(op, mo, en, B);
@@ -156,7 +171,8 @@ void register_exact(py::module_& m) {
            py::arg("velocities"), py::kw_only(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
            "The pre state as reversal restores it (its cells decoded at the centre).")
       .def("normal_speeds",
-           [](const Collision& c, const Array& v) {
+           [](const Collision& c, const ArrayArg& v_arg) {
+             const auto v = to_array(v_arg, "velocities");
              const ExactCollision& op = c.op();
              require(!rows_for(op, v).batched, "one state of shape (n, d)");
              return op.normal_speeds(v.data());

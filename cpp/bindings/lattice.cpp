@@ -24,6 +24,7 @@ using IArray = py::array_t<std::int64_t, py::array::c_style | py::array::forceca
 using FArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 std::vector<la::Vec2> vecs(const IArray& a, const char* what) {
+  require(static_cast<bool>(a), [&] { return std::string(what) + " must be an (n, 2) integer array"; });  // ensure() failed
   require(a.ndim() == 2 && a.shape(1) == 2, [&] { return std::string(what) + " must be an (n, 2) integer array"; });
   std::vector<la::Vec2> out(static_cast<std::size_t>(a.shape(0)));
   if (!out.empty()) std::memcpy(out.data(), a.data(), out.size() * sizeof(la::Vec2));
@@ -43,14 +44,16 @@ py::array_t<T> flat_array(const T* p, std::size_t n) {
 template <class T>
 std::vector<T> get_flat(const py::dict& d, const char* key) {
   require(d.contains(key), [&] { return std::string("lattice checkpoint is missing '") + key + "'"; });
-  auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(d[key]);
-  require(static_cast<bool>(a), [&] { return std::string("lattice checkpoint entry '") + key + "' is not an array"; });
-  return std::vector<T>(a.data(), a.data() + a.size());
+  return checkpoint_entry(key, [&] {
+    auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(d[key]);
+    require(static_cast<bool>(a), [&] { return std::string("lattice checkpoint entry '") + key + "' is not an array"; });
+    return std::vector<T>(a.data(), a.data() + a.size());
+  });
 }
 template <class T>
 T get(const py::dict& d, const char* key) {
   require(d.contains(key), [&] { return std::string("lattice checkpoint is missing '") + key + "'"; });
-  return py::cast<T>(d[key]);
+  return checkpoint_field<T>(d[key], key);
 }
 
 py::dict units_dict(const la::Units& u) {
@@ -161,8 +164,10 @@ la::Snapshot snapshot_from(const py::dict& d) {
   s.clock = get<std::int64_t>(d, "clock");
   s.origin = get<std::int64_t>(d, "origin");
   s.collisions = get<std::uint64_t>(d, "collisions");
-  s.x = vecs(IArray::ensure(d["x"]), "x");
-  s.v = vecs(IArray::ensure(d["v"]), "v");
+  for (const char* k : {"x", "v"})
+    require(d.contains(k), [&] { return std::string("lattice checkpoint is missing '") + k + "'"; });
+  s.x = checkpoint_entry("x", [&] { return vecs(IArray::ensure(d["x"]), "x"); });
+  s.v = checkpoint_entry("v", [&] { return vecs(IArray::ensure(d["v"]), "v"); });
   s.streams = get_flat<std::uint64_t>(d, "streams");
   s.bits = get_flat<std::uint64_t>(d, "bits");
   const auto li = get_flat<std::uint64_t>(d, "log_index");
@@ -176,7 +181,8 @@ la::Snapshot snapshot_from(const py::dict& d) {
   require(gi.size() == gd.size() && gi.size() == gs.size(), "lattice checkpoint: group arrays differ in length");
   // group_kind and group_v arrived with the group resolve; a checkpoint without them holds bounces only
   const auto gk = d.contains("group_kind") ? get_flat<std::int64_t>(d, "group_kind") : std::vector<std::int64_t>(gi.size(), 0);
-  const auto gv = d.contains("group_v") ? vecs(IArray::ensure(d["group_v"]), "group_v") : std::vector<la::Vec2>{};
+  const auto gv = d.contains("group_v") ? checkpoint_entry("group_v", [&] { return vecs(IArray::ensure(d["group_v"]), "group_v"); })
+                                        : std::vector<la::Vec2>{};
   require(gk.size() == gi.size(), "lattice checkpoint: group_kind and group_index differ in length");
   std::size_t at = 0, atv = 0;
   for (std::size_t k = 0; k < gi.size(); ++k) {

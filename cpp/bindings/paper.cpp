@@ -11,6 +11,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "args.hpp"
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "revcol/collide/batch.hpp"
@@ -121,8 +122,13 @@ Array run(Holder<Op>& h, const Array& velocities, const Array& geometry, const p
 template <class Op, class Cls>
 void common_methods(Cls& cls, const char* geometry_name) {
   cls.def("forward",
-          [](Holder<Op>& h, const Array& v, const Array& x, py::object rng, std::optional<Array> g,
-             std::optional<Array> momentum, std::optional<Array> energy) {
+          [geometry_name](Holder<Op>& h, const ArrayArg& v_arg, const ArrayArg& x_arg, py::object rng, std::optional<ArrayArg> g_arg,
+             std::optional<ArrayArg> momentum_arg, std::optional<ArrayArg> energy_arg) {
+            const auto v = to_array(v_arg, "velocities");
+            const auto x = to_array(x_arg, "positions");
+            const auto g = to_array(g_arg, "g");
+            const auto momentum = to_array(momentum_arg, "momentum");
+            const auto energy = to_array(energy_arg, "energy");
             return run<Op>(h, v, x, rng, g, momentum, energy, batch::Dir::forward);
           },
           py::arg("velocities"), py::arg(geometry_name), py::kw_only(), py::arg("rng") = py::none(),
@@ -131,8 +137,13 @@ void common_methods(Cls& cls, const char* geometry_name) {
           "[0,1]); momentum= and energy= hold the invariants. Every entry is validated first;\n"
           "on error nothing changes.")
       .def("reverse",
-           [](Holder<Op>& h, const Array& v, const Array& x, py::object rng, std::optional<Array> g,
-              std::optional<Array> momentum, std::optional<Array> energy) {
+           [geometry_name](Holder<Op>& h, const ArrayArg& v_arg, const ArrayArg& x_arg, py::object rng, std::optional<ArrayArg> g_arg,
+              std::optional<ArrayArg> momentum_arg, std::optional<ArrayArg> energy_arg) {
+             const auto v = to_array(v_arg, "velocities");
+             const auto x = to_array(x_arg, "positions");
+             const auto g = to_array(g_arg, "g");
+             const auto momentum = to_array(momentum_arg, "momentum");
+             const auto energy = to_array(energy_arg, "energy");
              return run<Op>(h, v, x, rng, g, momentum, energy, batch::Dir::reverse);
            },
            py::arg("velocities"), py::arg(geometry_name), py::kw_only(), py::arg("rng") = py::none(),
@@ -234,7 +245,8 @@ void register_pair3d(py::module_& m) {
   common_methods<Pair3DPaper>(p3, "normal");
   p3.def_property_readonly("printed_reverse", [](const Holder<Pair3DPaper>& h) { return h.op.printed_reverse(); })
       .def_static("angles",
-                  [](const Array& v) {
+                  [](const ArrayArg& v_arg) {
+                    const auto v = to_array(v_arg, "velocities");
                     return map_entries(v, {2, 3}, "velocities", 2, [](const double* p, double* out) {
                       const auto a = Pair3DPaper::angles(Conv<Pair3DPaper>::state(p));
                       out[0] = a[0];
@@ -243,7 +255,8 @@ void register_pair3d(py::module_& m) {
                   },
                   py::arg("velocities"), "V-to-Phi: (phi1 in [0, pi], phi2 in [0, 2 pi)) per entry.")
       .def_static("psi",
-                  [](const Array& g) {
+                  [](const ArrayArg& g_arg) {
+                    const auto g = to_array(g_arg, "g");
                     return map_entries(g, {2}, "g", 2, [](const double* p, double* out) {
                       require(p[0] >= 0 && p[0] <= 1 && p[1] >= 0 && p[1] <= 1, "random numbers must be in [0,1]");
                       out[0] = Pair3DPaper::psi1(p[0]);
@@ -271,7 +284,9 @@ void register_triple1d(py::module_& m) {
       .def_property_readonly("cos_tol", [](const Holder<Triple1DPaper>& h) { return h.op.cos_tol(); })
       .def_property_readonly("printed_reverse", [](const Holder<Triple1DPaper>& h) { return h.op.printed_reverse(); })
       .def_static("angle_of",
-                  [](const Array& v, const Array& x) {
+                  [](const ArrayArg& v_arg, const ArrayArg& x_arg) {
+                    const auto v = to_array(v_arg, "velocities");
+                    const auto x = to_array(x_arg, "positions");
                     Rows rows{};
                     const auto s = states_from<Triple1DPaper>(v, rows);
                     const auto xs = geometries_from<Triple1DPaper>(x, s.size());
@@ -283,7 +298,8 @@ void register_triple1d(py::module_& m) {
                   },
                   py::arg("velocities"), py::arg("positions"), "V-to-Phi: phi in [0, 2 pi) per entry.")
       .def("psi",
-           [](const Holder<Triple1DPaper>& h, const Array& g) {
+           [](const Holder<Triple1DPaper>& h, const ArrayArg& g_arg) {
+             const auto g = to_array(g_arg, "g");
              Array out(Shape(g.shape(), g.shape() + g.ndim()));
              for (py::ssize_t k = 0; k < g.size(); ++k) out.mutable_data()[k] = h.op.arc().psi(g.data()[k]);
              return out;
@@ -304,7 +320,9 @@ void register_triple2d(py::module_& m) {
   t2.def(py::init([]() { return Holder<Triple2DPaper>{Triple2DPaper(), {}}; }));
   common_methods<Triple2DPaper>(t2, "positions");
   t2.def_static("angles",
-                [](const Array& v, const Array& x) {
+                [](const ArrayArg& v_arg, const ArrayArg& x_arg) {
+                  const auto v = to_array(v_arg, "velocities");
+                  const auto x = to_array(x_arg, "positions");
                   Rows rows{};
                   const auto s = states_from<Triple2DPaper>(v, rows);
                   const auto xs = geometries_from<Triple2DPaper>(x, s.size());
@@ -321,7 +339,8 @@ void register_triple2d(py::module_& m) {
                 py::arg("velocities"), py::arg("positions"),
                 "V-to-Phi in the canonical frame: (phi1, phi2, phi3) per entry.")
       .def_static("configuration",
-                  [](const Array& x) {
+                  [](const ArrayArg& x_arg) {
+                    const auto x = to_array(x_arg, "positions");
                     const auto xs = geometries_from<Triple2DPaper>(x, 1);
                     const paper::Canonical cf = paper::canonical(xs[0]);
                     py::dict d;
@@ -337,7 +356,8 @@ void register_triple2d(py::module_& m) {
                   py::arg("positions"),
                   "The canonical configuration of positions (3, 2): config, ids of P1 P2 P3, theta, frame rows.")
       .def("psi",
-           [](const Holder<Triple2DPaper>& h, const Array& g) {
+           [](const Holder<Triple2DPaper>& h, const ArrayArg& g_arg) {
+             const auto g = to_array(g_arg, "g");
              return map_entries(g, {3}, "g", 3, [&](const double* p, double* out) {
                const auto psi = h.op.sampler().psi({p[0], p[1], p[2]});
                for (int k = 0; k < 3; ++k) out[k] = psi[k];

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 
+#include "args.hpp"
 #include "bindings.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/clcg4.hpp"
@@ -18,6 +19,8 @@ namespace py = pybind11;
 using revcol::InvalidArgument;
 using revcol::rng::CLCG4;
 using revcol::rng::Philox;
+using revcol::bind::PyInt;
+using revcol::bind::to_int;
 
 namespace {
 
@@ -60,9 +63,8 @@ py::tuple to_tuple(const std::array<std::uint32_t, N>& w) {
   return t;
 }
 
-std::size_t to_count(py::ssize_t n) {
-  if (n < 0) throw InvalidArgument("n must be >= 0, got " + std::to_string(n));
-  return static_cast<std::size_t>(n);
+std::size_t to_count(const PyInt& n) {
+  return to_int<std::size_t>(n, "n", 0, std::size_t{1} << 40);  // 2^40 draws = 8 TiB: beyond any memory
 }
 
 // n draws (Forward) or n undone draws (!Forward, values in the order undone) into a new
@@ -176,11 +178,11 @@ void register_rng(py::module_& m) {
            "Return the value the last next() returned, then step back: next(); prev() is the identity.")
       .def(
           "next_many",
-          [](CLCG4& g, py::ssize_t n) { return draw_many<true>(g, to_count(n)); },
+          [](CLCG4& g, PyInt n) { return draw_many<true>(g, to_count(n)); },
           py::arg("n"), "n draws as a float64 array, in draw order (same as n calls of next()).")
       .def(
           "prev_many",
-          [](CLCG4& g, py::ssize_t n) { return draw_many<false>(g, to_count(n)); },
+          [](CLCG4& g, PyInt n) { return draw_many<false>(g, to_count(n)); },
           py::arg("n"),
           "Undo n draws; float64 array in the order they are undone, i.e. REVERSED draw order:\n"
           "after a = g.next_many(n), g.prev_many(n) equals a[::-1] and the state is restored.")
@@ -216,11 +218,11 @@ void register_rng(py::module_& m) {
           "Draw k, in (0, 1), without changing the counter.")
       .def(
           "next_many",
-          [](Philox& g, py::ssize_t n) { return draw_many<true>(g, to_count(n)); },
+          [](Philox& g, PyInt n) { return draw_many<true>(g, to_count(n)); },
           py::arg("n"), "n draws as a float64 array, in draw order (same as n calls of next()).")
       .def(
           "prev_many",
-          [](Philox& g, py::ssize_t n) {
+          [](Philox& g, PyInt n) {
             const std::size_t count = to_count(n);
             if (count > g.counter())
               throw InvalidArgument("Philox: cannot step back before draw 0 (counter " + std::to_string(g.counter()) +

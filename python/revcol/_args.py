@@ -36,3 +36,19 @@ def real(x, name: str, *, finite: bool = True) -> float:
     if finite and not math.isfinite(v):
         raise ValueError(f"{name} must be finite, got {v}")
     return v
+
+
+def name(x, what: str) -> str:
+    """``x`` as a str; TypeError naming ``what`` otherwise."""
+    if not isinstance(x, str):
+        raise TypeError(f"{what} must be a string, got {type(x).__name__}")
+    return x
+
+
+def names(x, what: str) -> list:
+    """One name or a list/tuple of names, as a list; TypeError naming ``what`` otherwise."""
+    if isinstance(x, str):
+        return [x]
+    if isinstance(x, (list, tuple)) and all(isinstance(b, str) for b in x):
+        return list(x)
+    raise TypeError(f"{what} must be a name or a list of names (one per axis), got {x!r}")

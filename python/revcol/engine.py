@@ -41,6 +41,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
+from ._args import names
 from ._io import read_checkpoint, stamped, write_npz_atomic
 
 __all__ = ["Simulation"]
@@ -49,9 +50,7 @@ _Boundary = Union[str, Sequence[str]]
 
 
 def _boundary_list(boundary: _Boundary) -> list:
-    if isinstance(boundary, str):
-        return [boundary]
-    return [str(b) for b in boundary]
+    return names(boundary, "boundary")
 
 
 def _real_array(a, name: str) -> np.ndarray:
@@ -102,7 +101,7 @@ class Simulation:
         # scalars go through as given: the engine names a wrong type or range (issue 17)
         self._e = _core.Engine(x, v, box, _boundary_list(boundary), diameter, mode, law,
                                seed, bits, bool(groups), group_tol, time,
-                               str(generator), str(streams))
+                               generator, streams)
 
     @classmethod
     def random(cls, n: int, dim: int = 3, phi: float = 0.3, *, boundary: _Boundary = "periodic",

@@ -30,7 +30,7 @@ from typing import Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._args import integer, real
+from ._args import integer, name, names, real
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .engine import _real_array
 
@@ -40,11 +40,12 @@ _Boundary = Union[str, Sequence[str]]
 
 
 def _walls(boundary: _Boundary) -> list:
-    names = [boundary, boundary] if isinstance(boundary, str) else [str(b) for b in boundary]
-    if len(names) != 2:
+    given = names(boundary, "boundary")
+    given = given * 2 if isinstance(boundary, str) else given
+    if len(given) != 2:
         raise ValueError("the lattice engine is 2D: boundary must be one name or two")
     out = []
-    for b in names:
+    for b in given:
         if b in ("wall", "walls"):
             out.append(True)
         elif b == "periodic":
@@ -84,7 +85,7 @@ class LatticeSimulation:
         self._init_from_start(start, law, seed)
 
     def _init_from_start(self, start: dict, law: str, seed: int) -> None:
-        self._e = _core.LatticeEngine(start["units"], start["x"], start["v"], seed, str(law))
+        self._e = _core.LatticeEngine(start["units"], start["x"], start["v"], seed, name(law, "law"))
         self._q = {"max_position_error": start["max_position_error"],
                    "max_velocity_error": start["max_velocity_error"]}
 
@@ -97,7 +98,7 @@ class LatticeSimulation:
         kT = 1), quantized once. The same ``seed`` keys the streams."""
         if dim != 2:
             raise ValueError(f"the lattice engine is 2D, got dim={dim}")
-        start = _core.lattice_random_start(n, phi, _walls(boundary), diameter, seed, str(init), tick_bits)
+        start = _core.lattice_random_start(n, phi, _walls(boundary), diameter, seed, name(init, "init"), tick_bits)
         sim = cls.__new__(cls)
         sim._init_from_start(start, law, seed)
         return sim
