@@ -25,7 +25,7 @@
 namespace revcol::bind {
 
 /// A Python object standing for an integer argument, converted in the function body.
-struct PyInt {
+struct [[gnu::visibility("hidden")]] PyInt {
   pybind11::object o;  ///< the argument as given
 };
 
@@ -77,7 +77,7 @@ std::optional<T> to_int(const std::optional<PyInt>& x, const std::string& what,
 }
 
 /// A Python object standing for a real argument, converted in the function body.
-struct PyReal {
+struct [[gnu::visibility("hidden")]] PyReal {
   pybind11::object o;  ///< the argument as given
 };
 
@@ -100,7 +100,7 @@ inline std::optional<double> to_real(const std::optional<PyReal>& x, const std::
 }
 
 /// A Python object standing for a string argument, converted in the function body.
-struct PyStr {
+struct [[gnu::visibility("hidden")]] PyStr {
   pybind11::object o;  ///< the argument as given
 };
 
@@ -113,7 +113,7 @@ inline std::string to_str(const PyStr& x, const std::string& what) {
 }
 
 /// A Python object standing for a float64 array argument, converted in the function body.
-struct ArrayArg {
+struct [[gnu::visibility("hidden")]] ArrayArg {
   pybind11::object o;  ///< the argument as given
 };
 

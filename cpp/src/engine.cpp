@@ -262,6 +262,8 @@ std::unique_ptr<Simulation> restore_simulation(const Snapshot& s) {
     for (double q : s.v) vmax = std::max(vmax, std::fabs(q));
     require(limits::clock_fits(s.time, s.config.diameter, vmax) && limits::clock_fits(s.start_time, s.config.diameter, vmax),
             "snapshot: a time too large for the clock to resolve flights of one diameter (|t| v_max / D > 4.5e9)");
+    require(vmax >= limits::kMinGasSpeed && vmax <= limits::max_gas_speed(static_cast<double>(n), static_cast<int>(d)),
+            "snapshot: velocities outside the speeds the operators resolve ([2^-420, 2^450 / sqrt(N d)] for v_max)");
   }
   for (double t : s.t_local) require(std::isfinite(t), "snapshot: local times must be finite");
   for (double q : s.x) require(std::isfinite(q), "snapshot: positions must be finite");

@@ -248,3 +248,14 @@ def test_a_failed_save_keeps_the_previous_checkpoint(tmp_path, monkeypatch):
         s.save(path)
     assert path.read_bytes() == good
     assert [p.name for p in tmp_path.iterdir()] == ["ck.npz"]  # no temporary left behind
+
+
+def test_a_snapshot_with_speeds_outside_the_range_is_refused():
+    s = Simulation.random(50, 2, 0.3, seed=1)
+    s.run(collisions=20)
+    st = s.snapshot()
+    for scale in (1e-161, 1e-130):  # (above 2^450 the clock check refuses first)
+        bad = dict(st, v=np.asarray(st["v"]) * scale)
+        with pytest.raises(ValueError, match="snapshot: velocities outside the speeds"):
+            Simulation.from_snapshot(bad)
+    Simulation.from_snapshot(dict(st, v=np.asarray(st["v"]) * 1e-100))  # inside: accepted
