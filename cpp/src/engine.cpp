@@ -84,13 +84,13 @@ void validate_config(const Config& c) {
     });
     if (has_walls(c.boundary[k])) {
       require(limits::wall_axis_fits(L, c.diameter), [&] {
-        return "diameter " + std::to_string(c.diameter) + " is too large for the box: axis " + std::to_string(k) +
-               " has length " + std::to_string(L) + " (walls need L > D)";
+        return "diameter " + num(c.diameter) + " is too large for the box: axis " + std::to_string(k) +
+               " has length " + num(L) + " (walls need L > D)";
       });
     } else {
       require(limits::periodic_axis_fits(L, c.diameter), [&] {
         return "periodic box too small for the neighbour lists: axis " + std::to_string(k) + " has length " +
-               std::to_string(L) + " < 3 diameters (L >= 3 D keeps each listed neighbour's nearest image "
+               num(L) + " < 3 diameters (L >= 3 D keeps each listed neighbour's nearest image "
                "unique with a shell of at least 0.45 D)";
       });
     }
@@ -116,13 +116,13 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
       if (has_walls(c.boundary[k]))
         require(xk >= r && xk <= c.box[k] - r, [&] {
           return "particle " + std::to_string(i) + " is outside the box on axis " + std::to_string(k) + ": x = " +
-                 std::to_string(xk) + ", allowed [" + std::to_string(r) + ", " + std::to_string(c.box[k] - r) +
+                 num(xk) + ", allowed [" + num(r) + ", " + num(c.box[k] - r) +
                  "] (walls at 0 and L, centre at least D/2 inside)";
         });
       else
         require(xk >= 0.0 && xk < c.box[k], [&] {
           return "particle " + std::to_string(i) + " is outside the periodic box on axis " + std::to_string(k) +
-                 ": x = " + std::to_string(xk) + ", allowed [0, " + std::to_string(c.box[k]) + ")";
+                 ": x = " + num(xk) + ", allowed [0, " + num(c.box[k]) + ")";
         });
       e += 0.5 * vk * vk;
     }
@@ -183,7 +183,7 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
         }
         require(r2 >= min2, [&] {
           return "particles " + std::to_string(j) + " and " + std::to_string(i) + " overlap: distance " +
-                 std::to_string(std::sqrt(r2)) + " < diameter " + std::to_string(c.diameter);
+                 num(std::sqrt(r2)) + " < diameter " + num(c.diameter);
         });
       }
     }
@@ -233,8 +233,8 @@ std::unique_ptr<Simulation> make_simulation(const Config& c, const std::vector<d
   double vmax = 0.0;
   for (double q : v) vmax = std::max(vmax, std::fabs(q));
   require(limits::clock_fits(t0, c.diameter, vmax), [&] {
-    return "start time " + std::to_string(t0) + " is too large for the clock to resolve flights of one diameter (at most " +
-           std::to_string(limits::kMaxClockFlights) + " D / v_max = " + std::to_string(limits::kMaxClockFlights * c.diameter / vmax) +
+    return "start time " + num(t0) + " is too large for the clock to resolve flights of one diameter (at most " +
+           num(limits::kMaxClockFlights) + " D / v_max = " + num(limits::kMaxClockFlights * c.diameter / vmax) +
            "); shift the time origin";
   });
   if (c.dim == 1) return detail::make_engine<1>(c, x, v, t0);

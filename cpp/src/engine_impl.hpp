@@ -168,8 +168,8 @@ class EngineImpl final : public Simulation {
     require(std::isfinite(t_target) || max_collisions != std::numeric_limits<std::uint64_t>::max(),
             "run_back: give a finite target time or a collision count (an infinite run back never returns)");
     require(t_target <= clock_, [&] {
-      return "run_back: target time " + std::to_string(t_target) + " is later than the current time " +
-             std::to_string(clock_);
+      return "run_back: target time " + num(t_target) + " is later than the current time " +
+             num(clock_);
     });
     flip();
     RunResult r;

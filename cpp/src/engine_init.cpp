@@ -237,7 +237,7 @@ InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, do
   if (!place(rsa) && !(fallback && place(!rsa))) {
     if (rsa && !fallback)
       throw InvalidArgument("random sequential addition did not place every particle; use init='lattice'");
-    throw InvalidArgument(std::to_string(n) + " particles of diameter " + std::to_string(c.diameter) +
+    throw InvalidArgument(std::to_string(n) + " particles of diameter " + num(c.diameter) +
                           " do not fit on a lattice in this box (nearest sites closer than D)" +
                           (fallback ? ", nor by random sequential addition" : "") +
                           ": make the box larger or the packing fraction lower");
@@ -250,7 +250,7 @@ InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, do
 void check_energy(double energy) {
   // 0 asks for the default (kT = 1); NaN or a negative energy was taken as the default silently (issue 17)
   require(std::isfinite(energy) && energy >= 0.0,
-          "kinetic energy must be finite and > 0 (or omitted for kT = 1), got " + std::to_string(energy));
+          "kinetic energy must be finite and > 0 (or omitted for kT = 1), got " + num(energy));
 }
 
 void check_common(const Config& c, std::size_t n, std::uint64_t seed) {
@@ -286,21 +286,21 @@ InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, do
   const double D = c.diameter;
   for (int k = 0; k < d; ++k) {
     const double L = c.box[k];
-    const std::string axis = "axis " + std::to_string(k) + " has length " + std::to_string(L);
+    const std::string axis = "axis " + std::to_string(k) + " has length " + num(L);
     require(std::isfinite(L) && L > 0.0, "box length on " + axis + ": must be finite and > 0");
-    require(limits::box_ratio_fits(L, D), "box length on " + axis + ": more than 2^30 diameters of " + std::to_string(D));
+    require(limits::box_ratio_fits(L, D), "box length on " + axis + ": more than 2^30 diameters of " + num(D));
     if (has_walls(c.boundary[k]))
       require(L > D * (1.0 + limits::kWallMargin),
-              "diameter " + std::to_string(D) + " is too large for the box: " + axis + " (walls need L > D)");
+              "diameter " + num(D) + " is too large for the box: " + axis + " (walls need L > D)");
     else
       require(limits::periodic_axis_fits(L, D), "periodic box too small for the neighbour lists: " + axis +
                                                     " < 3 diameters");
   }
   const double phi = box_fraction(c, n);
   require(phi <= limits::max_fraction(d), [&] {
-    return std::to_string(n) + " particles of diameter " + std::to_string(D) +
-           " do not fit in this box: packing fraction " + std::to_string(phi) +
-           " above what the initialiser reaches (" + std::to_string(limits::max_fraction(d)) + " in " +
+    return std::to_string(n) + " particles of diameter " + num(D) +
+           " do not fit in this box: packing fraction " + num(phi) +
+           " above what the initialiser reaches (" + num(limits::max_fraction(d)) + " in " +
            std::to_string(d) + "D)";
   });
   const bool rsa = how == Placement::rsa || (how == Placement::automatic && phi <= limits::rsa_fraction(d));
@@ -315,13 +315,13 @@ InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t see
   const Placement how = parse_placement(init);
   const int d = c.dim;
   const double maxphi = limits::max_fraction(d);
-  require(phi <= maxphi, "packing fraction " + std::to_string(phi) + " above what the initialiser reaches (" +
+  require(phi <= maxphi, "packing fraction " + num(phi) + " above what the initialiser reaches (" +
                              std::to_string(maxphi) + " in " + std::to_string(d) + "D)");
   const double L = std::pow(static_cast<double>(n) * limits::particle_volume(d, c.diameter) / phi, 1.0 / d);
   // a tiny diameter underflows the particle volume and the box to 0 (issue 17)
   require(std::isfinite(L) && L > 0.0 && limits::box_ratio_fits(L, c.diameter), [&] {
-    return "the box for " + std::to_string(n) + " particles of diameter " + std::to_string(c.diameter) +
-           " at packing fraction " + std::to_string(phi) + " is not representable (length " + std::to_string(L) +
+    return "the box for " + std::to_string(n) + " particles of diameter " + num(c.diameter) +
+           " at packing fraction " + num(phi) + " is not representable (length " + num(L) +
            "): choose a diameter between 1e-100 and 1e100";
   });
   for (int k = 0; k < 3; ++k) c.box[k] = k < d ? L : 1.0;

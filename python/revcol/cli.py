@@ -116,6 +116,10 @@ def _run(args: argparse.Namespace) -> int:
     except OSError as e:  # an output that cannot be written (permissions, a file where a directory goes)
         print(f"revcol run: error: {e}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print("revcol run: error: not enough memory for this scene (fewer particles, or a larger machine)",
+              file=sys.stderr)
+        return 2
     print(format_report(report))
     if report.get("interrupted"):
         return 130

@@ -193,7 +193,7 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
               "case": ("str", None)},
     "system": {
         "dimension": ("int", tuple(LIMITS["dimensions"])),
-        "particles": ("int", (1, None)),
+        "particles": ("int", (1, (1 << 31) - 1)),
         "diameter": ("float", (0.0, None)),
         "packing_fraction": ("float", (0.0, None)),
         "box": ("floats", (0.0, None)),
@@ -346,6 +346,9 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
 
     base = base or Path.cwd()
     name = get("scene", "name", Path(source).stem if source.endswith(".toml") else "scene")
+    if not name or name in (".", "..") or any(c in name for c in "/\\\0"):
+        # it names files beside the scene (NAME-checkpoints): a path would put them elsewhere
+        raise _fail(source, "[scene] name", f"must be a plain name (no '/', '\\', '..'), got {name!r}")
     common = dict(kind=kind, name=name, description=get("scene", "description", ""), source=source,
                   generator=get("rng", "generator", "clcg4"), seed=get("rng", "seed", 0),
                   extra={"fields": sorted(f"{a}.{b}" for a, b in values)})
@@ -609,8 +612,13 @@ def load_scene(path: str | Path | None = None) -> Scene:
         raise SceneError(f"{p}: no such scene file")
     try:
         doc = tomllib.loads(p.read_text())
+    except RecursionError:
+        raise SceneError(f"{p}: not a usable scene: its arrays or tables are nested too deeply") from None
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"{p}: not valid TOML: {' '.join(str(e).split())}") from None
     except UnicodeDecodeError as e:
         raise SceneError(f"{p}: not a text file: {e}") from None
-    return scene_from_dict(doc, str(p), p.parent)
+    try:
+        return scene_from_dict(doc, str(p), p.parent)
+    except RecursionError:
+        raise SceneError(f"{p}: not a usable scene: its arrays or tables are nested too deeply") from None

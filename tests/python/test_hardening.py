@@ -259,3 +259,48 @@ def test_a_snapshot_with_speeds_outside_the_range_is_refused():
         with pytest.raises(ValueError, match="snapshot: velocities outside the speeds"):
             Simulation.from_snapshot(bad)
     Simulation.from_snapshot(dict(st, v=np.asarray(st["v"]) * 1e-100))  # inside: accepted
+
+
+# --- scenes: every failure exits 2 with one line, outputs checked before the run ---------
+
+SCENE = '[system]\ndimension = 2\npacking_fraction = 0.3\nparticles = 100\n[run]\ncollisions = 10\n'
+
+
+def _revcol_run(tmp_path, text, capsys, name="s.toml"):
+    from revcol.cli import main
+    path = tmp_path / name
+    path.write_text(text)
+    rc = main(["run", str(path), "--no-progress"])
+    err = capsys.readouterr().err.strip().splitlines()
+    return rc, err, path
+
+
+@pytest.mark.parametrize("text, field", [
+    ("[system]\ndimension = 2\nparticles = 100\nbox = " + "[" * 5000 + "1" + "]" * 5000 + "\n", "nested too deeply"),
+    (SCENE.replace("particles = 100", "particles = 2147483648"), "[system] particles"),
+    (SCENE.replace("[system]", '[scene]\nname = "../../../x"\n[system]') + "checkpoint_interval = 5\n", "[scene] name"),
+    (SCENE + '[output]\njson = "/proc/nope/r.json"\n', "[output] json"),
+    (SCENE + '[output]\njson = "."\n', "is a folder, not a file"),
+    (SCENE + '[output]\nplot = "s.toml"\n', "is the scene file itself"),
+])
+def test_a_bad_scene_exits_2_with_one_line_naming_the_field(tmp_path, capsys, text, field):
+    # were: a RecursionError traceback, a MemoryError traceback (exit 1), checkpoints written
+    # outside the scene's folder, an unwritable report found after the run (issue 17)
+    rc, err, path = _revcol_run(tmp_path, text, capsys)
+    assert rc == 2 and len(err) == 1 and field in err[0], err
+    assert path.read_text() == text  # the scene file is never an output
+
+
+def test_a_report_over_the_scene_file_is_refused_before_the_run(tmp_path, capsys):
+    text = SCENE + '[output]\njson = "s.toml"\n'
+    rc, err, path = _revcol_run(tmp_path, text, capsys)
+    assert rc == 2 and "is the scene file itself" in err[0] and path.read_text() == text  # was: overwritten
+
+
+def test_a_scene_too_large_for_memory_is_refused_before_allocating(tmp_path, capsys, monkeypatch):
+    import revcol.run as run_mod
+    monkeypatch.setattr(run_mod, "_available_bytes", lambda: 50 * 1024)  # 50 KiB: 100 particles need 100 KiB
+    rc, err, _ = _revcol_run(tmp_path, SCENE, capsys)
+    assert rc == 2 and "[system] particles: 100 particles need about" in err[0], err
+    monkeypatch.setattr(run_mod, "_available_bytes", lambda: 10 * 2**30)
+    assert _revcol_run(tmp_path, SCENE, capsys)[0] == 0
