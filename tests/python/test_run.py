@@ -208,7 +208,7 @@ def test_bad_output_requests_run_nothing(tmp_path, capsys, monkeypatch):
 @pytest.mark.parametrize("text,needle", [
     ("[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.1\nspeed = 3\n", "[system] speed: unknown field"),
     ("[system]\ndimension = '2'\nparticles = 10\npacking_fraction = 0.1\n", "[system] dimension: must be an integer, got '2'"),
-    ("[system]\ndimension = 2\nparticles = -3\npacking_fraction = 0.1\n", "[system] particles: must be >= 1, got -3"),
+    ("[system]\ndimension = 2\nparticles = -3\npacking_fraction = 0.1\n", "[system] particles: must be 1..2147483647, got -3"),
     ("[system]\ndimension = 2\nparticles = 3\nbox = [0.9, 5.0]\n", "[system] box: axis 0 length 0.9 is not larger than the diameter 1"),
     ("[system]\ndimension = 2\ninitial_state = 'overlap.npz'\nbox = [5.0, 5.0]\n",
      "[system] initial_state: overlap.npz: particles 0 and 1 overlap"),

@@ -61,7 +61,7 @@ trajectory_every = 10
     ("[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.1\ncolour = 'red'\n", "[system] colour: unknown field"),
     ("[sytem]\ndimension = 2\n", "[sytem]: unknown table"),
     ("[system]\ndimension = 2\nparticles = 'ten'\npacking_fraction = 0.1\n", "[system] particles: must be an integer"),
-    ("[system]\ndimension = 2\nparticles = -5\npacking_fraction = 0.1\n", "[system] particles: must be >= 1, got -5"),
+    ("[system]\ndimension = 2\nparticles = -5\npacking_fraction = 0.1\n", "[system] particles: must be 1..2147483647, got -5"),
     ("[system]\ndimension = 4\nparticles = 5\npacking_fraction = 0.1\n", "[system] dimension: must be 1..3"),
     ("[system]\ndimension = 2\nparticles = 5\nbox = [0.5, 3.0]\n", "[system] box: axis 0 length 0.5 is not larger than the diameter"),
     ("[system]\ndimension = 2\nparticles = 5\nbox = [3.0]\n", "[system] box: needs 2 lengths"),
