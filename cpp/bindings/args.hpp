@@ -169,51 +169,23 @@ inline bool poll_signals() { return PyErr_CheckSignals() == 0; }
 }  // namespace revcol::bind
 
 namespace pybind11::detail {
-/// Loads any object into PyInt (the body converts it, naming the argument); signatures show
-/// the same type text as pybind11's int.
-template <>
-struct type_caster<revcol::bind::PyInt> {
-  PYBIND11_TYPE_CASTER(revcol::bind::PyInt, io_name("typing.SupportsInt | typing.SupportsIndex", "int"));
-  bool load(handle src, bool) {
-    if (!src) return false;  // (std::optional<PyInt> turns None into nullopt before this)
-    value.o = reinterpret_borrow<object>(src);
-    return true;
-  }
-  static handle cast(const revcol::bind::PyInt& x, return_value_policy, handle) { return x.o.inc_ref(); }
-};
-/// Loads any object into PyStr; signatures show str.
-template <>
-struct type_caster<revcol::bind::PyStr> {
-  PYBIND11_TYPE_CASTER(revcol::bind::PyStr, const_name("str"));
-  bool load(handle src, bool) {
-    if (!src) return false;
-    value.o = reinterpret_borrow<object>(src);
-    return true;
-  }
-  static handle cast(const revcol::bind::PyStr& x, return_value_policy, handle) { return x.o.inc_ref(); }
-};
-/// Loads any object into ArrayArg; signatures show pybind11's float64 array type text.
-template <>
-struct type_caster<revcol::bind::ArrayArg> {
-  PYBIND11_TYPE_CASTER(revcol::bind::ArrayArg,
-                       io_name("typing.Annotated[numpy.typing.ArrayLike, numpy.float64]",
-                               "numpy.typing.NDArray[numpy.float64]"));
-  bool load(handle src, bool) {
-    if (!src) return false;
-    value.o = reinterpret_borrow<object>(src);
-    return true;
-  }
-  static handle cast(const revcol::bind::ArrayArg& x, return_value_policy, handle) { return x.o.inc_ref(); }
-};
-/// Loads any object into PyReal; signatures show pybind11's float type text.
-template <>
-struct type_caster<revcol::bind::PyReal> {
-  PYBIND11_TYPE_CASTER(revcol::bind::PyReal, io_name("typing.SupportsFloat | typing.SupportsIndex", "float"));
-  bool load(handle src, bool) {
-    if (!src) return false;
-    value.o = reinterpret_borrow<object>(src);
-    return true;
-  }
-  static handle cast(const revcol::bind::PyReal& x, return_value_policy, handle) { return x.o.inc_ref(); }
-};
+// One caster per argument type: it loads any object (the body converts it, naming the argument)
+// and shows `name` in signatures, the same text as pybind11's own caster of that type.
+#define REVCOL_OBJECT_ARG_CASTER(Type, name)                                   \
+  template <>                                                                  \
+  struct type_caster<revcol::bind::Type> {                                     \
+    PYBIND11_TYPE_CASTER(revcol::bind::Type, name);                            \
+    bool load(handle src, bool) {                                              \
+      if (!src) return false; /* optional<Type> turns None into nullopt first */ \
+      value.o = reinterpret_borrow<object>(src);                               \
+      return true;                                                             \
+    }                                                                          \
+    static handle cast(const revcol::bind::Type& x, return_value_policy, handle) { return x.o.inc_ref(); } \
+  };
+REVCOL_OBJECT_ARG_CASTER(PyInt, io_name("typing.SupportsInt | typing.SupportsIndex", "int"))
+REVCOL_OBJECT_ARG_CASTER(PyReal, io_name("typing.SupportsFloat | typing.SupportsIndex", "float"))
+REVCOL_OBJECT_ARG_CASTER(PyStr, const_name("str"))
+REVCOL_OBJECT_ARG_CASTER(ArrayArg, io_name("typing.Annotated[numpy.typing.ArrayLike, numpy.float64]",
+                                           "numpy.typing.NDArray[numpy.float64]"))
+#undef REVCOL_OBJECT_ARG_CASTER
 }  // namespace pybind11::detail

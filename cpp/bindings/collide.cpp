@@ -47,9 +47,12 @@ std::vector<std::array<double, 2>> normals_from(const Array& n, std::size_t B) {
 }
 
 // Runs forward or reverse with exactly one source of random numbers.
-Array run_pair2d(Pair2D& op, const Array& velocities, const Array& normal, const py::object& rng,
-                 const std::optional<Array>& g, const std::optional<Array>& momentum,
-                 const std::optional<Array>& energy, batch::Dir dir) {
+Array run_pair2d(Pair2D& op, const ArrayArg& velocities_arg, const ArrayArg& normal_arg, const py::object& rng,
+                 const std::optional<ArrayArg>& g_arg, const std::optional<ArrayArg>& momentum_arg,
+                 const std::optional<ArrayArg>& energy_arg, batch::Dir dir) {
+  const Array velocities = to_array(velocities_arg, "velocities"), normal = to_array(normal_arg, "normal");
+  const auto g = to_array(g_arg, "g"), momentum = to_array(momentum_arg, "momentum");
+  const auto energy = to_array(energy_arg, "energy");
   Rows rows{};
   std::vector<PairV<2>> v = pairs_from(velocities, rows);
   const auto n = normals_from(normal, v.size());
@@ -99,13 +102,8 @@ void register_collide(py::module_& m) {
            py::kw_only(), py::arg("mode") = "exact", py::arg("law") = "flux",
            py::arg("bits") = FixedPoint::default_bits, py::arg("printed_reverse") = false)
       .def("forward",
-           [](Pair2D& op, const ArrayArg& v_arg, const ArrayArg& n_arg, py::object rng, std::optional<ArrayArg> g_arg,
-              std::optional<ArrayArg> momentum_arg, std::optional<ArrayArg> energy_arg) {
-             const auto v = to_array(v_arg, "velocities");
-             const auto n = to_array(n_arg, "normal");
-             const auto g = to_array(g_arg, "g");
-             const auto momentum = to_array(momentum_arg, "momentum");
-             const auto energy = to_array(energy_arg, "energy");
+           [](Pair2D& op, const ArrayArg& v, const ArrayArg& n, py::object rng, std::optional<ArrayArg> g,
+              std::optional<ArrayArg> momentum, std::optional<ArrayArg> energy) {
              return run_pair2d(op, v, n, rng, g, momentum, energy, batch::Dir::forward);
            },
            py::arg("velocities"), py::arg("normal"), py::kw_only(), py::arg("rng") = py::none(),
@@ -114,13 +112,8 @@ void register_collide(py::module_& m) {
            "(B, 2) from j to i; exactly one of rng (drawn in entry order) or g (draws in [0,1]).\n"
            "Every entry is validated first; on error nothing changes.")
       .def("reverse",
-           [](Pair2D& op, const ArrayArg& v_arg, const ArrayArg& n_arg, py::object rng, std::optional<ArrayArg> g_arg,
-              std::optional<ArrayArg> momentum_arg, std::optional<ArrayArg> energy_arg) {
-             const auto v = to_array(v_arg, "velocities");
-             const auto n = to_array(n_arg, "normal");
-             const auto g = to_array(g_arg, "g");
-             const auto momentum = to_array(momentum_arg, "momentum");
-             const auto energy = to_array(energy_arg, "energy");
+           [](Pair2D& op, const ArrayArg& v, const ArrayArg& n, py::object rng, std::optional<ArrayArg> g,
+              std::optional<ArrayArg> momentum, std::optional<ArrayArg> energy) {
              return run_pair2d(op, v, n, rng, g, momentum, energy, batch::Dir::reverse);
            },
            py::arg("velocities"), py::arg("normal"), py::kw_only(), py::arg("rng") = py::none(),

@@ -39,8 +39,11 @@ std::optional<std::vector<Held>> held_for(const ExactCollision& op, const std::o
   return out;
 }
 
-Array run(Collision& c, const Array& v, const py::object& rng, const std::optional<Array>& g,
-          const std::optional<Array>& momentum, const std::optional<Array>& energy, batch::Dir dir) {
+Array run(Collision& c, const ArrayArg& v_arg, const py::object& rng, const std::optional<ArrayArg>& g_arg,
+          const std::optional<ArrayArg>& momentum_arg, const std::optional<ArrayArg>& energy_arg, batch::Dir dir) {
+  const Array v = to_array(v_arg, "velocities");
+  const auto g = to_array(g_arg, "g"), momentum = to_array(momentum_arg, "momentum");
+  const auto energy = to_array(energy_arg, "energy");
   const ExactCollision& op = c.op();
   const Rows rows = rows_for(op, v);
   const auto held = held_for(op, momentum, energy, rows.count);
@@ -122,22 +125,14 @@ void register_exact(py::module_& m) {
                   py::arg("name"), py::kw_only(), py::arg("law") = "flux", py::arg("bits") = 40,
                   "The operator of a named case (see revcol.named_cases()).")
       .def("forward",
-           [](Collision& c, const ArrayArg& v_arg, py::object rng, std::optional<ArrayArg> g_arg,
-              std::optional<ArrayArg> mo_arg, std::optional<ArrayArg> en_arg) {
-             const auto v = to_array(v_arg, "velocities");
-             const auto g = to_array(g_arg, "g");
-             const auto mo = to_array(mo_arg, "momentum");
-             const auto en = to_array(en_arg, "energy"); return run(c, v, rng, g, mo, en, batch::Dir::forward); },
+           [](Collision& c, const ArrayArg& v, py::object rng, std::optional<ArrayArg> g,
+              std::optional<ArrayArg> mo, std::optional<ArrayArg> en) { return run(c, v, rng, g, mo, en, batch::Dir::forward); },
            py::arg("velocities"), py::kw_only(), py::arg("rng") = py::none(), py::arg("g") = py::none(),
            py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
            "Pre -> post. velocities (n, d) or (B, n, d); exactly one of rng or g ((d_n,) or (B, d_n)).")
       .def("reverse",
-           [](Collision& c, const ArrayArg& v_arg, py::object rng, std::optional<ArrayArg> g_arg,
-              std::optional<ArrayArg> mo_arg, std::optional<ArrayArg> en_arg) {
-             const auto v = to_array(v_arg, "velocities");
-             const auto g = to_array(g_arg, "g");
-             const auto mo = to_array(mo_arg, "momentum");
-             const auto en = to_array(en_arg, "energy"); return run(c, v, rng, g, mo, en, batch::Dir::reverse); },
+           [](Collision& c, const ArrayArg& v, py::object rng, std::optional<ArrayArg> g,
+              std::optional<ArrayArg> mo, std::optional<ArrayArg> en) { return run(c, v, rng, g, mo, en, batch::Dir::reverse); },
            py::arg("velocities"), py::kw_only(), py::arg("rng") = py::none(), py::arg("g") = py::none(),
            py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
            "Post -> pre with the draws forward used (rng steps back).")

@@ -95,9 +95,12 @@ std::vector<typename Op::Geometry> geometries_from(const Array& x, std::size_t B
 
 // forward or reverse with exactly one source of random numbers.
 template <class Op>
-Array run(Holder<Op>& h, const Array& velocities, const Array& geometry, const py::object& rng,
-          const std::optional<Array>& g, const std::optional<Array>& momentum,
-          const std::optional<Array>& energy, batch::Dir dir) {
+Array run(Holder<Op>& h, const ArrayArg& velocities_arg, const ArrayArg& geometry_arg, const char* geometry_name,
+          const py::object& rng, const std::optional<ArrayArg>& g_arg, const std::optional<ArrayArg>& momentum_arg,
+          const std::optional<ArrayArg>& energy_arg, batch::Dir dir) {
+  const Array velocities = to_array(velocities_arg, "velocities"), geometry = to_array(geometry_arg, geometry_name);
+  const auto g = to_array(g_arg, "g"), momentum = to_array(momentum_arg, "momentum");
+  const auto energy = to_array(energy_arg, "energy");
   Rows rows{};
   std::vector<typename Op::State> v = states_from<Op>(velocities, rows);
   const auto x = geometries_from<Op>(geometry, v.size());
@@ -122,14 +125,9 @@ Array run(Holder<Op>& h, const Array& velocities, const Array& geometry, const p
 template <class Op, class Cls>
 void common_methods(Cls& cls, const char* geometry_name) {
   cls.def("forward",
-          [geometry_name](Holder<Op>& h, const ArrayArg& v_arg, const ArrayArg& x_arg, py::object rng, std::optional<ArrayArg> g_arg,
-             std::optional<ArrayArg> momentum_arg, std::optional<ArrayArg> energy_arg) {
-            const auto v = to_array(v_arg, "velocities");
-            const auto x = to_array(x_arg, "positions");
-            const auto g = to_array(g_arg, "g");
-            const auto momentum = to_array(momentum_arg, "momentum");
-            const auto energy = to_array(energy_arg, "energy");
-            return run<Op>(h, v, x, rng, g, momentum, energy, batch::Dir::forward);
+          [geometry_name](Holder<Op>& h, const ArrayArg& v, const ArrayArg& x, py::object rng, std::optional<ArrayArg> g,
+             std::optional<ArrayArg> momentum, std::optional<ArrayArg> energy) {
+            return run<Op>(h, v, x, geometry_name, rng, g, momentum, energy, batch::Dir::forward);
           },
           py::arg("velocities"), py::arg(geometry_name), py::kw_only(), py::arg("rng") = py::none(),
           py::arg("g") = py::none(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
@@ -137,14 +135,9 @@ void common_methods(Cls& cls, const char* geometry_name) {
           "[0,1]); momentum= and energy= hold the invariants. Every entry is validated first;\n"
           "on error nothing changes.")
       .def("reverse",
-           [geometry_name](Holder<Op>& h, const ArrayArg& v_arg, const ArrayArg& x_arg, py::object rng, std::optional<ArrayArg> g_arg,
-              std::optional<ArrayArg> momentum_arg, std::optional<ArrayArg> energy_arg) {
-             const auto v = to_array(v_arg, "velocities");
-             const auto x = to_array(x_arg, "positions");
-             const auto g = to_array(g_arg, "g");
-             const auto momentum = to_array(momentum_arg, "momentum");
-             const auto energy = to_array(energy_arg, "energy");
-             return run<Op>(h, v, x, rng, g, momentum, energy, batch::Dir::reverse);
+           [geometry_name](Holder<Op>& h, const ArrayArg& v, const ArrayArg& x, py::object rng, std::optional<ArrayArg> g,
+              std::optional<ArrayArg> momentum, std::optional<ArrayArg> energy) {
+             return run<Op>(h, v, x, geometry_name, rng, g, momentum, energy, batch::Dir::reverse);
            },
            py::arg("velocities"), py::arg(geometry_name), py::kw_only(), py::arg("rng") = py::none(),
            py::arg("g") = py::none(), py::arg("momentum") = py::none(), py::arg("energy") = py::none(),
