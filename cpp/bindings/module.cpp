@@ -5,6 +5,10 @@
 #include "bindings.hpp"
 #include "revcol/error.hpp"
 
+namespace revcol::bind {
+void register_randomness(pybind11::module_& m);  ///< randomness.cpp: the randomness study's word stream
+}  // namespace revcol::bind
+
 PYBIND11_MODULE(_core, m) {
   m.doc() = "revcol core (private): use the revcol package";
   pybind11::register_exception<revcol::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
@@ -18,4 +22,5 @@ PYBIND11_MODULE(_core, m) {
   revcol::bind::register_engine(m);
   revcol::bind::register_engine_init(m);
   revcol::bind::register_lattice(m);
+  revcol::bind::register_randomness(m);
 }
