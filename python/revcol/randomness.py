@@ -375,9 +375,12 @@ def _figure_triple1d(out: str, samples: int) -> str:
 def _figure_triple2d(out: str, case: str, samples: int) -> str:
     import matplotlib.pyplot as plt
 
+    from . import paper as P
+
     fig, ax = plt.subplots(3, 3, figsize=(10, 9.2), constrained_layout=True)
     for col, (mode, law) in enumerate(_MODES):
         post, _ = _posts(case, mode, law, samples)
+        keep = P._separates(case, post, P.paper_cases()[case]["geometry"])
         x, a = _relative(case, post)
         # projection 1: the plane of a_1, a_2 (their half planes are wedges there);
         # projection 2: its orthogonal complement (a_3's half plane, or no constraint)
@@ -397,7 +400,8 @@ def _figure_triple2d(out: str, case: str, samples: int) -> str:
                 nk = nk / np.linalg.norm(nk)
                 tk = np.array([-nk[1], nk[0]])
                 s.plot([-tk[0], tk[0]], [-tk[1], tk[1]], color="tab:red", lw=1)
-                s.annotate(f"a{k + 1}.x > 0", xy=0.55 * nk, fontsize=7, color="tab:red")
+                s.annotate(f"a{k + 1}.x > 0", xy=0.55 * nk, fontsize=7, color="tab:red", zorder=5,
+                           bbox={"fc": "white", "ec": "none", "alpha": 0.7})
             s.scatter(pr[:1500, 0], pr[:1500, 1], s=1, color="tab:blue", alpha=0.5, zorder=3)
             s.set_aspect("equal")
             s.set_xlim(-1.05, 1.05)
@@ -405,17 +409,19 @@ def _figure_triple2d(out: str, case: str, samples: int) -> str:
             s.set_xlabel(f"x . {names[0]}")
             s.set_ylabel(f"x . {names[1]}")
             if row == 0:
-                s.set_title(_title(mode, law), fontsize=10)
+                bad = f"\n{1 - keep.mean():.1%} of the posts do not separate" if not keep.all() else ""
+                s.set_title(_title(mode, law) + bad, fontsize=9)
         # the chart coordinates of the study's mapping (the law's own; paper: uniform), flat
         # when the posts follow that law
         op = _core.Collision.named(case, law=law)
-        ch = np.asarray(op.chart(post))
+        keep = P._separates(case, post, P.paper_cases()[case]["geometry"])
+        ch = np.asarray(op.chart(post[keep]))
         h = ax[2, col]
         for k in range(ch.shape[1]):
             h.hist(ch[:, k], bins=40, range=(0, 1), density=True, histtype="step", lw=1.2,
                    label=f"u{k + 1}")
         h.axhline(1.0, color="k", lw=1.5, label="the law: 1")
-        h.set_xlabel(f"{law}-law chart coordinates u of the post state")
+        h.set_xlabel(f"u: {law}-law chart of the separating posts")
         h.set_ylabel("density")
         h.set_ylim(0, 2.2)
         h.legend(fontsize=7, ncol=2)

@@ -90,3 +90,11 @@ def test_reduced_battery_good_passes_bad_fails(tmp_path):
                     1_000_000, (12,), workdir=str(tmp_path))
     assert bad["verdict"] == "FAILED", bad
     assert not os.listdir(tmp_path)  # the word files are removed
+
+
+def test_revcol_study_randomness_forwards(tmp_path):
+    from revcol import cli
+
+    path = tmp_path / "w.bin"
+    assert cli.main(["study", "randomness", "words", str(path), "--words", "100", "--case", "pair3d"]) == 0
+    assert path.stat().st_size == 400
