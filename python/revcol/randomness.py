@@ -25,6 +25,7 @@ Command line (``python -m revcol.randomness``, also ``revcol study randomness``)
     python -m revcol.randomness controls --words 3000000
     python -m revcol.randomness matrix --words 3000000 --json bench/results/randomness_3e6.json
     python -m revcol.randomness coverage --out docs/figures/randomness
+    python -m revcol.randomness table bench/results/randomness_paper_cases_3e6.json [--detail]
 
     >>> import revcol.randomness as R
     >>> w = R.stream("pair2d", mode="exact", law="flux", rng="philox").words(4)
@@ -49,7 +50,7 @@ import numpy as np
 from . import _core
 
 __all__ = ["PAPER_TESTS", "CI_TESTS", "stream", "stream_cases", "write_words", "has_dieharder",
-           "run_test", "battery", "controls", "ks_uniform", "coverage", "main"]
+           "run_test", "battery", "controls", "ks_uniform", "coverage", "table", "main"]
 
 #: the paper's Diehard tests as dieharder numbers: runs, craps, 3D spheres, minimum distance,
 #: parking lot, squeeze, birthdays, and the 32x32 and 6x8 binary rank tests. (The paper's
@@ -455,7 +456,7 @@ def _run_info(argv: Sequence[str], t0: float) -> dict:
     return {"command": "python -m revcol.randomness " + " ".join(argv),
             "commit": sh(["git", "rev-parse", "--short", "HEAD"]), "uptime": sh(["uptime"]),
             "wall_s": round(time.perf_counter() - t0, 1),
-            "dieharder": sh(["dieharder", "-l"]).splitlines()[1].strip() if has_dieharder() else ""}
+            "dieharder": " ".join(re.findall(r"dieharder version \S+", sh(["dieharder", "-l"]))[:1])}
 
 
 def _summary(b: dict) -> str:
@@ -463,6 +464,35 @@ def _summary(b: dict) -> str:
     tests = " ".join(f"{r['test']}:{r['verdict']}" for r in b["tests"])
     return (f"{c['case']:12s} {c['mode']:5s} {c['law']:7s} {c['rng']:16s} {b['verdict']:6s} "
             f"KS p={b['ks_p']:.3f}  restarts={b['stream']['restarts']}  {tests}")
+
+
+def table(runs: Sequence[dict], detail: bool = False) -> str:
+    """Markdown: one row per battery (verdict, KS of its p-values, extremes, WEAK tests and
+    their reruns); with ``detail``, one row per test and p-value column per battery."""
+    if detail:
+        head = ["test"] + [f"{r['config']['case']} {r['config']['mode']} {r['config']['law']} "
+                           f"{r['config']['rng']}" for r in runs]
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for i, t in enumerate(runs[0]["tests"]):
+            cells = [f"{t['name']} (-d {t['test']})"]
+            for r in runs:
+                rt = r["tests"][i]
+                ps = ", ".join(f"{row['p']:.4f}" for row in rt["rows"])
+                if "rerun" in rt:
+                    ps += " (WEAK; rerun: " + ", ".join(f"{row['p']:.4f}" for row in rt["rerun"]["rows"]) + ")"
+                cells.append(ps)
+            lines.append("| " + " | ".join(cells) + " |")
+        return "\n".join(lines)
+    lines = ["| case | mode | law | rng | words | restarts | n p | min p | max p | KS p | WEAK (rerun) | verdict |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in runs:
+        c = r["config"]
+        weak = "; ".join(f"-d {t['test']}: {t['verdict']}" for t in r["tests"] if "rerun" in t) or "-"
+        p = r["pvalues"]
+        lines.append(f"| {c['case']} | {c['mode']} | {c['law']} | {c['rng']} | {r['words']:.2g} | "
+                     f"{r['stream']['restarts']} | {len(p)} | {min(p):.2g} | {max(p):.4f} | {r['ks_p']:.3f} | "
+                     f"{weak} | **{r['verdict']}** |")
+    return "\n".join(lines)
 
 
 def _tests(spec: str) -> list[int]:
@@ -513,6 +543,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     for k, v in (("--case", "pair2d"), ("--mode", "exact"), ("--law", "flux"), ("--rng", "philox")):
         w.add_argument(k, default=v)
     w.add_argument("--seed", type=int, default=1)
+    tb = sub.add_parser("table", help="markdown tables of result files")
+    tb.add_argument("files", nargs="+")
+    tb.add_argument("--detail", action="store_true", help="one row per test, p-values per battery")
     c = sub.add_parser("coverage", help="the coverage figures")
     c.add_argument("--out", default="docs/figures/randomness")
     c.add_argument("--samples", type=int, default=20000)
@@ -521,6 +554,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if a.cmd == "coverage":
         for p in coverage(a.out, samples=a.samples):
             print(p)
+        return 0
+    if a.cmd == "table":
+        runs = [r for f in a.files for r in json.load(open(f))["runs"]]
+        print(table(runs, a.detail))
         return 0
     if a.cmd == "words":
         cfg = {"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}
