@@ -66,11 +66,13 @@ StreamConfig config(const std::string& name, Law law, Law cdf, const std::string
 
 }  // namespace
 
-TEST_CASE("exact mode: every case, both laws, both rngs: the words are uniform (KS, 1e5 words)") {
+TEST_CASE("exact mode: every case, both laws: the words are uniform (KS, 1e5 words; CLCG4 too for the paper's cases)") {
   for (const std::string& name : randomness::stream_cases(Mode::exact)) {
     if (name == "raw") continue;
+    const bool paper_case = name == "pair2d" || name == "triple1d" || name == "triple2d-c1";
     for (Law law : {Law::flux, Law::uniform})
       for (const char* rng : {"philox", "clcg4"}) {
+        if (!paper_case && std::string(rng) == "clcg4") continue;
         const StreamConfig c = config(name, law, law, rng);
         const int width = WordStream(c).width();
         const double k = worst_ks(take(c, 100000 - 100000 % width), width);
