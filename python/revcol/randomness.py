@@ -569,6 +569,15 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 2
     kw = {"workdir": a.workdir, "fit": not a.defaults}
     tests = _tests(a.tests)
+    commit = _run_info([], t0)["commit"]  # the code that runs (HEAD may move during a long run)
+
+    def save(runs: list[dict], complete: bool) -> None:
+        if a.json:  # after every battery of a matrix, so that a stopped run keeps what it did
+            with open(a.json + ".tmp", "w") as f:
+                json.dump(dict(_run_info(argv, t0), commit=commit, complete=complete, runs=runs), f, indent=1)
+                f.write("\n")
+            os.replace(a.json + ".tmp", a.json)
+
     if a.cmd == "battery":
         cfg = {"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}
         runs = [battery(cfg, int(a.words), tests, **kw)]
@@ -580,13 +589,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                                    a.rngs.split(",")):
             runs.append(battery(cfg, int(a.words), tests, **kw))
             print(_summary(runs[-1]), flush=True)
+            save(runs, False)
     if a.cmd != "matrix":
         for r in runs:
             print(_summary(r))
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump(dict(_run_info(argv, t0), runs=runs), f, indent=1)
-            f.write("\n")
+    save(runs, True)
     return 0
 
 
