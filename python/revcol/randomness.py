@@ -546,6 +546,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     tb = sub.add_parser("table", help="markdown tables of result files")
     tb.add_argument("files", nargs="+")
     tb.add_argument("--detail", action="store_true", help="one row per test, p-values per battery")
+    tb.add_argument("--only", help="batteries to show, e.g. pair2d:exact:flux:clcg4,triple1d:paper:uniform:clcg4")
     c = sub.add_parser("coverage", help="the coverage figures")
     c.add_argument("--out", default="docs/figures/randomness")
     c.add_argument("--samples", type=int, default=20000)
@@ -557,6 +558,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 0
     if a.cmd == "table":
         runs = [r for f in a.files for r in json.load(open(f))["runs"]]
+        if a.only:
+            key = [tuple(k.split(":")) for k in a.only.split(",")]
+            runs = [r for k in key for r in runs
+                    if tuple(r["config"][x] for x in ("case", "mode", "law", "rng")) == k]
         print(table(runs, a.detail))
         return 0
     if a.cmd == "words":
