@@ -310,17 +310,17 @@ void WordStream::fill(std::uint32_t* out, std::size_t n) {
 }
 
 void WordStream::write(const std::string& path, std::uint64_t n) {
-  std::FILE* f = std::fopen(path.c_str(), "ab");
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "ab"), &std::fclose);
   require(f != nullptr, [&] { return "cannot open '" + path + "' for writing"; });
   std::vector<std::uint32_t> buf(1 << 16);
   bool ok = true;
   while (n > 0 && ok) {
     const std::size_t k = n < buf.size() ? static_cast<std::size_t>(n) : buf.size();
-    fill(buf.data(), k);
-    ok = std::fwrite(buf.data(), sizeof(std::uint32_t), k, f) == k;
+    fill(buf.data(), k);  // may throw (a paper chain that cannot go on): the file is closed
+    ok = std::fwrite(buf.data(), sizeof(std::uint32_t), k, f.get()) == k;
     n -= k;
   }
-  ok = std::fclose(f) == 0 && ok;
+  ok = std::fclose(f.release()) == 0 && ok;
   require(ok, [&] { return "writing '" + path + "' failed (disk full?)"; });
 }
 

@@ -57,9 +57,9 @@ class WordStream {
  public:
   /// Builds the chain; throws InvalidArgument on an unknown case, mode, rng or bits.
   explicit WordStream(const StreamConfig& config);
-  ~WordStream();
-  WordStream(WordStream&&) noexcept;
-  WordStream& operator=(WordStream&&) noexcept;
+  ~WordStream();                                    ///< frees the chain
+  WordStream(WordStream&&) noexcept;                ///< moves the chain (not copyable)
+  WordStream& operator=(WordStream&&) noexcept;     ///< moves the chain
 
   /// The configuration it runs.
   const StreamConfig& config() const;
