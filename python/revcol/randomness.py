@@ -241,8 +241,15 @@ def _posts(case: str, mode: str, law: str, samples: int, seed: int = 7) -> tuple
 
     if case == "pair2d":
         v = np.array([[0.25, -0.5], [1.0, 0.75]])
-    else:
+    elif case in P.PAPER_CASES:
         v = P.paper_cases()[case]["velocities"]
+    else:  # standard normal velocities, the first draw that approaches at every contact
+        op = _core.Collision.named(case)
+        rng = np.random.default_rng(seed)
+        while True:
+            v = rng.normal(size=(op.particles, op.dim))
+            if max(op.normal_speeds(v)) < 0:
+                break
     n, d = v.shape
     if mode == "exact":
         op = _core.Collision.named(case, law=law)
@@ -433,9 +440,76 @@ def _figure_triple2d(out: str, case: str, samples: int) -> str:
     return _save(fig, path, 90)
 
 
+def _figure_pair3d(out: str, samples: int) -> str:
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(2, 3, figsize=(10, 6.4), constrained_layout=True)
+    a = np.ones(3) / np.sqrt(3.0)
+    t1 = np.array([1.0, -1.0, 0.0]) / np.sqrt(2.0)
+    t2 = np.cross(a, t1)
+    c_grid = np.linspace(0, 1, 200)
+    for col, (mode, law) in enumerate(_MODES):
+        post, _ = _posts("pair3d", mode, law, samples)
+        w = post[:, 0] - post[:, 1]
+        w /= np.linalg.norm(w, axis=1)[:, None]
+        c = w @ a
+        s = ax[0, col]
+        th = np.linspace(0, 2 * np.pi, 400)
+        s.plot(np.cos(th), np.sin(th), color="tab:green", lw=2, label="rim of the permitted hemisphere")
+        keep = c > 0
+        s.scatter((w @ t1)[:2000], (w @ t2)[:2000], s=1, alpha=0.5, zorder=3,
+                  c=np.where(keep[:2000], "tab:blue", "tab:red"))
+        s.set_aspect("equal")
+        s.set_xlabel("w.t1 / |w|")
+        s.set_ylabel("w.t2 / |w|")
+        bad = f"\n{1 - keep.mean():.1%} approach (red)" if not keep.all() else ""
+        s.set_title(_title(mode, law) + bad, fontsize=9)
+        if col == 0:
+            s.legend(fontsize=7, loc="lower left")
+        h = ax[1, col]
+        h.hist(c, bins=50, range=(-1, 1) if not keep.all() else (0, 1), density=True, color="tab:blue",
+               alpha=0.6, label=f"{samples} posts")
+        dens = 2 * c_grid if law == "flux" else np.ones_like(c_grid)
+        h.plot(c_grid, dens, color="k", lw=1.5, label="2 cos(theta)" if law == "flux" else "uniform: 1")
+        h.set_xlabel("cos(theta) = w.a / |w| of the post state")
+        h.set_ylabel("density")
+        h.legend(fontsize=7)
+    fig.suptitle("2 particles in 3D, normal (1,1,1): post directions seen from the normal, one pre state",
+                 fontsize=11)
+    return _save(fig, os.path.join(out, "coverage_pair3d.png"), 110)
+
+
+def _figure_exact_cases(out: str, samples: int) -> str:
+    import matplotlib.pyplot as plt
+
+    cases = [c for c in stream_cases("exact") if c not in ("raw", "pair2d", "pair3d", "triple1d")
+             and not c.startswith("triple2d")]
+    fig, ax = plt.subplots(2, len(cases), figsize=(2.2 * len(cases), 4.4), constrained_layout=True)
+    for col, case in enumerate(cases):
+        for row, law in enumerate(("flux", "uniform")):
+            post, _ = _posts(case, "exact", law, samples)
+            op = _core.Collision.named(case, law=law)
+            ch = np.asarray(op.chart(post))
+            h = ax[row, col]
+            for k in range(ch.shape[1]):
+                h.hist(ch[:, k], bins=25, range=(0, 1), density=True, histtype="step", lw=1)
+            h.axhline(1.0, color="k", lw=1)
+            h.set_ylim(0, 1.6)
+            h.set_title(f"{case}, {law}" + (f"\n{ch.shape[1]} coordinates" if row == 0 else ""), fontsize=8)
+            h.tick_params(labelsize=7)
+            if col == 0:
+                h.set_ylabel("density", fontsize=8)
+            if row == 1:
+                h.set_xlabel("chart coordinate u", fontsize=8)
+    fig.suptitle("The other exact cases: chart coordinates of 20000 post states of one pre state, "
+                 "each law read by its own chart (flat = the law)", fontsize=10)
+    return _save(fig, os.path.join(out, "coverage_exact_cases.png"), 100)
+
+
 def coverage(out: str = "docs/figures/randomness", samples: int = 20000) -> list[str]:
-    """The coverage figures (PNG): pair2d, triple1d and triple2d-c1..c4, exact flux and
-    uniform beside paper mode, from one fixed pre state each. Returns the paths."""
+    """The coverage figures (PNG): pair2d, triple1d, triple2d-c1..c4 and pair3d, exact flux
+    and uniform beside paper mode, and the chart coordinates of every other exact case, from
+    one fixed pre state each. Returns the paths."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -443,6 +517,7 @@ def coverage(out: str = "docs/figures/randomness", samples: int = 20000) -> list
     paths = [_figure_pair2d(out, samples), _figure_triple1d(out, samples)]
     for c in ("triple2d-c1", "triple2d-c2", "triple2d-c3", "triple2d-c4"):
         paths.append(_figure_triple2d(out, c, samples))
+    paths += [_figure_pair3d(out, samples), _figure_exact_cases(out, samples)]
     return paths
 
 
