@@ -98,3 +98,10 @@ def test_revcol_study_randomness_forwards(tmp_path):
     path = tmp_path / "w.bin"
     assert cli.main(["study", "randomness", "words", str(path), "--words", "100", "--case", "pair3d"]) == 0
     assert path.stat().st_size == 400
+
+
+def test_coverage_figures_are_written_small(tmp_path):
+    paths = R.coverage(str(tmp_path), samples=2000)
+    assert len(paths) == 8
+    for p in paths:
+        assert os.path.getsize(p) < 150_000, p
