@@ -50,7 +50,7 @@ import numpy as np
 from . import _core
 
 __all__ = ["PAPER_TESTS", "CI_TESTS", "stream", "stream_cases", "write_words", "has_dieharder",
-           "run_test", "battery", "controls", "ks_uniform", "coverage", "table", "main"]
+           "run_test", "battery", "controls", "ks_uniform", "coverage", "table", "marginals", "main"]
 
 #: the paper's Diehard tests as dieharder numbers: runs, craps, 3D spheres, minimum distance,
 #: parking lot, squeeze, birthdays, and the 32x32 and 6x8 binary rank tests. (The paper's
@@ -570,6 +570,21 @@ def table(runs: Sequence[dict], detail: bool = False) -> str:
     return "\n".join(lines)
 
 
+def marginals(config: dict, words: int = 3_000_000) -> dict:
+    """One-sample KS of each chart coordinate of the first ``words`` words of a stream against
+    the uniform law: D, sqrt(n) D and p per coordinate. A battery failure with a large D is
+    the law's (the operator's or the chart's), not the generator's."""
+    from scipy import stats
+
+    s = stream(**config)
+    w = s.words(int(words) - int(words) % s.width).reshape(-1, s.width)
+    out = []
+    for k in range(s.width):
+        r = stats.kstest((w[:, k] + 0.5) / 2.0**32, "uniform")
+        out.append({"D": float(r.statistic), "K": float(r.statistic * np.sqrt(len(w))), "p": float(r.pvalue)})
+    return {"config": dict(config), "words": int(w.size), "restarts": int(s.restarts), "coordinates": out}
+
+
 def _tests(spec: str) -> list[int]:
     return list(PAPER_TESTS) if spec == "paper" else [int(t) for t in spec.split(",")]
 
@@ -622,6 +637,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     tb.add_argument("files", nargs="+")
     tb.add_argument("--detail", action="store_true", help="one row per test, p-values per battery")
     tb.add_argument("--only", help="batteries to show, e.g. pair2d:exact:flux:clcg4,triple1d:paper:uniform:clcg4")
+    mg = sub.add_parser("marginals", help="per-coordinate KS of the words of each battery in result files")
+    mg.add_argument("files", nargs="+")
+    mg.add_argument("--words", type=float, default=3e6)
+    mg.add_argument("--json", help="write the results here")
     c = sub.add_parser("coverage", help="the coverage figures")
     c.add_argument("--out", default="docs/figures/randomness")
     c.add_argument("--samples", type=int, default=20000)
@@ -638,6 +657,19 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             runs = [r for k in key for r in runs
                     if tuple(r["config"][x] for x in ("case", "mode", "law", "rng")) == k]
         print(table(runs, a.detail))
+        return 0
+    if a.cmd == "marginals":
+        res = []
+        for f in a.files:
+            for r in json.load(open(f))["runs"]:
+                res.append(marginals({k: r["config"][k] for k in ("case", "mode", "law", "rng", "seed")}, int(a.words)))
+                c = res[-1]["config"]
+                ks = ", ".join(f"D={x['D']:.2g} p={x['p']:.2g}" for x in res[-1]["coordinates"])
+                print(f"| {c['case']} | {c['mode']} | {c['law']} | {c['rng']} | {ks} |", flush=True)
+        if a.json:
+            with open(a.json, "w") as f:
+                json.dump(dict(_run_info(argv, t0), runs=res), f, indent=1)
+                f.write("\n")
         return 0
     if a.cmd == "words":
         cfg = {"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}
