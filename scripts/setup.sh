@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs everything revcol needs, on a fresh Debian machine as root, and is cheap to run
-# again: Debian packages (compiler, Eigen 3, GSL, Python) only when missing, then a virtual
+# again: Debian packages (compiler, Eigen 3, GSL, Python, dieharder) only when missing, then a virtual
 # environment .venv with the build tools from PyPI and revcol itself (an incremental build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,6 +10,7 @@ command -v g++ >/dev/null 2>&1 || missing+=(g++)
 command -v make >/dev/null 2>&1 || missing+=(make)
 [ -f /usr/include/eigen3/Eigen/Core ] || missing+=(libeigen3-dev)
 [ -f /usr/include/gsl/gsl_sf_ellint.h ] || missing+=(libgsl-dev)
+command -v dieharder >/dev/null 2>&1 || missing+=(dieharder)  # the randomness battery (docs/randomness.md)
 command -v python3 >/dev/null 2>&1 || missing+=(python3 python3-dev python3-venv)
 if command -v python3 >/dev/null 2>&1 && ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
   missing+=(python3-venv)

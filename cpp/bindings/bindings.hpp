@@ -14,4 +14,5 @@ void register_statesave(pybind11::module_& m);  ///< statesave.cpp: the SS1/SS2/
 void register_engine(pybind11::module_& m);     ///< engine.cpp: the event-driven engine (Simulation)
 void register_engine_init(pybind11::module_& m);  ///< engine_init.cpp: the engine's random start and limits
 void register_lattice(pybind11::module_& m);     ///< lattice.cpp: the 2D lattice engine
+void register_randomness(pybind11::module_& m);  ///< randomness.cpp: the randomness study's word stream
 }  // namespace revcol::bind

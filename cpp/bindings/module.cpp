@@ -29,4 +29,5 @@ PYBIND11_MODULE(_core, m) {
   revcol::bind::register_engine(m);
   revcol::bind::register_engine_init(m);
   revcol::bind::register_lattice(m);
+  revcol::bind::register_randomness(m);
 }

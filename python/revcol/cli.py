@@ -5,6 +5,7 @@
     revcol run [SCENE.toml] --horizon [--seeds K] [--max-collisions N] [--engine float] [--json FILE] [--plot DIR]
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
+    revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.randomness ...)
 """
 from __future__ import annotations
 
@@ -80,6 +81,11 @@ def _parser() -> argparse.ArgumentParser:
     bsub = b.add_subparsers(dest="study", required=True)
     statesave.add_arguments(bsub.add_parser(
         "statesave", help="the paper's state saving vs reverse computation study (and lazy transport)"))
+    st = sub.add_parser("study", help="studies (their arguments go to the study's module)")
+    stsub = st.add_subparsers(dest="study", required=True)
+    rnd = stsub.add_parser("randomness", add_help=False,
+                           help="the paper's randomness (dieharder) and coverage experiments: python -m revcol.randomness")
+    rnd.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 
 
@@ -129,6 +135,11 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    words = sys.argv[1:] if argv is None else list(argv)
+    if words[:2] == ["study", "randomness"]:  # everything after it (-h included) is the study's
+        from . import randomness
+
+        return randomness.main(words[2:])
     args = _parser().parse_args(argv)
     if args.command == "run":
         return _run(args)
