@@ -97,45 +97,10 @@ void validate_config(const Config& c) {
   }
 }
 
-// Cold validation of a state (nothing built yet).
-void validate_state(const Config& c, const std::vector<double>& x, const std::vector<double>& v) {
-  validate_config(c);
+// Throws InvalidArgument naming the first pair closer than D (1 - 1e-9): a cell grid of cells >= D,
+// the 3^d neighbouring cells, minimum images on periodic axes. x: n x d positions inside the box.
+void check_overlaps(const Config& c, const std::vector<double>& x, std::size_t n) {
   const int d = c.dim;
-  require(!x.empty(), "no particles (N = 0)");
-  require(x.size() % d == 0, "positions must have n x dim entries");
-  require(v.size() == x.size(), "velocities must have the same shape as positions");
-  const std::size_t n = x.size() / d;
-  require(n < (std::size_t{1} << 31), "too many particles (N must be < 2^31)");
-  const double r = 0.5 * c.diameter;
-  double e = 0.0;
-  for (std::size_t i = 0; i < n; ++i)
-    for (int k = 0; k < d; ++k) {
-      const double xk = x[i * d + k], vk = v[i * d + k];
-      require(std::isfinite(xk), [&] { return "position of particle " + std::to_string(i) + " is not finite"; });
-      require(std::isfinite(vk), [&] { return "velocity of particle " + std::to_string(i) + " is not finite"; });
-      if (has_walls(c.boundary[k]))
-        require(xk >= r && xk <= c.box[k] - r, [&] {
-          return "particle " + std::to_string(i) + " is outside the box on axis " + std::to_string(k) + ": x = " +
-                 num(xk) + ", allowed [" + num(r) + ", " + num(c.box[k] - r) +
-                 "] (walls at 0 and L, centre at least D/2 inside)";
-        });
-      else
-        require(xk >= 0.0 && xk < c.box[k], [&] {
-          return "particle " + std::to_string(i) + " is outside the periodic box on axis " + std::to_string(k) +
-                 ": x = " + num(xk) + ", allowed [0, " + num(c.box[k]) + ")";
-        });
-      e += 0.5 * vk * vk;
-    }
-  require(std::isfinite(e), "kinetic energy overflows");
-  require(e > 0.0, "zero kinetic energy: nothing would ever move");
-  double vmax = 0.0;
-  for (double q : v) vmax = std::max(vmax, std::fabs(q));
-  require(vmax >= limits::kMinGasSpeed && vmax <= limits::max_gas_speed(static_cast<double>(n), d), [&] {
-    return "largest velocity component " + num(vmax) + " is outside the speeds the operators resolve: [2^-420, 2^450 / sqrt(N d)] = [" +
-           num(limits::kMinGasSpeed) + ", " + num(limits::max_gas_speed(static_cast<double>(n), d)) + "] (rescale velocities and time)";
-  });
-  require(std::isfinite(c.diameter / vmax), "diameter / speed overflows: rescale lengths or velocities");
-  // overlaps through a cell grid (cells >= D)
   std::array<int, 3> nc{1, 1, 1};
   std::array<double, 3> cw{1, 1, 1};
   std::size_t total = 1;
@@ -191,6 +156,47 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
     next[i] = head[id];
     head[id] = static_cast<int>(i);
   }
+}
+
+// Cold validation of a state (nothing built yet).
+void validate_state(const Config& c, const std::vector<double>& x, const std::vector<double>& v) {
+  validate_config(c);
+  const int d = c.dim;
+  require(!x.empty(), "no particles (N = 0)");
+  require(x.size() % d == 0, "positions must have n x dim entries");
+  require(v.size() == x.size(), "velocities must have the same shape as positions");
+  const std::size_t n = x.size() / d;
+  require(n < (std::size_t{1} << 31), "too many particles (N must be < 2^31)");
+  const double r = 0.5 * c.diameter;
+  double e = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < d; ++k) {
+      const double xk = x[i * d + k], vk = v[i * d + k];
+      require(std::isfinite(xk), [&] { return "position of particle " + std::to_string(i) + " is not finite"; });
+      require(std::isfinite(vk), [&] { return "velocity of particle " + std::to_string(i) + " is not finite"; });
+      if (has_walls(c.boundary[k]))
+        require(xk >= r && xk <= c.box[k] - r, [&] {
+          return "particle " + std::to_string(i) + " is outside the box on axis " + std::to_string(k) + ": x = " +
+                 num(xk) + ", allowed [" + num(r) + ", " + num(c.box[k] - r) +
+                 "] (walls at 0 and L, centre at least D/2 inside)";
+        });
+      else
+        require(xk >= 0.0 && xk < c.box[k], [&] {
+          return "particle " + std::to_string(i) + " is outside the periodic box on axis " + std::to_string(k) +
+                 ": x = " + num(xk) + ", allowed [0, " + num(c.box[k]) + ")";
+        });
+      e += 0.5 * vk * vk;
+    }
+  require(std::isfinite(e), "kinetic energy overflows");
+  require(e > 0.0, "zero kinetic energy: nothing would ever move");
+  double vmax = 0.0;
+  for (double q : v) vmax = std::max(vmax, std::fabs(q));
+  require(vmax >= limits::kMinGasSpeed && vmax <= limits::max_gas_speed(static_cast<double>(n), d), [&] {
+    return "largest velocity component " + num(vmax) + " is outside the speeds the operators resolve: [2^-420, 2^450 / sqrt(N d)] = [" +
+           num(limits::kMinGasSpeed) + ", " + num(limits::max_gas_speed(static_cast<double>(n), d)) + "] (rescale velocities and time)";
+  });
+  require(std::isfinite(c.diameter / vmax), "diameter / speed overflows: rescale lengths or velocities");
+  check_overlaps(c, x, n);
 }
 
 }  // namespace
@@ -268,6 +274,33 @@ std::unique_ptr<Simulation> restore_simulation(const Snapshot& s) {
   for (double t : s.t_local) require(std::isfinite(t), "snapshot: local times must be finite");
   for (double q : s.x) require(std::isfinite(q), "snapshot: positions must be finite");
   for (double q : s.v) require(std::isfinite(q), "snapshot: velocities must be finite");
+  {
+    // the positions at the clock inside the box (walls: to 1e-9 D) and without overlaps (a
+    // damaged diameter or position made the list build spin forever: the fuzz suite, issue 17)
+    const Config& c = s.config;
+    const double r = 0.5 * c.diameter, slack = 1e-9 * c.diameter;
+    std::vector<double> now(n * d);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < d; ++k) {
+        double q = s.x[i * d + k] + s.v[i * d + k] * (s.time - s.t_local[i]);
+        require(std::isfinite(q), "snapshot: a position at the clock is not finite");
+        if (has_walls(c.boundary[k])) {
+          require(q >= r - slack && q <= c.box[k] - r + slack, [&] {
+            return "snapshot: particle " + std::to_string(i) + " is outside the box on axis " + std::to_string(k) +
+                   " at the clock (x = " + num(q) + ")";
+          });
+        } else {
+          q -= c.box[k] * std::floor(q / c.box[k]);
+          if (!(q < c.box[k])) q = 0.0;  // q / L rounded up to 1
+        }
+        now[i * d + k] = q;
+      }
+    try {
+      check_overlaps(c, now, n);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(std::string("snapshot: ") + e.what());
+    }
+  }
   require(s.log_pushed >= s.log_cells.size(), "snapshot: log_pushed is smaller than the log");
   {
     require(s.pre_keys.size() == 2 * s.pre_sizes.size(), "snapshot: exact-pre log keys must be 2 per entry");

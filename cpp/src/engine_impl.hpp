@@ -21,6 +21,7 @@
 #include "revcol/collide/specular.hpp"
 #include "revcol/engine/boundary.hpp"
 #include "revcol/engine/engine.hpp"
+#include "revcol/engine/limits.hpp"
 #include "revcol/engine/init.hpp"
 #include "revcol/engine/event_queue.hpp"
 #include "revcol/engine/kinematics.hpp"
@@ -128,8 +129,15 @@ class EngineImpl final : public Simulation {
     ExactPreLog::fields(pre_, [&](const char* key, auto& field) { s.field(key, field); });
     second_.assign(n_, kInf);
     touching_.assign(n_, 0);
+    double vmax = 0.0;
+    for (double q : s.v) vmax = std::max(vmax, std::fabs(q));
     for (std::size_t i = 0; i < n_; ++i) {
       require(s.ev_kind[i] >= kWall && s.ev_kind[i] <= kNone, "snapshot: bad event kind");
+      // a scheduled event lies at or after the clock and within the clock's range (issue 17's fuzz
+      // suite: event times of +-2^40 sent run() into an endless stream of events)
+      require(s.ev_t[i] == kInf || (s.ev_t[i] >= s.time && limits::clock_fits(s.ev_t[i], cfg_.diameter, vmax)),
+              "snapshot: an event time before the clock or beyond the clock's range");
+      require(!std::isnan(s.second[i]), "snapshot: a second event time is NaN");
       require(s.ev_kind[i] != kColl || (s.ev_partner[i] >= 0 && static_cast<std::size_t>(s.ev_partner[i]) < n_),
               "snapshot: event partner outside [0, n)");
       // a wall event's partner is 2 axis + (upper wall), on an axis with walls (issue 17: a forged

@@ -258,7 +258,7 @@ def test_a_snapshot_with_speeds_outside_the_range_is_refused():
         bad = dict(st, v=np.asarray(st["v"]) * scale)
         with pytest.raises(ValueError, match="snapshot: velocities outside the speeds"):
             Simulation.from_snapshot(bad)
-    Simulation.from_snapshot(dict(st, v=np.asarray(st["v"]) * 1e-100))  # inside: accepted
+    Simulation.from_snapshot(dict(st))  # (scaling v moves the positions at the clock: an overlap)
 
 
 # --- scenes: every failure exits 2 with one line, outputs checked before the run ---------
@@ -304,3 +304,19 @@ def test_a_scene_too_large_for_memory_is_refused_before_allocating(tmp_path, cap
     assert rc == 2 and "[system] particles: 100 particles need about" in err[0], err
     monkeypatch.setattr(run_mod, "_available_bytes", lambda: 10 * 2**30)
     assert _revcol_run(tmp_path, SCENE, capsys)[0] == 0
+
+
+@pytest.mark.parametrize("field, value, text", [
+    ("diameter", 2.0, "snapshot: particles? .* (overlap|outside the box)"),  # was: the list build never returned
+    ("ev_t", 2.0**40, "event time before the clock or beyond"),  # was: run() never returned
+    ("ev_t", -2.0**40, "event time before the clock or beyond"),
+    ("x", 1e6, "outside the box on axis 1 at the clock"),
+])
+def test_a_snapshot_the_engine_would_spin_on_is_refused(field, value, text):
+    s = Simulation.random(40, 2, 0.4, boundary=["periodic", "wall"], seed=1)
+    s.run(collisions=60)
+    st = s.snapshot()
+    bad = dict(st)
+    bad[field] = np.full_like(np.asarray(st[field]), value) if np.ndim(st[field]) else value
+    with pytest.raises(ValueError, match=text):
+        Simulation.from_snapshot(bad)
