@@ -348,7 +348,6 @@ def _figure_triple1d(out: str, samples: int) -> str:
     lo, hi = 7 * np.pi / 6, 3 * np.pi / 2
     for col, (mode, law) in enumerate(_MODES):
         post, _ = _posts("triple1d", mode, law, samples)
-        x, _a = _relative("triple1d", post)
         # the paper's angle: x = (lambda / sqrt2)(cos phi, sin phi) in Jacobi coordinates
         # ((a-b)/sqrt2, (a+b-2c)/sqrt6); Helmert's rows are these up to sign
         j1 = (post[:, 0, 0] - post[:, 1, 0]) / np.sqrt(2)
