@@ -19,8 +19,12 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "revcol/error.hpp"
+#include "revcol/interrupt.hpp"
 
 namespace revcol::bind {
 
@@ -162,9 +166,54 @@ T checkpoint_field(pybind11::handle obj, const std::string& key) {
   }
 }
 
+/// A checkpoint array entry as a flat std::vector<T>, strictly: an integer field takes an
+/// integer (or bool) array whose every value fits T, a real field takes an integer or float
+/// array; anything else (strings, objects, floats in an integer field, -1 in a count) is an
+/// InvalidArgument naming the entry. (numpy's forcecast would turn NaN into a count silently.)
+template <class T>
+std::vector<T> checkpoint_array(pybind11::handle obj, const std::string& key) {
+  namespace py = pybind11;
+  const py::array a = py::array::ensure(obj);
+  require(static_cast<bool>(a), [&] { return "checkpoint entry '" + key + "' is not an array"; });
+  const char kind = a.dtype().kind();
+  const auto dtype = [&] { return std::string(py::str(a.dtype())); };
+  if constexpr (std::is_integral_v<T>) {
+    require(kind == 'i' || kind == 'u' || kind == 'b',
+            [&] { return "checkpoint entry '" + key + "' must hold integers, got dtype " + dtype(); });
+    std::vector<T> out(static_cast<std::size_t>(a.size()));
+    const auto fits = [&](auto q) {
+      return std::in_range<T>(q) ? true : (throw InvalidArgument("checkpoint entry '" + key + "' holds " +
+                                                                 std::to_string(q) + ", outside its type's range"), false);
+    };
+    if (kind == 'u') {
+      const auto u = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+      for (py::ssize_t k = 0; k < u.size(); ++k) out[k] = fits(u.data()[k]) ? static_cast<T>(u.data()[k]) : T{};
+    } else {
+      const auto s = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+      for (py::ssize_t k = 0; k < s.size(); ++k) out[k] = fits(s.data()[k]) ? static_cast<T>(s.data()[k]) : T{};
+    }
+    return out;
+  } else {
+    require(kind == 'f' || kind == 'i' || kind == 'u',
+            [&] { return "checkpoint entry '" + key + "' must hold numbers, got dtype " + dtype(); });
+    const auto f = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+    return std::vector<T>(f.data(), f.data() + f.size());
+  }
+}
+
 /// A long run's poll (engine::Poll): false once a signal handler (Ctrl-C) left a Python
 /// exception pending; the run stops at a valid point and the caller raises it.
 inline bool poll_signals() { return PyErr_CheckSignals() == 0; }
+
+/// A study's interrupt check (revcol/interrupt.hpp) for a loop that runs with the GIL
+/// released: takes the GIL and says stop once Ctrl-C left a KeyboardInterrupt pending (the
+/// module's translator of revcol::Interrupted then raises it).
+inline InterruptCheck released_signal_check() {
+  return [] {
+    pybind11::gil_scoped_acquire gil;
+    return PyErr_CheckSignals() != 0;
+  };
+}
 
 }  // namespace revcol::bind
 

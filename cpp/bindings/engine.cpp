@@ -49,11 +49,7 @@ py::array_t<T> vec_array(const std::vector<T>& v) {
 template <class T>
 std::vector<T> array_vec(const py::dict& d, const char* key) {
   require(d.contains(key), [&] { return std::string("checkpoint is missing '") + key + "'"; });
-  return checkpoint_entry(key, [&] {
-    auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(d[key]);
-    require(static_cast<bool>(a), [&] { return std::string("checkpoint entry '") + key + "' is not an array"; });
-    return std::vector<T>(a.data(), a.data() + a.size());
-  });
+  return checkpoint_array<T>(d[key], key);
 }
 
 en::Config make_config(int dim, const std::vector<double>& box, const std::vector<std::string>& boundary,
@@ -102,6 +98,7 @@ py::dict run_dict(const en::RunResult& r) {
   d["events"] = r.events;
   d["time"] = r.time;
   d["interrupted"] = r.interrupted;
+  d["diverged"] = r.diverged;
   return d;
 }
 
@@ -124,7 +121,7 @@ class PyEngine {
     if (PyErr_Occurred()) throw py::error_already_set();  // Ctrl-C: the run stopped between events
     return run_dict(r);
   }
-  py::dict run_back(std::optional<PyInt> collisions_arg, std::optional<PyReal> time_arg) {
+  py::dict run_back(std::optional<PyInt> collisions_arg, std::optional<PyReal> time_arg, bool stop_on_divergence) {
     const auto collisions = to_int<std::uint64_t>(collisions_arg, "collisions");
     const auto time = to_real(time_arg, "time");
     const std::uint64_t nc = collisions.value_or(std::numeric_limits<std::uint64_t>::max());
@@ -132,7 +129,7 @@ class PyEngine {
     // pass a time to go earlier
     const double tt = time.value_or(s_->start_time());
     require(!time || std::isfinite(*time), "run_back: time must be finite");
-    const en::RunResult r = s_->run_back(nc, tt, poll_signals);
+    const en::RunResult r = s_->run_back(nc, tt, poll_signals, stop_on_divergence);
     if (PyErr_Occurred()) throw py::error_already_set();
     return run_dict(r);
   }
@@ -154,6 +151,18 @@ class PyEngine {
     d["wall_log_entries"] = g.wall_log_entries;
     d["collisions_per_particle"] = g.collisions_per_particle;
     d["net_collisions"] = g.net_collisions;
+    // the collision trace (revcol/engine/trace.hpp): None where nothing was found yet
+    const auto count = [](std::int64_t m) -> py::object {
+      return m == en::CollisionTrace::kNever ? py::object(py::none()) : py::object(py::int_(m));
+    };
+    d["divergence"] = g.divergence == en::Divergence::none ? py::object(py::none())
+                                                           : py::object(py::str(en::to_string(g.divergence)));
+    d["diverged_at"] = count(g.diverged_at);
+    d["verified_at"] = count(g.verified_at);
+    d["trace_reorderings"] = g.trace_reorderings;
+    d["trace_stride"] = g.trace_stride;
+    d["trace_points"] = g.trace_points;
+    d["clock_deviation"] = g.clock_deviation;
     d["memory_bytes"] = s_->memory_bytes();
     d["events"] = counters_dict(g.counters);
     return d;
@@ -226,6 +235,8 @@ class PyEngine {
       using T = std::decay_t<decltype(field)>;
       // absent in checkpoints written before the neighbour lists: centres from x, events predicted anew
       if (std::strcmp(key, "centre") == 0 && !d.contains(key)) return;
+      // absent in checkpoints written before the collision trace: a new trace starts here
+      if (std::strcmp(key, "trace") == 0 && !d.contains(key)) return;
       if constexpr (is_vector<T>::value) field = array_vec<typename T::value_type>(d, key);
       else field = checkpoint_field<T>(get(key), key);
     });
@@ -277,7 +288,8 @@ void register_engine(py::module_& m) {
       .def_static("from_snapshot", &PyEngine::from_snapshot, py::arg("snapshot"))
       .def("run", &PyEngine::run, py::arg("collisions") = py::none(), py::arg("time") = py::none(),
            py::arg("callback") = py::none(), py::arg("every") = 10000)
-      .def("run_back", &PyEngine::run_back, py::arg("collisions") = py::none(), py::arg("time") = py::none())
+      .def("run_back", &PyEngine::run_back, py::arg("collisions") = py::none(), py::arg("time") = py::none(),
+           py::arg("stop_on_divergence") = false)
       .def_property_readonly("positions", &PyEngine::positions)
       .def_property_readonly("velocities", &PyEngine::velocities)
       .def_property_readonly("collision_counts", &PyEngine::collision_counts)

@@ -23,6 +23,11 @@ namespace la = revcol::lattice;
 using IArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 using FArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
+// An (n, 2) integer entry: its dtype checked first (forcecast would take floats and NaN).
+IArray int_array(py::handle obj, const char* what) {
+  (void)checkpoint_array<std::int64_t>(obj, what);  // integers of int64 range, or a named error
+  return IArray::ensure(obj);
+}
 std::vector<la::Vec2> vecs(const IArray& a, const char* what) {
   require(static_cast<bool>(a), [&] { return std::string(what) + " must be an (n, 2) integer array"; });  // ensure() failed
   require(a.ndim() == 2 && a.shape(1) == 2, [&] { return std::string(what) + " must be an (n, 2) integer array"; });
@@ -44,11 +49,7 @@ py::array_t<T> flat_array(const T* p, std::size_t n) {
 template <class T>
 std::vector<T> get_flat(const py::dict& d, const char* key) {
   require(d.contains(key), [&] { return std::string("lattice checkpoint is missing '") + key + "'"; });
-  return checkpoint_entry(key, [&] {
-    auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(d[key]);
-    require(static_cast<bool>(a), [&] { return std::string("lattice checkpoint entry '") + key + "' is not an array"; });
-    return std::vector<T>(a.data(), a.data() + a.size());
-  });
+  return checkpoint_array<T>(d[key], key);
 }
 template <class T>
 T get(const py::dict& d, const char* key) {
@@ -74,12 +75,15 @@ la::Units units_from(const py::dict& d) {
   u.sigma = get<std::int64_t>(d, "sigma");
   const auto L = get<std::vector<std::int64_t>>(d, "L");
   const auto w = get<std::vector<bool>>(d, "wall");
-  require(L.size() == 2 && w.size() == 2, "lattice units: L and wall need two entries");
+  require(L.size() == 2 && w.size() == 2, "lattice units: L and wall need two entries each");
   u.L = {L[0], L[1]};
   u.wall = {w[0], w[1]};
   u.vmax = get<std::int64_t>(d, "vmax");
   u.length_unit = get<double>(d, "length_unit");
   u.tick = get<double>(d, "tick");
+  // the float scales every reading goes through (positions = x length_unit, times = ticks tick)
+  require(std::isfinite(u.length_unit) && u.length_unit > 0.0, "lattice units: length_unit must be finite and > 0");
+  require(std::isfinite(u.tick) && u.tick > 0.0, "lattice units: tick must be finite and > 0");
   // tick_bits arrived with the finer-tick option; units without it are the default 20
   u.tick_bits = d.contains("tick_bits") ? get<int>(d, "tick_bits") : la::default_tick_bits;
   la::validate(u);
@@ -166,8 +170,8 @@ la::Snapshot snapshot_from(const py::dict& d) {
   s.collisions = get<std::uint64_t>(d, "collisions");
   for (const char* k : {"x", "v"})
     require(d.contains(k), [&] { return std::string("lattice checkpoint is missing '") + k + "'"; });
-  s.x = checkpoint_entry("x", [&] { return vecs(IArray::ensure(d["x"]), "x"); });
-  s.v = checkpoint_entry("v", [&] { return vecs(IArray::ensure(d["v"]), "v"); });
+  s.x = checkpoint_entry("x", [&] { return vecs(int_array(d["x"], "x"), "x"); });
+  s.v = checkpoint_entry("v", [&] { return vecs(int_array(d["v"], "v"), "v"); });
   s.streams = get_flat<std::uint64_t>(d, "streams");
   s.bits = get_flat<std::uint64_t>(d, "bits");
   const auto li = get_flat<std::uint64_t>(d, "log_index");
@@ -181,7 +185,7 @@ la::Snapshot snapshot_from(const py::dict& d) {
   require(gi.size() == gd.size() && gi.size() == gs.size(), "lattice checkpoint: group arrays differ in length");
   // group_kind and group_v arrived with the group resolve; a checkpoint without them holds bounces only
   const auto gk = d.contains("group_kind") ? get_flat<std::int64_t>(d, "group_kind") : std::vector<std::int64_t>(gi.size(), 0);
-  const auto gv = d.contains("group_v") ? checkpoint_entry("group_v", [&] { return vecs(IArray::ensure(d["group_v"]), "group_v"); })
+  const auto gv = d.contains("group_v") ? checkpoint_entry("group_v", [&] { return vecs(int_array(d["group_v"], "group_v"), "group_v"); })
                                         : std::vector<la::Vec2>{};
   require(gk.size() == gi.size(), "lattice checkpoint: group_kind and group_index differ in length");
   std::size_t at = 0, atv = 0;

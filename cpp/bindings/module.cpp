@@ -2,8 +2,11 @@
 // in the core library. One register_<area>() per area.
 #include <pybind11/pybind11.h>
 
+#include <exception>
+
 #include "bindings.hpp"
 #include "revcol/error.hpp"
+#include "revcol/interrupt.hpp"
 
 #define REVCOL_STR2(x) #x
 #define REVCOL_STR(x) REVCOL_STR2(x)
@@ -11,6 +14,15 @@
 PYBIND11_MODULE(_core, m) {
   m.doc() = "revcol core (private): use the revcol package";
   pybind11::register_exception<revcol::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
+  // a study stopped by its interrupt check (revcol/interrupt.hpp, bind::released_signal_check):
+  // the check left the KeyboardInterrupt pending; raise it (a bare one if none is)
+  pybind11::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const revcol::Interrupted&) {
+      if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt);
+    }
+  });
   // what built this module, stamped into checkpoints (python/revcol/_io.py)
   m.attr("build") = "gcc " __VERSION__ ", pybind11 " REVCOL_STR(PYBIND11_VERSION_MAJOR) "." REVCOL_STR(
       PYBIND11_VERSION_MINOR) "." REVCOL_STR(PYBIND11_VERSION_PATCH)

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "args.hpp"
 #include "bindings.hpp"
 #include "revcol/collide/calotte.hpp"
 #include "revcol/collide/ellipse_arc.hpp"
@@ -45,17 +46,18 @@ py::dict study_dict(const paper::StudyResult& r) {
 void register_paper_study(py::module_& m) {
   m.def(
       "paper_study",
-      [](const std::string& case_name, std::uint64_t collisions, std::uint64_t seed, const std::string& pre,
-         bool printed_reverse, double cos_tol, const std::string& arc, const std::string& angle) {
+      [](PyStr case_name, PyInt collisions, PyInt seed, PyStr pre, bool printed_reverse, PyReal cos_tol, PyStr arc,
+         PyStr angle) {
         paper::StudyConfig c;
-        c.case_name = case_name;
-        c.collisions = collisions;
-        c.seed = seed;
-        c.pre = pre;
+        c.case_name = to_str(case_name, "case");
+        c.collisions = to_int<std::uint64_t>(collisions, "collisions");
+        c.seed = to_int<std::uint64_t>(seed, "seed");
+        c.pre = to_str(pre, "pre");
         c.printed_reverse = printed_reverse;
-        c.cos_tol = cos_tol;
-        c.arc = paper::parse_arc_method(arc);
-        c.angle = paper::parse_arc_angle(angle);
+        c.cos_tol = to_real(cos_tol, "cos_tol");
+        c.arc = paper::parse_arc_method(to_str(arc, "arc"));
+        c.angle = paper::parse_arc_angle(to_str(angle, "angle"));
+        c.interrupt = released_signal_check();
         paper::StudyResult r;
         {
           py::gil_scoped_release release;

@@ -42,7 +42,7 @@ void register_randomness(py::module_& m) {
              std::uint32_t* p = out.mutable_data();
              {
                py::gil_scoped_release release;
-               s.fill(p, static_cast<std::size_t>(n));
+               s.fill(p, static_cast<std::size_t>(n), released_signal_check());
              }
              return out;
            },
@@ -52,7 +52,7 @@ void register_randomness(py::module_& m) {
              const std::string path = to_str(path_arg, "path");
              const auto n = to_int<std::int64_t>(n_arg, "n", 0);
              py::gil_scoped_release release;
-             s.write(path, static_cast<std::uint64_t>(n));
+             s.write(path, static_cast<std::uint64_t>(n), released_signal_check());
            },
            py::arg("path"), py::arg("n"), "Appends the next n words to a raw file (dieharder -g 201).")
       .def_property_readonly("width", &WordStream::width, "Words per collision (d_n; 1 for 'raw').")

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "args.hpp"
 #include "bindings.hpp"
 #include "revcol/error.hpp"
 #include "revcol/statesave.hpp"
@@ -18,29 +19,24 @@ namespace {
 
 namespace ss = revcol::statesave;
 
-// A signed Python integer as uint64 (pybind11 would raise TypeError for a negative one).
-std::uint64_t non_negative(std::int64_t x, const char* what) {
-  require(x >= 0, [&] { return std::string(what) + " must be >= 0, got " + std::to_string(x); });
-  return static_cast<std::uint64_t>(x);
-}
-
-ss::Config config_from(std::int64_t particles, std::int64_t collisions, const std::string& variant,
-                       const std::string& transport, const std::string& mode, const std::string& law,
-                       int bits, const std::string& rng, std::int64_t seed, double mean_dt,
-                       double grazing_tol, std::int64_t budget_bytes, bool prefault, bool capture) {
+// Every argument converted where its name is known (args.hpp): a wrong type or range names it.
+ss::Config config_from(const PyInt& particles, const PyInt& collisions, const PyStr& variant,
+                       const PyStr& transport, const PyStr& mode, const PyStr& law, const PyInt& bits,
+                       const PyStr& rng, const PyInt& seed, const PyReal& mean_dt, const PyReal& grazing_tol,
+                       const PyInt& budget_bytes, bool prefault, bool capture) {
   ss::Config c;
-  c.particles = non_negative(particles, "particles");
-  c.collisions = non_negative(collisions, "collisions");
-  c.variant = ss::parse_variant(variant);
-  c.transport = ss::parse_transport(transport);
-  c.mode = parse_mode(mode);
-  c.law = parse_law(law);
-  c.bits = bits;
-  c.rng = rng;
-  c.seed = non_negative(seed, "seed");
-  c.mean_dt = mean_dt;
-  c.grazing_tol = grazing_tol;
-  c.budget_bytes = non_negative(budget_bytes, "budget_bytes");
+  c.particles = to_int<std::uint64_t>(particles, "particles");
+  c.collisions = to_int<std::uint64_t>(collisions, "collisions");
+  c.variant = ss::parse_variant(to_str(variant, "variant"));
+  c.transport = ss::parse_transport(to_str(transport, "transport"));
+  c.mode = parse_mode(to_str(mode, "mode"));
+  c.law = parse_law(to_str(law, "law"));
+  c.bits = to_int<int>(bits, "bits");
+  c.rng = to_str(rng, "rng");
+  c.seed = to_int<std::uint64_t>(seed, "seed");
+  c.mean_dt = to_real(mean_dt, "mean_dt");
+  c.grazing_tol = to_real(grazing_tol, "grazing_tol");
+  c.budget_bytes = to_int<std::uint64_t>(budget_bytes, "budget_bytes");
   c.prefault = prefault;
   c.capture = capture;
   return c;
@@ -71,11 +67,11 @@ py::array_t<double> snapshot_array(const ss::Snapshot& s) {
 void register_statesave(py::module_& m) {
   m.def(
       "statesave_run",
-      [](std::int64_t particles, std::int64_t collisions, const std::string& variant, const std::string& transport,
-         const std::string& mode, const std::string& law, int bits, const std::string& rng, std::int64_t seed,
-         double mean_dt, double grazing_tol, std::int64_t budget_bytes, bool prefault, bool capture) {
-        const ss::Config c = config_from(particles, collisions, variant, transport, mode, law, bits, rng, seed,
-                                         mean_dt, grazing_tol, budget_bytes, prefault, capture);
+      [](PyInt particles, PyInt collisions, PyStr variant, PyStr transport, PyStr mode, PyStr law, PyInt bits,
+         PyStr rng, PyInt seed, PyReal mean_dt, PyReal grazing_tol, PyInt budget_bytes, bool prefault, bool capture) {
+        ss::Config c = config_from(particles, collisions, variant, transport, mode, law, bits, rng, seed,
+                                   mean_dt, grazing_tol, budget_bytes, prefault, capture);
+        c.interrupt = released_signal_check();
         ss::Result r;
         {
           py::gil_scoped_release release;
@@ -130,9 +126,8 @@ void register_statesave(py::module_& m) {
       REVCOL_STATESAVE_ARGS, "One run of the state-saving study (see revcol.statesave.run).");
   m.def(
       "statesave_projected_bytes",
-      [](std::int64_t particles, std::int64_t collisions, const std::string& variant, const std::string& transport,
-         const std::string& mode, const std::string& law, int bits, const std::string& rng, std::int64_t seed,
-         double mean_dt, double grazing_tol, std::int64_t budget_bytes, bool prefault, bool capture) {
+      [](PyInt particles, PyInt collisions, PyStr variant, PyStr transport, PyStr mode, PyStr law, PyInt bits,
+         PyStr rng, PyInt seed, PyReal mean_dt, PyReal grazing_tol, PyInt budget_bytes, bool prefault, bool capture) {
         const ss::Config c = config_from(particles, collisions, variant, transport, mode, law, bits, rng, seed,
                                          mean_dt, grazing_tol, budget_bytes, prefault, capture);
         py::dict d;

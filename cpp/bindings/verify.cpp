@@ -30,6 +30,7 @@ void register_verify(py::module_& m) {
         c.printed_reverse = printed_reverse;
         c.velocities = std::move(velocities);
         c.normal = std::move(normal);
+        c.interrupt = released_signal_check();
         VerifyResult r;
         {
           py::gil_scoped_release release;

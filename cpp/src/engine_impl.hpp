@@ -98,6 +98,7 @@ class EngineImpl final : public Simulation {
     const Diagnostics d = diagnostics();
     e0_ = d.energy;
     p0_ = d.momentum;
+    trace_ = CollisionTrace(n_, /*start=*/true);
     rebuild_events();
   }
 
@@ -132,20 +133,20 @@ class EngineImpl final : public Simulation {
     double vmax = 0.0;
     for (double q : s.v) vmax = std::max(vmax, std::fabs(q));
     for (std::size_t i = 0; i < n_; ++i) {
-      require(s.ev_kind[i] >= kWall && s.ev_kind[i] <= kNone, "snapshot: bad event kind");
+      require(s.ev_kind[i] >= kWall && s.ev_kind[i] <= kNone, "snapshot: ev_kind must be 0..3 (wall, renewal, collision, none)");
       // a scheduled event lies at or after the clock and within the clock's range (issue 17's fuzz
       // suite: event times of +-2^40 sent run() into an endless stream of events)
       require(s.ev_t[i] == kInf || (s.ev_t[i] >= s.time && limits::clock_fits(s.ev_t[i], cfg_.diameter, vmax)),
-              "snapshot: an event time before the clock or beyond the clock's range");
-      require(!std::isnan(s.second[i]), "snapshot: a second event time is NaN");
+              "snapshot: ev_t: an event time before the clock or beyond the clock's range");
+      require(!std::isnan(s.second[i]), "snapshot: second (a second event time) is NaN");
       require(s.ev_kind[i] != kColl || (s.ev_partner[i] >= 0 && static_cast<std::size_t>(s.ev_partner[i]) < n_),
-              "snapshot: event partner outside [0, n)");
+              "snapshot: ev_partner of a collision outside [0, n)");
       // a wall event's partner is 2 axis + (upper wall), on an axis with walls (issue 17: a forged
       // partner wrote out of bounds)
       require(s.ev_kind[i] != kWall || (s.ev_partner[i] >= 0 && s.ev_partner[i] < 2 * Dim &&
                                         has_walls(cfg_.boundary[static_cast<std::size_t>(s.ev_partner[i] / 2)])),
-              "snapshot: wall event on an axis without walls (partner must be 2 axis + upper)");
-      require(!std::isnan(s.ev_t[i]), "snapshot: event time is NaN");
+              "snapshot: ev_partner: wall event on an axis without walls (partner must be 2 axis + upper)");
+      require(!std::isnan(s.ev_t[i]), "snapshot: ev_t (an event time) is NaN");
       ev_[i] = Ev{s.ev_t[i], static_cast<std::int32_t>(s.ev_kind[i]), static_cast<std::int32_t>(s.ev_partner[i]),
                   s.ev_stamp[i]};
       second_[i] = s.second[i];
@@ -156,6 +157,8 @@ class EngineImpl final : public Simulation {
     counters_ = s.counters;
     e0_ = s.energy0;
     p0_ = s.momentum0;
+    // absent in checkpoints written before the trace: a new one (nothing below is checked)
+    trace_ = s.trace.empty() ? CollisionTrace(n_, s.net_collisions == 0) : CollisionTrace::load(s.trace, n_);
     build_lists();
     if (old_format) rebuild_events();
     else build_queue();
@@ -171,7 +174,8 @@ class EngineImpl final : public Simulation {
     return loop(max_collisions, t_end, cb, every, poll, /*reversed=*/false);
   }
 
-  RunResult run_back(std::uint64_t max_collisions, double t_target, const Poll& poll) override {
+  RunResult run_back(std::uint64_t max_collisions, double t_target, const Poll& poll,
+                     bool stop_on_divergence) override {
     require(!std::isnan(t_target), "target time must not be NaN");
     require(std::isfinite(t_target) || max_collisions != std::numeric_limits<std::uint64_t>::max(),
             "run_back: give a finite target time or a collision count (an infinite run back never returns)");
@@ -179,6 +183,8 @@ class EngineImpl final : public Simulation {
       return "run_back: target time " + num(t_target) + " is later than the current time " +
              num(clock_);
     });
+    const Divergence before = trace_.reason();
+    stop_on_divergence_ = stop_on_divergence && before == Divergence::none;  // a new divergence only
     flip();
     RunResult r;
     try {
@@ -188,6 +194,11 @@ class EngineImpl final : public Simulation {
       throw;
     }
     flip();
+    trace_.check_start(net_);
+    // back at the start time, every collision must be undone
+    if (clock_ == start_ && net_ != 0) trace_.diverge(net_, Divergence::sequence);
+    check_conservation();
+    r.diverged = before == Divergence::none && trace_.reason() != Divergence::none;
     if (clock_ == 0.0) clock_ = 0.0;  // -0 from the negations reads as 0
     r.time = clock_;
     return r;
@@ -234,6 +245,13 @@ class EngineImpl final : public Simulation {
     for (auto c : ncoll_) parts += c;
     d.collisions_per_particle = static_cast<double>(parts) / static_cast<double>(n_);
     d.net_collisions = net_;
+    d.divergence = trace_.reason();
+    d.diverged_at = trace_.diverged_at();
+    d.verified_at = trace_.verified_at();
+    d.trace_reorderings = trace_.reorderings();
+    d.trace_stride = trace_.stride();
+    d.trace_points = trace_.points();
+    d.clock_deviation = trace_.clock_deviation();
     d.counters = counters_;
     return d;
   }
@@ -277,6 +295,7 @@ class EngineImpl final : public Simulation {
     s.netc = netc_;
     WallLog::fields(wlog_, [&](const char* key, const auto& field) { s.field(key, field); });
     ExactPreLog::fields(pre_, [&](const char* key, const auto& field) { s.field(key, field); });
+    s.trace = trace_.save();
     s.counters = counters_;
     s.energy0 = e0_;
     s.momentum0 = p0_;
@@ -285,7 +304,7 @@ class EngineImpl final : public Simulation {
 
   std::size_t memory_bytes() const override {
     return n_ * (sizeof(Particle<Dim>) + sizeof(Ev) + sizeof(double) + 1 + 3 * sizeof(std::uint64_t)) +
-           nl_.memory_bytes() + queue_.memory_bytes() + log_.bytes() + pre_.bytes() + wlog_.bytes() +
+           nl_.memory_bytes() + queue_.memory_bytes() + log_.bytes() + pre_.bytes() + wlog_.bytes() + trace_.bytes() +
            clcg_.size() * sizeof(rng::CLCG4);
   }
 
@@ -515,6 +534,9 @@ class EngineImpl final : public Simulation {
     netc_[i] += reversed ? -1 : 1;
   }
   void validate_collision(const int* ids, int n) const;
+  void trace_collision(const int* ids, int n, bool reversed);
+  void trace_point(bool reversed);
+  void check_conservation();
 
   // ---- the event loop -----------------------------------------------------------------
 
@@ -570,7 +592,9 @@ class EngineImpl final : public Simulation {
           ++counters_.forward_collisions;
         }
         t_last = e.t;
+        if (trace_.on_grid(net_)) trace_point(reversed);
         if (res.collisions >= max_collisions) done_count = true;
+        if (reversed && stop_on_divergence_ && trace_.reason() != Divergence::none) done_count = true;
         if (cb && every > 0 && res.collisions % every == 0 && !cb(res.collisions)) {
           res.interrupted = true;
           done_count = true;
@@ -608,6 +632,8 @@ class EngineImpl final : public Simulation {
   Counters counters_;
   double e0_ = 0.0;
   std::array<double, 3> p0_{};
+  CollisionTrace trace_;                 // divergence detection for run_back (revcol/engine/trace.hpp)
+  bool stop_on_divergence_ = false;      // run_back stops where the trace finds a divergence
 };
 
 }  // namespace revcol::engine::detail

@@ -124,7 +124,7 @@ u128 kinetic2(const std::vector<Vec2>& v) noexcept {
 
 void validate_state(const Units& u, const std::vector<Vec2>& x, const std::vector<Vec2>& v) {
   validate(u);
-  require(x.size() == v.size(), "lattice: positions and velocities differ in length");
+  require(x.size() == v.size(), "lattice: x (positions) and v (velocities) differ in length");
   require(!x.empty(), "lattice: no particles");
   require(x.size() < (std::size_t{1} << 30), "lattice: at most 2^30 particles");
   const std::int64_t h = u.sigma / 2;

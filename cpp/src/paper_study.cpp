@@ -71,7 +71,9 @@ void run(const StudyConfig& c, StudyResult& r) {
     o << "]";
     r.first_failure = o.str();
   };
+  InterruptPoll poll(c.interrupt);
   for (std::uint64_t k = 0; k < c.collisions; ++k) {
+    poll.tick();
     for (double& gk : g) gk = gen.next();
     RareLog log;
     const typename Op::State post = op.forward(pre, x, g, log, &inv);
@@ -129,7 +131,9 @@ Throughput time_it(const StudyConfig& c) {
   double fwd = 0.0, rev = 0.0;
   std::uint64_t done = 0, reversed = 0;
   RareLog log;
+  const InterruptPoll poll(c.interrupt);
   while (done < c.collisions) {
+    poll.now();  // once per block of 4096, outside the timed loops
     const std::size_t m = static_cast<std::size_t>(std::min<std::uint64_t>(block, c.collisions - done));
     for (std::size_t k = 0; k < m; ++k)
       for (double& gk : draws[k]) gk = gen.next();

@@ -2,6 +2,7 @@
 // every operator signature, and the chart that maps a post state to words.
 #include "revcol/randomness.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <functional>
 
@@ -296,20 +297,26 @@ std::uint64_t WordStream::collisions() const { return impl_->steps; }
 std::uint64_t WordStream::words() const { return impl_->words; }
 std::uint64_t WordStream::restarts() const { return impl_->source->restarts; }
 
-void WordStream::fill(std::uint32_t* out, std::size_t n) {
+void WordStream::fill(std::uint32_t* out, std::size_t n, const InterruptCheck& interrupt) {
   Impl& s = *impl_;
-  for (std::size_t k = 0; k < n; ++k) {
-    if (s.next == s.pending.size()) {
-      s.source->step(*s.gen, s.pending.data());
-      ++s.steps;
-      s.next = 0;
+  constexpr std::size_t kChunk = std::size_t{1} << 16;  // words between interrupt checks
+  for (std::size_t at = 0; at < n;) {
+    const std::size_t end = std::min(n, at + kChunk);
+    for (std::size_t k = at; k < end; ++k) {
+      if (s.next == s.pending.size()) {
+        s.source->step(*s.gen, s.pending.data());
+        ++s.steps;
+        s.next = 0;
+      }
+      out[k] = to_word(s.pending[s.next++]);
     }
-    out[k] = to_word(s.pending[s.next++]);
+    s.words += end - at;
+    at = end;
+    if (at < n && interrupt && interrupt()) throw Interrupted{};
   }
-  s.words += n;
 }
 
-void WordStream::write(const std::string& path, std::uint64_t n) {
+void WordStream::write(const std::string& path, std::uint64_t n, const InterruptCheck& interrupt) {
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "ab"), &std::fclose);
   require(f != nullptr, [&] { return "cannot open '" + path + "' for writing"; });
   std::vector<std::uint32_t> buf(1 << 16);
@@ -319,6 +326,11 @@ void WordStream::write(const std::string& path, std::uint64_t n) {
     fill(buf.data(), k);  // may throw (a paper chain that cannot go on): the file is closed
     ok = std::fwrite(buf.data(), sizeof(std::uint32_t), k, f.get()) == k;
     n -= k;
+    if (n > 0 && ok && interrupt && interrupt()) {
+      ok = std::fclose(f.release()) == 0;
+      require(ok, [&] { return "writing '" + path + "' failed (disk full?)"; });
+      throw Interrupted{};  // the file holds every word the stream moved past
+    }
   }
   ok = std::fclose(f.release()) == 0 && ok;
   require(ok, [&] { return "writing '" + path + "' failed (disk full?)"; });

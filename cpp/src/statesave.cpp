@@ -93,8 +93,12 @@ class Workload {
 
   // N_c steps forward, saving what the variant saves.
   void forward(Result& r) {
+    InterruptPoll poll(c_.interrupt, poll_every());
     const auto t0 = Clock::now();
-    for (std::uint64_t k = 0; k < c_.collisions; ++k) step_forward(k);
+    for (std::uint64_t k = 0; k < c_.collisions; ++k) {
+      poll.tick();
+      step_forward(k);
+    }
     r.forward_s = seconds_since(t0);
     r.draws = draws_;
     r.grazes = grazes_;
@@ -108,13 +112,20 @@ class Workload {
   // N_c steps back: restoring (ss) or reverse computation (rc). A step the reverse operator
   // refuses stops the rollback and is reported.
   void rollback(Result& r) {
+    InterruptPoll poll(c_.interrupt, poll_every());
     const auto t0 = Clock::now();
     std::uint64_t k = c_.collisions;
     try {
       if (rc_) {
-        for (; k > 0; --k) step_reverse(k - 1);
+        for (; k > 0; --k) {
+          poll.tick();
+          step_reverse(k - 1);
+        }
       } else {
-        for (; k > 0; --k) restore(k - 1);
+        for (; k > 0; --k) {
+          poll.tick();
+          restore(k - 1);
+        }
       }
     } catch (const InvalidArgument& e) {
       r.error = "rollback of step " + std::to_string(k - 1) + " failed: " + e.what();
@@ -162,6 +173,10 @@ class Workload {
 
  private:
   double time() const { return static_cast<double>(ticks_) * tick_; }
+  // steps between interrupt checks: about 2^20 particle updates (an eager step moves all N)
+  std::uint32_t poll_every() const {
+    return static_cast<std::uint32_t>(std::max<std::uint64_t>(1, (std::uint64_t{1} << 20) / std::max<std::uint64_t>(1, lazy_ ? 1 : n_)));
+  }
 
   // u_pair -> ordered pair i != j, uniform over the N(N-1) ordered pairs.
   void pair(double u, std::uint32_t& i, std::uint32_t& j) const {

@@ -43,6 +43,7 @@ import numpy as np
 from . import _core
 from ._args import names
 from ._io import read_checkpoint, stamped, write_npz_atomic
+from .roundtrip import divergence_text
 
 __all__ = ["Simulation"]
 
@@ -143,11 +144,27 @@ class Simulation:
             cb = lambda k: bool(callback(k) is not False)  # None means go on
         return self._e.run(collisions, time, cb, every)
 
-    def run_back(self, collisions: Optional[int] = None, time: Optional[float] = None) -> dict:
+    def run_back(self, collisions: Optional[int] = None, time: Optional[float] = None,
+                 on_divergence: str = "warn") -> dict:
         """Backwards: until ``collisions`` collisions are undone or the clock is back at
         ``time`` (finite; it may be before the start); without ``time``, never past the start
-        time."""
-        return self._e.run_back(collisions, time)
+        time. Returns collisions, events, time, interrupted, diverged.
+
+        A float run reverses only within its round-off horizon (docs/engine.md). The collision
+        trace checks, without a log, that the collisions undone are the ones done and that
+        energy and momentum keep their values (``diagnostics()["diverged_at"]``,
+        docs/robustness.md). ``on_divergence``: ``"warn"`` (default) runs on to the target and
+        warns (``RuntimeWarning``) when this call finds the reversal off the forward
+        trajectory; ``"stop"`` stops there and warns; ``"ignore"`` runs on silently (the result's
+        ``diverged`` still says so)."""
+        if on_divergence not in ("warn", "stop", "ignore"):
+            raise ValueError(f"on_divergence must be 'warn', 'stop' or 'ignore', got {on_divergence!r}")
+        r = self._e.run_back(collisions, time, on_divergence == "stop")
+        if r["diverged"] and on_divergence != "ignore":
+            d = self._e.diagnostics()
+            warnings.warn("run_back diverged " + divergence_text(d) + " (beyond the round-off horizon, "
+                          "docs/engine.md)", RuntimeWarning, stacklevel=2)
+        return r
 
     # --- state ---------------------------------------------------------------------------
 

@@ -185,7 +185,7 @@ class _GasRun:
             return True
         if (done in self.plot_c) or (self.plot_t and sim.time in self.plot_t):
             clone = Simulation.from_snapshot(sim.snapshot())
-            clone.run_back()
+            clone.run_back(on_divergence="ignore")
             ex, ev = round_trip_errors(clone.positions, clone.velocities, self.x0, self.v0, self.box, self.periodic)
             self.curve.append({"collisions": done, "time": sim.time, "error_x": ex, "error_v": ev})
         return False
@@ -219,11 +219,11 @@ class _GasRun:
                     break
                 tick = _time.perf_counter()
                 if target is None:
-                    r = sim.run_back(collisions=chunk)
+                    r = sim.run_back(collisions=chunk, on_divergence="ignore")
                 elif target == "start" or target == self.t0:
-                    r = sim.run_back()
+                    r = sim.run_back(on_divergence="ignore")
                 else:
-                    r = sim.run_back(time=target)
+                    r = sim.run_back(time=target, on_divergence="ignore")
                 self.reverse_s += _time.perf_counter() - tick
                 self.back += int(r["collisions"])
                 bar.to(self.back)
@@ -261,6 +261,9 @@ class _GasRun:
                                   "momentum": "|P - P0| / sqrt(2 E0 N) over the periodic axes (None: walls only, or a bounce-back wall)"},
             "log_bytes_turn": int(diag_turn["log_bytes"]), "log_bytes_end": int(diag_end["log_bytes"]),
             "reverse_failures": int(diag_end["events"]["reverse_failures"]),
+            # the collision trace (docs/robustness.md): where the reversal was found off the forward run
+            "divergence": diag_end["divergence"], "diverged_at": diag_end["diverged_at"],
+            "verified_at": diag_end["verified_at"],
             "list_renewals_turn": list_renewals(diag_turn["events"]),
             "events_turn": diag_turn["events"],
             "peak_rss_bytes": peak_rss(),

@@ -221,6 +221,22 @@ class LatticeSimulation:
         """Rebuilds from ``snapshot()``; the run resumes bit for bit."""
         st = dict(snapshot)
         q = st.pop("quantization", None)
+        engine = st.get("engine", "lattice")
+        if str(np.asarray(engine)) != "lattice":
+            raise ValueError(f"snapshot: engine must be 'lattice', got {str(np.asarray(engine))[:40]!r}")
+        if q is not None:  # the float start's quantization errors: reported, so checked
+            if not isinstance(q, dict):
+                raise ValueError("snapshot: quantization must be a dict of errors")
+            clean = {}
+            for k, val in q.items():
+                try:
+                    x = float(np.asarray(val))
+                except (TypeError, ValueError):
+                    raise ValueError(f"snapshot: quantization.{k} must be a number") from None
+                if not (np.isfinite(x) and x >= 0.0):
+                    raise ValueError(f"snapshot: quantization.{k} must be finite and >= 0, got {x!r}")
+                clean[str(k)] = x
+            q = clean
         return cls(None, None, None, _engine=_core.LatticeEngine.from_snapshot(st), _quantization=q)
 
     def state(self) -> dict:

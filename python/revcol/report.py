@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from .roundtrip import BAR, ERROR_DEFINITIONS
+from .roundtrip import BAR, ERROR_DEFINITIONS, divergence_text
 
 __all__ = ["format_report", "format_horizon", "verify_lines", "write_json", "version"]
 
@@ -81,6 +81,8 @@ def _float_lines(r: dict) -> list[str]:
     ]
     if r["reverse_failures"]:
         lines.append(f"  reverse failures {r['reverse_failures']} (the reversed run left the forward one)")
+    if r.get("divergence"):
+        lines.append(f"  diverged         {divergence_text(r)}")
     return lines
 
 

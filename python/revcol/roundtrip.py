@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["BAR", "ERROR_DEFINITIONS", "round_trip_errors", "geometry"]
+__all__ = ["BAR", "ERROR_DEFINITIONS", "round_trip_errors", "geometry", "divergence_text"]
 
 #: the round-trip bar (the paper's): both errors must be at most this
 BAR = 1e-9
@@ -37,3 +37,16 @@ def geometry(sim) -> tuple[np.ndarray, np.ndarray]:
     """(box lengths, periodic flags) per axis of a :class:`revcol.Simulation`, the inputs of
     :func:`round_trip_errors`."""
     return np.asarray(sim.box, dtype=float)[: sim.dim], np.asarray(sim.periodic, dtype=bool)[: sim.dim]
+
+
+def divergence_text(d: dict) -> str:
+    """One line on what the collision trace found, from ``diagnostics()`` or a report's
+    ``divergence`` / ``diverged_at`` / ``verified_at`` (docs/robustness.md).
+
+    >>> divergence_text({"divergence": "collision sequence", "diverged_at": 4096, "verified_at": 8192})
+    'at forward collision 4,096 (collision sequence; last verified at 8,192): the state run_back restores is not the forward run's'
+    """
+    where = f"at forward collision {d['diverged_at']:,} ({d['divergence']}"
+    if d.get("verified_at") is not None:
+        where += f"; last verified at {d['verified_at']:,}"
+    return where + "): the state run_back restores is not the forward run's"

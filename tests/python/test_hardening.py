@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import revcol
-from revcol import Simulation
+from revcol import Simulation, _core
 
 
 def test_a_diameter_whose_box_underflows_is_refused():
@@ -256,7 +256,7 @@ def test_a_snapshot_with_speeds_outside_the_range_is_refused():
     st = s.snapshot()
     for scale in (1e-161, 1e-130):  # (above 2^450 the clock check refuses first)
         bad = dict(st, v=np.asarray(st["v"]) * scale)
-        with pytest.raises(ValueError, match="snapshot: velocities outside the speeds"):
+        with pytest.raises(ValueError, match="snapshot: v outside the speeds"):
             Simulation.from_snapshot(bad)
     Simulation.from_snapshot(dict(st))  # (scaling v moves the positions at the clock: an overlap)
 
@@ -320,3 +320,19 @@ def test_a_snapshot_the_engine_would_spin_on_is_refused(field, value, text):
     bad[field] = np.full_like(np.asarray(st[field]), value) if np.ndim(st[field]) else value
     with pytest.raises(ValueError, match=text):
         Simulation.from_snapshot(bad)
+
+
+@pytest.mark.parametrize("call, exc, text", [
+    (lambda: _core.statesave_run(particles=-1), ValueError, r"particles = -1 is outside \[0, "),
+    (lambda: _core.statesave_run(collisions=1.5), TypeError, "collisions must be an integer, got float"),
+    (lambda: _core.statesave_run(variant=3), TypeError, "variant must be a string"),
+    (lambda: _core.statesave_projected_bytes(mean_dt="x"), TypeError, "mean_dt must be a real number"),
+    (lambda: _core.paper_study(case="pair3d", collisions=-5), ValueError, r"collisions = -5 is outside"),
+    (lambda: _core.paper_study(case=None), TypeError, "case must be a string"),
+    (lambda: _core.paper_study(case="pair3d", cos_tol="tight"), TypeError, "cos_tol must be a real number"),
+])
+def test_study_bindings_name_their_arguments(call, exc, text):
+    """The last bindings that took plain types (issue 17): pybind's generic 'incompatible
+    function arguments' no longer reaches a user of the state-saving or paper study."""
+    with pytest.raises(exc, match=text):
+        call()

@@ -348,7 +348,7 @@ def test_ctrl_c_during_the_reversal_stops_it(tmp_path, capsys, monkeypatch):
     assert "the round trip is incomplete" in capsys.readouterr().out
     r = json.loads((tmp_path / "r.json").read_text())
     assert r["interrupted"] == "reverse" and not r["round_trip_complete"] and not r["passed"]
-    assert calls == [{"collisions": 4000}] and r["collisions_back"] == 4000 and r["collisions_forward"] == 20000
+    assert calls == [{"collisions": 4000, "on_divergence": "ignore"}] and r["collisions_back"] == 4000 and r["collisions_forward"] == 20000
 
 
 def test_reversal_builds_no_particles(monkeypatch):

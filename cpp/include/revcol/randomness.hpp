@@ -35,6 +35,7 @@
 
 #include "revcol/collide/common.hpp"
 #include "revcol/fixed_point.hpp"
+#include "revcol/interrupt.hpp"
 
 namespace revcol::randomness {
 
@@ -65,11 +66,14 @@ class WordStream {
   const StreamConfig& config() const;
   /// Words per collision: d_n (1 for "raw": one per draw).
   int width() const;
-  /// Writes the next n words to out.
-  void fill(std::uint32_t* out, std::size_t n);
+  /// Writes the next n words to out. `interrupt` is checked every 2^16 words; when it says
+  /// stop, Interrupted is thrown and the stream stays after the words written so far
+  /// (words() counts them).
+  void fill(std::uint32_t* out, std::size_t n, const InterruptCheck& interrupt = {});
   /// Appends the next n words to the file `path` (raw, native little-endian uint32);
-  /// throws InvalidArgument if it cannot be written.
-  void write(const std::string& path, std::uint64_t n);
+  /// throws InvalidArgument if it cannot be written. Interrupted: the file holds exactly the
+  /// words the stream moved past.
+  void write(const std::string& path, std::uint64_t n, const InterruptCheck& interrupt = {});
   /// Collisions taken so far (draws for "raw").
   std::uint64_t collisions() const;
   /// Words emitted so far.

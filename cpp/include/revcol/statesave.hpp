@@ -72,6 +72,7 @@
 
 #include "revcol/collide/common.hpp"
 #include "revcol/fixed_point.hpp"
+#include "revcol/interrupt.hpp"
 
 namespace revcol::statesave {
 
@@ -116,6 +117,7 @@ struct Config {
   std::uint64_t budget_bytes = default_budget_bytes;  ///< skip runs that would save more
   bool prefault = true;                  ///< ss: touch the records' pages before the clock starts
   bool capture = false;                  ///< keep the start, the turn and the end (tests)
+  InterruptCheck interrupt;              ///< polled about every 2^20 particle updates: true stops with Interrupted
 };
 
 /// Particle arrays (structure of arrays). Positions are at the snapshot's time (lazy: x0 + v t).

@@ -13,6 +13,7 @@
 #include "revcol/collide/common.hpp"
 #include "revcol/error.hpp"
 #include "revcol/fixed_point.hpp"
+#include "revcol/interrupt.hpp"
 #include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
 
@@ -30,6 +31,7 @@ struct VerifyConfig {
   bool printed_reverse = false;          ///< paper mode: the printed (faulty) Procedure 2
   std::vector<double> velocities;        ///< initial (v_i, v_j) flattened; empty: the default
   std::vector<double> normal;            ///< contact normal r_21; empty: the paper's (1, 1)
+  InterruptCheck interrupt;              ///< polled in the loops: true stops with Interrupted (Ctrl-C)
 };
 
 /// What it found. Velocities are flattened (v_i then v_j).
@@ -114,10 +116,12 @@ void reversal_chain(const A& a, typename A::State v, Gen& gen, const VerifyConfi
   std::vector<double> g(k > 0 ? k : 1);
   typename A::State last_pre = v, pre = v;  // the pre state of the last step (to take it back)
 
+  InterruptPoll poll(c.interrupt);
   auto t0 = Clock::now();
   std::uint64_t done = 0;
   try {
     for (; done < c.collisions; ++done) {
+      poll.tick();
       for (std::size_t j = 0; j < k; ++j) g[j] = gen.next();
       if constexpr (A::stops_early) pre = v;
       try {
@@ -153,6 +157,7 @@ void reversal_chain(const A& a, typename A::State v, Gen& gen, const VerifyConfi
   std::uint64_t undone = 0;
   try {
     for (; undone < done; ++undone) {
+      poll.tick();
       a.negate(v);
       for (std::size_t j = k; j-- > 0;) g[j] = gen.prev();
       a.reverse(v, g.data(), log, done - 1 - undone);

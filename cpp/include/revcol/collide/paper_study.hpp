@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "revcol/collide/ellipse_arc.hpp"
+#include "revcol/interrupt.hpp"
 
 namespace revcol::paper {
 
@@ -43,6 +44,7 @@ struct StudyConfig {
   double cos_tol = 1e-8;                  ///< triple1d: the cosine tolerance
   ArcMethod arc = ArcMethod::simpson;     ///< triple1d: G-to-Psi method
   ArcAngle angle = ArcAngle::parametric;  ///< triple1d: which angle psi is
+  InterruptCheck interrupt;               ///< polled in the loops: true stops with Interrupted (Ctrl-C)
 };
 
 /// What it found.

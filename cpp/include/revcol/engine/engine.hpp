@@ -94,6 +94,7 @@
 #include <vector>
 
 #include "revcol/collide/common.hpp"
+#include "revcol/engine/trace.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/streams.hpp"
 
@@ -212,6 +213,7 @@ struct RunResult {
   std::uint64_t events = 0;      ///< events popped
   double time = 0.0;             ///< the clock at the end
   bool interrupted = false;      ///< the progress callback (or the poll) asked to stop
+  bool diverged = false;         ///< run_back found this call's reversal off the forward trajectory (trace.hpp)
 };
 
 /// The full state, for checkpoints: restoring it resumes bit for bit.
@@ -244,6 +246,7 @@ struct Snapshot : Visitable<Snapshot> {
   std::vector<std::uint64_t> pre_sizes;        ///< exact-pre log: values per entry
   std::vector<double> pre_vals;                ///< exact-pre log: kept pre velocities
   std::uint64_t pre_pushed = 0;                ///< exact-pre entries ever pushed
+  std::vector<std::uint64_t> trace;            ///< the collision trace (CollisionTrace::save; empty: a new one)
   Counters counters;
   double energy0 = 0.0;                        ///< kinetic energy at construction
   std::array<double, 3> momentum0{};           ///< momentum at construction
@@ -313,6 +316,7 @@ struct Snapshot : Visitable<Snapshot> {
     f("pre_sizes", s.pre_sizes);
     f("pre_vals", s.pre_vals);
     f("pre_pushed", s.pre_pushed);
+    f("trace", s.trace);
     f("energy0", s.energy0);
   }
 };
@@ -330,6 +334,13 @@ struct Diagnostics {
   std::uint64_t log_pushed = 0;           ///< rare-log entries ever pushed
   double collisions_per_particle = 0.0;   ///< 2 pairs + group particles, over N (cumulative)
   std::int64_t net_collisions = 0;        ///< forward minus reverse
+  Divergence divergence = Divergence::none;  ///< why a reversed run was found off the forward one
+  std::int64_t diverged_at = CollisionTrace::kNever;  ///< net collision count where it was first found off
+  std::int64_t verified_at = CollisionTrace::kNever;  ///< the last net count a reversed run was found on
+  std::uint64_t trace_reorderings = 0;    ///< single mismatches not confirmed (swapped disjoint collisions)
+  std::uint64_t trace_stride = 0;         ///< the trace's grid stride now (collisions)
+  std::size_t trace_points = 0;           ///< grid points kept
+  double clock_deviation = 0.0;           ///< largest |t - t_forward| at the trace's points in the last reversed pass
   Counters counters;
 };
 
@@ -352,7 +363,11 @@ class Simulation {
                         std::uint64_t every = 0, const Poll& poll = {}) = 0;
   /// Runs backwards until `max_collisions` collisions are undone or the clock is back at
   /// t_target (<= time()), whichever first, ending between events (or when poll says stop).
-  virtual RunResult run_back(std::uint64_t max_collisions, double t_target, const Poll& poll = {}) = 0;
+  /// The collision trace checks that the reversal follows the forward trajectory
+  /// (revcol/engine/trace.hpp): a divergence sets RunResult::diverged and, with
+  /// stop_on_divergence, stops the run there as a collision count would.
+  virtual RunResult run_back(std::uint64_t max_collisions, double t_target, const Poll& poll = {},
+                             bool stop_on_divergence = false) = 0;
   /// Positions at the current time (n x dim, row-major).
   virtual std::vector<double> positions() const = 0;
   /// Velocities (n x dim).

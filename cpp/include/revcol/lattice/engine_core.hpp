@@ -161,7 +161,16 @@ class BasicEngine {
   /// Replaces the state by a snapshot (validated first: on bad input nothing changes).
   void restore(const Snapshot& s) {
     validate_state(s.units, s.x, s.v);
-    require(s.streams.size() == s.x.size(), "lattice snapshot: one stream counter per particle");
+    require(s.streams.size() == s.x.size(), "lattice snapshot: streams must hold one counter per particle");
+    {
+      // energy is kept by every collision to the lattice's rounding (~1e-11 relative over 10^4
+      // collisions per particle): a checkpoint whose energy0 is not its velocities' (1e-6
+      // relative) was not written by a run. (Momentum is not checked: a group bounce reverses
+      // its members' velocities.)
+      const double E = static_cast<double>(kinetic2(s.v));
+      const double E0 = static_cast<double>((static_cast<u128>(s.energy0[1]) << 64) | s.energy0[0]);
+      require(std::fabs(E - E0) <= 1e-6 * E0, "lattice snapshot: energy0 is not the sum |v|^2 of v (1e-6 relative)");
+    }
     for (const auto& e : s.groups) {
       require(e.index >= 1 && e.index <= s.collisions && e.members.size() >= 2 && e.drawer >= 0 &&
                   static_cast<std::size_t>(e.drawer) < s.x.size(),

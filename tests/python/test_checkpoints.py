@@ -1,0 +1,115 @@
+"""The crafted-checkpoint suite (issue 17): every entry of a saved checkpoint, on both engines,
+truncated, made of strings, NaN, huge (2^62 or 1e300), a pickled object, or missing. Each
+damaged file must either be refused with a ValueError/TypeError whose message names the entry,
+or be one of the loads listed in LEGAL below (with the reason it is legal), and then run and run
+back without any other exception."""
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+from revcol import Simulation
+
+DAMAGES = ("truncated", "strings", "nan", "huge", "pickle", "missing")
+
+# (engine, entry, damage) that load, and why that is right
+LEGAL = {
+    # counters, stamps and counts: any value of their type is a state a long run can reach
+    **{("float", k, "huge"): "a count or stamp" for k in
+       ("counters", "ev_stamp", "stamp", "ncoll", "net_collisions", "netc", "log_pushed", "pre_pushed", "rng")},
+    ("float", "second", "huge"): "a second collision far in the future is 'none soon'",
+    ("float", "cell", "huge"): "cells are recomputed from the list centres (kept for older readers)",
+    ("float", "momentum0", "huge"): "walls on every axis: momentum is not conserved, so not checked",
+    **{("float", k, "missing"): "written before the entry existed: a default" for k in
+       ("centre", "generator", "streams", "trace")},
+    ("lattice", "bits", "truncated"): "the bits-back integer: any integer is a state (a shorter one too)",
+    ("lattice", "bits", "huge"): "the bits-back integer: any integer is a state",
+    ("lattice", "collisions", "huge"): "a count",
+    ("lattice", "streams", "huge"): "Philox counters: any value",
+    ("lattice", "momentum0", "huge"): "not conserved (walls, group bounces), so not checked",
+    ("lattice", "units.L", "huge"): "2^62 is a box length the lattice's range holds (validate(u))",
+    ("lattice", "units.length_unit", "huge"): "a float scale of 1e300 is finite",
+    ("lattice", "units.tick", "huge"): "a float scale of 1e300 is finite",
+    ("lattice", "quantization.max_position_error", "huge"): "a reported error, finite",
+    ("lattice", "quantization.max_velocity_error", "huge"): "a reported error, finite",
+    **{("lattice", k, "missing"): "written before the entry existed: a default" for k in
+       ("engine", "group_kind", "group_v", "units.tick_bits", "quantization.max_position_error",
+        "quantization.max_velocity_error")},
+}
+
+
+def _damaged(a: np.ndarray, damage: str):
+    """The damaged value, or None when the damage would leave the entry as it is."""
+    if damage == "missing":
+        return "DEL"
+    if damage == "pickle":
+        return np.asarray([{"x": 1}], dtype=object)
+    if damage == "strings":
+        return np.asarray(["x"] * max(1, a.size)).reshape(a.shape) if a.size else np.asarray("x")
+    if a.size == 0:
+        return None  # an empty array damaged is the same empty array
+    if damage == "truncated":
+        return a[:-1] if a.ndim else None
+    if damage == "nan":
+        return np.full(a.shape, np.nan) if a.dtype.kind in "fiu" else None
+    if a.dtype.kind in "iu":
+        return np.full(a.shape, 2**62, dtype=np.int64)
+    return np.full(a.shape, 1e300) if a.dtype.kind == "f" else None
+
+
+def _cases(engine, tmp):
+    s = Simulation.random(60, 2, 0.3, seed=1, engine=engine, boundary="wall")
+    s.run(collisions=80)
+    path = os.path.join(tmp, f"{engine}.npz")
+    s.save(path)
+    with np.load(path) as z:
+        data = {k: z[k] for k in z.files}
+    for key in sorted(data):
+        if key.startswith("revcol_"):
+            continue
+        for damage in DAMAGES:
+            bad = _damaged(data[key], damage)
+            if bad is None:
+                continue
+            yield type(s), data, key, damage, bad
+
+
+@pytest.mark.parametrize("engine", ["float", "lattice"])
+def test_every_damaged_entry_is_refused_by_name_or_legal(engine, tmp_path):
+    refused = loaded = 0
+    problems = []
+    for cls, data, key, damage, bad in _cases(engine, str(tmp_path)):
+        d = dict(data)
+        if isinstance(bad, str):
+            del d[key]
+        else:
+            d[key] = bad
+        q = tmp_path / "b.npz"
+        if damage == "pickle":
+            np.savez(q, **d, allow_pickle=True)
+        else:
+            np.savez(q, **d)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                sim = cls.load(q)
+        except (ValueError, TypeError) as e:
+            refused += 1
+            leaf = key.split(".")[-1]
+            if leaf not in str(e) and damage != "pickle":
+                problems.append(f"{key}/{damage}: message does not name it: {e}")
+            continue
+        loaded += 1
+        if (engine, key, damage) not in LEGAL:
+            problems.append(f"{key}/{damage}: loaded")
+            continue
+        try:  # a legal load must also run and run back (or refuse with a named error)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                sim.run(collisions=50)
+                sim.run_back(collisions=50)
+        except (ValueError, OverflowError):
+            pass
+    assert not problems, "\n".join(problems)
+    assert refused > 50 and loaded == sum(1 for k in LEGAL if k[0] == engine), (refused, loaded)
