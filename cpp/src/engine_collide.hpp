@@ -142,6 +142,7 @@ void EngineImpl<Dim, Op>::flip_mask(int i, Reflection mask) {
 // Sets i's velocity to v, the result of the reflection `mask`, and counts it (reflections()).
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::set_velocity(int i, const Vec& v, Reflection mask) {
+  if (obs_) obs_->wall(clock_, i, v.data());
   for (int k = 0; k < Dim; ++k) p_[i].v[k] = v[k];
   counters_.wall_events += static_cast<std::uint64_t>(reflections(mask));
 }
@@ -231,6 +232,7 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
     ++counters_.reverse_failures;
     out = Specular<Dim>::reflect(in, r);
   }
+  if (obs_) obs_->pair(t, a, b, r.data(), out.i.data(), out.j.data());
   for (int k = 0; k < Dim; ++k) {
     p_[a].v[k] = out.i[k];
     p_[b].v[k] = out.j[k];
@@ -408,11 +410,38 @@ bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, b
   } catch (const InvalidArgument&) {
     return false;
   }
+  if (obs_ && !reversed) {  // image-consistent positions: the group's virial (observe.hpp)
+    int ids[kMaxGroup];
+    double xs[kMaxGroup * Dim];
+    for (int u = 0; u < n; ++u) {
+      ids[u] = g.id[order[u]];
+      for (int k = 0; k < Dim; ++k) xs[u * Dim + k] = pos_at(ids[u], k, t) + g.off[order[u]][k];
+    }
+    obs_->group(t, n, ids, xs, post.data());
+  }
   for (int u = 0; u < n; ++u) {
     const int id = g.id[order[u]];
     for (int k = 0; k < Dim; ++k) p_[id].v[k] = reversed ? -post[u * Dim + k] : post[u * Dim + k];
   }
   return true;
+}
+
+// ---- observation (revcol/engine/observe.hpp) ------------------------------------------------
+
+// A new observer from the state at the clock; built before the old one goes, so a bad
+// config changes nothing.
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::observe(const ObserveConfig& c) {
+  std::array<bool, 3> walls{};
+  for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
+  auto o = std::make_unique<Observer>(c, Dim, positions(), velocities(), clock_, cfg_.box, walls, cfg_.diameter);
+  observer_ = std::move(o);
+  obs_ = observer_.get();
+}
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::stop_observing() {
+  if (obs_) obs_->sync(clock_);
+  obs_ = nullptr;
 }
 
 // REVCOL_VALIDATE builds: after a collision, the members are not overlapping any listed

@@ -27,6 +27,7 @@
 #include "revcol/engine/kinematics.hpp"
 #include "revcol/engine/logs.hpp"
 #include "revcol/engine/neighbours.hpp"
+#include "revcol/engine/observe.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
@@ -168,7 +169,9 @@ class EngineImpl final : public Simulation {
     require(!std::isnan(t_end), "end time must not be NaN");
     require(std::isfinite(t_end) || max_collisions != std::numeric_limits<std::uint64_t>::max(),
             "run: give a finite end time or a collision count (an infinite run never returns)");
-    return loop(max_collisions, t_end, cb, every, poll, /*reversed=*/false);
+    const RunResult r = loop(max_collisions, t_end, cb, every, poll, /*reversed=*/false);
+    if (obs_) obs_->sync(clock_);
+    return r;
   }
 
   RunResult run_back(std::uint64_t max_collisions, double t_target, const Poll& poll) override {
@@ -179,6 +182,7 @@ class EngineImpl final : public Simulation {
       return "run_back: target time " + num(t_target) + " is later than the current time " +
              num(clock_);
     });
+    stop_observing();  // observation is forward only (revcol/engine/observe.hpp)
     flip();
     RunResult r;
     try {
@@ -282,6 +286,11 @@ class EngineImpl final : public Simulation {
     s.momentum0 = p0_;
     return s;
   }
+
+  void observe(const ObserveConfig& c) override;  // engine_collide.hpp
+  const Observer* observer() const override { return observer_.get(); }
+  bool observing() const override { return obs_ != nullptr; }
+  void stop_observing() override;
 
   std::size_t memory_bytes() const override {
     return n_ * (sizeof(Particle<Dim>) + sizeof(Ev) + sizeof(double) + 1 + 3 * sizeof(std::uint64_t)) +
@@ -608,6 +617,8 @@ class EngineImpl final : public Simulation {
   Counters counters_;
   double e0_ = 0.0;
   std::array<double, 3> p0_{};
+  std::unique_ptr<Observer> observer_;  // the running or last observation (observe.hpp)
+  Observer* obs_ = nullptr;             // observer_ while it runs, else null: the one test per velocity change
 };
 
 }  // namespace revcol::engine::detail
