@@ -127,6 +127,10 @@ def _run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 2
     print(format_report(report))
+    if report.get("observe"):
+        from .observe import report_lines
+
+        print("\n".join(report_lines(report["observe"])))
     if report.get("interrupted"):
         return 130
     if report["kind"] == "horizon":  # a measurement; on the lattice, a check that fails exits 1

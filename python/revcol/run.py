@@ -19,6 +19,10 @@ about an order of magnitude per collision per particle, so a round trip passes o
 *horizon* of a few collisions per particle; :func:`horizon` measures it (``revcol run
 --horizon``; on a lattice scene it checks a few N_c bit for bit instead: there is none).
 
+A float-engine gas scene with an ``[observe]`` table also reports its forward run's
+observables (``report["observe"]``: pressure, temperature, collision rate, ... with block
+errors; :mod:`revcol.observe`), measured on a second, observed forward run from the same start.
+
 *Reversal* scenes run the paper's illustration (:func:`revcol.verify`; velocities only, no
 positions are built), *statesave* scenes the paper's §6 study (:func:`revcol.statesave.study`).
 
@@ -56,7 +60,7 @@ from .report import format_horizon, format_report, write_json
 from .roundtrip import BAR, ERROR_DEFINITIONS, round_trip_errors  # noqa: F401
 from .scene import Scene, SceneError, load_scene, with_engine
 
-__all__ = ["BAR", "build_simulation", "run_gas", "run_reversal", "run_statesave", "horizon", "run_scene",
+__all__ = ["BAR", "build_simulation", "run_gas", "run_reversal", "run_statesave", "horizon", "run_scene", "observe_forward",
            "format_report", "format_horizon", "write_json", "round_trip_errors"]
 
 
@@ -105,6 +109,20 @@ def _check_output(source: str, what: str, path, folder: bool) -> None:
             pass
     except OSError as e:
         raise SceneError(f"{source}: {what}: cannot write into {parent} ({e.strerror or e})") from None
+
+
+def observe_forward(scene: Scene, report: dict) -> dict:
+    """A scene's ``[observe]``: its forward run again from the same start and seed, observed
+    (observing changes no bit of a trajectory, so this is the round trip's forward run), to the
+    same collision count (or end time); the observation as JSON-able values (revcol.observe)."""
+    sim = build_simulation(scene)
+    sim.observe(**scene.observe)
+    if scene.collisions is not None:
+        if report["collisions_forward"] > 0:
+            sim.run(collisions=report["collisions_forward"])
+    else:
+        sim.run(time=report["time_turn"])
+    return sim.observation().to_dict()
 
 
 def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str | os.PathLike | None = None,
@@ -167,6 +185,8 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
         r = run_statesave(scene, plot, progress)
     else:
         r = run_gas(scene, plot=plot, trajectory=trajectory, progress=progress)
+        if scene.observe is not None and scene.engine == "float":
+            r["observe"] = observe_forward(scene, r)
     if json_path is not None:
         r["written"].append(str(json_path))
         write_json(r, json_path)
