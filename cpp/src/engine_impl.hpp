@@ -291,6 +291,8 @@ class EngineImpl final : public Simulation {
   const Observer* observer() const override { return observer_.get(); }
   bool observing() const override { return obs_ != nullptr; }
   void stop_observing() override;
+  [[gnu::noinline, gnu::cold]] void note_wall(int i);  // observer hooks (engine_collide.hpp)
+  [[gnu::noinline, gnu::cold]] void note_pair(int a, int b);
 
   std::size_t memory_bytes() const override {
     return n_ * (sizeof(Particle<Dim>) + sizeof(Ev) + sizeof(double) + 1 + 3 * sizeof(std::uint64_t)) +

@@ -94,8 +94,13 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   require(vrms > 0.0 && std::isfinite(vrms), "observe: the particles must move");
   block_time_ = c.block_time > 0.0 ? c.block_time : diameter / vrms;
   speed_max_ = c.speed_max > 0.0 ? c.speed_max : 5.0 * vrms;
+  bin_scale_ = c.speed_bins / speed_max_;
   volume_ = 1.0;
-  for (int k = 0; k < dim; ++k) volume_ *= box[k];
+  for (int k = 0; k < 3; ++k) {
+    if (k >= dim) box_[k] = 1.0;
+    inv_box_[k] = 1.0 / box_[k];
+    if (k < dim) volume_ *= box[k];
+  }
   t_start_ = t_now_ = t;
   seg_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i) {
@@ -120,7 +125,7 @@ Observer::Block Observer::empty_block(double t0) const {
   return b;
 }
 
-void Observer::set_velocity(int i, const double* v) {
+[[gnu::always_inline]] inline void Observer::set_velocity(int i, const double* v) {
   Segment& s = seg_[i];
   double v2 = 0.0;
   for (int k = 0; k < dim_; ++k) {
@@ -131,22 +136,21 @@ void Observer::set_velocity(int i, const double* v) {
   s.speed = std::sqrt(v2);
   s.bin = -1;
   if (cfg_.speed_bins > 0) {
-    const double b = s.speed / speed_max_ * cfg_.speed_bins;
+    const double b = s.speed * bin_scale_;
     if (b < cfg_.speed_bins) s.bin = static_cast<int>(b);
   }
 }
 
 // Closes i's segment at t: its duration weights v^2, the speed, its speed bin and its slabs.
-void Observer::close(int i, double t) {
+// (Components beyond dim are 0: the loops run over 3, unrolled, with no test of dim.)
+[[gnu::always_inline]] inline void Observer::close(int i, double t) {
   Segment& s = seg_[i];
   const double dt = t - s.t0;
-  if (dt > 0.0) {
-    cur_.k2 += s.v2 * dt;
-    cur_.dist += s.speed * dt;
-    if (s.bin >= 0) cur_.speed[s.bin] += dt;
-    if (cfg_.slabs > 0) slab_walk(s, dt);
-    for (int k = 0; k < dim_; ++k) s.x[k] += s.v[k] * dt;
-  }
+  cur_.k2 += s.v2 * dt;
+  cur_.dist += s.speed * dt;
+  if (s.bin >= 0) cur_.speed[s.bin] += dt;
+  if (cfg_.slabs > 0 && dt > 0.0) slab_walk(s, dt);
+  for (int k = 0; k < 3; ++k) s.x[k] += s.v[k] * dt;
   s.t0 = t;
 }
 
@@ -214,7 +218,7 @@ void Observer::pair_interval(int i, int j, double t0, double t1) {
   }
 }
 
-void Observer::close_pairs(int i, double t) {
+[[gnu::always_inline]] inline void Observer::close_pairs(int i, double t) {
   if (cfg_.pair_bins == 0) return;
   for (std::size_t j = 0; j < n_; ++j) {
     if (static_cast<int>(j) == i) continue;
@@ -253,18 +257,25 @@ void Observer::end_block() {
   }
 }
 
-void Observer::reach(double t) {
+[[gnu::always_inline]] inline void Observer::reach(double t) {
   while (t >= cur_.t0 + block_time_) end_block();
   t_now_ = t;
 }
 
-void Observer::pair(double t, int a, int b, const double* r, const double* va, const double* vb) {
+void Observer::pair(double t, int a, int b, const double* va, const double* vb) {
   reach(t);
-  double w = 0.0;
-  for (int k = 0; k < dim_; ++k) w += r[k] * (va[k] - seg_[a].v[k]);
-  cur_.w += w;
   close(a, t);
   close(b, t);
+  double w = 0.0;
+  for (int k = 0; k < dim_; ++k) {
+    double r = seg_[a].x[k] - seg_[b].x[k];
+    if (!walls_[k]) {  // the nearest image (|r| = D < L / 2), rounding by a cast
+      const double q = r * inv_box_[k];
+      r -= box_[k] * static_cast<double>(static_cast<std::int64_t>(q + (q >= 0.0 ? 0.5 : -0.5)));
+    }
+    w += r * (va[k] - seg_[a].v[k]);
+  }
+  cur_.w += w;
   close_pairs(a, t);
   close_pairs(b, t);
   set_velocity(a, va);

@@ -3,8 +3,8 @@
 // (the engine tests one null pointer at each velocity change).
 //
 // What the engine tells the observer. Every velocity change, at the instant it happens:
-// a pair collision (the image-consistent separation r = x_a - x_b - s and both velocities
-// before and after the operator), a group collision (each member's image-consistent
+// a pair collision (both velocities after the operator; the separation comes from the
+// observer's positions, folded to the nearest image), a group collision (each member's image-consistent
 // position and its velocity after) and a wall reflection (the velocity after). Between
 // two velocity changes a particle flies freely, so the observer keeps, per particle, a
 // segment (start time t0, position x0 at t0, velocity v): x(t) = x0 + v (t - t0). It
@@ -114,8 +114,10 @@ class Observer {
   Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v, double t,
            const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter);
 
-  /// A pair collision at t: r = x_a - x_b - s (image-consistent), velocities after (va, vb).
-  void pair(double t, int a, int b, const double* r, const double* va, const double* vb);
+  /// A pair collision at t: the velocities after (va, vb). The separation r = x_a - x_b comes
+  /// from the observer's own positions, folded to the nearest image on periodic axes (at
+  /// contact |r| = D < L / 2: the image the engine collided).
+  void pair(double t, int a, int b, const double* va, const double* vb);
   /// A group collision at t: n members, ids, image-consistent positions and velocities after (n x dim).
   void group(double t, int n, const int* ids, const double* x, const double* v);
   /// A wall reflection of particle i at t (also at a collision's instant): its velocity after.
@@ -152,9 +154,9 @@ class Observer {
   ObserveConfig cfg_;
   int dim_;
   std::size_t n_;
-  std::array<double, 3> box_;
+  std::array<double, 3> box_, inv_box_;
   std::array<bool, 3> walls_;
-  double diameter_, volume_, block_time_, t_start_, t_now_, speed_max_;
+  double diameter_, volume_, block_time_, t_start_, t_now_, speed_max_, bin_scale_;
   std::vector<Segment> seg_;
   std::vector<double> start_;   // unwrapped positions at the start (n x dim)
   std::vector<double> pair_t_;  // small systems: when each pair's interval began (n x n)

@@ -1,0 +1,74 @@
+"""The equilibrium study's CI version (issue 16): two disks in a closed 2.5 x 2.5 box. The flux
+law (and the specular baseline) must keep the exact equilibrium: collision rate, time near
+contact and distance distribution within a few standard errors. The same test on the uniform
+law must see its drift, or the test could not fail."""
+import math
+
+import numpy as np
+import pytest
+
+from revcol import physics as P
+
+COLLISIONS = 200_000
+LIMIT = 3.5  # standard errors; the runs are seeded, so the result is the same bits every time
+
+
+def distance_z(r):
+    """z per bin of the measured distance density against the exact one, on [D, ell]."""
+    ell = r["box"] - 1.0
+    z0 = ell**4 - P._excluded(2, ell, 1.0)
+    h = 1.0 / P.BINS_PER_D
+    out = []
+    for k in range(P.BINS_PER_D, int(ell * P.BINS_PER_D)):
+        lo, hi = k * h, (k + 1) * h
+        exact = (P._excluded(2, ell, hi) - P._excluded(2, ell, lo)) / (z0 * h)
+        if r["distance_error"][k] > 0:
+            out.append((r["distance"][k] - exact) / r["distance_error"][k])
+    return np.asarray(out)
+
+
+def stats(law):
+    r = P.two_body(2, 2.5, law, COLLISIONS, seed=1)
+    ex = P.exact_pair(2, 2.5, r["energy"])
+    rate = (r["collision_rate"][0] - ex["collision_rate"]) / r["collision_rate"][1]
+    near = (r["near_contact"][0] - ex["near_contact"]) / r["near_contact"][1]
+    return r, rate, near, distance_z(r)
+
+
+@pytest.mark.parametrize("law", ["flux", "specular"])
+def test_equilibrium_laws_keep_the_exact_two_disk_equilibrium(law):
+    r, rate, near, z = stats(law)
+    assert r["blocks"] >= 32
+    assert abs(rate) < LIMIT, f"{law}: collision rate {rate:+.1f} standard errors from exact"
+    assert abs(near) < LIMIT, f"{law}: time near contact {near:+.1f} standard errors from exact"
+    assert (z * z).mean() < 1.5 and np.abs(z).max() < 4.5, f"{law}: distance distribution off the exact one"
+
+
+def test_the_uniform_law_drift_is_seen():
+    # the paper's uniform law: fewer collisions, more time at contact (docs/physics.md)
+    r, rate, near, z = stats("uniform")
+    assert rate < -5.0 and r["collision_rate"][0] < 0.92 * P.exact_pair(2, 2.5, r["energy"])["collision_rate"]
+    assert near > 5.0
+    assert (z * z).mean() > 3.0
+
+
+def test_exact_two_body_values_against_monte_carlo():
+    mc = P.monte_carlo(2, 2.5, 2_000_000, seed=3)
+    ex = P.exact_pair(2, 2.5, 1.0)
+    assert abs(mc["near_contact"] - ex["near_contact"]) < 4 * mc["near_contact_error"]
+    # the contact density: the first bin's density against p(D)
+    assert mc["distance"][P.BINS_PER_D] == pytest.approx(ex["contact_density"], rel=0.02)
+    # the inward speed at contact on the energy shell of 2 disks (m = 4): 4 sqrt(E) / (3 pi), i.e.
+    # 4 sqrt(2 T) / (3 pi) = 0.600 sqrt(T), where a Maxwellian would give sqrt(T / pi) = 0.564 sqrt(T)
+    assert ex["inward_speed"] == pytest.approx(4 / (3 * math.pi), rel=1e-12)
+    with pytest.raises(ValueError):
+        P.exact_pair(2, 2.0, 1.0)
+
+
+def test_equations_of_state_and_enskog():
+    assert P.henderson(0.5) == pytest.approx(4.125)
+    assert P.carnahan_starling(0.3) == pytest.approx((1 + 0.3 + 0.09 - 0.027) / 0.343)
+    # Enskog from the contact value; the low-density limit of 3D: 4 n sigma^2 sqrt(pi T)
+    n = 0.01 / (math.pi / 6)
+    assert P.enskog_rate(3, 0.01, 1.0, 1.0) == pytest.approx(4 * n * math.sqrt(math.pi))
+    assert P.contact_value(2, 0.5, 4.125) == pytest.approx(3.125)
