@@ -83,6 +83,28 @@ class Observation:
     ``blocks``, ``block_time``.
     """
 
+    dim: int
+    n: int
+    t_start: float
+    t_end: float
+    blocks: int
+    block_time: float
+    pair_collisions: int
+    group_collisions: int
+    particle_collisions: int
+    wall_reflections: int
+    temperature: Estimate
+    pressure_virial: Estimate
+    compressibility: Estimate
+    collision_rate: Estimate
+    mean_free_time: Estimate
+    mean_free_path: Estimate
+    virial_balance: Estimate
+    slab_density: Optional[Profile]
+    slab_temperature: Optional[Profile]
+    speed: Optional[Profile]
+    pair_distance: Optional[Profile]
+
     def __init__(self, raw: dict[str, Any]):
         self.raw = raw
         for key in ("dim", "n", "t_start", "t_end", "blocks", "block_time", "pair_collisions", "group_collisions",

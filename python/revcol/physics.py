@@ -38,7 +38,7 @@ import numpy as np
 from .engine import Simulation
 
 __all__ = ["LAWS", "exact_pair", "monte_carlo", "two_body", "small_study", "henderson", "carnahan_starling",
-           "enskog_rate", "maxwell_speed_density", "dense", "main"]
+           "enskog_rate", "maxwell_speed_density", "microcanonical_speed_density", "speed_check", "dense", "main"]
 
 #: the laws compared: name -> Simulation keywords
 LAWS = {"flux": {"mode": "exact", "law": "flux"}, "specular": {"mode": "specular"},
@@ -226,6 +226,41 @@ def maxwell_speed_density(d: int, s: np.ndarray, temperature: float) -> np.ndarr
     return np.sqrt(2 / math.pi) * s * s / temperature**1.5 * np.exp(-s * s / (2 * temperature))
 
 
+def microcanonical_speed_density(d: int, n: int, s: np.ndarray, temperature: float) -> np.ndarray:
+    """The exact speed density of one of n particles with total momentum 0 and kinetic energy
+    E = n d T / 2 (a periodic box): velocities uniform on the sphere of the d (n - 1)
+    dimensional subspace, whose one-particle marginal is proportional to
+    s^(d-1) (1 - n s^2 / (2 (n - 1) E))^((d (n - 1) - d - 2) / 2). Tends to Maxwell-Boltzmann as n grows."""
+    s = np.asarray(s, dtype=float)
+    energy = n * d * temperature / 2.0
+    a = n / (2.0 * (n - 1) * energy)
+    p = (d * (n - 1) - d - 2) / 2.0
+    grid = np.linspace(0.0, 1.0 / math.sqrt(a), 20001)
+    f = lambda x: np.where(a * x * x < 1.0, x ** (d - 1) * np.clip(1.0 - a * x * x, 0.0, None) ** p, 0.0)
+    norm = np.trapezoid(f(grid), grid)
+    return f(s) / norm
+
+
+def speed_check(r: dict[str, Any]) -> dict[str, float]:
+    """A dense run's time-weighted speed histogram against the bin averages of the exact
+    finite-n law (microcanonical, momentum 0) and of Maxwell-Boltzmann: chi^2 per bin and the
+    largest |z| of a bin (block errors)."""
+    c = np.asarray(r["speed_centres"])
+    h = c[1] - c[0]
+    val, err = np.asarray(r["speed"]), np.asarray(r["speed_error"])
+    T, d, n = r["temperature"][0], r["dim"], r["n"]
+    out = {}
+    for name, law in (("microcanonical", lambda x: microcanonical_speed_density(d, n, x, T)),
+                      ("maxwell", lambda x: maxwell_speed_density(d, x, T))):
+        u = np.linspace(-0.5, 0.5, 33)
+        ref = np.array([np.trapezoid(law(ci + h * u), u) for ci in c])  # bin averages
+        use = err > 0
+        z = (val[use] - ref[use]) / err[use]
+        out[f"speed_chi2_{name}"] = float((z * z).mean())
+        out[f"speed_max_z_{name}"] = float(np.abs(z).max())
+    return out
+
+
 def dense(d: int, phi: float, law: str, n: int = 1000, per_particle: float = 2000.0, seed: int = 1,
           frames: int = 40, speed_bins: int = 40, slabs: int = 8) -> dict[str, Any]:
     """(b) one dense gas: N particles at packing fraction ``phi`` in a periodic box under
@@ -254,9 +289,6 @@ def dense(d: int, phi: float, law: str, n: int = 1000, per_particle: float = 200
     near = (r > 1.0) & (r < 1.15)
     g_frames = float(np.polyval(np.polyfit(r[near] - 1.0, g[near], 2), 0.0)) if near.sum() >= 3 else float("nan")
     sp = o.speed
-    mb = maxwell_speed_density(d, sp.centres, o.temperature.value)
-    use = sp.error > 0
-    zs = (sp.value[use] - mb[use]) / sp.error[use]
     st = o.slab_temperature
     tz = (st.value - o.temperature.value) / st.error
     res = {"dim": d, "phi": phi, "law": law, "n": n, "seed": seed, "collisions": total, "cpu_s": cpu,
@@ -264,18 +296,18 @@ def dense(d: int, phi: float, law: str, n: int = 1000, per_particle: float = 200
            "z": [o.compressibility.value, o.compressibility.error], "z_ref": z_ref,
            "z_sigmas": (o.compressibility.value - z_ref) / o.compressibility.error,
            "g_contact": [contact_value(d, phi, o.compressibility.value),
-                         contact_value(d, phi, o.compressibility.error + 1.0) - contact_value(d, phi, 1.0)],
+                         o.compressibility.error / (2 ** (d - 1) * phi)],
            "g_contact_ref": g_ref, "g_contact_frames": g_frames,
            "collision_rate": [o.collision_rate.value, o.collision_rate.error], "collision_rate_ref": rate_ref,
            "collision_rate_sigmas": (o.collision_rate.value - rate_ref) / o.collision_rate.error,
            "speed_centres": sp.centres.tolist(), "speed": sp.value.tolist(), "speed_error": sp.error.tolist(),
-           "speed_chi2_per_bin": float((zs * zs).mean()), "speed_max_z": float(np.abs(zs).max()),
            "slab_temperature": st.value.tolist(), "slab_temperature_error": st.error.tolist(),
            "slab_temperature_max_z": float(np.abs(tz).max()),
            "g_r": [r.tolist(), g.tolist()], "mean_free_path": [o.mean_free_path.value, o.mean_free_path.error]}
+    res.update(speed_check(res))
     print(f"  {d}D phi {phi:.2f} {law:9s} Z {o.compressibility.value:.4f}+-{o.compressibility.error:.4f} "
           f"(ref {z_ref:.4f}, {res['z_sigmas']:+.1f} sd)  rate {res['collision_rate_sigmas']:+.1f} sd  "
-          f"speeds chi2/bin {res['speed_chi2_per_bin']:.2f}  slabs max|z| {res['slab_temperature_max_z']:.1f}  "
+          f"speeds chi2/bin {res['speed_chi2_microcanonical']:.2f}  slabs max|z| {res['slab_temperature_max_z']:.1f}  "
           f"{cpu:.0f} s", file=sys.stderr)
     return res
 
@@ -304,17 +336,32 @@ def small_table(study: dict) -> str:
 
 def dense_table(runs: Sequence[dict]) -> str:
     """(b) as a markdown table."""
-    rows = ["| d | phi | law | Z | reference | sd | Z - Z(specular) in sd | g(sigma) | collision rate | Enskog | sd "
-            "| speeds chi2/bin (max abs z) | slab T max abs z |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    rows = ["| d | phi | law | Z | EOS | sd (%) | Z - Z(specular) in sd | g(sigma) | collision rate | Enskog (EOS) | sd "
+            "| rate / Enskog (own Z): sd | speeds chi2/bin: exact finite N (Maxwell) | slab T max abs z |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     spec = {(r["dim"], r["phi"]): r for r in runs if r["law"] == "specular"}
     for r in runs:
+        r = {**r, **speed_check(r)}
         s = spec.get((r["dim"], r["phi"]))
         vs = "" if s is None or s is r else f"{(r['z'][0] - s['z'][0]) / math.hypot(r['z'][1], s['z'][1]):+.1f}"
+        own, own_err = self_consistency(r)
         rows.append(f"| {r['dim']} | {r['phi']:.2f} | {r['law']} | {_pm(*r['z'])} | {r['z_ref']:.5g} | "
-                    f"{r['z_sigmas']:+.1f} | {vs} | {r['g_contact'][0]:.4g} (frames {r['g_contact_frames']:.3g}) | "
+                    f"{r['z_sigmas']:+.1f} ({100 * (r['z'][0] / r['z_ref'] - 1):+.2f}%) | {vs} | {r['g_contact'][0]:.4g} (frames {r['g_contact_frames']:.3g}) | "
                     f"{_pm(*r['collision_rate'])} | {r['collision_rate_ref']:.5g} | {r['collision_rate_sigmas']:+.1f} | "
-                    f"{r['speed_chi2_per_bin']:.2f} ({r['speed_max_z']:.1f}) | {r['slab_temperature_max_z']:.1f} |")
+                    f"{r['collision_rate'][0] / own:.4f}: {(r['collision_rate'][0] - own) / own_err:+.1f} | "
+                    f"{r['speed_chi2_microcanonical']:.2f} ({r['speed_chi2_maxwell']:.2f}) | "
+                    f"{r['slab_temperature_max_z']:.1f} |")
     return "\n".join(rows)
+
+
+def self_consistency(r: dict) -> tuple[float, float]:
+    """Enskog's collision rate with the contact value of the run's own Z, and its error (the
+    rate's and Z's combined): in an equilibrium hard-sphere gas the collision rate and the
+    virial both follow from g(sigma), so their ratio is 1 whatever the equation of state."""
+    d, phi, T = r["dim"], r["phi"], r["temperature"][0]
+    own = enskog_rate(d, phi, T, contact_value(d, phi, r["z"][0]))
+    err = math.hypot(r["collision_rate"][1], own * r["z"][1] / (r["z"][0] - 1.0))
+    return own, err
 
 
 def _run_info(argv: Sequence[str], t0: float) -> dict[str, Any]:
@@ -343,54 +390,49 @@ def figures(paths: Sequence[str], out: str) -> list[str]:
     written = []
     colours = {"flux": "C0", "specular": "k", "uniform": "C3", "paper": "C1"}
     if dense_runs:
-        fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
-        for ax, d in zip(axes, (2, 3)):
+        fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharex="col")
+        for col, d in enumerate((2, 3)):
             rs = [r for r in dense_runs if r["dim"] == d]
             if not rs:
                 continue
+            ax, dev = axes[0][col], axes[1][col]
             ph = np.linspace(0.0, max(r["phi"] for r in rs) + 0.02, 100)
-            ax.plot(ph, [reference_z(d, p) for p in ph], "-", color="0.6",
-                    label="Henderson" if d == 2 else "Carnahan-Starling")
+            eos = "Henderson" if d == 2 else "Carnahan-Starling"
+            ax.plot(ph, [reference_z(d, p) for p in ph], "-", color="0.6", label=eos)
+            dev.axhline(0.0, color="0.6")
             for k, law in enumerate(LAWS):
                 sel = [r for r in rs if r["law"] == law]
-                if sel:
-                    ax.errorbar([r["phi"] + 0.004 * (k - 1.5) for r in sel], [r["z"][0] for r in sel],
-                                yerr=[r["z"][1] for r in sel], fmt="o", ms=3, color=colours[law], label=law)
-            ax.set_xlabel("packing fraction"), ax.set_ylabel("Z = PV / NkT"), ax.set_title(f"{d}D, N = {rs[0]['n']}")
+                if not sel:
+                    continue
+                x = [r["phi"] + 0.004 * (k - 1.5) for r in sel]
+                ax.errorbar(x, [r["z"][0] for r in sel], yerr=[r["z"][1] for r in sel], fmt="o", ms=3,
+                            color=colours[law], label=law)
+                dev.errorbar(x, [100 * (r["z"][0] / r["z_ref"] - 1) for r in sel],
+                             yerr=[100 * r["z"][1] / r["z_ref"] for r in sel], fmt="o", ms=3, color=colours[law])
+            ax.set_ylabel("Z = PV / NkT"), ax.set_title(f"{d}D, N = {rs[0]['n']}, periodic")
+            dev.set_xlabel("packing fraction"), dev.set_ylabel(f"Z / {eos} - 1 (%)")
             ax.legend(fontsize=7)
         fig.tight_layout()
         written.append(_save(fig, out, "z_vs_phi.png"))
-        fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
-        for ax, d in zip(axes, (2, 3)):
-            rs = [r for r in dense_runs if r["dim"] == d]
-            if not rs:
-                continue
-            top = max(r["phi"] for r in rs)
+        def g_panel(ax, d, phi, rs):
             for r in rs:
-                if r["phi"] == top:
-                    ax.plot(r["g_r"][0], r["g_r"][1], color=colours[r["law"]], lw=1, label=r["law"])
-            ax.set_xlabel("r / sigma"), ax.set_ylabel("g(r)"), ax.set_title(f"{d}D, phi = {top}")
-            ax.legend(fontsize=7)
-        fig.tight_layout()
-        written.append(_save(fig, out, "g_of_r.png"))
-        fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
-        for ax, d in zip(axes, (2, 3)):
-            rs = [r for r in dense_runs if r["dim"] == d]
-            if not rs:
-                continue
-            top = max(r["phi"] for r in rs)
+                ax.plot(r["g_r"][0], r["g_r"][1], color=colours[r["law"]], lw=1, label=r["law"])
+            ax.set_xlabel("r / sigma"), ax.set_ylabel("g(r) (40 frames)"), ax.set_title(f"{d}D, phi = {phi}")
+
+        written.append(_per_dim(plt, dense_runs, {2: 0.5, 3: 0.45}, g_panel, out, "g_of_r.png"))
+
+        def speed_panel(ax, d, phi, rs):
             for r in rs:
-                if r["phi"] == top:
-                    c = np.asarray(r["speed_centres"])
-                    ax.errorbar(c, r["speed"], yerr=r["speed_error"], fmt=".", ms=3, color=colours[r["law"]],
-                                label=r["law"])
-                    T = r["temperature"][0]
-            s = np.linspace(0, c.max(), 200)
-            ax.plot(s, maxwell_speed_density(d, s, T), "-", color="0.6", label="Maxwell-Boltzmann")
-            ax.set_xlabel("speed"), ax.set_ylabel("density (time-weighted)"), ax.set_title(f"{d}D, phi = {top}")
-            ax.legend(fontsize=7)
-        fig.tight_layout()
-        written.append(_save(fig, out, "speeds.png"))
+                c = np.asarray(r["speed_centres"])
+                ref = microcanonical_speed_density(d, r["n"], c, r["temperature"][0])
+                ax.errorbar(c, np.asarray(r["speed"]) / ref - 1.0, yerr=np.asarray(r["speed_error"]) / ref, fmt=".-",
+                            lw=0.6, ms=3, color=colours[r["law"]], label=r["law"])
+            ax.axhline(0.0, color="0.6")
+            ax.set_ylim(-0.05, 0.05), ax.set_xlim(0, 3.5 * math.sqrt(rs[0]["temperature"][0]))
+            ax.set_xlabel("speed"), ax.set_title(f"{d}D, phi = {phi}")
+            ax.set_ylabel("time-weighted density / exact - 1")
+
+        written.append(_per_dim(plt, dense_runs, {2: 0.3, 3: 0.1}, speed_panel, out, "speeds.png"))
     for st in small:
         fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
         for ax, d in zip(axes, (2, 3)):
@@ -411,6 +453,21 @@ def figures(paths: Sequence[str], out: str) -> list[str]:
         fig.tight_layout()
         written.append(_save(fig, out, "two_body_distance.png"))
     return written
+
+
+def _per_dim(plt, runs: Sequence[dict], phis: dict[int, float], panel, out: str, name: str) -> str:
+    """One panel per dimension, of the runs at phis[d] (or the densest), saved as out/name."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+    for ax, d in zip(axes, (2, 3)):
+        rs = [r for r in runs if r["dim"] == d]
+        if not rs:
+            continue
+        have = {r["phi"] for r in rs}
+        phi = phis[d] if phis[d] in have else max(have)
+        panel(ax, d, phi, [r for r in rs if r["phi"] == phi])
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return _save(fig, out, name)
 
 
 def _save(fig, out: str, name: str) -> str:
