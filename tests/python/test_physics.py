@@ -72,3 +72,31 @@ def test_equations_of_state_and_enskog():
     n = 0.01 / (math.pi / 6)
     assert P.enskog_rate(3, 0.01, 1.0, 1.0) == pytest.approx(4 * n * math.sqrt(math.pi))
     assert P.contact_value(2, 0.5, 4.125) == pytest.approx(3.125)
+
+
+def test_dense_gas_flux_matches_specular_and_enskog_uniform_does_not():
+    # a small, short version of (b): the same start under each law
+    runs = {law: P.dense(2, 0.4, law, n=300, per_particle=3000, seed=2, frames=4) for law in ("flux", "specular",
+                                                                                              "uniform")}
+    f, s, u = runs["flux"], runs["specular"], runs["uniform"]
+    assert abs(f["z"][0] - s["z"][0]) < LIMIT * math.hypot(f["z"][1], s["z"][1])
+    for r in (f, s):
+        own, err = P.self_consistency(r)
+        assert abs(r["collision_rate"][0] - own) < LIMIT * err, r["law"]
+        assert r["speed_chi2_microcanonical"] < 2.0 and r["slab_temperature_max_z"] < 4.0
+    own, err = P.self_consistency(u)
+    assert u["collision_rate"][0] > own + 5 * err  # more collisions than its pressure allows
+    assert u["z"][0] < s["z"][0] - 5 * math.hypot(u["z"][1], s["z"][1])
+
+
+def test_study_command_line(tmp_path, capsys):
+    from revcol.cli import main as cli_main
+
+    out = tmp_path / "small.json"
+    assert cli_main(["study", "equilibrium", "small", "--collisions", "20000", "--mc-samples", "1000000",
+                     "--dims", "2", "--laws", "flux", "uniform", "--json", str(out)]) == 0
+    assert "| two disks | flux |" in capsys.readouterr().out
+    assert cli_main(["study", "equilibrium", "table", str(out)]) == 0
+    assert "| two disks | uniform |" in capsys.readouterr().out
+    assert cli_main(["study", "equilibrium", "figures", str(out), "--out", str(tmp_path / "fig")]) == 0
+    assert (tmp_path / "fig" / "two_body_distance.png").stat().st_size > 1000
