@@ -19,6 +19,7 @@ the derivations, the tables and the figures.
 
     python -m revcol.physics small --collisions 4000000 --json bench/results/equilibrium_small.json
     python -m revcol.physics dense --dim 2 --phi 0.3 0.5 0.6 0.7 --json bench/results/equilibrium_dense2d.json
+    python -m revcol.physics walls --dim 2 --phi 0.5 --json bench/results/equilibrium_walls2d.json
     python -m revcol.physics figures --out docs/figures/physics bench/results/equilibrium_*.json
     revcol study equilibrium ...   (the same)
 """
@@ -38,7 +39,8 @@ import numpy as np
 from .engine import Simulation
 
 __all__ = ["LAWS", "exact_pair", "monte_carlo", "two_body", "small_study", "henderson", "carnahan_starling",
-           "enskog_rate", "maxwell_speed_density", "microcanonical_speed_density", "speed_check", "dense", "main"]
+           "enskog_rate", "maxwell_speed_density", "microcanonical_speed_density", "speed_check", "dense", "walled",
+           "main"]
 
 #: the laws compared: name -> Simulation keywords
 LAWS = {"flux": {"mode": "exact", "law": "flux"}, "specular": {"mode": "specular"},
@@ -312,6 +314,50 @@ def dense(d: int, phi: float, law: str, n: int = 1000, per_particle: float = 200
     return res
 
 
+def walled(d: int, phi: float, law: str, n: int = 1000, per_particle: float = 2000.0, seed: int = 1,
+           slabs: int = 10) -> dict[str, Any]:
+    """(b) in a closed box (specular walls on every axis): the temperature and the density in
+    ``slabs`` slabs along x, and the pressure on each pair of faces, with block errors."""
+    sim = Simulation.random(n=n, dim=d, phi=phi, seed=seed, boundary="wall", **LAWS[law])
+    sim.run(collisions=int(100 * n))
+    sim.observe(slabs=slabs)
+    tick = time.process_time()
+    sim.run(collisions=int(per_particle * n / 2))
+    cpu = time.process_time() - tick
+    o = sim.observation()
+    st, sd = o.slab_temperature, o.slab_density
+    tz = (st.value - o.temperature.value) / st.error
+    pw = [[e.value, e.error] for e in o.pressure_wall]
+    res = {"dim": d, "phi": phi, "law": law, "n": n, "seed": seed, "cpu_s": cpu, "box": sim.box.tolist(),
+           "blocks": o.blocks, "temperature": [o.temperature.value, o.temperature.error],
+           "slab_edges": st.edges.tolist(), "slab_temperature": st.value.tolist(),
+           "slab_temperature_error": st.error.tolist(), "slab_temperature_max_z": float(np.abs(tz).max()),
+           "slab_temperature_chi2_per_slab": float((tz * tz).mean()),
+           "slab_density": sd.value.tolist(), "slab_density_error": sd.error.tolist(), "pressure_wall": pw,
+           "virial_balance": [o.virial_balance.value, o.virial_balance.error]}
+    print(f"  walls {d}D phi {phi:.2f} {law:9s} slab T max|z| {res['slab_temperature_max_z']:.1f}  P_wall "
+          + " ".join(_pm(*p) for p in pw) + f"  {cpu:.0f} s", file=sys.stderr)
+    return res
+
+
+def walls_table(runs: Sequence[dict]) -> str:
+    """The closed boxes as a markdown table."""
+    rows = ["| d | phi | law | T | slab T: chi2 per slab (max abs z) | slab T range (%) | P on x faces | "
+            "P on y faces | (P_x - P_y) / error | P_x - P_x(specular) in sd |", "|---|---|---|---|---|---|---|---|---|---|"]
+    spec = {(r["dim"], r["phi"]): r for r in runs if r["law"] == "specular"}
+    for r in runs:
+        (px, ex), (py, ey) = r["pressure_wall"][0], r["pressure_wall"][1]
+        t = np.asarray(r["slab_temperature"]) / r["temperature"][0] - 1.0
+        s = spec.get((r["dim"], r["phi"]))
+        vs = "" if s is None or s is r else \
+            f"{(px - s['pressure_wall'][0][0]) / math.hypot(ex, s['pressure_wall'][0][1]):+.1f}"
+        rows.append(f"| {r['dim']} | {r['phi']:.2f} | {r['law']} | {_pm(*r['temperature'])} | "
+                    f"{r['slab_temperature_chi2_per_slab']:.2f} ({r['slab_temperature_max_z']:.1f}) | "
+                    f"{100 * t.min():+.2f} .. {100 * t.max():+.2f} | {_pm(px, ex)} | {_pm(py, ey)} | "
+                    f"{(px - py) / math.hypot(ex, ey):+.1f} | {vs} |")
+    return "\n".join(rows)
+
+
 # ---- tables, figures, command line -------------------------------------------------------
 
 def _pm(v: float, e: float) -> str:
@@ -433,6 +479,27 @@ def figures(paths: Sequence[str], out: str) -> list[str]:
             ax.set_ylabel("time-weighted density / exact - 1")
 
         written.append(_per_dim(plt, dense_runs, {2: 0.3, 3: 0.1}, speed_panel, out, "speeds.png"))
+    walls = [r for d in docs for r in d.get("walls", [])]
+    if walls:
+        dims = sorted({r["dim"] for r in walls})
+        fig, axes = plt.subplots(len(dims), 2, figsize=(9, 3.2 * len(dims)), squeeze=False)
+        for row, d in zip(axes, dims):
+            rs = [r for r in walls if r["dim"] == d]
+            for r in rs:
+                e = np.asarray(r["slab_edges"])
+                c = 0.5 * (e[1:] + e[:-1]) / e[-1]
+                T = r["temperature"][0]
+                row[0].errorbar(c, 100 * (np.asarray(r["slab_temperature"]) / T - 1),
+                                yerr=100 * np.asarray(r["slab_temperature_error"]) / T, fmt="o-", ms=3, lw=0.7,
+                                color=colours[r["law"]], label=r["law"])
+                row[1].plot(c, r["slab_density"], "o-", ms=3, lw=0.7, color=colours[r["law"]], label=r["law"])
+            row[0].axhline(0.0, color="0.6")
+            row[0].set_ylabel("slab temperature / T - 1 (%)"), row[1].set_ylabel("number density")
+            for ax in row:
+                ax.set_xlabel("x / L"), ax.legend(fontsize=7)
+                ax.set_title(f"{d}D, phi = {rs[0]['phi']}, walls, N = {rs[0]['n']}")
+        fig.tight_layout()
+        written.append(_save(fig, out, "walls_slabs.png"))
     for st in small:
         fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
         for ax, d in zip(axes, (2, 3)):
@@ -498,6 +565,14 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     b.add_argument("--laws", nargs="+", choices=tuple(LAWS))
     b.add_argument("--seed", type=int, default=1)
     b.add_argument("--json")
+    w = sub.add_parser("walls", help="(b) dense gases in a closed box: temperature and density by slab, wall pressure")
+    w.add_argument("--dim", type=int, choices=(2, 3), required=True)
+    w.add_argument("--phi", type=float, nargs="+", required=True)
+    w.add_argument("--n", type=int, default=1000)
+    w.add_argument("--per-particle", type=float, default=20000.0, help="observed collisions per particle")
+    w.add_argument("--laws", nargs="+", choices=tuple(LAWS))
+    w.add_argument("--seed", type=int, default=1)
+    w.add_argument("--json")
     f = sub.add_parser("figures", help="figures from the JSON files")
     f.add_argument("json", nargs="+")
     f.add_argument("--out", default="docs/figures/physics")
@@ -511,7 +586,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if args.what == "table":
         for p in args.json:
             doc = json.load(open(p))
-            print(small_table(doc["small"]) if "small" in doc else dense_table(doc["dense"]))
+            print(small_table(doc["small"]) if "small" in doc else
+                  walls_table(doc["walls"]) if "walls" in doc else dense_table(doc["dense"]))
         return 0
     if args.what == "small":
         st = small_study(args.collisions, seed=args.seed, mc_samples=args.mc_samples, dims=args.dims, laws=args.laws)
@@ -519,10 +595,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(small_table(st))
     else:
         laws = args.laws or [k for k in LAWS if args.dim == 2 or k != "paper"]
-        runs = [dense(args.dim, phi, law, n=args.n, per_particle=args.per_particle, seed=args.seed)
+        run = dense if args.what == "dense" else walled
+        runs = [run(args.dim, phi, law, n=args.n, per_particle=args.per_particle, seed=args.seed)
                 for phi in args.phi for law in laws]
-        doc = {"dense": runs}
-        print(dense_table(runs))
+        doc = {args.what: runs}
+        print(dense_table(runs) if args.what == "dense" else walls_table(runs))
     if args.json:
         doc.update(_run_info(argv, t0))
         with open(args.json, "w") as fh:

@@ -4,8 +4,9 @@
 //
 // What the engine tells the observer. Every velocity change, at the instant it happens:
 // a pair collision (both velocities after the operator; the separation comes from the
-// observer's positions, folded to the nearest image), a group collision (each member's image-consistent
-// position and its velocity after) and a wall reflection (the velocity after). Between
+// observer's positions, folded to the nearest image), a group collision (each member's
+// image-consistent position and its velocity after) and a wall reflection (the velocity
+// after; also those at a collision's instant, before and after the operator). Between
 // two velocity changes a particle flies freely, so the observer keeps, per particle, a
 // segment (start time t0, position x0 at t0, velocity v): x(t) = x0 + v (t - t0). It
 // integrates its own positions from the start of the observation, so they are unwrapped
@@ -47,6 +48,9 @@
 // the whole observed time; its error is s / sqrt(n_b), s the sample standard deviation of
 // the values of n_b complete blocks, merged down to [min_blocks, 2 min_blocks) first
 // (longer blocks are less correlated; the blocks are not independent otherwise).
+//
+// Cost: measured with callgrind in docs/physics.md (off: one pointer test per velocity
+// change in the engine's hooks, note_pair / note_wall, out of line and cold).
 //
 // Reversal: observation is forward only. run_back first syncs the observer at the clock
 // and stops it (its results stay readable, nothing more is added); a forward run after it
