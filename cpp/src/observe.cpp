@@ -158,8 +158,20 @@ Observer::Block Observer::empty_block(double t0) const {
 void Observer::slab_walk(const Segment& s, double dt) {
   const int a = cfg_.slab_axis, ns = cfg_.slabs;
   const double L = box_[a], w = L / ns, va = s.v[a];
-  double u = s.x[a] - L * std::floor(s.x[a] / L);  // folded into [0, L) (a periodic axis)
-  int sl = std::min(ns - 1, std::max(0, static_cast<int>(u / w)));
+  double u = s.x[a];
+  if (!walls_[a]) {  // folded into [0, L) (a periodic axis); floor by a cast (no libm call)
+    const double q = u * inv_box_[a];
+    double fl = static_cast<double>(static_cast<std::int64_t>(q));
+    if (fl > q) fl -= 1.0;
+    u -= L * fl;
+  }
+  int sl = std::min(ns - 1, std::max(0, static_cast<int>(u * (ns * inv_box_[a]))));
+  const double end = u + va * dt;
+  if (end >= sl * w && end < (sl + 1) * w) {  // the common case: the segment stays in its slab
+    cur_.slab_t[sl] += dt;
+    cur_.slab_k2[sl] += s.v2 * dt;
+    return;
+  }
   double rem = dt;
   while (rem > 0.0) {
     double piece = rem;
