@@ -100,3 +100,13 @@ def test_study_command_line(tmp_path, capsys):
     assert "| two disks | uniform |" in capsys.readouterr().out
     assert cli_main(["study", "equilibrium", "figures", str(out), "--out", str(tmp_path / "fig")]) == 0
     assert (tmp_path / "fig" / "two_body_distance.png").stat().st_size > 1000
+
+
+def test_closed_box_walls_share_the_pressure_uniform_lowers_it():
+    f = P.walled(2, 0.4, "flux", n=300, per_particle=3000, seed=3)
+    u = P.walled(2, 0.4, "uniform", n=300, per_particle=3000, seed=3)
+    (px, ex), (py, ey) = f["pressure_wall"]
+    assert abs(px - py) < LIMIT * math.hypot(ex, ey)  # one pressure on every face
+    assert abs(f["virial_balance"][0]) < LIMIT * f["virial_balance"][1] + 1e-3  # K2 + W + W_wall -> 0
+    assert f["slab_temperature_max_z"] < 4.0
+    assert u["pressure_wall"][0][0] < px - 5 * math.hypot(ex, u["pressure_wall"][0][1])
