@@ -152,17 +152,19 @@ class Observation:
 
 def report_lines(d: dict[str, Any]) -> list[str]:
     """Report lines of an observation's ``to_dict()`` (``revcol run`` prints them)."""
+    errors = (f"errors from {d['blocks']} blocks of {d['block_time']:.3g}" if d["blocks"] >= 2 else
+              "no errors: fewer than 2 complete blocks (run longer)")
     rows = [f"  observed         t = {d['t_start']:.6g} .. {d['t_end']:.6g}, {d['particle_collisions']:,} "
-            f"particle collisions, errors from {d['blocks']} blocks of {d['block_time']:.3g}"]
+            f"particle collisions, {errors}"]
     closed = any(v != 0.0 for v, _ in d["pressure_wall"]) and all(v != 0.0 for v, _ in d["pressure_wall"])
     for key in _SCALARS:
         if key == "virial_balance" and not closed:  # defined for a closed box only
             continue
         v, e = d[key]
-        rows.append(f"  {key:<16} {v:.5g} +- {e:.2g}")
+        rows.append(f"  {key:<16} {v:.5g}" + (f" +- {e:.2g}" if d["blocks"] >= 2 else ""))
     for k, (v, e) in enumerate(d["pressure_wall"]):
         if v != 0.0:
-            rows.append(f"  pressure_wall[{k}] {v:.5g} +- {e:.2g}")
+            rows.append(f"  pressure_wall[{k}] {v:.5g}" + (f" +- {e:.2g}" if d["blocks"] >= 2 else ""))
     if d["msd"]:
         rows.append(f"  msd              {d['msd'][-1]:.5g} at t = {d['msd_time'][-1]:.5g} after the start")
     return rows

@@ -116,6 +116,13 @@ def test_scene_observe_in_report_and_json(tmp_path, capsys):
                     '[collisions]\nengine = "float"\n[run]\ncollisions = 200\n[observe]\nspeed_bins = 10\n')
     assert cli_main(["run", str(path), "--no-progress"]) == 0
     assert "compressibility" in capsys.readouterr().out
+    # a run shorter than two blocks has no errors, and says so
+    sim = gas()
+    sim.observe(block_time=1e6)
+    sim.run(collisions=100)
+    o = sim.observation()
+    assert o.blocks == 0 and o.compressibility.error == 0.0
+    assert "no errors: fewer than 2 complete blocks" in "\n".join(o.lines())
 
 
 @pytest.mark.parametrize("observe, engine, word", [
