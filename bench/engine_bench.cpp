@@ -9,9 +9,11 @@
 // random start. engine/custom takes everything from the environment, and every key there
 // also overrides the named cases:
 //
-//   REVCOL_ENGINE="d=3,n=10000,phi=0.3,boundary=periodic,law=flux,mode=exact,seed=1,warm=10,groups=1,shell=0"
+//   REVCOL_ENGINE="d=3,n=10000,phi=0.3,boundary=periodic,law=flux,mode=exact,seed=1,warm=10,groups=1,shell=0,observe=0"
 //
-// (shell: the neighbour-list shell in diameters, Config::shell; 0, the default, chooses it from phi)
+// (shell: the neighbour-list shell in diameters, Config::shell; 0, the default, chooses it from phi;
+// observe: 1 observes the timed forward run's scalars, 2 also a 50-bin speed histogram and 10
+// slabs (revcol/engine/observe.hpp); run_back ends the observation, so the reverse is unobserved)
 //
 // Metrics: forward_per_s, reverse_per_s, events_per_collision, invalid_per_collision,
 // log_bytes, engine_bytes, peak_rss_bytes (the process's VmHWM: run one case per process
@@ -28,6 +30,7 @@
 #include "bench.hpp"
 #include "revcol/engine/engine.hpp"
 #include "revcol/engine/init.hpp"
+#include "revcol/engine/observe.hpp"
 #include "revcol/error.hpp"
 
 namespace revcol::bench {
@@ -46,10 +49,11 @@ struct Case {
   double warm = 10.0;
   bool groups = true;
   double shell = 0.0;  // Config::shell: 0 chooses it from phi
+  int observe = 0;     // 0 off, 1 scalars, 2 scalars + speed histogram + slabs
 };
 
 void apply_environment(Case& c) {
-  apply_settings("REVCOL_ENGINE", "d, n, phi, boundary, law, mode, seed, warm, groups, shell",
+  apply_settings("REVCOL_ENGINE", "d, n, phi, boundary, law, mode, seed, warm, groups, shell, observe",
                  [&](const std::string& key, const std::string& value) {
                    if (key == "d") c.d = std::stoi(value);
                    else if (key == "n") c.n = std::stoull(value);
@@ -61,6 +65,7 @@ void apply_environment(Case& c) {
                    else if (key == "warm") c.warm = std::stod(value);
                    else if (key == "groups") c.groups = value != "0";
                    else if (key == "shell") c.shell = std::stod(value);
+                   else if (key == "observe") c.observe = std::stoi(value);
                    else return false;
                    return true;
                  });
@@ -90,6 +95,14 @@ std::vector<Metric> run_case(Case c, std::uint64_t nc) {
   if (warm > 0) sim->run(warm, std::numeric_limits<double>::infinity());
   const auto v0 = sim->velocities();
   const en::Diagnostics d0 = sim->diagnostics();
+  if (c.observe > 0) {
+    en::ObserveConfig oc;
+    if (c.observe > 1) {
+      oc.speed_bins = 50;
+      oc.slabs = 10;
+    }
+    sim->observe(oc);
+  }
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const en::RunResult f = sim->run(nc, std::numeric_limits<double>::infinity());

@@ -144,6 +144,7 @@ template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::set_velocity(int i, const Vec& v, Reflection mask) {
   for (int k = 0; k < Dim; ++k) p_[i].v[k] = v[k];
   counters_.wall_events += static_cast<std::uint64_t>(reflections(mask));
+  if (obs_) [[unlikely]] note_wall(i);
 }
 // The mask a standalone wall event of i on axis k applies at time t (i's position then):
 // Boundaries::reflect_at, computed on a copy of the velocity.
@@ -236,6 +237,7 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
     p_[a].v[k] = out.i[k];
     p_[b].v[k] = out.j[k];
   }
+  if (obs_) [[unlikely]] note_pair(a, b);
   if (reversed) {
     flip_mask(a, w1[0]);
     flip_mask(b, w1[1]);
@@ -411,6 +413,15 @@ bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, b
   } catch (const InvalidArgument&) {
     return false;
   }
+  if (obs_ && !reversed) {  // image-consistent positions: the group's virial (observe.hpp)
+    int ids[kMaxGroup];
+    double xs[kMaxGroup * Dim];
+    for (int u = 0; u < n; ++u) {
+      ids[u] = g.id[order[u]];
+      for (int k = 0; k < Dim; ++k) xs[u * Dim + k] = pos_at(ids[u], k, t) + g.off[order[u]][k];
+    }
+    obs_->group(t, n, ids, xs, post.data());
+  }
   for (int u = 0; u < n; ++u) {
     const int id = g.id[order[u]];
     for (int k = 0; k < Dim; ++k) p_[id].v[k] = reversed ? -post[u * Dim + k] : post[u * Dim + k];
@@ -468,6 +479,35 @@ void EngineImpl<Dim, Op>::check_conservation() {
       trace_.diverge(net_, Divergence::momentum);
       return;
     }
+}
+
+// ---- observation (revcol/engine/observe.hpp) ------------------------------------------------
+
+// A new observer from the state at the clock; built before the old one goes, so a bad
+// config changes nothing.
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::observe(const ObserveConfig& c) {
+  std::array<bool, 3> walls{};
+  for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
+  auto o = std::make_unique<Observer>(c, Dim, positions(), velocities(), clock_, cfg_.box, walls, cfg_.diameter);
+  observer_ = std::move(o);
+  obs_ = observer_.get();
+}
+// The hooks, out of line and cold, called after the velocities changed with as little as
+// possible live (the observer keeps the velocities before and the positions): a run that
+// does not observe pays the pointer test only (measured: docs/physics.md).
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::note_wall(int i) {
+  obs_->wall(clock_, i, p_[i].v);
+}
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::note_pair(int a, int b) {
+  obs_->pair(clock_, a, b, p_[a].v, p_[b].v);
+}
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::stop_observing() {
+  if (obs_) obs_->sync(clock_);
+  obs_ = nullptr;
 }
 
 // REVCOL_VALIDATE builds: after a collision, the members are not overlapping any listed

@@ -27,6 +27,7 @@
 #include "revcol/engine/kinematics.hpp"
 #include "revcol/engine/logs.hpp"
 #include "revcol/engine/neighbours.hpp"
+#include "revcol/engine/observe.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
@@ -171,7 +172,9 @@ class EngineImpl final : public Simulation {
     require(!std::isnan(t_end), "end time must not be NaN");
     require(std::isfinite(t_end) || max_collisions != std::numeric_limits<std::uint64_t>::max(),
             "run: give a finite end time or a collision count (an infinite run never returns)");
-    return loop(max_collisions, t_end, cb, every, poll, /*reversed=*/false);
+    const RunResult r = loop(max_collisions, t_end, cb, every, poll, /*reversed=*/false);
+    if (obs_) obs_->sync(clock_);
+    return r;
   }
 
   RunResult run_back(std::uint64_t max_collisions, double t_target, const Poll& poll,
@@ -185,6 +188,7 @@ class EngineImpl final : public Simulation {
     });
     const Divergence before = trace_.reason();
     stop_on_divergence_ = stop_on_divergence && before == Divergence::none;  // a new divergence only
+    stop_observing();  // observation is forward only (revcol/engine/observe.hpp)
     flip();
     RunResult r;
     try {
@@ -301,6 +305,13 @@ class EngineImpl final : public Simulation {
     s.momentum0 = p0_;
     return s;
   }
+
+  void observe(const ObserveConfig& c) override;  // engine_collide.hpp
+  const Observer* observer() const override { return observer_.get(); }
+  bool observing() const override { return obs_ != nullptr; }
+  void stop_observing() override;
+  [[gnu::noinline, gnu::cold]] void note_wall(int i);  // observer hooks (engine_collide.hpp)
+  [[gnu::noinline, gnu::cold]] void note_pair(int a, int b);
 
   std::size_t memory_bytes() const override {
     return n_ * (sizeof(Particle<Dim>) + sizeof(Ev) + sizeof(double) + 1 + 3 * sizeof(std::uint64_t)) +
@@ -634,6 +645,8 @@ class EngineImpl final : public Simulation {
   std::array<double, 3> p0_{};
   CollisionTrace trace_;                 // divergence detection for run_back (revcol/engine/trace.hpp)
   bool stop_on_divergence_ = false;      // run_back stops where the trace finds a divergence
+  std::unique_ptr<Observer> observer_;  // the running or last observation (observe.hpp)
+  Observer* obs_ = nullptr;             // observer_ while it runs, else null: the one test per velocity change
 };
 
 }  // namespace revcol::engine::detail

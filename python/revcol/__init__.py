@@ -20,6 +20,7 @@ from .paper import Pair3DPaper, Triple1DPaper, Triple2DPaper
 from . import paper
 from . import statesave
 from .engine import Simulation
+from . import observe, physics
 
-__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper", "Simulation"]
+__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper", "Simulation", "observe", "physics"]
 __version__ = "0.1.0"

@@ -6,6 +6,7 @@
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
     revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.randomness ...)
+    revcol study equilibrium small|dense|figures|table ...   (= python -m revcol.physics ...)
 """
 from __future__ import annotations
 
@@ -86,6 +87,10 @@ def _parser() -> argparse.ArgumentParser:
     rnd = stsub.add_parser("randomness", add_help=False,
                            help="the paper's randomness (dieharder) and coverage experiments: python -m revcol.randomness")
     rnd.add_argument("rest", nargs=argparse.REMAINDER)
+    eq = stsub.add_parser("equilibrium", add_help=False,
+                          help="does a collision law keep equilibrium (two particles exactly, dense gases against "
+                          "the equations of state): python -m revcol.physics")
+    eq.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 
 
@@ -127,6 +132,10 @@ def _run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 2
     print(format_report(report))
+    if report.get("observe"):
+        from .observe import report_lines
+
+        print("\n".join(report_lines(report["observe"])))
     if report.get("interrupted"):
         return 130
     if report["kind"] == "horizon":  # a measurement; on the lattice, a check that fails exits 1
@@ -140,6 +149,10 @@ def main(argv: list[str] | None = None) -> int:
         from . import randomness
 
         return randomness.main(words[2:])
+    if words[:2] == ["study", "equilibrium"]:
+        from . import physics
+
+        return physics.main(words[2:])
     args = _parser().parse_args(argv)
     if args.command == "run":
         return _run(args)

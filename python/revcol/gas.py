@@ -84,6 +84,10 @@ class _GasRun:
     def __init__(self, scene: Scene, plot, trajectory, progress: bool, checkpoints: bool):
         self.scene, self.plot, self.progress = scene, plot, progress
         self.sim = sim = build_simulation(scene)
+        # [observe]: the forward run itself is observed (run_back ends the observation)
+        self.observation = None
+        if scene.observe is not None:
+            sim.observe(**scene.observe)
         self.n, self.d = sim.n, sim.dim
         self.box, self.periodic = geometry(sim)
         # momentum is conserved along periodic axes unless a bounce-back wall (v -> -v) takes it
@@ -194,6 +198,8 @@ class _GasRun:
         sim = self.sim
         self.t_turn = sim.time
         self.diag_turn = sim.diagnostics()
+        if self.scene.observe is not None:
+            self.observation = sim.observation()
         self.shot_turn = (sim.positions, sim.velocities)
         if self.plot is not None:
             self.energy_series.append((self.done, float(self.diag_turn["energy_drift"])))
@@ -261,6 +267,7 @@ class _GasRun:
                                   "momentum": "|P - P0| / sqrt(2 E0 N) over the periodic axes (None: walls only, or a bounce-back wall)"},
             "log_bytes_turn": int(diag_turn["log_bytes"]), "log_bytes_end": int(diag_end["log_bytes"]),
             "reverse_failures": int(diag_end["events"]["reverse_failures"]),
+            "observe": self.observation.to_dict() if self.observation is not None else None,
             # the collision trace (docs/robustness.md): where the reversal was found off the forward run
             "divergence": diag_end["divergence"], "diverged_at": diag_end["diverged_at"],
             "verified_at": diag_end["verified_at"],

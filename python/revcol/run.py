@@ -19,6 +19,10 @@ about an order of magnitude per collision per particle, so a round trip passes o
 *horizon* of a few collisions per particle; :func:`horizon` measures it (``revcol run
 --horizon``; on a lattice scene it checks a few N_c bit for bit instead: there is none).
 
+A float-engine gas scene with an ``[observe]`` table also reports its forward run's
+observables (``report["observe"]``: pressure, temperature, collision rate, ... with block
+errors; :mod:`revcol.observe`), measured on its forward run itself.
+
 *Reversal* scenes run the paper's illustration (:func:`revcol.verify`; velocities only, no
 positions are built), *statesave* scenes the paper's §6 study (:func:`revcol.statesave.study`).
 

@@ -76,6 +76,13 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     trajectory = "run.xyz"        # gas: extended XYZ (OVITO) or .gsd
     trajectory_every = 100        # gas: collisions between frames
     checkpoints = "checkpoints"   # gas: where checkpoint_interval writes (default NAME-checkpoints)
+
+    [observe]                     # gas, float engine: observables of the forward run (revcol.observe);
+                                  # the table alone observes the scalars; its values go in the report
+    speed_bins = 50               # time-weighted speed histogram over [0, speed_max] (default 5 v_rms)
+    slabs = 10                    # density and temperature in slabs along slab_axis (default 0)
+    block_time = 1.0              # the first blocks' length (default D / v_rms); min_blocks = 16
+    pair_bins = 100               # pair distances over [0, pair_rmax] (2-64 particles, walls on every axis)
 """
 from __future__ import annotations
 
@@ -144,6 +151,7 @@ class Scene:
     trajectory: Path | None = None
     trajectory_every: int = 100
     checkpoints: Path | None = None
+    observe: dict[str, Any] | None = None  # [observe]: Simulation.observe's arguments (None: no table)
     name: str = "scene"
     description: str = ""
     source: str = "<built-in>"
@@ -233,12 +241,22 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "trajectory_every": ("int", (1, None)),
         "checkpoints": ("str", None),
     },
+    "observe": {
+        "block_time": ("float", (0.0, None)),
+        "min_blocks": ("int", (2, 64)),
+        "slab_axis": ("int", (0, 2)),
+        "slabs": ("int", (0, 1 << 20)),
+        "speed_bins": ("int", (0, 1 << 20)),
+        "speed_max": ("float", (0.0, None)),
+        "pair_bins": ("int", (0, 1 << 20)),
+        "pair_rmax": ("float", (0.0, None)),
+    },
 }
 
 # what each kind uses; any other field is an error naming it ("*" = the whole table)
 _USES: dict[str, dict[str, Any]] = {
     "gas": {"scene": {"name", "description", "kind"}, "system": "*", "collisions": "*", "rng": "*",
-            "run": "*", "output": "*"},
+            "run": "*", "output": "*", "observe": "*"},
     "reversal": {"scene": {"name", "description", "kind", "case"}, "collisions": {"mode", "law", "bits"},
                  "rng": {"generator", "seed"}, "run": {"collisions"}, "output": {"json"}},
     "statesave": {"scene": {"name", "description", "kind"}, "statesave": "*", "collisions": {"mode", "law"},
@@ -334,6 +352,8 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
     # fields the kind does not use are errors, not silently ignored
     kind = values.get(("scene", "kind"), "gas")
     uses = _USES[kind]
+    if "observe" in doc and "observe" not in uses:
+        raise _fail(source, "[observe]", f"does not apply to kind = {kind!r} (used by: 'gas')")
     for table, key in values:
         used = uses.get(table)
         if used is None or (used != "*" and key not in used):
@@ -351,7 +371,7 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         raise _fail(source, "[scene] name", f"must be a plain name (no '/', '\\', '..'), got {name!r}")
     common = dict(kind=kind, name=name, description=get("scene", "description", ""), source=source,
                   generator=get("rng", "generator", "clcg4"), seed=get("rng", "seed", 0),
-                  extra={"fields": sorted(f"{a}.{b}" for a, b in values)})
+                  extra={"fields": sorted(f"{a}.{b}" for a, b in values), "tables": sorted(doc)})
 
     def out(key: str) -> Path | None:
         p = get("output", key)
@@ -451,6 +471,8 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
     if trajectory is not None and trajectory.suffix.lower() not in (".xyz", ".gsd"):
         raise _fail(source, "[output] trajectory", f"must end in .xyz (extended XYZ) or .gsd, got {trajectory.name!r}")
 
+    observe = _observe(source, values, d, n, bounds, engine) if "observe" in common["extra"]["tables"] else None
+
     scene = Scene(
         dimension=d, particles=n, diameter=sigma, box=tuple(box), packing_fraction=phi,
         boundaries=tuple(bounds), start=start, engine=engine,
@@ -459,10 +481,25 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         streams=get("rng", "streams", "per_particle"), collisions=nc, time=t_end,
         checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
         json=out("json"), plot=out("plot"), trajectory=trajectory,
-        trajectory_every=get("output", "trajectory_every", 100), **common)
+        trajectory_every=get("output", "trajectory_every", 100), observe=observe, **common)
     if arrays is not None:
         _check_initial(source, scene, *arrays)
     return scene
+
+
+def _observe(source: str, values: dict, d: int, n: int, bounds, engine: str) -> dict[str, Any]:
+    """The [observe] table as Simulation.observe's arguments, checked against the system."""
+    obs = {key: v for (table, key), v in values.items() if table == "observe"}
+    if engine == "lattice":
+        raise _fail(source, "[observe]", "observes the float engine's run only; use [collisions] engine = 'float'")
+    if obs.get("slab_axis", 0) >= d:
+        raise _fail(source, "[observe] slab_axis", f"must be an axis of the {d}D box (0..{d - 1}), got {obs['slab_axis']}")
+    if obs.get("pair_bins", 0) > 0:
+        if "pair_rmax" not in obs:
+            raise _fail(source, "[observe] pair_rmax", "is required with pair_bins > 0")
+        if not 2 <= n <= 64 or "periodic" in bounds:
+            raise _fail(source, "[observe] pair_bins", "pair distances need 2 to 64 particles and walls on every axis")
+    return obs
 
 
 def _check_lattice(source: str, d: int, mode: str, generator: str, streams: str, bits_given: bool) -> None:
@@ -501,6 +538,8 @@ def with_engine(scene: Scene, engine: str) -> Scene:
                            "collisions.bits" in fields)
         except SceneError as e:
             raise SceneError(f"{e} (--engine lattice)") from None
+        if scene.observe is not None:
+            raise SceneError(f"{scene.source}: [observe]: observes the float engine's run only (--engine lattice)")
     if scene.initial_state is not None:
         _check_initial(scene.source, out, *read_initial(scene.source, scene.initial_state, scene.dimension))
     return out

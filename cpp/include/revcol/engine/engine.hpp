@@ -353,6 +353,9 @@ using Poll = std::function<bool()>;
 /// Events between two polls: about 10 ms of events (a poll is one flag check in Python).
 inline constexpr std::uint32_t kPollEvents = 1u << 14;
 
+struct ObserveConfig;
+class Observer;
+
 /// The engine for any d (runtime); one implementation per d behind it.
 class Simulation {
  public:
@@ -388,6 +391,15 @@ class Simulation {
   virtual Snapshot snapshot() const = 0;
   /// Approximate bytes held by the engine's arrays.
   virtual std::size_t memory_bytes() const = 0;
+  /// Starts observing the forward run from the clock (revcol/engine/observe.hpp), replacing
+  /// any earlier observation; a bad config throws InvalidArgument and changes nothing.
+  virtual void observe(const ObserveConfig& c) = 0;
+  /// The running or last observation's accumulator (null if none was started).
+  virtual const Observer* observer() const = 0;
+  /// Whether an observation is running (run_back and stop_observing end it).
+  virtual bool observing() const = 0;
+  /// Ends the observation at the clock; its results stay readable.
+  virtual void stop_observing() = 0;
 };
 
 /// Builds a simulation from positions and velocities (n x dim each, row-major) at time t0.

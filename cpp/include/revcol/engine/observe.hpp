@@ -1,0 +1,172 @@
+// Observables of a float-engine run (issue 16), accumulated in C++ while the engine runs,
+// on by request (Simulation::observe): nothing is computed when no observation is running
+// (the engine tests one null pointer at each velocity change).
+//
+// What the engine tells the observer. Every velocity change, at the instant it happens:
+// a pair collision (both velocities after the operator; the separation comes from the
+// observer's positions, folded to the nearest image), a group collision (each member's
+// image-consistent position and its velocity after) and a wall reflection (the velocity
+// after; also those at a collision's instant, before and after the operator). Between
+// two velocity changes a particle flies freely, so the observer keeps, per particle, a
+// segment (start time t0, position x0 at t0, velocity v): x(t) = x0 + v (t - t0). It
+// integrates its own positions from the start of the observation, so they are unwrapped
+// on periodic axes (the engine wraps stored positions at list renewals; the observer
+// never wraps): the mean squared displacement needs no crossing count.
+//
+// Time averages, not event averages. A quantity that is constant on a segment (v^2, the
+// speed, the slab a stretch of the line lies in) is weighted by the segment's duration
+// when the segment closes (at the particle's next velocity change, at a block's end, or
+// at a sync). Speeds change only at collisions and walls, so the speed histogram is
+// time-weighted exactly, with no sampling of frames.
+//
+// Pressure. Unit masses, k_B = 1. The virial theorem for a stationary system,
+//     d P V = < sum_i m v_i^2 > + (1 / tau) sum_collisions sum_members x_u . Delta p_u,
+// holds for any impulsive force, whatever its direction: a randomized collision's impulse
+// is not along the centre line, and the sum over members (positions of one image) is what
+// enters, r . Delta p_a for a pair (Delta p_b = -Delta p_a). The observer accumulates
+// K2 = integral of sum_i v_i^2 dt and W = sum x . Delta p over collisions, so
+//     P_virial = (K2 + W) / (d V tau),   Z = P V / (N T) = 1 + W / K2,   T = K2 / (d N tau),
+// with V the box volume (the pressure of a periodic box; in a walled box the centres are
+// confined to [D/2, L - D/2] and the wall pressure below is the mechanical one). Wall
+// reflections: the normal impulse |Delta p_k| on each walled axis k the particle touches,
+//     P_wall_k = sum |Delta p_k| / (2 tau A_k),   A_k = prod_{j != k} L_j,
+// the force per area on the box's two faces normal to k; and their virial x . Delta p
+// (walled axes), so that K2 + W + W_wall -> 0 as tau grows in a closed box (a check).
+//
+// Collision rate per particle: (2 pairs + members of groups) / (N tau); mean free time its
+// inverse; mean free path: distance flown (sum |v| dt) over particle collisions.
+// Slabs (optional) along one axis: time-weighted occupancy (density) and v^2 (temperature
+// T_s = K2_s / (d occupancy_s)). Pair distances (optional, small closed systems): the time
+// each pair spends at each distance, integrated exactly on each stretch of relative free
+// flight (|r(t)|^2 is a quadratic in t), so the distance distribution and the time
+// fraction near contact have no sampling error beyond the dynamics' own.
+//
+// Errors: block averages. Blocks are of equal simulated time, starting at block_time (0:
+// D / v_rms, about a collision time at moderate density); at every block end all
+// segments close there. When 256 blocks are full, neighbours merge (the block time
+// doubles), so a long run keeps 128-255 blocks. A result's value comes from the totals of
+// the whole observed time; its error is s / sqrt(n_b), s the sample standard deviation of
+// the values of n_b complete blocks, merged down to [min_blocks, 2 min_blocks) first
+// (longer blocks are less correlated; the blocks are not independent otherwise).
+//
+// Cost: measured with callgrind in docs/physics.md (off: one pointer test per velocity
+// change in the engine's hooks, note_pair / note_wall, out of line and cold).
+//
+// Reversal: observation is forward only. run_back first syncs the observer at the clock
+// and stops it (its results stay readable, nothing more is added); a forward run after it
+// adds nothing until observe() starts a new observation. Snapshots do not keep it.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace revcol::engine {
+
+/// What to observe (Simulation::observe); the defaults observe the scalars only.
+struct ObserveConfig {
+  double block_time = 0.0;  ///< the first blocks' length in simulated time; 0: D / v_rms
+  int min_blocks = 16;      ///< errors from blocks merged down to [min_blocks, 2 min_blocks) (>= 2)
+  int slab_axis = 0;        ///< the axis of the slabs
+  int slabs = 0;            ///< number of slabs (0: none)
+  int speed_bins = 0;       ///< speed histogram bins (0: none)
+  double speed_max = 0.0;   ///< the histogram's upper edge; 0: 5 v_rms at the start
+  int pair_bins = 0;        ///< pair-distance histogram bins over [0, pair_rmax] (0: none; N <= 64, walls on every axis)
+  double pair_rmax = 0.0;   ///< its upper edge (> 0 when pair_bins > 0)
+};
+
+/// A time average and its standard error from block averages.
+struct Estimate {
+  double value = 0.0;  ///< from the totals of the whole observed time
+  double error = 0.0;  ///< standard error of the block values (0 with fewer than 2 blocks)
+};
+
+/// A histogram of time averages with their errors (per bin).
+struct Profile {
+  std::vector<double> edges;   ///< bin edges (bins + 1)
+  std::vector<double> value;   ///< per bin
+  std::vector<double> error;   ///< per bin
+};
+
+/// Everything an observation measured so far.
+struct Observation {
+  int dim = 0;                       ///< d
+  std::size_t n = 0;                 ///< particles
+  double t_start = 0.0, t_end = 0.0; ///< the observed interval
+  int blocks = 0;                    ///< complete blocks the errors use
+  double block_time = 0.0;           ///< their length
+  std::uint64_t pair_collisions = 0, group_collisions = 0, particle_collisions = 0, wall_reflections = 0;  ///< counts
+  Estimate temperature;              ///< K2 / (d N tau)
+  Estimate pressure_virial;          ///< (K2 + W) / (d V tau)
+  Estimate compressibility;          ///< Z = 1 + W / K2
+  Estimate collision_rate;           ///< collisions per particle per unit time
+  Estimate mean_free_time;           ///< N tau / particle collisions
+  Estimate mean_free_path;           ///< distance flown / particle collisions
+  std::array<Estimate, 3> pressure_wall{};  ///< per axis (0 on periodic axes)
+  Estimate virial_balance;           ///< (K2 + W + W_wall) / K2: -> 0 in a closed box
+  Profile slab_density;              ///< number density per slab
+  Profile slab_temperature;          ///< temperature per slab
+  Profile speed;                     ///< probability density of the speed (time-weighted)
+  Profile pair_distance;             ///< probability density of a pair's distance (time-weighted, all pairs)
+  std::vector<double> msd_time, msd; ///< mean squared displacement (unwrapped) at each block end
+};
+
+/// The accumulator behind Simulation::observe (any d; the engine calls the hooks).
+class Observer {
+ public:
+  /// Starts at time t with the particles' positions and velocities (n x dim each); box,
+  /// which axes have walls, the diameter. Throws InvalidArgument on a bad config.
+  Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v, double t,
+           const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter);
+
+  /// A pair collision at t: the velocities after (va, vb). The separation r = x_a - x_b comes
+  /// from the observer's own positions, folded to the nearest image on periodic axes (at
+  /// contact |r| = D < L / 2: the image the engine collided).
+  void pair(double t, int a, int b, const double* va, const double* vb);
+  /// A group collision at t: n members, ids, image-consistent positions and velocities after (n x dim).
+  void group(double t, int n, const int* ids, const double* x, const double* v);
+  /// A wall reflection of particle i at t (also at a collision's instant): its velocity after.
+  void wall(double t, int i, const double* v);
+  /// Every segment closed at t (the end of a run call); closes any block ended by then.
+  void sync(double t);
+  /// The results up to the last hook or sync.
+  Observation results() const;
+
+ private:
+  struct Segment {
+    double x[3], v[3];
+    double t0, v2, speed;
+    int bin;  // speed bin, -1 outside or no histogram
+  };
+  struct Block {
+    double t0 = 0.0, t1 = 0.0;
+    double k2 = 0.0, w = 0.0, w_wall = 0.0, dist = 0.0;
+    std::array<double, 3> wall_dp{};
+    std::uint64_t pairs = 0, groups = 0, parts = 0, walls = 0;
+    std::vector<double> slab_t, slab_k2, speed, pair;
+    void add(const Block& b);
+  };
+  void reach(double t);  // closes every block that ends at or before t
+  void close(int i, double t);
+  void set_velocity(int i, const double* v);
+  void close_pairs(int i, double t);
+  void pair_interval(int i, int j, double t0, double t1);
+  void slab_walk(const Segment& s, double dt);
+  void end_block();
+  Block empty_block(double t0) const;
+  double pos(int i, int k, double t) const { return seg_[i].x[k] + seg_[i].v[k] * (t - seg_[i].t0); }
+
+  ObserveConfig cfg_;
+  int dim_;
+  std::size_t n_;
+  std::array<double, 3> box_, inv_box_;
+  std::array<bool, 3> walls_;
+  double diameter_, volume_, block_time_, t_start_, t_now_, speed_max_, bin_scale_;
+  std::vector<Segment> seg_;
+  std::vector<double> start_;   // unwrapped positions at the start (n x dim)
+  std::vector<double> pair_t_;  // small systems: when each pair's interval began (n x n)
+  std::vector<Block> blocks_;   // complete blocks
+  Block cur_;                   // the open block
+  std::vector<double> msd_t_, msd_;
+};
+
+}  // namespace revcol::engine

@@ -1,0 +1,232 @@
+"""Observables of a float-engine run: pressure, temperature, collision rate, free time and
+path, mean squared displacement, speed and pair-distance distributions, with block errors.
+
+They are accumulated in C++ while the engine runs (``revcol/engine/observe.hpp`` has the
+definitions), on request only::
+
+    >>> import revcol
+    >>> sim = revcol.Simulation.random(n=400, dim=2, phi=0.4, seed=3, mode="specular")
+    >>> _ = sim.run(collisions=4000)            # equilibrate first
+    >>> sim.observe(speed_bins=40)
+    >>> _ = sim.run(collisions=40000)
+    >>> o = sim.observation()
+    >>> o.temperature.value > 0 and o.compressibility.error > 0
+    True
+
+Every average is over time, not over events: a segment of free flight weighs by its
+duration. Errors are block averages (blocks of equal simulated time, ``o.blocks`` of them).
+The observation is forward only: ``run_back`` ends it (its results stay readable).
+:func:`radial_distribution` computes g(r) from frames (freud when installed, numpy otherwise).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+__all__ = ["Estimate", "Profile", "Observation", "radial_distribution", "report_lines", "OBSERVE_FIELDS"]
+
+#: the arguments of ``Simulation.observe`` (and the fields of a scene's ``[observe]`` table)
+OBSERVE_FIELDS = ("block_time", "min_blocks", "slab_axis", "slabs", "speed_bins", "speed_max", "pair_bins",
+                  "pair_rmax")
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A time average (from the whole observed time) and its standard error (block averages)."""
+
+    value: float
+    error: float
+
+    def sigmas(self, reference: float) -> float:
+        """(value - reference) / error: how many standard errors from ``reference``."""
+        return (self.value - reference) / self.error if self.error > 0 else math.inf
+
+    def __format__(self, spec: str) -> str:
+        spec = spec or ".5g"
+        return f"{self.value:{spec}} +- {self.error:.2g}"
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A histogram of time averages: ``edges`` (bins + 1), ``value`` and ``error`` per bin."""
+
+    edges: np.ndarray
+    value: np.ndarray
+    error: np.ndarray
+
+    @property
+    def centres(self) -> np.ndarray:
+        """The bins' midpoints."""
+        return 0.5 * (self.edges[1:] + self.edges[:-1])
+
+
+_SCALARS = ("temperature", "pressure_virial", "compressibility", "collision_rate", "mean_free_time",
+            "mean_free_path", "virial_balance")
+_PROFILES = ("slab_density", "slab_temperature", "speed", "pair_distance")
+
+
+class Observation:
+    """The results of ``Simulation.observe`` so far (``Simulation.observation()``).
+
+    Scalars (:class:`Estimate`): ``temperature`` (K2 / (d N tau)), ``pressure_virial``
+    ((K2 + W) / (d V tau), the pressure of a periodic box), ``compressibility`` (Z = 1 + W / K2),
+    ``collision_rate`` (per particle), ``mean_free_time``, ``mean_free_path``,
+    ``pressure_wall`` (a list per axis: the force per area on the faces, walled axes),
+    ``virial_balance`` ((K2 + W + W_wall) / K2, near 0 in a closed box). Profiles
+    (:class:`Profile` or None): ``slab_density``, ``slab_temperature``, ``speed`` (probability
+    density of the speed), ``pair_distance`` (of a pair's distance). ``msd_time``, ``msd``: the
+    mean squared displacement (unwrapped) at each block end. Counts: ``pair_collisions``,
+    ``group_collisions``, ``particle_collisions``, ``wall_reflections``; ``t_start``, ``t_end``,
+    ``blocks``, ``block_time``.
+    """
+
+    dim: int
+    n: int
+    t_start: float
+    t_end: float
+    blocks: int
+    block_time: float
+    pair_collisions: int
+    group_collisions: int
+    particle_collisions: int
+    wall_reflections: int
+    temperature: Estimate
+    pressure_virial: Estimate
+    compressibility: Estimate
+    collision_rate: Estimate
+    mean_free_time: Estimate
+    mean_free_path: Estimate
+    virial_balance: Estimate
+    slab_density: Optional[Profile]
+    slab_temperature: Optional[Profile]
+    speed: Optional[Profile]
+    pair_distance: Optional[Profile]
+
+    def __init__(self, raw: dict[str, Any]):
+        self.raw = raw
+        for key in ("dim", "n", "t_start", "t_end", "blocks", "block_time", "pair_collisions", "group_collisions",
+                    "particle_collisions", "wall_reflections"):
+            setattr(self, key, raw[key])
+        for key in _SCALARS:
+            setattr(self, key, Estimate(float(raw[key]["value"]), float(raw[key]["error"])))
+        self.pressure_wall = [Estimate(float(e["value"]), float(e["error"])) for e in raw["pressure_wall"]]
+        for key in _PROFILES:
+            p = raw[key]
+            setattr(self, key, None if p is None else Profile(np.asarray(p["edges"]), np.asarray(p["value"]),
+                                                              np.asarray(p["error"])))
+        self.msd_time = np.asarray(raw["msd_time"])
+        self.msd = np.asarray(raw["msd"])
+
+    @property
+    def duration(self) -> float:
+        """The observed simulated time."""
+        return self.t_end - self.t_start
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-able values: scalars as [value, error], profiles as lists."""
+        out: dict[str, Any] = {k: getattr(self, k) for k in ("dim", "n", "t_start", "t_end", "blocks", "block_time",
+                                                            "pair_collisions", "group_collisions",
+                                                            "particle_collisions", "wall_reflections")}
+        for key in _SCALARS:
+            e = getattr(self, key)
+            out[key] = [e.value, e.error]
+        out["pressure_wall"] = [[e.value, e.error] for e in self.pressure_wall]
+        for key in _PROFILES:
+            p = getattr(self, key)
+            out[key] = None if p is None else {"edges": p.edges.tolist(), "value": p.value.tolist(),
+                                               "error": p.error.tolist()}
+        out["msd_time"], out["msd"] = self.msd_time.tolist(), self.msd.tolist()
+        return out
+
+    def lines(self) -> list[str]:
+        """The scalars as report lines."""
+        return report_lines(self.to_dict())
+
+    def __repr__(self) -> str:
+        return (f"Observation(t={self.t_start:.6g}..{self.t_end:.6g}, T={self.temperature}, "
+                f"Z={self.compressibility}, blocks={self.blocks})")
+
+
+def report_lines(d: dict[str, Any]) -> list[str]:
+    """Report lines of an observation's ``to_dict()`` (``revcol run`` prints them)."""
+    errors = (f"errors from {d['blocks']} blocks of {d['block_time']:.3g}" if d["blocks"] >= 2 else
+              "no errors: fewer than 2 complete blocks (run longer)")
+    rows = [f"  observed         t = {d['t_start']:.6g} .. {d['t_end']:.6g}, {d['particle_collisions']:,} "
+            f"particle collisions, {errors}"]
+    closed = any(v != 0.0 for v, _ in d["pressure_wall"]) and all(v != 0.0 for v, _ in d["pressure_wall"])
+    for key in _SCALARS:
+        if key == "virial_balance" and not closed:  # defined for a closed box only
+            continue
+        v, e = d[key]
+        rows.append(f"  {key:<16} {v:.5g}" + (f" +- {e:.2g}" if d["blocks"] >= 2 else ""))
+    for k, (v, e) in enumerate(d["pressure_wall"]):
+        if v != 0.0:
+            rows.append(f"  pressure_wall[{k}] {v:.5g}" + (f" +- {e:.2g}" if d["blocks"] >= 2 else ""))
+    if d["msd"]:
+        rows.append(f"  msd              {d['msd'][-1]:.5g} at t = {d['msd_time'][-1]:.5g} after the start")
+    return rows
+
+
+def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Optional[float] = None,
+                        periodic: Optional[Sequence[bool]] = None, use_freud: Optional[bool] = None):
+    """g(r) averaged over frames (an array (F, n, d) or one frame (n, d)) in a periodic box.
+
+    Uses freud (``freud.density.RDF``) when installed and ``use_freud`` is not False; otherwise
+    numpy (minimum image, pair distances by rows, normalized by the ideal gas's shell counts
+    at the same density). Returns (r centres, g). The box must be periodic on every axis (g(r)
+    of a bulk gas); ``r_max`` at most L / 2 (default: 0.5 min L)."""
+    x = np.asarray(frames, dtype=float)
+    if x.ndim == 2:
+        x = x[None]
+    if x.ndim != 3 or x.shape[2] not in (2, 3):
+        raise ValueError(f"frames must have shape (F, n, d) with d = 2 or 3, got {x.shape}")
+    d = x.shape[2]
+    L = np.asarray(box, dtype=float)
+    if L.shape != (d,):
+        raise ValueError(f"box needs {d} lengths, got {L.shape}")
+    if periodic is not None and not all(periodic):
+        raise ValueError("radial_distribution needs a periodic box on every axis")
+    if isinstance(bins, bool) or not isinstance(bins, int) or bins < 1:
+        raise TypeError(f"bins must be a positive integer, got {bins!r}")
+    r_max = 0.5 * float(L.min()) if r_max is None else float(r_max)
+    if not 0 < r_max <= 0.5 * L.min() + 1e-12:
+        raise ValueError(f"r_max must be in (0, L/2 = {0.5 * L.min():g}], got {r_max}")
+    freud = None
+    if use_freud is not False:
+        try:
+            import freud  # type: ignore
+        except ImportError:
+            if use_freud:
+                raise
+    if freud is not None:
+        fbox = freud.box.Box.from_box(list(L) + ([0.0] if d == 2 else []))
+        rdf = freud.density.RDF(bins=bins, r_max=r_max)
+        for f in x:
+            pts = np.zeros((f.shape[0], 3))
+            pts[:, :d] = f - 0.5 * L
+            rdf.compute((fbox, fbox.wrap(pts)), reset=False)
+        return np.asarray(rdf.bin_centers), np.asarray(rdf.rdf)
+    return _rdf_numpy(x, L, bins, r_max)
+
+
+def _rdf_numpy(x: np.ndarray, L: np.ndarray, bins: int, r_max: float):
+    F, n, d = x.shape
+    edges = np.linspace(0.0, r_max, bins + 1)
+    counts = np.zeros(bins)
+    rows = max(1, 2_000_000 // max(n, 1))
+    for f in x:
+        for lo in range(0, n, rows):
+            a = f[lo:lo + rows]
+            dr = a[:, None, :] - f[None, :, :]
+            dr -= L * np.round(dr / L)
+            r = np.sqrt((dr * dr).sum(-1))
+            r = r[r > 0]  # not i with itself
+            counts += np.histogram(r, bins=edges)[0]
+    rho = (n - 1) / float(np.prod(L))  # the other particles' density: g -> 1 at large r for any n
+    shell = (math.pi * (edges[1:] ** 2 - edges[:-1] ** 2) if d == 2
+             else 4.0 / 3.0 * math.pi * (edges[1:] ** 3 - edges[:-1] ** 3))
+    ideal = F * n * rho * shell  # ordered pairs: each pair counted from both ends
+    return 0.5 * (edges[1:] + edges[:-1]), counts / ideal

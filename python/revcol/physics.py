@@ -1,0 +1,605 @@
+"""The equilibrium study (issue 16): does a collision law keep a hard-sphere gas in equilibrium?
+
+(a) Two particles (disks or spheres, diameter D = 1) in a small closed box with specular
+walls, whose equilibrium is known exactly: configurations uniform over the non-overlapping
+ones, velocities uniform on the energy shell. Measured (time-weighted, ``revcol.observe``)
+against the exact values: the time fraction near contact (|r| < 1.01 D), the collision rate
+(:func:`exact_pair`), the distance distribution and the one-particle density along x (both
+against a Monte Carlo of uniform non-overlapping configurations, :func:`monte_carlo`).
+
+(b) Dense gases (N >= 1000, periodic): the compressibility factor Z from the collision
+virial against Henderson's equation of state (2D) and Carnahan-Starling's (3D), the contact
+value g(sigma) = (Z - 1) / (2^(d-1) phi) it implies, the collision rate against Enskog's
+with that g(sigma), the speeds against the Maxwell-Boltzmann law (chi^2 of the time-weighted
+histogram), and the temperature across slabs.
+
+Every law runs from the same start: ``flux`` (the default), ``specular`` (deterministic
+reflection: the textbook hard-sphere gas), ``uniform`` and ``paper`` (2D). docs/physics.md has
+the derivations, the tables and the figures.
+
+    python -m revcol.physics small --collisions 4000000 --json bench/results/equilibrium_small.json
+    python -m revcol.physics dense --dim 2 --phi 0.3 0.5 0.6 0.7 --json bench/results/equilibrium_dense2d.json
+    python -m revcol.physics walls --dim 2 --phi 0.5 --json bench/results/equilibrium_walls2d.json
+    python -m revcol.physics figures --out docs/figures/physics bench/results/equilibrium_*.json
+    revcol study equilibrium ...   (the same)
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from .engine import Simulation
+
+__all__ = ["LAWS", "exact_pair", "monte_carlo", "two_body", "small_study", "henderson", "carnahan_starling",
+           "enskog_rate", "maxwell_speed_density", "microcanonical_speed_density", "speed_check", "dense", "walled",
+           "main"]
+
+#: the laws compared: name -> Simulation keywords
+LAWS = {"flux": {"mode": "exact", "law": "flux"}, "specular": {"mode": "specular"},
+        "uniform": {"mode": "exact", "law": "uniform"}, "paper": {"mode": "paper"}}
+#: near contact: |r| < D (1 + NEAR)
+NEAR = 0.01
+#: pair-distance bins per diameter: one bin is [D, D (1 + NEAR)), so its block error is the
+#: near-contact fraction's
+BINS_PER_D = 100
+
+
+# ---- (a) two particles in a closed box: the exact answers -------------------------------
+
+def _excluded(d: int, ell: float, s: float) -> float:
+    """The integral of prod_k (ell - |r_k|) over |r| < s (s <= ell): the weight of the pair
+    separations r closer than s, x1 and x2 uniform in a cube of side ell (the centres' box)."""
+    if d == 2:
+        return math.pi * s**2 * ell**2 - 8.0 / 3.0 * ell * s**3 + s**4 / 2.0
+    return (4.0 / 3.0 * math.pi * s**3 * ell**3 - 1.5 * math.pi * s**4 * ell**2 + 1.6 * s**5 * ell - s**6 / 6.0)
+
+
+def _shell(d: int, ell: float, s: float) -> float:
+    """d/ds of _excluded: the weight of the separations at distance s (s <= ell)."""
+    if d == 2:
+        return s * (2.0 * math.pi * ell**2 - 8.0 * ell * s + 2.0 * s**2)
+    return 4.0 * math.pi * s**2 * ell**3 - 6.0 * math.pi * s**3 * ell**2 + 8.0 * s**4 * ell - s**5
+
+
+def exact_pair(d: int, box: float, energy: float, diameter: float = 1.0) -> dict[str, float]:
+    """The exact equilibrium of two particles in a closed cube of side ``box`` (specular walls):
+    centres uniform in the cube of side ell = box - D, not overlapping; velocities uniform on
+    the shell |v1|^2 + |v2|^2 = 2 ``energy`` (walls keep no momentum). Needs D + NEAR D <= ell.
+
+    Returns the contact density p(D) of the distance |r|, the fraction of time with |r| <
+    D (1 + NEAR), the mean inward normal speed E[(w.n)^-] at contact and the pair collision
+    rate p(D) E[(w.n)^-] (docs/physics.md derives it)."""
+    ell = box - diameter
+    s1 = diameter * (1.0 + NEAR)
+    if not s1 <= ell:
+        raise ValueError(f"the exact formulas need D (1 + {NEAR}) <= box - D, got box {box}")
+    z = ell ** (2 * d) - _excluded(d, ell, diameter)  # the configurations' volume
+    p_contact = _shell(d, ell, diameter) / z
+    near = (_excluded(d, ell, s1) - _excluded(d, ell, diameter)) / z
+    m = 2 * d  # the velocity sphere's dimension; radius sqrt(2 E)
+    mean_abs = math.exp(math.lgamma(m / 2) - math.lgamma((m + 1) / 2)) / math.sqrt(math.pi)  # E|u_1| on S^(m-1)
+    inward = math.sqrt(2.0) * math.sqrt(2.0 * energy) * 0.5 * mean_abs
+    return {"contact_density": p_contact, "near_contact": near, "inward_speed": inward,
+            "collision_rate": p_contact * inward}
+
+
+def monte_carlo(d: int, box: float, samples: int, seed: int = 1, diameter: float = 1.0,
+                slabs: int = 25) -> dict[str, Any]:
+    """Uniform non-overlapping configurations of two particles (centres in [D/2, box - D/2]^d):
+    the fraction near contact, the distance histogram (BINS_PER_D bins per D over [0, box
+    sqrt(d)]) and the one-particle density along x (``slabs`` over [0, box], as number
+    density of both particles), each with its binomial standard error."""
+    rng = np.random.default_rng(seed)
+    r_max = box * math.sqrt(d)
+    nb = int(round(r_max * BINS_PER_D / diameter))
+    h = diameter / BINS_PER_D
+    dist = np.zeros(nb)
+    xs = np.zeros(slabs)
+    kept = 0
+    lo, hi = diameter / 2, box - diameter / 2
+    for _ in range(0, samples, 1_000_000):
+        a = rng.uniform(lo, hi, (1_000_000, d))
+        b = rng.uniform(lo, hi, (1_000_000, d))
+        r = np.sqrt(((a - b) ** 2).sum(1))
+        ok = r >= diameter
+        kept += int(ok.sum())
+        dist += np.bincount(np.minimum((r[ok] / h).astype(int), nb - 1), minlength=nb)
+        for c in (a[ok, 0], b[ok, 0]):
+            xs += np.bincount(np.minimum((c / box * slabs).astype(int), slabs - 1), minlength=slabs)
+    near = dist[BINS_PER_D] / kept
+    vol = box**d / slabs
+    return {"samples": kept, "near_contact": near, "near_contact_error": math.sqrt(near * (1 - near) / kept),
+            "distance_edges": (np.arange(nb + 1) * h).tolist(),
+            "distance": (dist / (kept * h)).tolist(), "distance_error": (np.sqrt(dist) / (kept * h)).tolist(),
+            "slab_density": (xs / kept / vol).tolist(), "slab_density_error": (np.sqrt(xs) / kept / vol).tolist()}
+
+
+def two_body(d: int, box: float, law: str, collisions: int, seed: int = 1, slabs: int = 25) -> dict[str, Any]:
+    """Two particles (D = 1) in a closed cube of side ``box`` under ``law`` (a key of LAWS),
+    ``collisions`` pair collisions after 1000 to forget the start, observed: near-contact time
+    fraction, collision rate, distance histogram, slab density, each with block errors."""
+    c = box / 2
+    x = np.array([[c - 0.6] * d, [c + 0.6] * d]) + np.array([[0.0] * d, [0.05] + [0.0] * (d - 1)])
+    v = np.random.default_rng(seed).normal(size=(2, d))
+    sim = Simulation(x, v, [box] * d, boundary="wall", seed=seed, **LAWS[law])
+    sim.run(collisions=1000)
+    r_max = box * math.sqrt(d)
+    nb = int(round(r_max * BINS_PER_D))
+    sim.observe(pair_bins=nb, pair_rmax=nb / BINS_PER_D, slabs=slabs, min_blocks=32)
+    tick = time.process_time()
+    sim.run(collisions=collisions)
+    cpu = time.process_time() - tick
+    o = sim.observation()
+    h = 1.0 / BINS_PER_D
+    raw = o.pair_distance
+    near = [float(raw.value[BINS_PER_D] * h), float(raw.error[BINS_PER_D] * h)]
+    energy = float(sim.diagnostics()["energy"])
+    return {"law": law, "dim": d, "box": box, "collisions": collisions, "seed": seed, "cpu_s": cpu,
+            "energy": energy, "time": o.duration, "blocks": o.blocks,
+            "collision_rate": [o.collision_rate.value, o.collision_rate.error],
+            "near_contact": near,
+            "distance": raw.value.tolist(), "distance_error": raw.error.tolist(),
+            "slab_density": o.slab_density.value.tolist(), "slab_density_error": o.slab_density.error.tolist()}
+
+
+def small_study(collisions: int = 4_000_000, box: float = 2.5, seed: int = 1, mc_samples: int = 20_000_000,
+                dims: Sequence[int] = (2, 3), laws: Optional[Sequence[str]] = None) -> dict[str, Any]:
+    """(a) for each dimension and law: the two-particle run against the exact values and the
+    Monte Carlo; each statistic with its number of standard errors (``sigmas``) and its
+    relative deviation. The distance distribution and the slab density are summarized by
+    chi^2 per bin against the Monte Carlo (both errors) and the largest |z| of a bin."""
+    out: dict[str, Any] = {"box": box, "collisions": collisions, "seed": seed, "near": NEAR, "runs": []}
+    for d in dims:
+        mc = monte_carlo(d, box, mc_samples, seed=seed)
+        out[f"mc_{d}d"] = mc
+        for law in laws or [k for k in LAWS if d == 2 or k != "paper"]:
+            r = two_body(d, box, law, collisions, seed=seed)
+            ex = exact_pair(d, box, r["energy"])
+            r["exact"] = ex
+            for key in ("collision_rate", "near_contact"):
+                v, e = r[key]
+                r[key + "_sigmas"] = (v - ex[key]) / e
+                r[key + "_rel"] = v / ex[key] - 1.0
+            for key in ("distance", "slab_density"):
+                a, ea = np.asarray(r[key]), np.asarray(r[key + "_error"])
+                b, eb = np.asarray(mc[key]), np.asarray(mc[key + "_error"])
+                n = min(a.size, b.size)
+                a, ea, b, eb = a[:n], ea[:n], b[:n], eb[:n]
+                use = (ea > 0) & (eb > 0)
+                z = (a[use] - b[use]) / np.sqrt(ea[use] ** 2 + eb[use] ** 2)
+                r[key + "_chi2_per_bin"] = float((z * z).mean())
+                r[key + "_max_z"] = float(np.abs(z).max())
+                r[key + "_bins"] = int(use.sum())
+            out["runs"].append(r)
+            print(f"  {d}D {law:9s} rate {r['collision_rate_rel']:+.4f} ({r['collision_rate_sigmas']:+.1f} sd)  "
+                  f"near {r['near_contact_rel']:+.4f} ({r['near_contact_sigmas']:+.1f} sd)  "
+                  f"chi2/bin {r['distance_chi2_per_bin']:.2f} {r['slab_density_chi2_per_bin']:.2f}  "
+                  f"{r['cpu_s']:.0f} s", file=sys.stderr)
+    return out
+
+
+# ---- (b) dense gases -------------------------------------------------------------------
+
+def henderson(phi: float) -> float:
+    """Henderson's equation of state of hard disks (Mol. Phys. 30, 971 (1975)):
+    Z = (1 + phi^2 / 8) / (1 - phi)^2."""
+    return (1.0 + phi * phi / 8.0) / (1.0 - phi) ** 2
+
+
+def carnahan_starling(phi: float) -> float:
+    """Carnahan and Starling's equation of state of hard spheres (J. Chem. Phys. 51, 635
+    (1969)): Z = (1 + phi + phi^2 - phi^3) / (1 - phi)^3."""
+    return (1.0 + phi + phi**2 - phi**3) / (1.0 - phi) ** 3
+
+
+def reference_z(d: int, phi: float) -> float:
+    """Henderson (2D) or Carnahan-Starling (3D)."""
+    return henderson(phi) if d == 2 else carnahan_starling(phi)
+
+
+def contact_value(d: int, phi: float, z: float) -> float:
+    """g(sigma) from Z: Z - 1 = 2^(d-1) phi g(sigma) (the virial theorem for hard spheres)."""
+    return (z - 1.0) / (2 ** (d - 1) * phi)
+
+
+def enskog_rate(d: int, phi: float, temperature: float, g_contact: float, diameter: float = 1.0) -> float:
+    """Collisions per particle per unit time, Enskog: n sigma^(d-1) S g(sigma) sqrt(T / pi)
+    with S = 2 pi (2D) or ... : 2 n sigma g sqrt(pi T) in 2D, 4 n sigma^2 g sqrt(pi T) in 3D
+    (unit mass)."""
+    vol = math.pi / 4 * diameter**2 if d == 2 else math.pi / 6 * diameter**3
+    n = phi / vol
+    pref = 2.0 * n * diameter if d == 2 else 4.0 * n * diameter**2
+    return pref * g_contact * math.sqrt(math.pi * temperature)
+
+
+def maxwell_speed_density(d: int, s: np.ndarray, temperature: float) -> np.ndarray:
+    """The Maxwell-Boltzmann density of the speed in d dimensions (unit mass)."""
+    s = np.asarray(s, dtype=float)
+    if d == 2:
+        return s / temperature * np.exp(-s * s / (2 * temperature))
+    return np.sqrt(2 / math.pi) * s * s / temperature**1.5 * np.exp(-s * s / (2 * temperature))
+
+
+def microcanonical_speed_density(d: int, n: int, s: np.ndarray, temperature: float) -> np.ndarray:
+    """The exact speed density of one of n particles with total momentum 0 and kinetic energy
+    E = n d T / 2 (a periodic box): velocities uniform on the sphere of the d (n - 1)
+    dimensional subspace, whose one-particle marginal is proportional to
+    s^(d-1) (1 - n s^2 / (2 (n - 1) E))^((d (n - 1) - d - 2) / 2). Tends to Maxwell-Boltzmann as n grows."""
+    s = np.asarray(s, dtype=float)
+    energy = n * d * temperature / 2.0
+    a = n / (2.0 * (n - 1) * energy)
+    p = (d * (n - 1) - d - 2) / 2.0
+    grid = np.linspace(0.0, 1.0 / math.sqrt(a), 20001)
+    f = lambda x: np.where(a * x * x < 1.0, x ** (d - 1) * np.clip(1.0 - a * x * x, 0.0, None) ** p, 0.0)
+    norm = np.trapezoid(f(grid), grid)
+    return f(s) / norm
+
+
+def speed_check(r: dict[str, Any]) -> dict[str, float]:
+    """A dense run's time-weighted speed histogram against the bin averages of the exact
+    finite-n law (microcanonical, momentum 0) and of Maxwell-Boltzmann: chi^2 per bin and the
+    largest |z| of a bin (block errors)."""
+    c = np.asarray(r["speed_centres"])
+    h = c[1] - c[0]
+    val, err = np.asarray(r["speed"]), np.asarray(r["speed_error"])
+    T, d, n = r["temperature"][0], r["dim"], r["n"]
+    out = {}
+    for name, law in (("microcanonical", lambda x: microcanonical_speed_density(d, n, x, T)),
+                      ("maxwell", lambda x: maxwell_speed_density(d, x, T))):
+        u = np.linspace(-0.5, 0.5, 33)
+        ref = np.array([np.trapezoid(law(ci + h * u), u) for ci in c])  # bin averages
+        use = err > 0
+        z = (val[use] - ref[use]) / err[use]
+        out[f"speed_chi2_{name}"] = float((z * z).mean())
+        out[f"speed_max_z_{name}"] = float(np.abs(z).max())
+    return out
+
+
+def dense(d: int, phi: float, law: str, n: int = 1000, per_particle: float = 2000.0, seed: int = 1,
+          frames: int = 40, speed_bins: int = 40, slabs: int = 8) -> dict[str, Any]:
+    """(b) one dense gas: N particles at packing fraction ``phi`` in a periodic box under
+    ``law``, 200 collisions per particle to equilibrate, then ``per_particle`` observed; Z,
+    collision rate, speeds and slab temperatures with block errors, g(r) from ``frames``
+    frames (numpy or freud) and its contact value by a quadratic fit of the first bins."""
+    from .observe import radial_distribution
+
+    sim = Simulation.random(n=n, dim=d, phi=phi, seed=seed, boundary="periodic", **LAWS[law])
+    sim.run(collisions=int(100 * n))
+    T = float(sim.diagnostics()["energy"]) * 2.0 / (d * n)
+    sim.observe(speed_bins=speed_bins, speed_max=5.0 * math.sqrt(T), slabs=slabs)
+    total = int(per_particle * n / 2)
+    tick = time.process_time()
+    shots = []
+    for k in range(frames):
+        sim.run(collisions=total // frames)
+        shots.append(sim.positions)
+    cpu = time.process_time() - tick
+    o = sim.observation()
+    r, g = radial_distribution(shots, sim.box, bins=150, r_max=min(3.0, 0.5 * float(sim.box.min())))
+    z_ref = reference_z(d, phi)
+    g_ref = contact_value(d, phi, z_ref)
+    rate_ref = enskog_rate(d, phi, o.temperature.value, g_ref)
+    # g(sigma+) from frames: a quadratic through the first bins above contact, at r = 1
+    near = (r > 1.0) & (r < 1.15)
+    g_frames = float(np.polyval(np.polyfit(r[near] - 1.0, g[near], 2), 0.0)) if near.sum() >= 3 else float("nan")
+    sp = o.speed
+    st = o.slab_temperature
+    tz = (st.value - o.temperature.value) / st.error
+    res = {"dim": d, "phi": phi, "law": law, "n": n, "seed": seed, "collisions": total, "cpu_s": cpu,
+           "blocks": o.blocks, "temperature": [o.temperature.value, o.temperature.error],
+           "z": [o.compressibility.value, o.compressibility.error], "z_ref": z_ref,
+           "z_sigmas": (o.compressibility.value - z_ref) / o.compressibility.error,
+           "g_contact": [contact_value(d, phi, o.compressibility.value),
+                         o.compressibility.error / (2 ** (d - 1) * phi)],
+           "g_contact_ref": g_ref, "g_contact_frames": g_frames,
+           "collision_rate": [o.collision_rate.value, o.collision_rate.error], "collision_rate_ref": rate_ref,
+           "collision_rate_sigmas": (o.collision_rate.value - rate_ref) / o.collision_rate.error,
+           "speed_centres": sp.centres.tolist(), "speed": sp.value.tolist(), "speed_error": sp.error.tolist(),
+           "slab_temperature": st.value.tolist(), "slab_temperature_error": st.error.tolist(),
+           "slab_temperature_max_z": float(np.abs(tz).max()),
+           "g_r": [r.tolist(), g.tolist()], "mean_free_path": [o.mean_free_path.value, o.mean_free_path.error]}
+    res.update(speed_check(res))
+    print(f"  {d}D phi {phi:.2f} {law:9s} Z {o.compressibility.value:.4f}+-{o.compressibility.error:.4f} "
+          f"(ref {z_ref:.4f}, {res['z_sigmas']:+.1f} sd)  rate {res['collision_rate_sigmas']:+.1f} sd  "
+          f"speeds chi2/bin {res['speed_chi2_microcanonical']:.2f}  slabs max|z| {res['slab_temperature_max_z']:.1f}  "
+          f"{cpu:.0f} s", file=sys.stderr)
+    return res
+
+
+def walled(d: int, phi: float, law: str, n: int = 1000, per_particle: float = 2000.0, seed: int = 1,
+           slabs: int = 10) -> dict[str, Any]:
+    """(b) in a closed box (specular walls on every axis): the temperature and the density in
+    ``slabs`` slabs along x, and the pressure on each pair of faces, with block errors."""
+    sim = Simulation.random(n=n, dim=d, phi=phi, seed=seed, boundary="wall", **LAWS[law])
+    sim.run(collisions=int(100 * n))
+    sim.observe(slabs=slabs)
+    tick = time.process_time()
+    sim.run(collisions=int(per_particle * n / 2))
+    cpu = time.process_time() - tick
+    o = sim.observation()
+    st, sd = o.slab_temperature, o.slab_density
+    tz = (st.value - o.temperature.value) / st.error
+    pw = [[e.value, e.error] for e in o.pressure_wall]
+    res = {"dim": d, "phi": phi, "law": law, "n": n, "seed": seed, "cpu_s": cpu, "box": sim.box.tolist(),
+           "blocks": o.blocks, "temperature": [o.temperature.value, o.temperature.error],
+           "slab_edges": st.edges.tolist(), "slab_temperature": st.value.tolist(),
+           "slab_temperature_error": st.error.tolist(), "slab_temperature_max_z": float(np.abs(tz).max()),
+           "slab_temperature_chi2_per_slab": float((tz * tz).mean()),
+           "slab_density": sd.value.tolist(), "slab_density_error": sd.error.tolist(), "pressure_wall": pw,
+           "virial_balance": [o.virial_balance.value, o.virial_balance.error]}
+    print(f"  walls {d}D phi {phi:.2f} {law:9s} slab T max|z| {res['slab_temperature_max_z']:.1f}  P_wall "
+          + " ".join(_pm(*p) for p in pw) + f"  {cpu:.0f} s", file=sys.stderr)
+    return res
+
+
+def walls_table(runs: Sequence[dict]) -> str:
+    """The closed boxes as a markdown table."""
+    rows = ["| d | phi | law | T | slab T: chi2 per slab (max abs z) | slab T range (%) | P on x faces | "
+            "P on y faces | (P_x - P_y) / error | P_x - P_x(specular) in sd |", "|---|---|---|---|---|---|---|---|---|---|"]
+    spec = {(r["dim"], r["phi"]): r for r in runs if r["law"] == "specular"}
+    for r in runs:
+        (px, ex), (py, ey) = r["pressure_wall"][0], r["pressure_wall"][1]
+        t = np.asarray(r["slab_temperature"]) / r["temperature"][0] - 1.0
+        s = spec.get((r["dim"], r["phi"]))
+        vs = "" if s is None or s is r else \
+            f"{(px - s['pressure_wall'][0][0]) / math.hypot(ex, s['pressure_wall'][0][1]):+.1f}"
+        rows.append(f"| {r['dim']} | {r['phi']:.2f} | {r['law']} | {_pm(*r['temperature'])} | "
+                    f"{r['slab_temperature_chi2_per_slab']:.2f} ({r['slab_temperature_max_z']:.1f}) | "
+                    f"{100 * t.min():+.2f} .. {100 * t.max():+.2f} | {_pm(px, ex)} | {_pm(py, ey)} | "
+                    f"{(px - py) / math.hypot(ex, ey):+.1f} | {vs} |")
+    return "\n".join(rows)
+
+
+# ---- tables, figures, command line -------------------------------------------------------
+
+def _pm(v: float, e: float) -> str:
+    return f"{v:.5g} +- {e:.2g}"
+
+
+def small_table(study: dict) -> str:
+    """(a) as a markdown table: per dimension and law, value +- error, exact, sigmas, deviation."""
+    rows = ["| system | law | collision rate | exact | sd | deviation | time near contact | exact | sd | deviation "
+            "| distances chi2/bin (max abs z) | x density chi2/bin (max abs z) |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in study["runs"]:
+        ex = r["exact"]
+        name = "two disks" if r["dim"] == 2 else "two spheres"
+        rows.append(f"| {name} | {r['law']} | {_pm(*r['collision_rate'])} | {ex['collision_rate']:.5g} | "
+                    f"{r['collision_rate_sigmas']:+.1f} | {100 * r['collision_rate_rel']:+.2f}% | "
+                    f"{_pm(*r['near_contact'])} | {ex['near_contact']:.5g} | {r['near_contact_sigmas']:+.1f} | "
+                    f"{100 * r['near_contact_rel']:+.2f}% | {r['distance_chi2_per_bin']:.2f} "
+                    f"({r['distance_max_z']:.1f}) | {r['slab_density_chi2_per_bin']:.2f} ({r['slab_density_max_z']:.1f}) |")
+    return "\n".join(rows)
+
+
+def dense_table(runs: Sequence[dict]) -> str:
+    """(b) as a markdown table."""
+    rows = ["| d | phi | law | Z | EOS | sd (%) | Z - Z(specular) in sd | g(sigma) | collision rate | Enskog (EOS) | sd "
+            "| rate / Enskog (own Z): sd | speeds chi2/bin: exact finite N (Maxwell) | slab T max abs z |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    spec = {(r["dim"], r["phi"]): r for r in runs if r["law"] == "specular"}
+    for r in runs:
+        r = {**r, **speed_check(r)}
+        s = spec.get((r["dim"], r["phi"]))
+        vs = "" if s is None or s is r else f"{(r['z'][0] - s['z'][0]) / math.hypot(r['z'][1], s['z'][1]):+.1f}"
+        own, own_err = self_consistency(r)
+        rows.append(f"| {r['dim']} | {r['phi']:.2f} | {r['law']} | {_pm(*r['z'])} | {r['z_ref']:.5g} | "
+                    f"{r['z_sigmas']:+.1f} ({100 * (r['z'][0] / r['z_ref'] - 1):+.2f}%) | {vs} | {r['g_contact'][0]:.4g} (frames {r['g_contact_frames']:.3g}) | "
+                    f"{_pm(*r['collision_rate'])} | {r['collision_rate_ref']:.5g} | {r['collision_rate_sigmas']:+.1f} | "
+                    f"{r['collision_rate'][0] / own:.4f}: {(r['collision_rate'][0] - own) / own_err:+.1f} | "
+                    f"{r['speed_chi2_microcanonical']:.2f} ({r['speed_chi2_maxwell']:.2f}) | "
+                    f"{r['slab_temperature_max_z']:.1f} |")
+    return "\n".join(rows)
+
+
+def self_consistency(r: dict) -> tuple[float, float]:
+    """Enskog's collision rate with the contact value of the run's own Z, and its error (the
+    rate's and Z's combined): in an equilibrium hard-sphere gas the collision rate and the
+    virial both follow from g(sigma), so their ratio is 1 whatever the equation of state."""
+    d, phi, T = r["dim"], r["phi"], r["temperature"][0]
+    own = enskog_rate(d, phi, T, contact_value(d, phi, r["z"][0]))
+    err = math.hypot(r["collision_rate"][1], own * r["z"][1] / (r["z"][0] - 1.0))
+    return own, err
+
+
+def _run_info(argv: Sequence[str], t0: float) -> dict[str, Any]:
+    def sh(cmd: list[str]) -> str:
+        try:
+            return subprocess.run(cmd, capture_output=True, text=True, timeout=10).stdout.strip()
+        except (OSError, subprocess.SubprocessError):
+            return ""
+    return {"command": "python -m revcol.physics " + " ".join(argv), "commit": sh(["git", "rev-parse", "--short", "HEAD"]),
+            "uptime": sh(["uptime"]), "wall_s": time.time() - t0,
+            "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+
+
+def figures(paths: Sequence[str], out: str) -> list[str]:
+    """Z against phi with the equation of state, g(r), speed histograms with the Maxwellian,
+    and the two-disk distance distribution, from the study's JSON files; PNGs into ``out``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    docs = [json.load(open(p)) for p in paths]
+    dense_runs = [r for d in docs for r in d.get("dense", [])]
+    small = [d["small"] for d in docs if "small" in d]
+    os.makedirs(out, exist_ok=True)
+    written = []
+    colours = {"flux": "C0", "specular": "k", "uniform": "C3", "paper": "C1"}
+    if dense_runs:
+        fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharex="col")
+        for col, d in enumerate((2, 3)):
+            rs = [r for r in dense_runs if r["dim"] == d]
+            if not rs:
+                continue
+            ax, dev = axes[0][col], axes[1][col]
+            ph = np.linspace(0.0, max(r["phi"] for r in rs) + 0.02, 100)
+            eos = "Henderson" if d == 2 else "Carnahan-Starling"
+            ax.plot(ph, [reference_z(d, p) for p in ph], "-", color="0.6", label=eos)
+            dev.axhline(0.0, color="0.6")
+            for k, law in enumerate(LAWS):
+                sel = [r for r in rs if r["law"] == law]
+                if not sel:
+                    continue
+                x = [r["phi"] + 0.004 * (k - 1.5) for r in sel]
+                ax.errorbar(x, [r["z"][0] for r in sel], yerr=[r["z"][1] for r in sel], fmt="o", ms=3,
+                            color=colours[law], label=law)
+                dev.errorbar(x, [100 * (r["z"][0] / r["z_ref"] - 1) for r in sel],
+                             yerr=[100 * r["z"][1] / r["z_ref"] for r in sel], fmt="o", ms=3, color=colours[law])
+            ax.set_ylabel("Z = PV / NkT"), ax.set_title(f"{d}D, N = {rs[0]['n']}, periodic")
+            dev.set_xlabel("packing fraction"), dev.set_ylabel(f"Z / {eos} - 1 (%)")
+            ax.legend(fontsize=7)
+        fig.tight_layout()
+        written.append(_save(fig, out, "z_vs_phi.png"))
+        def g_panel(ax, d, phi, rs):
+            for r in rs:
+                ax.plot(r["g_r"][0], r["g_r"][1], color=colours[r["law"]], lw=1, label=r["law"])
+            ax.set_xlabel("r / sigma"), ax.set_ylabel("g(r) (40 frames)"), ax.set_title(f"{d}D, phi = {phi}")
+
+        written.append(_per_dim(plt, dense_runs, {2: 0.5, 3: 0.45}, g_panel, out, "g_of_r.png"))
+
+        def speed_panel(ax, d, phi, rs):
+            for r in rs:
+                c = np.asarray(r["speed_centres"])
+                ref = microcanonical_speed_density(d, r["n"], c, r["temperature"][0])
+                ax.errorbar(c, np.asarray(r["speed"]) / ref - 1.0, yerr=np.asarray(r["speed_error"]) / ref, fmt=".-",
+                            lw=0.6, ms=3, color=colours[r["law"]], label=r["law"])
+            ax.axhline(0.0, color="0.6")
+            ax.set_ylim(-0.05, 0.05), ax.set_xlim(0, 3.5 * math.sqrt(rs[0]["temperature"][0]))
+            ax.set_xlabel("speed"), ax.set_title(f"{d}D, phi = {phi}")
+            ax.set_ylabel("time-weighted density / exact - 1")
+
+        written.append(_per_dim(plt, dense_runs, {2: 0.3, 3: 0.1}, speed_panel, out, "speeds.png"))
+    walls = [r for d in docs for r in d.get("walls", [])]
+    if walls:
+        dims = sorted({r["dim"] for r in walls})
+        fig, axes = plt.subplots(len(dims), 2, figsize=(9, 3.2 * len(dims)), squeeze=False)
+        for row, d in zip(axes, dims):
+            rs = [r for r in walls if r["dim"] == d]
+            for r in rs:
+                e = np.asarray(r["slab_edges"])
+                c = 0.5 * (e[1:] + e[:-1]) / e[-1]
+                T = r["temperature"][0]
+                row[0].errorbar(c, 100 * (np.asarray(r["slab_temperature"]) / T - 1),
+                                yerr=100 * np.asarray(r["slab_temperature_error"]) / T, fmt="o-", ms=3, lw=0.7,
+                                color=colours[r["law"]], label=r["law"])
+                row[1].plot(c, r["slab_density"], "o-", ms=3, lw=0.7, color=colours[r["law"]], label=r["law"])
+            row[0].axhline(0.0, color="0.6")
+            row[0].set_ylabel("slab temperature / T - 1 (%)"), row[1].set_ylabel("number density")
+            for ax in row:
+                ax.set_xlabel("x / L"), ax.legend(fontsize=7)
+                ax.set_title(f"{d}D, phi = {rs[0]['phi']}, walls, N = {rs[0]['n']}")
+        fig.tight_layout()
+        written.append(_save(fig, out, "walls_slabs.png"))
+    for st in small:
+        fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+        for ax, d in zip(axes, (2, 3)):
+            mc = st.get(f"mc_{d}d")
+            if mc is None:
+                continue
+            e = np.asarray(mc["distance_edges"])
+            c = 0.5 * (e[1:] + e[:-1])
+            ax.plot(c, mc["distance"], "-", color="0.6", lw=2, label="Monte Carlo (exact)")
+            for r in st["runs"]:
+                if r["dim"] == d:
+                    n = min(len(c), len(r["distance"]))
+                    ax.plot(c[:n], r["distance"][:n], "-", lw=0.8, color=colours[r["law"]], label=r["law"])
+            ax.set_xlim(0.95, 1.6)
+            ax.set_xlabel("|r| / sigma"), ax.set_ylabel("density of the distance")
+            ax.set_title("two disks, box 2.5" if d == 2 else "two spheres, box 2.5")
+            ax.legend(fontsize=7)
+        fig.tight_layout()
+        written.append(_save(fig, out, "two_body_distance.png"))
+    return written
+
+
+def _per_dim(plt, runs: Sequence[dict], phis: dict[int, float], panel, out: str, name: str) -> str:
+    """One panel per dimension, of the runs at phis[d] (or the densest), saved as out/name."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+    for ax, d in zip(axes, (2, 3)):
+        rs = [r for r in runs if r["dim"] == d]
+        if not rs:
+            continue
+        have = {r["phi"] for r in rs}
+        phi = phis[d] if phis[d] in have else max(have)
+        panel(ax, d, phi, [r for r in rs if r["phi"] == phi])
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return _save(fig, out, name)
+
+
+def _save(fig, out: str, name: str) -> str:
+    import matplotlib.pyplot as plt
+
+    path = os.path.join(out, name)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    ap = argparse.ArgumentParser(prog="python -m revcol.physics", description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="what", required=True)
+    a = sub.add_parser("small", help="(a) two particles in a closed box against the exact equilibrium")
+    a.add_argument("--collisions", type=int, default=4_000_000)
+    a.add_argument("--mc-samples", type=int, default=20_000_000)
+    a.add_argument("--dims", type=int, nargs="+", default=[2, 3], choices=(2, 3))
+    a.add_argument("--laws", nargs="+", choices=tuple(LAWS))
+    a.add_argument("--seed", type=int, default=1)
+    a.add_argument("--json")
+    for name, text in (("dense", "(b) dense gases against the equations of state and Enskog"),
+                       ("walls", "(b) dense gases in a closed box: temperature and density by slab, wall pressure")):
+        g = sub.add_parser(name, help=text)
+        g.add_argument("--dim", type=int, choices=(2, 3), required=True)
+        g.add_argument("--phi", type=float, nargs="+", required=True)
+        g.add_argument("--n", type=int, default=1000)
+        g.add_argument("--per-particle", type=float, default=20000.0, help="observed collisions per particle")
+        g.add_argument("--laws", nargs="+", choices=tuple(LAWS))
+        g.add_argument("--seed", type=int, default=1)
+        g.add_argument("--json")
+    f = sub.add_parser("figures", help="figures from the JSON files")
+    f.add_argument("json", nargs="+")
+    f.add_argument("--out", default="docs/figures/physics")
+    t = sub.add_parser("table", help="the markdown tables of JSON files")
+    t.add_argument("json", nargs="+")
+    args = ap.parse_args(argv)
+    t0 = time.time()
+    if args.what == "figures":
+        print("\n".join(figures(args.json, args.out)))
+        return 0
+    if args.what == "table":
+        for p in args.json:
+            doc = json.load(open(p))
+            print(small_table(doc["small"]) if "small" in doc else
+                  walls_table(doc["walls"]) if "walls" in doc else dense_table(doc["dense"]))
+        return 0
+    if args.what == "small":
+        st = small_study(args.collisions, seed=args.seed, mc_samples=args.mc_samples, dims=args.dims, laws=args.laws)
+        doc: dict[str, Any] = {"small": st}
+        print(small_table(st))
+    else:
+        laws = args.laws or [k for k in LAWS if args.dim == 2 or k != "paper"]
+        run = dense if args.what == "dense" else walled
+        runs = [run(args.dim, phi, law, n=args.n, per_particle=args.per_particle, seed=args.seed)
+                for phi in args.phi for law in laws]
+        doc = {args.what: runs}
+        print(dense_table(runs) if args.what == "dense" else walls_table(runs))
+    if args.json:
+        doc.update(_run_info(argv, t0))
+        with open(args.json, "w") as fh:
+            json.dump(doc, fh, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

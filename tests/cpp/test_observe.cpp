@@ -1,0 +1,200 @@
+// The observer (revcol/engine/observe.hpp): constructed motions with answers worked out by
+// hand (a 1D head-on pair, a rod between walls, a free flight across periodic images, a
+// cradle), the virial balance of a closed gas, that observing changes no trajectory,
+// forward-only observation, and validation.
+#include <cmath>
+#include <limits>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "check.hpp"
+#include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
+#include "revcol/engine/observe.hpp"
+#include "revcol/error.hpp"
+
+using namespace revcol;
+using namespace revcol::engine;
+
+namespace {
+
+constexpr std::uint64_t kAll = ~std::uint64_t{0};
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+Config walled(int d, double L, Mode mode = Mode::specular) {
+  Config c;
+  c.dim = d;
+  c.boundary = {Boundary::wall, Boundary::wall, Boundary::wall};
+  c.box = {L, L, L};
+  c.mode = mode;
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("1D head-on pair: virial, Z, collision rate and pair distances by hand") {
+  // rods at 2 and 5 closing at speed 2: contact at t = 1, r = x_a - x_b = -1, dp_a = -2
+  auto s = make_simulation(walled(1, 10.0), {2.0, 5.0}, {1.0, -1.0});
+  ObserveConfig oc;
+  oc.pair_bins = 50;
+  oc.pair_rmax = 5.0;
+  oc.speed_bins = 4;
+  oc.speed_max = 2.0;
+  s->observe(oc);
+  s->run(kAll, 0.5);  // before the collision: |r| runs 3 -> 2, uniformly
+  Observation o = s->observer()->results();
+  for (int k = 20; k < 30; ++k) CHECK_NEAR(o.pair_distance.value[k], 1.0, 1e-12);
+  CHECK_NEAR(o.pair_distance.value[19] + o.pair_distance.value[30], 0.0, 1e-12);
+  CHECK_NEAR(o.speed.value[2], 2.0, 1e-12);  // every speed is 1: bin [1, 1.5) holds it all, density 1 / 0.5
+  s->run(kAll, 1.5);
+  o = s->observer()->results();
+  CHECK(o.pair_collisions == 1);
+  CHECK(o.particle_collisions == 2);
+  CHECK_NEAR(o.t_end - o.t_start, 1.5, 1e-15);
+  CHECK_NEAR(o.temperature.value, 1.0, 1e-12);                  // K2 = 2 x 1.5, T = K2 / (d N tau)
+  CHECK_NEAR(o.compressibility.value, 1.0 + 2.0 / 3.0, 1e-12);  // 1 + W / K2, W = 2
+  CHECK_NEAR(o.pressure_virial.value, 5.0 / 15.0, 1e-12);       // (K2 + W) / (d V tau)
+  CHECK_NEAR(o.collision_rate.value, 2.0 / 3.0, 1e-12);
+  CHECK_NEAR(o.mean_free_time.value, 1.5, 1e-12);
+  CHECK_NEAR(o.mean_free_path.value, 1.5, 1e-12);  // 3 units flown over 2 particle collisions
+}
+
+TEST_CASE("a rod between walls: wall pressure, slab occupancy, speeds") {
+  // walls for the centre at 0.5 and 3.5; from 2 to the right: reflections at 1.5, 4.5, 7.5, 10.5
+  auto s = make_simulation(walled(1, 4.0), {2.0}, {1.0});
+  ObserveConfig oc;
+  oc.slabs = 4;
+  s->observe(oc);
+  s->run(kAll, 12.0);  // two full periods
+  const Observation o = s->observer()->results();
+  CHECK(o.wall_reflections == 4);
+  CHECK_NEAR(o.pressure_wall[0].value, 8.0 / (2.0 * 12.0), 1e-12);
+  const double expect[4] = {1.0 / 6, 1.0 / 3, 1.0 / 3, 1.0 / 6};  // the centre never reaches [0, 0.5)
+  for (int k = 0; k < 4; ++k) {
+    CHECK_NEAR(o.slab_density.value[k], expect[k], 1e-12);
+    CHECK_NEAR(o.slab_temperature.value[k], 1.0, 1e-12);
+  }
+  CHECK_NEAR(o.virial_balance.value, 0.0, 1e-12);  // whole periods: K2 + W_wall = 0
+}
+
+TEST_CASE("periodic free flight: unwrapped mean squared displacement, blocks of equal time") {
+  Config c;
+  c.dim = 2;
+  c.box = {3.0, 3.0, 1.0};
+  auto s = make_simulation(c, {1.0, 1.0}, {1.0, 0.5});
+  ObserveConfig oc;
+  oc.block_time = 2.0;
+  oc.slabs = 4;  // along x, across the periodic images: 14 whole crossings fill them evenly
+  s->observe(oc);
+  s->run(kAll, 42.0);
+  const Observation o = s->observer()->results();
+  REQUIRE(o.msd.size() == 21);
+  for (std::size_t k = 0; k < o.msd.size(); ++k) {
+    CHECK_NEAR(o.msd_time[k], 2.0 * (k + 1), 1e-12);
+    CHECK_NEAR(o.msd[k], 1.25 * o.msd_time[k] * o.msd_time[k], 1e-9);
+  }
+  CHECK(o.blocks == 21);  // min_blocks 16: 21 complete blocks stay as they are
+  CHECK_NEAR(o.temperature.error, 0.0, 1e-15);
+  for (int k = 0; k < 4; ++k) CHECK_NEAR(o.slab_density.value[k], 1.0 / 9.0, 1e-12);
+}
+
+TEST_CASE("a 1D cradle: a group's virial sums x . dp over its members") {
+  auto s = make_simulation(walled(1, 10.0, Mode::exact), {2.0, 4.0, 6.0}, {1.0, 0.0, -1.0});
+  s->observe(ObserveConfig{});
+  s->run(kAll, 1.5);  // both contacts close at t = 1 (x = 3, 4, 5): one group of three
+  const Observation o = s->observer()->results();
+  REQUIRE(o.group_collisions == 1);
+  CHECK(o.particle_collisions == 3);
+  const auto v = s->velocities();
+  const double pre[3] = {1.0, 0.0, -1.0}, x[3] = {3.0, 4.0, 5.0};
+  double w = 0.0, k2 = 2.0 * 1.0;  // K2 before: 2 per unit time
+  double k2_after = 0.0;
+  for (int u = 0; u < 3; ++u) {
+    w += x[u] * (v[u] - pre[u]);
+    k2_after += v[u] * v[u];
+  }
+  k2 = k2 * 1.0 + k2_after * 0.5;
+  CHECK(w > 0.0);
+  CHECK_NEAR(o.compressibility.value, 1.0 + w / k2, 1e-9);
+}
+
+TEST_CASE("a closed 2D gas: K2 + W + W_wall -> 0; temperature from the energy; walls share the pressure") {
+  Config c = walled(2, 1.0, Mode::exact);
+  const InitialState st = random_state(c, 200, 0.3, 5);
+  auto s = make_simulation(st.config, st.x, st.v);
+  s->run(4000, kInfinity);
+  ObserveConfig oc;
+  oc.slabs = 5;
+  s->observe(oc);
+  s->run(100000, kInfinity);
+  const Observation o = s->observer()->results();
+  const Diagnostics d = s->diagnostics();
+  CHECK_NEAR(o.temperature.value, d.energy / 200.0, 1e-9 * d.energy / 200.0);  // T = 2E / (d N)
+  CHECK(std::fabs(o.virial_balance.value) < 3e-3);
+  CHECK(o.blocks >= 16 && o.blocks < 32);
+  // the two axes' wall pressures agree within their errors (isotropy)
+  const double dp = o.pressure_wall[0].value - o.pressure_wall[1].value;
+  CHECK(std::fabs(dp) < 4.0 * std::hypot(o.pressure_wall[0].error, o.pressure_wall[1].error));
+  CHECK(o.pressure_wall[0].error > 0.0);
+  for (int k = 0; k < 5; ++k) CHECK(std::fabs(o.slab_temperature.value[k] / o.temperature.value - 1.0) < 0.05);
+}
+
+TEST_CASE("observing changes no trajectory; run_back ends the observation; nothing observed when off") {
+  Config c;
+  c.dim = 2;
+  const InitialState st = random_state(c, 300, 0.4, 9);
+  auto a = make_simulation(st.config, st.x, st.v);
+  auto b = make_simulation(st.config, st.x, st.v);
+  CHECK(a->observer() == nullptr);
+  CHECK(!a->observing());
+  ObserveConfig oc;
+  oc.speed_bins = 20;
+  oc.slabs = 3;
+  b->observe(oc);
+  CHECK(b->observing());
+  a->run(3000, kInfinity);
+  b->run(3000, kInfinity);
+  CHECK(a->positions() == b->positions());
+  CHECK(a->velocities() == b->velocities());
+  const Observation before = b->observer()->results();
+  b->run_back(1000, 0.0);
+  CHECK(!b->observing());
+  b->run(1000, kInfinity);
+  const Observation after = b->observer()->results();
+  CHECK(after.t_end == before.t_end);
+  CHECK(after.particle_collisions == before.particle_collisions);
+  CHECK(after.pressure_virial.value == before.pressure_virial.value);
+}
+
+TEST_CASE("validation: a bad config throws InvalidArgument and keeps the running observation") {
+  Config c;
+  c.dim = 2;
+  const InitialState st = random_state(c, 50, 0.3, 2);
+  auto s = make_simulation(st.config, st.x, st.v);
+  s->observe(ObserveConfig{});
+  const Observer* first = s->observer();
+  auto bad = [&](auto set) {
+    ObserveConfig oc;
+    set(oc);
+    CHECK_THROWS_AS(s->observe(oc), InvalidArgument);
+    CHECK(s->observer() == first);
+    CHECK(s->observing());
+  };
+  bad([](ObserveConfig& o) { o.block_time = -1.0; });
+  bad([](ObserveConfig& o) { o.min_blocks = 1; });
+  bad([](ObserveConfig& o) { o.slabs = -2; });
+  bad([](ObserveConfig& o) {
+    o.slabs = 4;
+    o.slab_axis = 2;
+  });
+  bad([](ObserveConfig& o) { o.speed_bins = -1; });
+  bad([](ObserveConfig& o) { o.speed_max = std::nan(""); });
+  bad([](ObserveConfig& o) { o.pair_bins = 10; });  // no pair_rmax
+  bad([](ObserveConfig& o) {  // pair distances need walls on every axis: this box is periodic
+    o.pair_bins = 10;
+    o.pair_rmax = 2.0;
+  });
+}
+
+CHECK_MAIN()

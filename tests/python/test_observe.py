@@ -1,0 +1,147 @@
+"""Simulation.observe: the Python API, bad input named and harmless, forward-only observation,
+g(r) from frames (numpy fallback), the scene's [observe] table and its values in `revcol run`."""
+import json
+
+import numpy as np
+import pytest
+
+import revcol
+from revcol.cli import main as cli_main
+from revcol.observe import Estimate, Observation, radial_distribution
+from revcol.run import run_scene
+from revcol.scene import SceneError, scene_from_dict
+
+
+def gas(**kw):
+    return revcol.Simulation.random(n=300, dim=2, phi=0.4, seed=11, **kw)
+
+
+def test_observation_values_and_errors():
+    sim = gas(mode="specular")
+    assert sim.observation() is None and not sim.observing
+    sim.run(collisions=3000)
+    sim.observe(speed_bins=30, slabs=4)
+    sim.run(collisions=30000)
+    o = sim.observation()
+    assert isinstance(o, Observation) and sim.observing
+    assert o.particle_collisions == 60000 and o.blocks >= 16
+    e = sim.diagnostics()["energy"]
+    assert o.temperature.value == pytest.approx(e / 300, rel=1e-12)  # T = 2E / (d N), energy conserved
+    for est in (o.compressibility, o.collision_rate, o.mean_free_time, o.mean_free_path, o.pressure_virial):
+        assert isinstance(est, Estimate) and est.error > 0 and 0 < est.error < 0.05 * abs(est.value)
+    assert o.mean_free_time.value == pytest.approx(1.0 / o.collision_rate.value, rel=1e-12)
+    # the speed histogram is a probability density; slabs of a periodic box hold n / V each
+    assert np.sum(o.speed.value * np.diff(o.speed.edges)) == pytest.approx(1.0, abs=1e-3)
+    assert np.allclose(o.slab_density.value, 300 / np.prod(sim.box), rtol=0.05)
+    assert o.msd.size > 0 and np.all(np.diff(o.msd) > -1e-9 * o.msd[-1])  # grows (diffusion)
+    d = o.to_dict()
+    json.dumps(d)
+    assert d["compressibility"] == [o.compressibility.value, o.compressibility.error]
+
+
+def test_observing_changes_no_bit_and_run_back_ends_it():
+    a, b = gas(), gas()
+    b.observe(speed_bins=10)
+    a.run(collisions=2000)
+    b.run(collisions=2000)
+    assert np.array_equal(a.positions, b.positions) and np.array_equal(a.velocities, b.velocities)
+    before = b.observation().to_dict()
+    b.run_back(collisions=500)
+    assert not b.observing
+    b.run(collisions=500)
+    assert b.observation().to_dict() == before
+
+
+@pytest.mark.parametrize("kwargs, error, word", [
+    ({"speed_bins": -1}, ValueError, "speed_bins"),
+    ({"speed_bins": 2.5}, TypeError, "speed_bins"),
+    ({"slabs": "4"}, TypeError, "slabs"),
+    ({"block_time": -1.0}, ValueError, "block_time"),
+    ({"block_time": "x"}, TypeError, "block_time"),
+    ({"min_blocks": 1}, ValueError, "min_blocks"),
+    ({"slabs": 2, "slab_axis": 2}, ValueError, "slab_axis"),
+    ({"pair_bins": 10, "pair_rmax": 1.0}, ValueError, "pair distances"),
+    ({"pair_bins": 10}, ValueError, "pair_rmax"),
+    ({"speed_max": float("nan")}, ValueError, "speed_max"),
+])
+def test_bad_input_is_named_and_changes_nothing(kwargs, error, word):
+    sim = gas()
+    sim.observe()
+    sim.run(collisions=500)
+    before = sim.observation().to_dict()
+    with pytest.raises(error, match=word):
+        sim.observe(**kwargs)
+    assert sim.observing and sim.observation().to_dict() == before
+
+
+def test_radial_distribution_numpy_fallback():
+    rng = np.random.default_rng(1)
+    r, g = radial_distribution(rng.random((20, 400, 2)) * 10.0, [10.0, 10.0], bins=25, r_max=5.0, use_freud=False)
+    assert np.allclose(g[5:], 1.0, atol=0.06)  # ideal gas: g = 1
+    sim = revcol.Simulation.random(n=400, dim=2, phi=0.5, seed=2, mode="specular")
+    sim.run(collisions=4000)
+    frames = []
+    for _ in range(5):
+        sim.run(collisions=400)
+        frames.append(sim.positions)
+    r, g = radial_distribution(frames, sim.box, bins=50, r_max=3.0, use_freud=False)
+    assert np.all(g[r < 0.97] == 0.0)  # hard disks never overlap
+    assert g[(r > 1.0) & (r < 1.06)].max() > 2.0  # the contact peak
+    with pytest.raises(ValueError, match="periodic"):
+        radial_distribution(frames, sim.box, periodic=[True, False])
+    with pytest.raises(ValueError, match="r_max"):
+        radial_distribution(frames, sim.box, r_max=100.0)
+
+
+def observed_scene(tmp_path, **observe):
+    doc = {"system": {"dimension": 2, "particles": 200, "packing_fraction": 0.3, "boundaries": "periodic"},
+           "collisions": {"engine": "float"}, "rng": {"generator": "philox", "seed": 4},
+           "run": {"collisions": 400}, "observe": observe}
+    return doc
+
+
+def test_scene_observe_in_report_and_json(tmp_path, capsys):
+    doc = observed_scene(tmp_path, speed_bins=20, slabs=3)
+    scene = scene_from_dict(doc, "obs.toml", tmp_path)
+    assert scene.observe == {"speed_bins": 20, "slabs": 3}
+    r = run_scene(scene, json_path=tmp_path / "r.json", progress=False)
+    assert r["passed"] and r["observe"]["particle_collisions"] == 800
+    saved = json.loads((tmp_path / "r.json").read_text())
+    assert saved["observe"]["compressibility"][0] > 1.0 and len(saved["observe"]["speed"]["value"]) == 20
+    # an empty table observes the scalars
+    doc["observe"] = {}
+    assert scene_from_dict(doc, "obs.toml", tmp_path).observe == {}
+    path = tmp_path / "obs.toml"
+    path.write_text('[system]\ndimension = 2\nparticles = 100\npacking_fraction = 0.3\n'
+                    '[collisions]\nengine = "float"\n[run]\ncollisions = 200\n[observe]\nspeed_bins = 10\n')
+    assert cli_main(["run", str(path), "--no-progress"]) == 0
+    assert "compressibility" in capsys.readouterr().out
+    # a run shorter than two blocks has no errors, and says so
+    sim = gas()
+    sim.observe(block_time=1e6)
+    sim.run(collisions=100)
+    o = sim.observation()
+    assert o.blocks == 0 and o.compressibility.error == 0.0
+    assert "no errors: fewer than 2 complete blocks" in "\n".join(o.lines())
+
+
+@pytest.mark.parametrize("observe, engine, word", [
+    ({"slab_axis": 2}, "float", "slab_axis"),
+    ({"pair_bins": 10}, "float", "pair_rmax"),
+    ({"pair_bins": 10, "pair_rmax": 2.0}, "float", "pair_bins"),
+    ({"speed_bins": -1}, "float", "speed_bins"),
+    ({"speed_bins": 1.5}, "float", "speed_bins"),
+    ({"colour": 1}, "float", "colour"),
+    ({}, "lattice", "observe"),
+])
+def test_scene_observe_errors(tmp_path, observe, engine, word):
+    doc = observed_scene(tmp_path, **observe)
+    doc["collisions"]["engine"] = engine
+    with pytest.raises(SceneError, match=word):
+        scene_from_dict(doc, "obs.toml", tmp_path)
+
+
+def test_observe_table_only_for_gas(tmp_path):
+    doc = {"scene": {"kind": "reversal", "case": "pair2d"}, "observe": {}}
+    with pytest.raises(SceneError, match="observe"):
+        scene_from_dict(doc, "rev.toml", tmp_path)
