@@ -7,6 +7,7 @@
 
 #include "engine_collide.hpp"
 #include "engine_impl.hpp"
+#include "engine_state.hpp"
 #include "engine_operators.hpp"
 
 namespace revcol::engine::detail {
