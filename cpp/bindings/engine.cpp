@@ -1,5 +1,11 @@
 // Binding of the event-driven engine: numpy in and out, dicts for results, diagnostics and
 // checkpoints. No physics here (revcol/engine/engine.hpp).
+//
+// Threads (issue 19): run and run_back release the GIL for the event loop, so other Python
+// threads go on while the engine works; the progress callback and the Ctrl-C poll take the GIL
+// back while they call Python (RunGuard below). While a run is under way, a call on the same
+// engine from another thread raises RuntimeError instead of racing with the loop; the run's own
+// progress callback (same thread, between events) may read the state as before.
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -10,6 +16,8 @@
 #include <type_traits>
 #include <memory>
 #include <optional>
+#include <stdexcept>
+#include <thread>
 
 #include "bindings.hpp"
 #include "args.hpp"
@@ -103,9 +111,33 @@ py::dict run_dict(const en::RunResult& r) {
   return d;
 }
 
+/// The Ctrl-C poll of a loop that runs with the GIL released: takes the GIL for the check.
+bool poll_signals_released() {
+  py::gil_scoped_acquire gil;
+  return poll_signals();
+}
+
 class PyEngine {
  public:
   explicit PyEngine(std::unique_ptr<en::Simulation> s) : s_(std::move(s)) {}
+
+  /// Marks the engine as running on this thread for its lifetime (set and cleared with the GIL
+  /// held, so a plain member is race-free): another thread's call then raises, see sim().
+  class RunGuard {
+   public:
+    explicit RunGuard(PyEngine& e) : e_(e) {
+      e_.sim();  // raises if another thread is running it
+      // a run started from its own progress callback would re-enter the event loop mid-event
+      if (e_.runner_) throw std::runtime_error("run/run_back called from inside this Simulation's own run");
+      e_.runner_ = std::this_thread::get_id();
+    }
+    ~RunGuard() { e_.runner_.reset(); }
+    RunGuard(const RunGuard&) = delete;
+    RunGuard& operator=(const RunGuard&) = delete;
+
+   private:
+    PyEngine& e_;
+  };
 
   py::dict run(std::optional<PyInt> collisions_arg, std::optional<PyReal> time_arg,
                std::optional<std::function<bool(std::uint64_t)>> cb, PyInt every_arg) {
@@ -115,10 +147,20 @@ class PyEngine {
     require(collisions.has_value() || time.has_value(), "give collisions, time, or both");
     const std::uint64_t nc = collisions.value_or(std::numeric_limits<std::uint64_t>::max());
     const double te = time.value_or(std::numeric_limits<double>::infinity());
-    require(!time || *time >= s_->time(), "run: end time is earlier than the current time (use run_back)");
+    require(!time || *time >= sim().time(), "run: end time is earlier than the current time (use run_back)");
     en::Progress p;
-    if (cb) p = *cb;
-    const en::RunResult r = s_->run(nc, te, p, cb ? every : 0, poll_signals);
+    if (cb) {
+      p = [&cb](std::uint64_t done) {  // Python code: with the GIL
+        py::gil_scoped_acquire gil;
+        return (*cb)(done);
+      };
+    }
+    const RunGuard busy(*this);
+    en::RunResult r;
+    {
+      py::gil_scoped_release nogil;
+      r = s_->run(nc, te, p, cb ? every : 0, poll_signals_released);
+    }
     if (PyErr_Occurred()) throw py::error_already_set();  // Ctrl-C: the run stopped between events
     return run_dict(r);
   }
@@ -128,21 +170,26 @@ class PyEngine {
     const std::uint64_t nc = collisions.value_or(std::numeric_limits<std::uint64_t>::max());
     // collisions alone: never past the start (the reversed dynamics goes on forever before it);
     // pass a time to go earlier
-    const double tt = time.value_or(s_->start_time());
+    const double tt = time.value_or(sim().start_time());
     require(!time || std::isfinite(*time), "run_back: time must be finite");
-    const en::RunResult r = s_->run_back(nc, tt, poll_signals, stop_on_divergence);
+    const RunGuard busy(*this);
+    en::RunResult r;
+    {
+      py::gil_scoped_release nogil;
+      r = s_->run_back(nc, tt, poll_signals_released, stop_on_divergence);
+    }
     if (PyErr_Occurred()) throw py::error_already_set();
     return run_dict(r);
   }
-  py::array_t<double> positions() const { return to_array(s_->positions(), s_->size(), s_->config().dim); }
-  py::array_t<double> velocities() const { return to_array(s_->velocities(), s_->size(), s_->config().dim); }
-  py::array_t<std::uint64_t> collision_counts() const { return vec_array(s_->collision_counts()); }
+  py::array_t<double> positions() const { return to_array(sim().positions(), sim().size(), sim().config().dim); }
+  py::array_t<double> velocities() const { return to_array(sim().velocities(), sim().size(), sim().config().dim); }
+  py::array_t<std::uint64_t> collision_counts() const { return vec_array(sim().collision_counts()); }
 
   py::dict diagnostics() const {
-    const en::Diagnostics g = s_->diagnostics();
+    const en::Diagnostics g = sim().diagnostics();
     py::dict d;
     d["energy"] = g.energy;
-    d["momentum"] = std::vector<double>(g.momentum.begin(), g.momentum.begin() + s_->config().dim);
+    d["momentum"] = std::vector<double>(g.momentum.begin(), g.momentum.begin() + sim().config().dim);
     d["energy_drift"] = g.energy_drift;
     d["momentum_drift"] = g.momentum_drift;
     d["log_bytes"] = g.log_bytes;
@@ -164,13 +211,13 @@ class PyEngine {
     d["trace_stride"] = g.trace_stride;
     d["trace_points"] = g.trace_points;
     d["clock_deviation"] = g.clock_deviation;
-    d["memory_bytes"] = s_->memory_bytes();
+    d["memory_bytes"] = sim().memory_bytes();
     d["events"] = counters_dict(g.counters);
     return d;
   }
 
   py::dict snapshot() const {
-    const en::Snapshot s = s_->snapshot();
+    const en::Snapshot s = sim().snapshot();
     py::dict d;
     const en::Config& c = s.config;
     d["format"] = 1;
@@ -253,11 +300,25 @@ class PyEngine {
     return PyEngine(en::restore_simulation(s));
   }
 
-  en::Simulation& sim() { return *s_; }
-  const en::Simulation& sim() const { return *s_; }
+  /// The engine; a RuntimeError when another thread is running it (its loop has no GIL).
+  en::Simulation& sim() {
+    check_runner();
+    return *s_;
+  }
+  /// As sim(), read-only.
+  const en::Simulation& sim() const {
+    check_runner();
+    return *s_;
+  }
 
  private:
+  void check_runner() const {
+    if (runner_ && *runner_ != std::this_thread::get_id())
+      throw std::runtime_error("this Simulation is running in another thread: wait for its run to return");
+  }
+
   std::unique_ptr<en::Simulation> s_;
+  std::optional<std::thread::id> runner_;  ///< the thread whose run/run_back is under way
 };
 
 }  // namespace

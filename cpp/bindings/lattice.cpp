@@ -1,5 +1,9 @@
 // Binding of the 2D lattice engine: numpy int64 arrays in and out, dicts for starts,
 // diagnostics and checkpoints. No physics here (revcol/lattice/engine.hpp).
+//
+// Threads (issue 19): run and run_back release the GIL for the event loop and take it back for
+// the Ctrl-C poll only; while a run is under way, a call on the same engine from another thread
+// raises RuntimeError instead of racing with the loop (PyLattice::engine()).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -7,7 +11,9 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "args.hpp"
 #include "bindings.hpp"
@@ -217,6 +223,32 @@ la::Snapshot snapshot_from(const py::dict& d) {
 struct PyLattice {
   revcol::Law law;
   la::LatticeEngine e;
+  std::optional<std::thread::id> runner{};  ///< the thread whose run/run_back is under way (GIL held to touch)
+
+  /// The engine; a RuntimeError when a run is under way (its loop runs without the GIL).
+  la::LatticeEngine& engine() {
+    if (runner) throw std::runtime_error("this LatticeSimulation is running in another thread: wait for its run to return");
+    return e;
+  }
+  /// As engine(), read-only.
+  const la::LatticeEngine& engine() const { return const_cast<PyLattice*>(this)->engine(); }
+
+  /// f(engine) with the GIL released, the Ctrl-C poll taking it back; others' calls raise meanwhile.
+  template <class F>
+  auto run_released(F&& f) {
+    la::LatticeEngine& eng = engine();
+    runner = std::this_thread::get_id();
+    struct Clear {
+      std::optional<std::thread::id>& r;
+      ~Clear() { r.reset(); }
+    } clear{runner};
+    const auto poll = [] {
+      py::gil_scoped_acquire gil;
+      return poll_signals();
+    };
+    py::gil_scoped_release nogil;
+    return f(eng, poll);
+  }
 };
 
 }  // namespace
@@ -285,8 +317,10 @@ void register_lattice(py::module_& m) {
           [](PyLattice& p, std::optional<PyInt> collisions_arg, std::optional<PyInt> until_arg) {
             const auto collisions = to_int<std::uint64_t>(collisions_arg, "collisions");
             const auto until = to_int<std::int64_t>(until_arg, "until");
-            const std::uint64_t done = p.e.run(collisions.value_or(std::numeric_limits<std::uint64_t>::max()),
-                                               until.value_or(la::tick_limit - 1), poll_signals);
+            const std::uint64_t done = p.run_released([&](la::LatticeEngine& e, const auto& poll) {
+              return e.run(collisions.value_or(std::numeric_limits<std::uint64_t>::max()),
+                           until.value_or(la::tick_limit - 1), poll);
+            });
             if (PyErr_Occurred()) throw py::error_already_set();  // Ctrl-C: stopped at a valid tick
             return done;
           },
@@ -297,29 +331,33 @@ void register_lattice(py::module_& m) {
           [](PyLattice& p, std::optional<PyInt> to_collisions_arg, std::optional<PyInt> to_tick_arg) {
             const auto to_collisions = to_int<std::uint64_t>(to_collisions_arg, "to_collisions");
             const auto to_tick = to_int<std::int64_t>(to_tick_arg, "to_tick");
-            p.e.run_back(to_collisions.value_or(0), to_tick.value_or(p.e.origin()), poll_signals);
+            const std::int64_t origin = p.engine().origin();
+            p.run_released([&](la::LatticeEngine& e, const auto& poll) {
+              e.run_back(to_collisions.value_or(0), to_tick.value_or(origin), poll);
+              return 0;
+            });
             if (PyErr_Occurred()) throw py::error_already_set();
           },
           py::arg("to_collisions") = py::none(), py::arg("to_tick") = py::none(),
           "Back to collision count `to_collisions` or tick `to_tick` (default: the start).")
-      .def("snapshot", [](const PyLattice& p) { return snapshot_dict(p.e.snapshot(), p.law); })
-      .def_property_readonly("positions", [](const PyLattice& p) { return vec_array(p.e.positions()); })
-      .def_property_readonly("velocities", [](const PyLattice& p) { return vec_array(p.e.velocities()); })
-      .def_property_readonly("clock", [](const PyLattice& p) { return p.e.clock(); })
-      .def_property_readonly("origin", [](const PyLattice& p) { return p.e.origin(); })
-      .def_property_readonly("collisions", [](const PyLattice& p) { return p.e.collisions(); })
-      .def_property_readonly("units", [](const PyLattice& p) { return units_dict(p.e.units()); })
-      .def_property_readonly("n", [](const PyLattice& p) { return p.e.size(); })
+      .def("snapshot", [](const PyLattice& p) { return snapshot_dict(p.engine().snapshot(), p.law); })
+      .def_property_readonly("positions", [](const PyLattice& p) { return vec_array(p.engine().positions()); })
+      .def_property_readonly("velocities", [](const PyLattice& p) { return vec_array(p.engine().velocities()); })
+      .def_property_readonly("clock", [](const PyLattice& p) { return p.engine().clock(); })
+      .def_property_readonly("origin", [](const PyLattice& p) { return p.engine().origin(); })
+      .def_property_readonly("collisions", [](const PyLattice& p) { return p.engine().collisions(); })
+      .def_property_readonly("units", [](const PyLattice& p) { return units_dict(p.engine().units()); })
+      .def_property_readonly("n", [](const PyLattice& p) { return p.engine().size(); })
       .def_property_readonly("law", [](const PyLattice& p) { return std::string(to_string(p.law)); })
       .def("diagnostics", [](const PyLattice& p) {
-        const la::Diagnostics g = la::diagnostics(p.e);
-        py::dict d = counters_dict(p.e.counters());
+        const la::Diagnostics g = la::diagnostics(p.engine());
+        py::dict d = counters_dict(p.engine().counters());
         d["energy_drift"] = g.energy_drift;
         d["energy_drift_units"] = g.energy_drift_units;
         d["momentum_drift"] = py::make_tuple(g.momentum_drift[0], g.momentum_drift[1]);
         d["bits_length"] = g.bits_length;
         d["log_entries"] = g.log_entries;
-        d["group_log_entries"] = p.e.group_log_size();
+        d["group_log_entries"] = p.engine().group_log_size();
         d["collisions"] = g.collisions;
         d["clock"] = g.clock;
         d["time"] = g.time;

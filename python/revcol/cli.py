@@ -7,11 +7,21 @@
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
     revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.randomness ...)
     revcol study equilibrium small|dense|figures|table ...   (= python -m revcol.physics ...)
+    revcol --version
+
+Manners (issue 19): a mistyped subcommand, choice or option gets a "did you mean" suggestion
+(difflib; argparse's own ``suggest_on_error`` exists from Python 3.14 only) and the usage of the
+subcommand it was given to; ``--json -`` writes the JSON report to standard output (the text
+report then goes to standard error); a closed pipe (``revcol ... | head -1``) ends the command
+quietly with status 141 (128 + SIGPIPE, as a Unix tool killed by SIGPIPE), no traceback.
 """
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import difflib
 import json
+import os
 import sys
 import warnings
 
@@ -39,8 +49,46 @@ def _seed(text: str) -> int:
     return value
 
 
+def _did_you_mean(word: str, candidates) -> str:
+    """`` (did you mean 'x'?)`` for the closest candidate to a mistyped ``word``, or ``""``."""
+    close = difflib.get_close_matches(word, [str(c) for c in candidates], n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with typo suggestions for choices (subcommands included) and unknown options;
+    an unknown option is reported with the usage of the subcommand it was given to."""
+
+    def _check_value(self, action, value):  # argparse's hook for choices (3.11-3.13; 3.14 has its own)
+        try:
+            super()._check_value(action, value)
+        except argparse.ArgumentError as e:
+            choices = action.choices if action.choices is not None else ()
+            raise argparse.ArgumentError(action, e.message + _did_you_mean(str(value), choices)) from None
+
+    def parse_args(self, args=None, namespace=None):
+        ns, extras = self.parse_known_args(args, namespace)
+        if extras:
+            target = self._chosen(ns)
+            options = [s for a in target._actions for s in a.option_strings]
+            hints = "".join(_did_you_mean(w.split("=", 1)[0], options) for w in extras if w.startswith("-"))
+            target.error(f"unrecognized arguments: {' '.join(extras)}{hints}")
+        return ns
+
+    def _chosen(self, ns: argparse.Namespace) -> "argparse.ArgumentParser":
+        """The innermost subcommand's parser that ``ns`` went through."""
+        for a in self._actions:
+            if isinstance(a, argparse._SubParsersAction) and getattr(ns, a.dest, None) in a.choices:
+                sub = a.choices[getattr(ns, a.dest)]
+                return sub._chosen(ns) if isinstance(sub, _Parser) else sub
+        return self
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="revcol", description="Reversible elastic collisions.")
+    from . import __version__
+
+    p = _Parser(prog="revcol", description="Reversible elastic collisions.")
+    p.add_argument("--version", action="version", version=f"revcol {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a scene forward and back to its start, and report the round trip",
                        description="Run a scene (TOML; default: the built-in 2D hard-disk gas on the lattice "
@@ -48,8 +96,10 @@ def _parser() -> argparse.ArgumentParser:
                        "when it passes (lattice engine: every part of the state restored bit for bit; float "
                        "engine: both errors <= 1e-9), 1 when it fails, 2 on a bad scene or option, 130 when "
                        "interrupted.")
-    r.add_argument("scene", nargs="?", help="scene file (see scenes/ and docs/run.md)")
-    r.add_argument("--json", metavar="FILE", help="write the report as JSON")
+    r.add_argument("scene", nargs="?", help="scene file, or the name of a scene shipped with revcol "
+                   "(e.g. spheres-3d; see scenes/ and docs/run.md)")
+    r.add_argument("--json", metavar="FILE", help="write the report as JSON ('-': to standard output, and the "
+                   "text report to standard error)")
     r.add_argument("--plot", metavar="DIR", help="write PNG figures into DIR (needs matplotlib)")
     r.add_argument("--trajectory", metavar="FILE",
                    help="write frames forward and through the reversal: FILE.xyz (extended XYZ) or FILE.gsd")
@@ -113,11 +163,18 @@ def _run(args: argparse.Namespace) -> int:
     if args.seeds is not None and not args.horizon:
         print("revcol run: error: --seeds applies to --horizon only", file=sys.stderr)
         return 2
+    to_stdout = args.json == "-"
     try:
         with warnings.catch_warnings():  # a scene's deprecated spellings: one line each on stderr
             warnings.simplefilter("always", DeprecationWarning)
             warnings.showwarning = _warn_line
-            report = run_scene(args.scene, json_path=args.json, plot=args.plot, trajectory=args.trajectory,
+            scene = args.scene
+            if to_stdout:  # the scene's own [output] json is replaced by standard output
+                from .scene import load_scene
+
+                scene = dataclasses.replace(load_scene(scene), json=None)
+            report = run_scene(scene, json_path=None if to_stdout else args.json, plot=args.plot,
+                               trajectory=args.trajectory,
                                horizon_seeds=(args.seeds or 1) if args.horizon else None,
                                max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
                                engine=args.engine, progress=False if args.no_progress else None)
@@ -131,11 +188,16 @@ def _run(args: argparse.Namespace) -> int:
         print("revcol run: error: not enough memory for this scene (fewer particles, or a larger machine)",
               file=sys.stderr)
         return 2
-    print(format_report(report))
+    text = sys.stderr if to_stdout else sys.stdout
+    print(format_report(report), file=text)
     if report.get("observe"):
         from .observe import report_lines
 
-        print("\n".join(report_lines(report["observe"])))
+        print("\n".join(report_lines(report["observe"])), file=text)
+    if to_stdout:
+        from .report import _jsonable
+
+        print(json.dumps(_jsonable(report), indent=1))
     if report.get("interrupted"):
         return 130
     if report["kind"] == "horizon":  # a measurement; on the lattice, a check that fails exits 1
@@ -144,6 +206,22 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The ``revcol`` command; returns the exit status (141 when standard output was closed)."""
+    try:
+        try:
+            return _main(argv)
+        finally:  # a pipe closed early shows here, not at the interpreter's exit
+            sys.stdout.flush()
+    except BrokenPipeError:
+        # the reader is gone (revcol ... | head -1): stop quietly, as a Unix tool does on
+        # SIGPIPE; what is still buffered goes to /dev/null so that the exit flush is quiet too
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+        return 141
+
+
+def _main(argv: list[str] | None) -> int:
     words = sys.argv[1:] if argv is None else list(argv)
     if words[:2] == ["study", "randomness"]:  # everything after it (-h included) is the study's
         from . import randomness

@@ -287,5 +287,10 @@ class Simulation:
         st = {k: (a.item() if a.ndim == 0 else a) for k, a in read_checkpoint(path, "float").items()}
         return cls.from_snapshot(st)
 
+    def __reduce__(self):
+        """Pickling (threads, process pools, ensembles): the state is ``snapshot()``, rebuilt by
+        ``from_snapshot``, so an unpickled copy resumes bit for bit; ``copy.deepcopy`` too."""
+        return (type(self).from_snapshot, (self.snapshot(),))
+
     def __repr__(self) -> str:
         return f"Simulation(n={self.n}, dim={self.dim}, time={self.time:.6g})"

@@ -276,5 +276,10 @@ class LatticeSimulation:
                 st[k] = val
         return cls.from_snapshot(st)
 
+    def __reduce__(self):
+        """Pickling (threads, process pools, ensembles): the state is ``snapshot()``, rebuilt by
+        ``from_snapshot``, so an unpickled copy resumes bit for bit; ``copy.deepcopy`` too."""
+        return (type(self).from_snapshot, (self.snapshot(),))
+
     def __repr__(self) -> str:
         return f"LatticeSimulation(n={self.n}, collisions={self.collisions}, clock={self.clock})"

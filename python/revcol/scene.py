@@ -70,7 +70,7 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     budget_gib = 8.0              # skip state saving that would save more
     runner = "auto"               # "process" (fresh revcol-bench per run) | "inline" | "auto"
 
-    [output]                      # paths relative to the scene file
+    [output]                      # paths relative to the scene file (a scene found by name: below)
     json = "report.json"
     plot = "figures"              # a directory of PNGs (gas, statesave)
     trajectory = "run.xyz"        # gas: extended XYZ (OVITO) or .gsd
@@ -83,6 +83,13 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     slabs = 10                    # density and temperature in slabs along slab_axis (default 0)
     block_time = 1.0              # the first blocks' length (default D / v_rms); min_blocks = 16
     pair_bins = 100               # pair distances over [0, pair_rmax] (2-64 particles, walls on every axis)
+
+**Scenes by name.** The example scenes ship with the package (``revcol/scenes``, the repository's
+``scenes/``): ``load_scene("spheres-3d")`` (``revcol run spheres-3d``) reads the scene of that
+name when no file of that name exists (:func:`scene_names` lists them). Its initial-state files
+are read beside it; its ``[output]`` paths resolve as if it were ``./scenes/NAME.toml``, the
+repository's layout, so the examples' ``../out/X`` lands in ``./out/X`` under the current
+directory and nothing is written into the installed package.
 """
 from __future__ import annotations
 
@@ -327,11 +334,12 @@ def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: An
     raise AssertionError(kind)
 
 
-def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | None = None) -> Scene:
+def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | None = None,
+                    output_base: Path | None = None) -> Scene:
     """Validates a parsed scene document (tables of fields) and returns the :class:`Scene`.
 
     Relative paths (initial state, outputs) are taken relative to ``base`` (default: the
-    current directory).
+    current directory); the ``[output]`` paths relative to ``output_base`` when given.
     """
     if not isinstance(doc, dict):
         raise SceneError(f"{source}: a scene is a TOML document of tables")
@@ -373,9 +381,9 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
                   generator=get("rng", "generator", "clcg4"), seed=get("rng", "seed", 0),
                   extra={"fields": sorted(f"{a}.{b}" for a, b in values), "tables": sorted(doc)})
 
-    def out(key: str) -> Path | None:
-        p = get("output", key)
-        return Path(os.path.normpath(base / p)) if p is not None else None
+    def out(key: str, default: str | None = None) -> Path | None:
+        p = get("output", key, default)
+        return Path(os.path.normpath((output_base or base) / p)) if p is not None else None
 
     mode = get("collisions", "mode", "exact")
     law = get("collisions", "law", "flux")
@@ -466,7 +474,7 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
     if checkpoints is not None and checkpoint_interval == 0:
         raise _fail(source, "[output] checkpoints", "needs [run] checkpoint_interval > 0")
     if checkpoint_interval > 0 and checkpoints is None:
-        checkpoints = base / f"{name}-checkpoints"
+        checkpoints = out("checkpoints", f"{name}-checkpoints")
     trajectory = out("trajectory")
     if trajectory is not None and trajectory.suffix.lower() not in (".xyz", ".gsd"):
         raise _fail(source, "[output] trajectory", f"must end in .xyz (extended XYZ) or .gsd, got {trajectory.name!r}")
@@ -642,13 +650,51 @@ def lattice_options(scene: Scene) -> dict[str, Any]:
     return dict(boundary=list(scene.boundaries), diameter=scene.diameter, law=scene.law, seed=scene.seed)
 
 
+def scene_dirs() -> list[Path]:
+    """Where scenes are found by name: the package's ``scenes`` (installed from a wheel), else
+    the ``scenes/`` of the source checkout the package is imported from (a development build)."""
+    here = Path(__file__).resolve().parent
+    dirs = [here / "scenes"]
+    for up in here.parents[:4]:  # python/revcol, or a staged build-dev/pkg/revcol
+        if (up / "pyproject.toml").is_file() and (up / "scenes" / "default.toml").is_file():
+            dirs.append(up / "scenes")
+            break
+    return [d for d in dirs if d.is_dir()]
+
+
+def scene_names() -> list[str]:
+    """The names of the scenes shipped with revcol (``revcol run NAME``)."""
+    return sorted({p.stem for d in scene_dirs() for p in d.glob("*.toml")})
+
+
+def find_scene(name: str) -> Path | None:
+    """The shipped scene file called ``name`` (``"spheres-3d"`` or ``"spheres-3d.toml"``), or None."""
+    stem = name[:-5] if name.endswith(".toml") else name
+    if not stem or any(c in stem for c in "/\\\0") or stem in (".", ".."):
+        return None
+    for d in scene_dirs():
+        if (d / f"{stem}.toml").is_file():
+            return d / f"{stem}.toml"
+    return None
+
+
 def load_scene(path: str | Path | None = None) -> Scene:
-    """Reads and validates a scene file; ``None`` gives the built-in default scene."""
+    """Reads and validates a scene file, or a shipped scene by name when no such file exists;
+    ``None`` gives the built-in default scene."""
     if path is None:
         return scene_from_dict(DEFAULT_SCENE, "<default scene>")
     p = Path(path)
+    output_base = None
     if not p.is_file():
-        raise SceneError(f"{p}: no such scene file")
+        found = None if p.exists() else find_scene(str(path))
+        if found is None:
+            import difflib
+
+            close = difflib.get_close_matches(p.stem, scene_names(), n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise SceneError(f"{p}: no such scene file, nor a scene name (shipped: "
+                             f"{', '.join(scene_names()) or 'none found'}){hint}")
+        p, output_base = found, Path.cwd() / "scenes"
     try:
         doc = tomllib.loads(p.read_text())
     except RecursionError:
@@ -658,6 +704,6 @@ def load_scene(path: str | Path | None = None) -> Scene:
     except UnicodeDecodeError as e:
         raise SceneError(f"{p}: not a text file: {e}") from None
     try:
-        return scene_from_dict(doc, str(p), p.parent)
+        return scene_from_dict(doc, str(p), p.parent, output_base)
     except RecursionError:
         raise SceneError(f"{p}: not a usable scene: its arrays or tables are nested too deeply") from None
