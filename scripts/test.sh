@@ -28,6 +28,7 @@ echo "== Python tests that reach C++ (fuzz suite, crafted checkpoints, hardening
 # runtimes are preloaded and leak checking is off (the interpreter keeps its objects at exit)
 rm -rf build-sanitize/pkg && mkdir -p build-sanitize/pkg && cp -r python/revcol build-sanitize/pkg/
 cp build-sanitize/_core*.so build-sanitize/pkg/revcol/
+mkdir -p build-sanitize/pkg/revcol/scenes && cp scenes/*.toml scenes/*.npz build-sanitize/pkg/revcol/scenes/
 LD_PRELOAD="$(gcc -print-file-name=libasan.so) $(gcc -print-file-name=libubsan.so)" \
   ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 PYTHONPATH=build-sanitize/pkg \
   .venv/bin/python -m pytest -q -p no:cacheprovider tests/python/test_fuzz.py tests/python/test_checkpoints.py \

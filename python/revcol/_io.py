@@ -2,13 +2,14 @@
 crash, or Ctrl-C) never sees half a checkpoint."""
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
-from typing import Mapping, Union
+from typing import IO, Iterator, Mapping, Union
 
 import numpy as np
 
-__all__ = ["write_npz_atomic", "read_checkpoint", "STAMP_KEYS"]
+__all__ = ["write_npz_atomic", "atomic_open", "save_figure", "read_checkpoint", "STAMP_KEYS"]
 
 #: keys a checkpoint file carries besides the snapshot: what wrote it
 STAMP_KEYS = ("revcol_version", "revcol_build", "revcol_engine")
@@ -26,6 +27,38 @@ def _fsync_folder(folder: str) -> None:
         pass
     finally:
         os.close(fd)
+
+
+@contextlib.contextmanager
+def atomic_open(path: Union[str, os.PathLike], mode: str = "w", **kwargs) -> Iterator[IO]:
+    """A file to write ``path`` through: a temporary file beside it, fsynced and renamed over
+    ``path`` when the block ends without an exception; removed otherwise, leaving any previous
+    file at ``path`` whole. Every output the CLI writes goes through here (issue 17)."""
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    suffix = os.path.splitext(path)[1]
+    fd, tmp = tempfile.mkstemp(prefix=".revcol-", suffix=suffix + ".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, mode, **kwargs) as f:
+            yield f
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+        _fsync_folder(folder)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def save_figure(fig, path: Union[str, os.PathLike], **kwargs) -> None:
+    """``fig.savefig`` through :func:`atomic_open` (the format from the path's suffix)."""
+    fmt = os.path.splitext(os.fspath(path))[1].lstrip(".") or "png"
+    with atomic_open(path, "wb") as f:
+        fig.savefig(f, format=fmt, **kwargs)
 
 
 def write_npz_atomic(path: Union[str, os.PathLike], arrays: Mapping[str, np.ndarray]) -> None:

@@ -25,6 +25,7 @@ import os
 import sys
 import warnings
 
+from ._io import atomic_open
 from . import statesave
 from .verify import VERIFY_CASES, verify
 
@@ -247,7 +248,7 @@ def _main(argv: list[str] | None) -> int:
         else:
             print(_summary(report))
             if args.json:
-                with open(args.json, "w") as f:
+                with atomic_open(args.json) as f:
                     json.dump(report, f, indent=1)
         return 0 if report["passed"] else 1
     if args.command == "bench":

@@ -36,6 +36,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from ._io import atomic_open, save_figure
 from .engine import Simulation
 
 __all__ = ["LAWS", "exact_pair", "monte_carlo", "two_body", "small_study", "henderson", "carnahan_starling",
@@ -541,7 +542,7 @@ def _save(fig, out: str, name: str) -> str:
     import matplotlib.pyplot as plt
 
     path = os.path.join(out, name)
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path, dpi=90)
     plt.close(fig)
     return path
 
@@ -596,7 +597,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(dense_table(runs) if args.what == "dense" else walls_table(runs))
     if args.json:
         doc.update(_run_info(argv, t0))
-        with open(args.json, "w") as fh:
+        with atomic_open(args.json) as fh:
             json.dump(doc, fh, indent=1)
     return 0
 

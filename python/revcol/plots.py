@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._io import save_figure
 from .roundtrip import BAR
 from .scene import SceneError
 
@@ -156,7 +157,7 @@ def plot_horizon(r: dict, out: Path) -> list[str]:
 
 
 def _save(fig, path: Path, plt) -> str:
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return str(path)
 

@@ -47,6 +47,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from ._io import atomic_open
 from . import _core
 
 __all__ = ["PAPER_TESTS", "CI_TESTS", "stream", "stream_cases", "write_words", "has_dieharder",
@@ -666,7 +667,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 ks = ", ".join(f"D={x['D']:.2g} p={x['p']:.2g}" for x in res[-1]["coordinates"])
                 print(f"| {c['case']} | {c['mode']} | {c['law']} | {c['rng']} | {ks} |", flush=True)
         if a.json:
-            with open(a.json, "w") as f:
+            with atomic_open(a.json) as f:
                 json.dump(dict(_run_info(argv, t0), runs=res), f, indent=1)
                 f.write("\n")
         return 0
@@ -684,10 +685,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
     def save(runs: list[dict], complete: bool) -> None:
         if a.json:  # after every battery of a matrix, so that a stopped run keeps what it did
-            with open(a.json + ".tmp", "w") as f:
+            with atomic_open(a.json) as f:
                 json.dump(dict(_run_info(argv, t0), commit=commit, complete=complete, runs=runs), f, indent=1)
                 f.write("\n")
-            os.replace(a.json + ".tmp", a.json)
 
     if a.cmd == "battery":
         cfg = {"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}

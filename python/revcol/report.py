@@ -240,8 +240,10 @@ def _jsonable(o: Any) -> Any:
 
 def write_json(report: dict, path: str | os.PathLike) -> str:
     """Writes the report as indented JSON (creating the directory); returns the path."""
+    from ._io import atomic_open
+
     p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    p.write_text(json.dumps(_jsonable(report), indent=1) + "\n")
+    with atomic_open(p) as f:
+        f.write(json.dumps(_jsonable(report), indent=1) + "\n")
     return str(p)
 

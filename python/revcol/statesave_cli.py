@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import shlex
 import sys
 from pathlib import Path
@@ -48,7 +49,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--binary", help="the revcol-bench to run (default: next to python, or on PATH)")
     p.add_argument("--inline", action="store_true", help="run in this process (peak RSS is then shared)")
     p.add_argument("--no-progress", action="store_true")
-    p.add_argument("--json", metavar="FILE", help="write the report (and FILE's .csv next to it)")
+    p.add_argument("--json", metavar="FILE", help="write the report (and FILE's .csv next to it); - for standard output")
     p.add_argument("--csv", metavar="FILE", help="write the runs as CSV (default: next to --json)")
     p.add_argument("--plot", metavar="FILE", help="write the stacked bar plot (PNG)")
 
@@ -65,12 +66,15 @@ def cli_main(args: argparse.Namespace, argv: Sequence[str] | None = None) -> int
     except (ValueError, FileNotFoundError) as e:
         print(f"revcol bench statesave: error: {e}", file=sys.stderr)
         return 2
-    print(format_table(report))
+    to_stdout = args.json == "-"  # `--json -`: the JSON alone on stdout, the table on stderr
+    print(format_table(report), file=sys.stderr if to_stdout else sys.stdout)
     written = []
-    if args.json:
+    if to_stdout:
+        print(json.dumps(report, indent=1))
+    elif args.json:
         write_json(report, args.json)
         written.append(args.json)
-    csv_path = args.csv or (str(Path(args.json).with_suffix(".csv")) if args.json else None)
+    csv_path = args.csv or (str(Path(args.json).with_suffix(".csv")) if args.json and not to_stdout else None)
     if csv_path:
         write_csv(report, csv_path)
         written.append(csv_path)
@@ -78,5 +82,5 @@ def cli_main(args: argparse.Namespace, argv: Sequence[str] | None = None) -> int
         plot(report, args.plot)
         written.append(args.plot)
     if written:
-        print("written: " + " ".join(written))
+        print("written: " + " ".join(written), file=sys.stderr if to_stdout else sys.stdout)
     return 0 if report["passed"] else 1

@@ -8,6 +8,7 @@ import json
 import os
 from pathlib import Path
 
+from ._io import atomic_open, save_figure
 from .statesave_run import _GIB, _LABEL, _gib
 
 __all__ = ["write_json", "write_csv", "format_table", "plot"]
@@ -15,7 +16,8 @@ __all__ = ["write_json", "write_csv", "format_table", "plot"]
 
 def write_json(report: dict, path: str | os.PathLike) -> None:
     """The report as indented JSON."""
-    Path(path).write_text(json.dumps(report, indent=1) + "\n")
+    with atomic_open(path) as f:
+        f.write(json.dumps(report, indent=1) + "\n")
 
 
 _CSV_FIELDS = ["mode", "transport", "variant", "particles", "collisions", "status", "forward_ms",
@@ -29,7 +31,7 @@ _CSV_FIELDS = ["mode", "transport", "variant", "particles", "collisions", "statu
 def write_csv(report: dict, path: str | os.PathLike) -> None:
     """One row per run; state-saving rows carry RC's ratios to them."""
     ratio = {(q["mode"], q["particles"], q["vs"]): q for q in report["ratios"]}
-    with open(path, "w", newline="") as f:
+    with atomic_open(path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=_CSV_FIELDS, extrasaction="ignore")
         w.writeheader()
         for r in report["runs"]:
@@ -151,6 +153,6 @@ def plot(report: dict, path: str | os.PathLike) -> None:
                  f"N_c = {report['collisions']:,}, mode {'/'.join(report['modes'])}"
                  + (f" ({report['law']} law)" if "exact" in modes else ""), fontsize=11)
     fig.tight_layout(rect=(0, 0.04, 1, 0.96))
-    fig.savefig(path, dpi=130)
+    save_figure(fig, path, dpi=130)
     plt.close(fig)
 

@@ -61,8 +61,8 @@ class XYZWriter:
                       f'pbc="{" ".join("T" if p else "F" for p in pbc)}"')
         self._radius = 0.5 * diameter
         self.frames = 0
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._f = open(self.path, "w")
+        self._tmp = _part(self.path)
+        self._f = open(self._tmp, "w")
 
     def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
         x, v = _pad3(positions), _pad3(velocities)
@@ -75,6 +75,7 @@ class XYZWriter:
 
     def close(self) -> None:
         self._f.close()
+        _publish(self._tmp, self.path)
 
 
 class GSDWriter:
@@ -92,11 +93,11 @@ class GSDWriter:
         self._dimensions = 3 if self.dim == 3 else 2
         self._diameter = float(diameter)
         self.frames = 0
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._tmp = _part(self.path)
         try:
-            self._f = gsd.hoomd.open(str(self.path), mode="w")
+            self._f = gsd.hoomd.open(self._tmp, mode="w")
         except ValueError:  # gsd < 3 spells the modes "wb"
-            self._f = gsd.hoomd.open(str(self.path), mode="wb")
+            self._f = gsd.hoomd.open(self._tmp, mode="wb")
 
     def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
         frame_cls = getattr(self._hoomd, "Frame", None) or self._hoomd.Snapshot
@@ -125,6 +126,25 @@ class GSDWriter:
 
     def close(self) -> None:
         self._f.close()
+        _publish(self._tmp, self.path)
+
+
+def _part(path: Path) -> str:
+    """A temporary file beside ``path`` that the frames go to until close() (atomic output:
+    a reader never sees a file at ``path`` that is still being written)."""
+    import tempfile
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".revcol-", suffix=path.suffix + ".part", dir=path.parent)
+    os.close(fd)
+    return tmp
+
+
+def _publish(tmp: str, path: Path) -> None:
+    """Moves a closed trajectory into place (fsynced first), with the frames written so far."""
+    with open(tmp, "rb+") as f:
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
 
 
 def open_trajectory(path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],

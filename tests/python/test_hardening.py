@@ -1,5 +1,7 @@
 """Issue 17's reproducers that crashed or never returned: each now raises a clear error and
 leaves the simulation as it was (the first part of the hardening issue)."""
+import json
+import os
 import numpy as np
 import pytest
 
@@ -336,3 +338,67 @@ def test_study_bindings_name_their_arguments(call, exc, text):
     function arguments' no longer reaches a user of the state-saving or paper study."""
     with pytest.raises(exc, match=text):
         call()
+
+
+# --- every output the CLI writes is atomic -----------------------------------------------------
+
+
+def test_an_output_that_fails_half_way_keeps_the_previous_file(tmp_path):
+    from revcol._io import atomic_open
+    path = tmp_path / "r.json"
+    path.write_text('{"old": 1}\n')
+    with pytest.raises(RuntimeError, match="disk full"):
+        with atomic_open(path) as f:
+            f.write('{"new": ')
+            raise RuntimeError("disk full")
+    assert path.read_text() == '{"old": 1}\n'
+    assert [p.name for p in tmp_path.iterdir()] == ["r.json"]  # no temporary left behind
+    with atomic_open(path) as f:
+        f.write('{"new": 2}\n')
+    assert path.read_text() == '{"new": 2}\n' and [p.name for p in tmp_path.iterdir()] == ["r.json"]
+
+
+def test_a_report_figure_and_csv_keep_the_previous_file_when_the_write_fails(tmp_path, monkeypatch):
+    """report.write_json, the state-saving JSON and CSV and every figure go through
+    _io.atomic_open (before: write_text / open(path, "w"), which leave half a file)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from revcol._io import save_figure
+    from revcol.report import write_json
+    from revcol.statesave_output import write_csv, write_json as ss_json
+    fig = plt.figure()
+    writers = {"a.json": lambda p: write_json({"a": 1}, p), "b.json": lambda p: ss_json({"b": 2}, p),
+               "c.csv": lambda p: write_csv({"ratios": [], "runs": []}, p), "d.png": lambda p: save_figure(fig, p)}
+    for name in writers:
+        (tmp_path / name).write_text("old")
+
+    def no_rename(a, b):
+        raise OSError("disk full")
+    monkeypatch.setattr(os, "replace", no_rename)
+    for name, write in writers.items():
+        with pytest.raises(OSError, match="disk full"):
+            write(tmp_path / name)
+        assert (tmp_path / name).read_text() == "old", name
+    monkeypatch.undo()
+    plt.close(fig)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(writers)  # no temporaries left
+
+
+def test_a_trajectory_appears_only_when_closed(tmp_path):
+    from revcol.trajectory import open_trajectory
+    path = tmp_path / "t.xyz"
+    w = open_trajectory(path, [5.0, 5.0], [True, True], 1.0)
+    w.write(np.zeros((2, 2)) + [[1, 1], [3, 3]], np.zeros((2, 2)), 0.0, 0, "forward")
+    assert not path.exists()  # being written beside it
+    w.close()
+    assert path.read_text().startswith("2\n") and len(list(tmp_path.iterdir())) == 1
+
+
+def test_statesave_json_dash_is_standard_output(capsys):
+    from revcol.cli import main as cli_main
+    code = cli_main(["bench", "statesave", "--n", "100", "--collisions", "1e2", "--inline", "--variants", "rc",
+                     "--json", "-", "--no-progress"])
+    out = capsys.readouterr()
+    assert code == 0 and json.loads(out.out)["runs"] and not os.path.exists("-")
