@@ -237,7 +237,11 @@ def _part(path: Path) -> str:
 
 
 def _publish(tmp: str, path: Path) -> None:
-    """Moves a closed trajectory into place (fsynced first), with the frames written so far."""
+    """Moves a closed trajectory into place (fsynced first), with the frames written so far, and
+    with the permissions a plain ``open`` would give it (mkstemp makes it private, 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(tmp, 0o666 & ~mask)
     with open(tmp, "rb+") as f:
         os.fsync(f.fileno())
     os.replace(tmp, path)

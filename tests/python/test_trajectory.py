@@ -1,5 +1,6 @@
 """Trajectories that other tools read back: GSD (gsd.hoomd) with a monotonic step, image flags,
 diameters and walls; extended XYZ that ASE reads, with an element symbol and a 2D cell."""
+import os
 import warnings
 
 import numpy as np
@@ -136,3 +137,6 @@ def test_species_is_configurable_and_checked(tmp_path):
     w.close()
     with gsd_hoomd.open(str(tmp_path / "t.gsd"), "r") as f:
         assert f[0].particles.types == ["Ne"]
+    mask = os.umask(0)
+    os.umask(mask)
+    assert (tmp_path / "t.gsd").stat().st_mode & 0o777 == 0o666 & ~mask  # as open() makes it, not 0600
