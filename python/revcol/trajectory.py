@@ -58,7 +58,7 @@ from typing import Sequence
 
 import numpy as np
 
-__all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS", "ELEMENTS"]
+__all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS", "ELEMENTS", "net_collisions"]
 
 #: suffix -> what writes it
 FORMATS = {".xyz": "extended XYZ (OVITO, ASE)", ".gsd": "GSD (HOOMD-blue; needs the gsd package)"}
@@ -85,7 +85,40 @@ def _pad3(a: np.ndarray) -> np.ndarray:
     return out
 
 
-class XYZWriter:
+def net_collisions(sim) -> int:
+    """The net collision count of a :class:`revcol.Simulation` or a lattice simulation."""
+    if hasattr(sim, "collisions"):
+        return int(sim.collisions)
+    return int(sim.diagnostics()["net_collisions"])
+
+
+class _Writer:
+    """What both writers share: a frame of a simulation by calling the writer (so that a writer
+    can be attached to one: ``sim.attach(writer, every=1000)``), and ``close``."""
+
+    path: Path
+    _tmp: str
+
+    def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
+        raise NotImplementedError
+
+    def __call__(self, sim, phase: str = "forward") -> None:
+        """Writes the current state of ``sim`` as a frame (its clock and net collision count)."""
+        if getattr(self, "closed", False):
+            raise ValueError(f"trajectory {str(self.path)!r} is closed (detach it from the simulation)")
+        self.write(sim.positions, sim.velocities, sim.time, net_collisions(sim), phase)
+
+    def _close_file(self) -> None:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Closes the file and moves it into place; frames written so far are kept."""
+        self._close_file()
+        self.closed = True
+        _publish(self._tmp, self.path)
+
+
+class XYZWriter(_Writer):
     """Extended XYZ frames, appended to one text file."""
 
     def __init__(self, path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],
@@ -113,9 +146,8 @@ class XYZWriter:
         np.savetxt(self._f, rows, fmt=self.species + " %.12g" * 7)
         self.frames += 1
 
-    def close(self) -> None:
+    def _close_file(self) -> None:
         self._f.close()
-        _publish(self._tmp, self.path)
 
 
 class _Unwrap:
@@ -146,7 +178,7 @@ class _Unwrap:
         return self.image
 
 
-class GSDWriter:
+class GSDWriter(_Writer):
     """GSD frames through the ``gsd`` package (HOOMD-blue's schema)."""
 
     def __init__(self, path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],
@@ -220,9 +252,8 @@ class GSDWriter:
         self._f.append(f)
         self.frames += 1
 
-    def close(self) -> None:
+    def _close_file(self) -> None:
         self._f.close()
-        _publish(self._tmp, self.path)
 
 
 def _part(path: Path) -> str:

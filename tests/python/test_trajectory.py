@@ -140,3 +140,43 @@ def test_species_is_configurable_and_checked(tmp_path):
     mask = os.umask(0)
     os.umask(mask)
     assert (tmp_path / "t.gsd").stat().st_mode & 0o777 == 0o666 & ~mask  # as open() makes it, not 0600
+
+
+def test_a_writer_attached_to_a_simulation_writes_on_its_trigger_and_changes_nothing(tmp_path):
+    import pickle
+
+    make = lambda: revcol.Simulation.random(80, 2, 0.3, seed=6)  # noqa: E731
+    sim, twin = make(), make()
+    w = open_trajectory(tmp_path / "t.gsd", sim.box, sim.periodic, 1.0)
+    sim.attach(w, every=50)
+    seen = []
+    w(sim)  # the start, by hand
+    r1 = sim.run(collisions=300, callback=seen.append, every=40)
+    r2 = sim.run(collisions=300)  # the count goes on across run() calls
+    w.close()
+    assert r1["collisions"] == r2["collisions"] == 300 and not r1["interrupted"]
+    assert seen == list(range(40, 300, 40))  # the callback's count is per run() call, not per pause
+    twin.run(collisions=600)  # the pauses change nothing: bit for bit the run without them
+    assert np.array_equal(sim.positions, twin.positions) and np.array_equal(sim.velocities, twin.velocities)
+    assert sim.time == twin.time
+    with gsd_hoomd.open(str(tmp_path / "t.gsd"), "r") as f:
+        assert [int(fr.log["revcol/net_collisions"][0]) for fr in f] == list(range(0, 601, 50))
+    with pytest.raises(ValueError, match="is closed"):  # a closed writer says so
+        sim.run(collisions=100)
+    sim.detach(w)
+    sim.attach(seen.append, every=50)
+    # a time-ended run stops at its time, between triggers; a callback returning False stops it
+    r = sim.run(time=sim.time + 0.01)
+    assert r["collisions"] < 50
+    r = sim.run(collisions=1000, callback=lambda k: k < 60, every=30)
+    assert r["collisions"] == 60 and r["interrupted"]
+    sim.detach(seen.append)
+    assert not sim.__dict__["_attached"]
+    copy = pickle.loads(pickle.dumps(sim))  # the attachments are not part of the state
+    assert "_attached" not in copy.__dict__
+    with pytest.raises(ValueError, match="every"):
+        sim.attach(w, every=0)
+    with pytest.raises(TypeError, match="callable"):
+        sim.attach("t.gsd", every=10)
+    with pytest.raises(ValueError, match="not attached"):
+        sim.detach(w)
