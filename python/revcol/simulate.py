@@ -36,6 +36,7 @@ import time as _time
 from pathlib import Path
 from typing import Any
 
+from ._args import integer
 from .progress import Bar, Interrupt, peak_rss
 from .report import version
 from .scene import Scene, SceneError, load_scene, with_engine
@@ -68,6 +69,12 @@ def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, che
         collisions, time = scene.collisions, scene.time
     if scene.particles == 1 and time is None:
         raise SceneError(f"{src}: --collisions: a single particle never collides (give --time)")
+    for name, k in (("--every", every), ("--checkpoint-every", checkpoint_every)):
+        try:
+            if k is not None:
+                integer(k, name, lo=1)
+        except (TypeError, ValueError):
+            raise SceneError(f"{src}: {name} must be a positive integer, got {k!r}") from None
     trajectory = trajectory if trajectory is not None else scene.trajectory
     if every is not None and trajectory is None:
         raise SceneError(f"{src}: --every needs --trajectory (or the scene's [output] trajectory)")
@@ -78,9 +85,6 @@ def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, che
     checkpoint_every = checkpoint_every if checkpoint_every is not None else scene.checkpoint_interval
     if checkpoints is not None and not checkpoint_every:
         raise SceneError(f"{src}: --checkpoint needs --checkpoint-every K (or the scene's [run] checkpoint_interval)")
-    for name, k in (("--every", every), ("--checkpoint-every", checkpoint_every)):
-        if k is not None and (isinstance(k, bool) or int(k) != k or k < 0):
-            raise SceneError(f"{src}: {name} must be a positive integer, got {k!r}")
     if trajectory is not None:
         from .trajectory import check_format
 

@@ -127,6 +127,19 @@ def test_a_scene_that_is_not_a_gas_is_refused(tmp_path):
         simulate(load_scene("paper-pair2d-reversal"), collisions=10, progress=False)
 
 
+@pytest.mark.parametrize("kw,message", [
+    (dict(trajectory="t.xyz", every=0), "--every must be a positive integer"),
+    (dict(checkpoints="ck", checkpoint_every=2.5), "--checkpoint-every must be a positive integer"),
+    (dict(collisions=True), "--collisions must be a positive integer"),
+    (dict(time=float("nan")), "--time must be a positive finite number"),
+])
+def test_the_python_api_names_bad_values_too(tmp_path, kw, message):
+    kw = {k: (str(tmp_path / v) if k in ("trajectory", "checkpoints") else v) for k, v in kw.items()}
+    with pytest.raises(SceneError, match=message):
+        simulate(scene_file(tmp_path, FLOAT), progress=False, **kw)
+    assert sorted(os.listdir(tmp_path)) == ["s.toml"]
+
+
 def test_ctrl_c_stops_cleanly_with_the_outputs_closed(tmp_path, capsys, monkeypatch):
     import revcol.simulate as sm
 
