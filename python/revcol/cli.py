@@ -3,6 +3,8 @@
     revcol run [SCENE.toml] [--json FILE] [--plot DIR] [--trajectory FILE.xyz|.gsd] [--collisions N] [--seed S]
                [--engine float|lattice]
     revcol run [SCENE.toml] --horizon [--seeds K] [--max-collisions N] [--engine float] [--json FILE] [--plot DIR]
+    revcol simulate [SCENE] [--collisions N | --time T] [--trajectory FILE --every K] [--checkpoint DIR
+               --checkpoint-every K] [--resume CHECKPOINT] [--species Ar] [--json FILE]   (forward only)
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
     revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.randomness ...)
@@ -47,6 +49,16 @@ def _seed(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected an integer 0 .. 2^32 - 1, got {text!r}") from None
     if not 0 <= value < 2**32:
         raise argparse.ArgumentTypeError(f"expected an integer 0 .. 2^32 - 1, got {text!r}")
+    return value
+
+
+def _positive_real(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}") from None
+    if not (value > 0 and value != float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a positive finite number, got {text!r}")
     return value
 
 
@@ -117,6 +129,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="run a gas scene on this engine instead of its [collisions] engine (with --horizon: "
                    "--engine float measures the float engine's horizon for a lattice scene's gas)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
+    _simulate_parser(sub)
     v = sub.add_parser("verify", help="run the paper's reversal illustration and check the round trip")
     v.add_argument("case", choices=VERIFY_CASES)
     v.add_argument("--collisions", type=_positive_int, default=1_000_000, help="N_c (default 1e6)")
@@ -206,6 +219,71 @@ def _run(args: argparse.Namespace) -> int:
     return 0 if report["passed"] else 1
 
 
+def _simulate_parser(sub) -> None:
+    s = sub.add_parser("simulate", help="run a gas scene forward only (any length), with frames, checkpoints and "
+                       "observables", description="Run a gas scene forward only, for any number of collisions or "
+                       "any time (revcol run is the forward-and-back job). Outputs are triggered every K "
+                       "collisions (the net count since the scene's start). Exit 0 when it ran, 1 when the engine "
+                       "stopped on an error, 2 on a bad scene or option, 130 when interrupted (Ctrl-C: outputs "
+                       "written and closed).")
+    s.add_argument("scene", nargs="?", help="scene file, or the name of a scene shipped with revcol (default: the "
+                   "built-in 2D gas)")
+    length = s.add_mutually_exclusive_group()
+    length.add_argument("--collisions", type=_positive_int, metavar="N", help="run N collisions (default: the "
+                        "scene's [run] collisions or time)")
+    length.add_argument("--time", type=_positive_real, metavar="T", help="run for T units of time")
+    s.add_argument("--trajectory", metavar="FILE", help="frames at the start, every K collisions and at the end: "
+                   "FILE.xyz (extended XYZ) or FILE.gsd")
+    s.add_argument("--every", type=_positive_int, metavar="K", help="collisions between frames (default: the "
+                   "scene's [output] trajectory_every)")
+    s.add_argument("--checkpoint", metavar="DIR", help="write checkpoint-<collisions>.npz into DIR every K "
+                   "collisions and at the end")
+    s.add_argument("--checkpoint-every", type=_positive_int, metavar="K", help="collisions between checkpoints")
+    s.add_argument("--resume", metavar="FILE", help="continue from a checkpoint of this scene (bit for bit)")
+    s.add_argument("--seed", type=_seed, metavar="S", help="seed instead of the scene's [rng] seed")
+    s.add_argument("--engine", choices=("float", "lattice"), help="run the scene on this engine instead")
+    s.add_argument("--species", default="Ar", metavar="X", help="the trajectory's chemical element symbol "
+                   "(default Ar; ASE reads element symbols only)")
+    s.add_argument("--json", metavar="FILE", help="write the report as JSON ('-': to standard output, and the "
+                   "text report to standard error)")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
+
+
+def _simulate(args: argparse.Namespace) -> int:
+    """``revcol simulate``: exit 0 ran, 1 engine error, 2 bad scene/option, 130 interrupted."""
+    from .scene import SceneError, load_scene
+    from .simulate import format_simulate, simulate
+
+    to_stdout = args.json == "-"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", DeprecationWarning)
+            warnings.showwarning = lambda message, *rest: print(f"revcol simulate: warning: {message}",
+                                                                 file=sys.stderr)
+            scene = load_scene(args.scene)
+            if to_stdout:
+                scene = dataclasses.replace(scene, json=None)
+            report = simulate(scene, collisions=args.collisions, time=args.time, trajectory=args.trajectory,
+                              every=args.every, checkpoints=args.checkpoint, checkpoint_every=args.checkpoint_every,
+                              resume=args.resume, seed=args.seed, engine=args.engine, species=args.species,
+                              json_path=None if to_stdout else args.json,
+                              progress=False if args.no_progress else None)
+    except (SceneError, OSError) as e:
+        print(f"revcol simulate: error: {e}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("revcol simulate: error: not enough memory for this scene", file=sys.stderr)
+        return 2
+    print(format_simulate(report), file=sys.stderr if to_stdout else sys.stdout)
+    if to_stdout:
+        from .report import _jsonable
+
+        print(json.dumps(_jsonable(report), indent=1))
+    if report["interrupted"]:
+        return 130
+    return 1 if report["engine_error"] else 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """The ``revcol`` command; returns the exit status (141 when standard output was closed)."""
     try:
@@ -235,6 +313,8 @@ def _main(argv: list[str] | None) -> int:
     args = _parser().parse_args(argv)
     if args.command == "run":
         return _run(args)
+    if args.command == "simulate":
+        return _simulate(args)
     if args.command == "verify":
         try:
             report = verify(args.case, collisions=args.collisions, mode=args.mode, law=args.law,

@@ -1,43 +1,81 @@
 """Trajectory files that standard viewers open: extended XYZ (OVITO, ASE, VMD's plugin) and
-GSD (HOOMD-blue's format, through the ``gsd`` package).
+GSD (HOOMD-blue's format, through the ``gsd`` package; OVITO and freud read it).
 
 Frames are written as they come (nothing is buffered): ``open_trajectory(path, ...)`` picks
 the format from the suffix and returns a writer with ``write(positions, velocities, time,
-collisions, phase)`` and ``close()``. Positions of a 1D or 2D gas are padded to 3 components
-with zeros.
+collisions, phase)`` and ``close()``; ``collisions`` is the net count (forward minus undone),
+``phase`` ``"forward"`` or ``"reverse"``. Positions of a 1D or 2D gas are padded to 3
+components with zeros. The file appears at ``path`` on ``close()`` only.
 
-Extended XYZ, one frame::
+Extended XYZ, one frame (species: a chemical element symbol, ``"Ar"`` unless told, since ASE
+maps the species column to elements and fails on another name)::
 
     3
-    Lattice="10 0 0 0 10 0 0 0 1" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1 Time=0.5 Collisions=100 Phase="forward" pbc="F F F"
-    A 1.5 2.5 0 0.1 -0.3 0 0.5
+    Lattice="10 0 0 0 10 0 0 0 0" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1 Time=0.5 Collisions=100 Phase="forward" pbc="T T F"
+    Ar 1.5 2.5 0 0.1 -0.3 0 0.5
     ...
 
-The cell spans [0, L_k] per axis (OVITO's default origin); a missing axis gets the length
-of one diameter. GSD frames follow HOOMD's conventions instead: the box is centred on the
-origin (positions shifted by -L/2), a 2D box has Lz = 0, ``configuration.step`` holds the
-collision count and ``log/revcol/time`` the clock. A 1D gas is written as 2D (Ly = D).
+The cell spans [0, L_k] per axis (OVITO's default origin). A 2D gas has a third cell vector
+of zero length and ``pbc`` F on z (what ASE writes for a 2D cell; OVITO detects the
+dimensionality on import and ignores z in 2D mode, docs/run.md); a 1D gas is written the
+same way with a y vector of one diameter (not periodic).
+
+GSD frames follow HOOMD's conventions: the box is centred on the origin (positions shifted by
+-L/2), a 2D box has Lz = 0 (a 1D gas is written as 2D with Ly = D), and
+
+- ``configuration.step`` counts the collisions done in both directions since the first frame
+  (plus the first frame's net count), so it never decreases over a run that goes forward and
+  back (frames with no collision between them share a step);
+- ``log/revcol/net_collisions`` (int64) is the net count, ``log/revcol/direction`` (int8) +1
+  forward and -1 in the reversal, ``log/revcol/time`` (float64) the clock, and
+  ``log/revcol/walls`` (uint8, 3 values, x y z) 1 where an axis is closed by walls (or is a
+  padding axis) and 0 where it is periodic: HOOMD boxes are always periodic, so a reader must
+  take the walls from here (docs/run.md);
+- ``particles.image`` counts each particle's crossings of each periodic axis, so
+  x + image * L is its unwrapped position (MSD across periodic boundaries). The writer sees
+  only frames: it takes each particle's jump between consecutive frames as the minimum image,
+  which is exact while no particle moves more than L/2 along an axis between two frames. It
+  warns (RuntimeWarning, once) when some particle's minimum-image jump exceeds L/4 along a
+  periodic axis: frames that sparse may hide a crossing (write frames more often);
+- ``particles.diameter`` the diameter, ``particles.types`` the species;
+- with ``precise=True``, ``log/particles/revcol/position`` holds the float64 positions (same
+  centred frame) that ``particles.position`` (float32 in HOOMD's schema) rounds.
 
     >>> import numpy as np, tempfile, os
     >>> path = os.path.join(tempfile.mkdtemp(), "t.xyz")
     >>> w = open_trajectory(path, box=[4.0, 4.0], periodic=[False, False], diameter=1.0)
     >>> w.write(np.array([[1.0, 1.0], [3.0, 3.0]]), np.zeros((2, 2)), time=0.0, collisions=0, phase="forward")
     >>> w.close()
-    >>> open(path).readline().strip()
-    '2'
+    >>> open(path).readlines()[2].split()[0]
+    'Ar'
 """
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
-__all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS"]
+__all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS", "ELEMENTS", "net_collisions"]
 
 #: suffix -> what writes it
 FORMATS = {".xyz": "extended XYZ (OVITO, ASE)", ".gsd": "GSD (HOOMD-blue; needs the gsd package)"}
+
+#: the chemical element symbols, the species names that ASE reads
+ELEMENTS = frozenset((
+    "H He Li Be B C N O F Ne Na Mg Al Si P S Cl Ar K Ca Sc Ti V Cr Mn Fe Co Ni Cu Zn Ga Ge As Se Br Kr "
+    "Rb Sr Y Zr Nb Mo Tc Ru Rh Pd Ag Cd In Sn Sb Te I Xe Cs Ba La Ce Pr Nd Pm Sm Eu Gd Tb Dy Ho Er Tm Yb "
+    "Lu Hf Ta W Re Os Ir Pt Au Hg Tl Pb Bi Po At Rn Fr Ra Ac Th Pa U Np Pu Am Cm Bk Cf Es Fm Md No Lr Rf "
+    "Db Sg Bh Hs Mt Ds Rg Cn Nh Fl Mc Lv Ts Og").split())
+
+
+def _species(species: str) -> str:
+    if not isinstance(species, str) or species not in ELEMENTS:
+        raise ValueError(f"species must be a chemical element symbol (e.g. 'Ar'; ASE reads no other "
+                         f"name), got {species!r}")
+    return species
 
 
 def _pad3(a: np.ndarray) -> np.ndarray:
@@ -47,14 +85,49 @@ def _pad3(a: np.ndarray) -> np.ndarray:
     return out
 
 
-class XYZWriter:
+def net_collisions(sim) -> int:
+    """The net collision count of a :class:`revcol.Simulation` or a lattice simulation."""
+    if hasattr(sim, "collisions"):
+        return int(sim.collisions)
+    return int(sim.diagnostics()["net_collisions"])
+
+
+class _Writer:
+    """What both writers share: a frame of a simulation by calling the writer (so that a writer
+    can be attached to one: ``sim.attach(writer, every=1000)``), and ``close``."""
+
+    path: Path
+    _tmp: str
+
+    def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
+        raise NotImplementedError
+
+    def __call__(self, sim, phase: str = "forward") -> None:
+        """Writes the current state of ``sim`` as a frame (its clock and net collision count)."""
+        if getattr(self, "closed", False):
+            raise ValueError(f"trajectory {str(self.path)!r} is closed (detach it from the simulation)")
+        self.write(sim.positions, sim.velocities, sim.time, net_collisions(sim), phase)
+
+    def _close_file(self) -> None:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Closes the file and moves it into place; frames written so far are kept."""
+        self._close_file()
+        self.closed = True
+        _publish(self._tmp, self.path)
+
+
+class XYZWriter(_Writer):
     """Extended XYZ frames, appended to one text file."""
 
     def __init__(self, path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],
-                 diameter: float):
+                 diameter: float, *, species: str = "Ar"):
         self.path = Path(path)
         self.dim = len(box)
-        lengths = list(box) + [diameter] * (3 - len(box))
+        self.species = _species(species)
+        # 2D (and 1D, shown as 2D): a zero third vector and pbc F on z, as ASE writes a 2D cell
+        lengths = list(box) + [diameter] * max(0, 2 - len(box)) + [0.0] * (3 - max(2, len(box)))
         pbc = [bool(p) for p in periodic] + [False] * (3 - len(box))
         lattice = " ".join(f"{lengths[i] if i == j else 0.0:.17g}" for i in range(3) for j in range(3))
         self._head = (f'Lattice="{lattice}" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1 '
@@ -70,28 +143,65 @@ class XYZWriter:
         rows = np.empty((n, 7))
         rows[:, :3], rows[:, 3:6], rows[:, 6] = x, v, self._radius
         self._f.write(f"{n}\n{self._head} Time={time:.17g} Collisions={int(collisions)} Phase=\"{phase}\"\n")
-        np.savetxt(self._f, rows, fmt="A" + " %.12g" * 7)
+        np.savetxt(self._f, rows, fmt=self.species + " %.12g" * 7)
         self.frames += 1
 
-    def close(self) -> None:
+    def _close_file(self) -> None:
         self._f.close()
-        _publish(self._tmp, self.path)
 
 
-class GSDWriter:
+class _Unwrap:
+    """Image flags from consecutive wrapped frames: each jump taken as the minimum image."""
+
+    def __init__(self, box: np.ndarray, periodic: np.ndarray):
+        self.box, self.periodic = box, periodic
+        self.prev: np.ndarray | None = None
+        self.image: np.ndarray | None = None
+        self.warned = False
+
+    def update(self, x: np.ndarray) -> np.ndarray:
+        """The image flags (n, 3) after frame ``x`` (engine coordinates, padded to 3)."""
+        if self.prev is None or self.prev.shape != x.shape:
+            self.image = np.zeros(x.shape, dtype=np.int64)
+        else:
+            ax = np.flatnonzero(self.periodic)
+            jump = x[:, ax] - self.prev[:, ax]
+            wraps = np.rint(jump / self.box[ax]).astype(np.int64)
+            self.image[:, ax] -= wraps
+            rest = np.abs(jump - wraps * self.box[ax])
+            if not self.warned and rest.size and (rest > 0.25 * self.box[ax]).any():
+                self.warned = True
+                warnings.warn("trajectory: a particle moved more than L/4 along a periodic axis between two "
+                              "frames; image flags assume less than L/2, so frames this sparse may miss a "
+                              "crossing (write frames more often)", RuntimeWarning, stacklevel=3)
+        self.prev = x.copy()
+        return self.image
+
+
+class GSDWriter(_Writer):
     """GSD frames through the ``gsd`` package (HOOMD-blue's schema)."""
 
     def __init__(self, path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],
-                 diameter: float):
+                 diameter: float, *, species: str = "Ar", precise: bool = False):
         import gsd.hoomd  # checked by open_trajectory
 
         self._hoomd = gsd.hoomd
         self.path = Path(path)
         self.dim = len(box)
+        self.species = _species(species)
+        self.precise = bool(precise)
         # HOOMD boxes are 2D or 3D; a 1D gas is shown as 2D with one diameter of height
         self._lengths = np.array(list(box) + [diameter] * max(0, 2 - len(box)), dtype=float)
         self._dimensions = 3 if self.dim == 3 else 2
         self._diameter = float(diameter)
+        per = np.zeros(3, dtype=bool)
+        per[: self.dim] = [bool(p) for p in periodic]
+        self._walls = (~per).astype(np.uint8)
+        lengths3 = np.ones(3)
+        lengths3[: len(self._lengths)] = self._lengths
+        self._unwrap = _Unwrap(lengths3, per)
+        self._step: int | None = None
+        self._net: int | None = None
         self.frames = 0
         self._tmp = _part(self.path)
         try:
@@ -99,34 +209,51 @@ class GSDWriter:
         except ValueError:  # gsd < 3 spells the modes "wb"
             self._f = gsd.hoomd.open(self._tmp, mode="wb")
 
+    def _next_step(self, collisions: int) -> int:
+        """Collisions done in both directions: the step never decreases through a reversal."""
+        if self._step is None:
+            self._step = max(0, collisions)
+        else:
+            self._step += abs(collisions - self._net)
+        self._net = collisions
+        return self._step
+
     def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
         frame_cls = getattr(self._hoomd, "Frame", None) or self._hoomd.Snapshot
         f = frame_cls()
+        collisions = int(collisions)
         n = np.asarray(positions).shape[0]
         lx, ly = self._lengths[0], self._lengths[1]
         lz = self._lengths[2] if self._dimensions == 3 else 0.0
         f.configuration.box = [lx, ly, lz, 0.0, 0.0, 0.0]
         f.configuration.dimensions = self._dimensions
-        f.configuration.step = int(collisions)
-        x = _pad3(positions)
+        f.configuration.step = self._next_step(collisions)
+        raw = _pad3(positions)
+        image = self._unwrap.update(raw)
+        x = raw.copy()
         x[:, 0] -= 0.5 * lx
         x[:, 1] -= 0.5 * ly
         if self._dimensions == 3:
             x[:, 2] -= 0.5 * lz
         f.particles.N = n
-        f.particles.types = ["A"]
+        f.particles.types = [self.species]
         f.particles.typeid = np.zeros(n, dtype=np.uint32)
         f.particles.position = x.astype(np.float32)
+        f.particles.image = image.astype(np.int32)
         f.particles.velocity = _pad3(velocities).astype(np.float32)
         f.particles.diameter = np.full(n, self._diameter, dtype=np.float32)
+        if self.precise:
+            f.log["particles/revcol/position"] = x
         f.log["revcol/time"] = np.array([time], dtype=np.float64)
+        f.log["revcol/net_collisions"] = np.array([collisions], dtype=np.int64)
+        f.log["revcol/direction"] = np.array([-1 if phase == "reverse" else 1], dtype=np.int8)
         f.log["revcol/reverse"] = np.array([phase == "reverse"], dtype=np.uint8)
+        f.log["revcol/walls"] = self._walls.copy()
         self._f.append(f)
         self.frames += 1
 
-    def close(self) -> None:
+    def _close_file(self) -> None:
         self._f.close()
-        _publish(self._tmp, self.path)
 
 
 def _part(path: Path) -> str:
@@ -141,22 +268,28 @@ def _part(path: Path) -> str:
 
 
 def _publish(tmp: str, path: Path) -> None:
-    """Moves a closed trajectory into place (fsynced first), with the frames written so far."""
+    """Moves a closed trajectory into place (fsynced first), with the frames written so far, and
+    with the permissions a plain ``open`` would give it (mkstemp makes it private, 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(tmp, 0o666 & ~mask)
     with open(tmp, "rb+") as f:
         os.fsync(f.fileno())
     os.replace(tmp, path)
 
 
 def open_trajectory(path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],
-                    diameter: float) -> XYZWriter | GSDWriter:
-    """A writer for ``path``: ``.xyz`` (extended XYZ) or ``.gsd`` (needs ``gsd``). Raises
-    ValueError for another suffix, or for ``.gsd`` when ``gsd`` is not installed."""
+                    diameter: float, *, species: str = "Ar", precise: bool = False) -> XYZWriter | GSDWriter:
+    """A writer for ``path``: ``.xyz`` (extended XYZ) or ``.gsd`` (needs ``gsd``; ``precise``
+    adds the float64 positions). Raises ValueError for another suffix, for ``.gsd`` when ``gsd``
+    is not installed, or for a ``species`` that is not an element symbol."""
     suffix = Path(path).suffix.lower()
+    _species(species)
     if suffix == ".xyz":
-        return XYZWriter(path, box, periodic, diameter)
+        return XYZWriter(path, box, periodic, diameter, species=species)
     if suffix == ".gsd":
         check_format(path)
-        return GSDWriter(path, box, periodic, diameter)
+        return GSDWriter(path, box, periodic, diameter, species=species, precise=precise)
     raise ValueError(f"trajectory {str(path)!r}: the suffix must be .xyz (extended XYZ) or .gsd")
 
 

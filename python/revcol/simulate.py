@@ -1,0 +1,314 @@
+"""``revcol simulate``: a forward-only production run of a gas scene, of any length, with
+trajectory frames, checkpoints and the scene's observables (``revcol run`` is the
+forward-and-back job; this one never reverses, so its length has no round-off horizon).
+
+The run goes ``collisions`` more collisions or ``time`` more units of time (else the scene's
+``[run]`` collisions or time), on the scene's engine (float or lattice). Outputs are driven
+by triggers in *net collisions* (the engine's count since the scene's start, so a resumed run
+keeps the numbering of the run it resumes):
+
+- ``trajectory`` (``.xyz`` or ``.gsd``, :mod:`revcol.trajectory`): a frame at the start, at
+  every multiple of ``every`` collisions, and at the end;
+- ``checkpoints`` (a folder): ``checkpoint-<net collisions>.npz`` at every multiple of
+  ``checkpoint_every`` and at the end; ``resume`` continues from one bit for bit (the run that
+  resumes from checkpoint k and goes on to n collisions ends in the state of one that never
+  stopped);
+- a float-engine scene's ``[observe]`` table: the forward run is observed and its values go in
+  the report (``report["observe"]``, :mod:`revcol.observe`).
+
+Ctrl-C (SIGINT) stops the run between events (float engine) or between chunks of at most
+10^4 collisions (lattice engine); the last frame and checkpoint are written, the trajectory
+is closed, and the report says ``interrupted``. Every option is checked before anything runs;
+a bad one raises :class:`revcol.scene.SceneError` naming it.
+
+    >>> r = simulate("spheres-3d", collisions=2000, progress=False)
+    >>> r["collisions"], r["net_collisions"], r["interrupted"]
+    (2000, 2000, False)
+"""
+from __future__ import annotations
+
+import dataclasses
+import datetime as dt
+import math
+import os
+import sys
+import time as _time
+from pathlib import Path
+from typing import Any
+
+from ._args import integer
+from .progress import Bar, Interrupt, peak_rss
+from .report import version
+from .scene import Scene, SceneError, load_scene, with_engine
+
+__all__ = ["simulate", "format_simulate"]
+
+#: collisions per lattice engine call (how often Ctrl-C and the progress bar are looked at)
+LATTICE_CHUNK = 10_000
+
+
+def _net(sim) -> int:
+    """The engine's net collision count (forward minus undone, since the scene's start)."""
+    if hasattr(sim, "collisions"):
+        return int(sim.collisions)
+    return int(sim.diagnostics()["net_collisions"])
+
+
+def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume):
+    """The run's length and outputs, checked (SceneError naming the option)."""
+    src = scene.source
+    if scene.kind != "gas":
+        raise SceneError(f"{src}: revcol simulate runs 'gas' scenes, not {scene.kind!r} (use revcol run)")
+    if collisions is not None and time is not None:
+        raise SceneError(f"{src}: --collisions and --time: give one length, not both")
+    if collisions is not None and (isinstance(collisions, bool) or int(collisions) != collisions or collisions < 1):
+        raise SceneError(f"{src}: --collisions must be a positive integer, got {collisions!r}")
+    if time is not None and not (isinstance(time, (int, float)) and math.isfinite(time) and time > 0):
+        raise SceneError(f"{src}: --time must be a positive finite number, got {time!r}")
+    if collisions is None and time is None:
+        collisions, time = scene.collisions, scene.time
+    if scene.particles == 1 and time is None:
+        raise SceneError(f"{src}: --collisions: a single particle never collides (give --time)")
+    for name, k in (("--every", every), ("--checkpoint-every", checkpoint_every)):
+        try:
+            if k is not None:
+                integer(k, name, lo=1)
+        except (TypeError, ValueError):
+            raise SceneError(f"{src}: {name} must be a positive integer, got {k!r}") from None
+    trajectory = trajectory if trajectory is not None else scene.trajectory
+    if every is not None and trajectory is None:
+        raise SceneError(f"{src}: --every needs --trajectory (or the scene's [output] trajectory)")
+    every = every if every is not None else scene.trajectory_every
+    checkpoints = checkpoints if checkpoints is not None else scene.checkpoints
+    if checkpoint_every is not None and checkpoints is None:
+        raise SceneError(f"{src}: --checkpoint-every needs --checkpoint DIR (or the scene's [output] checkpoints)")
+    checkpoint_every = checkpoint_every if checkpoint_every is not None else scene.checkpoint_interval
+    if checkpoints is not None and not checkpoint_every:
+        raise SceneError(f"{src}: --checkpoint needs --checkpoint-every K (or the scene's [run] checkpoint_interval)")
+    if trajectory is not None:
+        from .trajectory import check_format
+
+        try:
+            check_format(trajectory)
+        except ValueError as e:
+            raise SceneError(f"{src}: {e}") from None
+    if resume is not None and not Path(resume).is_file():
+        raise SceneError(f"{src}: --resume: {os.fspath(resume)!r} is not a file")
+    return collisions, time, trajectory, int(every or 0), checkpoints, int(checkpoint_every or 0)
+
+
+def _build(scene: Scene, resume):
+    """The engine: from a checkpoint (``resume``, the scene's engine) or from the scene."""
+    if resume is None:
+        from .gas import build_simulation
+
+        return build_simulation(scene)
+    if scene.engine == "lattice":
+        from .lattice import LatticeSimulation as cls
+    else:
+        from .engine import Simulation as cls
+    try:
+        return cls.load(resume)
+    except (ValueError, KeyError, TypeError) as e:
+        raise SceneError(f"{scene.source}: --resume {os.fspath(resume)!r}: {e}") from None
+
+
+class _Production:
+    """One forward run with its outputs; ``go`` runs it, ``report`` describes it."""
+
+    def __init__(self, scene: Scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
+                 species: str, precise: bool):
+        self.scene, self.sim = scene, sim
+        self.lattice = scene.engine == "lattice"
+        self.start = self.done = _net(sim)
+        self.target = None if collisions is None else self.start + int(collisions)
+        self.t_start = sim.time
+        self.t_end = None if time is None else self.t_start + float(time)
+        self.every, self.ckpt_every = every, checkpoint_every
+        self.checkpoints = None if checkpoints is None else Path(checkpoints)
+        self.written_ckpt: list[str] = []
+        self.trajectory, self.writer, self.last_frame = trajectory, None, None
+        if trajectory is not None:
+            from .trajectory import open_trajectory
+
+            if self.lattice:
+                from .lattice_gas import geometry
+            else:
+                from .roundtrip import geometry
+
+            box, periodic = geometry(sim)
+            self.writer = open_trajectory(trajectory, box, periodic, scene.diameter, species=species,
+                                          precise=precise)
+        if scene.observe is not None and not self.lattice:
+            sim.observe(**scene.observe)
+        self.interrupted, self.engine_error, self.stalled, self.wall_s = False, None, False, 0.0
+
+    def finished(self) -> bool:
+        return ((self.target is not None and self.done >= self.target)
+                or (self.t_end is not None and self.sim.time >= self.t_end))
+
+    def next_stop(self) -> int | None:
+        stops = [(self.done // k + 1) * k for k in (self.every if self.writer else 0, self.ckpt_every) if k]
+        if self.target is not None:
+            stops.append(self.target)
+        return min(stops) if stops else None
+
+    def frame(self) -> None:
+        if self.writer is not None and self.last_frame != self.done:
+            sim = self.sim
+            self.writer.write(sim.positions, sim.velocities, sim.time, self.done, "forward")
+            self.last_frame = self.done
+
+    def checkpoint(self) -> None:
+        if self.checkpoints is not None and (not self.written_ckpt or not self.written_ckpt[-1].endswith(
+                f"-{self.done:012d}.npz")):
+            path = self.checkpoints / f"checkpoint-{self.done:012d}.npz"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            self.sim.save(path)
+            self.written_ckpt.append(str(path))
+
+    def step(self, stop: Interrupt, bar: Bar, stop_c: int | None) -> int:
+        """One engine call towards ``stop_c`` (or the end time); the collisions it did."""
+        sim, more = self.sim, None if stop_c is None else stop_c - self.done
+        if self.lattice:
+            more = LATTICE_CHUNK if more is None else min(more, LATTICE_CHUNK)
+            try:
+                return int(sim.run(collisions=more, time=self.t_end)["collisions"])
+            except RuntimeError as e:  # a collision the lattice engine cannot resolve: stop here
+                self.engine_error = str(e)
+                return _net(sim) - self.done
+        base = self.done
+
+        def callback(k: int) -> bool:
+            bar.to(base + k - self.start if self.target is not None else sim.time - self.t_start)
+            return stop.presses == 0
+        chunk = max(1, min(10_000, sim.n))
+        return int(sim.run(collisions=more, time=self.t_end, callback=callback, every=chunk)["collisions"])
+
+    def go(self, progress: bool) -> None:
+        total = float(self.target - self.start) if self.target is not None else float(self.t_end - self.t_start)
+        bar = Bar(progress, total, "simulate", "coll" if self.target is not None else "t")
+        tick = _time.perf_counter()
+        try:
+            with Interrupt() as stop:
+                self.frame()
+                while not self.finished():
+                    did = self.step(stop, bar, self.next_stop())
+                    self.done += did
+                    bar.to(self.done - self.start if self.target is not None else self.sim.time - self.t_start)
+                    if stop.presses:
+                        self.interrupted = True
+                    if self.interrupted or self.engine_error is not None:
+                        break
+                    if did == 0 and not self.finished():  # nothing left to happen (e.g. all at rest)
+                        self.stalled = True
+                        break
+                    if self.every and self.done % self.every == 0:
+                        self.frame()
+                    if self.ckpt_every and self.done % self.ckpt_every == 0:
+                        self.checkpoint()
+                self.frame()
+                self.checkpoint()
+        finally:
+            self.wall_s = _time.perf_counter() - tick
+            bar.close()
+            if self.writer is not None:
+                self.writer.close()
+
+    def report(self, resume) -> dict[str, Any]:
+        sim, scene = self.sim, self.scene
+        d = sim.diagnostics()
+        obs = sim.observation() if scene.observe is not None and not self.lattice else None
+        ran = self.done - self.start
+        return {
+            "kind": "simulate", "revcol_version": version(), "scene": scene.to_dict(), "summary": scene.summary(),
+            "engine": scene.engine, "particles": sim.n, "dimension": sim.dim,
+            "resumed_from": None if resume is None else os.fspath(resume),
+            "collisions": ran, "net_collisions": self.done, "collisions_per_particle": 2.0 * ran / sim.n,
+            "time_start": self.t_start, "time_end": sim.time,
+            "wall_s": self.wall_s, "collisions_per_s": ran / self.wall_s if self.wall_s > 0 else None,
+            "energy_drift": float(d["energy_drift"]),
+            "energy_drift_definition": "(E - E0) / E0, E0 at the scene's start",
+            "interrupted": self.interrupted, "engine_error": self.engine_error, "stalled": self.stalled,
+            "trajectory": None if self.trajectory is None else os.fspath(self.trajectory),
+            "trajectory_frames": self.writer.frames if self.writer is not None else 0,
+            "checkpoints": self.written_ckpt,
+            "observe": obs.to_dict() if obs is not None else None,
+            "peak_rss_bytes": peak_rss(),
+            "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+            "written": ([os.fspath(self.trajectory)] if self.writer is not None else []) + list(self.written_ckpt),
+        }
+
+
+def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int | None = None,
+             time: float | None = None, trajectory: str | os.PathLike | None = None, every: int | None = None,
+             checkpoints: str | os.PathLike | None = None, checkpoint_every: int | None = None,
+             resume: str | os.PathLike | None = None, seed: int | None = None, engine: str | None = None,
+             species: str = "Ar", precise: bool = False, json_path: str | os.PathLike | None = None,
+             progress: bool | None = None) -> dict:
+    """Runs a gas scene forward only (see the module's docstring) and returns the report; with
+    ``json_path`` also writes it (atomically). ``species`` names the trajectory's element,
+    ``precise`` adds float64 positions to a GSD trajectory. A bad option raises SceneError
+    before anything runs."""
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene)
+    if engine is not None:
+        scene = with_engine(scene, engine)
+    if seed is not None:
+        scene = dataclasses.replace(scene, seed=int(seed))
+    json_path = json_path if json_path is not None else scene.json
+    collisions, time, trajectory, every, checkpoints, checkpoint_every = _options(
+        scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume)
+    from .run import _check_memory, _check_output
+
+    for what, path, folder in (("--json", json_path, False), ("--trajectory", trajectory, False),
+                               ("--checkpoint", checkpoints, True)):
+        _check_output(scene.source, what, path, folder)
+    try:
+        from .trajectory import _species
+
+        _species(species)
+    except ValueError as e:
+        raise SceneError(f"{scene.source}: --species: {e}") from None
+    _check_memory(scene)
+    sim = _build(scene, resume)
+    run = _Production(scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
+                      species, precise)
+    run.go(sys.stdout.isatty() if progress is None else progress)
+    r = run.report(resume)
+    if json_path is not None:
+        from .report import write_json
+
+        r["written"].append(os.fspath(json_path))
+        write_json(r, json_path)
+    return r
+
+
+def format_simulate(r: dict) -> str:
+    """The report as text."""
+    s = r["scene"]
+    rate = r["collisions_per_s"]
+    lines = [f"revcol simulate {s['name']}  ({s['source']})", f"  scene            {r['summary']}",
+             f"  engine           {r['engine']}" + (f"  (resumed from {r['resumed_from']})" if r["resumed_from"] else ""),
+             f"  collisions       {r['collisions']:,} ({r['collisions_per_particle']:.3g} per particle; "
+             f"net count now {r['net_collisions']:,})",
+             f"  time             {r['time_start']:.6g} -> {r['time_end']:.6g}",
+             f"  wall             {r['wall_s']:.3g} s" + (f"  ({rate:,.0f} collisions/s)" if rate else ""),
+             f"  energy drift     {r['energy_drift']:.3g}  ((E - E0) / E0)"]
+    if r["trajectory"]:
+        lines.append(f"  trajectory       {r['trajectory']}  ({r['trajectory_frames']} frames)")
+    if r["checkpoints"]:
+        lines.append(f"  checkpoints      {len(r['checkpoints'])}, last {r['checkpoints'][-1]}")
+    if r["interrupted"]:
+        lines.append("  interrupted      (Ctrl-C): stopped between events; the last frame and checkpoint are written")
+    if r["engine_error"]:
+        lines.append(f"  engine error     {r['engine_error']} (stopped there)")
+    if r["stalled"]:
+        lines.append("  stalled          the engine had no more collisions to do before the end")
+    if r["observe"]:
+        from .observe import report_lines
+
+        lines += report_lines(r["observe"])
+    if r["written"]:
+        lines.append("  written          " + " ".join(r["written"]))
+    return "\n".join(lines)
