@@ -29,6 +29,13 @@ def _fsync_folder(folder: str) -> None:
         os.close(fd)
 
 
+def _open_permissions(path: str) -> None:
+    """The mode open() would have given a new file (0666 less the umask)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(path, 0o666 & ~mask)
+
+
 @contextlib.contextmanager
 def atomic_open(path: Union[str, os.PathLike], mode: str = "w", **kwargs) -> Iterator[IO]:
     """A file to write ``path`` through: a temporary file beside it, fsynced and renamed over
@@ -40,6 +47,7 @@ def atomic_open(path: Union[str, os.PathLike], mode: str = "w", **kwargs) -> Ite
     suffix = os.path.splitext(path)[1]
     fd, tmp = tempfile.mkstemp(prefix=".revcol-", suffix=suffix + ".tmp", dir=folder)
     try:
+        _open_permissions(tmp)  # mkstemp's 0600 would make every output private
         with os.fdopen(fd, mode, **kwargs) as f:
             yield f
             f.flush()
@@ -68,6 +76,7 @@ def write_npz_atomic(path: Union[str, os.PathLike], arrays: Mapping[str, np.ndar
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".revcol-", suffix=".npz.tmp", dir=folder)
     try:
+        _open_permissions(tmp)
         with os.fdopen(fd, "wb") as f:
             np.savez(f, **arrays)
             f.flush()

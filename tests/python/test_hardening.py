@@ -356,6 +356,11 @@ def test_an_output_that_fails_half_way_keeps_the_previous_file(tmp_path):
     with atomic_open(path) as f:
         f.write('{"new": 2}\n')
     assert path.read_text() == '{"new": 2}\n' and [p.name for p in tmp_path.iterdir()] == ["r.json"]
+    mask = os.umask(0)
+    os.umask(mask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~mask  # readable as open() would make it, not mkstemp's 0600
+    Simulation.random(20, 2, 0.3, seed=1).save(tmp_path / "c.npz")
+    assert (tmp_path / "c.npz").stat().st_mode & 0o777 == 0o666 & ~mask
 
 
 def test_a_report_figure_and_csv_keep_the_previous_file_when_the_write_fails(tmp_path, monkeypatch):
