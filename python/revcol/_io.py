@@ -70,25 +70,10 @@ def save_figure(fig, path: Union[str, os.PathLike], **kwargs) -> None:
 
 
 def write_npz_atomic(path: Union[str, os.PathLike], arrays: Mapping[str, np.ndarray]) -> None:
-    """Writes ``arrays`` as an ``.npz`` to ``path`` atomically (temporary file in the same folder,
-    fsync, then ``os.replace``): a failed save leaves any previous file at ``path`` whole."""
-    path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".revcol-", suffix=".npz.tmp", dir=folder)
-    try:
-        _open_permissions(tmp)
-        with os.fdopen(fd, "wb") as f:
-            np.savez(f, **arrays)
-            f.flush()
-            os.fsync(f.fileno())  # the data is on disk before the name points at it
-        os.replace(tmp, path)
-        _fsync_folder(folder)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    """Writes ``arrays`` as an ``.npz`` to ``path`` atomically (:func:`atomic_open`): a failed
+    save leaves any previous file at ``path`` whole."""
+    with atomic_open(path, "wb") as f:
+        np.savez(f, **arrays)
 
 
 def stamped(arrays: Mapping[str, np.ndarray], engine: str) -> dict:
