@@ -48,10 +48,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="state saving faults its record pages in inside the forward time")
     p.add_argument("--binary", help="the revcol-bench to run (default: next to python, or on PATH)")
     p.add_argument("--inline", action="store_true", help="run in this process (peak RSS is then shared)")
+    p.add_argument("--cpu", type=int, metavar="K", help="pin every run to core K (taskset); the variants "
+                   "are interleaved round by round in any case")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--json", metavar="FILE", help="write the report (and FILE's .csv next to it); - for standard output")
     p.add_argument("--csv", metavar="FILE", help="write the runs as CSV (default: next to --json)")
-    p.add_argument("--plot", metavar="FILE", help="write the stacked bar plot (PNG)")
+    p.add_argument("--plot", metavar="FILE", help="write the stacked bar plot (.png, .pdf or .svg)")
 
 
 def cli_main(args: argparse.Namespace, argv: Sequence[str] | None = None) -> int:
@@ -62,7 +64,7 @@ def cli_main(args: argparse.Namespace, argv: Sequence[str] | None = None) -> int
                        variants=args.variants, repeats=args.repeats, budget_gib=args.budget_gib,
                        seed=args.seed, rng=args.rng, mean_dt=args.mean_dt, grazing_tol=args.grazing_tol,
                        prefault=not args.first_touch, binary=args.binary, inline=args.inline,
-                       progress=False if args.no_progress else None, command=command)
+                       progress=False if args.no_progress else None, command=command, cpu=args.cpu)
     except (ValueError, FileNotFoundError) as e:
         print(f"revcol bench statesave: error: {e}", file=sys.stderr)
         return 2

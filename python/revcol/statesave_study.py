@@ -1,7 +1,13 @@
-"""The state-saving study (:func:`study`): every (mode, N, variant), each in a fresh
+"""The state-saving study (:func:`study`): every (mode, N, variant), each repeat in a fresh
 ``revcol-bench`` process (so that its peak resident set is its own) or in this process,
-repeated, with the repeat of median total time reported; runs over the budget are skipped
-with their projection, and RC's ratios to each state-saving variant are computed.
+with the repeat of median total time reported; runs over the budget are skipped with their
+projection, and RC's ratios to each state-saving variant are computed.
+
+The machines are shared, so the variants of one (mode, N) are *interleaved*: round r runs
+every variant once (the order reversed on odd rounds: A B, B A, ...), so that a change in the
+machine's load hits all of them alike. Each run records the 1-minute load average before it;
+``cpu=K`` pins every run to core K (``taskset``). The ratios RC / SS are given for the medians
+and, round by round, as the median and range of the paired ratios.
 """
 from __future__ import annotations
 
@@ -81,7 +87,7 @@ class _Progress:
             sys.stdout.flush()
 
 
-def _run_process(binary: str, kw: dict, repeats: int) -> list[dict]:
+def _run_process(binary: str, kw: dict, repeats: int, cpu: int | None = None) -> list[dict]:
     env = dict(os.environ)
     env["REVCOL_STATESAVE"] = ",".join([
         f"n={kw['particles']}", f"seed={kw['seed']}", f"rng={kw['rng']}", f"law={kw['law']}",
@@ -92,6 +98,8 @@ def _run_process(binary: str, kw: dict, repeats: int) -> list[dict]:
         out = Path(tmp) / "run.json"
         cmd = [binary, "--bench", name, "--collisions", str(kw["collisions"]), "--repeats", str(repeats),
                "--json", str(out)]
+        if cpu is not None:
+            cmd = ["taskset", "-c", str(cpu)] + cmd
         # its own session: a terminal's Ctrl-C reaches the study (which stops after this run)
         # and not the run (a KeyboardInterrupt here makes subprocess.run kill the run)
         p = subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
@@ -131,6 +139,9 @@ def _row(kw: dict, reps: list[dict], record_bytes: int, projected: int) -> dict:
         "total_ms": 1e3 * totals[med],
         "forward_ms_all": [1e3 * x["forward_s"] for x in reps],
         "rollback_ms_all": [1e3 * x["rollback_s"] for x in reps],
+        "total_ms_all": [1e3 * t for t in totals],
+        "total_ms_min": 1e3 * min(totals), "total_ms_max": 1e3 * max(totals),
+        "load_1m_all": [x.get("load_1m") for x in reps],
         "bytes_saved": saved, "projected_bytes": projected, "record_bytes": record_bytes,
         "state_bytes": 32 * kw["particles"],
         "peak_rss_bytes": int(max(float(x["peak_rss_bytes"]) for x in reps)),
@@ -158,6 +169,7 @@ def _skipped_row(kw: dict, record_bytes: int, projected: int) -> dict:
     row.update({"mode": kw["mode"], "transport": kw["transport"], "variant": kw["variant"],
                 "particles": kw["particles"], "collisions": kw["collisions"], "skipped": True,
                 "status": _skip_text(projected), "forward_ms_all": [], "rollback_ms_all": [],
+                "total_ms_all": [], "total_ms_min": None, "total_ms_max": None, "load_1m_all": [],
                 "projected_bytes": projected, "record_bytes": record_bytes,
                 "state_bytes": 32 * kw["particles"]})
     return row
@@ -174,9 +186,14 @@ def _ratios(runs: list[dict]) -> list[dict]:
                 continue
             ran = not s["skipped"] and not rc["skipped"]
             ss_bytes = s["projected_bytes"] if s["skipped"] else s["bytes_saved"]
+            # round by round: RC's k-th run against SS's k-th, run next to each other
+            paired = sorted(a / b for a, b in zip(rc["total_ms_all"], s["total_ms_all"]) if b > 0) if ran else []
             out.append({
                 "mode": mode, "particles": n, "vs": v2,
                 "time": rc["total_ms"] / s["total_ms"] if ran and s["total_ms"] > 0 else None,
+                "time_paired_median": paired[(len(paired) - 1) // 2] if paired else None,
+                "time_paired_min": paired[0] if paired else None,
+                "time_paired_max": paired[-1] if paired else None,
                 "bytes_saved": rc["bytes_saved"] / ss_bytes if not rc["skipped"] and ss_bytes else None,
                 "peak_rss": rc["peak_rss_bytes"] / s["peak_rss_bytes"] if ran and s["peak_rss_bytes"] else None,
                 "note": "state saving skipped: bytes ratio against its projection" if s["skipped"] else "",
@@ -200,21 +217,27 @@ def _machine() -> dict:
     return info
 
 
+class _Stopped(Exception):
+    """``stop()`` said to end the study (the (mode, N) under way is dropped)."""
+
+
 def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1000, *,
           lazy: bool = False, modes: Sequence[str] = ("exact",), law: str = "flux",
           variants: Sequence[str] | None = None, repeats: int = 3, budget_gib: float = 8.0,
           seed: int = 0, rng: str = "clcg4", mean_dt: float = 1e-5, grazing_tol: float = 1e-11,
           prefault: bool = True, binary: str | None = None, inline: bool = False,
           progress: bool | None = None, command: str | None = None,
-          stop: Callable[[], bool] | None = None) -> dict:
+          stop: Callable[[], bool] | None = None, cpu: int | None = None) -> dict:
     """Runs every (mode, N, variant) and returns the report (see the module doc).
 
-    Each run is a fresh ``revcol-bench`` process (``binary``: explicit, ``$REVCOL_BENCH``,
-    next to this Python, or on PATH), repeated ``repeats`` times in it; ``inline=True`` runs
-    in this process instead (peak RSS is then this whole process's). Runs whose saved
+    Each repeat is a fresh ``revcol-bench`` process (``binary``: explicit, ``$REVCOL_BENCH``,
+    next to this Python, or on PATH), the variants of one (mode, N) interleaved round by
+    round; ``inline=True`` runs in this process instead (peak RSS is then this whole
+    process's). ``cpu``: pin each process to that core (``taskset -c``). Runs whose saved
     state exceeds ``budget_gib`` are not attempted. ``progress``: None = when stdout is a
     terminal. ``stop``: asked before each run; when it returns True the study ends there
-    (the report has the runs done, ``interrupted`` True and ``not_run`` the rest).
+    (the report has the (mode, N) groups done, ``interrupted`` True and ``not_run`` the
+    (mode, N, variant) rows left out).
     """
     ns = list(n) if not isinstance(n, (int, float)) else [n]
     if not ns:
@@ -232,29 +255,46 @@ def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1
     base = _kwargs(ns[0], collisions, vs[0], lazy, modes[0], law, rng, seed, mean_dt, grazing_tol,
                    budget_gib, prefault)
     exe = None if inline else _find_binary(binary)
+    if cpu is not None:
+        cpu = _int(cpu, "cpu", 0, (os.cpu_count() or 1) - 1)
+        if inline:
+            raise ValueError("cpu pins the fresh processes: it needs inline=False")
+        if shutil.which("taskset") is None:
+            raise FileNotFoundError("cpu needs taskset (util-linux), which is not on PATH")
 
-    plan = [(m, N, v) for m in modes for N in ns for v in vs]
-    bar = _Progress(len(plan), progress)
+    groups = [(m, N) for m in modes for N in ns]
+    bar = _Progress(len(groups) * len(vs) * repeats, progress)
     runs = []
     not_run = 0
+    loads = [os.getloadavg()[0]]
     try:
-        for k, (m, N, v) in enumerate(plan):
-            if stop is not None and stop():
-                not_run = len(plan) - k
-                break
-            kw = dict(base, mode=m, particles=N, variant=v)
-            proj = _core.statesave_projected_bytes(**kw)
-            label = f"{m} N={N:,} {_LABEL[v]}"
-            if proj["over_budget"]:
-                runs.append(_skipped_row(kw, proj["record_bytes"], proj["projected_bytes"]))
-            else:
-                reps = _run_inline(kw, repeats) if inline else _run_process(exe, kw, repeats)
-                row = _row(kw, reps, proj["record_bytes"], proj["projected_bytes"])
-                row["status"] = "ok" if row["restored"] else "FAILED"
-                runs.append(row)
-            bar.update(label)
+        for g, (m, N) in enumerate(groups):
+            kws = {v: dict(base, mode=m, particles=N, variant=v) for v in vs}
+            projs = {v: _core.statesave_projected_bytes(**kws[v]) for v in vs}
+            live = [v for v in vs if not projs[v]["over_budget"]]
+            reps: dict[str, list[dict]] = {v: [] for v in live}
+            for r in range(repeats):
+                for v in (live if r % 2 == 0 else live[::-1]):
+                    if stop is not None and stop():
+                        raise _Stopped
+                    load = os.getloadavg()[0]
+                    one = _run_inline(kws[v], 1) if inline else _run_process(exe, kws[v], 1, cpu)
+                    one[0]["load_1m"] = load
+                    reps[v] += one
+                    bar.update(f"{m} N={N:,} {_LABEL[v]} {r + 1}/{repeats}")
+            for v in vs:
+                p = projs[v]
+                if p["over_budget"]:
+                    runs.append(_skipped_row(kws[v], p["record_bytes"], p["projected_bytes"]))
+                else:
+                    row = _row(kws[v], reps[v], p["record_bytes"], p["projected_bytes"])
+                    row["status"] = "ok" if row["restored"] else "FAILED"
+                    runs.append(row)
+    except _Stopped:
+        not_run = (len(groups) - len({(r["mode"], r["particles"]) for r in runs})) * len(vs)
     finally:
         bar.close()
+    loads.append(os.getloadavg()[0])
     passed = all(r["skipped"] or r["restored"] for r in runs) and \
         all(not r["skipped"] for r in runs if r["variant"] == "rc")
     return {
@@ -265,7 +305,9 @@ def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1
         "runner": "inline" if inline else "process",
         "rss_note": ("peak RSS of this whole Python process (inline)" if inline else
                      "peak RSS (VmHWM) of a fresh revcol-bench process per (mode, N, variant)"),
-        "time_note": f"the repeat with the median total of {repeats}",
+        "time_note": (f"the repeat with the median total of {repeats}, the variants of each (mode, N) "
+                      "interleaved round by round, each repeat a fresh process"),
+        "cpu": cpu, "load_1m_start": loads[0], "load_1m_end": loads[-1],
         "binary": exe, "command": command, "machine": _machine(),
         "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
         "runs": runs, "ratios": _ratios(runs), "passed": passed,

@@ -3,6 +3,7 @@
 import json
 import math
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -138,6 +139,59 @@ def test_study_writes_json_csv_and_plot(tmp_path):
     assert (tmp_path / "s.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_study_interleaves_variants_round_by_round(monkeypatch):
+    import revcol.statesave_study as sst
+    order = []
+    real = sst._run_inline
+
+    def spy(kw, repeats):
+        order.append((kw["particles"], kw["variant"]))
+        return real(kw, repeats)
+
+    monkeypatch.setattr(sst, "_run_inline", spy)
+    rep = ss.study([100, 200], 50, variants=["ss1", "rc"], repeats=3, inline=True, progress=False)
+    # A B, B A, A B for each N in turn: a change of load hits every variant alike
+    assert order == [(100, "ss1"), (100, "rc"), (100, "rc"), (100, "ss1"), (100, "ss1"), (100, "rc"),
+                     (200, "ss1"), (200, "rc"), (200, "rc"), (200, "ss1"), (200, "ss1"), (200, "rc")]
+    for r in rep["runs"]:
+        assert len(r["total_ms_all"]) == 3 and len(r["load_1m_all"]) == 3
+        assert r["total_ms_min"] <= r["total_ms"] <= r["total_ms_max"]
+    assert rep["load_1m_start"] >= 0 and rep["load_1m_end"] >= 0
+    for q in rep["ratios"]:
+        rc = next(r for r in rep["runs"] if r["particles"] == q["particles"] and r["variant"] == "rc")
+        s1 = next(r for r in rep["runs"] if r["particles"] == q["particles"] and r["variant"] == "ss1")
+        paired = sorted(a / b for a, b in zip(rc["total_ms_all"], s1["total_ms_all"]))
+        assert (q["time_paired_min"], q["time_paired_median"], q["time_paired_max"]) == \
+            (paired[0], paired[1], paired[2])
+
+
+def test_study_stop_drops_the_group_under_way():
+    calls = []
+
+    def stop():
+        calls.append(1)
+        return len(calls) > 5  # 4 runs of N=100 (2 variants x 2 rounds), then one of N=200
+
+    rep = ss.study([100, 200], 50, variants=["ss1", "rc"], repeats=2, inline=True, progress=False, stop=stop)
+    assert rep["interrupted"] and rep["not_run"] == 2
+    assert [(r["particles"], r["variant"]) for r in rep["runs"]] == [(100, "ss1"), (100, "rc")]
+
+
+def test_study_cpu_argument():
+    with pytest.raises(ValueError, match="cpu"):
+        ss.study([50], 10, cpu=-1, binary=_bench_binary() or "/bin/true")
+    with pytest.raises(ValueError, match="cpu"):
+        ss.study([50], 10, cpu=0, inline=True)
+
+
+def test_plot_marks_zero_bytes_and_writes_pdf(tmp_path):
+    pytest.importorskip("matplotlib")
+    rep = ss.study([100], 50, modes=["paper"], repeats=2, inline=True, progress=False)
+    assert next(r for r in rep["runs"] if r["variant"] == "rc")["bytes_saved"] == 0
+    ss.plot(rep, tmp_path / "s.pdf")
+    assert (tmp_path / "s.pdf").read_bytes()[:5] == b"%PDF-"
+
+
 def _bench_binary():
     for c in (os.environ.get("REVCOL_BENCH"), str(Path(sys.executable).parent / "revcol-bench")):
         if c and Path(c).is_file():
@@ -149,8 +203,9 @@ def test_study_in_fresh_processes():
     exe = _bench_binary()
     if exe is None:
         pytest.skip("revcol-bench not found (set REVCOL_BENCH or install the package)")
-    rep = ss.study([200], 200, modes=["exact"], repeats=2, binary=exe, progress=False)
-    assert rep["runner"] == "process" and rep["passed"]
+    cpu = 0 if shutil.which("taskset") else None
+    rep = ss.study([200], 200, modes=["exact"], repeats=2, binary=exe, progress=False, cpu=cpu)
+    assert rep["runner"] == "process" and rep["passed"] and rep["cpu"] == cpu
     rows = {r["variant"]: r for r in rep["runs"]}
     assert rows["ss1"]["bytes_saved"] == (32 * 200 + 24) * 200
     assert rows["ss1"]["peak_rss_bytes"] > rows["ss1"]["bytes_saved"]
