@@ -113,7 +113,9 @@ def _parser() -> argparse.ArgumentParser:
                    "(e.g. spheres-3d; see scenes/ and docs/run.md)")
     r.add_argument("--json", metavar="FILE", help="write the report as JSON ('-': to standard output, and the "
                    "text report to standard error)")
-    r.add_argument("--plot", metavar="DIR", help="write PNG figures into DIR (needs matplotlib)")
+    r.add_argument("--plot", metavar="DIR", help="write the figures into DIR (needs matplotlib)")
+    r.add_argument("--plot-format", choices=("png", "pdf", "svg"), default="png",
+                   help="the figures' file format (default png; pdf and svg are vector)")
     r.add_argument("--trajectory", metavar="FILE",
                    help="write frames forward and through the reversal: FILE.xyz (extended XYZ) or FILE.gsd")
     r.add_argument("--horizon", action="store_true",
@@ -191,7 +193,8 @@ def _run(args: argparse.Namespace) -> int:
                                trajectory=args.trajectory,
                                horizon_seeds=(args.seeds or 1) if args.horizon else None,
                                max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
-                               engine=args.engine, progress=False if args.no_progress else None)
+                               engine=args.engine, progress=False if args.no_progress else None,
+                               plot_format=args.plot_format)
     except SceneError as e:
         print(f"revcol run: error: {e}", file=sys.stderr)
         return 2

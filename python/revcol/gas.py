@@ -285,7 +285,7 @@ class _GasRun:
 
 def run_gas(scene: Scene, *, plot: str | os.PathLike | None = None,
             trajectory: str | os.PathLike | None = None, progress: bool | None = None,
-            checkpoints: bool = True) -> dict:
+            checkpoints: bool = True, plot_format: str = "png") -> dict:
     """Runs a gas scene forward and back; returns the report (a dict, see :mod:`revcol.run`;
     a lattice scene's: :mod:`revcol.lattice_gas`).
 
@@ -305,19 +305,21 @@ def run_gas(scene: Scene, *, plot: str | os.PathLike | None = None,
         except ValueError as e:
             raise SceneError(str(e)) from None
     if plot is not None:
-        from .plots import require_matplotlib
+        from .plots import check_format, require_matplotlib
 
         require_matplotlib()
+        check_format(plot_format)
     if progress is None:
         progress = sys.stdout.isatty()
     if scene.engine == "lattice":
         from .lattice_gas import run_lattice_gas
 
-        return run_lattice_gas(scene, plot=plot, trajectory=trajectory, progress=progress, checkpoints=checkpoints)
-    return round_trip(_GasRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_gas")
+        return run_lattice_gas(scene, plot=plot, trajectory=trajectory, progress=progress, checkpoints=checkpoints,
+                               plot_format=plot_format)
+    return round_trip(_GasRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_gas", plot_format)
 
 
-def round_trip(run, plot, figures: str) -> dict:
+def round_trip(run, plot, figures: str, plot_format: str = "png") -> dict:
     """Forward, turn, back (Ctrl-C counted throughout), the report, and with ``plot`` the
     figures drawn by ``revcol.plots.<figures>``. ``run`` is a gas run (this module's, or the
     lattice engine's in :mod:`revcol.lattice_gas`)."""
@@ -331,5 +333,5 @@ def round_trip(run, plot, figures: str) -> dict:
 
         sim = run.sim
         report["written"] += getattr(plots, figures)(report, Path(plot), (run.x0, run.v0), run.shot_turn,
-                                                     (sim.positions, sim.velocities))
+                                                     (sim.positions, sim.velocities), fmt=plot_format)
     return report

@@ -312,14 +312,15 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
 
 
 def run_lattice_gas(scene: Scene, *, plot=None, trajectory=None, progress: bool | None = None,
-                    checkpoints: bool = True) -> dict:
+                    checkpoints: bool = True, plot_format: str = "png") -> dict:
     """Runs a lattice gas scene forward and back; returns the report (outputs as
     :func:`revcol.gas.run_gas`; the figures are the energy drift, X's size and snapshots)."""
     from .gas import round_trip
 
     if progress is None:
         progress = sys.stdout.isatty()
-    return round_trip(_LatticeRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_lattice_gas")
+    return round_trip(_LatticeRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_lattice_gas",
+                      plot_format)
 
 
 def lattice_horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000,

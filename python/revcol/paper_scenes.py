@@ -31,7 +31,8 @@ def run_reversal(scene: Scene) -> dict:
     return r
 
 
-def run_statesave(scene: Scene, plot: str | os.PathLike | None = None, progress: bool | None = None) -> dict:
+def run_statesave(scene: Scene, plot: str | os.PathLike | None = None, progress: bool | None = None,
+                  plot_format: str = "png") -> dict:
     """The paper's state-saving study for the scene's settings (:func:`revcol.statesave.study`).
     ``runner = "auto"`` runs each point in a fresh ``revcol-bench`` process when one is
     found (so peak RSS is the run's own), in this process otherwise."""
@@ -66,7 +67,7 @@ def run_statesave(scene: Scene, plot: str | os.PathLike | None = None, progress:
     r.update({"kind": "statesave", "scene": scene.to_dict(), "summary": scene.summary(),
               "interrupted": "statesave" if r["interrupted"] or stop.presses else None, "written": []})
     if plot is not None:
-        out = Path(plot) / "statesave.png"
+        out = Path(plot) / f"statesave.{plot_format}"
         out.parent.mkdir(parents=True, exist_ok=True)
         statesave.plot(r, out)
         r["written"].append(str(out))

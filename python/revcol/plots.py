@@ -1,6 +1,16 @@
-"""The PNG figures of ``revcol run --plot``: a gas run's round-trip error, energy drift and
+"""The figures of ``revcol run --plot``: a gas run's round-trip error, energy drift and
 snapshots (start, turn, end), a lattice run's energy drift, bits-back size and snapshots, and
 the horizon's error against collisions per particle.
+
+Every figure is written as PNG (150 dpi), PDF or SVG (``fmt``). What they promise a reader:
+axes with their quantities and units (lengths in the scene's units, the particle diameter
+drawn to scale), a colourbar wherever colour carries a value, periodic axes drawn dashed and
+walls solid, log axes that never invent a value (an exact zero is drawn as an open marker on
+the axis floor, and the legend says so), legends inside the axes, no tables inside figures.
+
+1D gases are drawn in phase space (position against velocity): a line of rods shows nothing.
+3D gases are drawn as a slice through the middle of the box (the spheres' cross sections in
+|z - Lz/2| < D/2, to scale), not as a projection in which thousands of spheres overlap.
 
 matplotlib is imported only here and only when a figure is drawn (Agg backend unless pyplot
 is already in use); :func:`require_matplotlib` checks for it before a run starts.
@@ -17,7 +27,11 @@ from ._io import save_figure
 from .roundtrip import BAR
 from .scene import SceneError
 
-__all__ = ["require_matplotlib", "plot_gas", "plot_lattice_gas", "plot_horizon"]
+__all__ = ["FORMATS", "require_matplotlib", "check_format", "plot_gas", "plot_lattice_gas", "plot_horizon"]
+
+#: the file formats of the figures (``--plot-format``)
+FORMATS = ("png", "pdf", "svg")
+_EPS = float(np.finfo(float).eps)
 
 
 def require_matplotlib() -> None:
@@ -26,6 +40,13 @@ def require_matplotlib() -> None:
         import matplotlib  # noqa: F401
     except ImportError:
         raise SceneError("--plot needs matplotlib (pip install matplotlib)") from None
+
+
+def check_format(fmt: str) -> str:
+    """``fmt`` if it is one of :data:`FORMATS`, else SceneError naming the choices."""
+    if fmt not in FORMATS:
+        raise SceneError(f"--plot-format: {fmt!r} is not one of {', '.join(FORMATS)}")
+    return fmt
 
 
 def _pyplot():
@@ -38,7 +59,38 @@ def _pyplot():
     return plt
 
 
-def plot_gas(r: dict, out: Path, start, turn, end) -> list[str]:
+def _log_series(ax, x, y, marker: str, label: str, color: str, plot="semilogy") -> list[float]:
+    """Draws the positive values of y on a log axis; returns the x of the exact zeros (drawn
+    by :func:`_mark_zeros` once the floor is known)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    pos = y > 0
+    getattr(ax, plot)(x[pos], y[pos], marker + "-", label=label, color=color, ms=4)
+    return list(x[~pos])
+
+
+def _mark_zeros(ax, zeros: list[tuple[list[float], str]], ymin_pos: float) -> None:
+    """Exact zeros as open markers on the log axis' floor, a decade below the smallest value."""
+    if not any(z for z, _ in zeros):
+        return
+    floor = ymin_pos / 10.0
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(floor / 3.0, max(hi, ymin_pos * 10))
+    first = True
+    for xs, color in zeros:
+        if xs:
+            ax.plot(xs, [floor] * len(xs), "v", mfc="none", color=color, ms=6,
+                    label=f"exactly 0 (drawn at {floor:.0e})" if first else None)
+            first = False
+    ax.axhline(floor, color="0.7", lw=0.5, ls="-")
+
+
+def _finish(ax, legend: bool = True) -> None:
+    ax.grid(True, which="both", alpha=0.3)
+    if legend:
+        ax.legend(fontsize=8, loc="best", framealpha=0.85)
+
+
+def plot_gas(r: dict, out: Path, start, turn, end, fmt: str = "png") -> list[str]:
     """A gas run's figures in ``out``: round-trip error and energy drift against collisions,
     and snapshots; ``start``, ``turn``, ``end`` are (positions, velocities). Returns the paths."""
     plt = _pyplot()
@@ -48,23 +100,24 @@ def plot_gas(r: dict, out: Path, start, turn, end) -> list[str]:
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     c = [p["collisions"] for p in r["curve"]]
-    ax.semilogy(c, [max(p["error_x"], 1e-18) for p in r["curve"]], "o-", label="positions: max |x - x0| / L")
-    ax.semilogy(c, [max(p["error_v"], 1e-18) for p in r["curve"]], "s-", label="velocities: max |v - v0| / max |v0|")
+    ex, ev = [p["error_x"] for p in r["curve"]], [p["error_v"] for p in r["curve"]]
+    zeros = [(_log_series(ax, c, ex, "o", "positions: max |x - x0| / L", "C0"), "C0"),
+             (_log_series(ax, c, ev, "s", "velocities: max |v - v0| / max |v0|", "C1"), "C1")]
     ax.axhline(BAR, color="k", ls=":", lw=1, label="bar 1e-9")
-    ax.set_xlabel("collisions forward (then back to the start)")
-    ax.set_ylabel("round-trip error")
+    _mark_zeros(ax, zeros, min([y for y in ex + ev if y > 0] + [BAR]))
+    ax.set_xlabel("collisions forward (each point: forward to here, then back to the start)")
+    ax.set_ylabel("round-trip error (relative)")
     ax.set_title(title, fontsize=7)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    _finish(ax)
     fig.tight_layout()
-    written.append(_save(fig, out / "roundtrip_error.png", plt))
+    written.append(_save(fig, out / f"roundtrip_error.{fmt}", plt))
 
-    written.append(_energy_figure(r, out, plt, title))
-    written.append(_snapshots_figure(r, out, plt, title, start, turn, end))
+    written.append(_energy_figure(r, out, plt, title, fmt, exact=False))
+    written.append(_snapshots_figure(r, out, plt, title, start, turn, end, fmt))
     return written
 
 
-def plot_lattice_gas(r: dict, out: Path, start, turn, end) -> list[str]:
+def plot_lattice_gas(r: dict, out: Path, start, turn, end, fmt: str = "png") -> list[str]:
     """A lattice run's figures in ``out``: energy drift and the bits-back integer's size against
     collisions (sampled after each chunk of the forward run), and snapshots; ``start``,
     ``turn``, ``end`` are (positions, velocities). There is no round-trip error curve: every
@@ -72,92 +125,177 @@ def plot_lattice_gas(r: dict, out: Path, start, turn, end) -> list[str]:
     plt = _pyplot()
     out.mkdir(parents=True, exist_ok=True)
     title = textwrap.fill(r["summary"], 110)
-    written = [_energy_figure(r, out, plt, title)]
+    written = [_energy_figure(r, out, plt, title, fmt, exact=True)]
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     bs = np.array(r["bits_series"], dtype=float).reshape(-1, 2)
-    ax.plot(bs[:, 0], bs[:, 1], "-", lw=1)
+    ax.plot(bs[:, 0], bs[:, 1], "o-" if len(bs) < 30 else "-", lw=1, ms=3, label="bit length of X")
     ax.set_xlabel("collisions forward")
-    ax.set_ylabel("bits-back integer X: bit length")
+    ax.set_ylabel("bits-back integer X: bit length (bits)")
     ax.set_title(title, fontsize=7)
-    ax.grid(True, alpha=0.3)
+    _finish(ax)
     fig.tight_layout()
-    written.append(_save(fig, out / "bits_back.png", plt))
-    written.append(_snapshots_figure(r, out, plt, title, start, turn, end))
+    written.append(_save(fig, out / f"bits_back.{fmt}", plt))
+    written.append(_snapshots_figure(r, out, plt, title, start, turn, end, fmt))
     return written
 
 
-def _energy_figure(r: dict, out: Path, plt, title: str) -> str:
+def _energy_figure(r: dict, out: Path, plt, title: str, fmt: str, exact: bool) -> str:
+    """The energy's relative drift in units of the double's epsilon (float engine: round-off is
+    all there is to see, and this is the scale on which it is visible), or the lattice
+    engine's exact integer energy (a drift that is 0 at every sample, said so in words)."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
     es = np.array(r["energy_series"], dtype=float).reshape(-1, 2)
-    ax.plot(es[:, 0], es[:, 1], "-", lw=1)
+    style = "o-" if len(es) < 30 else "-"
+    if exact:
+        ax.plot(es[:, 0], es[:, 1], style, lw=1, ms=3, label="(E - E0) / E0")
+        ax.set_ylabel("energy drift (E - E0) / E0")
+        if not np.any(es[:, 1]):
+            ax.text(0.5, 0.6, f"exactly 0 at all {len(es)} samples\n(integer energy)", transform=ax.transAxes,
+                    ha="center", fontsize=9)
+    else:
+        ax.plot(es[:, 0], es[:, 1] / _EPS, style, lw=1, ms=3, label="(E - E0) / E0 in units of eps")
+        ax.set_ylabel(f"energy drift (E - E0) / E0  [eps = {_EPS:.2e}]")
     ax.axhline(0.0, color="k", lw=0.5)
-    ax.set_xlabel("collisions forward")
-    ax.set_ylabel("energy drift (E - E0) / E0")
+    ax.set_xlabel(f"collisions forward ({len(es)} samples)")
     ax.set_title(title, fontsize=7)
-    ax.grid(True, alpha=0.3)
+    _finish(ax)
     fig.tight_layout()
-    return _save(fig, out / "energy_drift.png", plt)
+    return _save(fig, out / f"energy_drift.{fmt}", plt)
 
 
-def _snapshots_figure(r: dict, out: Path, plt, title: str, start, turn, end) -> str:
-    fig, axes = plt.subplots(1, 3, figsize=(13, 4.6))
+def _snapshots_figure(r: dict, out: Path, plt, title: str, start, turn, end, fmt: str) -> str:
+    d, box = r["dimension"], np.asarray(r["box"], float)
+    periodic = list(r.get("periodic", [False] * d))
+    sigma = r["scene"]["diameter"]
     shots = [("start", *start), (f"after {r['collisions_forward']:,} collisions forward", *turn),
              ("after reversal", *end)]
-    for ax, (label, x, v) in zip(axes, shots):
-        _draw_particles(ax, x, v, r["box"], r["scene"]["diameter"])
+    vmax = max(float(np.max(np.linalg.norm(np.asarray(v, float).reshape(len(v), -1), axis=1), initial=0.0))
+               for _, _, v in shots) or 1.0
+    wide = d >= 2 and box[0] >= 1.6 * box[1]
+    fig, axes = plt.subplots(3 if wide else 1, 1 if wide else 3, figsize=(8, 9) if wide else (13, 4.6),
+                             squeeze=False, constrained_layout=True)
+    mappable = None
+    for ax, (label, x, v) in zip(axes.ravel(), shots):
+        x, v = np.asarray(x, float).reshape(len(x), -1), np.asarray(v, float).reshape(len(v), -1)
+        if d == 1:
+            mappable = _phase_space(ax, x, v, box, periodic, vmax)
+        else:
+            mappable = _disks(ax, x, v, box, periodic, sigma, vmax, d)
         ax.set_title(label, fontsize=9)
-    fig.suptitle(title + ("  (x-y projection, colour: speed)" if r["dimension"] == 3 else "  (colour: speed)"),
-                 fontsize=7)
-    fig.tight_layout()
-    return _save(fig, out / "snapshots.png", plt)
+    if d == 1:
+        view = "phase space: position against velocity"
+    elif d == 3:
+        view = f"slice |z - Lz/2| < D/2 through the middle (cross sections to scale, {_slice_count(start[0], box, sigma)} " \
+               "spheres at the start)"
+    else:
+        view = "disks to scale"
+    bounds = ", ".join(f"{'xyz'[k]}: {'periodic (dashed)' if periodic[k] else 'walls (solid)'}" for k in range(min(d, 2)))
+    fig.suptitle(f"{title}\n{view}; {bounds}", fontsize=7)
+    if mappable is not None:
+        fig.colorbar(mappable, ax=axes.ravel().tolist(), shrink=0.85, label="speed |v|")
+    return _save(fig, out / f"snapshots.{fmt}", plt)
 
 
-def _draw_particles(ax, x, v, box, sigma) -> None:
+def _slice_count(x, box, sigma) -> int:
+    z = np.asarray(x, float)[:, 2]
+    return int(np.count_nonzero(np.abs(z - 0.5 * box[2]) < 0.5 * sigma))
+
+
+def _edges(ax, box, periodic) -> None:
+    """The box: walls as solid lines, periodic edges dashed."""
+    lx, ly = box[0], box[1]
+    for k, segs in ((0, [((0, 0), (0, ly)), ((lx, lx), (0, ly))]), (1, [((0, lx), (0, 0)), ((0, lx), (ly, ly))])):
+        for xs, ys in segs:
+            if periodic[k]:
+                ax.plot(xs, ys, ls=(0, (4, 3)), color="0.45", lw=0.9)
+            else:
+                ax.plot(xs, ys, ls="-", color="k", lw=1.6)
+
+
+def _disks(ax, x, v, box, periodic, sigma, vmax, d):
     from matplotlib.collections import EllipseCollection
-    from matplotlib.patches import Rectangle
 
-    x = np.asarray(x)
-    xy = x[:, :2] if x.shape[1] >= 2 else np.column_stack([x[:, 0], np.zeros(len(x))])
-    ly = box[1] if len(box) >= 2 else sigma
-    ec = EllipseCollection(sigma, sigma, 0.0, units="xy", offsets=xy if len(box) >= 2 else xy + [0, 0.5 * ly],
-                           offset_transform=ax.transData, cmap="viridis", linewidths=0)
-    ec.set_array(np.linalg.norm(v, axis=1))
+    speed = np.linalg.norm(v, axis=1)
+    diam = np.full(len(x), float(sigma))
+    if d == 3:
+        dz = x[:, 2] - 0.5 * box[2]
+        keep = np.abs(dz) < 0.5 * sigma
+        x, speed = x[keep], speed[keep]
+        diam = 2.0 * np.sqrt(np.maximum(0.25 * sigma * sigma - dz[keep] ** 2, 0.0))
+    xy = x[:, :2]
+    # periodic images of particles that cross a periodic edge, so the picture wraps as the box does
+    imgs, cols, ds = [xy], [speed], [diam]
+    for k in range(2):
+        if periodic[k]:
+            for sgn in (-1.0, 1.0):
+                shift = np.zeros(2)
+                shift[k] = sgn * box[k]
+                near = (xy[:, k] < 0.5 * sigma) if sgn > 0 else (xy[:, k] > box[k] - 0.5 * sigma)
+                imgs.append(xy[near] + shift)
+                cols.append(speed[near])
+                ds.append(diam[near])
+    xy, speed, diam = np.concatenate(imgs), np.concatenate(cols), np.concatenate(ds)
+    ec = EllipseCollection(diam, diam, 0.0, units="xy", offsets=xy, offset_transform=ax.transData,
+                           cmap="viridis", linewidths=0, clim=(0.0, vmax))
+    ec.set_array(speed)
     ax.add_collection(ec)
-    ax.add_patch(Rectangle((0, 0), box[0], ly, fill=False, lw=0.8))
-    ax.set_xlim(-0.02 * box[0], 1.02 * box[0])
-    ax.set_ylim(-0.02 * max(ly, box[0]) if len(box) >= 2 else -ly, 1.02 * ly if len(box) >= 2 else 2 * ly)
-    ax.set_aspect("equal" if len(box) >= 2 else "auto")
-    ax.set_xticks([])
-    ax.set_yticks([])
+    _edges(ax, box, periodic)
+    pad = 0.03 * max(box[0], box[1])
+    ax.set_xlim(-pad, box[0] + pad)
+    ax.set_ylim(-pad, box[1] + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"x (length units; D = {sigma:g})")
+    ax.set_ylabel(f"y (length units; D = {sigma:g})")
+    return ec
 
 
-def plot_horizon(r: dict, out: Path) -> list[str]:
-    """The horizon's figure (horizon.png in ``out``); returns its path."""
+def _phase_space(ax, x, v, box, periodic, vmax):
+    speed = np.abs(v[:, 0])
+    sc = ax.scatter(x[:, 0], v[:, 0], c=speed, s=6 if len(x) > 2000 else 14, cmap="viridis", vmin=0.0, vmax=vmax,
+                    linewidths=0)
+    for edge in (0.0, box[0]):
+        if periodic[0]:
+            ax.axvline(edge, ls=(0, (4, 3)), color="0.45", lw=0.9)
+        else:
+            ax.axvline(edge, ls="-", color="k", lw=1.6)
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.set_xlim(-0.03 * box[0], 1.03 * box[0])
+    ax.set_ylim(-1.08 * vmax, 1.08 * vmax)
+    ax.set_xlabel("x (length units)")
+    ax.set_ylabel("velocity v_x")
+    return sc
+
+
+def plot_horizon(r: dict, out: Path, fmt: str = "png") -> list[str]:
+    """The horizon's figure (horizon.<fmt> in ``out``); returns its path."""
     plt = _pyplot()
     out.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(7, 4.5))
     pp = [row["per_particle"] for row in r["rows"]]
-    ax.loglog(pp, [max(row["error_x"], 1e-18) for row in r["rows"]], "o-", label="positions: max |x - x0| / L")
-    ax.loglog(pp, [max(row["error_v"], 1e-18) for row in r["rows"]], "s-", label="velocities: max |v - v0| / max |v0|")
+    ex, ev = [row["error_x"] for row in r["rows"]], [row["error_v"] for row in r["rows"]]
+    zeros = [(_log_series(ax, pp, ex, "o", "positions: max |x - x0| / L", "C0", "loglog"), "C0"),
+             (_log_series(ax, pp, ev, "s", "velocities: max |v - v0| / max |v0|", "C1", "loglog"), "C1")]
+    values = ex + ev
     if r["seeds"] > 1:
-        ax.loglog(pp, [max(row["median"], 1e-18) for row in r["rows"]], ":", color="0.5",
-                  label="median over seeds (the larger of the two errors)")
+        med = [row["median"] for row in r["rows"]]
+        zeros.append((_log_series(ax, pp, med, "", "median over seeds (the larger of the two errors)", "0.5",
+                                  "loglog"), "0.5"))
+        values += med
     ax.axhline(BAR, color="k", ls=":", lw=1, label="bar 1e-9")
     if r["horizon_collisions"]:
         ax.axvline(r["horizon_per_particle"], color="C2", ls="--", lw=1,
                    label=f"horizon: N_c = {r['horizon_collisions']:,}")
+    _mark_zeros(ax, zeros, min([y for y in values if y > 0] + [BAR]))
     ax.set_xlabel("collisions per particle (2 N_c / N), forward then back")
-    ax.set_ylabel(f"round-trip error (worst of {r['seeds']} seed{'s' if r['seeds'] > 1 else ''})")
+    ax.set_ylabel(f"round-trip error, relative (worst of {r['seeds']} seed{'s' if r['seeds'] > 1 else ''})")
     ax.set_title(textwrap.fill(r["summary"], 110), fontsize=7)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    _finish(ax)
     fig.tight_layout()
-    return [_save(fig, out / "horizon.png", plt)]
+    return [_save(fig, out / f"horizon.{fmt}", plt)]
 
 
 def _save(fig, path: Path, plt) -> str:
-    save_figure(fig, path, dpi=110)
+    save_figure(fig, path, dpi=150)
     plt.close(fig)
     return str(path)
-

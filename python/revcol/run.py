@@ -115,11 +115,12 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
               plot: str | os.PathLike | None = None, trajectory: str | os.PathLike | None = None,
               horizon_seeds: int | None = None, max_collisions: int = 1_000_000,
               collisions: int | None = None, seed: int | None = None, engine: str | None = None,
-              progress: bool | None = None) -> dict:
+              progress: bool | None = None, plot_format: str = "png") -> dict:
     """Runs any scene (a :class:`Scene`, a path, or None for the built-in default) and writes
     the outputs asked for (arguments here, else the scene's ``[output]``). ``collisions``
     overrides N_c (a gas's end time included); ``horizon_seeds`` measures the horizon over
-    that many seeds instead of one round trip; ``engine`` (``"float"`` or ``"lattice"``) runs a
+    that many seeds instead of one round trip; ``plot_format``: the figures' file format
+    (png, pdf or svg); ``engine`` (``"float"`` or ``"lattice"``) runs a
     gas scene on that engine instead of its own. Returns the report; every output is checked
     before anything runs, and a bad one raises :class:`SceneError`."""
     if not isinstance(scene, Scene):
@@ -148,9 +149,10 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
         raise SceneError(f"{scene.source}: --horizon --plot: a lattice scene has no horizon to plot "
                          "(every round trip is bit for bit); add --engine float for the float engine's")
     if plot is not None:
-        from .plots import require_matplotlib
+        from .plots import check_format, require_matplotlib
 
         require_matplotlib()
+        check_format(plot_format)
     # every output and the memory are checked before anything runs: a run must not be lost to
     # an unwritable report at its end (issue 17)
     for what, path, folder in (("[output] json / --json", json_path, False), ("[output] plot / --plot", plot, True),
@@ -164,13 +166,13 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
         if plot is not None:
             from .plots import plot_horizon
 
-            r["written"] += plot_horizon(r, Path(plot))
+            r["written"] += plot_horizon(r, Path(plot), fmt=plot_format)
     elif scene.kind == "reversal":
         r = run_reversal(scene)
     elif scene.kind == "statesave":
-        r = run_statesave(scene, plot, progress)
+        r = run_statesave(scene, plot, progress, plot_format)
     else:
-        r = run_gas(scene, plot=plot, trajectory=trajectory, progress=progress)
+        r = run_gas(scene, plot=plot, trajectory=trajectory, progress=progress, plot_format=plot_format)
     if json_path is not None:
         r["written"].append(str(json_path))
         write_json(r, json_path)
