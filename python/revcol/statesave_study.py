@@ -217,8 +217,20 @@ def _machine() -> dict:
     return info
 
 
+def _rows(runs: list[dict], vs: Sequence[str], kws: dict, projs: dict, reps: dict) -> None:
+    """Appends the rows of one (mode, N): skipped over the budget, or its repeats' summary."""
+    for v in vs:
+        p = projs[v]
+        if p["over_budget"]:
+            runs.append(_skipped_row(kws[v], p["record_bytes"], p["projected_bytes"]))
+        else:
+            row = _row(kws[v], reps[v], p["record_bytes"], p["projected_bytes"])
+            row["status"] = "ok" if row["restored"] else "FAILED"
+            runs.append(row)
+
+
 class _Stopped(Exception):
-    """``stop()`` said to end the study (the (mode, N) under way is dropped)."""
+    """``stop()`` said to end the study."""
 
 
 def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1000, *,
@@ -236,8 +248,9 @@ def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1
     process's). ``cpu``: pin each process to that core (``taskset -c``). Runs whose saved
     state exceeds ``budget_gib`` are not attempted. ``progress``: None = when stdout is a
     terminal. ``stop``: asked before each run; when it returns True the study ends there
-    (the report has the (mode, N) groups done, ``interrupted`` True and ``not_run`` the
-    (mode, N, variant) rows left out).
+    (the report has the rows of the runs done, those of the (mode, N) under way with the
+    repeats they got, ``interrupted`` True and ``not_run`` the (mode, N, variant) rows left
+    out).
     """
     ns = list(n) if not isinstance(n, (int, float)) else [n]
     if not ns:
@@ -282,16 +295,10 @@ def study(n: Iterable[int] = (1000, 10000, 100000, 1000000), collisions: int = 1
                     one[0]["load_1m"] = load
                     reps[v] += one
                     bar.update(f"{m} N={N:,} {_LABEL[v]} {r + 1}/{repeats}")
-            for v in vs:
-                p = projs[v]
-                if p["over_budget"]:
-                    runs.append(_skipped_row(kws[v], p["record_bytes"], p["projected_bytes"]))
-                else:
-                    row = _row(kws[v], reps[v], p["record_bytes"], p["projected_bytes"])
-                    row["status"] = "ok" if row["restored"] else "FAILED"
-                    runs.append(row)
-    except _Stopped:
-        not_run = (len(groups) - len({(r["mode"], r["particles"]) for r in runs})) * len(vs)
+            _rows(runs, vs, kws, projs, reps)
+    except _Stopped:  # the group under way keeps the variants that ran at least once
+        _rows(runs, [v for v in vs if reps.get(v)], kws, projs, reps)
+        not_run = len(groups) * len(vs) - len(runs)
     finally:
         bar.close()
     loads.append(os.getloadavg()[0])

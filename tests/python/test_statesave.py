@@ -165,7 +165,7 @@ def test_study_interleaves_variants_round_by_round(monkeypatch):
             (paired[0], paired[1], paired[2])
 
 
-def test_study_stop_drops_the_group_under_way():
+def test_study_stop_keeps_the_runs_done():
     calls = []
 
     def stop():
@@ -173,8 +173,9 @@ def test_study_stop_drops_the_group_under_way():
         return len(calls) > 5  # 4 runs of N=100 (2 variants x 2 rounds), then one of N=200
 
     rep = ss.study([100, 200], 50, variants=["ss1", "rc"], repeats=2, inline=True, progress=False, stop=stop)
-    assert rep["interrupted"] and rep["not_run"] == 2
-    assert [(r["particles"], r["variant"]) for r in rep["runs"]] == [(100, "ss1"), (100, "rc")]
+    assert rep["interrupted"] and rep["not_run"] == 1
+    assert [(r["particles"], r["variant"], len(r["total_ms_all"])) for r in rep["runs"]] == \
+        [(100, "ss1", 2), (100, "rc", 2), (200, "ss1", 1)]
 
 
 def test_study_cpu_argument():
