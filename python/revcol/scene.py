@@ -75,7 +75,7 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     plot = "figures"              # a directory of PNGs (gas, statesave)
     trajectory = "run.xyz"        # gas: extended XYZ (OVITO) or .gsd
     trajectory_every = 100        # gas: collisions between frames
-    checkpoints = "checkpoints"   # gas: where checkpoint_interval writes (default NAME-checkpoints)
+    checkpoints = "checkpoints"   # gas: where checkpoint_interval writes (default ./NAME-checkpoints)
 
     [observe]                     # gas, float engine: observables of the forward run (revcol.observe);
                                   # the table alone observes the scalars; its values go in the report
@@ -375,7 +375,7 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
     base = base or Path.cwd()
     name = get("scene", "name", Path(source).stem if source.endswith(".toml") else "scene")
     if not name or name in (".", "..") or any(c in name for c in "/\\\0"):
-        # it names files beside the scene (NAME-checkpoints): a path would put them elsewhere
+        # it names output files (NAME-checkpoints): a path would put them elsewhere
         raise _fail(source, "[scene] name", f"must be a plain name (no '/', '\\', '..'), got {name!r}")
     common = dict(kind=kind, name=name, description=get("scene", "description", ""), source=source,
                   generator=get("rng", "generator", "clcg4"), seed=get("rng", "seed", 0),
@@ -680,11 +680,11 @@ def find_scene(name: str) -> Path | None:
 
 def load_scene(path: str | Path | None = None) -> Scene:
     """Reads and validates a scene file, or a shipped scene by name when no such file exists;
-    ``None`` gives the built-in default scene."""
+    ``None`` gives the built-in default scene. Its relative input paths are read beside the
+    file, its relative ``[output]`` paths under the current directory."""
     if path is None:
         return scene_from_dict(DEFAULT_SCENE, "<default scene>")
     p = Path(path)
-    output_base = None
     if not p.is_file():
         found = None if p.exists() else find_scene(str(path))
         if found is None:
@@ -694,7 +694,7 @@ def load_scene(path: str | Path | None = None) -> Scene:
             hint = f"; did you mean {close[0]!r}?" if close else ""
             raise SceneError(f"{p}: no such scene file, nor a scene name (shipped: "
                              f"{', '.join(scene_names()) or 'none found'}){hint}")
-        p, output_base = found, Path.cwd() / "scenes"
+        p = found
     try:
         doc = tomllib.loads(p.read_text())
     except RecursionError:
@@ -704,6 +704,8 @@ def load_scene(path: str | Path | None = None) -> Scene:
     except UnicodeDecodeError as e:
         raise SceneError(f"{p}: not a text file: {e}") from None
     try:
-        return scene_from_dict(doc, str(p), p.parent, output_base)
+        # inputs (an initial state) beside the scene file; outputs under the current directory,
+        # wherever the scene lives (a clone, the installed package)
+        return scene_from_dict(doc, str(p), p.parent, Path.cwd())
     except RecursionError:
         raise SceneError(f"{p}: not a usable scene: its arrays or tables are nested too deeply") from None

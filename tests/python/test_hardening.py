@@ -272,7 +272,12 @@ def _revcol_run(tmp_path, text, capsys, name="s.toml"):
     from revcol.cli import main
     path = tmp_path / name
     path.write_text(text)
-    rc = main(["run", str(path), "--no-progress"])
+    cwd = os.getcwd()
+    os.chdir(tmp_path)  # a scene's [output] paths are taken under the current directory
+    try:
+        rc = main(["run", str(path), "--no-progress"])
+    finally:
+        os.chdir(cwd)
     err = capsys.readouterr().err.strip().splitlines()
     return rc, err, path
 

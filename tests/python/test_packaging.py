@@ -101,7 +101,7 @@ def test_scenes_are_found_by_name(tmp_path, monkeypatch):
         assert s.name == "spheres-3d" and s.dimension == 3 and s.particles == 1000
         assert Path(s.source) == find_scene("spheres-3d")
         assert Path(s.source).read_bytes() == (ROOT / "scenes" / "spheres-3d.toml").read_bytes()
-    # outputs land under the current directory (../out/X as from ./scenes/), never in the package
+    # outputs land under the current directory, never in the package
     s = load_scene("periodic-2d")
     assert s.json == tmp_path / "out" / "periodic-2d" / "report.json"
     assert s.checkpoints == tmp_path / "out" / "periodic-2d" / "checkpoints"
@@ -114,6 +114,14 @@ def test_scenes_are_found_by_name(tmp_path, monkeypatch):
     with pytest.raises(SceneError, match=r"no such scene file, nor a scene name .*did you mean 'spheres-3d'"):
         load_scene("sphere-3d")
     assert find_scene("../scenes/default") is None  # names only, no paths
+    # a scene file given by path writes under the current directory too, not beside the file
+    other = tmp_path / "elsewhere"
+    other.mkdir()
+    s = load_scene(ROOT / "scenes" / "periodic-2d.toml")
+    assert s.json == tmp_path / "out" / "periodic-2d" / "report.json"
+    monkeypatch.chdir(other)
+    assert load_scene(ROOT / "scenes" / "periodic-2d.toml").plot == other / "out" / "periodic-2d" / "figures"
+    assert load_scene(ROOT / "scenes" / "initial-state.toml").particles > 0  # its .npz read beside it
 
 
 def test_revcol_run_by_name(tmp_path, monkeypatch, capsys):

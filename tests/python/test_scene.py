@@ -23,7 +23,7 @@ def test_default_scene():
     assert "1000 particles in 2D" in s.summary()
 
 
-def test_full_scene_and_relative_paths(tmp_path):
+def test_full_scene_and_relative_paths(tmp_path, monkeypatch):
     p = write(tmp_path, """
 [scene]
 name = "spheres"
@@ -54,6 +54,10 @@ trajectory_every = 10
     s = load_scene(p)
     assert s.name == "spheres" and s.box == (4.0, 4.0, 5.0) and s.boundaries == ("periodic", "periodic", "wall")
     assert (s.law, s.bits, s.generator, s.streams, s.seed, s.time, s.collisions) == ("uniform", 36, "philox", "single", 7, 2.5, None)
+    # [output] paths under the current directory, wherever the scene file is
+    assert s.json == Path.cwd() / "out/r.json" and s.trajectory == Path.cwd() / "t.xyz"
+    monkeypatch.chdir(tmp_path)
+    s = load_scene(p)
     assert s.json == tmp_path / "out/r.json" and s.trajectory == tmp_path / "t.xyz"
 
 
