@@ -52,3 +52,12 @@ def names(x, what: str) -> list:
     if isinstance(x, (list, tuple)) and all(isinstance(b, str) for b in x):
         return list(x)
     raise TypeError(f"{what} must be a name or a list of names (one per axis), got {x!r}")
+
+
+def packing_fraction(phi, packing_fraction, default: float = 0.3):
+    """The packing fraction given as ``phi`` or as ``packing_fraction`` (the scenes' name), not
+    both; ``default`` when neither. The value itself is checked by the engine's limits."""
+    if phi is not None and packing_fraction is not None:
+        raise TypeError("give the packing fraction once: phi= or packing_fraction=, not both")
+    v = phi if phi is not None else packing_fraction
+    return default if v is None else v

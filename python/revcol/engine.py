@@ -42,6 +42,7 @@ import numpy as np
 
 from . import _core
 from ._args import integer, names
+from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .roundtrip import divergence_text
 
@@ -105,15 +106,18 @@ class Simulation:
                                generator, streams)
 
     @classmethod
-    def random(cls, n: int, dim: int = 3, phi: float = 0.3, *, boundary: _Boundary = "periodic",
+    def random(cls, n: int, dim: int = 3, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
                diameter: float = 1.0, seed: int = 1, energy: Optional[float] = None,
-               init: str = "auto", equal_speeds: bool = False, engine: str = "float", **kwargs) -> "Simulation":
-        """n particles at packing fraction phi in a cubic box: random sequential addition
+               init: str = "auto", equal_speeds: bool = False, engine: str = "float",
+               packing_fraction: Optional[float] = None, **kwargs) -> "Simulation":
+        """n particles at packing fraction ``phi`` (or ``packing_fraction=``, the scenes' name;
+        default 0.3) in a cubic box: random sequential addition
         or a jittered lattice (square; face-centred cubic in 3D), Gaussian velocities with
         zero momentum scaled to kinetic ``energy`` (default n d / 2, kT = 1), or all of one
         speed (``equal_speeds``). Other keywords go to the constructor (mode, law, ...);
         the same ``seed`` keys the collision streams. ``engine="lattice"``: the 2D lattice
         engine's ``LatticeSimulation.random`` (reversed bit for bit; ``law`` and ``seed`` apply)."""
+        phi = _packing_fraction(phi, packing_fraction)
         if engine == "lattice":
             from .lattice import LatticeSimulation
             if energy is not None or equal_speeds:

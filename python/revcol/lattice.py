@@ -31,6 +31,7 @@ import numpy as np
 
 from . import _core
 from ._args import integer, name, names, real
+from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .engine import _real_array
 
@@ -90,12 +91,14 @@ class LatticeSimulation:
                    "max_velocity_error": start["max_velocity_error"]}
 
     @classmethod
-    def random(cls, n: int, dim: int = 2, phi: float = 0.3, *, boundary: _Boundary = "periodic",
+    def random(cls, n: int, dim: int = 2, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
                diameter: float = 1.0, seed: int = 1, init: str = "auto", law: str = "flux",
-               tick_bits: int = 20) -> "LatticeSimulation":
-        """n disks at area fraction phi in a square box (the float engine's ``random_state``:
+               tick_bits: int = 20, packing_fraction: Optional[float] = None) -> "LatticeSimulation":
+        """n disks at area fraction ``phi`` (or ``packing_fraction=``; default 0.3) in a square
+        box (the float engine's ``random_state``:
         random sequential addition or a jittered lattice, Gaussian velocities with zero momentum,
         kT = 1), quantized once. The same ``seed`` keys the streams."""
+        phi = _packing_fraction(phi, packing_fraction)
         if dim != 2:
             raise ValueError(f"the lattice engine is 2D, got dim={dim}")
         start = _core.lattice_random_start(n, phi, _walls(boundary), diameter, seed, name(init, "init"), tick_bits)

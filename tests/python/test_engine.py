@@ -273,3 +273,18 @@ def test_bounce_boundary_random_start_and_limits():
         from revcol.roundtrip import geometry, round_trip_errors
         ex, ev = round_trip_errors(s.positions, s.velocities, x0, v0, *geometry(s))  # minimum image
         assert ex < 1e-9 and ev < 1e-9
+
+
+def test_random_takes_the_scenes_name_for_the_packing_fraction():
+    # one vocabulary (issue 19): packing_fraction= as in the scenes, phi= as before, not both
+    a = revcol.Simulation.random(n=50, dim=2, phi=0.25, seed=3)
+    b = revcol.Simulation.random(n=50, dim=2, packing_fraction=0.25, seed=3)
+    assert np.array_equal(a.positions, b.positions) and np.array_equal(a.box, b.box)
+    c = revcol.Simulation.random(n=50, dim=2, seed=3)  # the default stays 0.3
+    d = revcol.Simulation.random(n=50, dim=2, phi=0.3, seed=3)
+    assert np.array_equal(c.box, d.box) and not np.array_equal(a.box, c.box)
+    with pytest.raises(TypeError, match="phi= or packing_fraction=, not both"):
+        revcol.Simulation.random(n=50, dim=2, phi=0.2, packing_fraction=0.2)
+    la = revcol.Simulation.random(n=50, dim=2, packing_fraction=0.25, seed=3, engine="lattice")
+    lb = revcol.lattice.LatticeSimulation.random(50, phi=0.25, seed=3)
+    assert np.array_equal(la.positions, lb.positions)
