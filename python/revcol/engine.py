@@ -43,6 +43,7 @@ import numpy as np
 from . import _core
 from ._args import integer, names
 from ._args import packing_fraction as _packing_fraction
+from ._attach import Attachable
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .roundtrip import divergence_text
 
@@ -63,7 +64,7 @@ def _real_array(a, name: str) -> np.ndarray:
         raise TypeError(f"{name} must be an array of real numbers ({e})") from None
 
 
-class Simulation:
+class Simulation(Attachable):
     """N hard spheres in d = 1, 2, 3, run forward and backwards (revcol/engine/engine.hpp).
 
     Build from arrays (``Simulation(positions, velocities, box=...)``) or at random
@@ -146,31 +147,11 @@ class Simulation:
         cb = None
         if callback is not None:
             cb = lambda k: bool(callback(k) is not False)  # None means go on
-        attached = self.__dict__.get("_attached")
+        attached = self._attachments()
         if not attached or (collisions is None and time is None):
             return self._e.run(collisions, time, cb, every)
         return self._run_triggered(integer(collisions, "collisions", lo=0) if collisions is not None else None,
                                    time, cb, every, attached)
-
-    def attach(self, action: Callable[["Simulation"], object], every: int) -> None:
-        """Runs ``action(sim)`` during :meth:`run` whenever the net collision count
-        (``diagnostics()["net_collisions"]``) reaches a multiple of ``every``, as HOOMD's writers
-        on a periodic trigger. A trajectory writer is such an action
-        (``sim.attach(open_trajectory("t.gsd", sim.box, sim.periodic, 1.0), every=1000)`` writes
-        a frame every 1000 collisions; close it after the runs). ``run`` pauses there, between
-        events, and goes on: the trajectory is the one without the pauses, bit for bit. Attached
-        actions are not part of ``snapshot()``, ``save`` or a pickle."""
-        if not callable(action):
-            raise TypeError(f"action must be callable (e.g. a trajectory writer), got {type(action).__name__}")
-        k = integer(every, "every", lo=1)
-        self.__dict__.setdefault("_attached", []).append((action, k))
-
-    def detach(self, action: Callable[["Simulation"], object]) -> None:
-        """Removes every attachment of ``action`` (ValueError if there is none)."""
-        kept = [(a, k) for a, k in self.__dict__.get("_attached", []) if not (a is action or a == action)]
-        if len(kept) == len(self.__dict__.get("_attached", [])):
-            raise ValueError("detach: this action is not attached")
-        self._attached = kept
 
     def _run_triggered(self, collisions: Optional[int], time, cb, every, attached) -> dict:
         """``run`` in segments that end at the attached actions' triggers and, with a callback,
@@ -180,7 +161,7 @@ class Simulation:
         done, events, out = 0, 0, None
         net = int(self._e.diagnostics()["net_collisions"])
         while True:
-            seg = min((net // k + 1) * k for _, k in attached) - net
+            seg = self._to_next_trigger(attached, net)
             if cb is not None:
                 seg = min(seg, (done // every + 1) * every - done)
             if collisions is not None:
@@ -189,9 +170,7 @@ class Simulation:
             did = int(out["collisions"])
             done, events, net = done + did, events + int(out["events"]), net + did
             if did:
-                for action, k in list(attached):
-                    if net % k == 0:
-                        action(self)
+                self._fire(attached, net)
             if cb is not None and did and done % every == 0 and not cb(done):
                 out["interrupted"] = True
             if out["interrupted"] or did < seg or (collisions is not None and done >= collisions):

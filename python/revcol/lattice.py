@@ -32,6 +32,7 @@ import numpy as np
 from . import _core
 from ._args import integer, name, names, real
 from ._args import packing_fraction as _packing_fraction
+from ._attach import Attachable
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .engine import _real_array
 
@@ -56,7 +57,7 @@ def _walls(boundary: _Boundary) -> list:
     return out
 
 
-class LatticeSimulation:
+class LatticeSimulation(Attachable):
     """N hard disks on the integer lattice, run forward and back bit for bit (2D only).
 
     Build from float arrays (``LatticeSimulation(positions, velocities, box)``, quantized once)
@@ -116,13 +117,29 @@ class LatticeSimulation:
 
     def run(self, collisions: Optional[int] = None, time: Optional[float] = None) -> dict:
         """Forward until ``collisions`` more collisions (the clock then at the last one's tick)
-        or the clock reaches ``time`` (rounded to a tick), whichever comes first. Returns
-        collisions done, clock and time."""
+        or the clock reaches ``time`` (rounded to a tick), whichever comes first; actions
+        attached with :meth:`attach` run at their triggers. Returns collisions done, clock and
+        time."""
         if collisions is None and time is None:
             raise ValueError("run needs collisions= or time=")
         until = None if time is None else self._tick(time)
-        done = self._e.run(None if collisions is None else integer(collisions, "collisions", 0), until)
-        return {"collisions": int(done), "clock": self.clock, "time": self.time}
+        n = None if collisions is None else integer(collisions, "collisions", 0)
+        attached = self._attachments()
+        if not attached:
+            done = int(self._e.run(n, until))
+        else:  # in segments that end at the attached actions' triggers
+            done, net = 0, int(self._e.collisions)
+            while n is None or done < n:
+                seg = self._to_next_trigger(attached, net)
+                if n is not None:
+                    seg = min(seg, n - done)
+                did = int(self._e.run(seg, until))
+                done, net = done + did, net + did
+                if did:
+                    self._fire(attached, net)
+                if did < seg:  # the clock reached time
+                    break
+        return {"collisions": done, "clock": self.clock, "time": self.time}
 
     def run_back(self, collisions: Optional[int] = None, time: Optional[float] = None,
                  to_collision: Optional[int] = None) -> dict:

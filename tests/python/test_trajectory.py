@@ -180,3 +180,36 @@ def test_a_writer_attached_to_a_simulation_writes_on_its_trigger_and_changes_not
         sim.attach("t.gsd", every=10)
     with pytest.raises(ValueError, match="not attached"):
         sim.detach(w)
+
+
+def test_a_writer_attached_to_a_lattice_simulation(tmp_path):
+    # the lattice engine takes attachments too (issue 19): frames on the trigger, and the run
+    # with pauses is the run without them, bit for bit
+    from revcol.lattice import LatticeSimulation
+    from revcol.lattice_gas import geometry
+
+    make = lambda: LatticeSimulation.random(80, phi=0.3, seed=6)  # noqa: E731
+    sim, twin = make(), make()
+    box, periodic = geometry(sim)
+    w = open_trajectory(tmp_path / "t.xyz", box, periodic, 1.0)
+    sim.attach(w, every=70)
+    counts = []
+    sim.attach(lambda s: counts.append(s.collisions), every=100)
+    assert sim.run(collisions=250)["collisions"] == 250
+    assert sim.run(collisions=250)["collisions"] == 250
+    w.close()
+    twin.run(collisions=500)
+    assert np.array_equal(sim.lattice_positions, twin.lattice_positions)
+    assert np.array_equal(sim.lattice_velocities, twin.lattice_velocities) and sim.clock == twin.clock
+    assert counts == [100, 200, 300, 400, 500]
+    frames = (tmp_path / "t.xyz").read_text().count("Lattice=")
+    assert frames == len(range(70, 501, 70))
+    # a time-ended run stops at its time, between triggers, and the count goes on from there
+    t = sim.time
+    r = sim.run(time=t + 1e-3)
+    assert r["collisions"] < 100 and sim.time <= t + 1e-3 + sim.units["tick"]
+    sim.detach(w)
+    with pytest.raises(ValueError, match="not attached"):
+        sim.detach(w)
+    sim.run_back()
+    assert sim.collisions == 0
