@@ -239,6 +239,8 @@ def _simulate_parser(sub) -> None:
                    "FILE.xyz (extended XYZ) or FILE.gsd")
     s.add_argument("--every", type=_positive_int, metavar="K", help="collisions between frames (default: the "
                    "scene's [output] trajectory_every)")
+    s.add_argument("--every-time", type=_positive_real, metavar="T", help="frames at every multiple of T in time "
+                   "instead (independent of the collisions: what g(r) at contact needs)")
     s.add_argument("--checkpoint", metavar="DIR", help="write checkpoint-<collisions>.npz into DIR every K "
                    "collisions and at the end")
     s.add_argument("--checkpoint-every", type=_positive_int, metavar="K", help="collisions between checkpoints")
@@ -270,7 +272,7 @@ def _simulate(args: argparse.Namespace) -> int:
                               every=args.every, checkpoints=args.checkpoint, checkpoint_every=args.checkpoint_every,
                               resume=args.resume, seed=args.seed, engine=args.engine, species=args.species,
                               json_path=None if to_stdout else args.json,
-                              progress=False if args.no_progress else None)
+                              progress=False if args.no_progress else None, every_time=args.every_time)
     except (SceneError, OSError) as e:
         print(f"revcol simulate: error: {e}", file=sys.stderr)
         return 2

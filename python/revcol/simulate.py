@@ -8,7 +8,10 @@ by triggers in *net collisions* (the engine's count since the scene's start, so 
 keeps the numbering of the run it resumes):
 
 - ``trajectory`` (``.xyz`` or ``.gsd``, :mod:`revcol.trajectory`): a frame at the start, at
-  every multiple of ``every`` collisions, and at the end;
+  every multiple of ``every`` collisions (or, with ``every_time`` T instead, at every multiple
+  of T in time), and at the end. A frame on a collision trigger is taken at a collision: one
+  pair sits exactly at contact in it. Structure (g(r) at contact) wants frames at times
+  independent of the events: ``every_time`` (bench/production_check.py measures the bias);
 - ``checkpoints`` (a folder): ``checkpoint-<net collisions>.npz`` at every multiple of
   ``checkpoint_every`` and at the end; ``resume`` continues from one bit for bit (the run that
   resumes from checkpoint k and goes on to n collisions ends in the state of one that never
@@ -54,7 +57,8 @@ def _net(sim) -> int:
     return int(sim.diagnostics()["net_collisions"])
 
 
-def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume):
+def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume,
+             every_time=None):
     """The run's length and outputs, checked (SceneError naming the option)."""
     src = scene.source
     if scene.kind != "gas":
@@ -78,6 +82,15 @@ def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, che
     trajectory = trajectory if trajectory is not None else scene.trajectory
     if every is not None and trajectory is None:
         raise SceneError(f"{src}: --every needs --trajectory (or the scene's [output] trajectory)")
+    if every_time is not None:
+        if isinstance(every_time, bool) or not isinstance(every_time, (int, float)) or \
+                not (math.isfinite(every_time) and every_time > 0):
+            raise SceneError(f"{src}: --every-time must be a positive finite number, got {every_time!r}")
+        if every is not None:
+            raise SceneError(f"{src}: --every and --every-time: give one frame trigger, not both")
+        if trajectory is None:
+            raise SceneError(f"{src}: --every-time needs --trajectory (or the scene's [output] trajectory)")
+        every = 0  # no collision trigger
     every = every if every is not None else scene.trajectory_every
     checkpoints = checkpoints if checkpoints is not None else scene.checkpoints
     if checkpoint_every is not None and checkpoints is None:
@@ -117,14 +130,19 @@ class _Production:
     """One forward run with its outputs; ``go`` runs it, ``report`` describes it."""
 
     def __init__(self, scene: Scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
-                 species: str, precise: bool):
+                 species: str, precise: bool, every_time: float | None = None):
         self.scene, self.sim = scene, sim
         self.lattice = scene.engine == "lattice"
         self.start = self.done = _net(sim)
         self.target = None if collisions is None else self.start + int(collisions)
         self.t_start = sim.time
+        # the clock's resolution: a lattice run to a time ends on the nearest tick
+        self.t_eps = float(sim.units["tick"]) if self.lattice else 0.0
         self.t_end = None if time is None else self.t_start + float(time)
         self.every, self.ckpt_every = every, checkpoint_every
+        # time trigger: frames at the multiples of every_time on the engine's clock
+        self.every_time = float(every_time) if every_time else None
+        self.next_t = None if self.every_time is None else (math.floor(sim.time / self.every_time) + 1) * self.every_time
         self.checkpoints = None if checkpoints is None else Path(checkpoints)
         self.written_ckpt: list[str] = []
         self.trajectory, self.writer, self.last_frame = trajectory, None, None
@@ -143,9 +161,19 @@ class _Production:
             sim.observe(**scene.observe)
         self.interrupted, self.engine_error, self.stalled, self.wall_s = False, None, False, 0.0
 
+    def advance_frame_time(self) -> None:
+        """The next multiple of every_time after the clock (counted in whole periods, so that
+        a product that rounds back onto the current time cannot stall the run)."""
+        k = round(self.next_t / self.every_time)
+        while True:
+            k += 1
+            self.next_t = k * self.every_time
+            if self.next_t > self.sim.time + self.t_eps:
+                return
+
     def finished(self) -> bool:
         return ((self.target is not None and self.done >= self.target)
-                or (self.t_end is not None and self.sim.time >= self.t_end))
+                or (self.t_end is not None and self.sim.time >= self.t_end - self.t_eps))
 
     def next_stop(self) -> int | None:
         stops = [(self.done // k + 1) * k for k in (self.every if self.writer else 0, self.ckpt_every) if k]
@@ -154,10 +182,10 @@ class _Production:
         return min(stops) if stops else None
 
     def frame(self) -> None:
-        if self.writer is not None and self.last_frame != self.done:
-            sim = self.sim
+        sim = self.sim
+        if self.writer is not None and self.last_frame != (self.done, sim.time):
             self.writer.write(sim.positions, sim.velocities, sim.time, self.done, "forward")
-            self.last_frame = self.done
+            self.last_frame = (self.done, sim.time)
 
     def checkpoint(self) -> None:
         if self.checkpoints is not None and (not self.written_ckpt or not self.written_ckpt[-1].endswith(
@@ -167,13 +195,20 @@ class _Production:
             self.sim.save(path)
             self.written_ckpt.append(str(path))
 
+    def stop_time(self) -> float | None:
+        """The clock at which the next engine call ends: the end time or the next time frame."""
+        ts = [t for t in (self.t_end, self.next_t if self.writer is not None else None) if t is not None]
+        return min(ts) if ts else None
+
     def step(self, stop: Interrupt, bar: Bar, stop_c: int | None) -> int:
-        """One engine call towards ``stop_c`` (or the end time); the collisions it did."""
+        """One engine call towards ``stop_c`` (or the end time, or the next time frame); the
+        collisions it did."""
         sim, more = self.sim, None if stop_c is None else stop_c - self.done
+        until = self.stop_time()
         if self.lattice:
             more = LATTICE_CHUNK if more is None else min(more, LATTICE_CHUNK)
             try:
-                return int(sim.run(collisions=more, time=self.t_end)["collisions"])
+                return int(sim.run(collisions=more, time=until)["collisions"])
             except RuntimeError as e:  # a collision the lattice engine cannot resolve: stop here
                 self.engine_error = str(e)
                 return _net(sim) - self.done
@@ -183,7 +218,7 @@ class _Production:
             bar.to(base + k - self.start if self.target is not None else sim.time - self.t_start)
             return stop.presses == 0
         chunk = max(1, min(10_000, sim.n))
-        return int(sim.run(collisions=more, time=self.t_end, callback=callback, every=chunk)["collisions"])
+        return int(sim.run(collisions=more, time=until, callback=callback, every=chunk)["collisions"])
 
     def go(self, progress: bool) -> None:
         total = float(self.target - self.start) if self.target is not None else float(self.t_end - self.t_start)
@@ -200,11 +235,15 @@ class _Production:
                         self.interrupted = True
                     if self.interrupted or self.engine_error is not None:
                         break
-                    if did == 0 and not self.finished():  # nothing left to happen (e.g. all at rest)
+                    at_frame_time = self.next_t is not None and self.sim.time >= self.next_t - self.t_eps
+                    if did == 0 and not self.finished() and not at_frame_time:  # nothing left to happen
                         self.stalled = True
                         break
                     if self.every and self.done % self.every == 0:
                         self.frame()
+                    if at_frame_time:
+                        self.frame()
+                        self.advance_frame_time()
                     if self.ckpt_every and self.done % self.ckpt_every == 0:
                         self.checkpoint()
                 self.frame()
@@ -245,11 +284,12 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
              checkpoints: str | os.PathLike | None = None, checkpoint_every: int | None = None,
              resume: str | os.PathLike | None = None, seed: int | None = None, engine: str | None = None,
              species: str = "Ar", precise: bool = False, json_path: str | os.PathLike | None = None,
-             progress: bool | None = None) -> dict:
+             progress: bool | None = None, every_time: float | None = None) -> dict:
     """Runs a gas scene forward only (see the module's docstring) and returns the report; with
     ``json_path`` also writes it (atomically). ``species`` names the trajectory's element,
-    ``precise`` adds float64 positions to a GSD trajectory. A bad option raises SceneError
-    before anything runs."""
+    ``precise`` adds float64 positions to a GSD trajectory; ``every_time`` writes frames at the
+    multiples of that time instead of every ``every`` collisions. A bad option raises
+    SceneError before anything runs."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     if engine is not None:
@@ -258,7 +298,7 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
         scene = dataclasses.replace(scene, seed=int(seed))
     json_path = json_path if json_path is not None else scene.json
     collisions, time, trajectory, every, checkpoints, checkpoint_every = _options(
-        scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume)
+        scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume, every_time)
     from .run import _check_memory, _check_output
 
     for what, path, folder in (("--json", json_path, False), ("--trajectory", trajectory, False),
@@ -273,7 +313,7 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
     _check_memory(scene)
     sim = _build(scene, resume)
     run = _Production(scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
-                      species, precise)
+                      species, precise, every_time)
     run.go(sys.stdout.isatty() if progress is None else progress)
     r = run.report(resume)
     if json_path is not None:

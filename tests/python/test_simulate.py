@@ -95,6 +95,25 @@ def test_gsd_frames_of_a_simulate_run(tmp_path):
         assert all(int(fr.log["revcol/direction"][0]) == 1 for fr in f) and len(f) == r["trajectory_frames"]
 
 
+@pytest.mark.parametrize("text", [FLOAT, LATTICE], ids=["float", "lattice"])
+def test_frames_on_a_time_trigger(tmp_path, text):
+    # every_time: a frame at each multiple of T on the clock (between events, not at a
+    # collision), the start and the end; the run is bit for bit the one without the pauses
+    s = scene_file(tmp_path, text)
+    r = simulate(s, time=2.0, trajectory=tmp_path / "t.xyz", every_time=0.25, progress=False)
+    lines = open(tmp_path / "t.xyz").read().splitlines()
+    times = [float(ln.split("Time=")[1].split()[0]) for ln in lines if "Time=" in ln]
+    tick = 0.0 if text == FLOAT else 1e-3
+    assert len(times) == 9 == r["trajectory_frames"]
+    assert np.allclose(times, np.arange(0.0, 2.01, 0.25), atol=tick)
+    twin = simulate(s, time=2.0, progress=False)
+    assert twin["net_collisions"] == r["net_collisions"] and twin["time_end"] == r["time_end"]
+    # a period whose multiples round back below themselves (floor(3 * 0.7 / 0.7) == 2) must not
+    # stall the run at a frame time (it did: the next frame time was computed as the current one)
+    r = simulate(s, collisions=400, trajectory=tmp_path / "u.xyz", every_time=0.7, progress=False)
+    assert r["collisions"] == 400 and not r["stalled"] and r["trajectory_frames"] > 4
+
+
 @pytest.mark.parametrize("args,message", [
     (["--collisions", "10", "--time", "1"], "not allowed with argument"),
     (["--collisions", "0"], "expected a positive integer"),
@@ -106,6 +125,9 @@ def test_gsd_frames_of_a_simulate_run(tmp_path):
     (["--trajectory", "t.xyz", "--species", "A"], "chemical element symbol"),
     (["--resume", "missing.npz"], "is not a file"),
     (["--colisions", "10"], "did you mean '--collisions'"),
+    (["--every-time", "0.5"], "--every-time needs --trajectory"),
+    (["--trajectory", "t.xyz", "--every", "5", "--every-time", "0.5"], "give one frame trigger, not both"),
+    (["--trajectory", "t.xyz", "--every-time", "-1"], "expected a positive"),
 ])
 def test_bad_options_are_named_errors_and_run_nothing(tmp_path, capsys, args, message):
     s = scene_file(tmp_path, FLOAT)
@@ -132,6 +154,7 @@ def test_a_scene_that_is_not_a_gas_is_refused(tmp_path):
     (dict(checkpoints="ck", checkpoint_every=2.5), "--checkpoint-every must be a positive integer"),
     (dict(collisions=True), "--collisions must be a positive integer"),
     (dict(time=float("nan")), "--time must be a positive finite number"),
+    (dict(trajectory="t.xyz", every_time=float("inf")), "--every-time must be a positive finite number"),
 ])
 def test_the_python_api_names_bad_values_too(tmp_path, kw, message):
     kw = {k: (str(tmp_path / v) if k in ("trajectory", "checkpoints") else v) for k, v in kw.items()}
