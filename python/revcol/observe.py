@@ -26,7 +26,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["Estimate", "Profile", "Observation", "radial_distribution", "report_lines", "OBSERVE_FIELDS"]
+__all__ = ["Estimate", "Profile", "Observation", "radial_distribution", "contact_value", "compressibility_from_contact", "report_lines", "OBSERVE_FIELDS"]
 
 #: the arguments of ``Simulation.observe`` (and the fields of a scene's ``[observe]`` table)
 OBSERVE_FIELDS = ("block_time", "min_blocks", "slab_axis", "slabs", "speed_bins", "speed_max", "pair_bins",
@@ -176,7 +176,9 @@ def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Op
 
     Uses freud (``freud.density.RDF``) when installed and ``use_freud`` is not False; otherwise
     numpy (minimum image, pair distances by rows, normalized by the ideal gas's shell counts
-    at the same density). Returns (r centres, g). The box must be periodic on every axis (g(r)
+    at the same density). Both normalize by the other particles' density (n - 1) / V (freud's
+    ``normalization_mode="finite_size"``), so they agree up to the pairs that float32
+    positions in freud move across a bin edge (``test_observe``). Returns (r centres, g). The box must be periodic on every axis (g(r)
     of a bulk gas); ``r_max`` at most L / 2 (default: 0.5 min L)."""
     x = np.asarray(frames, dtype=float)
     if x.ndim == 2:
@@ -203,13 +205,32 @@ def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Op
                 raise
     if freud is not None:
         fbox = freud.box.Box.from_box(list(L) + ([0.0] if d == 2 else []))
-        rdf = freud.density.RDF(bins=bins, r_max=r_max)
+        rdf = freud.density.RDF(bins=bins, r_max=r_max, normalization_mode="finite_size")
         for f in x:
             pts = np.zeros((f.shape[0], 3))
             pts[:, :d] = f - 0.5 * L
             rdf.compute((fbox, fbox.wrap(pts)), reset=False)
         return np.asarray(rdf.bin_centers), np.asarray(rdf.rdf)
     return _rdf_numpy(x, L, bins, r_max)
+
+
+def contact_value(r, g, diameter: float = 1.0, width: float = 0.2, order: int = 2) -> float:
+    """g(D+), the radial distribution at contact: a least-squares polynomial of ``order`` in
+    r - D through the bins whose centres lie in (D, D + ``width``], evaluated at r = D."""
+    r, g = np.asarray(r, dtype=float), np.asarray(g, dtype=float)
+    sel = (r > diameter) & (r <= diameter + width)
+    if np.count_nonzero(sel) < order + 2:
+        raise ValueError(f"contact_value needs at least {order + 2} bins in (D, D + width]; "
+                         f"got {np.count_nonzero(sel)} (finer bins or a larger width)")
+    return float(np.polyval(np.polyfit(r[sel] - diameter, g[sel], order), 0.0))
+
+
+def compressibility_from_contact(g_contact: float, packing_fraction: float, dim: int) -> float:
+    """Z = P / (n kT) of hard spheres from the contact value: 1 + 2^(d-1) phi g(D+) (the
+    virial theorem: 1D 1 + phi g, 2D 1 + 2 phi g, 3D 1 + 4 phi g)."""
+    if dim not in (1, 2, 3):
+        raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
+    return 1.0 + 2.0 ** (dim - 1) * float(packing_fraction) * float(g_contact)
 
 
 def _rdf_numpy(x: np.ndarray, L: np.ndarray, bins: int, r_max: float):

@@ -58,7 +58,8 @@ from typing import Sequence
 
 import numpy as np
 
-__all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS", "ELEMENTS", "net_collisions"]
+__all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS", "ELEMENTS", "net_collisions",
+           "read_gsd"]
 
 #: suffix -> what writes it
 FORMATS = {".xyz": "extended XYZ (OVITO, ASE)", ".gsd": "GSD (HOOMD-blue; needs the gsd package)"}
@@ -254,6 +255,35 @@ class GSDWriter(_Writer):
 
     def _close_file(self) -> None:
         self._f.close()
+
+
+def read_gsd(path: str | os.PathLike) -> dict:
+    """A GSD trajectory written by :class:`GSDWriter`, read back as arrays in the engine's
+    coordinates ([0, L) per axis): ``time`` and ``net_collisions`` (F,), ``positions`` (F, n,
+    d: the float64 positions when the file was written ``precise``, else float32's),
+    ``image`` (F, n, d), ``unwrapped`` = positions + image L on periodic axes (what an MSD
+    across periodic boundaries uses), ``box`` (d,), ``periodic`` (d,). Needs ``gsd``."""
+    import gsd.hoomd
+
+    with gsd.hoomd.open(os.fspath(path), mode="r") as f:
+        frames = list(f)
+    if not frames:
+        raise ValueError(f"{path}: no frames")
+    first = frames[0]
+    walls = np.asarray(first.log["revcol/walls"], dtype=bool) if "revcol/walls" in first.log else None
+    d = 3 if first.configuration.dimensions == 3 else 2
+    box = np.asarray(first.configuration.box[:d], dtype=float)
+    precise = "particles/revcol/position" in first.log
+    pos = np.array([np.asarray(fr.log["particles/revcol/position"] if precise else fr.particles.position,
+                               dtype=float)[:, :d] for fr in frames])
+    pos += 0.5 * box
+    image = np.array([np.asarray(fr.particles.image)[:, :d] for fr in frames], dtype=np.int64)
+    periodic = ~walls[:d] if walls is not None else np.ones(d, dtype=bool)
+    unwrapped = pos + image * (box * periodic)
+    return {"time": np.array([float(fr.log["revcol/time"][0]) for fr in frames]),
+            "net_collisions": np.array([int(fr.log["revcol/net_collisions"][0]) for fr in frames]),
+            "positions": pos, "image": image, "unwrapped": unwrapped, "box": box, "periodic": periodic,
+            "precise": precise}
 
 
 def _part(path: Path) -> str:
