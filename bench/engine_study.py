@@ -4,7 +4,7 @@ Maxwell-Boltzmann speeds, and memory over long runs. Writes bench/results/engine
     PYTHONPATH=build-dev/pkg python3 bench/engine_study.py horizon   [--n 1000] [--max 1e6]
     PYTHONPATH=build-dev/pkg python3 bench/engine_study.py maxwell   [--n 1000]
     PYTHONPATH=build-dev/pkg python3 bench/engine_study.py memory    [--n 10000] [--max 1e7]
-    PYTHONPATH=build-dev/pkg python3 bench/engine_study.py throughput [--bin build-dev/revcol-bench]
+    PYTHONPATH=build-dev/pkg python3 bench/engine_study.py throughput [--bin build-dev/revcol-bench] [--rounds 5] [--cpu 1]
     PYTHONPATH=build-dev/pkg python3 bench/engine_study.py all
 
 horizon: for each (d, phi) a fresh random gas (N particles, periodic box, exact mode, flux
@@ -18,9 +18,11 @@ per particle; then `samples` snapshots, `gap` collisions per particle apart, are
 the speeds compared with the Maxwell-Boltzmann law of the measured kT by Kolmogorov-Smirnov
 (p > 0.001 is the criterion; pooled snapshots are correlated, so p is optimistic).
 
-throughput: revcol-bench --bench engine/<case> --collisions 1e6 (2e6 for N = 1e5) --repeats 3,
-one process per case (peak RSS per case), merged into engine_throughput.json with the
-reference rates of the fastest public EDMD code measured on this machine.
+throughput: revcol-bench --bench engine/<case> --collisions 1e6 (2e6 for N = 1e5), one fresh
+process per run (peak RSS per case), every case once per round and the rounds interleaved
+(--rounds, default 5; --cpu K pins to core K); medians and ranges with the load recorded per
+run, merged into engine_throughput.json with the reference rates of the fastest public EDMD
+code measured on this machine.
 
 memory: one process per run (peak RSS is the process's VmHWM); the RSS after 1e5, 1e6 and
 1e7 collisions at N = 1e4 spheres, and the engine's log bytes.
@@ -201,34 +203,70 @@ REFERENCE = {  # collisions/s of the fastest public EDMD code on this machine (t
 }
 
 
+THROUGHPUT_CASES = ["engine/d3/n10000/phi0.3", "engine/d3/n10000/phi0.45", "engine/d3/n100000/phi0.3",
+                    "engine/d3/n100000/phi0.45", "engine/d2/n10000/phi0.5"]
+
+
 def throughput(args):
+    """Every case once per round, the rounds interleaved (case order reversed on odd rounds), one
+    fresh process per run, pinned to core ``--cpu`` when given; the 1-minute load before each
+    run is recorded. Medians and ranges over the rounds."""
     import tempfile
+    rounds = args.rounds
+    runs = {c: [] for c in THROUGHPUT_CASES}
+    loads = []
+    for r in range(rounds):
+        order = THROUGHPUT_CASES if r % 2 == 0 else THROUGHPUT_CASES[::-1]
+        for case in order:
+            nc = 2000000 if "n100000" in case else 1000000
+            with tempfile.TemporaryDirectory() as tmp:
+                js = os.path.join(tmp, "b.json")
+                cmd = [args.bin, "--bench", case, "--collisions", str(nc), "--repeats", "1", "--json", js]
+                if args.cpu is not None:
+                    cmd = ["taskset", "-c", str(args.cpu)] + cmd
+                load = os.getloadavg()[0]
+                subprocess.run(cmd, check=True, capture_output=True)
+                with open(js) as f:
+                    data = json.load(f)
+            one = {res["metric"]: res["values"][0] for res in data["results"] if res["bench"] == case}
+            one["load_1m"] = load
+            loads.append(load)
+            runs[case].append(one)
+            print(f"round {r + 1}/{rounds} {case:28s} forward {one['forward_per_s']:.3g}/s "
+                  f"reverse {one['reverse_per_s']:.3g}/s  load {load:.2f}", flush=True)
     rows = []
-    for case in ["engine/d3/n10000/phi0.3", "engine/d3/n10000/phi0.45", "engine/d3/n100000/phi0.3",
-                 "engine/d3/n100000/phi0.45", "engine/d2/n10000/phi0.5"]:
+    for case in THROUGHPUT_CASES:
+        reps = runs[case]
         nc = 2000000 if "n100000" in case else 1000000
-        with tempfile.TemporaryDirectory() as tmp:
-            js = os.path.join(tmp, "b.json")
-            subprocess.run([args.bin, "--bench", case, "--collisions", str(nc), "--repeats", "3", "--json", js],
-                           check=True, capture_output=True)
-            with open(js) as f:
-                data = json.load(f)
-        med = {r["metric"]: r["median"] for r in data["results"] if r["bench"] == case}
-        row = dict(case=case, collisions=nc, **med)
+        row = dict(case=case, collisions=nc, rounds=rounds)
+        for k in reps[0]:
+            if k == "load_1m":
+                continue
+            vals = [x[k] for x in reps]
+            row[k] = float(np.median(vals))
+            if k in ("forward_per_s", "reverse_per_s"):
+                row[k + "_min"], row[k + "_max"], row[k + "_all"] = min(vals), max(vals), vals
+        row["load_1m_all"] = [x["load_1m"] for x in reps]
         ref = REFERENCE.get(case)
         if ref:
             row["reference_per_s"] = ref
             row["target_per_s"] = ref / 2
             row["meets_target"] = bool(row["forward_per_s"] >= ref / 2 and row["reverse_per_s"] >= ref / 2)
         rows.append(row)
-        print(f"{case:28s} forward {row['forward_per_s']:.3g}/s reverse {row['reverse_per_s']:.3g}/s "
-              f"peak RSS {row['peak_rss_bytes'] / 2**20:.1f} MiB"
+        print(f"{case:28s} forward {row['forward_per_s']:.3g}/s [{row['forward_per_s_min']:.3g}, "
+              f"{row['forward_per_s_max']:.3g}] reverse {row['reverse_per_s']:.3g}/s "
+              f"[{row['reverse_per_s_min']:.3g}, {row['reverse_per_s_max']:.3g}]"
               + (f"  target {ref / 2:.3g}: {'met' if row['meets_target'] else 'MISSED'}" if ref else ""))
     os.makedirs(RESULTS, exist_ok=True)
-    with open(os.path.join(RESULTS, "engine_throughput.json"), "w") as f:
-        json.dump(dict(command=" ".join(sys.argv), rows=rows), f, indent=1)
-    with open(os.path.join(RESULTS, "engine_throughput.csv"), "w") as f:
-        keys = ["case", "collisions", "forward_per_s", "reverse_per_s", "peak_rss_bytes", "events_per_collision",
+    sys.path.insert(0, os.path.join(HERE, "..", "python"))
+    from revcol._io import atomic_open
+    with atomic_open(os.path.join(RESULTS, "engine_throughput.json"), "w") as f:
+        json.dump(dict(command=" ".join(sys.argv), rounds=rounds, cpu=args.cpu,
+                       date=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                       load_1m_min=min(loads), load_1m_max=max(loads), rows=rows), f, indent=1)
+    with atomic_open(os.path.join(RESULTS, "engine_throughput.csv"), "w") as f:
+        keys = ["case", "collisions", "rounds", "forward_per_s", "forward_per_s_min", "forward_per_s_max",
+                "reverse_per_s", "reverse_per_s_min", "reverse_per_s_max", "peak_rss_bytes", "events_per_collision",
                 "invalid_per_collision", "log_bytes", "reference_per_s", "meets_target"]
         f.write(",".join(keys) + "\n")
         for r in rows:
@@ -240,6 +278,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("study", choices=["horizon", "maxwell", "memory", "throughput", "all"])
     ap.add_argument("--bin", default=os.path.join(HERE, "..", "build-dev", "revcol-bench"))
+    ap.add_argument("--rounds", type=int, default=5, help="throughput: interleaved rounds (every case once each)")
+    ap.add_argument("--cpu", type=int, default=None, help="throughput: pin each run to this core (taskset)")
     ap.add_argument("--n", type=int, default=None)
     ap.add_argument("--max", type=float, default=None)
     ap.add_argument("--relax", type=float, default=40.0, help="maxwell: collisions per particle to relax")
