@@ -69,6 +69,16 @@ def test_exact_two_body_values_against_monte_carlo():
 def test_equations_of_state_and_enskog():
     assert P.henderson(0.5) == pytest.approx(4.125)
     assert P.carnahan_starling(0.3) == pytest.approx((1 + 0.3 + 0.09 - 0.027) / 0.343)
+    # Liu's forms: Henderson's and Carnahan-Starling's low-density virial coefficients
+    # (B2: Z = 1 + 2 phi in 2D, 1 + 4 phi in 3D), and the values they are fitted to
+    for d, b2 in ((2, 2.0), (3, 4.0)):
+        assert (P.reference_z(d, 1e-6) - 1) / 1e-6 == pytest.approx(b2, rel=1e-4)
+    assert P.liu_disks(0.5) == pytest.approx((1 + 0.25 / 8 + 0.125 / 18 - 4 * 0.0625 / 21) / 0.25)
+    assert P.liu_spheres(0.45) == pytest.approx(9.40431, rel=1e-5)
+    assert P.classic_z(2, 0.5) == P.henderson(0.5) and P.reference_z(3, 0.3) == P.liu_spheres(0.3)
+    # where they part: Henderson 0.5% above Liu at 0.5, Carnahan-Starling 0.2-0.3% below
+    assert P.henderson(0.5) / P.liu_disks(0.5) - 1 == pytest.approx(0.0048, abs=5e-4)
+    assert -0.004 < P.carnahan_starling(0.45) / P.liu_spheres(0.45) - 1 < -0.001
     # Enskog from the contact value; the low-density limit of 3D: 4 n sigma^2 sqrt(pi T)
     n = 0.01 / (math.pi / 6)
     assert P.enskog_rate(3, 0.01, 1.0, 1.0) == pytest.approx(4 * n * math.sqrt(math.pi))
