@@ -8,7 +8,7 @@ against the exact values: the time fraction near contact (|r| < 1.01 D), the col
 against a Monte Carlo of uniform non-overlapping configurations, :func:`monte_carlo`).
 
 (b) Dense gases (N >= 1000, periodic): the compressibility factor Z from the collision
-virial against Henderson's equation of state (2D) and Carnahan-Starling's (3D), the contact
+virial against Liu's equations of state (2D, 3D; Henderson's and Carnahan-Starling's beside them), the contact
 value g(sigma) = (Z - 1) / (2^(d-1) phi) it implies, the collision rate against Enskog's
 with that g(sigma), the speeds against the Maxwell-Boltzmann law (chi^2 of the time-weighted
 histogram), and the temperature across slabs.
