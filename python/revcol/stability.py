@@ -467,6 +467,9 @@ def _one_value(op: Operator, geo: _Geometry, cls: str, value: float, rng: np.ran
         "failures": len(refused) + nonfinite + mismatch + (1 if left else 0),
         "first_refusal": refused[0] if refused else "",
         "log_rate": pushed / count, "left_in_log": left, "posts_aimed": int(post.sum()) if post is not None else 0,
+        # entry s of grazing grazes contact s mod m; of edges, every contact but s mod m (f = 0)
+        "mismatch_by_entry_mod_m": [int(((ok & ~mid_bad & finite & ~(err <= MISMATCH))
+                                         & (np.arange(count) % geo.m == k)).sum()) for k in range(geo.m)],
         "min_speed_ratio": float(np.nanmin(ratio)) if cls in ("grazing", "edges") and np.isfinite(ratio).any() else None,
     }
 
@@ -644,6 +647,68 @@ def _line(r: dict) -> str:
             f"log {_fmt(r['log_rate'])} {extra} ({r['seconds']:.1f} s)")
 
 
+def _span(values) -> str:
+    v = [r["value"] for r in values]
+    return f"{v[0]:.0e} .. {v[-1]:.0e}" if len(v) > 1 else f"{v[0]:g}"
+
+
+def _failed_at(values) -> str:
+    bad = [r for r in values if r["failures"]]
+    if not bad:
+        return ""
+    kinds = sorted({k for r in bad for k in ("refused", "nonfinite", "mismatch") if r[k]})
+    return f" at {_span(bad)} ({', '.join(kinds)})"
+
+
+def _magnitude_row(r: dict, q, law: str) -> str:
+    """Magnitudes: the scales handled, and those refused (below and above) with their message."""
+    done = [v for v in r["values"] if v["refused"] < r["count"]]
+    lo = min((v["value"] for v in done), default=math.inf)
+    parts = []
+    for side in ([v for v in r["values"] if v["value"] < lo], [v for v in r["values"] if v["value"] > lo and v not in done]):
+        if side:
+            msgs = sorted({v["first_refusal"].split(":")[0] for v in side})
+            parts.append(f"refused {_span(side)} (" + "; ".join(f'"{m}"' for m in msgs) + ")")
+    other = sum(v["nonfinite"] + v["mismatch"] + v["refused"] for v in done)
+    said = ", ".join(parts) if parts else "none refused"
+    return (f"| magnitude | handled {_span(done)}, {said} | {_fmt(r['roundtrip'])} | {_fmt(q)} "
+            f"| {law} | {other} / {r['count'] * len(done)} handled{_failed_at(done)} | {_fmt(r['log_rate'])} |")
+
+
+def markdown(res: dict) -> str:
+    """One table per operator, a row per class, from a :func:`run` result."""
+    out = []
+    by: dict = {}
+    for r in res["results"]:
+        by.setdefault(r["operator"], []).append(r)
+    for name, rows in by.items():
+        out += [f"### {name}", "",
+                "| class | values | worst round trip | quantization | law KS D (bound) | failures / round trips "
+                "| rare log per collision |", "|---|---|---|---|---|---|---|"]
+        for r in rows:
+            if not r.get("applies", True):
+                out.append(f"| {r['class']} | n/a: {r['why']} | | | | | |")
+            elif r["class"] == "chains":
+                last = r["values"][-1]
+                drift = ("bit for bit at every length" if r["bit_exact_all"] else
+                         f"growth exponent {_fmt(r['growth_exponent'])}")
+                out.append(f"| chains | 1e2 .. {last['collisions']:.0e} collisions | {_fmt(r['roundtrip'])} "
+                           f"({drift}) | | | {r['failures']} of {len(r['values'])} lengths fail verify "
+                           f"| {_fmt(r['log_rate'])} |")
+            else:
+                q = max((v["quantization"] for v in r["values"] if v.get("quantization") is not None), default=None)
+                law = "-" if r["law_D"] is None else f"{r['law_D']:.2g} ({r['law_D_bound']:.2g})"
+                n = r["count"] * len(r["values"])
+                extra = f"; {r['not_pre']} not pre states" if r.get("not_pre") else ""
+                if r["class"] == "magnitude":
+                    out.append(_magnitude_row(r, q, law))
+                    continue
+                out.append(f"| {r['class']} | {_span(r['values'])} | {_fmt(r['roundtrip'])} | {_fmt(q)} | {law} "
+                           f"| {r['failures']} / {n}{_failed_at(r['values'])}{extra} | {_fmt(r['log_rate'])} |")
+        out.append("")
+    return "\n".join(out)
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m revcol.stability", description=__doc__.split("\n\n")[0])
     ap.add_argument("--full", action="store_true", help="the bench counts (else the CI's reduced counts)")
@@ -656,7 +721,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--ripple", type=int, metavar="SAMPLES",
                     help="instead of the suite: the paper 1D triple's post density ripple, both readings")
     ap.add_argument("--json", metavar="FILE", help="write the results as JSON to FILE")
+    ap.add_argument("--markdown", metavar="FILE", help="instead of a run: the tables of a saved JSON result")
     a = ap.parse_args(argv)
+    if a.markdown:
+        with open(a.markdown) as f:
+            print(markdown(json.load(f)))
+        return 0
     t = time.perf_counter()
     if a.ripple:
         res: dict = {"ripple": [ripple(angle, samples=a.ripple) for angle in ("parametric", "polar")]}

@@ -167,3 +167,7 @@ def test_the_command_line_writes_its_json(tmp_path):
     res = json.loads(out.read_text())
     assert [r["class"] for r in res["results"]] == ["head-on", "chains"]
     assert res["results"][0]["failures"] == 0 and np.isfinite(res["results"][0]["roundtrip"])
+    table = S.markdown(res).splitlines()
+    assert table[0] == "### pair2d/exact/flux"
+    assert table[4].startswith("| head-on | 0 | ") and "| 0 / 32 |" in table[4]
+    assert table[5].startswith("| chains | 1e2 .. 1e+03 collisions |") and "bit for bit" in table[5]
