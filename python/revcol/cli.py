@@ -157,6 +157,9 @@ def _parser() -> argparse.ArgumentParser:
                           help="does a collision law keep equilibrium (two particles exactly, dense gases against "
                           "the equations of state): python -m revcol.physics")
     eq.add_argument("rest", nargs=argparse.REMAINDER)
+    stab = stsub.add_parser("stability", add_help=False,
+                            help="the numerical stress suite, every class for every operator: python -m revcol.stability")
+    stab.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 
 
@@ -315,6 +318,10 @@ def _main(argv: list[str] | None) -> int:
         from . import physics
 
         return physics.main(words[2:])
+    if words[:2] == ["study", "stability"]:
+        from . import stability
+
+        return stability.main(words[2:])
     args = _parser().parse_args(argv)
     if args.command == "run":
         return _run(args)
