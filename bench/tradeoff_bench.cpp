@@ -6,6 +6,8 @@
 //
 //   tradeoff/op      one collision operator (REVCOL_TRADEOFF: case, mode, law, rng, bits, seed, arc)
 //   tradeoff/engine  the float engine on a small periodic gas (dim, particles, phi, group_tol, bits, rng, seed, warm)
+//   tradeoff/arc     the 1D triple's G-to-Psi (arc = simpson | elliptic | table, tol, cells)
+//   tradeoff/calotte the 2D triple's G-to-Psi tables (cells, nodes)
 //
 //   REVCOL_TRADEOFF="case=triple2d-c1,mode=exact,law=flux,rng=clcg4,bits=40" revcol-bench --bench tradeoff/op --collisions 100000 --repeats 1
 //
@@ -34,6 +36,13 @@
 // collisions per particle), roundtrip_error (max |v - v_start| / max |v_start|),
 // log_bytes_per_collision (the engine's logs after the forward run over N), group_fraction
 // (collisions of three or more over N), energy_drift (relative, after the forward run).
+//
+// tradeoff/arc and tradeoff/calotte: ns_per_sample (one G-to-Psi evaluation: a collision does
+// one forward and one reverse), map_error (arc: the parametric angle's largest error against
+// EllipseArc::reference_parametric; calotte: the largest CDF error |F(psi(g)) - g| of either
+// table against CalotteTable::fraction_direct, i.e. the error of the sampled probability),
+// build_ms (calotte: building both tables).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -43,7 +52,10 @@
 
 #include "../cpp/src/paper_adapt.hpp"  // the paper operators behind one interface (private glue)
 #include "bench.hpp"
+#include "revcol/collide/calotte.hpp"
 #include "revcol/collide/cases.hpp"
+#include "revcol/collide/ellipse_arc.hpp"
+#include "revcol/rng/clcg4.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
 #include "revcol/collide/pair2d_paper.hpp"
 #include "revcol/engine/engine.hpp"
@@ -62,11 +74,15 @@ struct Point {
   double phi = 0.3;                               ///< engine: packing fraction
   double group_tol = 1e-9;                        ///< engine: contact tolerance (relative to D)
   double warm = 5.0;                              ///< engine: collisions per particle before timing
+  double tol = paper::EllipseArc::simpson_tolerance;   ///< arc map: the simpson method's tolerance
+  int cells = 0;                                  ///< arc / calotte map: table cells (0: the default)
+  int nodes = paper::CalotteTable::quadrature_nodes;   ///< calotte map: Gauss-Legendre nodes per cell
 };
 
 Point read_point() {
   Point p;
-  apply_settings("REVCOL_TRADEOFF", "case, mode, law, rng, bits, seed, arc, dim, particles, phi, group_tol, warm",
+  apply_settings("REVCOL_TRADEOFF",
+                 "case, mode, law, rng, bits, seed, arc, dim, particles, phi, group_tol, warm, tol, cells, nodes",
                  [&](const std::string& key, const std::string& value) {
                    if (key == "case") p.verify.case_name = value;
                    else if (key == "mode") p.verify.mode = parse_mode(value);
@@ -80,6 +96,9 @@ Point read_point() {
                    else if (key == "phi") p.phi = std::stod(value);
                    else if (key == "group_tol") p.group_tol = std::stod(value);
                    else if (key == "warm") p.warm = std::stod(value);
+                   else if (key == "tol") p.tol = std::stod(value);
+                   else if (key == "cells") p.cells = std::stoi(value);
+                   else if (key == "nodes") p.nodes = std::stoi(value);
                    else return false;
                    return true;
                  });
@@ -295,11 +314,71 @@ std::vector<Metric> run_engine(std::uint64_t n) {
           {"collisions", coll}};
 }
 
+// ---- the G-to-Psi maps of the paper's triples, with their accuracy knobs ------------------------
+
+using Clock = std::chrono::steady_clock;
+
+// ns per call of f(g) over n CLCG4 draws (each call takes `per` draws).
+template <class F>
+double ns_per_sample(std::uint64_t n, int per, F&& f) {
+  rng::CLCG4 gen(7);
+  double sink = 0.0;
+  const auto t0 = Clock::now();
+  for (std::uint64_t k = 0; k < n; ++k) {
+    double g[2] = {gen.next(), per > 1 ? gen.next() : 0.0};
+    sink += f(g);
+  }
+  const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+  volatile double keep = sink;  // the loop must run
+  (void)keep;
+  return dt / static_cast<double>(n) * 1e9;
+}
+
+// The ellipse arc (triple1d): ns per psi, and the largest error of the parametric angle against
+// the long double reference at 400 evenly spread G.
+std::vector<Metric> run_arc(std::uint64_t n) {
+  const Point pt = read_point();
+  const int cells = pt.cells > 0 ? pt.cells : paper::EllipseArc::table_cells;
+  const paper::EllipseArc ell(pt.arc, paper::ArcAngle::parametric, paper::kPaperAspect, pt.tol, cells);
+  // the paper's Simpson method costs ~20 us a sample: fewer samples
+  const std::uint64_t m = pt.arc == paper::ArcMethod::simpson ? std::max<std::uint64_t>(1, n / 20) : n;
+  const double ns = ns_per_sample(m, 1, [&](const double* g) { return ell.parametric(g[0]); });
+  long double err = 0.0L;
+  for (int k = 0; k < 400; ++k) {
+    const double g = (k + 0.375) / 400.0;
+    const long double ref = paper::EllipseArc::reference_parametric(g, paper::kPaperAspect);
+    err = std::max(err, std::fabs(static_cast<long double>(ell.parametric(g)) - ref));
+  }
+  return {{"ns_per_sample", ns}, {"map_error", static_cast<double>(err)}};
+}
+
+// The calotte tables (triple2d, Procedure 5): ns per (psi_1, psi_2), the build time of the two
+// tables, and the largest CDF error |F(F_table^-1(g)) - g| of either (F by direct quadrature)
+// at 60 evenly spread g.
+std::vector<Metric> run_calotte(std::uint64_t n) {
+  const Point pt = read_point();
+  const int cells = pt.cells > 0 ? pt.cells : paper::CalotteTable::cells;
+  const auto t0 = Clock::now();
+  const paper::CalotteTable h4 = paper::CalotteTable::build(4, cells, pt.nodes);
+  const paper::CalotteTable h3 = paper::CalotteTable::build(3, cells, pt.nodes);
+  const double build_ms = std::chrono::duration<double>(Clock::now() - t0).count() * 1e3;
+  const double ns = ns_per_sample(n, 2, [&](const double* g) { return h4.inverse(g[0]) + h3.inverse(g[1]); });
+  double err = 0.0;
+  for (int k = 0; k < 60; ++k) {
+    const double g = (k + 0.375) / 60.0;
+    for (const paper::CalotteTable* t : {&h4, &h3})
+      err = std::fmax(err, std::fabs(paper::CalotteTable::fraction_direct(t->dim(), t->inverse(g)) - g));
+  }
+  return {{"ns_per_sample", ns}, {"map_error", err}, {"build_ms", build_ms}};
+}
+
 }  // namespace
 
 void add_tradeoff_benches(std::vector<Bench>& out) {
   out.push_back({"tradeoff/op", "collisions/s", run_op});
   out.push_back({"tradeoff/engine", "collisions/s", run_engine});
+  out.push_back({"tradeoff/arc", "ns/sample", run_arc});
+  out.push_back({"tradeoff/calotte", "ns/sample", run_calotte});
 }
 
 }  // namespace revcol::bench

@@ -26,6 +26,10 @@ Per point:
   held invariants (relative energy; momentum over sqrt(energy)).
 - ``failure_rate``: paper mode, the fraction of single collisions that do not reverse
   (``paper::study``); exact mode, the fraction of the chain not carried out (0 unless it broke).
+- ``map_error`` (the paper triples' G-to-Psi maps, timed alone: ``tradeoff/arc``,
+  ``tradeoff/calotte``; their time per collision is two evaluations, forward and reverse):
+  the ellipse arc's largest angle error against a long double reference, the calotte
+  tables' largest error of the sampled probability, |F(psi(G)) - G|.
 
     >>> from revcol import tradeoff
     >>> rep = tradeoff.run(tradeoff.reduced_points(), repeats=1, collisions=2000, samples=2000)  # doctest: +SKIP
@@ -67,7 +71,8 @@ ERRORS = {"roundtrip_error": "round-trip error (max |v_end - v_0| / max |v_0|)",
           "energy_drift": "energy drift per collision (nothing held)",
           "momentum_drift": "momentum drift per collision (nothing held)",
           "log_bytes_per_collision": "rare log, bytes per collision",
-          "failure_rate": "failure rate (collisions not reversed)"}
+          "failure_rate": "failure rate (collisions not reversed)",
+          "map_error": "G-to-Psi map error (arc: angle; calotte: probability)"}
 _OP_DEFAULTS = {"mode": "exact", "law": "flux", "rng": "clcg4", "bits": 40, "arc": "simpson", "seed": 0}
 _ENGINE_DEFAULTS = {"dim": 2, "particles": 2000, "phi": 0.3, "group_tol": 1e-9, "bits": 40, "rng": "philox",
                     "law": "flux", "seed": 1, "warm": 5}
@@ -86,6 +91,23 @@ def _engine(knob: str, curve: str, label: str, **settings) -> dict:
     s = {**_ENGINE_DEFAULTS, **settings}
     default = s["group_tol"] == _ENGINE_DEFAULTS["group_tol"] and s["rng"] == _ENGINE_DEFAULTS["rng"]
     return {"knob": knob, "curve": curve, "label": label, "kind": "engine", "settings": s, "default": default}
+
+
+def _map(kind: str, curve: str, label: str, default: bool, **settings) -> dict:
+    return {"knob": kind, "curve": curve, "label": label, "kind": kind, "settings": settings, "default": default}
+
+
+def map_points() -> list[dict]:
+    """The G-to-Psi maps' knobs: the Simpson tolerance, the arc table's and the calotte tables'
+    cells, the calotte quadrature's nodes per cell (defaults 1e-9, 4096, 2048, 10)."""
+    pts = [_map("arc", "arc map: simpson tolerance", f"tol={t:g}", t == 1e-9, arc="simpson", tol=t)
+           for t in (1e-5, 1e-7, 1e-9, 1e-11)]
+    pts.append(_map("arc", "arc map: elliptic", "elliptic", False, arc="elliptic"))
+    pts += [_map("arc", "arc map: table cells", f"cells={c}", c == 4096, arc="table", cells=c)
+            for c in (256, 1024, 4096, 16384)]
+    pts += [_map("calotte", "calotte map: cells", f"cells={c}", c == 2048, cells=c) for c in (256, 512, 2048, 8192)]
+    pts += [_map("calotte", "calotte map: nodes per cell", f"nodes={q}", q == 10, nodes=q) for q in (1, 2, 4, 10)]
+    return pts
 
 
 def all_points() -> list[dict]:
@@ -112,15 +134,18 @@ def all_points() -> list[dict]:
         pts.append(_engine("rng", "rng: float engine 2D", rng, rng=rng))
     pts.append({"knob": "engine", "curve": "lattice engine 2D", "label": "lattice", "kind": "lattice",
                 "settings": {"bench": _LATTICE_BENCH}, "default": True})
-    return pts
+    return pts + map_points()
 
 
 def reduced_points() -> list[dict]:
-    """The CI's subset: K at 24, 40, 52 on pair2d, both generators, one paper case, the engine."""
+    """The CI's subset: K at 24, 40, 52 on pair2d, both generators, one paper case, the engine,
+    the arc and calotte tables at 256 cells and their defaults."""
     pts = [_op("bits", "K: pair2d", f"K={k}", case="pair2d", bits=k) for k in (24, 40, 52)]
     pts += [_op("rng", "rng: pair2d", r, case="pair2d", rng=r) for r in ("clcg4", "philox")]
     pts.append(_op("operator", "paper", "triple2d-c1", case="triple2d-c1", mode="paper"))
     pts.append(_engine("group_tol", "group_tol: float engine 2D", "1e-09", particles=200))
+    pts += [_map("arc", "arc map: table cells", f"cells={c}", c == 4096, arc="table", cells=c) for c in (256, 4096)]
+    pts += [_map("calotte", "calotte map: cells", f"cells={c}", c == 2048, cells=c) for c in (256, 2048)]
     return pts
 
 
@@ -142,7 +167,7 @@ def _bench(binary: str, point: dict, collisions: int, pin: list[str]) -> dict[st
     if point["kind"] == "lattice":
         name = s["bench"]
     else:
-        name = "tradeoff/op" if point["kind"] == "op" else "tradeoff/engine"
+        name = "tradeoff/" + point["kind"]
         env["REVCOL_TRADEOFF"] = ",".join(f"{k}={v}" for k, v in s.items())
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "r.json"
@@ -161,6 +186,8 @@ def _collisions(binary: str, point: dict, pin: list[str], collisions: int, budge
         return 2 * int(point["settings"]["particles"])  # ~4 collisions per particle: inside the horizon
     if point["kind"] == "lattice":
         return min(collisions, 20_000)
+    if point["kind"] in ("arc", "calotte"):
+        return min(collisions, 100_000)  # map evaluations (simpson: a twentieth of them)
     m = _bench(binary, point, min(2000, collisions), pin)
     rate = min(m["forward_per_s"], m["reverse_per_s"])
     return int(max(min(collisions, floor), min(collisions, budget_s * rate)))
@@ -289,6 +316,16 @@ def _row(point: dict, runs: list[dict[str, float]], collisions: int, law: dict |
     first = runs[0]
     row = {k: point[k] for k in ("knob", "curve", "label", "kind", "default")}
     row["settings"] = point["settings"]
+    row.update({k: None for k in ERRORS})
+    if point["kind"] in ("arc", "calotte"):  # a map: forward and reverse evaluate it once each
+        row["collisions"] = collisions
+        row["forward_us"] = row["reverse_us"] = _stat([r["ns_per_sample"] / 1e3 for r in runs])
+        row["time_us"] = 2 * row["forward_us"]["median"]
+        row.update(map_error=first["map_error"], bit_exact=None, law_D_noise=None, invalid_post=None,
+                   deterministic=all(r["map_error"] == first["map_error"] for r in runs))
+        if "build_ms" in first:
+            row["build_ms"] = _stat([r["build_ms"] for r in runs])
+        return row
     row["collisions"] = int(first.get("collisions", collisions))
     row["forward_us"] = _stat([1e6 / r["forward_per_s"] for r in runs])
     row["reverse_us"] = _stat([1e6 / r["reverse_per_s"] for r in runs])
@@ -383,21 +420,22 @@ def _fmt(x, spec: str = ".2g") -> str:
 def format_table(rep: dict) -> str:
     """The points as a Markdown table."""
     head = ("| knob | curve | setting | N | fwd us | rev us | round trip | bit exact | law D (noise) "
-            "| E drift/coll | P drift/coll | log B/coll | failure |")
-    lines = [head, "|" + "---|" * 13]
+            "| E drift/coll | P drift/coll | log B/coll | failure | map error |")
+    lines = [head, "|" + "---|" * 14]
     for r in rep["points"]:
         t = lambda s: f"{s['median']:.3g} [{s['min']:.3g}, {s['max']:.3g}]"  # noqa: E731
         law = "-" if r["law_D"] is None else f"{r['law_D']:.2g} ({r['law_D_noise']:.1g})"
         lines.append(f"| {r['knob']} | {r['curve']} | {r['label']}{' **(default)**' if r['default'] else ''} "
                      f"| {r['collisions']} | {t(r['forward_us'])} | {t(r['reverse_us'])} "
                      f"| {_fmt(r['roundtrip_error'])} | {_fmt(r['bit_exact'])} | {law} | {_fmt(r['energy_drift'])} "
-                     f"| {_fmt(r['momentum_drift'])} | {_fmt(r['log_bytes_per_collision'])} | {_fmt(r['failure_rate'])} |")
+                     f"| {_fmt(r['momentum_drift'])} | {_fmt(r['log_bytes_per_collision'])} | {_fmt(r['failure_rate'])} "
+                     f"| {_fmt(r['map_error'])} |")
     return "\n".join(lines)
 
 
 _CSV_COLUMNS = ("knob", "curve", "label", "default", "collisions", "time_us", "roundtrip_error", "bit_exact",
                 "law_D", "law_D_noise", "invalid_post", "energy_drift", "momentum_drift",
-                "log_bytes_per_collision", "failure_rate", "deterministic")
+                "log_bytes_per_collision", "failure_rate", "map_error", "deterministic")
 
 
 def write_json(rep: dict, path: str | os.PathLike) -> None:

@@ -29,7 +29,7 @@ def report():
     if exe is None:
         pytest.skip("revcol-bench not found (set REVCOL_BENCH or install the package)")
     pts = tradeoff.reduced_points()
-    # K = 24 .. 52 on the 2D pair, both generators, one paper case and the engine
+    # K = 24, 40, 52 on the 2D pair, both generators, one paper case, the engine, two map tables
     return tradeoff.run(pts, repeats=3, collisions=3000, min_collisions=3000, samples=4000, binary=exe,
                         command="test")
 
@@ -161,3 +161,15 @@ def test_cli(tmp_path, capsys):
     rep = json.loads(out.read_text())
     assert rep["command"].startswith("revcol bench tradeoff") and out.with_suffix(".csv").exists()
     assert cli_main(["bench", "tradeoff", "--repeats", "0", "--binary", exe]) == 2
+
+
+def test_map_errors_fall_with_the_table_cells(report):
+    """Cubic Hermite tables: the error falls about as cells^-4 (16 times the cells: over 1e3
+    times smaller), and the defaults are accurate to ~1e-12 or better."""
+    for kind, default in (("arc", 4096), ("calotte", 2048)):
+        rows = {r["settings"]["cells"]: r for r in report["points"] if r["kind"] == kind}
+        assert sorted(rows) == sorted((256, default))
+        assert rows[default]["default"] and not rows[256]["default"]
+        assert rows[default]["map_error"] < 1e-12 < rows[256]["map_error"]
+        assert rows[256]["map_error"] / rows[default]["map_error"] > 1e3
+        assert rows[default]["deterministic"] and rows[default]["time_us"] > 0
