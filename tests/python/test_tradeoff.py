@@ -133,6 +133,15 @@ def test_law_distance_sees_a_wrong_law():
     np.testing.assert_allclose((same ** 2).sum(axis=(1, 2)), (v ** 2).sum(), rtol=1e-12)
 
 
+def test_paper_pair2d_meets_its_uniform_target():
+    """The paper's Procedure 1 samples the post angle uniformly: the one paper case whose law
+    is the uniform law (and the exact flux law is not it)."""
+    paper = tradeoff.law_distance({**tradeoff._OP_DEFAULTS, "case": "pair2d", "mode": "paper"}, 20_000)
+    assert paper["law_D"] < paper["law_D_noise"] and paper["invalid_post"] == 0.0
+    exact = tradeoff.law_distance({**tradeoff._OP_DEFAULTS, "case": "pair2d"}, 20_000)  # flux vs flux
+    assert exact["law_D"] < exact["law_D_noise"]
+
+
 def test_outputs(report, tmp_path):
     tradeoff.write_json(report, tmp_path / "t.json")
     tradeoff.write_csv(report, tmp_path / "t.csv")
