@@ -62,19 +62,19 @@ __all__ = ["all_points", "reduced_points", "run", "law_distance", "rejection_pos
 #: K values of the chart-bits knob
 BITS = (24, 28, 32, 36, 40, 44, 48, 52)
 #: engine contact tolerances (relative to D)
-GROUP_TOLS = (1e-12, 1e-9, 1e-6, 1e-4)
+GROUP_TOLS = (1e-12, 1e-9, 1e-6, 1e-5, 1e-4)
 #: the paper-mode cases (pair2d: the paper's Procedures 1-2)
 PAPER_CASES = ("pair2d", "pair3d", "triple1d", "triple2d-c1", "triple2d-c2", "triple2d-c3", "triple2d-c4")
 #: the error metrics a Pareto plot is drawn for, with their axis labels
 ERRORS = {"roundtrip_error": "round-trip error (max |v_end - v_0| / max |v_0|)",
-          "law_D": "law error (KS D of the target law's chart)",
+          "law_D": "law error (KS D against rejection samples of the target law)",
           "energy_drift": "energy drift per collision (nothing held)",
           "momentum_drift": "momentum drift per collision (nothing held)",
           "log_bytes_per_collision": "rare log, bytes per collision",
           "failure_rate": "failure rate (collisions not reversed)",
           "map_error": "G-to-Psi map error (arc: angle; calotte: probability)"}
 _OP_DEFAULTS = {"mode": "exact", "law": "flux", "rng": "clcg4", "bits": 40, "arc": "simpson", "seed": 0}
-_ENGINE_DEFAULTS = {"dim": 2, "particles": 2000, "phi": 0.3, "group_tol": 1e-9, "bits": 40, "rng": "philox",
+_ENGINE_DEFAULTS = {"dim": 2, "particles": 10000, "phi": 0.5, "group_tol": 1e-9, "bits": 40, "rng": "philox",
                     "law": "flux", "seed": 1, "warm": 5}
 _LATTICE_BENCH = "lattice/periodic/n10000/phi0.3"
 
@@ -512,13 +512,18 @@ def plot(rep: dict, outdir: str | os.PathLike) -> list[Path]:
             fig.savefig(fh, format="png", dpi=130, bbox_inches="tight")
         plt.close(fig)
         files.append(f)
-    fig, axes = plt.subplots(2, 3, figsize=(17, 10))
+    fig, axes = plt.subplots(2, 4, figsize=(22, 10))
     for ax, error in zip(axes.ravel(), ERRORS):
         panel(ax, error)
-    h, lab = axes[0, 0].get_legend_handles_labels()
-    fig.legend(h, lab, loc="lower center", ncol=6, fontsize=7)
+    handles = {}
+    for ax in axes.ravel()[:len(ERRORS)]:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    legend_ax = axes.ravel()[-1]
+    legend_ax.axis("off")
+    legend_ax.legend(list(handles.values()), list(handles), loc="center", fontsize=8, title="curves (one per knob)")
     fig.suptitle("revcol: run time against error for every operator and knob (black ring: the default)")
-    fig.tight_layout(rect=(0, 0.07, 1, 0.97))
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
     f = outdir / "tradeoff.png"
     with atomic_open(f, "wb") as fh:
         fig.savefig(fh, format="png", dpi=110)
@@ -543,6 +548,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", metavar="FILE", help="write the report (and FILE's .csv next to it); - for standard output")
     p.add_argument("--plot", metavar="DIR", help="write the Pareto plots (PNG) into DIR")
     p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--from-json", metavar="FILE", help="no run: read a report written by --json and redo the "
+                   "table, the CSV and the plots from it")
 
 
 def cli_main(args: argparse.Namespace, argv: Sequence[str] | None = None) -> int:
@@ -552,11 +559,14 @@ def cli_main(args: argparse.Namespace, argv: Sequence[str] | None = None) -> int
     progress = None if args.no_progress or not sys.stderr.isatty() else (
         lambda s: print(f"\r{s[:100]:<100}", end="", file=sys.stderr, flush=True))
     try:
-        rep = run(reduced_points() if args.reduced else all_points(), repeats=args.repeats,
-                  collisions=int(args.collisions), budget_s=args.budget, min_collisions=int(args.min_collisions),
-                  samples=int(args.samples), binary=args.binary, pin=not args.no_pin, command=command,
-                  progress=progress)
-    except (ValueError, FileNotFoundError, RuntimeError) as e:
+        if args.from_json:
+            rep = json.loads(Path(args.from_json).read_text())
+        else:
+            rep = run(reduced_points() if args.reduced else all_points(), repeats=args.repeats,
+                      collisions=int(args.collisions), budget_s=args.budget, min_collisions=int(args.min_collisions),
+                      samples=int(args.samples), binary=args.binary, pin=not args.no_pin, command=command,
+                      progress=progress)
+    except (ValueError, OSError, RuntimeError) as e:
         print(f"revcol bench tradeoff: error: {e}", file=sys.stderr)
         return 2
     if progress:

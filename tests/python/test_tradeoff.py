@@ -170,6 +170,10 @@ def test_cli(tmp_path, capsys):
     rep = json.loads(out.read_text())
     assert rep["command"].startswith("revcol bench tradeoff") and out.with_suffix(".csv").exists()
     assert cli_main(["bench", "tradeoff", "--repeats", "0", "--binary", exe]) == 2
+    # the table, CSV and plots again from the JSON, without a run
+    again = tmp_path / "again.json"
+    assert cli_main(["bench", "tradeoff", "--from-json", str(out), "--json", str(again)]) == 0
+    assert json.loads(again.read_text())["points"] == rep["points"]
 
 
 def test_map_errors_fall_with_the_table_cells(report):
