@@ -5,7 +5,7 @@
 // from the bound operators); this file does the timing and the chain errors.
 //
 //   tradeoff/op      one collision operator (REVCOL_TRADEOFF: case, mode, law, rng, bits, seed, arc)
-//   tradeoff/engine  the float engine on a small periodic gas (dim, particles, phi, group_tol, bits, rng, seed, warm)
+//   tradeoff/engine  the float engine on periodic gases (dim, particles, phi, group_tol, bits, rng, seed, seeds, warm)
 //   tradeoff/arc     the 1D triple's G-to-Psi (arc = simpson | elliptic | table, tol, cells)
 //   tradeoff/calotte the 2D triple's G-to-Psi tables (cells, nodes)
 //
@@ -32,10 +32,12 @@
 //   paper::throughput (the same chain restarted where a post state does not separate; reverse
 //   over the valid post states): the illustration's chain can stop after a few collisions
 //
-// tradeoff/engine metrics: forward_per_s, reverse_per_s (N collisions each way after `warm`
-// collisions per particle), roundtrip_error (max |v - v_start| / max |v_start|),
-// log_bytes_per_collision (the engine's logs after the forward run over N), group_fraction
-// (collisions of three or more over N), energy_drift (relative, after the forward run).
+// tradeoff/engine metrics, over `seeds` gases (seed, seed + 1, ...): forward_per_s,
+// reverse_per_s (N collisions each way after `warm` collisions per particle, summed over the
+// gases), roundtrip_error (the worst max |v - v_start| / max |v_start|), broken_fraction (gases
+// whose round trip exceeds 1e-6), log_bytes_per_collision (the engine's logs after the forward
+// run over N), group_fraction (collisions of three or more over N, forward), energy_drift (the
+// worst relative drift, after the forward run).
 //
 // tradeoff/arc and tradeoff/calotte: ns_per_sample (one G-to-Psi evaluation: a collision does
 // one forward and one reverse), map_error (arc: the parametric angle's largest error against
@@ -77,12 +79,13 @@ struct Point {
   double tol = paper::EllipseArc::simpson_tolerance;   ///< arc map: the simpson method's tolerance
   int cells = 0;                                  ///< arc / calotte map: table cells (0: the default)
   int nodes = paper::CalotteTable::quadrature_nodes;   ///< calotte map: Gauss-Legendre nodes per cell
+  int seeds = 1;                                  ///< engine: gases (seed, seed + 1, ...)
 };
 
 Point read_point() {
   Point p;
   apply_settings("REVCOL_TRADEOFF",
-                 "case, mode, law, rng, bits, seed, arc, dim, particles, phi, group_tol, warm, tol, cells, nodes",
+                 "case, mode, law, rng, bits, seed, arc, dim, particles, phi, group_tol, warm, tol, cells, nodes, seeds",
                  [&](const std::string& key, const std::string& value) {
                    if (key == "case") p.verify.case_name = value;
                    else if (key == "mode") p.verify.mode = parse_mode(value);
@@ -99,6 +102,7 @@ Point read_point() {
                    else if (key == "tol") p.tol = std::stod(value);
                    else if (key == "cells") p.cells = std::stoi(value);
                    else if (key == "nodes") p.nodes = std::stoi(value);
+                   else if (key == "seeds") p.seeds = std::max(1, std::stoi(value));
                    else return false;
                    return true;
                  });
@@ -273,45 +277,74 @@ std::vector<Metric> run_op(std::uint64_t n) {
 
 // ---- the float engine on a small gas ---------------------------------------------------------
 
-std::vector<Metric> run_engine(std::uint64_t n) {
-  const Point pt = read_point();
+// One gas (seed `seed`): warm-up, n collisions forward timed, n back timed.
+struct EngineRun {
+  double forward_s = 0.0, reverse_s = 0.0, error = 0.0, energy_drift = 0.0;
+  std::uint64_t collisions = 0, back = 0, groups = 0, log_bytes = 0;
+};
+
+EngineRun engine_once(const Point& pt, std::uint64_t seed, std::uint64_t n) {
   namespace en = revcol::engine;
+  using Clock = std::chrono::steady_clock;
+  constexpr double inf = std::numeric_limits<double>::infinity();
   en::Config cfg;
   cfg.dim = pt.dim;
   cfg.law = pt.verify.law;
   cfg.bits = pt.verify.bits;
   cfg.group_tol = pt.group_tol;
-  cfg.seed = static_cast<std::uint32_t>(pt.verify.seed);
+  cfg.seed = static_cast<std::uint32_t>(seed);
   cfg.generator = en::parse_generator(pt.verify.rng);
-  const en::InitialState st = en::random_state(cfg, pt.particles, pt.phi, pt.verify.seed + 1);
+  const en::InitialState st = en::random_state(cfg, pt.particles, pt.phi, seed + 1);
   auto sim = en::make_simulation(st.config, st.x, st.v);
-  constexpr double inf = std::numeric_limits<double>::infinity();
   sim->run(static_cast<std::uint64_t>(pt.warm * static_cast<double>(pt.particles) / 2.0), inf);
   const std::vector<double> v0 = sim->velocities();
   const en::Diagnostics d0 = sim->diagnostics();
-  using Clock = std::chrono::steady_clock;
+  EngineRun r;
   const auto t0 = Clock::now();
-  const en::RunResult fwd = sim->run(n, inf);
+  r.collisions = sim->run(n, inf).collisions;
   const auto t1 = Clock::now();
   const en::Diagnostics d1 = sim->diagnostics();
-  const en::RunResult back = sim->run_back(n, -inf);
-  const auto t2 = Clock::now();
+  r.back = sim->run_back(n, -inf).collisions;
+  r.reverse_s = std::chrono::duration<double>(Clock::now() - t1).count();
+  r.forward_s = std::chrono::duration<double>(t1 - t0).count();
   const std::vector<double> v1 = sim->velocities();
-  double scale = 0.0, err = 0.0;
+  double scale = 0.0;
   for (std::size_t k = 0; k < v0.size(); ++k) {
     scale = std::fmax(scale, std::fabs(v0[k]));
-    err = std::fmax(err, std::fabs(v1[k] - v0[k]));
+    r.error = std::fmax(r.error, std::fabs(v1[k] - v0[k]));
   }
-  const auto secs = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
-  const auto coll = static_cast<double>(fwd.collisions);
-  const auto groups = static_cast<double>(d1.counters.group_collisions - d0.counters.group_collisions);
-  return {{"forward_per_s", coll / secs(t0, t1)},
-          {"reverse_per_s", static_cast<double>(back.collisions) / secs(t1, t2)},
-          {"roundtrip_error", err / scale},
-          {"log_bytes_per_collision", static_cast<double>(d1.log_bytes) / coll},
+  r.error /= scale;
+  r.groups = d1.counters.group_collisions - d0.counters.group_collisions;
+  r.log_bytes = d1.log_bytes;
+  r.energy_drift = std::fabs(d1.energy_drift);
+  return r;
+}
+
+// `seeds` gases (seed, seed + 1, ...): times summed, the worst round trip, and the fraction of
+// gases whose round trip exceeds 1e-6 (a reversal that left the forward trajectory).
+std::vector<Metric> run_engine(std::uint64_t n) {
+  const Point pt = read_point();
+  double fs = 0.0, bs = 0.0, err = 0.0, drift = 0.0, coll = 0.0, back = 0.0, groups = 0.0, log = 0.0, broken = 0.0;
+  for (int k = 0; k < pt.seeds; ++k) {
+    const EngineRun r = engine_once(pt, pt.verify.seed + static_cast<std::uint64_t>(k), n);
+    fs += r.forward_s;
+    bs += r.reverse_s;
+    coll += static_cast<double>(r.collisions);
+    back += static_cast<double>(r.back);
+    groups += static_cast<double>(r.groups);
+    log += static_cast<double>(r.log_bytes);
+    err = std::fmax(err, r.error);
+    drift = std::fmax(drift, r.energy_drift);
+    broken += r.error > 1e-6 ? 1.0 : 0.0;
+  }
+  return {{"forward_per_s", coll / fs},
+          {"reverse_per_s", back / bs},
+          {"roundtrip_error", err},
+          {"broken_fraction", broken / pt.seeds},
+          {"log_bytes_per_collision", log / coll},
           {"group_fraction", groups / coll},
-          {"energy_drift", std::fabs(d1.energy_drift)},
-          {"collisions", coll}};
+          {"energy_drift", drift},
+          {"collisions", coll / pt.seeds}};
 }
 
 // ---- the G-to-Psi maps of the paper's triples, with their accuracy knobs ------------------------

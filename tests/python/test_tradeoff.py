@@ -89,7 +89,8 @@ def test_drift_without_held_invariants_is_round_off(report):
 
 def test_engine_round_trip_within_its_horizon(report):
     (r,) = _rows(report, "group_tol")
-    assert r["kind"] == "engine" and r["roundtrip_error"] < 1e-6
+    assert r["kind"] == "engine" and r["roundtrip_error"] < 1e-6 and r["failure_rate"] == 0.0
+    assert r["settings"]["seeds"] == 6
 
 
 def test_default_is_on_or_near_the_pareto_front(report):
