@@ -34,6 +34,7 @@ void add_engine_benches(std::vector<Bench>& out);     ///< engine_bench.cpp: the
 void add_skip_benches(std::vector<Bench>& out);       ///< skip_bench.cpp: what a pair-only scene does not pay for
 void add_lattice_op_benches(std::vector<Bench>& out);  ///< lattice_op_bench.cpp: the exact lattice pair operator
 void add_lattice_benches(std::vector<Bench>& out);     ///< lattice_engine_bench.cpp: the 2D lattice engine
+void add_tradeoff_benches(std::vector<Bench>& out);    ///< tradeoff_bench.cpp: run time against error per operator and knob
 
 /// Applies the environment variable `var`'s comma-separated key=value list: set(key, value)
 /// for each entry (it returns false for an unknown key). A malformed entry, an unknown key

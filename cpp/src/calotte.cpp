@@ -63,40 +63,47 @@ double cap_integral(int s, double a, double b, int panels, const GlTable& outer,
 
 }  // namespace
 
-CalotteTable::CalotteTable(int s) : s_(s), F_(cells + 1), dF_(cells + 1) {
+CalotteTable::CalotteTable(int s, int n, int nodes) : s_(s), n_(n), nodes_(nodes), F_(n + 1), dF_(n + 1) {
   detail::note_table_built();
-  const GlTable outer(10), inner(64);
-  const double h = kPi / cells;
+  const GlTable outer(static_cast<std::size_t>(nodes)), inner(64);
+  const double h = kPi / n_;
   F_[0] = 0.0;
-  for (int k = 1; k <= cells; ++k)
+  for (int k = 1; k <= n_; ++k)
     F_[k] = F_[k - 1] + cap_integral(s, (k - 1) * h, k * h, 1, outer, inner);
-  total_ = F_[cells];
-  for (int k = 0; k <= cells; ++k) {
+  total_ = F_[n_];
+  for (int k = 0; k <= n_; ++k) {
     F_[k] /= total_;
     dF_[k] = cap_density(s, k * h, inner) / total_;
   }
-  F_[cells] = 1.0;
+  F_[n_] = 1.0;
+}
+
+CalotteTable CalotteTable::build(int s, int n, int nodes) {
+  require(s == 3 || s == 4, "calotte tables exist for s = 3 and s = 4");
+  require(n >= 16 && n <= (1 << 20), "the calotte table's cells must be in [16, 2^20]");
+  require(nodes >= 1 && nodes <= 64, "the calotte quadrature's nodes per cell must be in [1, 64]");
+  return CalotteTable(s, n, nodes);
 }
 
 const CalotteTable& CalotteTable::h4() {
-  static const CalotteTable t(4);  // built once, on first use, thread-safe
+  static const CalotteTable t(4, cells, quadrature_nodes);  // built once, on first use, thread-safe
   return t;
 }
 const CalotteTable& CalotteTable::h3() {
-  static const CalotteTable t(3);
+  static const CalotteTable t(3, cells, quadrature_nodes);
   return t;
 }
 
 double CalotteTable::hermite(int k, double u) const {
-  const double h = kPi / cells, u2 = u * u, u3 = u2 * u;
+  const double h = kPi / n_, u2 = u * u, u3 = u2 * u;
   return (2 * u3 - 3 * u2 + 1) * F_[k] + (u3 - 2 * u2 + u) * h * dF_[k] +
          (-2 * u3 + 3 * u2) * F_[k + 1] + (u3 - u2) * h * dF_[k + 1];
 }
 
 double CalotteTable::fraction(double psi) const {
   require(psi >= 0.0 && psi <= kPi, "latitude must be in [0, pi]");
-  const double x = psi / kPi * cells;
-  const int k = std::min(static_cast<int>(x), cells - 1);
+  const double x = psi / kPi * n_;
+  const int k = std::min(static_cast<int>(x), n_ - 1);
   return hermite(k, x - k);
 }
 
@@ -109,14 +116,14 @@ double CalotteTable::inverse(double g) const {
   // the cell: F_k <= g < F_{k+1}
   const auto it = std::upper_bound(F_.begin(), F_.end(), g);
   int k = static_cast<int>(it - F_.begin()) - 1;
-  k = std::clamp(k, 0, cells - 1);
+  k = std::clamp(k, 0, n_ - 1);
   // bisection on the (monotone) Hermite cubic of that cell
   double lo = 0.0, hi = 1.0;
   for (int it2 = 0; it2 < 64 && hi - lo > 1e-16; ++it2) {
     const double mid = 0.5 * (lo + hi);
     if (hermite(k, mid) < g) lo = mid; else hi = mid;
   }
-  return (k + 0.5 * (lo + hi)) * (kPi / cells);
+  return (k + 0.5 * (lo + hi)) * (kPi / n_);
 }
 
 double CalotteTable::density(double psi) const {

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 namespace revcol::paper {
@@ -110,29 +111,37 @@ struct EllipseArc::Table {
   std::vector<double> t, slope;  // t(G_k) and dt/dG at G_k = k / cells
 };
 
+std::shared_ptr<const EllipseArc::Table> EllipseArc::build_table(int cells) {
+  detail::note_table_built();
+  const EllipseArc ell(ArcMethod::elliptic, ArcAngle::parametric, kPaperAspect);
+  auto tb = std::make_shared<Table>();
+  tb->perimeter = ell.perimeter();
+  tb->t.resize(cells + 1);
+  tb->slope.resize(cells + 1);
+  for (int k = 0; k <= cells; ++k) {
+    const double g = static_cast<double>(k) / cells;
+    tb->t[k] = k == cells ? kTwoPi : ell.parametric(g);
+    tb->slope[k] = tb->perimeter / ell.speed(tb->t[k]);
+  }
+  return tb;
+}
+
 const EllipseArc::Table& EllipseArc::paper_table() {
   // Built once, on first use, thread-safe (a function-local static).
-  static const Table table = [] {
-    detail::note_table_built();
-    const EllipseArc ell(ArcMethod::elliptic, ArcAngle::parametric, kPaperAspect);
-    Table tb;
-    tb.perimeter = ell.perimeter();
-    tb.t.resize(table_cells + 1);
-    tb.slope.resize(table_cells + 1);
-    for (int k = 0; k <= table_cells; ++k) {
-      const double g = static_cast<double>(k) / table_cells;
-      tb.t[k] = k == table_cells ? kTwoPi : ell.parametric(g);
-      tb.slope[k] = tb.perimeter / ell.speed(tb.t[k]);
-    }
-    return tb;
-  }();
-  return table;
+  static const std::shared_ptr<const Table> table = build_table(table_cells);
+  return *table;
 }
 
 EllipseArc::EllipseArc(ArcMethod method, ArcAngle angle, double aspect)
-    : method_(method), angle_(angle), q_(aspect) {
+    : EllipseArc(method, angle, aspect, simpson_tolerance, table_cells) {}
+
+EllipseArc::EllipseArc(ArcMethod method, ArcAngle angle, double aspect, double tolerance, int cells)
+    : method_(method), angle_(angle), q_(aspect), tol_(tolerance), cells_(cells) {
   require(std::isfinite(aspect) && aspect > 0.0 && aspect <= 1.0,
           "ellipse aspect d_y / d_x must be in (0, 1]");
+  require(std::isfinite(tolerance) && tolerance >= 1e-14 && tolerance <= 1e-2,
+          "the simpson tolerance must be in [1e-14, 1e-2]");
+  require(cells >= 16 && cells <= (1 << 20), "the table's cells must be in [16, 2^20]");
   k_ = std::sqrt((1.0 - q_) * (1.0 + q_));
   if (method_ == ArcMethod::simpson) {
     perimeter_ = series_perimeter(q_);
@@ -141,7 +150,12 @@ EllipseArc::EllipseArc(ArcMethod method, ArcAngle angle, double aspect)
   }
   if (method_ == ArcMethod::table) {
     require(q_ == kPaperAspect, "the table method exists for the paper's ellipse only (aspect 1/sqrt(3))");
-    table_ = &paper_table();
+    if (cells_ == table_cells) {
+      table_ = &paper_table();
+    } else {
+      own_table_ = build_table(cells_);
+      table_ = own_table_.get();
+    }
   }
 }
 
@@ -220,9 +234,9 @@ double EllipseArc::simpson_arc(double a, double b, double tol) const {
 double EllipseArc::simpson_parametric(double g) const {
   const double target = g * perimeter_;
   double lo = 0.0, hi = kTwoPi, arc_lo = 0.0;
-  while (hi - lo > simpson_tolerance) {
+  while (hi - lo > tol_) {
     const double mid = 0.5 * (lo + hi);
-    const double arc_mid = arc_lo + simpson_arc(lo, mid, simpson_tolerance);
+    const double arc_mid = arc_lo + simpson_arc(lo, mid, tol_);
     if (arc_mid < target) {
       lo = mid;
       arc_lo = arc_mid;
@@ -252,9 +266,9 @@ double EllipseArc::elliptic_parametric(double g) const {
 
 double EllipseArc::table_parametric(double g) const {
   const Table& tb = *table_;
-  const double x = g * table_cells;
-  const int k = std::min(static_cast<int>(x), table_cells - 1);
-  const double u = x - k, h = 1.0 / table_cells;
+  const double x = g * cells_;
+  const int k = std::min(static_cast<int>(x), cells_ - 1);
+  const double u = x - k, h = 1.0 / cells_;
   const double u2 = u * u, u3 = u2 * u;
   const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
   return h00 * tb.t[k] + h10 * h * tb.slope[k] + h01 * tb.t[k + 1] + h11 * h * tb.slope[k + 1];

@@ -7,6 +7,7 @@
                --checkpoint-every K] [--resume CHECKPOINT] [--species Ar] [--json FILE]   (forward only)
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
+    revcol bench tradeoff [--reduced] [--repeats 3] --json bench/results/tradeoff.json --plot docs/figures/tradeoff
     revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.randomness ...)
     revcol study equilibrium small|dense|figures|table ...   (= python -m revcol.physics ...)
     revcol --version
@@ -148,6 +149,9 @@ def _parser() -> argparse.ArgumentParser:
     bsub = b.add_subparsers(dest="study", required=True)
     statesave.add_arguments(bsub.add_parser(
         "statesave", help="the paper's state saving vs reverse computation study (and lazy transport)"))
+    from . import tradeoff  # revcol bench tradeoff (issue 18): run time against error
+    tradeoff.add_arguments(bsub.add_parser(
+        "tradeoff", help="run time against error for every operator and accuracy knob, with Pareto plots"))
     st = sub.add_parser("study", help="studies (their arguments go to the study's module)")
     stsub = st.add_subparsers(dest="study", required=True)
     rnd = stsub.add_parser("randomness", add_help=False,
@@ -343,6 +347,10 @@ def _main(argv: list[str] | None) -> int:
                 with atomic_open(args.json) as f:
                     json.dump(report, f, indent=1)
         return 0 if report["passed"] else 1
+    if args.command == "bench" and args.study == "tradeoff":
+        from . import tradeoff
+
+        return tradeoff.cli_main(args, argv)
     if args.command == "bench":
         return statesave.cli_main(args, argv)
     return 2

@@ -21,8 +21,9 @@
 //        cap(psi) ~ int_0^psi sin^2 t I(t) dt,  I(t) = int_0^pi sin s sqrt(1 + 2 sin^2 t sin^2 s) ds
 //   H_3: |Lambda^-1 u|^2 = 1 + 2 sin^2 psi_2,  cap(psi) ~ int_0^psi sin t sqrt(1 + 2 sin^2 t) dt
 // Both shapes are fixed up to scale, so each cap fraction F(psi) = cap(psi)/cap(pi) is
-// computed once by GSL Gauss-Legendre quadrature (gsl_integration_glfixed) on 2048 cells of
-// [0, pi] and interpolated by cubic Hermite with the exact density as slope; the tables are
+// computed once by GSL Gauss-Legendre quadrature (gsl_integration_glfixed, 10 nodes per cell) on
+// 2048 cells of [0, pi] and interpolated by cubic Hermite with the exact density as slope (both
+// counts are arguments of CalotteTable::build, for measuring them: docs/tradeoff.md); the tables are
 // built on first use (function-local statics: thread-safe, and never built by a scene that
 // samples no 2D triple). psi = F^-1(G) by bisection on the interpolant, as the paper says.
 //
@@ -43,8 +44,10 @@ namespace revcol::paper {
 /// Calotte-area fraction F(psi) of one of the paper's two ellipsoid shapes, tabulated.
 class CalotteTable {
  public:
-  /// Cells of the table on [0, pi].
+  /// Default cells of the table on [0, pi].
   static constexpr int cells = 2048;
+  /// Default Gauss-Legendre nodes per cell of the cap integral.
+  static constexpr int quadrature_nodes = 10;
 
   /// H_4 = (1, 1, 1/sqrt3, 1/sqrt3) (built on first call).
   static const CalotteTable& h4();
@@ -62,13 +65,24 @@ class CalotteTable {
   /// Dimension s of the ellipsoid (4 or 3).
   int dim() const { return s_; }
 
+  /// Cells of this table.
+  int table_cells() const { return n_; }
+  /// Gauss-Legendre nodes per cell this table was integrated with.
+  int nodes() const { return nodes_; }
+
   /// F(psi) by direct GSL quadrature, no table (for tests).
   static double fraction_direct(int s, double psi);
+  /// A table of shape s (4: H_4, 3: H_3) with `cells` cells (in [16, 2^20]) integrated with
+  /// `nodes` Gauss-Legendre nodes per cell (in [1, 64]), built now (not shared). With the
+  /// defaults it equals h4() / h3() bit for bit. For measuring the knobs
+  /// (`revcol-bench --bench tradeoff/calotte`); the sampler uses h4() and h3().
+  static CalotteTable build(int s, int cells, int nodes);
 
  private:
-  explicit CalotteTable(int s);
+  CalotteTable(int s, int n, int nodes);
   double hermite(int k, double u) const;
   int s_;
+  int n_ = cells, nodes_ = quadrature_nodes;
   double total_;
   std::vector<double> F_, dF_;  // at psi_k = k pi / cells
 };

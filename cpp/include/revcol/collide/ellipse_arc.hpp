@@ -26,17 +26,19 @@
 // same G gives the same psi in forward and reverse, which is all reversal needs):
 //   simpson   the paper's: bisection on [0, 2 pi] starting at pi, L by adaptive Simpson
 //             (Richardson-corrected, tolerance 1e-9 per step), stopping when the bracket is
-//             below 1e-9 (the paper's "precision of 1e-9 in the computation of angles");
+//             below 1e-9 (the paper's "precision of 1e-9 in the computation of angles"; the
+//             tolerance is a constructor argument, for measuring it: docs/tradeoff.md);
 //             L(lower) is carried so each step integrates only the new half bracket.
 //             Error <= 1e-9 (measured: 4e-10).
 //   elliptic  GSL's incomplete elliptic integral of the second kind, in Carlson's form with
 //             GSL's R_F and R_D (gsl_sf_ellint_E itself is wrong by up to 6e-9 near
 //             amplitudes +-pi/2: see ellipse_arc.cpp), and safeguarded Newton (dL/dt >= q > 0). ~1e-15.
-//   table     psi(G) tabulated once on first use (4096 cells, cubic Hermite with the exact
+//   table     psi(G) tabulated once on first use (4096 cells by default, cubic Hermite with the exact
 //             slope dpsi/dG = L(2 pi) / L'(psi)); nodes from the elliptic method. ~1e-13.
 // Measured errors and times: docs/paper-findings.md and `revcol-bench --bench paper/arc`.
 #pragma once
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "revcol/error.hpp"
@@ -63,19 +65,27 @@ inline constexpr double kPaperAspect = 0.57735026918962576450914878050195746;
 /// Uniform arc-length sampling of an ellipse with aspect q = d_y / d_x (0 < q <= 1).
 class EllipseArc {
  public:
-  /// Bracket width at which the paper's bisection stops (its angle precision).
+  /// Default bracket width at which the paper's bisection stops (its angle precision).
   static constexpr double simpson_tolerance = 1e-9;
-  /// Cells of the table method.
+  /// Default cells of the table method.
   static constexpr int table_cells = 4096;
 
   /// A sampler; the table method exists for the paper's aspect only (its table is built
   /// once, on the first construction that asks for it). Throws InvalidArgument otherwise.
   explicit EllipseArc(ArcMethod method = ArcMethod::simpson,
                       ArcAngle angle = ArcAngle::parametric, double aspect = kPaperAspect);
+  /// As above with the simpson method's tolerance (bracket width and Simpson tolerance per
+  /// step, in [1e-14, 1e-2]) and the table method's cells (in [16, 2^20]; a table of other
+  /// than table_cells cells is built for this sampler, the default one is shared). The
+  /// defaults give the same bits as the constructor above. For measuring the knobs
+  /// (`revcol-bench --bench tradeoff/arc`).
+  EllipseArc(ArcMethod method, ArcAngle angle, double aspect, double tolerance, int cells);
 
   ArcMethod method() const { return method_; }  ///< the method
   ArcAngle angle() const { return angle_; }     ///< the angle convention
   double aspect() const { return q_; }          ///< q = d_y / d_x
+  double tolerance() const { return tol_; }     ///< the simpson method's tolerance
+  int cells() const { return cells_; }          ///< the table method's cells
 
   /// G-to-Psi: g in [0, 1] -> psi in [0, 2 pi] (the chosen angle of the point at arc
   /// length g L(2 pi)). Throws InvalidArgument unless 0 <= g <= 1.
@@ -106,6 +116,7 @@ class EllipseArc {
  private:
   struct Table;
   static const Table& paper_table();
+  static std::shared_ptr<const Table> build_table(int cells);
   double simpson_parametric(double g) const;
   double elliptic_parametric(double g) const;
   double table_parametric(double g) const;
@@ -116,7 +127,10 @@ class EllipseArc {
   ArcAngle angle_;
   double q_, k_;
   double perimeter_;
+  double tol_ = simpson_tolerance;
+  int cells_ = table_cells;
   const Table* table_ = nullptr;
+  std::shared_ptr<const Table> own_table_;  // a table of other than table_cells cells
 };
 
 }  // namespace revcol::paper
