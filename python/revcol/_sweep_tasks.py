@@ -52,12 +52,17 @@ def run_point(task: dict) -> dict:
     from .run import run_scene
 
     t0 = time.perf_counter()
-    scene = scene_from_dict(task["doc"], task["label"], Path(task["base"]))
     opts = task["options"]
-    if task["study"] == "horizon":
+    if task["study"] in ("randomness", "equilibrium"):
+        from . import _sweep_studies
+
+        r = _sweep_studies.run(task["study"], opts)
+    elif task["study"] == "horizon":
+        scene = scene_from_dict(task["doc"], task["label"], Path(task["base"]))
         r = run_scene(scene, horizon_seeds=opts.get("seeds", 1), max_collisions=opts.get("max_collisions", 1_000_000),
                       engine=opts.get("engine"), progress=False)
     else:
+        scene = scene_from_dict(task["doc"], task["label"], Path(task["base"]))
         r = run_scene(scene, engine=opts.get("engine"), progress=False)
     return {"report": _jsonable(r), "seconds": time.perf_counter() - t0, "host": socket.gethostname(),
             "pid": os.getpid()}
@@ -138,7 +143,7 @@ def _serial(spec, todo, state: _State, finished) -> None:
     for p in todo:
         try:
             result = run_point(p.task(spec.base, spec.study))
-        except (SceneError, ValueError, RuntimeError, MemoryError) as e:
+        except (SceneError, ValueError, RuntimeError, MemoryError, OSError) as e:
             state.fail(p, e)
             continue
         if result["report"].get("interrupted"):  # Ctrl-C reached the run: not a finished point

@@ -12,6 +12,7 @@ gives the same report (less its dates, timings and memory figures).
     description = "..."
     study = "horizon"            # "run" (the scene's revcol run: a gas's round trip, a reversal,
                                  # a statesave study) | "horizon" (revcol run --horizon) | "statesave"
+                                 # | "randomness" | "equilibrium" (these two run no scene)
     scene = "default"            # a scene name (revcol run NAME) or a path relative to this file;
                                  # default: "default" ("paper-statesave" for study = "statesave")
     combine = "grid"             # "grid": every combination of [vary]; "list": the k-th of each
@@ -32,7 +33,11 @@ The names a point sets: scene fields ``seed``, ``particles`` (a statesave scene:
 ``kinetic_energy``, ``mode``, ``law``, ``bits``, ``generator``, ``streams``, ``collisions``,
 ``time``, ``variants``, ``lazy``, ``repeats``, ``budget_gib``, ``runner`` (or any
 ``"table.field"`` of a scene), and the study's options: ``engine`` (run, horizon),
-``max_collisions`` and ``seeds`` (horizon, default 1 seed per point). Every point is validated
+``max_collisions`` and ``seeds`` (horizon, default 1 seed per point). The studies without a scene
+take their own parameters (:data:`revcol._sweep_studies.SCENELESS`): ``randomness`` (``case``,
+``mode``, ``law``, ``rng``, ``seed``, ``words``, ``tests``: one dieharder battery) and
+``equilibrium`` (``dimension``, ``packing_fraction``, ``law``, ``particles``, ``per_particle``,
+``seed``: one dense gas against the equation of state). Every point is validated
 as a scene before anything runs; a bad sweep file raises :class:`SweepError` naming the file,
 the field (or the point) and what is allowed.
 
@@ -70,7 +75,7 @@ __all__ = ["SweepError", "Sweep", "Point", "load_sweep", "sweep_from_dict", "swe
 
 #: the studies a sweep runs, and the options each takes besides the scene's fields
 STUDIES: dict[str, tuple[str, ...]] = {"run": ("engine",), "horizon": ("engine", "max_collisions", "seeds"),
-                                       "statesave": ()}
+                                       "statesave": (), "randomness": (), "equilibrium": ()}
 
 #: a point's scene parameters: name -> (table, field) of the scene document
 SCENE_PARAMS: dict[str, tuple[str, str]] = {
@@ -108,7 +113,7 @@ class Point:
     params: dict[str, Any]
     doc: dict[str, Any]
     options: dict[str, Any]
-    scene: Scene
+    scene: Scene | None  # None for the studies without a scene (randomness, equilibrium)
     hash: str
     memory_bytes: int
 
@@ -284,6 +289,17 @@ def sweep_from_dict(doc: dict, source: str = "<dict>", base: str | os.PathLike |
     if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= 100:
         raise _fail(source, "[resources] retries", f"must be an integer 0..100, got {retries!r}")
     base = Path(base) if base is not None else Path.cwd()
+    fixed, vary = doc.get("options", {}), doc.get("vary", {})
+    both = sorted(set(fixed) & set(vary))
+    if both:
+        raise _fail(source, "[options]", f"{', '.join(both)} also in [vary]: give each parameter once")
+    if study in ("randomness", "equilibrium"):
+        if "scene" in head:
+            raise _fail(source, "[sweep] scene", f"study {study!r} runs no scene (its parameters go in [vary] / "
+                        "[options])")
+        points = _sceneless_points(source, study, fixed, _combinations(source, vary, combine), mem)
+        return Sweep(name=name, description=head.get("description", ""), study=study, scene_name="-", source=source,
+                     base=str(base), points=tuple(points), retries=retries, memory_given=mem is not None)
     scene_name = head.get("scene", "paper-statesave" if study == "statesave" else "default")
     scene_doc, scene_base, scene_label = _scene_doc(source, scene_name, base)
     # a point writes nothing of its own (no [output], no checkpoints: points running at once would
@@ -296,10 +312,6 @@ def sweep_from_dict(doc: dict, source: str = "<dict>", base: str | os.PathLike |
         raise _fail(source, "[sweep] scene", f"study 'statesave' needs a statesave scene, {scene_label} is {kind!r}")
     if study == "horizon" and kind != "gas":
         raise _fail(source, "[sweep] scene", f"study 'horizon' needs a gas scene, {scene_label} is {kind!r}")
-    fixed, vary = doc.get("options", {}), doc.get("vary", {})
-    both = sorted(set(fixed) & set(vary))
-    if both:
-        raise _fail(source, "[options]", f"{', '.join(both)} also in [vary]: give each parameter once")
     points, seen = [], {}
     for k, params in enumerate(_combinations(source, vary, combine)):
         pdoc, options = copy.deepcopy(scene_doc), {}
@@ -316,6 +328,28 @@ def sweep_from_dict(doc: dict, source: str = "<dict>", base: str | os.PathLike |
     return Sweep(name=name, description=head.get("description", ""), study=study, scene_name=scene_label,
                  source=source, base=str(scene_base), points=tuple(points), retries=retries,
                  memory_given=mem is not None)
+
+
+def _sceneless_points(source: str, study: str, fixed: dict, combos: list[dict], mem) -> list[Point]:
+    """The points of a study without a scene: its defaults, then [options], then [vary]."""
+    from . import _sweep_studies
+
+    points, seen = [], {}
+    for k, params in enumerate(combos):
+        given = dict(list(fixed.items()) + list(params.items()))
+        try:
+            _sweep_studies.check(study, given)
+        except ValueError as e:
+            raise _fail(source, f"point {k} ({', '.join(f'{a}={b!r}' for a, b in params.items()) or 'no parameters'})",
+                        str(e)) from None
+        full = dict(_sweep_studies.defaults(study), **given)
+        h = _hash({}, full, study)
+        if h in seen:
+            raise _fail(source, "[vary]", f"points {seen[h]} and {k} are the same run (a value listed twice?)")
+        seen[h] = k
+        need = int(mem * 2**30) if mem is not None else BASE_BYTES + _sweep_studies.memory(study, full)
+        points.append(Point(k, given, {}, full, None, h, need))
+    return points
 
 
 def _point_scene(doc: dict, options: dict, where: str, base: str) -> Scene:

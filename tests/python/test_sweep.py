@@ -215,6 +215,31 @@ def test_run_and_statesave_studies(tmp_path):
     assert all(r["passed"] for r in reports)
 
 
+def test_randomness_and_equilibrium_studies(tmp_path):
+    """The studies without a scene: one dieharder battery, one dense gas per point; the same
+    parameters give the same report as the study's own function."""
+    from revcol import physics, randomness
+
+    doc = {"sweep": {"name": "rnd", "study": "randomness"}, "vary": {"rng": ["philox", "clcg4"]},
+           "options": {"case": "raw", "words": 30000, "tests": [15]}}
+    s = sweep(sweep_from_dict(doc), out=tmp_path / "rnd", workers=0)
+    assert s["complete"] and not s["failed"]
+    rows = (tmp_path / "rnd" / "rnd.csv").read_text().splitlines()
+    assert len(rows) == 3 and rows[0].startswith("index,hash,case,words,tests,rng,kind,")
+    p = sweep_from_dict(doc).points[0]
+    got = json.loads((tmp_path / "rnd" / "points" / f"{p.hash}.json").read_text())["report"]
+    ref = randomness.battery({"case": "raw", "mode": "exact", "law": "flux", "rng": "philox", "seed": 0}, 30000, (15,))
+    assert got["pvalues"] == ref["pvalues"] and got["verdict"] == ref["verdict"]
+    doc = {"sweep": {"name": "eq", "study": "equilibrium"}, "vary": {"packing_fraction": [0.2, 0.4]},
+           "options": {"particles": 64, "per_particle": 10.0}}
+    s = sweep(sweep_from_dict(doc), out=tmp_path / "eq", workers=0)
+    assert s["complete"] and not s["failed"]
+    p = sweep_from_dict(doc).points[1]
+    got = json.loads((tmp_path / "eq" / "points" / f"{p.hash}.json").read_text())["report"]
+    ref = physics.dense(2, 0.4, "flux", n=64, per_particle=10.0, seed=1)
+    assert got["z"] == ref["z"] and got["collisions"] == ref["collisions"] and got["kind"] == "equilibrium"
+
+
 BAD = [
     ({"swep": {}}, "[swep]: unknown table"),
     ({"sweep": {"studdy": "run"}}, "[sweep] studdy: unknown field"),
@@ -238,6 +263,13 @@ BAD = [
     ({"sweep": {"study": "horizon"}, "options": {"seeds": 0}}, "seeds must be a positive integer"),
     ({"sweep": {"study": "horizon"}, "options": {"engine": "gpu"}}, "--engine must be one of"),
     ({"sweep": {"study": "run"}, "options": {"max_collisions": 5}}, "parameter 'max_collisions': unknown"),
+    ({"sweep": {"study": "randomness", "scene": "default"}}, "study 'randomness' runs no scene"),
+    ({"sweep": {"study": "randomness"}, "vary": {"rng": ["philox", "mt"]}}, "point 1 (rng='mt'): parameter 'rng'"),
+    ({"sweep": {"study": "randomness"}, "options": {"tests": [99]}}, "parameter 'tests': must be a non-empty list"),
+    ({"sweep": {"study": "randomness"}, "options": {"case": "pair9d"}}, "parameter 'case': must be a word-stream"),
+    ({"sweep": {"study": "equilibrium"}, "options": {"dimension": 3, "packing_fraction": 0.72}},
+     "at most 0.7 in 3D"),
+    ({"sweep": {"study": "equilibrium"}, "vary": {"temperature": [1.0]}}, "parameter 'temperature': unknown"),
 ]
 
 
