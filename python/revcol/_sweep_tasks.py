@@ -16,8 +16,10 @@ import datetime as dt
 import json
 import logging
 import os
+import signal
 import socket
 import sys
+import threading
 import time
 import uuid
 from pathlib import Path
@@ -114,12 +116,14 @@ def execute(spec, out: Path, *, workers, scheduler, scheduler_file, client, prog
     log(f"revcol sweep {spec.name}: {len(spec.points)} points ({spec.study} of {spec.scene_name}); "
         f"{reused} already done in {out}, {len(todo)} to run")
     state = _State()
-    bar = Bar(sys.stdout.isatty() if progress is None else progress, float(len(todo)), spec.name, "pt")
+    bars: list[Bar] = []  # drawn from the first result on, below the cluster's lines
 
     def finished(p, result: dict) -> bool:
         _write_point(out, spec, p, result)
         state.ran += 1
-        bar.to(state.ran + len(state.failed))
+        if not bars:
+            bars.append(Bar(sys.stdout.isatty() if progress is None else progress, float(len(todo)), spec.name, "pt"))
+        bars[0].to(state.ran + len(state.failed))
         if on_result is not None:
             on_result({"index": p.index, "hash": p.hash, "point": p.params})
         return stop_after is not None and state.ran >= stop_after
@@ -133,7 +137,8 @@ def execute(spec, out: Path, *, workers, scheduler, scheduler_file, client, prog
     except KeyboardInterrupt:
         state.interrupted = True
     finally:
-        bar.close()
+        for b in bars:
+            b.close()
     return gather(spec, out, state, reused=reused, seconds=time.perf_counter() - t0, load=(load0, os.getloadavg()),
                   log=log)
 
@@ -164,10 +169,17 @@ def _connect(workers, scheduler, scheduler_file, log):
     n = workers or os.cpu_count() or 1
     total = _total_memory()
     per = total // n if total else None
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                           memory_limit=per if per else "auto", resources={MEMORY: per} if per else None,
-                           silence_logs=logging.ERROR,
-                           worker_dashboard_address=":0")  # free ports: others on this machine may hold 8787
+    # the workers start with SIGINT ignored (inherited through exec): a terminal's Ctrl-C reaches
+    # the whole process group, and only this process is to act on it (it cancels, writes, closes)
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() else None
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               memory_limit=per if per else "auto", resources={MEMORY: per} if per else None,
+                               silence_logs=logging.ERROR,
+                               worker_dashboard_address=":0")  # free ports: others on this machine may hold 8787
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGINT, old)
     c = Client(cluster)
     return c, [c, cluster], "local"
 

@@ -153,6 +153,30 @@ def test_interrupted_sweep_resumes_without_redoing(small, client, tmp_path):
     assert s["ran"] == 0 and s["reused"] == 6
 
 
+def test_ctrl_c_on_a_terminal_stops_keeps_and_resumes(small, tmp_path):
+    """SIGINT to the whole process group (what a terminal's Ctrl-C does): exit 130, the finished
+    points kept, no worker traceback; the same command again completes."""
+    f, serial = small
+    cmd = [sys.executable, "-m", "revcol", "sweep", str(f), "--workers", "2", "--out", str(tmp_path), "--no-progress"]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and len(list((tmp_path / "points").glob("*.json"))) < 1:
+            time.sleep(0.05)
+        os.killpg(p.pid, signal.SIGINT)
+        out, err = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+    kept = len(list((tmp_path / "points").glob("*.json")))
+    assert p.returncode == 130 and "Traceback" not in err, err
+    assert kept >= 1
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert f"{kept} already done" in done.stderr and _reports(tmp_path) == serial
+
+
 def _start(cmd, log):
     return subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
 
