@@ -110,10 +110,10 @@ def combine_horizon(reports: list[dict]) -> dict | None:
 
 
 def _groups(spec, points: list[dict]) -> list[dict]:
-    """The horizon points grouped by every parameter but the seed, each group combined."""
+    """The horizon points grouped by every varied parameter but the seed, each group combined."""
     groups: dict[str, list[dict]] = {}
     for d in points:
-        key = json.dumps({k: v for k, v in d["point"].items() if k != "seed"}, sort_keys=True, default=str)
+        key = json.dumps({k: d["point"][k] for k in spec.varied if k != "seed"}, default=str)
         groups.setdefault(key, []).append(d)
     out = []
     for key, ds in groups.items():

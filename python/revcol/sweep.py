@@ -139,6 +139,7 @@ class Sweep:
     points: tuple[Point, ...]
     retries: int
     memory_given: bool
+    varied: tuple[str, ...] = ()  # the [vary] names, in the file's order
 
 
 def _fail(source: str, where: str, msg: str) -> SweepError:
@@ -299,7 +300,8 @@ def sweep_from_dict(doc: dict, source: str = "<dict>", base: str | os.PathLike |
                         "[options])")
         points = _sceneless_points(source, study, fixed, _combinations(source, vary, combine), mem)
         return Sweep(name=name, description=head.get("description", ""), study=study, scene_name="-", source=source,
-                     base=str(base), points=tuple(points), retries=retries, memory_given=mem is not None)
+                     base=str(base), points=tuple(points), retries=retries, memory_given=mem is not None,
+                     varied=tuple(vary))
     scene_name = head.get("scene", "paper-statesave" if study == "statesave" else "default")
     scene_doc, scene_base, scene_label = _scene_doc(source, scene_name, base)
     # a point writes nothing of its own (no [output], no checkpoints: points running at once would
@@ -327,7 +329,7 @@ def sweep_from_dict(doc: dict, source: str = "<dict>", base: str | os.PathLike |
         points.append(Point(k, dict(list(fixed.items()) + list(params.items())), pdoc, options, scene, h, need))
     return Sweep(name=name, description=head.get("description", ""), study=study, scene_name=scene_label,
                  source=source, base=str(scene_base), points=tuple(points), retries=retries,
-                 memory_given=mem is not None)
+                 memory_given=mem is not None, varied=tuple(vary))
 
 
 def _sceneless_points(source: str, study: str, fixed: dict, combos: list[dict], mem) -> list[Point]:
