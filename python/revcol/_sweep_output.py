@@ -61,8 +61,16 @@ def _write_table(path: Path, rows: list[dict]) -> list[str]:
         import pyarrow.parquet as pq
     except ImportError:
         return written
-    table = pa.Table.from_pylist([{c: (None if r.get(c) is None else str(r[c])) if c in ("host",) else r.get(c)
-                                   for c in cols} for r in rows])
+    columns = {}
+    for c in cols:  # one type a column: a column mixing text and numbers (e.g. "inf") is text
+        values = [r.get(c) for r in rows]
+        kinds = {type(v) for v in values if v is not None}
+        mixed = str in kinds and len(kinds) > 1
+        columns[c] = [str(v) if mixed and v is not None else v for v in values]
+    try:
+        table = pa.table(columns)
+    except (pa.ArrowInvalid, pa.ArrowTypeError):  # the CSV has it all; Parquet is a convenience
+        return written
     with atomic_open(path.with_suffix(".parquet"), "wb") as f:
         pq.write_table(table, f)
     return written + [str(path.with_suffix(".parquet"))]

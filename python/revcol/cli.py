@@ -296,7 +296,7 @@ def _sweep_parser(sub) -> None:
                        "every point is done, 1 when some failed, 2 on a bad sweep file or option, 130 when "
                        "interrupted (run it again to resume).")
     s.add_argument("sweep_file", metavar="SWEEP.toml", help="the sweep file (e.g. sweeps/default-horizon.toml)")
-    s.add_argument("--out", metavar="DIR", help="output folder (default ./sweeps-out/NAME)")
+    s.add_argument("--out", metavar="DIR", help="output folder (default ./out/sweeps/NAME, beside the scenes' ./out)")
     where = s.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, metavar="K", help="local cluster of K worker processes, one thread "
                        "each (default: the number of cores; 0: no Dask, one point after another here)")

@@ -41,7 +41,7 @@ take their own parameters (:data:`revcol._sweep_studies.SCENELESS`): ``randomnes
 as a scene before anything runs; a bad sweep file raises :class:`SweepError` naming the file,
 the field (or the point) and what is allowed.
 
-**Outputs** (``out``, default ``./sweeps-out/NAME``): ``points/<hash>.json``, one per finished
+**Outputs** (``out``, default ``./out/sweeps/NAME``): ``points/<hash>.json``, one per finished
 point, written atomically as it finishes (``{"point", "hash", "report", ...}``; the hash is of the
 point's scene document, study options and revcol build, so a changed scene never reuses an old
 result); ``NAME.csv`` (one row per point: its parameters and the report's scalars; also
@@ -55,6 +55,11 @@ lost client, ``stop_after``) run again does only what is left, and the table has
 point, never two. **Execution**: a Dask ``LocalCluster`` on this machine's cores (processes, one
 thread each) unless ``scheduler`` (``tcp://HOST:PORT``) or ``scheduler_file`` names a running
 cluster; ``workers=0`` runs the points in this process, one after another (docs/sweep.md).
+
+    >>> s = sweep_from_dict({"sweep": {"study": "horizon"}, "vary": {"seed": {"start": 0, "count": 3}},
+    ...                      "options": {"particles": 100}})
+    >>> [p.params for p in s.points], [p.scene.seed for p in s.points]
+    ([{'particles': 100, 'seed': 0}, {'particles': 100, 'seed': 1}, {'particles': 100, 'seed': 2}], [0, 1, 2])
 """
 from __future__ import annotations
 
@@ -410,7 +415,7 @@ def sweep(spec: Sweep | str | os.PathLike, *, out: str | os.PathLike | None = No
         raise SweepError("give at most one of scheduler, scheduler_file and client")
     if workers is not None and (scheduler is not None or scheduler_file is not None or client is not None):
         raise SweepError("workers sets the size of a local cluster; an existing cluster has its own")
-    out = Path(out) if out is not None else Path.cwd() / "sweeps-out" / spec.name
+    out = Path(out) if out is not None else Path.cwd() / "out" / "sweeps" / spec.name
     if out.exists() and not out.is_dir():
         raise SweepError(f"{out}: exists and is not a folder")
     return execute(spec, out, workers=workers, scheduler=scheduler,

@@ -264,6 +264,19 @@ def test_randomness_and_equilibrium_studies(tmp_path):
     assert got["z"] == ref["z"] and got["collisions"] == ref["collisions"] and got["kind"] == "equilibrium"
 
 
+def test_default_output_folder_and_table(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    doc = {"sweep": {"name": "tiny", "study": "horizon"}, "vary": {"seed": [5, 6]}, "options": {"particles": 50}}
+    s = sweep(sweep_from_dict(doc), workers=0)
+    out = tmp_path / "out" / "sweeps" / "tiny"
+    assert s["out"] == str(out) and json.loads((out / "tiny.json").read_text())["done"] == 2
+    import csv
+
+    rows = list(csv.DictReader((out / "tiny.csv").open()))
+    assert [r["seed"] for r in rows] == ["5", "6"] and all(r["passed"] == "True" for r in rows)
+    assert {r["hash"] for r in rows} == {p.stem for p in (out / "points").glob("*.json")}
+
+
 BAD = [
     ({"swep": {}}, "[swep]: unknown table"),
     ({"sweep": {"studdy": "run"}}, "[sweep] studdy: unknown field"),
