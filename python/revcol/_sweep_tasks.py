@@ -109,7 +109,6 @@ def execute(spec, out: Path, *, workers, scheduler, scheduler_file, client, prog
     from ._sweep_output import gather
     from .progress import Bar
 
-    (out / "points").mkdir(parents=True, exist_ok=True)
     todo = [p for p in spec.points if read_point(out, p.hash) is None]
     reused = len(spec.points) - len(todo)
     load0, t0 = os.getloadavg(), time.perf_counter()
@@ -163,8 +162,20 @@ def _connect(workers, scheduler, scheduler_file, log):
     from distributed import Client, LocalCluster
 
     if scheduler is not None or scheduler_file is not None:
-        c = Client(address=scheduler, scheduler_file=scheduler_file, timeout="30s")
-        c.wait_for_workers(1, timeout=60)
+        from .sweep import SweepError
+
+        where = scheduler or f"the scheduler in {scheduler_file}"
+        if scheduler_file is not None and not os.path.isfile(scheduler_file):  # Client would wait for it forever
+            raise SweepError(f"{scheduler_file}: no such scheduler file (dask scheduler --scheduler-file writes it)")
+        try:
+            c = Client(address=scheduler, scheduler_file=scheduler_file, timeout="10s")
+        except (OSError, TimeoutError, ValueError) as e:
+            raise SweepError(f"cannot reach {where}: {e}") from None
+        try:
+            c.wait_for_workers(1, timeout=60)
+        except (OSError, TimeoutError) as e:
+            c.close()
+            raise SweepError(f"{where} has no worker (none joined within 60 s): {e}") from None
         return c, [c], "existing"
     n = workers or os.cpu_count() or 1
     total = _total_memory()

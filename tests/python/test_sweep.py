@@ -335,7 +335,8 @@ def test_bad_arguments_and_files_exit_2(tmp_path, capsys):
     (tmp_path / "file").write_text("")
     assert main(["sweep", str(good), "--out", str(tmp_path / "file")]) == 2
     assert "exists and is not a folder" in capsys.readouterr().err
-    for kw in ({"workers": -1}, {"stop_after": 0}, {"workers": 2, "scheduler": "tcp://127.0.0.1:1"}):
+    for kw in ({"workers": -1}, {"stop_after": 0}, {"workers": 2, "scheduler": "tcp://127.0.0.1:1"},
+               {"scheduler_file": tmp_path / "no-scheduler.json"}):
         with pytest.raises(SweepError):
             sweep(good, out=tmp_path / "o", **kw)
     assert not (tmp_path / "o").exists()  # a refused sweep wrote nothing
