@@ -177,6 +177,18 @@ def test_ctrl_c_on_a_terminal_stops_keeps_and_resumes(small, tmp_path):
     assert f"{kept} already done" in done.stderr and _reports(tmp_path) == serial
 
 
+def test_a_point_larger_than_every_worker_is_refused(client, tmp_path):
+    """Tasks claim the MEMORY resource; one no worker offers would wait forever: refused up front."""
+    doc = {"sweep": {"name": "big", "study": "horizon"}, "vary": {"seed": [0, 1]},
+           "options": {"particles": 50}, "resources": {"memory_gib": 8.0}}
+    with pytest.raises(SweepError, match=r"point 0 \(.*\) needs 8.00 GiB, the largest worker offers 4.00 GiB"):
+        sweep(sweep_from_dict(doc), out=tmp_path, client=client)
+    assert not (tmp_path / "points").exists()
+    assert sweep_from_dict(doc).points[0].memory_bytes == 8 * 2**30
+    auto = sweep_from_dict({"sweep": {"study": "horizon"}, "options": {"particles": 10000}}).points[0]
+    assert auto.memory_bytes == 256 * 2**20 + 2 * 1024 * 10000  # the engine and the clone running back
+
+
 def _start(cmd, log):
     return subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
 
