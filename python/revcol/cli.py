@@ -133,6 +133,7 @@ def _parser() -> argparse.ArgumentParser:
                    "--engine float measures the float engine's horizon for a lattice scene's gas)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
     _simulate_parser(sub)
+    _sweep_parser(sub)
     v = sub.add_parser("verify", help="run the paper's reversal illustration and check the round trip")
     v.add_argument("case", choices=VERIFY_CASES)
     v.add_argument("--collisions", type=_positive_int, default=1_000_000, help="N_c (default 1e6)")
@@ -296,6 +297,49 @@ def _simulate(args: argparse.Namespace) -> int:
     return 1 if report["engine_error"] else 0
 
 
+# --- revcol sweep (issue 20): many runs of one study on Dask distributed ---------------------------
+
+def _sweep_parser(sub) -> None:
+    s = sub.add_parser("sweep", help="run a sweep file's points (a study over seeds, N, packing fraction, ...) on "
+                       "Dask distributed", description="Run every point of a sweep file (TOML, docs/sweep.md) as a "
+                       "Dask task: on a local cluster of this machine's cores by default, or on a running cluster "
+                       "(--scheduler / --scheduler-file). Each point's report is written as it finishes "
+                       "(OUT/points/HASH.json); a sweep run again does only the points not yet written. Exit 0 when "
+                       "every point is done, 1 when some failed, 2 on a bad sweep file or option, 130 when "
+                       "interrupted (run it again to resume).")
+    s.add_argument("sweep_file", metavar="SWEEP.toml", help="the sweep file (e.g. sweeps/default-horizon.toml)")
+    s.add_argument("--out", metavar="DIR", help="output folder (default ./out/sweeps/NAME, beside the scenes' ./out)")
+    where = s.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, metavar="K", help="local cluster of K worker processes, one thread "
+                       "each (default: the number of cores; 0: no Dask, one point after another here)")
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on this running Dask scheduler's workers")
+    where.add_argument("--scheduler-file", metavar="FILE", help="run on the Dask cluster this scheduler file names")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    """``revcol sweep``: exit 0 all done, 1 some points failed, 2 bad sweep file/option, 130 interrupted."""
+    from .sweep import SweepError, sweep
+
+    if args.workers is not None and args.workers < 0:
+        print(f"revcol sweep: error: --workers must be >= 0, got {args.workers}", file=sys.stderr)
+        return 2
+    try:
+        summary = sweep(args.sweep_file, out=args.out, workers=args.workers, scheduler=args.scheduler,
+                        scheduler_file=args.scheduler_file, progress=False if args.no_progress else None,
+                        log=lambda line: print(line, file=sys.stderr))
+    except (SweepError, OSError) as e:
+        print(f"revcol sweep: error: {e}", file=sys.stderr)
+        return 2
+    for f in summary["failed"]:
+        print(f"revcol sweep: point {f['index']} ({f['point']}) failed: {f['error']}", file=sys.stderr)
+    print(f"{summary['name']}: {summary['done']}/{summary['points']} points done, {len(summary['failed'])} failed; "
+          f"summary {summary['out']}/{summary['name']}.json")
+    if summary["interrupted"]:
+        return 130
+    return 1 if summary["failed"] or summary["missing"] else 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """The ``revcol`` command; returns the exit status (141 when standard output was closed)."""
     try:
@@ -331,6 +375,8 @@ def _main(argv: list[str] | None) -> int:
         return _run(args)
     if args.command == "simulate":
         return _simulate(args)
+    if args.command == "sweep":
+        return _sweep(args)
     if args.command == "verify":
         try:
             report = verify(args.case, collisions=args.collisions, mode=args.mode, law=args.law,
