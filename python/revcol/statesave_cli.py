@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 from typing import Sequence
 
-from .statesave_output import format_table, plot, write_csv, write_json
+from .statesave_output import format_table, markdown, plot, write_csv, write_json
 from .statesave_run import MODES
 from .statesave_study import study
 
@@ -54,11 +54,23 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", metavar="FILE", help="write the report (and FILE's .csv next to it); - for standard output")
     p.add_argument("--csv", metavar="FILE", help="write the runs as CSV (default: next to --json)")
     p.add_argument("--plot", metavar="FILE", help="write the stacked bar plot (.png, .pdf or .svg)")
+    p.add_argument("--markdown-from", metavar="JSON", help="print the markdown tables of a saved report (no run; "
+                   "with --plot, redraw its figure)")
 
 
 def cli_main(args: argparse.Namespace, argv: Sequence[str] | None = None) -> int:
     """Runs ``revcol bench statesave`` from parsed arguments; exit code 0 when it passed."""
     command = "revcol " + " ".join(shlex.quote(a) for a in (sys.argv[1:] if argv is None else argv))
+    if args.markdown_from:
+        try:
+            saved = json.loads(Path(args.markdown_from).read_text())
+        except (OSError, ValueError) as e:
+            print(f"revcol bench statesave: error: --markdown-from: {e}", file=sys.stderr)
+            return 2
+        print(markdown(saved, Path(args.markdown_from).name))
+        if args.plot:
+            plot(saved, args.plot)
+        return 0
     try:
         report = study(args.n, args.collisions, lazy=args.lazy, modes=args.mode, law=args.law,
                        variants=args.variants, repeats=args.repeats, budget_gib=args.budget_gib,

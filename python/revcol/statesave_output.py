@@ -93,6 +93,52 @@ def format_table(report: dict) -> str:
     return "\n".join(lines)
 
 
+def _md_ratio(q: dict) -> str:
+    if q.get("time_paired_median") is None:
+        return "-"
+    return (f"{_fmt_ratio(q['time_paired_median'])} [{_fmt_ratio(q['time_paired_min'])}, "
+            f"{_fmt_ratio(q['time_paired_max'])}]")
+
+
+def markdown(report: dict, name: str = "statesave.json") -> str:
+    """The docs' tables of a report: one table of runs per mode (the median repeat's times,
+    the range of the totals) and the ratios RC / state saving (the paired ratios' median and
+    range over the interleaved rounds, bytes saved, peak RSS)."""
+    out = []
+    n_c = f"N_c = {report['collisions']:,}"
+    for mode in report["modes"]:
+        out += [f"**{name}, mode {mode}** ({n_c}; times: the repeat with the median total of {report['repeats']}, "
+                "and the range of the totals)", "",
+                "| N | variant | forward ms | rollback ms | total ms [range] | bytes saved | peak RSS | max rel error |",
+                "|---:|---|---:|---:|---:|---:|---:|---:|"]
+        for r in report["runs"]:
+            if r["mode"] != mode:
+                continue
+            if r["skipped"]:
+                out.append(f"| {r['particles']:,} | {_LABEL[r['variant']]} | – | – | – | {r['status']} | – | – |")
+                continue
+            span = f"{r['total_ms']:.2f} [{r['total_ms_min']:.2f}, {r['total_ms_max']:.2f}]"
+            out.append(f"| {r['particles']:,} | {_LABEL[r['variant']]} | {r['forward_ms']:.2f} | {r['rollback_ms']:.2f} | "
+                       f"{span} | {r['bytes_saved']:,} | {_fmt_bytes(r['peak_rss_bytes'])} | {r['max_rel_error']:.2e} |")
+        out.append("")
+    vs = [v for v in report["variants"] if v != "rc"]
+    head = " | ".join(f"RC/{_LABEL[v]} time [range] | saved | RSS" for v in vs)
+    out += [f"**{name}: RC / state saving** (time: the median and range of RC's total over the state "
+            "saving's, round by round; saved: bytes saved, against the projection where state saving was "
+            "skipped; RSS: peak resident set of each fresh process)", "",
+            f"| mode | N | {head} |", "|---|---:|" + "---:|---:|---:|" * len(vs)]
+    by = {(q["mode"], q["particles"], q["vs"]): q for q in report["ratios"]}
+    for mode in report["modes"]:
+        for n in report["particles"]:
+            cells = []
+            for v in vs:
+                q = by.get((mode, n, v))
+                cells.append("- | - | -" if q is None else
+                             f"{_md_ratio(q)} | {_fmt_ratio(q['bytes_saved'])} | {_fmt_ratio(q['peak_rss'])}")
+            out.append(f"| {mode} | {n:,} | " + " | ".join(cells) + " |")
+    return "\n".join(out)
+
+
 def plot(report: dict, path: str | os.PathLike) -> None:
     """Stacked forward/rollback bars per N (the paper's figure) with each total's range over
     the repeats, and the memory bars below (log scale; a variant that saved 0 bytes gets no

@@ -234,3 +234,21 @@ def test_cli(tmp_path, capsys):
 
 def test_exported():
     assert revcol.statesave is ss and "statesave" in revcol.__all__
+
+
+def test_markdown_tables_of_a_saved_report(tmp_path, capsys):
+    rep = ss.study([100, 200], 50, modes=["exact", "paper"], variants=["ss2", "rc"], repeats=3, inline=True,
+                   progress=False)
+    from revcol.statesave_output import markdown
+    text = markdown(rep, "s.json")
+    lines = text.splitlines()
+    # a table of 4 runs per mode, and one ratio row per (mode, N) with the paired median [range]
+    assert sum(ln.startswith("| 100 |") or ln.startswith("| 200 |") for ln in lines) == 8
+    ratio_rows = [ln for ln in lines if ln.startswith("| exact |") or ln.startswith("| paper |")]
+    assert len(ratio_rows) == 4
+    q = next(q for q in rep["ratios"] if q["mode"] == "exact" and q["particles"] == 100)
+    assert f"{q['time_paired_median']:.3f} [{q['time_paired_min']:.3f}, {q['time_paired_max']:.3f}]" in ratio_rows[0]
+    ss.write_json(rep, tmp_path / "s.json")
+    assert cli_main(["bench", "statesave", "--markdown-from", str(tmp_path / "s.json")]) == 0
+    assert capsys.readouterr().out.strip() == markdown(json.loads((tmp_path / "s.json").read_text()), "s.json")
+    assert cli_main(["bench", "statesave", "--markdown-from", str(tmp_path / "missing.json")]) == 2
