@@ -361,14 +361,19 @@ def _row(point: dict, runs: list[dict[str, float]], collisions: int, law: dict |
 
 
 def _git_commit() -> str | None:
-    try:
-        here = Path(__file__).resolve().parent
-        out = subprocess.run(["git", "-C", str(here), "rev-parse", "HEAD"], capture_output=True, text=True)
-        dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True).stdout.strip()
-        return (out.stdout.strip() + ("-dirty" if dirty else "")) if out.returncode == 0 else None
-    except OSError:
-        return None
+    """The commit of the package's source tree, else of the current directory's (a staged or
+    installed package lives outside the repository); None outside any."""
+    for where in (Path(__file__).resolve().parent, Path.cwd()):
+        try:
+            out = subprocess.run(["git", "-C", str(where), "rev-parse", "HEAD"], capture_output=True, text=True)
+            if out.returncode != 0:
+                continue
+            dirty = subprocess.run(["git", "-C", str(where), "status", "--porcelain", "--untracked-files=no"],
+                                   capture_output=True, text=True).stdout.strip()
+            return out.stdout.strip() + ("-dirty" if dirty else "")
+        except OSError:
+            return None
+    return None
 
 
 def run(points: Sequence[dict], *, repeats: int = 3, collisions: int = 1_000_000, budget_s: float = 0.25,
