@@ -258,8 +258,7 @@ def throughput(args):
               f"[{row['reverse_per_s_min']:.3g}, {row['reverse_per_s_max']:.3g}]"
               + (f"  target {ref / 2:.3g}: {'met' if row['meets_target'] else 'MISSED'}" if ref else ""))
     os.makedirs(RESULTS, exist_ok=True)
-    sys.path.insert(0, os.path.join(HERE, "..", "python"))
-    from revcol._io import atomic_open
+    from revcol._io import atomic_open  # the package under test (PYTHONPATH=build-dev/pkg)
     with atomic_open(os.path.join(RESULTS, "engine_throughput.json"), "w") as f:
         json.dump(dict(command=" ".join(sys.argv), rounds=rounds, cpu=args.cpu,
                        date=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
