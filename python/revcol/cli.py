@@ -3,13 +3,15 @@
     revcol run [SCENE.toml] [--json FILE] [--plot DIR] [--trajectory FILE.xyz|.gsd] [--collisions N] [--seed S]
                [--engine float|lattice]
     revcol run [SCENE.toml] --horizon [--seeds K] [--max-collisions N] [--engine float] [--json FILE] [--plot DIR]
-    revcol simulate [SCENE] [--collisions N | --time T] [--trajectory FILE --every K] [--checkpoint DIR
+    revcol simulate [SCENE] [--collisions N | --time T] [--trajectory FILE --every K|--every-time T] [--checkpoint DIR
                --checkpoint-every K] [--resume CHECKPOINT] [--species Ar] [--json FILE]   (forward only)
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
     revcol bench tradeoff [--reduced] [--repeats 3] --json bench/results/tradeoff.json --plot docs/figures/tradeoff
     revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.randomness ...)
     revcol study equilibrium small|dense|figures|table ...   (= python -m revcol.physics ...)
+    revcol study stability [--full] [--json FILE] [--markdown]   (= python -m revcol.stability ...)
+    revcol sweep SWEEP.toml|NAME [--out DIR] [--workers K | --scheduler tcp://HOST:PORT | --scheduler-file F]
     revcol --version
 
 Manners (issue 19): a mistyped subcommand, choice or option gets a "did you mean" suggestion

@@ -373,9 +373,39 @@ def _point_scene(doc: dict, options: dict, where: str, base: str) -> Scene:
     return scene
 
 
+def sweep_dirs() -> list[Path]:
+    """Where sweeps are found by name: the package's ``sweeps`` (installed from a wheel), else
+    the ``sweeps/`` of the source checkout the package is imported from."""
+    here = Path(__file__).resolve().parent
+    dirs = [here / "sweeps"]
+    for up in here.parents[:4]:
+        if (up / "pyproject.toml").is_file() and (up / "sweeps").is_dir():
+            dirs.append(up / "sweeps")
+            break
+    return [d for d in dirs if d.is_dir()]
+
+
+def sweep_names() -> list[str]:
+    """The names of the sweeps shipped with revcol (``revcol sweep NAME``)."""
+    return sorted({p.stem for d in sweep_dirs() for p in d.glob("*.toml")})
+
+
 def load_sweep(path: str | os.PathLike) -> Sweep:
-    """Reads and validates a sweep file (:class:`SweepError` naming the problem)."""
+    """Reads and validates a sweep file, or a sweep shipped with revcol by name when no such
+    file exists (:class:`SweepError` naming the problem)."""
     p = Path(path)
+    if not p.exists() and p.parent == Path(".") and "/" not in str(path):
+        stem = p.stem if p.suffix == ".toml" else p.name
+        found = [d / f"{stem}.toml" for d in sweep_dirs() if (d / f"{stem}.toml").is_file()]
+        if found:
+            p = found[0]
+        else:
+            import difflib
+
+            close = difflib.get_close_matches(stem, sweep_names(), n=1)
+            raise SweepError(f"{p}: no such sweep file, nor a sweep name (shipped: "
+                             f"{', '.join(sweep_names()) or 'none found'})"
+                             + (f"; did you mean {close[0]!r}?" if close else ""))
     try:
         doc = tomllib.loads(p.read_text())
     except FileNotFoundError:

@@ -70,7 +70,8 @@ def test_pip_builds_out_of_tree_and_ships_the_scenes():
         os.chdir(cwd)
     # no persistent build-dir: a fresh temporary directory per build, never the tree's build/
     assert settings.build_dir == ""
-    assert settings.wheel.packages == {"revcol": "python/revcol", "revcol/scenes": "scenes"}
+    assert settings.wheel.packages == {"revcol": "python/revcol", "revcol/scenes": "scenes",
+                                       "revcol/sweeps": "sweeps"}
     scenes = sorted(p.name for p in (ROOT / "scenes").glob("*.toml"))
     assert "default.toml" in scenes and "spheres-3d.toml" in scenes
 

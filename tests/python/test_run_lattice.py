@@ -279,9 +279,10 @@ def test_ctrl_c_during_the_lattice_reversal_stops_it(tmp_path, capsys, monkeypat
     assert calls == [{"to_collision": 18000}] and r["collisions_back"] == 2000
 
 
-def test_lattice_trajectory_replays_the_forward_frames_exactly(tmp_path):
+def test_lattice_trajectory_replays_the_forward_frames_exactly(tmp_path, monkeypatch):
     from test_run import read_xyz
 
+    monkeypatch.chdir(tmp_path)  # the checkpoints (./small-checkpoints) land under the current directory
     r = run_scene(small(tmp_path, collisions=1000, checkpoint_interval=400), trajectory=tmp_path / "t.xyz",
                   progress=False)
     assert r["passed"] and r["trajectory_frames"] == 2 * len(range(0, 1000, 100)) + 1
@@ -294,6 +295,7 @@ def test_lattice_trajectory_replays_the_forward_frames_exactly(tmp_path):
         assert f["time"] == g["time"] and np.array_equal(f["x"], g["x"]) and np.array_equal(f["v"], g["v"])
     # checkpoints: LatticeSimulation.load resumes, and its run_back reaches the start
     assert [Path(c).name for c in r["checkpoints"]] == ["checkpoint-000000000400.npz", "checkpoint-000000000800.npz"]
+    assert all(Path(c).parent == tmp_path / "small-checkpoints" for c in r["checkpoints"])
     sim = LatticeSimulation.load(r["checkpoints"][1])
     assert sim.collisions == 800
     start = lg.build_lattice(load_scene(small(tmp_path, collisions=1000)))

@@ -352,3 +352,27 @@ def test_bad_arguments_and_files_exit_2(tmp_path, capsys):
         with pytest.raises(SweepError):
             sweep(good, out=tmp_path / "o", **kw)
     assert not (tmp_path / "o").exists()  # a refused sweep wrote nothing
+
+
+def test_shipped_sweeps_are_found_by_name(tmp_path, monkeypatch):
+    # the example sweeps ship in the wheel (revcol/sweeps) and are found by name, as scenes are
+    from revcol.sweep import SweepError, load_sweep, sweep_names
+
+    monkeypatch.chdir(tmp_path)
+    assert {"default-horizon", "horizon-phi-n", "paper-statesave"} <= set(sweep_names())
+    for name in ("default-horizon", "default-horizon.toml"):
+        s = load_sweep(name)
+        assert Path(s.source).name == "default-horizon.toml" and Path(s.source).is_file()
+    with pytest.raises(SweepError, match=r"nor a sweep name .*did you mean 'default-horizon'"):
+        load_sweep("default-horizn")
+    # a file of that name in the current directory wins
+    (tmp_path / "default-horizon.toml").write_text('[sweep]\nstudy = "nope"\n')
+    with pytest.raises(SweepError, match="study"):
+        load_sweep("default-horizon.toml")
+
+
+def test_revcol_sweep_is_the_function():
+    import revcol
+    from revcol.sweep import sweep as fn
+
+    assert revcol.sweep is fn and "sweep" in revcol.__all__
