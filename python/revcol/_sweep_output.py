@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ._io import atomic_open
+from .horizon import combine_seeds
 from .roundtrip import BAR
 
 __all__ = ["gather", "combine_horizon", "table_rows"]
@@ -99,19 +100,8 @@ def combine_horizon(reports: list[dict]) -> dict | None:
     grid = [row["collisions"] for row in max((r["rows"] for r in reports), key=len)]
     if any([row["collisions"] for row in r["rows"]] != grid[:len(r["rows"])] for r in reports):
         return None
-    table = []
-    for k, nc in enumerate(grid):
-        ex = [float(r["rows"][k]["error_x"]) if k < len(r["rows"]) else math.inf for r in reports]
-        ev = [float(r["rows"][k]["error_v"]) if k < len(r["rows"]) else math.inf for r in reports]
-        worst = [max(a, b) for a, b in zip(ex, ev)]
-        table.append({"collisions": nc, "per_particle": 2.0 * nc / n, "error_x": max(ex), "error_v": max(ev),
-                      "median": float(np.median(worst)), "fails": int(sum(w > BAR for w in worst)),
-                      "seeds": len(reports)})
-    h = 0
-    for row in table:
-        if max(row["error_x"], row["error_v"]) > BAR:
-            break
-        h = row["collisions"]
+    per_seed = [[(float(row["error_x"]), float(row["error_v"])) for row in r["rows"]] for r in reports]
+    table, h = combine_seeds(grid, n, per_seed)
     return {"engine": "float", "seeds": len(reports), "seed_first": reports[0]["seed_first"], "rows": table,
             "horizon_collisions": h, "horizon_per_particle": 2.0 * h / n,
             "horizon_reached": any(max(r["error_x"], r["error_v"]) > BAR for r in table)}

@@ -25,6 +25,29 @@ __all__ = ["HORIZON_GRID", "horizon"]
 HORIZON_GRID = tuple(m * 10.0**e for e in range(-1, 5) for m in (1, 1.5, 2, 3, 5, 7))
 
 
+def combine_seeds(grid: list[int], n: int, per_seed: list[list[tuple[float, float]]]) -> tuple[list[dict], int]:
+    """The horizon's table from each seed's (position, velocity) errors at the grid's N_c (a seed
+    stops early once O(1)): per N_c the worst of the seeds (a stopped seed counts as infinite),
+    the median of each seed's larger error and how many fail the bar; and the horizon, the
+    largest N_c before the first that fails. ``revcol sweep`` combines its seeds with this too."""
+    rows = []
+    for k, nc in enumerate(grid):
+        if all(k >= len(e) for e in per_seed):
+            break
+        ex = [e[k][0] if k < len(e) else math.inf for e in per_seed]
+        ev = [e[k][1] if k < len(e) else math.inf for e in per_seed]
+        worst = [max(a, b) for a, b in zip(ex, ev)]
+        rows.append({"collisions": nc, "per_particle": 2.0 * nc / n, "error_x": max(ex), "error_v": max(ev),
+                     "median": float(np.median(worst)), "fails": int(sum(w > BAR for w in worst)),
+                     "seeds": len(per_seed)})
+    h = 0
+    for r in rows:
+        if max(r["error_x"], r["error_v"]) > BAR:
+            break
+        h = r["collisions"]
+    return rows, h
+
+
 def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1: float = 0.1,
             progress: bool | None = None) -> dict:
     """Round-trip error against collisions per particle (2 N_c / N) for a gas scene.
@@ -78,21 +101,7 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
             interrupted = stop.presses > 0
     finally:
         bar.close()
-    rows = []
-    for k, nc in enumerate(grid):
-        ex = [e[k][0] if k < len(e) else math.inf for e in per_seed]
-        ev = [e[k][1] if k < len(e) else math.inf for e in per_seed]
-        if all(k >= len(e) for e in per_seed):
-            break
-        worst = [max(a, b) for a, b in zip(ex, ev)]
-        rows.append({"collisions": nc, "per_particle": 2.0 * nc / n, "error_x": max(ex), "error_v": max(ev),
-                     "median": float(np.median(worst)), "fails": int(sum(w > BAR for w in worst)),
-                     "seeds": len(per_seed)})
-    h = 0
-    for r in rows:
-        if max(r["error_x"], r["error_v"]) > BAR:
-            break
-        h = r["collisions"]
+    rows, h = combine_seeds(grid, n, per_seed)
     reached = any(max(r["error_x"], r["error_v"]) > BAR for r in rows)
     return {"kind": "horizon", "scene": scene.to_dict(), "summary": scene.summary(), "seeds": len(per_seed),
             "seed_first": scene.seed, "max_collisions": int(max_collisions), "o1": o1, "bar": BAR,
