@@ -14,11 +14,9 @@ import csv
 import datetime as dt
 import io
 import json
-import math
 import os
 from pathlib import Path
 
-import numpy as np
 
 from ._io import atomic_open
 from .horizon import combine_seeds
