@@ -17,7 +17,6 @@ import json
 import os
 from pathlib import Path
 
-
 from ._io import atomic_open
 from .horizon import combine_seeds
 from .roundtrip import BAR
