@@ -96,13 +96,13 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import tomllib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from . import _core
+from ._toml import read_toml, shipped_dirs
 
 __all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "engine_options", "lattice_options", "with_engine",
            "DEFAULT_SCENE", "KINDS", "ENGINES"]
@@ -653,13 +653,7 @@ def lattice_options(scene: Scene) -> dict[str, Any]:
 def scene_dirs() -> list[Path]:
     """Where scenes are found by name: the package's ``scenes`` (installed from a wheel), else
     the ``scenes/`` of the source checkout the package is imported from (a development build)."""
-    here = Path(__file__).resolve().parent
-    dirs = [here / "scenes"]
-    for up in here.parents[:4]:  # python/revcol, or a staged build-dev/pkg/revcol
-        if (up / "pyproject.toml").is_file() and (up / "scenes" / "default.toml").is_file():
-            dirs.append(up / "scenes")
-            break
-    return [d for d in dirs if d.is_dir()]
+    return shipped_dirs("scenes", "default.toml")
 
 
 def scene_names() -> list[str]:
@@ -695,14 +689,7 @@ def load_scene(path: str | Path | None = None) -> Scene:
             raise SceneError(f"{p}: no such scene file, nor a scene name (shipped: "
                              f"{', '.join(scene_names()) or 'none found'}){hint}")
         p = found
-    try:
-        doc = tomllib.loads(p.read_text())
-    except RecursionError:
-        raise SceneError(f"{p}: not a usable scene: its arrays or tables are nested too deeply") from None
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"{p}: not valid TOML: {' '.join(str(e).split())}") from None
-    except UnicodeDecodeError as e:
-        raise SceneError(f"{p}: not a text file: {e}") from None
+    doc = read_toml(p, SceneError, "scene")
     try:
         # inputs (an initial state) beside the scene file; outputs under the current directory,
         # wherever the scene lives (a clone, the installed package)

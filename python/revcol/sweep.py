@@ -74,6 +74,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from ._toml import read_toml, shipped_dirs
 from .scene import DEFAULT_SCENE, Scene, SceneError, find_scene, scene_from_dict
 
 __all__ = ["SweepError", "Sweep", "Point", "load_sweep", "sweep_from_dict", "sweep", "STUDIES", "SCENE_PARAMS"]
@@ -376,13 +377,7 @@ def _point_scene(doc: dict, options: dict, where: str, base: str) -> Scene:
 def sweep_dirs() -> list[Path]:
     """Where sweeps are found by name: the package's ``sweeps`` (installed from a wheel), else
     the ``sweeps/`` of the source checkout the package is imported from."""
-    here = Path(__file__).resolve().parent
-    dirs = [here / "sweeps"]
-    for up in here.parents[:4]:
-        if (up / "pyproject.toml").is_file() and (up / "sweeps").is_dir():
-            dirs.append(up / "sweeps")
-            break
-    return [d for d in dirs if d.is_dir()]
+    return shipped_dirs("sweeps")
 
 
 def sweep_names() -> list[str]:
@@ -406,19 +401,7 @@ def load_sweep(path: str | os.PathLike) -> Sweep:
             raise SweepError(f"{p}: no such sweep file, nor a sweep name (shipped: "
                              f"{', '.join(sweep_names()) or 'none found'})"
                              + (f"; did you mean {close[0]!r}?" if close else ""))
-    try:
-        doc = tomllib.loads(p.read_text())
-    except FileNotFoundError:
-        raise SweepError(f"{p}: no such sweep file") from None
-    except IsADirectoryError:
-        raise SweepError(f"{p}: is a folder, not a sweep file") from None
-    except RecursionError:
-        raise SweepError(f"{p}: nested too deeply") from None
-    except tomllib.TOMLDecodeError as e:
-        raise SweepError(f"{p}: not valid TOML: {' '.join(str(e).split())}") from None
-    except UnicodeDecodeError as e:
-        raise SweepError(f"{p}: not a text file: {e}") from None
-    return sweep_from_dict(doc, str(p), p.parent)
+    return sweep_from_dict(read_toml(p, SweepError, "sweep"), str(p), p.parent)
 
 
 def sweep(spec: Sweep | str | os.PathLike, *, out: str | os.PathLike | None = None, workers: int | None = None,
