@@ -48,7 +48,7 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
   cfg.wall = {c.walls, c.walls};
   cfg.seed = static_cast<std::uint32_t>(c.seed);
   const la::LatticeStart st = la::random_start(cfg, c.n, c.phi, c.seed, c.phi > 0.35 ? "lattice" : "auto");
-  la::LatticeEngine e(st.units, st.x, st.v, cfg.seed, la::LatticePair2D(st.units.sigma));
+  la::LatticeEngine e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
   // warm up a collision per particle from the initialiser's lattice, then start the clock
   e.run(c.n, la::tick_limit - 1);
   const la::Snapshot s0 = e.snapshot();

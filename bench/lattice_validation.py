@@ -213,7 +213,7 @@ def _after_failure(sim, f: dict):
 
 
 def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, samples: int = 100,
-            law: str = "flux", tick_bits: int = 20) -> dict:
+            law: str = "flux", tick_bits: int = 0, cell_bits: int = 16) -> dict:
     """One gas: C collisions forward (snapshot at C/2), back to C/2 (compared), back to 0
     (compared). Returns the row (see the module doc). If the engine fails on the way forward, the
     row says so (``completed`` false, ``forward_error``) and the checks run on the collisions done,
@@ -221,7 +221,7 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     from revcol.lattice import LatticeSimulation
     load0 = os.getloadavg()
     sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi), law=law,
-                                   tick_bits=tick_bits)
+                                   tick_bits=tick_bits or None, cell_bits=cell_bits)
     s0 = sim.snapshot()
     units = sim.units
     wall = [bool(w) for w in units["wall"]]
@@ -280,16 +280,17 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
 
 def _child(args) -> int:
     row = run_gas(args.n, args.phi, args.boundary, int(float(args.collisions)), args.seed,
-                  tick_bits=args.tick_bits)
+                  tick_bits=args.tick_bits, cell_bits=args.cell_bits)
     print("ROW " + json.dumps(row), flush=True)
     return 0
 
 
-def run_child(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, tick_bits: int = 20) -> dict:
+def run_child(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, tick_bits: int = 0,
+              cell_bits: int = 16) -> dict:
     """``run_gas`` in a fresh subprocess; adds the child's ru_maxrss (wait4) and exit status."""
     cmd = [sys.executable, os.path.abspath(__file__), "gas", "--n", str(n), "--phi", str(phi),
            "--boundary", boundary, "--collisions", str(int(collisions)), "--seed", str(seed),
-           "--tick-bits", str(tick_bits)]
+           "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits)]
     t0 = time.time()
     with tempfile.TemporaryFile(mode="w+") as ferr:
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=ferr, text=True)
@@ -313,11 +314,11 @@ def matrix(args) -> dict:
     path = os.path.join(RESULTS, f"lattice_validation_{args.out}.json")
     res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
            "build": _build_info(), "collisions": c, "law": "flux", "seed": args.seed, "tick_bits": args.tick_bits,
-           "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "rows": []}
+           "cell_bits": args.cell_bits, "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "rows": []}
     for phi in args.phi:  # in the order given: a run cut short still covers both N
         for n in args.n:
             for b in args.boundary:
-                row = run_child(n, phi, b, c, args.seed, args.tick_bits)
+                row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits)
                 res["rows"].append(row)
                 res["updated_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
                 _write_atomic(path, res)
@@ -557,7 +558,9 @@ def main(argv=None) -> int:
     ap.add_argument("--phi", type=float, nargs="+", default=None, help="matrix default 0.1 0.3 0.5 0.7; equilibrium 0.5")
     ap.add_argument("--boundary", nargs="+", default=["wall", "periodic"], choices=["wall", "periodic"])
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--tick-bits", type=int, default=20, help="matrix, gas: a typical particle moves 2^-T D per tick")
+    ap.add_argument("--tick-bits", type=int, default=0,
+                    help="matrix, gas: a typical particle moves 2^-T D per tick (0: automatic, the engine's default)")
+    ap.add_argument("--cell-bits", type=int, default=16, help="matrix, gas: 2^B direction cells per turn in the pair operator")
     ap.add_argument("--out", default="matrix", help="matrix: writes lattice_validation_<out>.json")
     ap.add_argument("--seeds", type=int, default=4, help="equilibrium: independent gases")
     ap.add_argument("--relax", type=float, default=50.0, help="equilibrium: collisions per particle")

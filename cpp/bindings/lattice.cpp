@@ -73,6 +73,7 @@ py::dict units_dict(const la::Units& u) {
   d["length_unit"] = u.length_unit;
   d["tick"] = u.tick;
   d["tick_bits"] = u.tick_bits;
+  d["cell_bits"] = u.cell_bits;
   return d;
 }
 la::Units units_from(const py::dict& d) {
@@ -91,7 +92,9 @@ la::Units units_from(const py::dict& d) {
   require(std::isfinite(u.length_unit) && u.length_unit > 0.0, "lattice units: length_unit must be finite and > 0");
   require(std::isfinite(u.tick) && u.tick > 0.0, "lattice units: tick must be finite and > 0");
   // tick_bits arrived with the finer-tick option; units without it are the default 20
-  u.tick_bits = d.contains("tick_bits") ? get<int>(d, "tick_bits") : la::default_tick_bits;
+  u.tick_bits = d.contains("tick_bits") ? get<int>(d, "tick_bits") : la::legacy_tick_bits;
+  // cell_bits arrived with the coarser direction cells; units without it ran 2^20 cells
+  u.cell_bits = d.contains("cell_bits") ? get<int>(d, "cell_bits") : la::max_units_cell_bits;
   la::validate(u);
   return u;
 }
@@ -257,7 +260,7 @@ void register_lattice(py::module_& m) {
   m.def(
       "lattice_random_start",
       [](PyInt n_arg, PyReal phi_arg, std::vector<bool> wall, PyReal diameter_arg, PyInt seed_arg, const std::string& init,
-         PyInt tick_bits_arg) {
+         PyInt tick_bits_arg, PyInt cell_bits_arg) {
         const auto n = to_int<std::size_t>(n_arg, "n");
         const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
         const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
@@ -268,15 +271,16 @@ void register_lattice(py::module_& m) {
         c.diameter = diameter;
         c.seed = static_cast<std::uint32_t>(seed);
         c.tick_bits = tick_bits;
+        c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
         return start_dict(la::random_start(c, n, phi, seed, init));
       },
       py::arg("n"), py::arg("phi"), py::arg("wall"), py::arg("diameter"), py::arg("seed"), py::arg("init"),
-      py::arg("tick_bits") = la::default_tick_bits,
+      py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
       "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
   m.def(
       "lattice_quantize",
       [](const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, PyReal diameter_arg,
-         PyInt tick_bits_arg) {
+         PyInt tick_bits_arg, PyInt cell_bits_arg) {
         const double diameter = to_real(diameter_arg, "diameter");
         const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
         require(box.size() == 2 && wall.size() == 2, "lattice: box and walls need two entries (2D)");
@@ -286,11 +290,12 @@ void register_lattice(py::module_& m) {
         c.wall = {wall[0], wall[1]};
         c.diameter = diameter;
         c.tick_bits = tick_bits;
+        c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
         return start_dict(la::quantize_start(c, std::vector<double>(x.data(), x.data() + x.size()),
                                              std::vector<double>(v.data(), v.data() + v.size())));
       },
       py::arg("x"), py::arg("v"), py::arg("box"), py::arg("wall"), py::arg("diameter"),
-      py::arg("tick_bits") = la::default_tick_bits,
+      py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
       "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
 
   py::class_<PyLattice>(m, "LatticeEngine", "The 2D lattice engine (revcol/lattice/engine.hpp).")
@@ -301,7 +306,7 @@ void register_lattice(py::module_& m) {
              const la::Units u = units_from(units);
              const revcol::Law lw = parse_law(law);
              return PyLattice{lw, la::LatticeEngine(u, vecs(x, "x"), vecs(v, "v"), static_cast<std::uint32_t>(seed),
-                                                    la::LatticePair2D(u.sigma, lw), clock)};
+                                                    la::operator_for(u, lw), clock)};
            }),
            py::arg("units"), py::arg("x"), py::arg("v"), py::arg("seed"), py::arg("law"), py::arg("clock") = 0)
       .def_static(
@@ -309,7 +314,7 @@ void register_lattice(py::module_& m) {
           [](const py::dict& d) {
             const la::Snapshot s = snapshot_from(d);
             const revcol::Law lw = parse_law(get<std::string>(d, "law"));
-            return PyLattice{lw, la::LatticeEngine(s, la::LatticePair2D(s.units.sigma, lw))};
+            return PyLattice{lw, la::LatticeEngine(s, la::operator_for(s.units, lw))};
           },
           py::arg("snapshot"), "Rebuilds an engine from snapshot(); it resumes bit for bit.")
       .def(

@@ -146,12 +146,20 @@ bool in_cell(i64 wx, i64 wy, std::int64_t k) {
   return cross(boundary(2 * k), wx, wy) >= 0 && cross(boundary(2 * k + 2), wx, wy) < 0;
 }
 
-std::int64_t normal_cell(i64 xc, i64 sigma) {
+bool in_coarse_cell(i64 wx, i64 wy, std::int64_t k, int shift) {
+  return cross(boundary((2 * k) << shift), wx, wy) >= 0 && cross(boundary((2 * k + 2) << shift), wx, wy) < 0;
+}
+
+std::int64_t normal_cell(i64 xc, i64 sigma) { return normal_cell(xc, sigma, 0); }
+
+std::int64_t normal_cell(i64 xc, i64 sigma, int shift) {
   require(sigma >= 1 && xc > -sigma && xc < sigma, "normal_cell: needs |xc| < sigma");
+  require(shift >= 0 && shift <= kCellBits - 4, "normal_cell: shift must be in [0, 16]");
   const double phi = std::acos(static_cast<float>(static_cast<double>(xc) / static_cast<double>(sigma)));
-  std::int64_t k = std::llround(phi * kCellsPerRadian);
+  std::int64_t k = std::llround(std::ldexp(phi * kCellsPerRadian, -shift));
   const i128 lhs = static_cast<i128>(xc) << kFixBits;
-  auto bound = [&](std::int64_t h) { return static_cast<i128>(sigma) * boundary_x(h); };
+  // the coarse half-cell point h is the fine half-cell point h 2^shift
+  auto bound = [&](std::int64_t h) { return static_cast<i128>(sigma) * boundary_x(h << shift); };
   // phi in [theta(2k-1), theta(2k+1)) <=> sigma*B(2k+1).x < xc*2^62 <= sigma*B(2k-1).x
   while (lhs > bound(2 * k - 1)) --k;
   while (lhs <= bound(2 * k + 1)) ++k;

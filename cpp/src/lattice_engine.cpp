@@ -26,6 +26,7 @@ std::vector<std::uint64_t> initial_bits(std::uint32_t seed) {
 bool same_state(const Snapshot& a, const Snapshot& b) {
   const Units &u = a.units, &w = b.units;
   return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.vmax == w.vmax &&
+         u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
          a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&
          a.groups == b.groups &&
@@ -38,7 +39,7 @@ LatticeStart quantize_start(const LatticeConfig& c, const std::vector<double>& x
   for (double a : v) s2 += a * a;
   const double v_rms = std::sqrt(s2 / static_cast<double>(x.size() / 2));
   LatticeStart s;
-  s.units = choose_units(c.box, c.diameter, v_rms, c.wall, c.tick_bits);
+  s.units = choose_units(c.box, c.diameter, v_rms, c.wall, c.tick_bits, c.cell_bits);
   Quantized q = quantize(s.units, x, v);
   s.x = std::move(q.x);
   s.v = std::move(q.v);

@@ -84,12 +84,16 @@ void validate(const Units& u) {
   }
   require(u.vmax >= 1 && u.vmax <= u.sigma / 256, "lattice units: vmax must be in [1, sigma / 256]");
   require(u.tick_bits >= min_tick_bits && u.tick_bits <= max_tick_bits, "lattice units: tick_bits must be in [16, 26]");
+  require(u.cell_bits >= min_units_cell_bits && u.cell_bits <= max_units_cell_bits,
+          "lattice units: cell_bits must be in [12, 20]");
 }
 
 Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
-                   int tick_bits) {
-  require(tick_bits >= min_tick_bits && tick_bits <= max_tick_bits,
-          "lattice: tick_bits must be in [16, 26] (a typical particle moves 2^-tick_bits diameters per tick)");
+                   int tick_bits, int cell_bits) {
+  require(tick_bits == auto_tick_bits || (tick_bits >= min_tick_bits && tick_bits <= max_tick_bits),
+          "lattice: tick_bits must be in [16, 26] (a typical particle moves 2^-tick_bits diameters per tick), or 0 (automatic)");
+  require(cell_bits >= min_units_cell_bits && cell_bits <= max_units_cell_bits,
+          "lattice: cell_bits must be in [12, 20] (2^cell_bits direction cells per turn)");
   require(std::isfinite(D) && D > 0.0, "lattice: the diameter must be positive and finite");
   require(std::isfinite(v_rms) && v_rms > 0.0, "lattice: the rms speed must be positive and finite (a gas at rest has no dynamics)");
   double longest = 0.0;
@@ -103,6 +107,7 @@ Units choose_units(const std::array<double, 2>& box, double D, double v_rms, con
     return "lattice: a box of " + std::to_string(longest) +
            " diameters is too long for the lattice (at most 2^21 diameters per axis)";
   });
+  if (tick_bits == auto_tick_bits) tick_bits = std::clamp(S - velocity_bits, 16, 24);
   Units u;
   u.S = S;
   u.sigma = std::int64_t{1} << S;
@@ -112,6 +117,7 @@ Units choose_units(const std::array<double, 2>& box, double D, double v_rms, con
   u.length_unit = std::ldexp(D, -S);
   u.tick = std::ldexp(D, -tick_bits) / v_rms;
   u.tick_bits = tick_bits;
+  u.cell_bits = cell_bits;
   validate(u);
   return u;
 }

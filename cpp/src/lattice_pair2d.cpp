@@ -7,10 +7,8 @@
 namespace revcol::lattice {
 namespace {
 
-constexpr std::int64_t kMask = kCells - 1;
 constexpr i64 kMaxComp = LatticePair2D::max_component;
 constexpr i64 kMaxVel = 1LL << 61;
-constexpr std::uint64_t kUniformFreq = 1ULL << (kRansBits - (kCellBits - 1));  // 2^48 / 2^19
 
 inline i128 norm2(i64 x, i64 y) { return static_cast<i128>(x) * x + static_cast<i128>(y) * y; }
 inline bool small(i64 v, i64 bound) { return v > -bound && v < bound; }
@@ -28,11 +26,11 @@ struct Frame {
   i64 xc, py;
   IVec w;
   i64 yin;   // the highest inside point of the column
-  std::int64_t jn;  // the normal cell of the column
+  std::int64_t jn;  // the normal cell of the column (ND / 2^shift cells per turn)
 };
 
 // The face frame of an inside point p with velocity w (the phase column and its top).
-Frame make_frame(i64 px, i64 py, const Vec2& w, i128 sigma2, std::int64_t sigma) {
+Frame make_frame(i64 px, i64 py, const Vec2& w, i128 sigma2, std::int64_t sigma, int shift) {
   Frame fr;
   fr.face = face_of(px, py);
   const IVec p = rot90({px, py}, fr.face);
@@ -41,7 +39,7 @@ Frame make_frame(i64 px, i64 py, const Vec2& w, i128 sigma2, std::int64_t sigma)
   fr.xc = p.x;
   fr.py = p.y;
   fr.yin = static_cast<i64>(isqrt(static_cast<u128>(sigma2 - static_cast<i128>(p.x) * p.x - 1)));
-  fr.jn = normal_cell(p.x, sigma);
+  fr.jn = normal_cell(p.x, sigma, shift);
   return fr;
 }
 
@@ -89,13 +87,19 @@ std::optional<i64> lo_post(i128 sigma2, i64 xc, int strict, i64 wx, i64 wy) {
   return static_cast<i64>(lo);
 }
 
-LatticePair2D::LatticePair2D(std::int64_t sigma, Law law)
-    : sigma_(sigma), sigma2_(static_cast<i128>(sigma) * sigma), law_(law) {
+LatticePair2D::LatticePair2D(std::int64_t sigma, Law law, int cell_bits)
+    : sigma_(sigma), sigma2_(static_cast<i128>(sigma) * sigma), law_(law), shift_(kCellBits - cell_bits) {
   require(sigma >= 2 && sigma <= (1LL << 61), "LatticePair2D: sigma must be in [2, 2^61] lattice units");
+  require(cell_bits >= min_cell_bits && cell_bits <= max_cell_bits,
+          "LatticePair2D: cell_bits must be in [12, 20] (2^cell_bits direction cells per turn)");
+  mask_ = (std::int64_t{1} << cell_bits) - 1;
+  half_ = std::int64_t{1} << (cell_bits - 1);
+  quarter_ = std::int64_t{1} << (cell_bits - 2);
+  ufreq_ = std::uint64_t{1} << (kRansBits - (cell_bits - 1));
 }
 
 std::uint64_t LatticePair2D::cum(std::int64_t a) const {
-  return law_ == Law::flux ? flux_cum(a) : static_cast<std::uint64_t>(a) * kUniformFreq;
+  return law_ == Law::flux ? flux_cum(a << shift_) : static_cast<std::uint64_t>(a) * ufreq_;
 }
 
 std::int64_t LatticePair2D::decode(std::uint64_t s) const {
@@ -104,10 +108,17 @@ std::int64_t LatticePair2D::decode(std::uint64_t s) const {
 }
 
 std::int64_t LatticePair2D::decode(std::uint64_t s, std::uint64_t& c, std::uint64_t& f) const {
-  if (law_ == Law::flux) return flux_decode(s, c, f);
-  const std::int64_t b = static_cast<std::int64_t>(s / kUniformFreq);
-  c = static_cast<std::uint64_t>(b) * kUniformFreq;
-  f = kUniformFreq;
+  if (law_ == Law::flux) {
+    std::int64_t b = flux_decode(s, c, f);
+    if (shift_ == 0) return b;
+    b >>= shift_;  // the coarse cell holding the fine one; its frequency sums its fine cells'
+    c = flux_cum(b << shift_);
+    f = flux_cum((b + 1) << shift_) - c;
+    return b;
+  }
+  const std::int64_t b = static_cast<std::int64_t>(s / ufreq_);
+  c = static_cast<std::uint64_t>(b) * ufreq_;
+  f = ufreq_;
   return b;
 }
 
@@ -117,10 +128,10 @@ Refusal LatticePair2D::check_pre(const Vec2& q, const Vec2& w) const {
   require(norm2(q[0], q[1]) >= sigma2_, "LatticePair2D::forward: q must be outside (|q|^2 >= sigma^2)");
   require(norm2(px, py) < sigma2_, "LatticePair2D::forward: q + w must be inside (|q+w|^2 < sigma^2)");
   if (px == 0 && py == 0) return Refusal::out_of_domain;  // coinciding centres: no face
-  const Frame fr = make_frame(px, py, w, sigma2_, sigma_);
+  const Frame fr = make_frame(px, py, w, sigma2_, sigma_, shift_);
   if (!lo_pre(sigma2_, fr.xc, fr.strict, fr.w.x, fr.w.y)) return Refusal::out_of_domain;
-  const std::int64_t jpre = ((dir_cell(fr.w.x, fr.w.y) - fr.jn) & kMask) - kHalfTurn;
-  if (jpre < -kQuarterTurn || jpre >= kQuarterTurn) return Refusal::not_approaching;
+  const std::int64_t jpre = ((dir(fr.w.x, fr.w.y) - fr.jn) & mask_) - half_;
+  if (jpre < -quarter_ || jpre >= quarter_) return Refusal::not_approaching;
   return Refusal::none;
 }
 
@@ -136,7 +147,7 @@ Refusal LatticePair2D::forward(const Vec2& q, const Vec2& w, std::uint64_t g, co
     X_out = X;
     return Refusal::out_of_domain;
   }
-  const Frame fr = make_frame(px, py, w, sigma2_, sigma_);
+  const Frame fr = make_frame(px, py, w, sigma2_, sigma_, shift_);
   Trace tr;
   tr.face = fr.face;
   tr.jn = fr.jn;
@@ -150,12 +161,12 @@ Refusal LatticePair2D::forward(const Vec2& q, const Vec2& w, std::uint64_t g, co
   if (!lo) return refuse(Refusal::out_of_domain);
   tr.m = fr.yin - *lo + 1;
   // 3. pre direction about the quantized normal
-  const std::int64_t jd = dir_cell(fr.w.x, fr.w.y);
-  tr.jpre = ((jd - fr.jn) & kMask) - kHalfTurn;
-  if (tr.jpre < -kQuarterTurn || tr.jpre >= kQuarterTurn) return refuse(Refusal::not_approaching);
+  const std::int64_t jd = dir(fr.w.x, fr.w.y);
+  tr.jpre = ((jd - fr.jn) & mask_) - half_;
+  if (tr.jpre < -quarter_ || tr.jpre >= quarter_) return refuse(Refusal::not_approaching);
   X_out = X;
   X_out.push_uniform(static_cast<std::uint64_t>(fr.py - *lo), static_cast<std::uint64_t>(tr.m));
-  const std::int64_t a = tr.jpre + kQuarterTurn;
+  const std::int64_t a = tr.jpre + quarter_;
   const std::uint64_t ca = cum(a);
   X_out.push_rans(ca, cum(a + 1) - ca);
   // 4. torus shift, 5. post direction
@@ -163,16 +174,16 @@ Refusal LatticePair2D::forward(const Vec2& q, const Vec2& w, std::uint64_t g, co
   std::uint64_t cb, fb;
   const std::int64_t b = decode(X_out.low48(), cb, fb);
   X_out.pop_rans(cb, fb);
-  tr.jpost = b - kQuarterTurn;
-  const std::int64_t k = (fr.jn + tr.jpost - jd) & kMask;
-  const IVec W2 = rotate(fr.w, rot_coef(k));
+  tr.jpost = b - quarter_;
+  const std::int64_t k = (fr.jn + tr.jpost - jd) & mask_;
+  const IVec W2 = rotate(fr.w, rot_coef(k << shift_));
   if (!small(W2.x, kMaxComp) || !small(W2.y, kMaxComp)) return refuse(Refusal::out_of_domain);
   // 6. post phase (the refusals in the prototype's order: interval, empty, then read-back)
   const auto lo2 = lo_post(sigma2_, fr.xc, fr.strict, W2.x, W2.y);
   if (!lo2) return refuse(Refusal::out_of_domain);
   tr.m2 = fr.yin - *lo2 + 1;
   if (tr.m2 <= 0) return refuse(Refusal::empty_post);
-  if (!in_cell(W2.x, W2.y, (fr.jn + tr.jpost) & kMask)) return refuse(Refusal::cell_readback);
+  if (!in_coarse_cell(W2.x, W2.y, (fr.jn + tr.jpost) & mask_, shift_)) return refuse(Refusal::cell_readback);
   const std::uint64_t idx2 = X_out.pop_uniform(static_cast<std::uint64_t>(tr.m2));
   const i128 qx = static_cast<i128>(fr.xc) + W2.x;
   const i128 qy = static_cast<i128>(*lo2) + static_cast<i128>(idx2) + W2.y;
@@ -189,15 +200,15 @@ void LatticePair2D::reverse(const Vec2& q2, const Vec2& w2, std::uint64_t g, Bit
   const i64 px = q2[0] - w2[0], py = q2[1] - w2[1];
   require(norm2(q2[0], q2[1]) >= sigma2_, "LatticePair2D::reverse: q2 must be outside (|q2|^2 >= sigma^2)");
   require(norm2(px, py) < sigma2_, "LatticePair2D::reverse: q2 - w2 must be inside (|q2-w2|^2 < sigma^2)");
-  const Frame fr = make_frame(px, py, w2, sigma2_, sigma_);
+  const Frame fr = make_frame(px, py, w2, sigma2_, sigma_, shift_);
   const auto lo2 = lo_post(sigma2_, fr.xc, fr.strict, fr.w.x, fr.w.y);
   require(lo2.has_value(), "LatticePair2D::reverse: post phases do not form an interval (not a forward's output)");
   const i64 m2 = fr.yin - *lo2 + 1;
   const i64 idx2 = fr.py - *lo2;
   require(idx2 >= 0 && idx2 < m2, "LatticePair2D::reverse: post phase outside its interval");
-  const std::int64_t jpost = ((dir_cell(fr.w.x, fr.w.y) - fr.jn + kHalfTurn) & kMask) - kHalfTurn;
-  require(jpost >= -kQuarterTurn && jpost < kQuarterTurn, "LatticePair2D::reverse: w2 is not outgoing about the normal");
-  const std::int64_t b = jpost + kQuarterTurn;
+  const std::int64_t jpost = ((dir(fr.w.x, fr.w.y) - fr.jn + half_) & mask_) - half_;
+  require(jpost >= -quarter_ && jpost < quarter_, "LatticePair2D::reverse: w2 is not outgoing about the normal");
+  const std::int64_t b = jpost + quarter_;
   const std::uint64_t cb = cum(b), fb = cum(b + 1) - cb;
   X.push_uniform(static_cast<std::uint64_t>(idx2), static_cast<std::uint64_t>(m2));
   X.push_rans(cb, fb);
@@ -205,8 +216,8 @@ void LatticePair2D::reverse(const Vec2& q2, const Vec2& w2, std::uint64_t g, Bit
   std::uint64_t ca, fa;
   const std::int64_t a = decode(X.low48(), ca, fa);
   X.pop_rans(ca, fa);
-  const std::int64_t jd = (a - kQuarterTurn + fr.jn + kHalfTurn) & kMask;
-  const IVec W = rotate_inv(fr.w, rot_coef((fr.jn + jpost - jd) & kMask));
+  const std::int64_t jd = (a - quarter_ + fr.jn + half_) & mask_;
+  const IVec W = rotate_inv(fr.w, rot_coef(((fr.jn + jpost - jd) & mask_) << shift_));
   const auto lo = lo_pre(sigma2_, fr.xc, fr.strict, W.x, W.y);
   const i64 m = lo ? fr.yin - *lo + 1 : 0;
   if (m <= 0 || !small(W.x, kMaxComp) || !small(W.y, kMaxComp)) {

@@ -57,6 +57,11 @@ def _walls(boundary: _Boundary) -> list:
     return out
 
 
+def _tick(tick_bits: Optional[int]) -> int:
+    """The binding's tick_bits: 0 asks for the automatic tick."""
+    return 0 if tick_bits is None else integer(tick_bits, "tick_bits", 16, 26)
+
+
 class LatticeSimulation(Attachable):
     """N hard disks on the integer lattice, run forward and back bit for bit (2D only).
 
@@ -64,14 +69,19 @@ class LatticeSimulation(Attachable):
     or at random (``LatticeSimulation.random(n, phi=...)``, the float engine's initialiser then
     quantized). ``boundary``: ``"periodic"`` or ``"wall"`` (one or per axis). ``law``: ``"flux"``
     (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and X's
-    first 256 bits. ``tick_bits`` T (16..26, default 20): a particle of rms speed moves 2^-T
-    diameters per tick; a finer tick (larger T) makes redraws and group collisions (a third body
-    within one tick) rarer, in proportion to the tick, at the cost of T - 20 fewer bits of
-    velocity resolution (docs/lattice.md). Bad input raises ``ValueError`` naming the problem.
+    first 256 bits. ``tick_bits`` T (16..26; default ``None``: automatic): a particle of rms speed
+    moves 2^-T diameters per tick; a finer tick (larger T) makes redraws and group collisions (a
+    third body within one tick) rarer at the cost of fewer bits of velocity resolution (2^(S-T)
+    units for the rms speed, S set by the box). The automatic tick keeps 30 bits:
+    T = clamp(S - 30, 16, 24) (docs/lattice.md). ``cell_bits`` (12..20, default 16): the pair operator
+    cuts directions into 2^cell_bits equal-angle cells per turn; fewer cells make the lifting
+    rotation's read-back redraws rarer (docs/lattice.md). Bad input raises ``ValueError`` naming
+    the problem.
     """
 
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
-                 diameter: float = 1.0, law: str = "flux", seed: int = 1, tick_bits: int = 20, _engine=None,
+                 diameter: float = 1.0, law: str = "flux", seed: int = 1, tick_bits: Optional[int] = None,
+                 cell_bits: int = 16, _engine=None,
                  _quantization: Optional[dict] = None):
         if _engine is not None:
             self._e = _engine
@@ -83,7 +93,7 @@ class LatticeSimulation(Attachable):
         if box.ndim > 1 or box.size not in (1, 2):
             raise ValueError(f"box must be one length or two (2D), got shape {box.shape}")
         start = _core.lattice_quantize(x, v, [float(b) for b in np.broadcast_to(box, (2,))],
-                                       _walls(boundary), diameter, tick_bits)
+                                       _walls(boundary), diameter, _tick(tick_bits), cell_bits)
         self._init_from_start(start, law, seed)
 
     def _init_from_start(self, start: dict, law: str, seed: int) -> None:
@@ -94,7 +104,8 @@ class LatticeSimulation(Attachable):
     @classmethod
     def random(cls, n: int, dim: int = 2, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
                diameter: float = 1.0, seed: int = 1, init: str = "auto", law: str = "flux",
-               tick_bits: int = 20, packing_fraction: Optional[float] = None) -> "LatticeSimulation":
+               tick_bits: Optional[int] = None, cell_bits: int = 16,
+               packing_fraction: Optional[float] = None) -> "LatticeSimulation":
         """n disks at area fraction ``phi`` (or ``packing_fraction=``; default 0.3) in a square
         box (the float engine's ``random_state``:
         random sequential addition or a jittered lattice, Gaussian velocities with zero momentum,
@@ -102,7 +113,8 @@ class LatticeSimulation(Attachable):
         phi = _packing_fraction(phi, packing_fraction)
         if dim != 2:
             raise ValueError(f"the lattice engine is 2D, got dim={dim}")
-        start = _core.lattice_random_start(n, phi, _walls(boundary), diameter, seed, name(init, "init"), tick_bits)
+        start = _core.lattice_random_start(n, phi, _walls(boundary), diameter, seed, name(init, "init"), _tick(tick_bits),
+                                            cell_bits)
         sim = cls.__new__(cls)
         sim._init_from_start(start, law, seed)
         return sim

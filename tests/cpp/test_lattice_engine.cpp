@@ -70,7 +70,7 @@ LatticeStart start(std::size_t n, double phi, bool walls, std::uint64_t seed) {
 
 LatticeEngine make(std::size_t n, double phi, bool walls, std::uint64_t seed) {
   LatticeStart s = start(n, phi, walls, seed);
-  return LatticeEngine(s.units, s.x, s.v, static_cast<std::uint32_t>(seed), LatticePair2D(s.units.sigma));
+  return LatticeEngine(s.units, s.x, s.v, static_cast<std::uint32_t>(seed), operator_for(s.units));
 }
 
 // forward `per` collisions per particle, back to the start: everything restored bit for bit
@@ -187,7 +187,7 @@ TEST_CASE("wall mirror: a bijection of the pre phases onto the post phases, its 
 }
 
 TEST_CASE("units: tick_bits sets the tick (a typical particle moves 2^-T sigma per tick) and is range-checked") {
-  const Units u20 = choose_units({20.0, 20.0}, 1.0, 2.0, {false, false});
+  const Units u20 = choose_units({20.0, 20.0}, 1.0, 2.0, {false, false}, 20);
   const Units u22 = choose_units({20.0, 20.0}, 1.0, 2.0, {false, false}, 22);
   CHECK(u20.tick_bits == 20);
   CHECK(u22.tick_bits == 22);
@@ -211,6 +211,43 @@ TEST_CASE("units: tick_bits sets the tick (a typical particle moves 2^-T sigma p
   CHECK_THROWS_AS(validate(bad), revcol::InvalidArgument);
 }
 
+TEST_CASE("units: the automatic tick keeps 30 bits of velocity, T = clamp(S - 30, 16, 24)") {
+  // a box of 20 diameters: S = 56 -> T = 24; 200: S = 53 -> 23; 1000: S = 51 -> 21; 2^18: S = 42 -> 16 (clamped)
+  const std::pair<double, int> cases[] = {{20.0, 24}, {200.0, 23}, {1000.0, 21}, {262144.0, 16}};
+  for (const auto& [box, t] : cases) {
+    const Units u = choose_units({box, box}, 1.0, 1.0, {false, false});
+    CHECK(u.tick_bits == t);
+    CHECK(u.tick_bits == std::clamp(u.S - velocity_bits, 16, 24));
+    CHECK(u.tick == std::ldexp(1.0, -t));
+  }
+}
+
+TEST_CASE("units: cell_bits is kept in the units, range-checked, and the engine's operator must match it") {
+  const Units u = choose_units({20.0, 20.0}, 1.0, 1.0, {false, false}, 20, 14);
+  CHECK(u.cell_bits == 14);
+  CHECK(choose_units({20.0, 20.0}, 1.0, 1.0, {false, false}).cell_bits == default_cell_bits);
+  for (int bad : {11, 21}) {
+    bool threw = false;
+    try {
+      choose_units({20.0, 20.0}, 1.0, 1.0, {false, false}, 20, bad);
+    } catch (const revcol::InvalidArgument& e) {
+      threw = std::string(e.what()).find("cell_bits") != std::string::npos;
+    }
+    CHECK(threw);
+    Units v = u;
+    v.cell_bits = bad;
+    CHECK_THROWS_AS(validate(v), revcol::InvalidArgument);
+  }
+  LatticeConfig c;
+  c.cell_bits = 14;
+  const LatticeStart s = random_start(c, 60, 0.3, 2);
+  CHECK(s.units.cell_bits == 14);
+  CHECK_THROWS_AS(LatticeEngine(s.units, s.x, s.v, 2, LatticePair2D(s.units.sigma)), revcol::InvalidArgument);
+  LatticeEngine e(s.units, s.x, s.v, 2, operator_for(s.units));
+  CHECK(e.op().cell_bits() == 14);
+  round_trip(e, 3000, "cell_bits 14");
+}
+
 TEST_CASE("units: a box too long or too fast for the lattice is refused with a clear error") {
   bool threw = false;
   try {
@@ -224,7 +261,7 @@ TEST_CASE("units: a box too long or too fast for the lattice is refused with a c
   CHECK(u.L[0] == std::llround(std::ldexp(20.0, 56)));
   threw = false;
   try {
-    quantize(u, {1.0, 1.0, 5.0, 5.0}, {5000.0, 0.0, 0.0, 0.0});
+    quantize(u, {1.0, 1.0, 5.0, 5.0}, {1e5, 0.0, 0.0, 0.0});  // vmax is 2^16 v_rms at the automatic T = 24
   } catch (const revcol::InvalidArgument& e) {
     threw = std::string(e.what()).find("faster") != std::string::npos;
   }
@@ -318,7 +355,7 @@ TEST_CASE("a reversal to collision k of n equals the snapshot taken at k; by tim
   e.run_back(0, t);
   const Snapshot st = e.snapshot();
   CHECK(e.clock() == t);
-  LatticeEngine f(s0, LatticePair2D(s0.units.sigma));
+  LatticeEngine f(s0, operator_for(s0.units));
   f.run(UINT64_MAX, t);
   CHECK(same_state(f.snapshot(), st));
   e.run_back(0, e.origin());
@@ -331,7 +368,7 @@ TEST_CASE("a snapshot resumes bit for bit (also one taken right after a collisio
   const Snapshot s = e.snapshot();
   e.run(5000, tick_limit - 1);
   const Snapshot a = e.snapshot();
-  LatticeEngine f(s, LatticePair2D(s.units.sigma));
+  LatticeEngine f(s, operator_for(s.units));
   CHECK(same_state(f.snapshot(), s));
   f.run(5000, tick_limit - 1);
   CHECK(same_state(f.snapshot(), a));
@@ -423,7 +460,7 @@ TEST_CASE("group collisions (a third body within one tick): forced on every coll
         CHECK(c.group_resolves == 0);
       }
       const Snapshot s1 = e.snapshot();
-      LatticeEngine f(s1, LatticePair2D(s1.units.sigma));  // a snapshot with group entries resumes
+      LatticeEngine f(s1, operator_for(s1.units));  // a snapshot with group entries resumes
       f.max_redraws = -1;
       f.group_resolve = resolve;
       e.run(1000, tick_limit - 1);

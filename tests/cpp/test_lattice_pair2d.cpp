@@ -125,9 +125,9 @@ struct LawRun {
 
 // n collisions of one fixed pre state (normal angle phn, incidence inc): the post angles'
 // KS p-value against the law, X's size, exact inverse spot checks.
-LawRun run_law(Law law, double phn, double inc_deg, long n, std::uint64_t seed) {
+LawRun run_law(Law law, double phn, double inc_deg, long n, std::uint64_t seed, int cell_bits = kCellBits) {
   const i64 sigma = 1LL << 60;
-  const LatticePair2D op(sigma, law);
+  const LatticePair2D op(sigma, law, cell_bits);
   Vec2 q, w;
   const bool ok = make_pre(sigma, phn, inc_deg * std::numbers::pi / 180.0, std::ldexp(1.0, 41), 0.37, q, w);
   LawRun out;
@@ -369,7 +369,8 @@ TEST_CASE("round trip: 1.2e5 random pre states, sigma 2^20..2^61, speeds 2^20..2
   BitsBack X = random_bits(rng.gen, 256);
   for (int i = 0; tried < 120000; ++i) {
     const i64 sigma = sigmas[i % 8];
-    const LatticePair2D op(sigma, (i % 7 == 3) ? Law::uniform : Law::flux);
+    // the cell resolution cycles over 20, 16, 12 (i % 3), independently of sigma (i % 8)
+    const LatticePair2D op(sigma, (i % 7 == 3) ? Law::uniform : Law::flux, 20 - 4 * (i % 3));
     const int top = std::min(45, static_cast<int>(std::log2(static_cast<double>(sigma))) - 4);
     const double speed = std::ldexp(1.0 + rng.uni(), 20 + static_cast<int>(rng.gen() % static_cast<unsigned>(std::max(1, top - 19))));
     const bool grazing = i % 4 == 0;
@@ -671,14 +672,15 @@ TEST_CASE("bad input: a clear InvalidArgument, nothing changed") {
   CHECK(P == X);
 }
 
-TEST_CASE("post law: KS against the flux law at 4 fixed pre states (p > 0.001), X bounded") {
+TEST_CASE("post law: KS against the flux law at 4 fixed pre states (p > 0.001), X bounded, 2^20 and 2^16 cells") {
   const double states[4][2] = {{0.3, 0.0}, {1.1, 45.0}, {2.9, 80.0}, {-2.0, 89.0}};
   const long n = g_long > 0 ? g_long : 20000;
-  for (int i = 0; i < 4; ++i) {
-    const LawRun r = run_law(Law::flux, states[i][0], states[i][1], n, 100 + static_cast<std::uint64_t>(i));
-    std::printf("  flux, normal %+.2f rad, incidence %4.1f deg, n %ld: KS p = %.4f, mean cos %.5f (pi/4 = %.5f), "
+  for (int i = 0; i < 8; ++i) {
+    const int cb = i < 4 ? 20 : 16;  // the prototype's cells, the engine's default
+    const LawRun r = run_law(Law::flux, states[i % 4][0], states[i % 4][1], n, 100 + static_cast<std::uint64_t>(i), cb);
+    std::printf("  flux, 2^%d cells, normal %+.2f rad, incidence %4.1f deg, n %ld: KS p = %.4f, mean cos %.5f (pi/4 = %.5f), "
                 "refused %d, X bits %g -> %g (min %g, max %g)\n",
-                states[i][0], states[i][1], n, r.p, r.mean_cos, std::numbers::pi / 4, r.refusals, r.bits_start,
+                cb, states[i % 4][0], states[i % 4][1], n, r.p, r.mean_cos, std::numbers::pi / 4, r.refusals, r.bits_start,
                 r.bits_end, r.bits_min, r.bits_max);
     CHECK(r.bad == 0);
     CHECK(r.p > 0.001);
@@ -706,8 +708,9 @@ TEST_CASE("X's size over a gas of pre states: bounded under flux, +0.557 bit/col
   // (f ~ cos) that is ~0 every time; under the uniform law its mean is
   // E_flux[log2 cos] - E_uniform[log2 cos] = log2(e) (2 ln 2 - 1) = 0.5573 bit.
   const long n = 20000;
+  for (const int cb : {20, 16})
   for (const Law law : {Law::flux, Law::uniform}) {
-    const LatticePair2D op(1LL << 60, law);
+    const LatticePair2D op(1LL << 60, law, cb);
     Rng rng(law == Law::flux ? 61 : 62);
     BitsBack X = random_bits(rng.gen, 256), X2;
     const double start = static_cast<double>(X.bit_length());
@@ -725,7 +728,7 @@ TEST_CASE("X's size over a gas of pre states: bounded under flux, +0.557 bit/col
       ++k;
     }
     const double rate = (static_cast<double>(X.bit_length()) - start) / static_cast<double>(n);
-    std::printf("  %s: X %g -> %zu bits over %ld collisions (min %g, max %g): %.4f bit/collision\n", to_string(law), start,
+    std::printf("  %s, 2^%d cells: X %g -> %zu bits over %ld collisions (min %g, max %g): %.4f bit/collision\n", to_string(law), cb, start,
                 X.bit_length(), n, lo, hi, rate);
     CHECK(bad == 0);
     if (law == Law::flux) CHECK(hi - lo <= 16);

@@ -45,7 +45,7 @@ def test_midpoint_and_time_reversal_equal_the_forward_states():
 
 
 def test_tick_bits_finer_tick_round_trip_and_checkpoint(tmp_path):
-    coarse = LatticeSimulation.random(n=120, phi=0.5, boundary="wall", seed=4)
+    coarse = LatticeSimulation.random(n=120, phi=0.5, boundary="wall", seed=4, tick_bits=20)
     fine = LatticeSimulation.random(n=120, phi=0.5, boundary="wall", seed=4, tick_bits=22)
     assert coarse.units["tick_bits"] == 20 and fine.units["tick_bits"] == 22
     assert fine.units["tick"] == pytest.approx(coarse.units["tick"] / 4, rel=1e-12)
@@ -60,9 +60,37 @@ def test_tick_bits_finer_tick_round_trip_and_checkpoint(tmp_path):
     assert other.units["tick_bits"] == 22 and _same(other.snapshot(), fine.snapshot())
     other.run_back()
     assert _same(other.snapshot(), s0)
-    for bad in (15, 27):
+    for bad in (15, 27, 0):
         with pytest.raises(ValueError, match="tick_bits"):
             LatticeSimulation.random(n=50, phi=0.3, tick_bits=bad)
+
+
+def test_automatic_tick_keeps_30_velocity_bits():
+    for n, phi in ((120, 0.5), (2000, 0.1)):
+        u = LatticeSimulation.random(n=n, phi=phi, seed=4).units
+        assert u["tick_bits"] == min(24, max(16, u["S"] - 30))
+    big = LatticeSimulation.random(n=10000, phi=0.1, seed=4).units  # a box of 280 diameters
+    assert big["S"] == 52 and big["tick_bits"] == 22
+
+
+def test_cell_bits_round_trip_checkpoint_and_bad_values(tmp_path):
+    sims = {cb: LatticeSimulation.random(n=120, phi=0.5, boundary="wall", seed=4, cell_bits=cb) for cb in (16, 20)}
+    assert LatticeSimulation.random(n=50, phi=0.3).units["cell_bits"] == 16  # the default
+    for cb, sim in sims.items():
+        assert sim.units["cell_bits"] == cb
+        s0 = sim.snapshot()
+        sim.run(collisions=4000)
+        path = tmp_path / f"c{cb}.npz"
+        sim.save(path)
+        other = LatticeSimulation.load(path)
+        assert other.units["cell_bits"] == cb and _same(other.snapshot(), sim.snapshot())
+        other.run_back()
+        assert _same(other.snapshot(), s0)
+    # the cell resolution is part of the dynamics: the two runs part from the same start
+    assert not np.array_equal(sims[16].lattice_velocities, sims[20].lattice_velocities)
+    for bad in (11, 21):
+        with pytest.raises(ValueError, match="cell_bits"):
+            LatticeSimulation.random(n=50, phi=0.3, cell_bits=bad)
 
 
 def test_save_load_resumes_bit_for_bit(tmp_path):

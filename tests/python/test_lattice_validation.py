@@ -105,7 +105,7 @@ def test_third_bodies_measures_a_gap_in_ticks_of_travel():
     tick = 2.0 ** -20 / v_rms  # units.hpp: a tick moves a particle of rms speed 2^-20 D
     x = np.array([[5.0, 5.0], [6.5, 5.0], [5.0, 6.0 + 2.0 * tick]])  # body 2 two ticks' travel above 0
     v = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 0.0]])
-    sim = lattice.LatticeSimulation(x, v, 10.0, boundary="periodic")
+    sim = lattice.LatticeSimulation(x, v, 10.0, boundary="periodic", tick_bits=20)
     assert abs(sim.units["tick"] / tick - 1.0) < 1e-6
     got = lv._third_bodies(sim, 0, 1, sim.clock)
     assert [(g["body"], g["near"]) for g in got] == [(2, 0)]

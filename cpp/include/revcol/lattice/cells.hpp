@@ -76,8 +76,13 @@ i64 boundary_y(std::int64_t h);
 std::int64_t dir_cell(i64 wx, i64 wy);
 /// dir_cell(wx, wy) == k, decided by two exact cross products (w != 0, 0 <= k < ND).
 bool in_cell(i64 wx, i64 wy, std::int64_t k);
+/// dir_cell(wx, wy) >> shift == k: w lies in the coarse cell k of ND / 2^shift cells per turn
+/// (its boundaries are the fine boundaries k 2^shift and (k+1) 2^shift); shift = 0 is in_cell.
+bool in_coarse_cell(i64 wx, i64 wy, std::int64_t k, int shift);
 /// The cell nearest to the normal angle acos(xc/sigma); needs |xc| < sigma, sigma <= 2^61.
 std::int64_t normal_cell(i64 xc, i64 sigma);
+/// The coarse cell (ND / 2^shift per turn) nearest to acos(xc/sigma); shift = 0 is normal_cell.
+std::int64_t normal_cell(i64 xc, i64 sigma, int shift);
 
 /// The lifting coefficients of a rotation by k cells.
 struct RotCoef {

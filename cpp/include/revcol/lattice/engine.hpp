@@ -34,6 +34,7 @@ struct LatticeConfig {
   Law law = Law::flux;                     ///< the operator's post-direction law
   std::uint32_t seed = 1;                  ///< stream seed (Philox key {particle, seed}) and X's first bits
   int tick_bits = default_tick_bits;       ///< a particle of rms speed moves 2^-tick_bits D per tick (units.hpp)
+  int cell_bits = default_cell_bits;       ///< the pair operator's 2^cell_bits direction cells per turn (pair2d.hpp)
 };
 
 /// A quantized start and what the quantization cost.
@@ -70,6 +71,9 @@ struct Diagnostics {
 };
 /// Diagnostics of an engine.
 Diagnostics diagnostics(const LatticeEngine& e);
+
+/// The pair operator the units ask for (their sigma and cell_bits) with the given law.
+inline LatticePair2D operator_for(const Units& u, Law law = Law::flux) { return LatticePair2D(u.sigma, law, u.cell_bits); }
 
 /// The same snapshot from the engine (a convenience for bindings).
 inline Snapshot snapshot_of(const LatticeEngine& e) { return e.snapshot(); }

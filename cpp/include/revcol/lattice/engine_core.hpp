@@ -136,6 +136,7 @@ class BasicEngine {
   BasicEngine(const Units& u, std::vector<Vec2> x, std::vector<Vec2> v, std::uint32_t seed, Op op,
               std::int64_t clock = 0)
       : op_(std::move(op)) {
+    check_operator(u);
     validate_state(u, x, v);
     require(clock > -tick_limit / 2 && clock < tick_limit / 2, "lattice: the start tick must be within +-2^60");
     Snapshot s;
@@ -184,7 +185,7 @@ class BasicEngine {
     }
     require(s.origin <= s.clock && s.clock < tick_limit / 2 && s.origin > -tick_limit / 2,
             "lattice snapshot: origin <= clock within +-2^60 required");
-    require(op_.sigma() == s.units.sigma, "lattice snapshot: the operator's sigma differs from the units'");
+    check_operator(s.units);
     load(s);
   }
 
@@ -902,6 +903,13 @@ class BasicEngine {
     for (int q : g) predict(q, a);
   }
 
+  // The operator must work in the units' lattice: the same sigma and (an operator with
+  // direction cells) the same cell resolution.
+  void check_operator(const Units& u) const {
+    require(op_.sigma() == u.sigma, "lattice: the operator's sigma differs from the units'");
+    if constexpr (requires { op_.cell_bits(); })
+      require(op_.cell_bits() == u.cell_bits, "lattice: the operator's cell_bits differ from the units'");
+  }
   Op op_;
   Units u_;
   std::uint32_t seed_ = 1;

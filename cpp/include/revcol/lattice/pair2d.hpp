@@ -13,6 +13,12 @@
 //     (exact integer square roots; if they do not form an interval, or p = 0 has no face:
 //     out_of_domain);
 //     m = Yin - lo + 1. X <- X*m + (Py - lo).
+// Direction cells: ND = 2^cell_bits equal-angle cells per turn (12..20, default 20; the engine
+// takes it from its Units). A coarse cell is 2^(20 - cell_bits) of cells.hpp's cells, so it is
+// decided by the same exact boundaries (coarse cell = fine cell >> shift), and its flux
+// frequency is the sum of its fine cells'. Fewer cells make the step-5 read-back refusal rarer
+// (it needs the lifting's ~1-unit round-off to cross a cell boundary: probability ~ ND / |W|)
+// at no cost to the law (the post direction keeps the pre direction's offset in its cell).
 //  3. Pre direction: jn = normal cell of column xc, jd = cell of W, jpre = ((jd - jn) mod ND)
 //     - ND/2 is the cell of -W about the normal; it must lie in [-ND/4, ND/4) (else
 //     not_approaching). rANS push of a = jpre + ND/4 with the law's (cum, f).
@@ -85,16 +91,21 @@ struct Trace {
   std::int64_t jpost = 0; ///< post cell about the normal, [-ND/4, ND/4)
 };
 
+/// Allowed direction-cell resolutions: 2^cell_bits cells per turn (cells.hpp's 2^20 is the finest).
+inline constexpr int min_cell_bits = 12, max_cell_bits = kCellBits;
+
 /// The exact pair operator (LATTICE.md §3) for disks of diameter sigma lattice units.
 class LatticePair2D {
  public:
-  /// Throws InvalidArgument unless 2 <= sigma <= 2^61.
-  explicit LatticePair2D(std::int64_t sigma, Law law = Law::flux);
+  /// Throws InvalidArgument unless 2 <= sigma <= 2^61 and 12 <= cell_bits <= 20.
+  explicit LatticePair2D(std::int64_t sigma, Law law = Law::flux, int cell_bits = kCellBits);
   static constexpr int draw_bits = 48;   ///< G is a 48-bit integer
   static constexpr std::int64_t max_component = 1LL << 62;  ///< |q|, |w| components must be below
 
   std::int64_t sigma() const { return sigma_; }  ///< disk diameter in lattice units
   Law law() const { return law_; }               ///< flux or uniform
+  int cell_bits() const { return kCellBits - shift_; }  ///< 2^cell_bits direction cells per turn
+  std::int64_t cells() const { return mask_ + 1; }      ///< ND, direction cells per turn
 
   /// The G-independent refusal of a pre state (none, not_approaching or out_of_domain): when
   /// it is not none, no redraw can help. Same input checks as forward.
@@ -119,7 +130,7 @@ class LatticePair2D {
   void pair_reverse(const Vec2& xi2, const Vec2& xj2, const Vec2& vi2, const Vec2& vj2, std::uint64_t g,
                     BitsBack& X, Vec2& xi, Vec2& xj, Vec2& vi, Vec2& vj) const;
 
-  /// The law's cumulative frequency of relative cell a in [0, 2^19] (total 2^48).
+  /// The law's cumulative frequency of relative cell a in [0, ND/2] (total 2^48).
   std::uint64_t cum(std::int64_t a) const;
   /// The relative cell b with cum(b) <= s < cum(b+1), s < 2^48.
   std::int64_t decode(std::uint64_t s) const;
@@ -127,9 +138,15 @@ class LatticePair2D {
   std::int64_t decode(std::uint64_t s, std::uint64_t& c, std::uint64_t& f) const;
 
  private:
+  std::int64_t dir(i64 wx, i64 wy) const { return dir_cell(wx, wy) >> shift_; }  // the (coarse) cell of w
   std::int64_t sigma_;
   i128 sigma2_;
   Law law_;
+  int shift_;               // cells are 2^shift_ of cells.hpp's 2^20 per turn
+  std::int64_t mask_;       // ND - 1
+  std::int64_t half_;       // ND / 2
+  std::int64_t quarter_;    // ND / 4
+  std::uint64_t ufreq_;     // the uniform law's frequency, 2^48 / (ND / 2)
 };
 
 }  // namespace revcol::lattice

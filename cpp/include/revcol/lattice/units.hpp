@@ -6,11 +6,15 @@
 // differences are then below 2^62 and their squares fit 128-bit integers, geometry.hpp). S < 40 (a box longer than 2^22 diameters) is refused: the
 // velocity resolution would fall below ~2^20 units.
 // Velocity: the root-mean-square speed v_rms of the float state is mapped to 2^(S-T) units per
-// tick, so a tick moves a typical particle 2^-T sigma; T = tick_bits, 20 by default (the
-// prototype's choice), 16..26 allowed. One tick is then D 2^-T / v_rms in the float state's time
-// unit. A finer tick (larger T) makes third bodies within one tick, and so redraws and group
-// collisions, rarer (their rate is proportional to the tick) at the cost of T - 20 fewer bits of
-// velocity resolution (2^(S-T) units for v_rms); N is bounded by 2^(2 (T - 8)) (vmax below). Speeds are bounded by vmax = 2^(S-8) units per
+// tick, so a tick moves a typical particle 2^-T sigma; T = tick_bits, 16..26 allowed. One tick is
+// then D 2^-T / v_rms in the float state's time unit. A finer tick (larger T) makes third bodies
+// within one tick, and so redraws and group collisions, rarer at the cost of fewer bits of
+// velocity resolution (2^(S-T) units for v_rms), which makes the pair operator's read-back
+// redraws (~ cells / |w|) and the energy random walk (~2^-(S-T) per collision) larger. The
+// automatic tick (the default) balances the two: T = clamp(S - 30, 16, 24), so v_rms is 2^30
+// units per tick wherever the box allows (docs/lattice.md "Choosing the tick and the cells", measured). The
+// prototype's T = 20 is what units written before the automatic choice carry. N is bounded by
+// 2^(2 (T - 8)) (vmax below). Speeds are bounded by vmax = 2^(S-8) units per
 // tick per axis (1/256 sigma per tick): a relative move per tick below sigma/128, which the cell
 // grid (cell_grid.hpp) relies on. Because no particle can be faster than sqrt(total kinetic energy),
 // a state with sqrt(sum |v|^2) > vmax is refused (N > ~2^24 at the default scale).
@@ -45,10 +49,17 @@ struct Units {
   double length_unit = 0.0;                  ///< float length of one lattice unit (D / sigma)
   double tick = 0.0;                         ///< float time of one tick
   int tick_bits = 20;                        ///< T: a particle of rms speed moves 2^-T sigma per tick
+  int cell_bits = 20;                        ///< the pair operator's 2^cell_bits direction cells per turn
 };
 
-/// Default and allowed range of tick_bits.
-inline constexpr int default_tick_bits = 20, min_tick_bits = 16, max_tick_bits = 26;
+/// Allowed range of tick_bits; the tick of units written before the automatic choice (20).
+inline constexpr int min_tick_bits = 16, max_tick_bits = 26, legacy_tick_bits = 20;
+/// tick_bits = auto_tick_bits asks choose_units for T = clamp(S - velocity_bits, 16, 24).
+inline constexpr int auto_tick_bits = 0, default_tick_bits = auto_tick_bits;
+/// The velocity resolution the automatic tick aims at: v_rms = 2^velocity_bits units per tick.
+inline constexpr int velocity_bits = 30;
+/// Default and allowed range of cell_bits (pair2d.hpp; 20 is the prototype's resolution).
+inline constexpr int default_cell_bits = 16, min_units_cell_bits = 12, max_units_cell_bits = 20;
 
 /// Checks a Units value (box lengths, sigma, vmax); throws InvalidArgument naming the problem.
 void validate(const Units& u);
@@ -56,7 +67,7 @@ void validate(const Units& u);
 /// Units for a float box of lengths box (per axis) and diameter D holding particles whose
 /// root-mean-square speed is v_rms; throws InvalidArgument if the lattice cannot hold it.
 Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
-                   int tick_bits = default_tick_bits);
+                   int tick_bits = default_tick_bits, int cell_bits = default_cell_bits);
 
 /// A float state quantized to the lattice: integer positions and velocities, and the errors.
 struct Quantized {
