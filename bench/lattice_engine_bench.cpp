@@ -8,6 +8,8 @@
 //
 //   revcol-bench --bench lattice/ --collisions 200000
 //
+// REVCOL_LATTICE=tick_bits=T,cell_bits=B overrides the units' defaults (automatic T, 2^16 cells).
+//
 // Metrics: forward_per_s, reverse_per_s, forward_cpu_per_s, reverse_cpu_per_s, bit_exact (1 when positions, velocities, streams, X and
 // clock are restored bit for bit), events_per_collision, log_entries, redraws_per_collision,
 // multi_body, wall_body, bits_length (X after the forward run), energy_drift (relative, after the
@@ -47,6 +49,13 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
   la::LatticeConfig cfg;
   cfg.wall = {c.walls, c.walls};
   cfg.seed = static_cast<std::uint32_t>(c.seed);
+  // REVCOL_LATTICE=tick_bits=20,cell_bits=20 runs the engine as before the automatic tick
+  apply_settings("REVCOL_LATTICE", "tick_bits, cell_bits", [&](const std::string& k, const std::string& v) {
+    if (k == "tick_bits") cfg.tick_bits = std::stoi(v);
+    else if (k == "cell_bits") cfg.cell_bits = std::stoi(v);
+    else return false;
+    return true;
+  });
   const la::LatticeStart st = la::random_start(cfg, c.n, c.phi, c.seed, c.phi > 0.35 ? "lattice" : "auto");
   la::LatticeEngine e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
   // warm up a collision per particle from the initialiser's lattice, then start the clock

@@ -142,10 +142,12 @@ std::vector<Metric> run_pair(std::uint64_t n) {
 // collision, X chained as in a gas); a G-dependent refusal is redrawn, a G-independent one
 // skips the state. Under the flux law X stays bounded; under the uniform law it grows by
 // E[log2 cos(pre)] - E[log2 cos(post)] = log2(e) (2 ln 2 - 1) = 0.557 bit per collision.
+// The engine's 2^16 cells run the flux law too (metrics with the suffix _cells16).
 std::vector<Metric> run_drift(std::uint64_t n) {
   std::vector<Metric> out;
-  for (const revcol::Law law : {revcol::Law::flux, revcol::Law::uniform}) {
-    const LatticePair2D op(1LL << 60, law);
+  const std::pair<revcol::Law, int> runs[] = {{revcol::Law::flux, 20}, {revcol::Law::uniform, 20}, {revcol::Law::flux, 16}};
+  for (const auto& [law, cb] : runs) {
+    const LatticePair2D op(1LL << 60, law, cb);
     BitsBack X = x256(), X2;
     const double start = static_cast<double>(X.bit_length());
     double lo = start, hi = start;
@@ -163,21 +165,24 @@ std::vector<Metric> run_drift(std::uint64_t n) {
       ++k;
     }
     const std::string tag = law == revcol::Law::flux ? "flux_" : "uniform_";
+    const std::string cells = cb == 20 ? "" : "_cells" + std::to_string(cb);
     const double dn = static_cast<double>(n);
-    out.push_back({tag + "bits_per_collision", (static_cast<double>(X.bit_length()) - start) / dn});
-    out.push_back({tag + "bits_max_minus_start", hi - start});
-    out.push_back({tag + "bits_start_minus_min", start - lo});
-    out.push_back({tag + "redraws_per_collision", static_cast<double>(redraws) / dn});
-    out.push_back({tag + "seconds", secs(t0)});
+    out.push_back({tag + "bits_per_collision" + cells, (static_cast<double>(X.bit_length()) - start) / dn});
+    out.push_back({tag + "bits_max_minus_start" + cells, hi - start});
+    out.push_back({tag + "bits_start_minus_min" + cells, start - lo});
+    out.push_back({tag + "redraws_per_collision" + cells, static_cast<double>(redraws) / dn});
+    out.push_back({tag + "seconds" + cells, secs(t0)});
   }
   return out;
 }
 
 // The fraction of draws the operator refuses with cell_readback (the lifting round-off moved
-// w2 across a cell boundary) at relative speeds 2^20 .. 2^44 lattice units per tick.
+// w2 across a cell boundary) at relative speeds 2^20 .. 2^44 lattice units per tick, for 2^20
+// direction cells per turn (the prototype's) and 2^16 (the engine's default; suffix _cells16).
 std::vector<Metric> run_readback(std::uint64_t n) {
   std::vector<Metric> out;
-  const LatticePair2D op(1LL << 60);
+  for (const int cb : {20, 16}) {
+  const LatticePair2D op(1LL << 60, revcol::Law::flux, cb);
   const BitsBack X = x256();
   BitsBack x2 = X;
   std::mt19937_64 rng(7);
@@ -189,7 +194,9 @@ std::vector<Metric> run_readback(std::uint64_t n) {
       ++tried;
       readback += op.forward(q, w, rng() >> 16, X, q2, w2, x2) == Refusal::cell_readback;
     }
-    out.push_back({"readback_at_2^" + std::to_string(e), static_cast<double>(readback) / static_cast<double>(n)});
+    out.push_back({"readback_at_2^" + std::to_string(e) + (cb == 20 ? "" : "_cells" + std::to_string(cb)),
+                   static_cast<double>(readback) / static_cast<double>(n)});
+  }
   }
   return out;
 }

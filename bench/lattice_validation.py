@@ -6,6 +6,7 @@ bench/results/lattice_validation_*.json.
     PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py equilibrium [--n 1000] [--phi 0.5]
     PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py failures [--phi 0.5 0.7] [--seeds 4] [--collisions 2e6] --out failures
     PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py gas --n 1000 --phi 0.3 --boundary wall --collisions 1e5
+    PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py probe --n 1000 --phi 0.7 --boundary wall --collisions 3e6 --ticks 20 22 24 --cells 20 16 --out probe
 
 matrix: every gas (N x area fraction x boundary, flux law) in its own subprocess (``gas``), one
 at a time. The child runs C collisions forward, taking a snapshot at C/2, then runs back to C/2
@@ -24,6 +25,11 @@ running back from the failed state works, and checks bit for bit from the latest
 the failure (taken every C/100 collisions) back to an earlier one and to 0. Rows are written
 after each gas (atomically: a temporary file renamed), with the commit of the build and the load
 average before and after.
+
+probe: forward only, one gas per (N, area fraction, boundary) for each tick (--ticks) and cell
+resolution (--cells): the rare log's entries, the group entries and the redraws by reason, the
+energy drift. It is how the engine's automatic tick and 2^16 cells were chosen (docs/lattice.md
+"Choosing the tick and the cells"). Writes lattice_validation_<out>.json.
 
 failures: forward only, several seeds, up to --collisions: the first engine error and, rebuilt
 from the snapshot before it, the bodies within 3 ticks' travel of the failing pair; and a census
@@ -550,9 +556,41 @@ def failures(args) -> dict:
     return res
 
 
+def probe(args) -> dict:
+    """Forward only: the rare log's entries and the redraws by reason for each tick T (--ticks,
+    0: automatic) and cell resolution (--cells) on each gas: what chooses the defaults."""
+    from revcol.lattice import LatticeSimulation
+    c = int(float(args.collisions))
+    path = os.path.join(RESULTS, f"lattice_validation_{args.out}.json")
+    res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
+           "build": _build_info(), "collisions": c, "seed": args.seed, "rows": []}
+    for phi in args.phi:
+        for n in args.n:
+            for b in args.boundary:
+                for t in args.ticks:
+                    for cb in args.cells:
+                        t0 = time.time()
+                        sim = LatticeSimulation.random(n=n, phi=phi, boundary=b, seed=args.seed, init=_init_for(phi),
+                                                       tick_bits=t or None, cell_bits=cb)
+                        sim.run(collisions=c)
+                        d = sim.diagnostics()
+                        row = {"n": n, "phi": phi, "boundary": b, "S": sim.units["S"], "tick_bits": sim.units["tick_bits"],
+                               "cell_bits": cb, "collisions": sim.collisions, "log_entries": d["log_entries"],
+                               "log_entries_per_collision": d["log_entries"] / max(sim.collisions, 1),
+                               "group_entries": d["group_log_entries"], "redraws": dict(d["redraws"]),
+                               "energy_drift": d["energy_drift"], "wall_s": time.time() - t0,
+                               "loadavg": list(os.getloadavg())}
+                        res["rows"].append(row)
+                        _write_atomic(path, res)
+                        print(json.dumps({k: row[k] for k in ("n", "phi", "boundary", "tick_bits", "cell_bits",
+                                                              "log_entries", "group_entries")}), flush=True)
+    print("wrote", path)
+    return res
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=["matrix", "equilibrium", "gas", "failures"])
+    ap.add_argument("what", choices=["matrix", "equilibrium", "gas", "failures", "probe"])
     ap.add_argument("--collisions", default="1e7")
     ap.add_argument("--n", type=int, nargs="+", default=None, help="matrix default 1000 10000; equilibrium 1000")
     ap.add_argument("--phi", type=float, nargs="+", default=None, help="matrix default 0.1 0.3 0.5 0.7; equilibrium 0.5")
@@ -561,7 +599,9 @@ def main(argv=None) -> int:
     ap.add_argument("--tick-bits", type=int, default=0,
                     help="matrix, gas: a typical particle moves 2^-T D per tick (0: automatic, the engine's default)")
     ap.add_argument("--cell-bits", type=int, default=16, help="matrix, gas: 2^B direction cells per turn in the pair operator")
-    ap.add_argument("--out", default="matrix", help="matrix: writes lattice_validation_<out>.json")
+    ap.add_argument("--ticks", type=int, nargs="+", default=[0], help="probe: tick_bits to try (0: automatic)")
+    ap.add_argument("--cells", type=int, nargs="+", default=[16], help="probe: cell_bits to try")
+    ap.add_argument("--out", default="matrix", help="matrix, probe, failures: writes lattice_validation_<out>.json")
     ap.add_argument("--seeds", type=int, default=4, help="equilibrium: independent gases")
     ap.add_argument("--relax", type=float, default=50.0, help="equilibrium: collisions per particle")
     ap.add_argument("--gap", type=float, default=4.0, help="equilibrium: collisions per particle between snapshots")
@@ -581,6 +621,8 @@ def main(argv=None) -> int:
         matrix(a)
     elif a.what == "failures":
         failures(a)
+    elif a.what == "probe":
+        probe(a)
     else:
         a.n, a.phi = a.n[0], a.phi[0]
         equilibrium(a)

@@ -274,6 +274,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "summary": scene.summary(), "particles": n, "dimension": 2, "box": run.box.tolist(),
         "periodic": run.periodic.tolist(),
         "units": {"S": units["S"], "sigma": units["sigma"], "tick": units["tick"],
+                  "tick_bits": units["tick_bits"], "cell_bits": units["cell_bits"],
                   "length_unit": units["length_unit"], "L": list(units["L"])},
         "quantization": sim.quantization,
         "collisions_forward": done, "collisions_back": run.back, "per_particle": 2.0 * done / n,

@@ -113,7 +113,7 @@ def _lattice_lines(r: dict) -> list[str]:
                f"({', '.join(f'{p:+.0f}' for p in r['momentum_drift_end']['lattice_units'])}) after reversal")
     lines = [
         f"  engine           lattice: sigma = 2^{u['S']} lattice units per diameter, a tick = {u['tick']:.3g} time "
-        "units (a typical particle moves 2^-20 sigma per tick)",
+        f"units (a typical particle moves 2^-{u['tick_bits']} sigma per tick), 2^{u['cell_bits']} direction cells",
         f"  start            quantized once: positions within {_err(q['max_position_error'], 'diameters')}, "
         f"velocities within {_err(q['max_velocity_error'], 'v_rms')}; exact from there on",
         f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:,.4g} per particle) to "
