@@ -1,0 +1,88 @@
+"""The peer benchmark's parts that need no peer (bench/peers/fs_edmd.py, issue 21): the source
+patches, the state file, the fluid check, and the clear message when the peer is absent."""
+import importlib.util
+import os
+
+import numpy as np
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SPEC = importlib.util.spec_from_file_location("fs_edmd", os.path.join(HERE, "..", "..", "bench", "peers", "fs_edmd.py"))
+fs = importlib.util.module_from_spec(SPEC)
+SPEC.loader.exec_module(fs)
+
+# the lines of the peer's mdSingle.c (commit 2d0c862) that the benchmark patches, in context
+PEER_LIKE = """#include <stdio.h>
+#include <string.h>
+double maxtime = 100;
+double writeinterval = 1;
+const int usethermostat = 1;
+int main()
+{
+    init();
+    while (simtime <= maxtime)
+    {
+      step();
+    }
+    simtime = maxtime;
+}
+"""
+
+
+def test_patch_source_turns_off_the_thermostat_and_times_a_fixed_number_of_collisions():
+    out = fs.patch_source(PEER_LIKE, 2000, 50000)
+    assert "const int usethermostat = 0;" in out and "usethermostat = 1" not in out
+    assert "double writeinterval = 1e30;" in out and "double maxtime = 1e30;" in out
+    assert "#include <time.h>" in out and "clock_gettime(CLOCK_MONOTONIC" in out
+    assert "long long warm = 2000, timed = 50000;" in out and "REVCOL_PEER" in out
+    assert "while (simtime <= maxtime)" not in out
+
+
+def test_patch_source_names_a_patch_that_does_not_match_this_peer():
+    with pytest.raises(ValueError, match="usethermostat"):
+        fs.patch_source(PEER_LIKE.replace("const int usethermostat = 1;", ""), 1, 1)
+    with pytest.raises(ValueError, match="found 2"):
+        fs.patch_source(PEER_LIKE + "double maxtime = 100;\n", 1, 1)
+
+
+def test_sph_file_round_trip(tmp_path):
+    rng = np.random.default_rng(3)
+    box = np.array([7.5, 7.5, 7.5])
+    x = rng.uniform(0, 7.5, size=(40, 3))
+    path = str(tmp_path / "init.sph")
+    fs.write_sph(path, x, box)
+    y, b = fs.read_sph(path)
+    assert np.array_equal(y, x) and np.array_equal(b, box)  # 17 significant digits: exact
+    with open(path) as fh:
+        lines = fh.read().splitlines()
+    assert lines[0] == "40" and lines[2].startswith("a ") and lines[2].endswith(" 0.5")
+    assert not os.path.exists(path + ".part")
+
+
+def test_structure_factor_tells_a_crystal_from_a_fluid():
+    m, a = 4, 1.6  # 4 m^3 = 256 FCC sites, lattice constant a
+    cell = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]])
+    x = np.array([(np.array([i, j, k]) + c) * a for i in range(m) for j in range(m) for k in range(m) for c in cell])
+    box = np.full(3, m * a)
+    k = fs.fcc_bragg_vectors(len(x), box)
+    assert np.allclose(fs.structure_factor(x, k), len(x))  # every Bragg peak: S = N
+    gas = np.random.default_rng(5).uniform(0, m * a, size=x.shape)
+    assert fs.structure_factor(gas, k).max() < 10.0  # no order: S ~ 1 (exponential, mean 1)
+    with pytest.raises(ValueError, match="4 m\\^3"):
+        fs.fcc_bragg_vectors(1000, box)
+
+
+def test_wrapped_folds_into_the_box():
+    box = np.array([2.0, 3.0, 4.0])
+    x = np.array([[-1e-17, 3.0, 9.0], [2.5, -0.5, 3.999]])
+    y = fs.wrapped(x, box)
+    assert np.all(y >= 0) and np.all(y < box)
+    assert np.allclose(y[1], [0.5, 2.5, 3.999])
+
+
+def test_missing_peer_says_where_its_source_goes_and_measures_nothing(tmp_path, capsys):
+    out = tmp_path / "peer.json"
+    assert fs.main(["--src", str(tmp_path / "nowhere"), "--json", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "git clone https://github.com/FSmallenburg/EDMD" in said and "2d0c862" in said
+    assert not out.exists()
