@@ -39,7 +39,7 @@ LatticeStart quantize_start(const LatticeConfig& c, const std::vector<double>& x
   for (double a : v) s2 += a * a;
   const double v_rms = std::sqrt(s2 / static_cast<double>(x.size() / 2));
   LatticeStart s;
-  s.units = choose_units(c.box, c.diameter, v_rms, c.wall, c.tick_bits, c.cell_bits);
+  s.units = choose_units(c.box, c.diameter, v_rms, c.wall, c.tick_bits, c.cell_bits, x.size() / 2);
   Quantized q = quantize(s.units, x, v);
   s.x = std::move(q.x);
   s.v = std::move(q.v);

@@ -89,7 +89,7 @@ void validate(const Units& u) {
 }
 
 Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
-                   int tick_bits, int cell_bits) {
+                   int tick_bits, int cell_bits, std::size_t n) {
   require(tick_bits == auto_tick_bits || (tick_bits >= min_tick_bits && tick_bits <= max_tick_bits),
           "lattice: tick_bits must be in [16, 26] (a typical particle moves 2^-tick_bits diameters per tick), or 0 (automatic)");
   require(cell_bits >= min_units_cell_bits && cell_bits <= max_units_cell_bits,
@@ -107,7 +107,13 @@ Units choose_units(const std::array<double, 2>& box, double D, double v_rms, con
     return "lattice: a box of " + std::to_string(longest) +
            " diameters is too long for the lattice (at most 2^21 diameters per axis)";
   });
-  if (tick_bits == auto_tick_bits) tick_bits = std::clamp(S - velocity_bits, 16, 24);
+  if (tick_bits == auto_tick_bits) {
+    tick_bits = std::clamp(S - velocity_bits, 16, 24);
+    // sqrt(n) v_rms <= vmax / 2 = 2^(S-9): T >= 9 + log2(n) / 2 (a huge gas in a huge box)
+    int t_n = 9;
+    while (n > 0 && static_cast<double>(n) > std::ldexp(1.0, 2 * (t_n - 9))) ++t_n;
+    tick_bits = std::min(std::max(tick_bits, t_n), max_tick_bits);
+  }
   Units u;
   u.S = S;
   u.sigma = std::int64_t{1} << S;

@@ -2,6 +2,7 @@
 // geometry.hpp, units.hpp): exact predicates, walls, forward and back bit for bit, midpoint
 // reversal against a snapshot, snapshot resume, bad input, and the event sequence against the
 // prototype (tests/data/lattice/engine_*.txt from tests/reference/lattice_engine_vectors.py).
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -220,6 +221,12 @@ TEST_CASE("units: the automatic tick keeps 30 bits of velocity, T = clamp(S - 30
     CHECK(u.tick_bits == std::clamp(u.S - velocity_bits, 16, 24));
     CHECK(u.tick == std::ldexp(1.0, -t));
   }
+  // a huge gas in a huge box: the tick keeps sqrt(N) v_rms <= vmax / 2 (T >= 9 + log2(N) / 2)
+  const Units big = choose_units({5000.0, 5000.0}, 1.0, 1.0, {false, false}, auto_tick_bits, 16, 10000000);
+  CHECK(big.S == 48);
+  CHECK(big.tick_bits == 21);  // S - 30 = 18 would allow only N <= 2^20
+  CHECK(std::sqrt(1e7) * std::ldexp(1.0, big.S - big.tick_bits) <= static_cast<double>(big.vmax) / 2);
+  CHECK(choose_units({5000.0, 5000.0}, 1.0, 1.0, {false, false}, auto_tick_bits, 16, 1000).tick_bits == 18);
 }
 
 TEST_CASE("units: cell_bits is kept in the units, range-checked, and the engine's operator must match it") {

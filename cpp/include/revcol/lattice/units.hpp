@@ -11,7 +11,8 @@
 // within one tick, and so redraws and group collisions, rarer at the cost of fewer bits of
 // velocity resolution (2^(S-T) units for v_rms), which makes the pair operator's read-back
 // redraws (~ cells / |w|) and the energy random walk (~2^-(S-T) per collision) larger. The
-// automatic tick (the default) balances the two: T = clamp(S - 30, 16, 24), so v_rms is 2^30
+// automatic tick (the default) balances the two: T = clamp(S - 30, 16, 24) (and at least
+// 9 + ceil(log2(N) / 2), so that sqrt(N) v_rms <= vmax / 2 for a huge gas), so v_rms is 2^30
 // units per tick wherever the box allows (docs/lattice.md "Choosing the tick and the cells", measured). The
 // prototype's T = 20 is what units written before the automatic choice carry. N is bounded by
 // 2^(2 (T - 8)) (vmax below). Speeds are bounded by vmax = 2^(S-8) units per
@@ -22,6 +23,7 @@
 // tick_limit = 2^61 (about 2^41 mean free times of a typical particle); a run that would pass it
 // stops with an error, nothing changed past the last event.
 #pragma once
+#include <cstddef>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -64,10 +66,12 @@ inline constexpr int default_cell_bits = 16, min_units_cell_bits = 12, max_units
 /// Checks a Units value (box lengths, sigma, vmax); throws InvalidArgument naming the problem.
 void validate(const Units& u);
 
-/// Units for a float box of lengths box (per axis) and diameter D holding particles whose
-/// root-mean-square speed is v_rms; throws InvalidArgument if the lattice cannot hold it.
+/// Units for a float box of lengths box (per axis) and diameter D holding n particles (0: not
+/// known) whose root-mean-square speed is v_rms; throws InvalidArgument if the lattice cannot
+/// hold it. The automatic tick is also at least 9 + ceil(log2(n) / 2), so that the total
+/// kinetic energy fits vmax with a bit to spare (sqrt(n) v_rms <= vmax / 2).
 Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
-                   int tick_bits = default_tick_bits, int cell_bits = default_cell_bits);
+                   int tick_bits = default_tick_bits, int cell_bits = default_cell_bits, std::size_t n = 0);
 
 /// A float state quantized to the lattice: integer positions and velocities, and the errors.
 struct Quantized {
