@@ -453,7 +453,7 @@ class EngineImpl final : public Simulation {
   bool collide(int a, int b, double t, bool reversed);
   PairV<Dim> apply_pair(const PairV<Dim>& in, const Vec& r, int stream, bool reversed);
   bool group_collide(Group& g, double t, bool reversed);
-  bool group_operator(Group& g, const int* order, double t, bool reversed);
+  bool group_operator(Group& g, const int* order, double t, bool reversed, const Reflection* w1);
   Reflection touch_walls(int i);
   void flip_mask(int i, Reflection mask);
   void set_velocity(int i, const Vec& v, Reflection mask);

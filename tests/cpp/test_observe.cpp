@@ -119,6 +119,31 @@ TEST_CASE("a 1D cradle: a group's virial sums x . dp over its members") {
   CHECK_NEAR(o.compressibility.value, 1.0 + w / k2, 1e-9);
 }
 
+TEST_CASE("a refused group's wall reflections are not observed: impulses are those that happened") {
+  // A rigid train (particles 1..4, touching, speed -2) catches particle 0 (speed -1) at t = 1,
+  // when 0 is 2^-34 short of the left wall (within group_tol): the contacts make a chain of
+  // five, four contacts, which ExactCollision refuses (at most 3). The group reflected 0 off
+  // the wall (W1) and undid it; the pair that follows does it for real. Until nothing has
+  // reached the right wall, every impulse is on the left wall and positive, so their sum is
+  // the momentum gained: sum |dp| = P(t) - P(0) (a counted-twice W1 adds 2 |dv| = 4).
+  const double e = std::ldexp(1.0, -34);
+  Config c = walled(1, 10.0, Mode::exact);
+  c.force_group_search = true;
+  auto s = make_simulation(c, {1.5 + e, 3.5 + e, 4.5 + e, 5.5 + e, 6.5 + e}, {-1.0, -2.0, -2.0, -2.0, -2.0});
+  const double p0 = s->diagnostics().momentum[0];
+  s->observe(ObserveConfig{});
+  s->run(kAll, 1.25);
+  const Observation o = s->observer()->results();
+  const Diagnostics d = s->diagnostics();
+  REQUIRE(d.counters.group_fallbacks >= 1);
+  for (double x : s->positions()) REQUIRE(x < 9.0);  // nothing near the right wall yet
+  const double tau = o.t_end - o.t_start;
+  const double impulse = o.pressure_wall[0].value * 2.0 * tau;  // P_wall = sum |dp| / (2 tau A), A = 1
+  CHECK(d.momentum[0] - p0 > 0.0);
+  CHECK_NEAR(impulse, d.momentum[0] - p0, 1e-12);
+  // (the refused W1 and its undoing add opposite virials x dv, so only the impulse shows it)
+}
+
 TEST_CASE("a closed 2D gas: K2 + W + W_wall -> 0; temperature from the energy; walls share the pressure") {
   Config c = walled(2, 1.0, Mode::exact);
   const InitialState st = random_state(c, 200, 0.3, 5);
