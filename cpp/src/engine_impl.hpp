@@ -163,6 +163,14 @@ class EngineImpl final : public Simulation {
     build_lists();
     if (old_format) rebuild_events();
     else build_queue();
+    require(!s.observer.empty() || s.observer_counts.empty(), "snapshot: observer_counts without observer");
+    if (!s.observer.empty()) {  // a running observation resumes (revcol/engine/observe.hpp)
+      std::array<bool, 3> walls{};
+      for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
+      observer_ = std::make_unique<Observer>(s.observer, s.observer_counts, Dim, s.v, clock_, cfg_.box, walls,
+                                             cfg_.diameter);
+      obs_ = observer_.get();
+    }
   }
 
   // ---- the Simulation interface -------------------------------------------------------

@@ -61,13 +61,10 @@ void Observer::Block::add(const Block& b) {
   sum(pair, b.pair);
 }
 
-Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v,
-                   double t, const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter)
-    : cfg_(c), dim_(dim), n_(0), box_(box), walls_(walls), diameter_(diameter) {
-  require(dim >= 1 && dim <= 3, "observe: dim must be 1, 2 or 3");
-  require(!x.empty() && x.size() % static_cast<std::size_t>(dim) == 0 && v.size() == x.size(),
-          "observe: positions and velocities must be n x dim");
-  n_ = x.size() / static_cast<std::size_t>(dim);
+namespace {
+
+// The config's checks (the constructor's and a snapshot's): n particles in dim dimensions.
+void check_config(const ObserveConfig& c, int dim, std::size_t n, const std::array<bool, 3>& walls) {
   require(std::isfinite(c.block_time) && c.block_time >= 0.0,
           [&] { return "observe: block_time must be finite and >= 0, got " + num(c.block_time); });
   require(c.min_blocks >= 2 && c.min_blocks <= 64,
@@ -85,9 +82,21 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   if (c.pair_bins > 0) {
     require(std::isfinite(c.pair_rmax) && c.pair_rmax > 0.0,
             [&] { return "observe: pair_rmax must be finite and > 0 with pair_bins, got " + num(c.pair_rmax); });
-    require(n_ <= kMaxPairParticles && n_ >= 2, "observe: pair distances need 2 to 64 particles");
+    require(n <= kMaxPairParticles && n >= 2, "observe: pair distances need 2 to 64 particles");
     for (int k = 0; k < dim; ++k) require(walls[k], "observe: pair distances need walls on every axis");
   }
+}
+
+}  // namespace
+
+Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v,
+                   double t, const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter)
+    : cfg_(c), dim_(dim), n_(0), box_(box), walls_(walls), diameter_(diameter) {
+  require(dim >= 1 && dim <= 3, "observe: dim must be 1, 2 or 3");
+  require(!x.empty() && x.size() % static_cast<std::size_t>(dim) == 0 && v.size() == x.size(),
+          "observe: positions and velocities must be n x dim");
+  n_ = x.size() / static_cast<std::size_t>(dim);
+  check_config(c, dim, n_, walls);
   double vv = 0.0;
   for (double q : v) vv += q * q;
   const double vrms = std::sqrt(vv / static_cast<double>(n_));
@@ -95,12 +104,7 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   block_time_ = c.block_time > 0.0 ? c.block_time : diameter / vrms;
   speed_max_ = c.speed_max > 0.0 ? c.speed_max : 5.0 * vrms;
   bin_scale_ = c.speed_bins / speed_max_;
-  volume_ = 1.0;
-  for (int k = 0; k < 3; ++k) {
-    if (k >= dim) box_[k] = 1.0;
-    inv_box_[k] = 1.0 / box_[k];
-    if (k < dim) volume_ *= box[k];
-  }
+  set_geometry(box);
   t_start_ = t_now_ = t;
   seg_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i) {
@@ -113,6 +117,15 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   start_ = x;
   if (c.pair_bins > 0) pair_t_.assign(n_ * n_, t);
   cur_ = empty_block(t);
+}
+
+void Observer::set_geometry(const std::array<double, 3>& box) {
+  volume_ = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    if (k >= dim_) box_[k] = 1.0;
+    inv_box_[k] = 1.0 / box_[k];
+    if (k < dim_) volume_ *= box[k];
+  }
 }
 
 Observer::Block Observer::empty_block(double t0) const {
@@ -139,6 +152,125 @@ Observer::Block Observer::empty_block(double t0) const {
     const double b = s.speed * bin_scale_;
     if (b < cfg_.speed_bins) s.bin = static_cast<int>(b);
   }
+}
+
+// ---- snapshots ------------------------------------------------------------------------
+// reals: a header of kHeader values (dim, n, the config's eight fields in declaration
+// order, block_time_, t_start_, t_now_, speed_max_, complete blocks, MSD points); per
+// particle its segment (x, v: dim each; t0); start_ (n x dim); pair_t_ (n x n, with pair
+// bins); each complete block then the open one (t0, t1, k2, w, w_wall, dist, wall_dp[3],
+// slab_t, slab_k2, speed, pair); msd_t_, msd_. counts: per block (the same order) pairs,
+// groups, parts, walls. Integers among the reals are exact (all far below 2^53).
+
+namespace {
+constexpr std::size_t kHeader = 16, kBlockReals = 9, kBlockCounts = 4;
+}  // namespace
+
+void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const {
+  const ObserveConfig& c = cfg_;
+  reals = {static_cast<double>(dim_), static_cast<double>(n_), c.block_time, static_cast<double>(c.min_blocks),
+           static_cast<double>(c.slab_axis), static_cast<double>(c.slabs), static_cast<double>(c.speed_bins),
+           c.speed_max, static_cast<double>(c.pair_bins), c.pair_rmax, block_time_, t_start_, t_now_, speed_max_,
+           static_cast<double>(blocks_.size()), static_cast<double>(msd_.size())};
+  for (const Segment& s : seg_) {
+    reals.insert(reals.end(), s.x, s.x + dim_);
+    reals.insert(reals.end(), s.v, s.v + dim_);
+    reals.push_back(s.t0);
+  }
+  reals.insert(reals.end(), start_.begin(), start_.end());
+  reals.insert(reals.end(), pair_t_.begin(), pair_t_.end());
+  counts.clear();
+  auto block = [&](const Block& b) {
+    for (double q : {b.t0, b.t1, b.k2, b.w, b.w_wall, b.dist, b.wall_dp[0], b.wall_dp[1], b.wall_dp[2]}) reals.push_back(q);
+    for (const auto* a : {&b.slab_t, &b.slab_k2, &b.speed, &b.pair}) reals.insert(reals.end(), a->begin(), a->end());
+    for (std::uint64_t q : {b.pairs, b.groups, b.parts, b.walls}) counts.push_back(q);
+  };
+  for (const Block& b : blocks_) block(b);
+  block(cur_);
+  reals.insert(reals.end(), msd_t_.begin(), msd_t_.end());
+  reals.insert(reals.end(), msd_.begin(), msd_.end());
+}
+
+Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint64_t>& counts, int dim,
+                   const std::vector<double>& v, double t, const std::array<double, 3>& box,
+                   const std::array<bool, 3>& walls, double diameter)
+    : dim_(dim), n_(0), box_(box), walls_(walls), diameter_(diameter) {
+  require(dim >= 1 && dim <= 3 && !v.empty() && v.size() % static_cast<std::size_t>(dim) == 0,
+          "snapshot: observer: the particles' velocities must be n x dim");
+  n_ = v.size() / static_cast<std::size_t>(dim);
+  require(reals.size() >= kHeader, "snapshot: observer holds fewer values than its header");
+  for (double q : reals) require(std::isfinite(q), "snapshot: observer values must be finite");
+  auto whole = [&](std::size_t k, double lo, double hi, const char* name) {
+    const double q = reals[k];
+    require(q >= lo && q <= hi && q == std::floor(q),
+            [&] { return std::string("snapshot: observer ") + name + " must be a whole number in range, got " + num(q); });
+    return static_cast<std::int64_t>(q);
+  };
+  require(whole(0, 1, 3, "dim") == dim && whole(1, 1, 1e15, "n") == static_cast<std::int64_t>(n_),
+          "snapshot: observer was taken of another number of particles or dimensions");
+  cfg_.block_time = reals[2];
+  cfg_.min_blocks = static_cast<int>(whole(3, 2, 64, "min_blocks"));
+  cfg_.slab_axis = static_cast<int>(whole(4, 0, 2, "slab_axis"));
+  cfg_.slabs = static_cast<int>(whole(5, 0, kMaxBins, "slabs"));
+  cfg_.speed_bins = static_cast<int>(whole(6, 0, kMaxBins, "speed_bins"));
+  cfg_.speed_max = reals[7];
+  cfg_.pair_bins = static_cast<int>(whole(8, 0, kMaxBins, "pair_bins"));
+  cfg_.pair_rmax = reals[9];
+  check_config(cfg_, dim, n_, walls);
+  block_time_ = reals[10];
+  t_start_ = reals[11];
+  t_now_ = reals[12];
+  speed_max_ = reals[13];
+  require(block_time_ > 0.0 && speed_max_ > 0.0, "snapshot: observer block time and speed_max must be > 0");
+  require(t_start_ <= t_now_ && t_now_ <= t, "snapshot: observer times must be ordered: start <= last update <= clock");
+  const auto nb = static_cast<std::size_t>(whole(14, 0, kMaxBlocks - 1, "block count"));
+  const auto nm = static_cast<std::size_t>(whole(15, 0, 1e12, "MSD count"));
+  const std::size_t d = static_cast<std::size_t>(dim), np = cfg_.pair_bins > 0 ? n_ * n_ : 0;
+  const std::size_t per_block = kBlockReals + 2 * cfg_.slabs + cfg_.speed_bins + cfg_.pair_bins;
+  require(reals.size() == kHeader + n_ * (3 * d + 1) + np + (nb + 1) * per_block + 2 * nm,
+          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points)");
+  require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
+  bin_scale_ = cfg_.speed_bins / speed_max_;
+  set_geometry(box);
+  std::size_t u = kHeader;
+  seg_.resize(n_);
+  for (std::size_t i = 0; i < n_; ++i) {
+    Segment& s = seg_[i];
+    for (int k = 0; k < 3; ++k) s.x[k] = s.v[k] = 0.0;
+    for (std::size_t k = 0; k < d; ++k) s.x[k] = reals[u++];
+    for (std::size_t k = 0; k < d; ++k)
+      require(reals[u++] == v[i * d + k], "snapshot: observer: a segment's velocity is not its particle's");
+    s.t0 = reals[u++];
+    require(s.t0 >= t_start_ && s.t0 <= t, "snapshot: observer: a segment starts outside the observed time");
+    set_velocity(static_cast<int>(i), &v[i * d]);
+  }
+  auto take = [&](std::vector<double>& out, std::size_t m) {
+    out.assign(reals.begin() + static_cast<std::ptrdiff_t>(u), reals.begin() + static_cast<std::ptrdiff_t>(u + m));
+    u += m;
+  };
+  take(start_, n_ * d);
+  take(pair_t_, np);
+  auto block = [&](std::size_t b) {
+    Block k = empty_block(reals[u]);
+    k.t1 = reals[u + 1];
+    k.k2 = reals[u + 2];
+    k.w = reals[u + 3];
+    k.w_wall = reals[u + 4];
+    k.dist = reals[u + 5];
+    for (int a = 0; a < 3; ++a) k.wall_dp[a] = reals[u + 6 + a];
+    require(k.t0 >= t_start_ && k.t1 >= k.t0 && k.t1 <= t, "snapshot: observer: a block outside the observed time");
+    u += kBlockReals;
+    for (auto* a : {&k.slab_t, &k.slab_k2, &k.speed, &k.pair}) take(*a, a->size());
+    k.pairs = counts[b * kBlockCounts];
+    k.groups = counts[b * kBlockCounts + 1];
+    k.parts = counts[b * kBlockCounts + 2];
+    k.walls = counts[b * kBlockCounts + 3];
+    return k;
+  };
+  for (std::size_t b = 0; b < nb; ++b) blocks_.push_back(block(b));
+  cur_ = block(nb);
+  take(msd_t_, nm);
+  take(msd_, nm);
 }
 
 // Closes i's segment at t: its duration weights v^2, the speed, its speed bin and its slabs.

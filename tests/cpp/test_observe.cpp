@@ -31,6 +31,33 @@ Config walled(int d, double L, Mode mode = Mode::specular) {
   return c;
 }
 
+bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+bool same(const Estimate& a, const Estimate& b) { return same(a.value, b.value) && same(a.error, b.error); }
+bool same(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (!same(a[k], b[k])) return false;
+  return true;
+}
+bool same(const Profile& a, const Profile& b) { return same(a.edges, b.edges) && same(a.value, b.value) && same(a.error, b.error); }
+
+// Every result of two observations, bit for bit.
+bool same(const Observation& a, const Observation& b) {
+  bool ok = a.dim == b.dim && a.n == b.n && same(a.t_start, b.t_start) && same(a.t_end, b.t_end) &&
+            a.blocks == b.blocks && same(a.block_time, b.block_time) && a.pair_collisions == b.pair_collisions &&
+            a.group_collisions == b.group_collisions && a.particle_collisions == b.particle_collisions &&
+            a.wall_reflections == b.wall_reflections;
+  for (const auto m : {&Observation::temperature, &Observation::pressure_virial, &Observation::compressibility,
+                       &Observation::collision_rate, &Observation::mean_free_time, &Observation::mean_free_path,
+                       &Observation::virial_balance})
+    ok = ok && same(a.*m, b.*m);
+  for (int k = 0; k < 3; ++k) ok = ok && same(a.pressure_wall[k], b.pressure_wall[k]);
+  for (const auto m : {&Observation::slab_density, &Observation::slab_temperature, &Observation::speed,
+                       &Observation::pair_distance})
+    ok = ok && same(a.*m, b.*m);
+  return ok && same(a.msd_time, b.msd_time) && same(a.msd, b.msd);
+}
+
 }  // namespace
 
 TEST_CASE("1D head-on pair: virial, Z, collision rate and pair distances by hand") {
@@ -190,6 +217,77 @@ TEST_CASE("observing changes no trajectory; run_back ends the observation; nothi
   CHECK(after.t_end == before.t_end);
   CHECK(after.particle_collisions == before.particle_collisions);
   CHECK(after.pressure_virial.value == before.pressure_virial.value);
+}
+
+TEST_CASE("snapshots keep a running observation: a resumed run's results equal an uninterrupted one's, bit for bit") {
+  auto check = [](const Config& c0, std::size_t n, double phi, const ObserveConfig& oc, std::uint64_t first,
+                  std::uint64_t second) {
+    const InitialState st = random_state(c0, n, phi, 4);
+    auto a = make_simulation(st.config, st.x, st.v);
+    a->run(first, kInfinity);
+    a->observe(oc);
+    a->run(first, kInfinity);
+    const Snapshot snap = a->snapshot();
+    REQUIRE(!snap.observer.empty());
+    a->run(second, kInfinity);
+    const Observation ra = a->observer()->results();
+    auto b = restore_simulation(snap);
+    REQUIRE(b->observing());
+    b->run(second, kInfinity);
+    const Observation rb = b->observer()->results();
+    CHECK(ra.particle_collisions > 0);
+    CHECK(same(ra, rb));
+    CHECK(a->positions() == b->positions());
+    return ra;
+  };
+  ObserveConfig full;
+  full.slabs = 6;
+  full.speed_bins = 30;
+  full.block_time = 0.002;  // past 256 blocks: the merges go on across the snapshot
+  const Observation o = check(walled(2, 1.0, Mode::exact), 150, 0.35, full, 3000, 5000);
+  CHECK(o.blocks >= 16);
+  Config per;
+  per.dim = 3;
+  check(per, 200, 0.3, ObserveConfig{}, 2000, 2000);
+  ObserveConfig pairs;
+  pairs.pair_bins = 40;
+  pairs.pair_rmax = 2.0;
+  check(walled(2, 2.5, Mode::exact), 3, 0.2, pairs, 500, 700);
+}
+
+TEST_CASE("snapshot observer data: none (old snapshots) resumes nothing; bad data is a named error") {
+  Config c = walled(2, 1.0, Mode::exact);
+  const InitialState st = random_state(c, 60, 0.3, 3);
+  auto s = make_simulation(st.config, st.x, st.v);
+  ObserveConfig oc;
+  oc.slabs = 3;
+  s->observe(oc);
+  s->run(1000, kInfinity);
+  const Snapshot good = s->snapshot();
+  Snapshot old = good;
+  old.observer.clear();
+  old.observer_counts.clear();
+  auto r = restore_simulation(old);
+  CHECK(r->observer() == nullptr);
+  CHECK(!r->observing());
+  s->stop_observing();
+  CHECK(s->snapshot().observer.empty());  // a stopped observation is not kept
+  auto bad = [&](auto spoil) {
+    Snapshot b = good;
+    spoil(b);
+    CHECK_THROWS_AS(restore_simulation(b), InvalidArgument);
+  };
+  bad([](Snapshot& b) { b.observer.pop_back(); });
+  bad([](Snapshot& b) { b.observer.push_back(0.0); });
+  bad([](Snapshot& b) { b.observer_counts.pop_back(); });
+  bad([](Snapshot& b) { b.observer.clear(); });  // counts without the observer
+  bad([](Snapshot& b) { b.observer.back() = std::nan(""); });
+  bad([](Snapshot& b) { b.observer[1] = 61.0; });    // another n
+  bad([](Snapshot& b) { b.observer[3] = 1.0; });     // min_blocks < 2
+  bad([](Snapshot& b) { b.observer[5] = 2.5; });     // slabs not whole
+  bad([](Snapshot& b) { b.observer[12] = 1e9; });    // last update after the clock
+  bad([](Snapshot& b) { b.observer[16 + 2] += 1.0; });  // particle 0's velocity is not the particle's
+  bad([](Snapshot& b) { b.observer[14] = 300.0; });  // more blocks than are ever kept
 }
 
 TEST_CASE("validation: a bad config throws InvalidArgument and keeps the running observation") {

@@ -54,7 +54,15 @@
 //
 // Reversal: observation is forward only. run_back first syncs the observer at the clock
 // and stops it (its results stay readable, nothing more is added); a forward run after it
-// adds nothing until observe() starts a new observation. Snapshots do not keep it.
+// adds nothing until observe() starts a new observation.
+//
+// Snapshots keep a running observation: its whole state (config, segments, start
+// positions, blocks, MSD) as reals and counts (save; the layout is in observe.cpp), from
+// which a restored simulation resumes it, so that its results are those of a run never
+// interrupted, bit for bit (the quantities a segment derives from its velocity, v^2, the
+// speed and its bin, are recomputed by the same operations). A stopped observation is not
+// kept. Loading checks every size, that every real is finite, the times are ordered and
+// the segments' velocities are the particles' (InvalidArgument naming the first problem).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -117,6 +125,13 @@ class Observer {
   /// which axes have walls, the diameter. Throws InvalidArgument on a bad config.
   Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v, double t,
            const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter);
+  /// Resumes a saved observation (save) of the particles with velocities v (n x dim) at the
+  /// clock t, in this box; throws InvalidArgument naming what is inconsistent.
+  Observer(const std::vector<double>& reals, const std::vector<std::uint64_t>& counts, int dim,
+           const std::vector<double>& v, double t, const std::array<double, 3>& box,
+           const std::array<bool, 3>& walls, double diameter);
+  /// The whole state, for a snapshot: reals (times, sums, positions) and counts.
+  void save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const;
 
   /// A pair collision at t: the velocities after (va, vb). The separation r = x_a - x_b comes
   /// from the observer's own positions, folded to the nearest image on periodic axes (at
@@ -153,6 +168,7 @@ class Observer {
   void slab_walk(const Segment& s, double dt);
   void end_block();
   Block empty_block(double t0) const;
+  void set_geometry(const std::array<double, 3>& box);
   double pos(int i, int k, double t) const { return seg_[i].x[k] + seg_[i].v[k] * (t - seg_[i].t0); }
 
   ObserveConfig cfg_;
