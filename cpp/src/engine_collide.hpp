@@ -313,7 +313,7 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
   const int n = g.n;
   const int first = g.id[order[0]];
   const std::int64_t wkey = reversed ? netc_[first] - 1 : netc_[first];
-  Reflection w1[kMaxGroup], w2[kMaxGroup];
+  Reflection w1[kMaxGroup] = {}, w2[kMaxGroup] = {};
   for (int u = 0; u < n; ++u) advance(g.id[order[u]], t);
   // W1 reaches the observer only once the operator accepts the group (group_operator tells
   // it then): a refused group undoes W1, and the pair that follows reflects for real

@@ -105,6 +105,7 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   speed_max_ = c.speed_max > 0.0 ? c.speed_max : 5.0 * vrms;
   bin_scale_ = c.speed_bins / speed_max_;
   set_geometry(box);
+  slab_w_ = c.slabs > 0 ? box_[c.slab_axis] / c.slabs : 0.0;
   t_start_ = t_now_ = t;
   seg_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i) {
@@ -112,6 +113,8 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
     for (int k = 0; k < 3; ++k) s.x[k] = s.v[k] = 0.0;
     for (int k = 0; k < dim; ++k) s.x[k] = x[i * dim + k];
     s.t0 = t;
+    s.v2 = s.speed = 0.0;
+    if (c.slabs > 0) set_cell(s, std::floor(s.x[c.slab_axis] / slab_w_));
     set_velocity(static_cast<int>(i), &v[i * dim]);
   }
   start_ = x;
@@ -145,25 +148,30 @@ Observer::Block Observer::empty_block(double t0) const {
     s.v[k] = v[k];
     v2 += v[k] * v[k];
   }
+  const double speed = std::sqrt(v2);
+  v2_sum_ += v2 - s.v2;  // sum_i v_i^2 and sum_i |v_i| (their time integrals: accumulate)
+  speed_sum_ += speed - s.speed;
   s.v2 = v2;
-  s.speed = std::sqrt(v2);
+  s.speed = speed;
   s.bin = -1;
   if (cfg_.speed_bins > 0) {
     const double b = s.speed * bin_scale_;
     if (b < cfg_.speed_bins) s.bin = static_cast<int>(b);
   }
+
 }
 
 // ---- snapshots ------------------------------------------------------------------------
 // reals: a header of kHeader values (dim, n, the config's eight fields in declaration
-// order, block_time_, t_start_, t_now_, speed_max_, complete blocks, MSD points); per
+// order, block_time_, t_start_, t_now_, speed_max_, complete blocks, MSD points, the
+// running sums of v^2 and |v|); per
 // particle its segment (x, v: dim each; t0); start_ (n x dim); pair_t_ (n x n, with pair
 // bins); each complete block then the open one (t0, t1, k2, w, w_wall, dist, wall_dp[3],
 // slab_t, slab_k2, speed, pair); msd_t_, msd_. counts: per block (the same order) pairs,
 // groups, parts, walls. Integers among the reals are exact (all far below 2^53).
 
 namespace {
-constexpr std::size_t kHeader = 16, kBlockReals = 9, kBlockCounts = 4;
+constexpr std::size_t kHeader = 18, kBlockReals = 9, kBlockCounts = 4;
 }  // namespace
 
 void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const {
@@ -171,11 +179,12 @@ void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& coun
   reals = {static_cast<double>(dim_), static_cast<double>(n_), c.block_time, static_cast<double>(c.min_blocks),
            static_cast<double>(c.slab_axis), static_cast<double>(c.slabs), static_cast<double>(c.speed_bins),
            c.speed_max, static_cast<double>(c.pair_bins), c.pair_rmax, block_time_, t_start_, t_now_, speed_max_,
-           static_cast<double>(blocks_.size()), static_cast<double>(msd_.size())};
+           static_cast<double>(blocks_.size()), static_cast<double>(msd_.size()), v2_sum_, speed_sum_};
   for (const Segment& s : seg_) {
     reals.insert(reals.end(), s.x, s.x + dim_);
     reals.insert(reals.end(), s.v, s.v + dim_);
     reals.push_back(s.t0);
+    if (cfg_.slabs > 0) reals.push_back(std::round(s.lo / slab_w_));  // its cell
   }
   reals.insert(reals.end(), start_.begin(), start_.end());
   reals.insert(reals.end(), pair_t_.begin(), pair_t_.end());
@@ -227,21 +236,31 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   const auto nm = static_cast<std::size_t>(whole(15, 0, 1e12, "MSD count"));
   const std::size_t d = static_cast<std::size_t>(dim), np = cfg_.pair_bins > 0 ? n_ * n_ : 0;
   const std::size_t per_block = kBlockReals + 2 * cfg_.slabs + cfg_.speed_bins + cfg_.pair_bins;
-  require(reals.size() == kHeader + n_ * (3 * d + 1) + np + (nb + 1) * per_block + 2 * nm,
+  const std::size_t per_particle = 3 * d + 1 + (cfg_.slabs > 0 ? 1 : 0);
+  require(reals.size() == kHeader + n_ * per_particle + np + (nb + 1) * per_block + 2 * nm,
           "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points)");
   require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
   bin_scale_ = cfg_.speed_bins / speed_max_;
   set_geometry(box);
+  slab_w_ = cfg_.slabs > 0 ? box_[cfg_.slab_axis] / cfg_.slabs : 0.0;
   std::size_t u = kHeader;
   seg_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i) {
     Segment& s = seg_[i];
     for (int k = 0; k < 3; ++k) s.x[k] = s.v[k] = 0.0;
+    s.v2 = s.speed = 0.0;
     for (std::size_t k = 0; k < d; ++k) s.x[k] = reals[u++];
     for (std::size_t k = 0; k < d; ++k)
       require(reals[u++] == v[i * d + k], "snapshot: observer: a segment's velocity is not its particle's");
     s.t0 = reals[u++];
     require(s.t0 >= t_start_ && s.t0 <= t, "snapshot: observer: a segment starts outside the observed time");
+    if (cfg_.slabs > 0) {
+      const double cell = reals[u++];
+      require(cell == std::floor(cell) && std::fabs(cell) < 1e15 &&
+                  (!walls_[cfg_.slab_axis] || (cell >= 0.0 && cell < cfg_.slabs)),
+              "snapshot: observer: a segment's slab cell must be a whole number (in [0, slabs) between walls)");
+      set_cell(s, cell);
+    }
     set_velocity(static_cast<int>(i), &v[i * d]);
   }
   auto take = [&](std::vector<double>& out, std::size_t m) {
@@ -271,62 +290,64 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   cur_ = block(nb);
   take(msd_t_, nm);
   take(msd_, nm);
+  v2_sum_ = reals[16];  // the running sums as they were (set_velocity above rebuilt them afresh)
+  speed_sum_ = reals[17];
 }
 
-// Closes i's segment at t: its duration weights v^2, the speed, its speed bin and its slabs.
-// (Components beyond dim are 0: the loops run over 3, unrolled, with no test of dim.)
+// Closes i's segment at t: its duration weights its speed bin and its slabs (credited to
+// the open block); its position moves to t. (Components beyond dim are 0: the loops run
+// over 3, unrolled, with no test of dim.)
 [[gnu::always_inline]] inline void Observer::close(int i, double t) {
   Segment& s = seg_[i];
   const double dt = t - s.t0;
-  cur_.k2 += s.v2 * dt;
-  cur_.dist += s.speed * dt;
   if (s.bin >= 0) cur_.speed[s.bin] += dt;
-  if (cfg_.slabs > 0 && dt > 0.0) slab_walk(s, dt);
+  if (cfg_.slabs > 0) {
+    const double end = s.x[cfg_.slab_axis] + s.v[cfg_.slab_axis] * dt;
+    if (end >= s.lo && end < s.lo + slab_w_) {
+      cur_.slab_t[s.slab] += dt;
+      cur_.slab_k2[s.slab] += s.v2 * dt;
+    } else {
+      slab_cross(s, t, end);
+    }
+  }
   for (int k = 0; k < 3; ++k) s.x[k] += s.v[k] * dt;
   s.t0 = t;
 }
 
-// The slabs s's line crosses in dt after its start, each with the time spent in it.
-void Observer::slab_walk(const Segment& s, double dt) {
+// Slabs. A segment keeps its cell along the slab axis, cell = floor(x_a / w) in unwrapped
+// coordinates (any whole number on a periodic axis; [0, slabs) between walls), as the
+// cell's lower edge lo = cell w, and its slab (cell mod slabs). A segment whose end is
+// still in its cell never left it (the motion is linear): closing it is two comparisons and
+// two additions. One that crossed walks the cells it went through (a piece of its duration
+// to each) and takes its cell afresh from its end position (round-off at an edge never
+// accumulates).
+void Observer::set_cell(Segment& s, double c) const {
+  const int ns = cfg_.slabs;
+  if (walls_[cfg_.slab_axis]) c = std::min(static_cast<double>(ns - 1), std::max(0.0, c));
+  s.lo = c * slab_w_;
+  const double m = std::fmod(c, static_cast<double>(ns));
+  s.slab = static_cast<int>(m < 0.0 ? m + ns : m);
+}
+
+// s's line left its cell before t: each cell it went through gets its piece of [t0, t]
+// (s.x, s.t0 are still the segment's start; end is its position on the axis at t).
+void Observer::slab_cross(Segment& s, double t, double end) {
   const int a = cfg_.slab_axis, ns = cfg_.slabs;
-  const double L = box_[a], w = L / ns, va = s.v[a];
-  double u = s.x[a];
-  if (!walls_[a]) {  // folded into [0, L) (a periodic axis); floor by a cast (no libm call)
-    const double q = u * inv_box_[a];
-    double fl = static_cast<double>(static_cast<std::int64_t>(q));
-    if (fl > q) fl -= 1.0;
-    u -= L * fl;
+  const double va = s.v[a], step = slab_w_ / std::fabs(va);
+  const int dir = va > 0.0 ? 1 : -1;
+  int sl = s.slab;
+  double from = s.t0, edge = s.t0 + ((va > 0.0 ? s.lo + slab_w_ : s.lo) - s.x[a]) / va;
+  while (true) {
+    const double until = std::min(t, std::max(from, edge));
+    cur_.slab_t[sl] += until - from;
+    cur_.slab_k2[sl] += s.v2 * (until - from);
+    from = until;
+    if (!(t > edge)) break;
+    sl += dir;
+    if (sl < 0 || sl >= ns) sl = walls_[a] ? std::min(ns - 1, std::max(0, sl)) : (sl < 0 ? ns - 1 : 0);
+    edge += step;
   }
-  int sl = std::min(ns - 1, std::max(0, static_cast<int>(u * (ns * inv_box_[a]))));
-  const double end = u + va * dt;
-  if (end >= sl * w && end < (sl + 1) * w) {  // the common case: the segment stays in its slab
-    cur_.slab_t[sl] += dt;
-    cur_.slab_k2[sl] += s.v2 * dt;
-    return;
-  }
-  double rem = dt;
-  while (rem > 0.0) {
-    double piece = rem;
-    if (va != 0.0) {
-      const double d = std::max(0.0, va > 0.0 ? (sl + 1) * w - u : u - sl * w);
-      piece = std::min(rem, d / std::fabs(va));
-    }
-    cur_.slab_t[sl] += piece;
-    cur_.slab_k2[sl] += s.v2 * piece;
-    rem -= piece;
-    if (rem <= 0.0) break;
-    sl += va > 0.0 ? 1 : -1;
-    if (sl < 0 || sl >= ns) {
-      if (walls_[a]) {  // round-off at a wall: the rest stays in the end slab
-        sl = std::min(ns - 1, std::max(0, sl));
-        cur_.slab_t[sl] += rem;
-        cur_.slab_k2[sl] += s.v2 * rem;
-        break;
-      }
-      sl = sl < 0 ? ns - 1 : 0;
-    }
-    u = va > 0.0 ? sl * w : (sl + 1) * w;
-  }
+  set_cell(s, std::floor(end / slab_w_));
 }
 
 // Pair (i, j) from t0 to t1: the time |r| spends in each distance bin, exactly.
@@ -363,7 +384,10 @@ void Observer::pair_interval(int i, int j, double t0, double t1) {
 }
 
 [[gnu::always_inline]] inline void Observer::close_pairs(int i, double t) {
-  if (cfg_.pair_bins == 0) return;
+  if (cfg_.pair_bins > 0) pairs_to(i, t);  // out of line: the hooks' hot path keeps fewer registers
+}
+
+void Observer::pairs_to(int i, double t) {
   for (std::size_t j = 0; j < n_; ++j) {
     if (static_cast<int>(j) == i) continue;
     const std::size_t lo = std::min<std::size_t>(i, j), hi = std::max<std::size_t>(i, j);
@@ -373,16 +397,30 @@ void Observer::pair_interval(int i, int j, double t0, double t1) {
   }
 }
 
+// The integrals of sum v^2 and sum |v| (constant between velocity changes) from the last
+// update to t, which becomes the last update.
+[[gnu::always_inline]] inline void Observer::accumulate(double t) {
+  const double dt = t - t_now_;
+  cur_.k2 += v2_sum_ * dt;
+  cur_.dist += speed_sum_ * dt;
+  t_now_ = t;
+}
+
+// The open block ends at te: the sums are integrated to te and the MSD is taken from every
+// particle's position then, without closing the segments (a segment's profile time goes
+// to the block in which it closes), except with pair distances (small systems, exact).
 void Observer::end_block() {
   const double te = cur_.t0 + block_time_;
-  for (std::size_t i = 0; i < n_; ++i) {
-    close(static_cast<int>(i), te);
-    close_pairs(static_cast<int>(i), te);
-  }
+  accumulate(te);
+  if (cfg_.pair_bins > 0)
+    for (std::size_t i = 0; i < n_; ++i) {
+      close(static_cast<int>(i), te);
+      close_pairs(static_cast<int>(i), te);
+    }
   double msd = 0.0;
   for (std::size_t i = 0; i < n_; ++i)
     for (int k = 0; k < dim_; ++k) {
-      const double d = seg_[i].x[k] - start_[i * dim_ + k];
+      const double d = pos(static_cast<int>(i), k, te) - start_[i * dim_ + k];
       msd += d * d;
     }
   msd_t_.push_back(te - t_start_);
@@ -403,7 +441,7 @@ void Observer::end_block() {
 
 [[gnu::always_inline]] inline void Observer::reach(double t) {
   while (t >= cur_.t0 + block_time_) end_block();
-  t_now_ = t;
+  accumulate(t);
 }
 
 void Observer::pair(double t, int a, int b, const double* va, const double* vb) {

@@ -286,7 +286,7 @@ TEST_CASE("snapshot observer data: none (old snapshots) resumes nothing; bad dat
   bad([](Snapshot& b) { b.observer[3] = 1.0; });     // min_blocks < 2
   bad([](Snapshot& b) { b.observer[5] = 2.5; });     // slabs not whole
   bad([](Snapshot& b) { b.observer[12] = 1e9; });    // last update after the clock
-  bad([](Snapshot& b) { b.observer[16 + 2] += 1.0; });  // particle 0's velocity is not the particle's
+  bad([](Snapshot& b) { b.observer[18 + 2] += 1.0; });  // particle 0's velocity is not the particle's
   bad([](Snapshot& b) { b.observer[14] = 300.0; });  // more blocks than are ever kept
 }
 

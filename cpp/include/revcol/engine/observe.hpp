@@ -13,11 +13,14 @@
 // on periodic axes (the engine wraps stored positions at list renewals; the observer
 // never wraps): the mean squared displacement needs no crossing count.
 //
-// Time averages, not event averages. A quantity that is constant on a segment (v^2, the
-// speed, the slab a stretch of the line lies in) is weighted by the segment's duration
-// when the segment closes (at the particle's next velocity change, at a block's end, or
-// at a sync). Speeds change only at collisions and walls, so the speed histogram is
-// time-weighted exactly, with no sampling of frames.
+// Time averages, not event averages. Sums over the particles that change only at velocity
+// changes (sum v^2, sum |v|) are kept as running sums and integrated exactly from one
+// change to the next. A quantity constant on a segment (its speed bin, the slab a stretch
+// of the line lies in) is weighted by the segment's duration when the segment closes (at
+// the particle's next velocity change, or at a sync). Speeds change only at collisions and
+// walls, so the speed histogram is time-weighted exactly, with no sampling of frames.
+// Slabs: a segment keeps its cell along the slab axis; one that ends in its cell never
+// left it (two comparisons), one that crossed walks its cells (observe.cpp).
 //
 // Pressure. Unit masses, k_B = 1. The virial theorem for a stationary system,
 //     d P V = < sum_i m v_i^2 > + (1 / tau) sum_collisions sum_members x_u . Delta p_u,
@@ -42,8 +45,13 @@
 // fraction near contact have no sampling error beyond the dynamics' own.
 //
 // Errors: block averages. Blocks are of equal simulated time, starting at block_time (0:
-// D / v_rms, about a collision time at moderate density); at every block end all
-// segments close there. When 256 blocks are full, neighbours merge (the block time
+// D / v_rms, about a collision time at moderate density). At a block end the running
+// sums are integrated to it and the MSD is taken from every particle's position then, but
+// the segments do not close there: a segment's profile time (speed bin, slabs) goes to the
+// block in which it closes, which blurs the profiles' block values by about a free time at
+// each block edge (their totals are exact). Closing all N segments at every block end cost
+// about as much per collision as the rest of the observer. With pair distances (small
+// systems) every segment does close at each block end. When 256 blocks are full, neighbours merge (the block time
 // doubles), so a long run keeps 128-255 blocks. A result's value comes from the totals of
 // the whole observed time; its error is s / sqrt(n_b), s the sample standard deviation of
 // the values of n_b complete blocks, merged down to [min_blocks, 2 min_blocks) first
@@ -51,6 +59,9 @@
 //
 // Cost: measured with callgrind in docs/physics.md (off: one pointer test per velocity
 // change in the engine's hooks, note_pair / note_wall, out of line and cold).
+//
+// Energy: K2 uses the running sum of v^2, so the temperature is 2 E / (d N) of the energy
+// the particles have, and its block error is round-off (E is conserved).
 //
 // Reversal: observation is forward only. run_back first syncs the observer at the clock
 // and stops it (its results stay readable, nothing more is added); a forward run after it
@@ -150,7 +161,9 @@ class Observer {
   struct Segment {
     double x[3], v[3];
     double t0, v2, speed;
-    int bin;  // speed bin, -1 outside or no histogram
+    double lo;  // slabs: the lower edge of its cell along the slab axis (unwrapped)
+    int bin;    // speed bin, -1 outside or no histogram
+    int slab;   // slabs: cell mod slabs
   };
   struct Block {
     double t0 = 0.0, t1 = 0.0;
@@ -161,11 +174,14 @@ class Observer {
     void add(const Block& b);
   };
   void reach(double t);  // closes every block that ends at or before t
+  void accumulate(double t);
   void close(int i, double t);
   void set_velocity(int i, const double* v);
   void close_pairs(int i, double t);
+  [[gnu::noinline]] void pairs_to(int i, double t);
   void pair_interval(int i, int j, double t0, double t1);
-  void slab_walk(const Segment& s, double dt);
+  void set_cell(Segment& s, double cell) const;
+  void slab_cross(Segment& s, double t, double end);
   void end_block();
   Block empty_block(double t0) const;
   void set_geometry(const std::array<double, 3>& box);
@@ -177,6 +193,8 @@ class Observer {
   std::array<double, 3> box_, inv_box_;
   std::array<bool, 3> walls_;
   double diameter_, volume_, block_time_, t_start_, t_now_, speed_max_, bin_scale_;
+  double v2_sum_ = 0.0, speed_sum_ = 0.0;  // sum v^2 and sum |v|, integrated up to t_now_
+  double slab_w_ = 0.0;                    // the slabs' width
   std::vector<Segment> seg_;
   std::vector<double> start_;   // unwrapped positions at the start (n x dim)
   std::vector<double> pair_t_;  // small systems: when each pair's interval began (n x n)
