@@ -9,6 +9,10 @@
 
 #include "revcol/error.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace revcol::engine {
 
 namespace {
@@ -17,6 +21,7 @@ constexpr std::size_t kMaxBlocks = 256;  // merged pairwise when full
 constexpr int kMaxBins = 1 << 20;
 constexpr std::size_t kMaxPairParticles = 64;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kRound = 6755399441055744.0;  // 1.5 2^52
 
 // Time tau in [0, span] with a tau^2 + 2 b tau + c < q (a >= 0): the measure of the
 // interval between the roots of the quadratic, clipped to [0, span].
@@ -27,6 +32,16 @@ double time_below(double a, double b, double c, double q, double span) {
   const double sq = std::sqrt(disc);
   const double lo = std::max(0.0, (-b - sq) / a), hi = std::min(span, (-b + sq) / a);
   return hi > lo ? hi - lo : 0.0;
+}
+
+// sqrt of x >= 0, correctly rounded like std::sqrt, without its errno branch (x is a sum of
+// squares: never negative).
+inline double root(double x) {
+#if defined(__SSE2__)
+  return _mm_cvtsd_f64(_mm_sqrt_sd(_mm_setzero_pd(), _mm_set_sd(x)));
+#else
+  return std::sqrt(x);
+#endif
 }
 
 double sample_sd(const std::vector<double>& x) {
@@ -127,6 +142,7 @@ void Observer::set_geometry(const std::array<double, 3>& box) {
   for (int k = 0; k < 3; ++k) {
     if (k >= dim_) box_[k] = 1.0;
     inv_box_[k] = 1.0 / box_[k];
+    fold_[k] = k < dim_ && !walls_[k] ? box_[k] : 0.0;
     if (k < dim_) volume_ *= box[k];
   }
 }
@@ -148,7 +164,7 @@ Observer::Block Observer::empty_block(double t0) const {
     s.v[k] = v[k];
     v2 += v[k] * v[k];
   }
-  const double speed = std::sqrt(v2);
+  const double speed = root(v2);
   v2_sum_ += v2 - s.v2;  // sum_i v_i^2 and sum_i |v_i| (their time integrals: accumulate)
   speed_sum_ += speed - s.speed;
   s.v2 = v2;
@@ -450,11 +466,10 @@ void Observer::pair(double t, int a, int b, const double* va, const double* vb) 
   close(b, t);
   double w = 0.0;
   for (int k = 0; k < dim_; ++k) {
-    double r = seg_[a].x[k] - seg_[b].x[k];
-    if (!walls_[k]) {  // the nearest image (|r| = D < L / 2), rounding by a cast
-      const double q = r * inv_box_[k];
-      r -= box_[k] * static_cast<double>(static_cast<std::int64_t>(q + (q >= 0.0 ? 0.5 : -0.5)));
-    }
+    // the nearest image (|r| = D < L / 2; fold_ is 0 on walled axes), rounding q to the
+    // nearest whole number by adding and subtracting 1.5 2^52 (|q| < 2^51; no branch)
+    const double r0 = seg_[a].x[k] - seg_[b].x[k], q = r0 * inv_box_[k];
+    const double r = r0 - fold_[k] * ((q + kRound) - kRound);
     w += r * (va[k] - seg_[a].v[k]);
   }
   cur_.w += w;

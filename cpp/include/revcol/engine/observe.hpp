@@ -190,7 +190,7 @@ class Observer {
   ObserveConfig cfg_;
   int dim_;
   std::size_t n_;
-  std::array<double, 3> box_, inv_box_;
+  std::array<double, 3> box_, inv_box_, fold_;  // fold_: L on periodic axes, 0 on walled ones
   std::array<bool, 3> walls_;
   double diameter_, volume_, block_time_, t_start_, t_now_, speed_max_, bin_scale_;
   double v2_sum_ = 0.0, speed_sum_ = 0.0;  // sum v^2 and sum |v|, integrated up to t_now_
