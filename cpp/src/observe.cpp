@@ -206,7 +206,8 @@ void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& coun
   reals.insert(reals.end(), pair_t_.begin(), pair_t_.end());
   counts.clear();
   auto block = [&](const Block& b) {
-    for (double q : {b.t0, b.t1, b.k2, b.w, b.w_wall, b.dist, b.wall_dp[0], b.wall_dp[1], b.wall_dp[2]}) reals.push_back(q);
+    for (double q : {b.t0, b.t1, b.k2, b.w, b.w_wall, b.dist, b.wall_dp[0], b.wall_dp[1], b.wall_dp[2]})
+      reals.push_back(q);
     for (const auto* a : {&b.slab_t, &b.slab_k2, &b.speed, &b.pair}) reals.insert(reals.end(), a->begin(), a->end());
     for (std::uint64_t q : {b.pairs, b.groups, b.parts, b.walls}) counts.push_back(q);
   };
@@ -228,7 +229,8 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   auto whole = [&](std::size_t k, double lo, double hi, const char* name) {
     const double q = reals[k];
     require(q >= lo && q <= hi && q == std::floor(q),
-            [&] { return std::string("snapshot: observer ") + name + " must be a whole number in range, got " + num(q); });
+            [&] { return std::string("snapshot: observer ") + name + " must be a whole number in range, got " +
+                         num(q); });
     return static_cast<std::int64_t>(q);
   };
   require(whole(0, 1, 3, "dim") == dim && whole(1, 1, 1e15, "n") == static_cast<std::int64_t>(n_),

@@ -39,7 +39,9 @@ bool same(const std::vector<double>& a, const std::vector<double>& b) {
     if (!same(a[k], b[k])) return false;
   return true;
 }
-bool same(const Profile& a, const Profile& b) { return same(a.edges, b.edges) && same(a.value, b.value) && same(a.error, b.error); }
+bool same(const Profile& a, const Profile& b) {
+  return same(a.edges, b.edges) && same(a.value, b.value) && same(a.error, b.error);
+}
 
 // Every result of two observations, bit for bit.
 bool same(const Observation& a, const Observation& b) {
