@@ -18,6 +18,7 @@ namespace revcol::engine {
 namespace {
 
 constexpr std::size_t kMaxBlocks = 256;  // merged pairwise when full
+constexpr std::size_t kHeader = 18, kBlockReals = 9, kBlockCounts = 4;  // snapshots (save)
 constexpr int kMaxBins = 1 << 20;
 constexpr std::size_t kMaxPairParticles = 64;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -177,18 +178,7 @@ Observer::Block Observer::empty_block(double t0) const {
 
 }
 
-// ---- snapshots ------------------------------------------------------------------------
-// reals: a header of kHeader values (dim, n, the config's eight fields in declaration
-// order, block_time_, t_start_, t_now_, speed_max_, complete blocks, MSD points, the
-// running sums of v^2 and |v|); per
-// particle its segment (x, v: dim each; t0); start_ (n x dim); pair_t_ (n x n, with pair
-// bins); each complete block then the open one (t0, t1, k2, w, w_wall, dist, wall_dp[3],
-// slab_t, slab_k2, speed, pair); msd_t_, msd_. counts: per block (the same order) pairs,
-// groups, parts, walls. Integers among the reals are exact (all far below 2^53).
-
-namespace {
-constexpr std::size_t kHeader = 18, kBlockReals = 9, kBlockCounts = 4;
-}  // namespace
+// ---- snapshots (the layout of save's reals and counts: observe.hpp) ----------------------
 
 void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const {
   const ObserveConfig& c = cfg_;

@@ -142,6 +142,13 @@ class Observer {
            const std::vector<double>& v, double t, const std::array<double, 3>& box,
            const std::array<bool, 3>& walls, double diameter);
   /// The whole state, for a snapshot: reals (times, sums, positions) and counts.
+  /// reals: a header of 18 values (dim, n, the config's eight fields in declaration order,
+  /// block_time_, t_start_, t_now_, speed_max_, complete blocks, MSD points, the running
+  /// sums of v^2 and |v|); per particle its segment (x, v: dim each; t0; with slabs its
+  /// cell); start_ (n x dim); pair_t_ (n x n, with pair bins); each complete block, then the
+  /// open one (t0, t1, k2, w, w_wall, dist, wall_dp[3], slab_t, slab_k2, speed, pair);
+  /// msd_t_, msd_. counts: per block (the same order) pairs, groups, parts, walls.
+  /// Integers among the reals are exact (all far below 2^53).
   void save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const;
 
   /// A pair collision at t: the velocities after (va, vb). The separation r = x_a - x_b comes
