@@ -239,8 +239,13 @@ class PyEngine {
     d["group_tol"] = c.group_tol;
     s.visit([&](const char* key, const auto& field) {
       using T = std::decay_t<decltype(field)>;
-      if constexpr (is_vector<T>::value) d[key] = vec_array(field);
-      else d[key] = field;
+      if constexpr (is_vector<T>::value) {
+        // no observation running: no observer entries (the file reads as one written before them)
+        if (field.empty() && (std::strcmp(key, "observer") == 0 || std::strcmp(key, "observer_counts") == 0)) return;
+        d[key] = vec_array(field);
+      } else {
+        d[key] = field;
+      }
     });
     std::vector<std::uint64_t> counters;
     s.counters.visit([&](const char*, std::uint64_t q) { counters.push_back(q); });
@@ -285,6 +290,8 @@ class PyEngine {
       if (std::strcmp(key, "centre") == 0 && !d.contains(key)) return;
       // absent in checkpoints written before the collision trace: a new trace starts here
       if (std::strcmp(key, "trace") == 0 && !d.contains(key)) return;
+      // absent in checkpoints written before snapshots kept observations: none resumes
+      if ((std::strcmp(key, "observer") == 0 || std::strcmp(key, "observer_counts") == 0) && !d.contains(key)) return;
       if constexpr (is_vector<T>::value) field = array_vec<typename T::value_type>(d, key);
       else field = checkpoint_field<T>(get(key), key);
     });

@@ -313,8 +313,12 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
   const int n = g.n;
   const int first = g.id[order[0]];
   const std::int64_t wkey = reversed ? netc_[first] - 1 : netc_[first];
-  Reflection w1[kMaxGroup], w2[kMaxGroup];
+  Reflection w1[kMaxGroup] = {}, w2[kMaxGroup] = {};
   for (int u = 0; u < n; ++u) advance(g.id[order[u]], t);
+  // W1 reaches the observer only once the operator accepts the group (group_operator tells
+  // it then): a refused group undoes W1, and the pair that follows reflects for real
+  Observer* const obs = obs_;
+  obs_ = nullptr;
   if (reversed) {
     wlog_.pop(first, wkey, n, w1, w2);
     for (int u = 0; u < n; ++u) flip_mask(g.id[order[u]], w2[u]);
@@ -323,9 +327,12 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
   }
   int ids[kMaxGroup];
   for (int u = 0; u < n; ++u) ids[u] = g.id[order[u]];
-  if (!group_operator(g, order, t, reversed)) {
+  obs_ = obs;
+  if (!group_operator(g, order, t, reversed, w1)) {
     // refused before any draw was consumed (validation comes first): undo the walls
+    obs_ = nullptr;
     for (int u = 0; u < n; ++u) flip_mask(ids[u], reversed ? w2[u] : w1[u]);
+    obs_ = obs;
     if (reversed && (std::any_of(w1, w1 + n, [](Reflection q) { return q != 0; }) ||
                      std::any_of(w2, w2 + n, [](Reflection q) { return q != 0; })))
       wlog_.push(first, wkey, t, n, ids, netc_.data(), w1, w2);  // put the masks back
@@ -357,8 +364,10 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
 // The group's velocities through ExactCollision (members in id order): forward, or
 // -reverse(-v) with the draws stepped back; the exact-pre log for resting contacts. Sets
 // the members' velocities; returns false, nothing changed, when the operator refuses.
+// Observing, an accepted group first tells the observer its W1 reflections (masks w1, in
+// id order; group_collide held them back), then the collision.
 template <int Dim, PairOperator Op>
-bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, bool reversed) {
+bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, bool reversed, const Reflection* w1) {
   const int n = g.n;
   int rank[kMaxGroup];
   for (int u = 0; u < n; ++u) rank[order[u]] = u;
@@ -416,6 +425,8 @@ bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, b
   if (obs_ && !reversed) {  // image-consistent positions: the group's virial (observe.hpp)
     int ids[kMaxGroup];
     double xs[kMaxGroup * Dim];
+    for (int u = 0; u < n; ++u)
+      if (w1[u] != 0) note_wall(g.id[order[u]]);  // the velocities are still those after W1
     for (int u = 0; u < n; ++u) {
       ids[u] = g.id[order[u]];
       for (int k = 0; k < Dim; ++k) xs[u * Dim + k] = pos_at(ids[u], k, t) + g.off[order[u]][k];

@@ -163,6 +163,14 @@ class EngineImpl final : public Simulation {
     build_lists();
     if (old_format) rebuild_events();
     else build_queue();
+    require(!s.observer.empty() || s.observer_counts.empty(), "snapshot: observer_counts without observer");
+    if (!s.observer.empty()) {  // a running observation resumes (revcol/engine/observe.hpp)
+      std::array<bool, 3> walls{};
+      for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
+      observer_ = std::make_unique<Observer>(s.observer, s.observer_counts, Dim, s.v, clock_, cfg_.box, walls,
+                                             cfg_.diameter);
+      obs_ = observer_.get();
+    }
   }
 
   // ---- the Simulation interface -------------------------------------------------------
@@ -453,7 +461,7 @@ class EngineImpl final : public Simulation {
   bool collide(int a, int b, double t, bool reversed);
   PairV<Dim> apply_pair(const PairV<Dim>& in, const Vec& r, int stream, bool reversed);
   bool group_collide(Group& g, double t, bool reversed);
-  bool group_operator(Group& g, const int* order, double t, bool reversed);
+  bool group_operator(Group& g, const int* order, double t, bool reversed, const Reflection* w1);
   Reflection touch_walls(int i);
   void flip_mask(int i, Reflection mask);
   void set_velocity(int i, const Vec& v, Reflection mask);

@@ -88,6 +88,7 @@ Snapshot EngineImpl<Dim, Op>::snapshot() const {
   s.counters = counters_;
   s.energy0 = e0_;
   s.momentum0 = p0_;
+  if (obs_) obs_->save(s.observer, s.observer_counts);  // a running observation resumes (observe.hpp)
   return s;
 }
 

@@ -9,14 +9,20 @@
 
 #include "revcol/error.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace revcol::engine {
 
 namespace {
 
 constexpr std::size_t kMaxBlocks = 256;  // merged pairwise when full
+constexpr std::size_t kHeader = 18, kBlockReals = 9, kBlockCounts = 4;  // snapshots (save)
 constexpr int kMaxBins = 1 << 20;
 constexpr std::size_t kMaxPairParticles = 64;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kRound = 6755399441055744.0;  // 1.5 2^52
 
 // Time tau in [0, span] with a tau^2 + 2 b tau + c < q (a >= 0): the measure of the
 // interval between the roots of the quadratic, clipped to [0, span].
@@ -27,6 +33,16 @@ double time_below(double a, double b, double c, double q, double span) {
   const double sq = std::sqrt(disc);
   const double lo = std::max(0.0, (-b - sq) / a), hi = std::min(span, (-b + sq) / a);
   return hi > lo ? hi - lo : 0.0;
+}
+
+// sqrt of x >= 0, correctly rounded like std::sqrt, without its errno branch (x is a sum of
+// squares: never negative).
+inline double root(double x) {
+#if defined(__SSE2__)
+  return _mm_cvtsd_f64(_mm_sqrt_sd(_mm_setzero_pd(), _mm_set_sd(x)));
+#else
+  return std::sqrt(x);
+#endif
 }
 
 double sample_sd(const std::vector<double>& x) {
@@ -61,13 +77,10 @@ void Observer::Block::add(const Block& b) {
   sum(pair, b.pair);
 }
 
-Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v,
-                   double t, const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter)
-    : cfg_(c), dim_(dim), n_(0), box_(box), walls_(walls), diameter_(diameter) {
-  require(dim >= 1 && dim <= 3, "observe: dim must be 1, 2 or 3");
-  require(!x.empty() && x.size() % static_cast<std::size_t>(dim) == 0 && v.size() == x.size(),
-          "observe: positions and velocities must be n x dim");
-  n_ = x.size() / static_cast<std::size_t>(dim);
+namespace {
+
+// The config's checks (the constructor's and a snapshot's): n particles in dim dimensions.
+void check_config(const ObserveConfig& c, int dim, std::size_t n, const std::array<bool, 3>& walls) {
   require(std::isfinite(c.block_time) && c.block_time >= 0.0,
           [&] { return "observe: block_time must be finite and >= 0, got " + num(c.block_time); });
   require(c.min_blocks >= 2 && c.min_blocks <= 64,
@@ -85,9 +98,21 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   if (c.pair_bins > 0) {
     require(std::isfinite(c.pair_rmax) && c.pair_rmax > 0.0,
             [&] { return "observe: pair_rmax must be finite and > 0 with pair_bins, got " + num(c.pair_rmax); });
-    require(n_ <= kMaxPairParticles && n_ >= 2, "observe: pair distances need 2 to 64 particles");
+    require(n <= kMaxPairParticles && n >= 2, "observe: pair distances need 2 to 64 particles");
     for (int k = 0; k < dim; ++k) require(walls[k], "observe: pair distances need walls on every axis");
   }
+}
+
+}  // namespace
+
+Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v,
+                   double t, const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter)
+    : cfg_(c), dim_(dim), n_(0), box_(box), walls_(walls), diameter_(diameter) {
+  require(dim >= 1 && dim <= 3, "observe: dim must be 1, 2 or 3");
+  require(!x.empty() && x.size() % static_cast<std::size_t>(dim) == 0 && v.size() == x.size(),
+          "observe: positions and velocities must be n x dim");
+  n_ = x.size() / static_cast<std::size_t>(dim);
+  check_config(c, dim, n_, walls);
   double vv = 0.0;
   for (double q : v) vv += q * q;
   const double vrms = std::sqrt(vv / static_cast<double>(n_));
@@ -95,12 +120,8 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   block_time_ = c.block_time > 0.0 ? c.block_time : diameter / vrms;
   speed_max_ = c.speed_max > 0.0 ? c.speed_max : 5.0 * vrms;
   bin_scale_ = c.speed_bins / speed_max_;
-  volume_ = 1.0;
-  for (int k = 0; k < 3; ++k) {
-    if (k >= dim) box_[k] = 1.0;
-    inv_box_[k] = 1.0 / box_[k];
-    if (k < dim) volume_ *= box[k];
-  }
+  set_geometry(box);
+  slab_w_ = c.slabs > 0 ? box_[c.slab_axis] / c.slabs : 0.0;
   t_start_ = t_now_ = t;
   seg_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i) {
@@ -108,11 +129,23 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
     for (int k = 0; k < 3; ++k) s.x[k] = s.v[k] = 0.0;
     for (int k = 0; k < dim; ++k) s.x[k] = x[i * dim + k];
     s.t0 = t;
+    s.v2 = s.speed = 0.0;
+    if (c.slabs > 0) set_cell(s, std::floor(s.x[c.slab_axis] / slab_w_));
     set_velocity(static_cast<int>(i), &v[i * dim]);
   }
   start_ = x;
   if (c.pair_bins > 0) pair_t_.assign(n_ * n_, t);
   cur_ = empty_block(t);
+}
+
+void Observer::set_geometry(const std::array<double, 3>& box) {
+  volume_ = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    if (k >= dim_) box_[k] = 1.0;
+    inv_box_[k] = 1.0 / box_[k];
+    fold_[k] = k < dim_ && !walls_[k] ? box_[k] : 0.0;
+    if (k < dim_) volume_ *= box[k];
+  }
 }
 
 Observer::Block Observer::empty_block(double t0) const {
@@ -132,69 +165,197 @@ Observer::Block Observer::empty_block(double t0) const {
     s.v[k] = v[k];
     v2 += v[k] * v[k];
   }
+  const double speed = root(v2);
+  v2_sum_ += v2 - s.v2;  // sum_i v_i^2 and sum_i |v_i| (their time integrals: accumulate)
+  speed_sum_ += speed - s.speed;
   s.v2 = v2;
-  s.speed = std::sqrt(v2);
+  s.speed = speed;
   s.bin = -1;
   if (cfg_.speed_bins > 0) {
     const double b = s.speed * bin_scale_;
     if (b < cfg_.speed_bins) s.bin = static_cast<int>(b);
   }
+
 }
 
-// Closes i's segment at t: its duration weights v^2, the speed, its speed bin and its slabs.
-// (Components beyond dim are 0: the loops run over 3, unrolled, with no test of dim.)
+// ---- snapshots (the layout of save's reals and counts: observe.hpp) ----------------------
+
+void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const {
+  const ObserveConfig& c = cfg_;
+  reals = {static_cast<double>(dim_), static_cast<double>(n_), c.block_time, static_cast<double>(c.min_blocks),
+           static_cast<double>(c.slab_axis), static_cast<double>(c.slabs), static_cast<double>(c.speed_bins),
+           c.speed_max, static_cast<double>(c.pair_bins), c.pair_rmax, block_time_, t_start_, t_now_, speed_max_,
+           static_cast<double>(blocks_.size()), static_cast<double>(msd_.size()), v2_sum_, speed_sum_};
+  for (const Segment& s : seg_) {
+    reals.insert(reals.end(), s.x, s.x + dim_);
+    reals.insert(reals.end(), s.v, s.v + dim_);
+    reals.push_back(s.t0);
+    if (cfg_.slabs > 0) reals.push_back(std::round(s.lo / slab_w_));  // its cell
+  }
+  reals.insert(reals.end(), start_.begin(), start_.end());
+  reals.insert(reals.end(), pair_t_.begin(), pair_t_.end());
+  counts.clear();
+  auto block = [&](const Block& b) {
+    for (double q : {b.t0, b.t1, b.k2, b.w, b.w_wall, b.dist, b.wall_dp[0], b.wall_dp[1], b.wall_dp[2]})
+      reals.push_back(q);
+    for (const auto* a : {&b.slab_t, &b.slab_k2, &b.speed, &b.pair}) reals.insert(reals.end(), a->begin(), a->end());
+    for (std::uint64_t q : {b.pairs, b.groups, b.parts, b.walls}) counts.push_back(q);
+  };
+  for (const Block& b : blocks_) block(b);
+  block(cur_);
+  reals.insert(reals.end(), msd_t_.begin(), msd_t_.end());
+  reals.insert(reals.end(), msd_.begin(), msd_.end());
+}
+
+Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint64_t>& counts, int dim,
+                   const std::vector<double>& v, double t, const std::array<double, 3>& box,
+                   const std::array<bool, 3>& walls, double diameter)
+    : dim_(dim), n_(0), box_(box), walls_(walls), diameter_(diameter) {
+  require(dim >= 1 && dim <= 3 && !v.empty() && v.size() % static_cast<std::size_t>(dim) == 0,
+          "snapshot: observer: the particles' velocities must be n x dim");
+  n_ = v.size() / static_cast<std::size_t>(dim);
+  require(reals.size() >= kHeader, "snapshot: observer holds fewer values than its header");
+  for (double q : reals) require(std::isfinite(q), "snapshot: observer values must be finite");
+  auto whole = [&](std::size_t k, double lo, double hi, const char* name) {
+    const double q = reals[k];
+    require(q >= lo && q <= hi && q == std::floor(q),
+            [&] { return std::string("snapshot: observer ") + name + " must be a whole number in range, got " +
+                         num(q); });
+    return static_cast<std::int64_t>(q);
+  };
+  require(whole(0, 1, 3, "dim") == dim && whole(1, 1, 1e15, "n") == static_cast<std::int64_t>(n_),
+          "snapshot: observer was taken of another number of particles or dimensions");
+  cfg_.block_time = reals[2];
+  cfg_.min_blocks = static_cast<int>(whole(3, 2, 64, "min_blocks"));
+  cfg_.slab_axis = static_cast<int>(whole(4, 0, 2, "slab_axis"));
+  cfg_.slabs = static_cast<int>(whole(5, 0, kMaxBins, "slabs"));
+  cfg_.speed_bins = static_cast<int>(whole(6, 0, kMaxBins, "speed_bins"));
+  cfg_.speed_max = reals[7];
+  cfg_.pair_bins = static_cast<int>(whole(8, 0, kMaxBins, "pair_bins"));
+  cfg_.pair_rmax = reals[9];
+  check_config(cfg_, dim, n_, walls);
+  block_time_ = reals[10];
+  t_start_ = reals[11];
+  t_now_ = reals[12];
+  speed_max_ = reals[13];
+  require(block_time_ > 0.0 && speed_max_ > 0.0, "snapshot: observer block time and speed_max must be > 0");
+  require(t_start_ <= t_now_ && t_now_ <= t, "snapshot: observer times must be ordered: start <= last update <= clock");
+  const auto nb = static_cast<std::size_t>(whole(14, 0, kMaxBlocks - 1, "block count"));
+  const auto nm = static_cast<std::size_t>(whole(15, 0, 1e12, "MSD count"));
+  const std::size_t d = static_cast<std::size_t>(dim), np = cfg_.pair_bins > 0 ? n_ * n_ : 0;
+  const std::size_t per_block = kBlockReals + 2 * cfg_.slabs + cfg_.speed_bins + cfg_.pair_bins;
+  const std::size_t per_particle = 3 * d + 1 + (cfg_.slabs > 0 ? 1 : 0);
+  require(reals.size() == kHeader + n_ * per_particle + np + (nb + 1) * per_block + 2 * nm,
+          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points)");
+  require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
+  bin_scale_ = cfg_.speed_bins / speed_max_;
+  set_geometry(box);
+  slab_w_ = cfg_.slabs > 0 ? box_[cfg_.slab_axis] / cfg_.slabs : 0.0;
+  std::size_t u = kHeader;
+  seg_.resize(n_);
+  for (std::size_t i = 0; i < n_; ++i) {
+    Segment& s = seg_[i];
+    for (int k = 0; k < 3; ++k) s.x[k] = s.v[k] = 0.0;
+    s.v2 = s.speed = 0.0;
+    for (std::size_t k = 0; k < d; ++k) s.x[k] = reals[u++];
+    for (std::size_t k = 0; k < d; ++k)
+      require(reals[u++] == v[i * d + k], "snapshot: observer: a segment's velocity is not its particle's");
+    s.t0 = reals[u++];
+    require(s.t0 >= t_start_ && s.t0 <= t, "snapshot: observer: a segment starts outside the observed time");
+    if (cfg_.slabs > 0) {
+      const double cell = reals[u++];
+      require(cell == std::floor(cell) && std::fabs(cell) < 1e15 &&
+                  (!walls_[cfg_.slab_axis] || (cell >= 0.0 && cell < cfg_.slabs)),
+              "snapshot: observer: a segment's slab cell must be a whole number (in [0, slabs) between walls)");
+      set_cell(s, cell);
+    }
+    set_velocity(static_cast<int>(i), &v[i * d]);
+  }
+  auto take = [&](std::vector<double>& out, std::size_t m) {
+    out.assign(reals.begin() + static_cast<std::ptrdiff_t>(u), reals.begin() + static_cast<std::ptrdiff_t>(u + m));
+    u += m;
+  };
+  take(start_, n_ * d);
+  take(pair_t_, np);
+  auto block = [&](std::size_t b) {
+    Block k = empty_block(reals[u]);
+    k.t1 = reals[u + 1];
+    k.k2 = reals[u + 2];
+    k.w = reals[u + 3];
+    k.w_wall = reals[u + 4];
+    k.dist = reals[u + 5];
+    for (int a = 0; a < 3; ++a) k.wall_dp[a] = reals[u + 6 + a];
+    require(k.t0 >= t_start_ && k.t1 >= k.t0 && k.t1 <= t, "snapshot: observer: a block outside the observed time");
+    u += kBlockReals;
+    for (auto* a : {&k.slab_t, &k.slab_k2, &k.speed, &k.pair}) take(*a, a->size());
+    k.pairs = counts[b * kBlockCounts];
+    k.groups = counts[b * kBlockCounts + 1];
+    k.parts = counts[b * kBlockCounts + 2];
+    k.walls = counts[b * kBlockCounts + 3];
+    return k;
+  };
+  for (std::size_t b = 0; b < nb; ++b) blocks_.push_back(block(b));
+  cur_ = block(nb);
+  take(msd_t_, nm);
+  take(msd_, nm);
+  v2_sum_ = reals[16];  // the running sums as they were (set_velocity above rebuilt them afresh)
+  speed_sum_ = reals[17];
+}
+
+// Closes i's segment at t: its duration weights its speed bin and its slabs (credited to
+// the open block); its position moves to t. (Components beyond dim are 0: the loops run
+// over 3, unrolled, with no test of dim.)
 [[gnu::always_inline]] inline void Observer::close(int i, double t) {
   Segment& s = seg_[i];
   const double dt = t - s.t0;
-  cur_.k2 += s.v2 * dt;
-  cur_.dist += s.speed * dt;
   if (s.bin >= 0) cur_.speed[s.bin] += dt;
-  if (cfg_.slabs > 0 && dt > 0.0) slab_walk(s, dt);
+  if (cfg_.slabs > 0) {
+    const double end = s.x[cfg_.slab_axis] + s.v[cfg_.slab_axis] * dt;
+    if (end >= s.lo && end < s.lo + slab_w_) {
+      cur_.slab_t[s.slab] += dt;
+      cur_.slab_k2[s.slab] += s.v2 * dt;
+    } else {
+      slab_cross(s, t, end);
+    }
+  }
   for (int k = 0; k < 3; ++k) s.x[k] += s.v[k] * dt;
   s.t0 = t;
 }
 
-// The slabs s's line crosses in dt after its start, each with the time spent in it.
-void Observer::slab_walk(const Segment& s, double dt) {
+// Slabs. A segment keeps its cell along the slab axis, cell = floor(x_a / w) in unwrapped
+// coordinates (any whole number on a periodic axis; [0, slabs) between walls), as the
+// cell's lower edge lo = cell w, and its slab (cell mod slabs). A segment whose end is
+// still in its cell never left it (the motion is linear): closing it is two comparisons and
+// two additions. One that crossed walks the cells it went through (a piece of its duration
+// to each) and takes its cell afresh from its end position (round-off at an edge never
+// accumulates).
+void Observer::set_cell(Segment& s, double c) const {
+  const int ns = cfg_.slabs;
+  if (walls_[cfg_.slab_axis]) c = std::min(static_cast<double>(ns - 1), std::max(0.0, c));
+  s.lo = c * slab_w_;
+  const double m = std::fmod(c, static_cast<double>(ns));
+  s.slab = static_cast<int>(m < 0.0 ? m + ns : m);
+}
+
+// s's line left its cell before t: each cell it went through gets its piece of [t0, t]
+// (s.x, s.t0 are still the segment's start; end is its position on the axis at t).
+void Observer::slab_cross(Segment& s, double t, double end) {
   const int a = cfg_.slab_axis, ns = cfg_.slabs;
-  const double L = box_[a], w = L / ns, va = s.v[a];
-  double u = s.x[a];
-  if (!walls_[a]) {  // folded into [0, L) (a periodic axis); floor by a cast (no libm call)
-    const double q = u * inv_box_[a];
-    double fl = static_cast<double>(static_cast<std::int64_t>(q));
-    if (fl > q) fl -= 1.0;
-    u -= L * fl;
+  const double va = s.v[a], step = slab_w_ / std::fabs(va);
+  const int dir = va > 0.0 ? 1 : -1;
+  int sl = s.slab;
+  double from = s.t0, edge = s.t0 + ((va > 0.0 ? s.lo + slab_w_ : s.lo) - s.x[a]) / va;
+  while (true) {
+    const double until = std::min(t, std::max(from, edge));
+    cur_.slab_t[sl] += until - from;
+    cur_.slab_k2[sl] += s.v2 * (until - from);
+    from = until;
+    if (!(t > edge)) break;
+    sl += dir;
+    if (sl < 0 || sl >= ns) sl = walls_[a] ? std::min(ns - 1, std::max(0, sl)) : (sl < 0 ? ns - 1 : 0);
+    edge += step;
   }
-  int sl = std::min(ns - 1, std::max(0, static_cast<int>(u * (ns * inv_box_[a]))));
-  const double end = u + va * dt;
-  if (end >= sl * w && end < (sl + 1) * w) {  // the common case: the segment stays in its slab
-    cur_.slab_t[sl] += dt;
-    cur_.slab_k2[sl] += s.v2 * dt;
-    return;
-  }
-  double rem = dt;
-  while (rem > 0.0) {
-    double piece = rem;
-    if (va != 0.0) {
-      const double d = std::max(0.0, va > 0.0 ? (sl + 1) * w - u : u - sl * w);
-      piece = std::min(rem, d / std::fabs(va));
-    }
-    cur_.slab_t[sl] += piece;
-    cur_.slab_k2[sl] += s.v2 * piece;
-    rem -= piece;
-    if (rem <= 0.0) break;
-    sl += va > 0.0 ? 1 : -1;
-    if (sl < 0 || sl >= ns) {
-      if (walls_[a]) {  // round-off at a wall: the rest stays in the end slab
-        sl = std::min(ns - 1, std::max(0, sl));
-        cur_.slab_t[sl] += rem;
-        cur_.slab_k2[sl] += s.v2 * rem;
-        break;
-      }
-      sl = sl < 0 ? ns - 1 : 0;
-    }
-    u = va > 0.0 ? sl * w : (sl + 1) * w;
-  }
+  set_cell(s, std::floor(end / slab_w_));
 }
 
 // Pair (i, j) from t0 to t1: the time |r| spends in each distance bin, exactly.
@@ -231,7 +392,10 @@ void Observer::pair_interval(int i, int j, double t0, double t1) {
 }
 
 [[gnu::always_inline]] inline void Observer::close_pairs(int i, double t) {
-  if (cfg_.pair_bins == 0) return;
+  if (cfg_.pair_bins > 0) pairs_to(i, t);  // out of line: the hooks' hot path keeps fewer registers
+}
+
+void Observer::pairs_to(int i, double t) {
   for (std::size_t j = 0; j < n_; ++j) {
     if (static_cast<int>(j) == i) continue;
     const std::size_t lo = std::min<std::size_t>(i, j), hi = std::max<std::size_t>(i, j);
@@ -241,16 +405,30 @@ void Observer::pair_interval(int i, int j, double t0, double t1) {
   }
 }
 
+// The integrals of sum v^2 and sum |v| (constant between velocity changes) from the last
+// update to t, which becomes the last update.
+[[gnu::always_inline]] inline void Observer::accumulate(double t) {
+  const double dt = t - t_now_;
+  cur_.k2 += v2_sum_ * dt;
+  cur_.dist += speed_sum_ * dt;
+  t_now_ = t;
+}
+
+// The open block ends at te: the sums are integrated to te and the MSD is taken from every
+// particle's position then, without closing the segments (a segment's profile time goes
+// to the block in which it closes), except with pair distances (small systems, exact).
 void Observer::end_block() {
   const double te = cur_.t0 + block_time_;
-  for (std::size_t i = 0; i < n_; ++i) {
-    close(static_cast<int>(i), te);
-    close_pairs(static_cast<int>(i), te);
-  }
+  accumulate(te);
+  if (cfg_.pair_bins > 0)
+    for (std::size_t i = 0; i < n_; ++i) {
+      close(static_cast<int>(i), te);
+      close_pairs(static_cast<int>(i), te);
+    }
   double msd = 0.0;
   for (std::size_t i = 0; i < n_; ++i)
     for (int k = 0; k < dim_; ++k) {
-      const double d = seg_[i].x[k] - start_[i * dim_ + k];
+      const double d = pos(static_cast<int>(i), k, te) - start_[i * dim_ + k];
       msd += d * d;
     }
   msd_t_.push_back(te - t_start_);
@@ -271,7 +449,7 @@ void Observer::end_block() {
 
 [[gnu::always_inline]] inline void Observer::reach(double t) {
   while (t >= cur_.t0 + block_time_) end_block();
-  t_now_ = t;
+  accumulate(t);
 }
 
 void Observer::pair(double t, int a, int b, const double* va, const double* vb) {
@@ -280,11 +458,10 @@ void Observer::pair(double t, int a, int b, const double* va, const double* vb) 
   close(b, t);
   double w = 0.0;
   for (int k = 0; k < dim_; ++k) {
-    double r = seg_[a].x[k] - seg_[b].x[k];
-    if (!walls_[k]) {  // the nearest image (|r| = D < L / 2), rounding by a cast
-      const double q = r * inv_box_[k];
-      r -= box_[k] * static_cast<double>(static_cast<std::int64_t>(q + (q >= 0.0 ? 0.5 : -0.5)));
-    }
+    // the nearest image (|r| = D < L / 2; fold_ is 0 on walled axes), rounding q to the
+    // nearest whole number by adding and subtracting 1.5 2^52 (|q| < 2^51; no branch)
+    const double r0 = seg_[a].x[k] - seg_[b].x[k], q = r0 * inv_box_[k];
+    const double r = r0 - fold_[k] * ((q + kRound) - kRound);
     w += r * (va[k] - seg_[a].v[k]);
   }
   cur_.w += w;

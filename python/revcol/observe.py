@@ -171,15 +171,27 @@ def report_lines(d: dict[str, Any]) -> list[str]:
 
 
 def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Optional[float] = None,
-                        periodic: Optional[Sequence[bool]] = None, use_freud: Optional[bool] = None):
-    """g(r) averaged over frames (an array (F, n, d) or one frame (n, d)) in a periodic box.
+                        periodic: Optional[Sequence[bool]] = None, use_freud: Optional[bool] = None,
+                        diameter: Optional[float] = None):
+    """g(r) averaged over frames (an array (F, n, d) or one frame (n, d)).
 
-    Uses freud (``freud.density.RDF``) when installed and ``use_freud`` is not False; otherwise
-    numpy (minimum image, pair distances by rows, normalized by the ideal gas's shell counts
-    at the same density). Both normalize by the other particles' density (n - 1) / V (freud's
-    ``normalization_mode="finite_size"``), so they agree up to the pairs that float32
-    positions in freud move across a bin edge (``test_observe``). Returns (r centres, g). The box must be periodic on every axis (g(r)
-    of a bulk gas); ``r_max`` at most L / 2 (default: 0.5 min L)."""
+    Periodic box (``periodic`` None or all True): freud (``freud.density.RDF``) when installed
+    and ``use_freud`` is not False, otherwise numpy (minimum image, pair distances by rows,
+    normalized by the ideal gas's shell counts at the same density). Both normalize by the
+    other particles' density (n - 1) / V (freud's ``normalization_mode="finite_size"``), so
+    they agree up to the pairs that float32 positions in freud move across a bin edge
+    (``test_observe``). ``r_max`` at most L / 2 (default: 0.5 min L).
+
+    Walled axes (``periodic[k]`` False; numpy only, freud's normalization is periodic): the
+    centres lie in [D/2, L - D/2] on those axes (``diameter`` D is then required; 0 for
+    points anywhere in [0, L]), no minimum image there, and each reference particle's ideal
+    count in a shell is (n - 1) / V' times the part of the shell inside that region (V' its
+    volume), exactly: the full shell less the caps beyond the walls within r, plus the parts
+    beyond two (and three) walls at once (closed forms; in 3D those are one-dimensional
+    integrals done by 24-point Gauss-Legendre, relative error below 1e-8). So an ideal gas in a
+    walled box has g = 1 at every r, not the periodic formula's dip near r_max. ``r_max`` at
+    most half the region's shortest side (each axis cuts a shell at one wall at most).
+    Returns (r centres, g)."""
     x = np.asarray(frames, dtype=float)
     if x.ndim == 2:
         x = x[None]
@@ -189,13 +201,26 @@ def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Op
     L = np.asarray(box, dtype=float)
     if L.shape != (d,):
         raise ValueError(f"box needs {d} lengths, got {L.shape}")
-    if periodic is not None and not all(periodic):
-        raise ValueError("radial_distribution needs a periodic box on every axis")
+    walls = np.zeros(d, dtype=bool) if periodic is None else ~np.asarray(periodic, dtype=bool)
+    if walls.shape != (d,):
+        raise ValueError(f"periodic needs {d} flags, got {walls.shape}")
     if isinstance(bins, bool) or not isinstance(bins, int) or bins < 1:
         raise TypeError(f"bins must be a positive integer, got {bins!r}")
-    r_max = 0.5 * float(L.min()) if r_max is None else float(r_max)
-    if not 0 < r_max <= 0.5 * L.min() + 1e-12:
-        raise ValueError(f"r_max must be in (0, L/2 = {0.5 * L.min():g}], got {r_max}")
+    if walls.any():
+        if diameter is None or not 0.0 <= float(diameter) < float(L[walls].min()):
+            raise ValueError("a walled box needs the particles' diameter (0 <= diameter < L on walled axes): "
+                             f"their centres lie in [D/2, L - D/2] there; got {diameter!r}")
+        if use_freud:
+            raise ValueError("freud's g(r) is for a periodic box; a walled box uses numpy (use_freud=None or False)")
+        half = float(diameter) / 2.0
+        x = x - np.where(walls, half, 0.0)  # the centres' region [0, L'] on walled axes
+        L = L - np.where(walls, 2.0 * half, 0.0)
+    limit = 0.5 * float(L.min())
+    r_max = limit if r_max is None else float(r_max)
+    if not 0 < r_max <= limit + 1e-12:
+        raise ValueError(f"r_max must be in (0, {'L' if not walls.any() else 'L - D'}/2 = {limit:g}], got {r_max}")
+    if walls.any():
+        return _rdf_numpy(x, L, bins, r_max, walls)
     freud = None
     if use_freud is not False:
         try:
@@ -211,7 +236,7 @@ def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Op
             pts[:, :d] = f - 0.5 * L
             rdf.compute((fbox, fbox.wrap(pts)), reset=False)
         return np.asarray(rdf.bin_centers), np.asarray(rdf.rdf)
-    return _rdf_numpy(x, L, bins, r_max)
+    return _rdf_numpy(x, L, bins, r_max, walls)
 
 
 def contact_value(r, g, diameter: float = 1.0, width: float = 0.2, order: int = 2) -> float:
@@ -233,21 +258,95 @@ def compressibility_from_contact(g_contact: float, packing_fraction: float, dim:
     return 1.0 + 2.0 ** (dim - 1) * float(packing_fraction) * float(g_contact)
 
 
-def _rdf_numpy(x: np.ndarray, L: np.ndarray, bins: int, r_max: float):
+def _rdf_numpy(x: np.ndarray, L: np.ndarray, bins: int, r_max: float, walls: np.ndarray):
     F, n, d = x.shape
     edges = np.linspace(0.0, r_max, bins + 1)
     counts = np.zeros(bins)
     rows = max(1, 2_000_000 // max(n, 1))
+    wrap = np.where(walls, 0.0, 1.0)  # the minimum image on periodic axes only
+    inside = np.zeros(bins + 1)  # sum over reference particles of the ball volume inside the region
     for f in x:
         for lo in range(0, n, rows):
             a = f[lo:lo + rows]
             dr = a[:, None, :] - f[None, :, :]
-            dr -= L * np.round(dr / L)
+            dr -= wrap * L * np.round(dr / L)
             r = np.sqrt((dr * dr).sum(-1))
             r = r[r > 0]  # not i with itself
             counts += np.histogram(r, bins=edges)[0]
+        inside += _ball_inside(f, L, walls, edges).sum(axis=0) if walls.any() else n * _ball(edges, d)
     rho = (n - 1) / float(np.prod(L))  # the other particles' density: g -> 1 at large r for any n
-    shell = (math.pi * (edges[1:] ** 2 - edges[:-1] ** 2) if d == 2
-             else 4.0 / 3.0 * math.pi * (edges[1:] ** 3 - edges[:-1] ** 3))
-    ideal = F * n * rho * shell  # ordered pairs: each pair counted from both ends
+    ideal = rho * np.diff(inside)  # ordered pairs: each pair counted from both ends
     return 0.5 * (edges[1:] + edges[:-1]), counts / ideal
+
+
+def _ball(r, d: int):
+    """The volume of the d-ball of radius r (d = 2, 3)."""
+    r = np.asarray(r, dtype=float)
+    return math.pi * r ** 2 if d == 2 else 4.0 / 3.0 * math.pi * r ** 3
+
+
+def _corner2(p, q, rho):
+    """The area of {u1 > p, u2 > q, |u| < rho} (p, q >= 0): the integral over u1 in [p, m],
+    m = sqrt(rho^2 - q^2), of sqrt(rho^2 - u1^2) - q; 0 when p^2 + q^2 >= rho^2."""
+    p, q, rho = np.broadcast_arrays(np.asarray(p, float), np.asarray(q, float), np.asarray(rho, float))
+    r2 = rho * rho
+    live = p * p + q * q < r2
+    m = np.sqrt(np.maximum(r2 - q * q, 0.0))
+    safe = np.where(live, rho, 1.0)
+
+    def prim(u):  # an antiderivative of sqrt(rho^2 - u^2)
+        return 0.5 * (u * np.sqrt(np.maximum(r2 - u * u, 0.0)) + r2 * np.arcsin(np.clip(u / safe, -1.0, 1.0)))
+
+    return np.where(live, prim(m) - prim(p) - q * (m - p), 0.0)
+
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(24)
+
+
+def _beyond_two_3d(p, q, r, s=None):
+    """The volume of {u1 > p, u2 > q, |u| < r} in 3D (and u3 > s when s is given): the
+    integral over u3 of _corner2 at radius sqrt(r^2 - u3^2), over |u3| < zm (u3 in [s, zm]),
+    zm = sqrt(r^2 - p^2 - q^2); u3 = zm sin(theta) smooths the ends for Gauss-Legendre."""
+    p, q, r = np.broadcast_arrays(np.asarray(p, float), np.asarray(q, float), np.asarray(r, float))
+    zm = np.sqrt(np.maximum(r * r - p * p - q * q, 0.0))
+    lo = -0.5 * math.pi * np.ones_like(zm) if s is None else np.arcsin(
+        np.clip(np.asarray(s, float) / np.where(zm > 0, zm, 1.0), -1.0, 1.0))
+    lo = np.where(zm > 0, lo, 0.5 * math.pi)
+    hi = 0.5 * math.pi
+    th = lo[..., None] + (hi - lo)[..., None] * 0.5 * (_GL_X + 1.0)
+    z = zm[..., None] * np.sin(th)
+    rho = np.sqrt(np.maximum(r[..., None] ** 2 - z * z, 0.0))
+    f = _corner2(p[..., None], q[..., None], rho) * zm[..., None] * np.cos(th)
+    return (f * _GL_W).sum(-1) * 0.5 * (hi - lo)
+
+
+def _ball_inside(f: np.ndarray, L: np.ndarray, walls: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """(n, len(r)): the volume of each particle's ball of radius r inside the region [0, L]
+    on walled axes (r <= L / 2: one wall per axis at most), by inclusion and exclusion of
+    the parts beyond the nearest wall of each walled axis."""
+    n, d = f.shape
+    h = np.where(walls, np.minimum(f, L - f), np.inf)  # distance to the nearest wall (inf: periodic)
+    rr = np.broadcast_to(r, (n, len(r)))
+    out = np.broadcast_to(_ball(r, d), (n, len(r))).copy()
+    hk = [np.clip(h[:, k, None], 0.0, None) for k in range(d)]
+    for k in range(d):  # one wall: a segment (2D) or a cap (3D)
+        c = np.minimum(hk[k], rr)
+        if d == 2:
+            out -= np.where(hk[k] < rr, rr * rr * np.arccos(np.clip(c / np.where(rr > 0, rr, 1.0), -1.0, 1.0))
+                            - c * np.sqrt(np.maximum(rr * rr - c * c, 0.0)), 0.0)
+        else:
+            out -= np.where(hk[k] < rr, math.pi * (rr - c) ** 2 * (2.0 * rr + c) / 3.0, 0.0)
+    for k in range(d):  # two walls at once (added back)
+        for j in range(k + 1, d):
+            near = (hk[k] < rr) & (hk[j] < rr)
+            if not near.any():
+                continue
+            pk, pj = np.where(near, hk[k], rr), np.where(near, hk[j], rr)
+            twice = _corner2(pk, pj, rr) if d == 2 else _beyond_two_3d(pk, pj, rr)
+            out += np.where(near, twice, 0.0)
+    if d == 3:  # three walls at once (taken away again)
+        near = (hk[0] < rr) & (hk[1] < rr) & (hk[2] < rr)
+        if near.any():
+            p0, p1, p2 = (np.where(near, hk[k], rr) for k in range(3))
+            out -= np.where(near, _beyond_two_3d(p0, p1, rr, s=p2), 0.0)
+    return out

@@ -432,6 +432,51 @@ def dense_table(runs: Sequence[dict]) -> str:
     return "\n".join(rows)
 
 
+def extrapolate(ns: Sequence[float], zs: Sequence[float], errors: Sequence[float]) -> tuple[float, float, float]:
+    """Z(N) = Z_inf + a / N through runs at two or more sizes, weighted least squares (weights
+    1 / error^2): (Z_inf, its standard error, a). With two sizes the line goes through both."""
+    x = 1.0 / np.asarray(ns, dtype=float)
+    z, e = np.asarray(zs, dtype=float), np.asarray(errors, dtype=float)
+    if len(x) < 2 or len(set(x.tolist())) < 2:
+        raise ValueError("extrapolate needs runs at two different sizes at least")
+    w = 1.0 / e ** 2
+    a_mat = np.array([[w.sum(), (w * x).sum()], [(w * x).sum(), (w * x * x).sum()]])
+    cov = np.linalg.inv(a_mat)
+    zi, slope = cov @ np.array([(w * z).sum(), (w * x * z).sum()])
+    return float(zi), float(math.sqrt(cov[0, 0])), float(slope)
+
+
+def finite_size(runs: Sequence[dict]) -> list[dict[str, Any]]:
+    """Z(N -> infinity) per (d, phi, law) from dense runs at several N (``extrapolate``),
+    against Liu's equation of state: value, error, number of standard errors."""
+    groups: dict[tuple, list[dict]] = {}
+    for r in runs:
+        groups.setdefault((r["dim"], r["phi"], r["law"]), []).append(r)
+    out = []
+    for (d, phi, law), rs in sorted(groups.items()):
+        rs = sorted(rs, key=lambda r: r["n"])
+        if len({r["n"] for r in rs}) < 2:
+            continue
+        zi, ei, slope = extrapolate([r["n"] for r in rs], [r["z"][0] for r in rs], [r["z"][1] for r in rs])
+        ref = reference_z(d, phi)
+        out.append({"dim": d, "phi": phi, "law": law, "n": [r["n"] for r in rs],
+                    "collisions": [r["collisions"] for r in rs], "cpu_s": [r["cpu_s"] for r in rs],
+                    "z": [r["z"] for r in rs], "z_sigmas": [(r["z"][0] - ref) / r["z"][1] for r in rs],
+                    "z_inf": [zi, ei], "slope": slope, "z_ref": ref, "z_inf_sigmas": (zi - ref) / ei})
+    return out
+
+
+def finite_size_table(rows: Sequence[dict]) -> str:
+    """``finite_size`` as a markdown table."""
+    out = ["| d | phi | law | Z at each N (sd from Liu) | Z(inf) = Z(N) - a / N | Liu | sd | a |",
+           "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        each = "; ".join(f"{n}: {_pm(*z)} ({s:+.1f})" for n, z, s in zip(r["n"], r["z"], r["z_sigmas"]))
+        out.append(f"| {r['dim']} | {r['phi']:.2f} | {r['law']} | {each} | {_pm(*r['z_inf'])} | {r['z_ref']:.5g} | "
+                   f"{r['z_inf_sigmas']:+.1f} | {r['slope']:+.3g} |")
+    return "\n".join(out)
+
+
 def self_consistency(r: dict) -> tuple[float, float]:
     """Enskog's collision rate with the contact value of the run's own Z, and its error (the
     rate's and Z's combined): in an equilibrium hard-sphere gas the collision rate and the
@@ -610,10 +655,20 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     f.add_argument("--out", default="docs/figures/physics")
     t = sub.add_parser("table", help="the markdown tables of JSON files")
     t.add_argument("json", nargs="+")
+    fs = sub.add_parser("finite-size", help="Z(N -> infinity) from dense runs at several N against Liu")
+    fs.add_argument("runs", nargs="+", help="JSON files of `dense` runs (any sizes, laws, densities)")
+    fs.add_argument("--json")
     args = ap.parse_args(argv)
     t0 = time.time()
     if args.what == "figures":
         print("\n".join(figures(args.json, args.out)))
+        return 0
+    if args.what == "finite-size":
+        rows = finite_size([r for p in args.runs for r in json.load(open(p))["dense"]])
+        print(finite_size_table(rows))
+        if args.json:
+            with atomic_open(args.json) as fh:
+                json.dump({"finite_size": rows, "inputs": args.runs, **_run_info(argv, t0)}, fh, indent=1)
         return 0
     if args.what == "table":
         for p in args.json:

@@ -31,6 +31,35 @@ Config walled(int d, double L, Mode mode = Mode::specular) {
   return c;
 }
 
+bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+bool same(const Estimate& a, const Estimate& b) { return same(a.value, b.value) && same(a.error, b.error); }
+bool same(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (!same(a[k], b[k])) return false;
+  return true;
+}
+bool same(const Profile& a, const Profile& b) {
+  return same(a.edges, b.edges) && same(a.value, b.value) && same(a.error, b.error);
+}
+
+// Every result of two observations, bit for bit.
+bool same(const Observation& a, const Observation& b) {
+  bool ok = a.dim == b.dim && a.n == b.n && same(a.t_start, b.t_start) && same(a.t_end, b.t_end) &&
+            a.blocks == b.blocks && same(a.block_time, b.block_time) && a.pair_collisions == b.pair_collisions &&
+            a.group_collisions == b.group_collisions && a.particle_collisions == b.particle_collisions &&
+            a.wall_reflections == b.wall_reflections;
+  for (const auto m : {&Observation::temperature, &Observation::pressure_virial, &Observation::compressibility,
+                       &Observation::collision_rate, &Observation::mean_free_time, &Observation::mean_free_path,
+                       &Observation::virial_balance})
+    ok = ok && same(a.*m, b.*m);
+  for (int k = 0; k < 3; ++k) ok = ok && same(a.pressure_wall[k], b.pressure_wall[k]);
+  for (const auto m : {&Observation::slab_density, &Observation::slab_temperature, &Observation::speed,
+                       &Observation::pair_distance})
+    ok = ok && same(a.*m, b.*m);
+  return ok && same(a.msd_time, b.msd_time) && same(a.msd, b.msd);
+}
+
 }  // namespace
 
 TEST_CASE("1D head-on pair: virial, Z, collision rate and pair distances by hand") {
@@ -119,6 +148,31 @@ TEST_CASE("a 1D cradle: a group's virial sums x . dp over its members") {
   CHECK_NEAR(o.compressibility.value, 1.0 + w / k2, 1e-9);
 }
 
+TEST_CASE("a refused group's wall reflections are not observed: impulses are those that happened") {
+  // A rigid train (particles 1..4, touching, speed -2) catches particle 0 (speed -1) at t = 1,
+  // when 0 is 2^-34 short of the left wall (within group_tol): the contacts make a chain of
+  // five, four contacts, which ExactCollision refuses (at most 3). The group reflected 0 off
+  // the wall (W1) and undid it; the pair that follows does it for real. Until nothing has
+  // reached the right wall, every impulse is on the left wall and positive, so their sum is
+  // the momentum gained: sum |dp| = P(t) - P(0) (a counted-twice W1 adds 2 |dv| = 4).
+  const double e = std::ldexp(1.0, -34);
+  Config c = walled(1, 10.0, Mode::exact);
+  c.force_group_search = true;
+  auto s = make_simulation(c, {1.5 + e, 3.5 + e, 4.5 + e, 5.5 + e, 6.5 + e}, {-1.0, -2.0, -2.0, -2.0, -2.0});
+  const double p0 = s->diagnostics().momentum[0];
+  s->observe(ObserveConfig{});
+  s->run(kAll, 1.25);
+  const Observation o = s->observer()->results();
+  const Diagnostics d = s->diagnostics();
+  REQUIRE(d.counters.group_fallbacks >= 1);
+  for (double x : s->positions()) REQUIRE(x < 9.0);  // nothing near the right wall yet
+  const double tau = o.t_end - o.t_start;
+  const double impulse = o.pressure_wall[0].value * 2.0 * tau;  // P_wall = sum |dp| / (2 tau A), A = 1
+  CHECK(d.momentum[0] - p0 > 0.0);
+  CHECK_NEAR(impulse, d.momentum[0] - p0, 1e-12);
+  // (the refused W1 and its undoing add opposite virials x dv, so only the impulse shows it)
+}
+
 TEST_CASE("a closed 2D gas: K2 + W + W_wall -> 0; temperature from the energy; walls share the pressure") {
   Config c = walled(2, 1.0, Mode::exact);
   const InitialState st = random_state(c, 200, 0.3, 5);
@@ -165,6 +219,77 @@ TEST_CASE("observing changes no trajectory; run_back ends the observation; nothi
   CHECK(after.t_end == before.t_end);
   CHECK(after.particle_collisions == before.particle_collisions);
   CHECK(after.pressure_virial.value == before.pressure_virial.value);
+}
+
+TEST_CASE("snapshots keep a running observation: a resumed run's results equal an uninterrupted one's, bit for bit") {
+  auto check = [](const Config& c0, std::size_t n, double phi, const ObserveConfig& oc, std::uint64_t first,
+                  std::uint64_t second) {
+    const InitialState st = random_state(c0, n, phi, 4);
+    auto a = make_simulation(st.config, st.x, st.v);
+    a->run(first, kInfinity);
+    a->observe(oc);
+    a->run(first, kInfinity);
+    const Snapshot snap = a->snapshot();
+    REQUIRE(!snap.observer.empty());
+    a->run(second, kInfinity);
+    const Observation ra = a->observer()->results();
+    auto b = restore_simulation(snap);
+    REQUIRE(b->observing());
+    b->run(second, kInfinity);
+    const Observation rb = b->observer()->results();
+    CHECK(ra.particle_collisions > 0);
+    CHECK(same(ra, rb));
+    CHECK(a->positions() == b->positions());
+    return ra;
+  };
+  ObserveConfig full;
+  full.slabs = 6;
+  full.speed_bins = 30;
+  full.block_time = 0.002;  // past 256 blocks: the merges go on across the snapshot
+  const Observation o = check(walled(2, 1.0, Mode::exact), 150, 0.35, full, 3000, 5000);
+  CHECK(o.blocks >= 16);
+  Config per;
+  per.dim = 3;
+  check(per, 200, 0.3, ObserveConfig{}, 2000, 2000);
+  ObserveConfig pairs;
+  pairs.pair_bins = 40;
+  pairs.pair_rmax = 2.0;
+  check(walled(2, 2.5, Mode::exact), 3, 0.2, pairs, 500, 700);
+}
+
+TEST_CASE("snapshot observer data: none (old snapshots) resumes nothing; bad data is a named error") {
+  Config c = walled(2, 1.0, Mode::exact);
+  const InitialState st = random_state(c, 60, 0.3, 3);
+  auto s = make_simulation(st.config, st.x, st.v);
+  ObserveConfig oc;
+  oc.slabs = 3;
+  s->observe(oc);
+  s->run(1000, kInfinity);
+  const Snapshot good = s->snapshot();
+  Snapshot old = good;
+  old.observer.clear();
+  old.observer_counts.clear();
+  auto r = restore_simulation(old);
+  CHECK(r->observer() == nullptr);
+  CHECK(!r->observing());
+  s->stop_observing();
+  CHECK(s->snapshot().observer.empty());  // a stopped observation is not kept
+  auto bad = [&](auto spoil) {
+    Snapshot b = good;
+    spoil(b);
+    CHECK_THROWS_AS(restore_simulation(b), InvalidArgument);
+  };
+  bad([](Snapshot& b) { b.observer.pop_back(); });
+  bad([](Snapshot& b) { b.observer.push_back(0.0); });
+  bad([](Snapshot& b) { b.observer_counts.pop_back(); });
+  bad([](Snapshot& b) { b.observer.clear(); });  // counts without the observer
+  bad([](Snapshot& b) { b.observer.back() = std::nan(""); });
+  bad([](Snapshot& b) { b.observer[1] = 61.0; });    // another n
+  bad([](Snapshot& b) { b.observer[3] = 1.0; });     // min_blocks < 2
+  bad([](Snapshot& b) { b.observer[5] = 2.5; });     // slabs not whole
+  bad([](Snapshot& b) { b.observer[12] = 1e9; });    // last update after the clock
+  bad([](Snapshot& b) { b.observer[18 + 2] += 1.0; });  // particle 0's velocity is not the particle's
+  bad([](Snapshot& b) { b.observer[14] = 300.0; });  // more blocks than are ever kept
 }
 
 TEST_CASE("validation: a bad config throws InvalidArgument and keeps the running observation") {

@@ -87,10 +87,91 @@ def test_radial_distribution_numpy_fallback():
     r, g = radial_distribution(frames, sim.box, bins=50, r_max=3.0, use_freud=False)
     assert np.all(g[r < 0.97] == 0.0)  # hard disks never overlap
     assert g[(r > 1.0) & (r < 1.06)].max() > 2.0  # the contact peak
-    with pytest.raises(ValueError, match="periodic"):
+    with pytest.raises(ValueError, match="diameter"):  # a walled axis: the centres' region needs D
         radial_distribution(frames, sim.box, periodic=[True, False])
     with pytest.raises(ValueError, match="r_max"):
         radial_distribution(frames, sim.box, r_max=100.0)
+
+
+def test_snapshot_resumes_the_observation_bit_for_bit(tmp_path):
+    """observe, run, snapshot (dict, file, pickle), run: the resumed runs' results equal the
+    uninterrupted run's exactly; a snapshot without the observer keys (an older one) loads
+    with no observation; a spoiled observer entry is a named error."""
+    import pickle
+
+    sim = revcol.Simulation.random(n=120, dim=2, phi=0.4, seed=5, boundary="wall")
+    sim.run(collisions=2000)
+    sim.observe(speed_bins=20, slabs=4, block_time=0.01)
+    sim.run(collisions=3000)
+    snap = sim.snapshot()
+    assert len(snap["observer"]) > 0 and len(snap["observer_counts"]) > 0
+    sim.save(tmp_path / "c.npz")
+    copy = pickle.loads(pickle.dumps(sim))
+    sim.run(collisions=4000)
+    want = sim.observation().to_dict()
+    for resumed in (revcol.Simulation.from_snapshot(snap), revcol.Simulation.load(tmp_path / "c.npz"), copy):
+        assert resumed.observing
+        resumed.run(collisions=4000)
+        assert resumed.observation().to_dict() == want
+    old = {k: v for k, v in snap.items() if k not in ("observer", "observer_counts")}
+    plain = revcol.Simulation.from_snapshot(old)
+    assert not plain.observing and plain.observation() is None
+    bad = dict(snap)
+    bad["observer"] = np.asarray(snap["observer"])[:-1]
+    with pytest.raises(ValueError, match="observer"):
+        revcol.Simulation.from_snapshot(bad)
+
+
+def _batched_rdf(points, box, batches, **kw):
+    """g(r) of each batch of frames: the mean and its standard error over the batches."""
+    gs = []
+    for part in np.array_split(points, batches):
+        r, g = radial_distribution(part, box, **kw)
+        gs.append(g)
+    gs = np.asarray(gs)
+    return r, gs.mean(0), gs.std(0, ddof=1) / np.sqrt(batches)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_radial_distribution_walled_box_ideal_gas(d):
+    """Uniform points in a walled box: g(r) = 1 within its error at every r up to r_max,
+    with each reference point's shell cut by the walls; the periodic normalization (the
+    whole shell) fails the same test near r_max (its ideal count is too large there)."""
+    rng = np.random.default_rng(7 + d)
+    D = 0.5
+    L = np.array([8.0, 9.0, 10.0][:d])
+    n, frames, batches = (300, 48, 12) if d == 2 else (250, 48, 12)
+    pts = D / 2 + rng.random((frames, n, d)) * (L - D)  # centres in [D/2, L - D/2]
+    r_max = 0.5 * float((L - D).min())
+    kw = dict(bins=20, r_max=r_max, periodic=[False] * d, diameter=D)
+    r, g, err = _batched_rdf(pts, L, batches, **kw)
+    assert np.all(err > 0)
+    assert np.all(np.abs(g - 1.0) < 4.0 * err), (g - 1.0) / err
+    # the same pairs normalized by the whole shell (no walls): g falls well below 1 near r_max
+    edges = np.linspace(0.0, r_max, 21)
+    shell = np.diff(np.pi * edges ** 2 if d == 2 else 4.0 / 3.0 * np.pi * edges ** 3)
+    gp = []
+    for part in np.array_split(pts, batches):
+        c = np.zeros(20)
+        for f in part:
+            dr = np.sqrt(((f[:, None, :] - f[None, :, :]) ** 2).sum(-1))
+            c += np.histogram(dr[dr > 0], bins=edges)[0]
+        gp.append(c / (len(part) * n * (n - 1) / np.prod(L - D) * shell))
+    gp = np.asarray(gp)
+    gpm, gpe = gp.mean(0), gp.std(0, ddof=1) / np.sqrt(batches)
+    assert (1.0 - gpm[-1]) > 10.0 * gpe[-1]  # the periodic normalization misses by > 10 SE
+
+
+def test_radial_distribution_walled_box_arguments():
+    pts = np.random.default_rng(3).random((2, 50, 2)) * 4.0
+    with pytest.raises(ValueError, match="diameter"):
+        radial_distribution(pts, [4.0, 4.0], periodic=[False, True])
+    with pytest.raises(ValueError, match="r_max"):
+        radial_distribution(pts, [4.0, 4.0], periodic=[False, True], diameter=1.0, r_max=1.6)
+    with pytest.raises(ValueError, match="freud"):
+        radial_distribution(pts, [4.0, 4.0], periodic=[False, False], diameter=0.0, use_freud=True)
+    r, g = radial_distribution(pts, [4.0, 4.0], periodic=[False, True], diameter=1.0, bins=5)
+    assert r[-1] < 1.5 and g.shape == (5,)  # r_max defaults to (L - D) / 2 on the walled axis
 
 
 def observed_scene(tmp_path, **observe):

@@ -121,3 +121,19 @@ def test_closed_box_walls_share_the_pressure_uniform_lowers_it():
     assert abs(f["virial_balance"][0]) < LIMIT * f["virial_balance"][1] + 1e-3  # K2 + W + W_wall -> 0
     assert f["slab_temperature_max_z"] < 4.0
     assert u["pressure_wall"][0][0] < px - 5 * math.hypot(ex, u["pressure_wall"][0][1])
+
+
+def test_extrapolate_in_one_over_n():
+    """Z(N) = Z_inf + a / N: two sizes give the line through both (error propagated by hand),
+    three on a line give it back exactly, and one size is refused."""
+    from revcol.physics import extrapolate
+
+    zi, ei, a = extrapolate([1000, 4000], [6.4609, 6.4568], [0.0022, 0.0012])
+    assert zi == pytest.approx((4 * 6.4568 - 6.4609) / 3, abs=1e-12)
+    assert ei == pytest.approx(math.sqrt(16 * 0.0012 ** 2 + 0.0022 ** 2) / 3, rel=1e-9)
+    assert a == pytest.approx((6.4609 - 6.4568) * 4000 / 3, rel=1e-9)
+    ns = [1000, 4000, 16000]
+    zi, ei, a = extrapolate(ns, [9.4 + 12.0 / n for n in ns], [0.004, 0.002, 0.001])
+    assert zi == pytest.approx(9.4, abs=1e-12) and a == pytest.approx(12.0, rel=1e-9) and ei > 0
+    with pytest.raises(ValueError, match="two different sizes"):
+        extrapolate([1000, 1000], [1.0, 1.1], [0.1, 0.1])

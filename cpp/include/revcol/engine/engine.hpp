@@ -247,6 +247,8 @@ struct Snapshot : Visitable<Snapshot> {
   std::vector<double> pre_vals;                ///< exact-pre log: kept pre velocities
   std::uint64_t pre_pushed = 0;                ///< exact-pre entries ever pushed
   std::vector<std::uint64_t> trace;            ///< the collision trace (CollisionTrace::save; empty: a new one)
+  std::vector<double> observer;                ///< a running observation (Observer::save; empty: none)
+  std::vector<std::uint64_t> observer_counts;  ///< its counts per block
   Counters counters;
   double energy0 = 0.0;                        ///< kinetic energy at construction
   std::array<double, 3> momentum0{};           ///< momentum at construction
@@ -318,6 +320,8 @@ struct Snapshot : Visitable<Snapshot> {
     f("pre_pushed", s.pre_pushed);
     f("trace", s.trace);
     f("energy0", s.energy0);
+    f("observer", s.observer);
+    f("observer_counts", s.observer_counts);
   }
 };
 

@@ -13,11 +13,14 @@
 // on periodic axes (the engine wraps stored positions at list renewals; the observer
 // never wraps): the mean squared displacement needs no crossing count.
 //
-// Time averages, not event averages. A quantity that is constant on a segment (v^2, the
-// speed, the slab a stretch of the line lies in) is weighted by the segment's duration
-// when the segment closes (at the particle's next velocity change, at a block's end, or
-// at a sync). Speeds change only at collisions and walls, so the speed histogram is
-// time-weighted exactly, with no sampling of frames.
+// Time averages, not event averages. Sums over the particles that change only at velocity
+// changes (sum v^2, sum |v|) are kept as running sums and integrated exactly from one
+// change to the next. A quantity constant on a segment (its speed bin, the slab a stretch
+// of the line lies in) is weighted by the segment's duration when the segment closes (at
+// the particle's next velocity change, or at a sync). Speeds change only at collisions and
+// walls, so the speed histogram is time-weighted exactly, with no sampling of frames.
+// Slabs: a segment keeps its cell along the slab axis; one that ends in its cell never
+// left it (two comparisons), one that crossed walks its cells (observe.cpp).
 //
 // Pressure. Unit masses, k_B = 1. The virial theorem for a stationary system,
 //     d P V = < sum_i m v_i^2 > + (1 / tau) sum_collisions sum_members x_u . Delta p_u,
@@ -42,8 +45,13 @@
 // fraction near contact have no sampling error beyond the dynamics' own.
 //
 // Errors: block averages. Blocks are of equal simulated time, starting at block_time (0:
-// D / v_rms, about a collision time at moderate density); at every block end all
-// segments close there. When 256 blocks are full, neighbours merge (the block time
+// D / v_rms, about a collision time at moderate density). At a block end the running
+// sums are integrated to it and the MSD is taken from every particle's position then, but
+// the segments do not close there: a segment's profile time (speed bin, slabs) goes to the
+// block in which it closes, which blurs the profiles' block values by about a free time at
+// each block edge (their totals are exact). Closing all N segments at every block end cost
+// about as much per collision as the rest of the observer. With pair distances (small
+// systems) every segment does close at each block end. When 256 blocks are full, neighbours merge (the block time
 // doubles), so a long run keeps 128-255 blocks. A result's value comes from the totals of
 // the whole observed time; its error is s / sqrt(n_b), s the sample standard deviation of
 // the values of n_b complete blocks, merged down to [min_blocks, 2 min_blocks) first
@@ -52,9 +60,20 @@
 // Cost: measured with callgrind in docs/physics.md (off: one pointer test per velocity
 // change in the engine's hooks, note_pair / note_wall, out of line and cold).
 //
+// Energy: K2 uses the running sum of v^2, so the temperature is 2 E / (d N) of the energy
+// the particles have, and its block error is round-off (E is conserved).
+//
 // Reversal: observation is forward only. run_back first syncs the observer at the clock
 // and stops it (its results stay readable, nothing more is added); a forward run after it
-// adds nothing until observe() starts a new observation. Snapshots do not keep it.
+// adds nothing until observe() starts a new observation.
+//
+// Snapshots keep a running observation: its whole state (config, segments, start
+// positions, blocks, MSD) as reals and counts (save; the layout is in observe.cpp), from
+// which a restored simulation resumes it, so that its results are those of a run never
+// interrupted, bit for bit (the quantities a segment derives from its velocity, v^2, the
+// speed and its bin, are recomputed by the same operations). A stopped observation is not
+// kept. Loading checks every size, that every real is finite, the times are ordered and
+// the segments' velocities are the particles' (InvalidArgument naming the first problem).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -117,6 +136,20 @@ class Observer {
   /// which axes have walls, the diameter. Throws InvalidArgument on a bad config.
   Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v, double t,
            const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter);
+  /// Resumes a saved observation (save) of the particles with velocities v (n x dim) at the
+  /// clock t, in this box; throws InvalidArgument naming what is inconsistent.
+  Observer(const std::vector<double>& reals, const std::vector<std::uint64_t>& counts, int dim,
+           const std::vector<double>& v, double t, const std::array<double, 3>& box,
+           const std::array<bool, 3>& walls, double diameter);
+  /// The whole state, for a snapshot: reals (times, sums, positions) and counts.
+  /// reals: a header of 18 values (dim, n, the config's eight fields in declaration order,
+  /// block_time_, t_start_, t_now_, speed_max_, complete blocks, MSD points, the running
+  /// sums of v^2 and |v|); per particle its segment (x, v: dim each; t0; with slabs its
+  /// cell); start_ (n x dim); pair_t_ (n x n, with pair bins); each complete block, then the
+  /// open one (t0, t1, k2, w, w_wall, dist, wall_dp[3], slab_t, slab_k2, speed, pair);
+  /// msd_t_, msd_. counts: per block (the same order) pairs, groups, parts, walls.
+  /// Integers among the reals are exact (all far below 2^53).
+  void save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const;
 
   /// A pair collision at t: the velocities after (va, vb). The separation r = x_a - x_b comes
   /// from the observer's own positions, folded to the nearest image on periodic axes (at
@@ -135,7 +168,9 @@ class Observer {
   struct Segment {
     double x[3], v[3];
     double t0, v2, speed;
-    int bin;  // speed bin, -1 outside or no histogram
+    double lo;  // slabs: the lower edge of its cell along the slab axis (unwrapped)
+    int bin;    // speed bin, -1 outside or no histogram
+    int slab;   // slabs: cell mod slabs
   };
   struct Block {
     double t0 = 0.0, t1 = 0.0;
@@ -146,21 +181,27 @@ class Observer {
     void add(const Block& b);
   };
   void reach(double t);  // closes every block that ends at or before t
+  void accumulate(double t);
   void close(int i, double t);
   void set_velocity(int i, const double* v);
   void close_pairs(int i, double t);
+  [[gnu::noinline]] void pairs_to(int i, double t);
   void pair_interval(int i, int j, double t0, double t1);
-  void slab_walk(const Segment& s, double dt);
+  void set_cell(Segment& s, double cell) const;
+  void slab_cross(Segment& s, double t, double end);
   void end_block();
   Block empty_block(double t0) const;
+  void set_geometry(const std::array<double, 3>& box);
   double pos(int i, int k, double t) const { return seg_[i].x[k] + seg_[i].v[k] * (t - seg_[i].t0); }
 
   ObserveConfig cfg_;
   int dim_;
   std::size_t n_;
-  std::array<double, 3> box_, inv_box_;
+  std::array<double, 3> box_, inv_box_, fold_;  // fold_: L on periodic axes, 0 on walled ones
   std::array<bool, 3> walls_;
   double diameter_, volume_, block_time_, t_start_, t_now_, speed_max_, bin_scale_;
+  double v2_sum_ = 0.0, speed_sum_ = 0.0;  // sum v^2 and sum |v|, integrated up to t_now_
+  double slab_w_ = 0.0;                    // the slabs' width
   std::vector<Segment> seg_;
   std::vector<double> start_;   // unwrapped positions at the start (n x dim)
   std::vector<double> pair_t_;  // small systems: when each pair's interval began (n x n)
