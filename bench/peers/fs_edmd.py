@@ -16,13 +16,15 @@ nothing (CI has no network; ``tests/python/test_peers.py`` checks the parts that
 What it does, per workload (N, packing fraction; 3D, periodic, unit diameter, kT = 1):
 
 1. **The state.** revcol's ``Simulation.random`` (FCC start at these densities), run for
-   ``--warmup`` collisions per particle (default 50) with the flux law, then checked for a
-   fluid: the static structure factor S(k) = |sum_j exp(i k . r_j)|^2 / N at the start
+   ``--warmup`` collisions per particle (default 50) with the flux law, and on in steps of that
+   length (up to ``--max-warmup``) until it is a fluid: the static structure factor
+   S(k) = |sum_j exp(i k . r_j)|^2 / N at the start
    lattice's Bragg vectors (the (111) and (200) families of its FCC cell) must be below 10 (a
    crystal remnant gives ~N; a fluid ~1, at most ~2.9 at the first peak: Hansen-Verlet).
    The positions go to the peer as its ``init.sph`` (``N``, box, then ``a x y z 0.5`` per
    line); the peer draws its own Gaussian velocities at kT = 1 (its ``randommovement``), revcol
    keeps the equilibrated ones: the same positions, the same temperature.
+   (At 0.45 the superheated crystal takes hundreds of collisions per particle to melt.)
 2. **The peer's build.** Its ``Single/`` sources are copied to a build folder (next to the
    source, git-ignored) and patched, as a peer benchmark must: the thermostat off
    (``usethermostat = 0``), no screen output inside the run (``writeinterval`` 1e30), and a
@@ -164,19 +166,29 @@ def structure_factor(x: np.ndarray, k: np.ndarray) -> np.ndarray:
     return (np.cos(ph).sum(axis=0) ** 2 + np.sin(ph).sum(axis=0) ** 2) / len(x)
 
 
-def equilibrated_state(n: int, phi: float, warmup_per_particle: float, seed: int = 1) -> dict:
-    """revcol's random start, run for warm-up collisions per particle; positions, velocities,
-    box, and the structure factor at the start lattice's Bragg vectors before and after."""
+def equilibrated_state(n: int, phi: float, warmup_per_particle: float, seed: int = 1,
+                       max_per_particle: float = 2000.0) -> dict:
+    """revcol's random start, run for warm-up collisions per particle, then on in steps of the
+    same length until the start lattice's Bragg peaks have melted (S(k) < 10 at every Bragg
+    vector; a superheated FCC at 0.45 takes hundreds of collisions per particle) or
+    max_per_particle is reached; positions, velocities, box, S(k) before and after, the
+    collisions per particle it took."""
     from revcol import Simulation
     sim = Simulation.random(n, 3, phi, seed=seed, init="lattice")
     k = fcc_bragg_vectors(n, sim.box)
     s_before = float(structure_factor(sim.positions, k).max())
     t0 = time.time()
-    sim.run(collisions=int(warmup_per_particle * n / 2))
-    x = wrapped(sim.positions, sim.box)  # the engine wraps lazily (at list renewals)
-    s_after = float(structure_factor(x, k).max())
+    step, done = int(warmup_per_particle * n / 2), 0
+    while True:
+        sim.run(collisions=step)
+        done += step
+        x = wrapped(sim.positions, sim.box)  # the engine wraps lazily (at list renewals)
+        s_after = float(structure_factor(x, k).max())
+        if s_after < 10.0 or 2.0 * done / n >= max_per_particle:
+            break
     return {"x": x, "v": sim.velocities, "box": sim.box, "s_bragg_start": s_before,
-            "s_bragg_after": s_after, "fluid": s_after < 10.0, "warmup_s": time.time() - t0}
+            "s_bragg_after": s_after, "fluid": s_after < 10.0, "warmup_per_particle": 2.0 * done / n,
+            "warmup_s": time.time() - t0}
 
 
 def _pin(cmd: list, cpu: int) -> list:
@@ -243,10 +255,11 @@ def measure(args, src: str) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         for n in args.n:
             for phi in args.phi:
-                st = equilibrated_state(n, phi, args.warmup)
+                st = equilibrated_state(n, phi, args.warmup, max_per_particle=args.max_warmup)
                 if not st["fluid"]:
                     raise RuntimeError(f"N = {n}, phi = {phi}: S(k) at the start's Bragg vectors is still "
-                                       f"{st['s_bragg_after']:.3g} after the warm-up: not a fluid (raise --warmup)")
+                                       f"{st['s_bragg_after']:.3g} after {st['warmup_per_particle']:.0f} collisions per "
+                                       "particle: not a fluid (raise --max-warmup)")
                 sph, npz = os.path.join(tmp, "init.sph"), os.path.join(tmp, "state.npz")
                 write_sph(sph, st["x"], st["box"])
                 np.savez(npz, x=st["x"], v=st["v"], box=st["box"])
@@ -261,14 +274,24 @@ def measure(args, src: str) -> dict:
                             fwd.append(r["forward"])
                             rev.append(r["reverse"])
                 row = {"n": n, "phi": phi, "s_bragg_start": st["s_bragg_start"], "s_bragg_after": st["s_bragg_after"],
+                       "warmup_per_particle": st["warmup_per_particle"],
                        "peer_per_s": _summary(peer), "revcol_forward_per_s": _summary(fwd),
                        "revcol_reverse_per_s": _summary(rev),
                        "ratio_forward": float(np.median(fwd) / np.median(peer)),
                        "ratio_reverse": float(np.median(rev) / np.median(peer)),
                        "load_before_runs": loads}
                 res["workloads"].append(row)
+                _write_json(args.json, res)  # after every workload: a run cut short keeps what it measured
                 print(json.dumps({k: row[k] for k in ("n", "phi", "ratio_forward", "ratio_reverse")}), flush=True)
+    res["finished_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
     return res
+
+
+def _write_json(path: str, res: dict) -> None:
+    tmp = path + ".part"
+    with open(tmp, "w") as fh:
+        json.dump(res, fh, indent=1)
+    os.replace(tmp, path)
 
 
 def main(argv: Optional[list] = None) -> int:
@@ -279,6 +302,8 @@ def main(argv: Optional[list] = None) -> int:
     ap.add_argument("--collisions", default="1e6", help="timed collisions per run")
     ap.add_argument("--warmup-peer", default="2e5", help="untimed collisions before the timing, in each run")
     ap.add_argument("--warmup", type=float, default=50.0, help="collisions per particle that equilibrate the state")
+    ap.add_argument("--max-warmup", type=float, default=2000.0,
+                    help="collisions per particle at most, in steps of --warmup, until the start lattice has melted")
     ap.add_argument("--pairs", type=int, default=3, help="interleaved (peer, revcol) pairs per workload")
     ap.add_argument("--cpu", type=int, default=1, help="core each run is pinned to (-1: none)")
     ap.add_argument("--json", default=os.path.join(RESULTS, "peer_fs_edmd.json"))
@@ -288,10 +313,7 @@ def main(argv: Optional[list] = None) -> int:
     except PeerMissing as e:
         print(str(e))
         return 0
-    tmp = args.json + ".part"
-    with open(tmp, "w") as fh:
-        json.dump(res, fh, indent=1)
-    os.replace(tmp, args.json)
+    _write_json(args.json, res)
     print("wrote", args.json)
     return 0
 
