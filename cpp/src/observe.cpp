@@ -278,6 +278,7 @@ void Observer::pair(double t, int a, int b, const double* va, const double* vb) 
   reach(t);
   close(a, t);
   close(b, t);
+  if (cfg_.collision_record) [[unlikely]] record_pair(a, b, va, vb);
   double w = 0.0;
   for (int k = 0; k < dim_; ++k) {
     double r = seg_[a].x[k] - seg_[b].x[k];
@@ -412,6 +413,19 @@ Observation Observer::results() const {
   o.msd_time = msd_t_;
   o.msd = msd_;
   return o;
+}
+
+// The collision record's entry of a pair at the positions just closed (header comment).
+void Observer::record_pair(int a, int b, const double* va, const double* vb) {
+  double r[3] = {0.0, 0.0, 0.0}, rr = 0.0;
+  for (int k = 0; k < dim_; ++k) {
+    r[k] = seg_[a].x[k] - seg_[b].x[k];
+    if (!walls_[k]) r[k] -= box_[k] * std::nearbyint(r[k] * inv_box_[k]);  // the nearest image
+    rr += r[k] * r[k];
+  }
+  const double inv = 1.0 / std::sqrt(rr);
+  for (int k = 0; k < dim_; ++k) record_.push_back(r[k] * inv);
+  for (int k = 0; k < dim_; ++k) record_.push_back(va[k] - vb[k]);
 }
 
 }  // namespace revcol::engine
