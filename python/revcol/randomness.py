@@ -9,6 +9,9 @@ uint32 words, the format ``dieharder -g 201 -f FILE`` reads. Under the operator'
 words are uniform; through the other law's CDF, or from a biased operator, they are not.
 Paper mode is read through the exact uniform law's chart: the paper's stated law (uniform
 on the permitted set, uniform in its angles on a round circle for pair2d and triple1d).
+The cases gas2d and gas3d are the float engine's pair collisions in a periodic gas (exact
+mode): the direction of each post relative velocity about its contact normal, read through
+the law's CDF (revcol/randomness.hpp).
 
 The battery runs the paper's tests by dieharder number (``PAPER_TESTS``), one process per
 test and each from the start of the file, without dieharder's ``rate`` output field (its
@@ -22,6 +25,7 @@ test against the uniform law.
 Command line (``python -m revcol.randomness``, also ``revcol study randomness``)::
 
     python -m revcol.randomness battery --case pair2d --mode exact --law flux --rng philox --words 3000000
+    python -m revcol.randomness battery --case gas2d --particles 1000 --fraction 0.2 --words 3000000
     python -m revcol.randomness controls --words 3000000
     python -m revcol.randomness matrix --words 3000000 --json bench/results/randomness_3e6.json
     python -m revcol.randomness coverage --out docs/figures/randomness
