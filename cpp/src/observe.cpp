@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <string>
 
 #include "revcol/error.hpp"
@@ -21,7 +20,6 @@ constexpr std::size_t kMaxBlocks = 256;  // merged pairwise when full
 constexpr std::size_t kHeader = 18, kBlockReals = 9, kBlockCounts = 4;  // snapshots (save)
 constexpr int kMaxBins = 1 << 20;
 constexpr std::size_t kMaxPairParticles = 64;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kRound = 6755399441055744.0;  // 1.5 2^52
 
 // Time tau in [0, span] with a tau^2 + 2 b tau + c < q (a >= 0): the measure of the
@@ -45,15 +43,6 @@ inline double root(double x) {
 #endif
 }
 
-double sample_sd(const std::vector<double>& x) {
-  const double n = static_cast<double>(x.size());
-  double m = 0.0;
-  for (double q : x) m += q;
-  m /= n;
-  double s = 0.0;
-  for (double q : x) s += (q - m) * (q - m);
-  return std::sqrt(s / (n - 1.0));
-}
 
 }  // namespace
 
@@ -456,6 +445,7 @@ void Observer::pair(double t, int a, int b, const double* va, const double* vb) 
   reach(t);
   close(a, t);
   close(b, t);
+  if (cfg_.collision_record) [[unlikely]] record_pair(a, b, va, vb);
   double w = 0.0;
   for (int k = 0; k < dim_; ++k) {
     // the nearest image (|r| = D < L / 2; fold_ is 0 on walled axes), rounding q to the
@@ -510,85 +500,17 @@ void Observer::sync(double t) {
   }
 }
 
-Observation Observer::results() const {
-  Observation o;
-  o.dim = dim_;
-  o.n = n_;
-  o.t_start = t_start_;
-  o.t_end = t_now_;
-  Block tot = empty_block(t_start_);
-  for (const Block& b : blocks_) tot.add(b);
-  tot.add(cur_);
-  tot.t1 = t_now_;
-  o.pair_collisions = tot.pairs;
-  o.group_collisions = tot.groups;
-  o.particle_collisions = tot.parts;
-  o.wall_reflections = tot.walls;
-  // the blocks of the errors: complete ones, merged down to [min_blocks, 2 min_blocks)
-  std::vector<Block> bl = blocks_;
-  while (bl.size() >= 2 * static_cast<std::size_t>(cfg_.min_blocks)) {
-    std::vector<Block> m;
-    for (std::size_t u = 0; u + 1 < bl.size(); u += 2) {
-      m.push_back(bl[u]);
-      m.back().add(bl[u + 1]);
-    }
-    bl = std::move(m);
-  }
-  o.blocks = static_cast<int>(bl.size());
-  o.block_time = bl.empty() ? 0.0 : bl[0].t1 - bl[0].t0;
-  const double N = static_cast<double>(n_), d = dim_;
-  auto est = [&](auto f) {
-    Estimate e;
-    const double tau = tot.t1 - tot.t0;
-    e.value = tau > 0.0 ? f(tot, tau) : kNaN;
-    if (bl.size() >= 2) {
-      std::vector<double> vals;
-      for (const Block& b : bl) vals.push_back(f(b, b.t1 - b.t0));
-      e.error = sample_sd(vals) / std::sqrt(static_cast<double>(vals.size()));
-    }
-    return e;
-  };
-  auto ratio = [](double a, double b) { return b != 0.0 ? a / b : kNaN; };
-  o.temperature = est([&](const Block& b, double tau) { return b.k2 / (d * N * tau); });
-  o.pressure_virial = est([&](const Block& b, double tau) { return (b.k2 + b.w) / (d * volume_ * tau); });
-  o.compressibility = est([&](const Block& b, double) { return 1.0 + ratio(b.w, b.k2); });
-  o.collision_rate = est([&](const Block& b, double tau) { return static_cast<double>(b.parts) / (N * tau); });
-  o.mean_free_time = est([&](const Block& b, double tau) { return ratio(N * tau, static_cast<double>(b.parts)); });
-  o.mean_free_path = est([&](const Block& b, double) { return ratio(b.dist, static_cast<double>(b.parts)); });
-  o.virial_balance = est([&](const Block& b, double) { return ratio(b.k2 + b.w + b.w_wall, b.k2); });
+// The collision record's entry of a pair at the positions just closed (header comment).
+void Observer::record_pair(int a, int b, const double* va, const double* vb) {
+  double r[3] = {0.0, 0.0, 0.0}, rr = 0.0;
   for (int k = 0; k < dim_; ++k) {
-    if (!walls_[k]) continue;
-    const double area = volume_ / box_[k];
-    o.pressure_wall[k] = est([&](const Block& b, double tau) { return b.wall_dp[k] / (2.0 * tau * area); });
+    r[k] = seg_[a].x[k] - seg_[b].x[k];
+    if (!walls_[k]) r[k] -= box_[k] * std::nearbyint(r[k] * inv_box_[k]);  // the nearest image
+    rr += r[k] * r[k];
   }
-  auto profile = [&](int bins, double width, auto f) {
-    Profile p;
-    for (int u = 0; u <= bins; ++u) p.edges.push_back(u * width);
-    for (int u = 0; u < bins; ++u) {
-      const Estimate e = est([&](const Block& b, double tau) { return f(b, tau, u); });
-      p.value.push_back(e.value);
-      p.error.push_back(e.error);
-    }
-    return p;
-  };
-  if (cfg_.slabs > 0) {
-    const double w = box_[cfg_.slab_axis] / cfg_.slabs, vol = volume_ / cfg_.slabs;
-    o.slab_density = profile(cfg_.slabs, w, [&](const Block& b, double tau, int u) { return b.slab_t[u] / (tau * vol); });
-    o.slab_temperature =
-        profile(cfg_.slabs, w, [&](const Block& b, double, int u) { return ratio(b.slab_k2[u], d * b.slab_t[u]); });
-  }
-  if (cfg_.speed_bins > 0) {
-    const double h = speed_max_ / cfg_.speed_bins;
-    o.speed = profile(cfg_.speed_bins, h, [&](const Block& b, double tau, int u) { return b.speed[u] / (N * tau * h); });
-  }
-  if (cfg_.pair_bins > 0) {
-    const double h = cfg_.pair_rmax / cfg_.pair_bins, np = 0.5 * N * (N - 1.0);
-    o.pair_distance =
-        profile(cfg_.pair_bins, h, [&](const Block& b, double tau, int u) { return b.pair[u] / (np * tau * h); });
-  }
-  o.msd_time = msd_t_;
-  o.msd = msd_;
-  return o;
+  const double inv = 1.0 / std::sqrt(rr);
+  for (int k = 0; k < dim_; ++k) record_.push_back(r[k] * inv);
+  for (int k = 0; k < dim_; ++k) record_.push_back(va[k] - vb[k]);
 }
 
 }  // namespace revcol::engine

@@ -5,11 +5,16 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <limits>
 
 #include "paper_adapt.hpp"
 #include "revcol/collide/cases.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
 #include "revcol/collide/pair2d_paper.hpp"
+#include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
+#include "revcol/engine/limits.hpp"
+#include "revcol/engine/observe.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
@@ -70,6 +75,7 @@ struct Source {
   virtual int width() const = 0;
   virtual void step(Uniforms& gen, double* u) = 0;
   std::uint64_t restarts = 0;
+  std::uint64_t skipped = 0;  // gas: group collisions (no words)
 };
 
 struct Raw final : Source {
@@ -168,13 +174,24 @@ std::unique_ptr<Source> pair2d(Op op, Law cdf_law, int bits, bool may_fail) {
       });
 }
 
+// The chain's first pre state: a Newton's cradle starts at rest but for particle 0, which
+// moves towards the others (verify_exact.cpp's start: v_0 = 1, in 2D (1, 1/4)); every other
+// case from approaching_state(op, 1).
+std::vector<double> start_state(const NamedCase& nc, const ExactCollision& op) {
+  if (nc.name.rfind("cradle", 0) != 0) return approaching_state(op, 1);
+  std::vector<double> v(static_cast<std::size_t>(nc.n * nc.d), 0.0);
+  v[0] = 1.0;
+  if (nc.d > 1) v[1] = 0.25;
+  return v;
+}
+
 // Every named case in exact mode through the general operator (verify_exact.cpp's chain:
 // the held momentum follows the sign of the negated velocities).
 std::unique_ptr<Source> exact_case(const NamedCase& nc, const StreamConfig& c) {
   auto op = std::make_shared<const ExactCollision>(exact_operator(nc, c.law, c.bits));
   auto mapper = std::make_shared<const ExactCollision>(exact_operator(nc, c.cdf_law, c.bits));
   require(op->draws() >= 1, [&] { return nc.name + " has no free parameter (d_n = 0): no words"; });
-  const std::vector<double> v = approaching_state(*op, 1);
+  const std::vector<double> v = start_state(nc, *op);
   auto mp = std::make_shared<std::vector<double>>(nc.d, 0.0);
   auto mn = std::make_shared<std::vector<double>>(nc.d, 0.0);
   double e = 0.0;
@@ -234,10 +251,99 @@ std::unique_ptr<Source> paper_chain(const paper::PaperCase& pc, const StreamConf
       });
 }
 
+// --- the engine's collisions in a gas -------------------------------------------------------
+
+// The direction of a pair's post relative velocity w about its contact normal a (unit) as d - 1
+// CDF values of the law (randomness.hpp): 2D the signed angle eta from a, 3D the polar angle
+// eta and the azimuth phi in the frame of pair3d_exact.hpp (t1 along e_k x a, e_k the axis
+// least aligned with a; t2 = a x t1).
+void gas_chart(int dim, Law law, const double* a, const double* w, double* u) {
+  constexpr double kPi = engine::limits::kPi;
+  if (dim == 2) {
+    const double p = w[0] * a[0] + w[1] * a[1], q = w[1] * a[0] - w[0] * a[1];
+    u[0] = law == Law::flux ? 0.5 * (1.0 + q / std::hypot(p, q)) : std::atan2(q, p) / kPi + 0.5;
+    return;
+  }
+  int k = 0;
+  for (int j = 1; j < 3; ++j)
+    if (std::fabs(a[j]) < std::fabs(a[k])) k = j;
+  double t1[3] = {0.0, 0.0, 0.0};  // e_k x a
+  t1[(k + 1) % 3] = -a[(k + 2) % 3];
+  t1[(k + 2) % 3] = a[(k + 1) % 3];
+  const double s = 1.0 / std::hypot(t1[0], t1[1], t1[2]);
+  for (double& x : t1) x *= s;
+  const double t2[3] = {a[1] * t1[2] - a[2] * t1[1], a[2] * t1[0] - a[0] * t1[2], a[0] * t1[1] - a[1] * t1[0]};
+  double p = 0.0, q1 = 0.0, q2 = 0.0;
+  for (int j = 0; j < 3; ++j) {
+    p += w[j] * a[j];
+    q1 += w[j] * t1[j];
+    q2 += w[j] * t2[j];
+  }
+  const double T = q1 * q1 + q2 * q2, N = std::sqrt(p * p + T);
+  u[0] = law == Law::flux ? T / (p * p + T) : (p > 0.0 ? T / (N * (N + p)) : 1.0 - p / N);
+  const double phi = std::atan2(q2, q1) / (2.0 * kPi);
+  u[1] = phi < 0.0 ? phi + 1.0 : phi;
+}
+
+// A periodic gas of the float engine in exact mode: each pair collision's post direction
+// about its normal, read by gas_chart through cdf_law. The engine runs in chunks, each with
+// a fresh observation whose collision record (observe.hpp) holds the chunk's pair
+// collisions; group collisions give no word (counted in `skipped`).
+class Gas final : public Source {
+ public:
+  Gas(const StreamConfig& c, int dim) : dim_(dim), law_(c.cdf_law) {
+    require(c.mode == Mode::exact, "the gas streams run in exact mode only");
+    require(c.rng == "philox" || c.rng == "clcg4", [&] { return "a gas stream's rng must be philox or clcg4, got '" + c.rng + "'"; });
+    require(c.seed < (std::uint64_t{1} << 32), "a gas stream's seed must be < 2^32");
+    require(c.gas_particles >= 2, "a gas needs at least 2 particles");
+    require(std::isfinite(c.gas_warmup) && c.gas_warmup >= 0.0 && c.gas_warmup <= 1e6,
+            "gas warm-up must be in [0, 1e6] collisions per particle");
+    engine::Config ec;
+    ec.dim = dim;
+    ec.mode = Mode::exact;
+    ec.law = c.law;
+    ec.bits = c.bits;
+    ec.seed = static_cast<std::uint32_t>(c.seed);
+    ec.generator = engine::parse_generator(c.rng);
+    const engine::InitialState s = engine::random_state(ec, c.gas_particles, c.gas_fraction, c.seed);
+    sim_ = engine::make_simulation(s.config, s.x, s.v);
+    const double warm = std::ceil(0.5 * c.gas_warmup * static_cast<double>(c.gas_particles));
+    if (warm > 0.0) sim_->run(static_cast<std::uint64_t>(warm), kInf);  // a collision moves 2 particles
+  }
+  int width() const override { return dim_ - 1; }
+  void step(Uniforms&, double* u) override {
+    while (at_ == record_.size()) refill();
+    gas_chart(dim_, law_, &record_[at_], &record_[at_ + dim_], u);
+    at_ += 2 * static_cast<std::size_t>(dim_);
+  }
+
+ private:
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  static constexpr std::uint64_t kChunk = 1 << 16;  // collisions per observation
+  void refill() {
+    engine::ObserveConfig oc;
+    oc.collision_record = true;
+    sim_->observe(oc);
+    const std::uint64_t groups = sim_->diagnostics().counters.group_collisions;
+    const engine::RunResult r = sim_->run(kChunk, kInf);
+    require(r.collisions > 0, "the gas made no collision");
+    skipped += sim_->diagnostics().counters.group_collisions - groups;
+    record_ = sim_->observer()->collision_record();
+    sim_->stop_observing();
+    at_ = 0;
+  }
+  int dim_;
+  Law law_;
+  std::unique_ptr<engine::Simulation> sim_;
+  std::vector<double> record_;
+  std::size_t at_ = 0;
+};
+
 std::unique_ptr<Source> make_source(const StreamConfig& c) {
   FixedPoint check_bits(c.bits);  // validates K
   (void)check_bits;
   if (c.case_name == "raw") return std::make_unique<Raw>();
+  if (c.case_name == "gas2d" || c.case_name == "gas3d") return std::make_unique<Gas>(c, c.case_name[3] - '0');
   if (c.mode == Mode::exact) {
     if (c.case_name == "pair2d") return pair2d(Pair2DExact(c.law, c.bits), c.cdf_law, c.bits, false);
     for (const NamedCase& nc : named_cases())
@@ -264,6 +370,8 @@ std::vector<std::string> stream_cases(Mode mode) {
   if (mode == Mode::exact) {
     for (const NamedCase& nc : named_cases())
       if (nc.name != "pair2d" && (nc.n - 1) * nc.d >= 2) out.push_back(nc.name);
+    out.push_back("gas2d");
+    out.push_back("gas3d");
   } else if (mode == Mode::paper) {
     for (const paper::PaperCase& pc : paper::paper_cases()) out.push_back(pc.name);
   }
@@ -296,6 +404,7 @@ int WordStream::width() const { return impl_->source->width(); }
 std::uint64_t WordStream::collisions() const { return impl_->steps; }
 std::uint64_t WordStream::words() const { return impl_->words; }
 std::uint64_t WordStream::restarts() const { return impl_->source->restarts; }
+std::uint64_t WordStream::skipped() const { return impl_->source->skipped; }
 
 void WordStream::fill(std::uint32_t* out, std::size_t n, const InterruptCheck& interrupt) {
   Impl& s = *impl_;

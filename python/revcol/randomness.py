@@ -9,6 +9,9 @@ uint32 words, the format ``dieharder -g 201 -f FILE`` reads. Under the operator'
 words are uniform; through the other law's CDF, or from a biased operator, they are not.
 Paper mode is read through the exact uniform law's chart: the paper's stated law (uniform
 on the permitted set, uniform in its angles on a round circle for pair2d and triple1d).
+The cases gas2d and gas3d are the float engine's pair collisions in a periodic gas (exact
+mode): the direction of each post relative velocity about its contact normal, read through
+the law's CDF (revcol/randomness.hpp).
 
 The battery runs the paper's tests by dieharder number (``PAPER_TESTS``), one process per
 test and each from the start of the file, without dieharder's ``rate`` output field (its
@@ -22,6 +25,7 @@ test against the uniform law.
 Command line (``python -m revcol.randomness``, also ``revcol study randomness``)::
 
     python -m revcol.randomness battery --case pair2d --mode exact --law flux --rng philox --words 3000000
+    python -m revcol.randomness battery --case gas2d --particles 1000 --fraction 0.2 --words 3000000
     python -m revcol.randomness controls --words 3000000
     python -m revcol.randomness matrix --words 3000000 --json bench/results/randomness_3e6.json
     python -m revcol.randomness coverage --out docs/figures/randomness
@@ -60,6 +64,8 @@ PAPER_TESTS = {15: "runs", 16: "craps", 12: "3d spheres", 11: "minimum distance 
                10: "parking lot", 13: "squeeze", 0: "birthdays", 2: "rank 32x32", 3: "rank 6x8"}
 #: the reduced battery of the CI test
 CI_TESTS = (15, 12, 10)
+#: the gas streams' defaults: particles, packing fraction, warm-up collisions per particle
+GAS_PARTICLES, GAS_FRACTION, GAS_WARMUP = 1000, 0.2, 5.0
 
 _FIELDS = ["-D", "test_name", "-D", "ntuple", "-D", "tsamples", "-D", "psamples", "-D", "pvalues",
            "-D", "assessment"]
@@ -72,29 +78,44 @@ def stream_cases(mode: str = "exact") -> list[str]:
 
 
 def stream(case: str, *, mode: str = "exact", law: str = "flux", rng: str = "philox", seed: int = 0,
-           cdf_law: Optional[str] = None, bits: int = 40) -> Any:
+           cdf_law: Optional[str] = None, bits: int = 40, particles: int = GAS_PARTICLES,
+           fraction: float = GAS_FRACTION, warmup: float = GAS_WARMUP) -> Any:
     """A :class:`revcol._core.WordStream`: ``.words(n)`` (numpy uint32), ``.write(path, n)``.
 
     cdf_law: the law whose chart maps post states to words; default ``law`` in exact mode
     and ``"uniform"`` (the paper's stated law) in paper mode. rng: clcg4, philox, or the
     bad controls randu and philox-repeat100. case "raw": the generator's own draws.
+    case "gas2d" / "gas3d": the float engine's pair collisions in a periodic gas of
+    ``particles`` at packing fraction ``fraction``, after ``warmup`` collisions per particle
+    (exact mode, philox or clcg4; group collisions give no word, ``.skipped`` counts them).
     """
     if cdf_law is None:
         cdf_law = law if mode == "exact" else "uniform"
     return _core.WordStream(case=case, mode=mode, law=law, cdf_law=cdf_law, rng=rng, seed=int(seed),
-                            bits=int(bits))
+                            bits=int(bits), particles=int(particles), fraction=float(fraction),
+                            warmup=float(warmup))
 
 
 def write_words(path: str, n: int, **config: Any) -> dict:
-    """Writes n words of ``stream(**config)`` to a new raw file; returns the stream's counts
-    and the wall time."""
+    """Writes n words of ``stream(**config)`` to a new raw file, atomically: into
+    ``path + ".part"``, renamed when complete, so that an error or Ctrl-C (KeyboardInterrupt,
+    the stream polls every 2^16 words) leaves no file. Returns the stream's counts (gas:
+    the group collisions skipped) and the wall time."""
     if os.path.exists(path):
         os.remove(path)
+    part = path + ".part"
     s = stream(**config)
     t0 = time.perf_counter()
-    s.write(path, int(n))
+    try:
+        if os.path.exists(part):
+            os.remove(part)
+        s.write(part, int(n))
+        os.replace(part, path)
+    finally:
+        if os.path.exists(part):
+            os.remove(part)
     return {"words": int(s.emitted), "collisions": int(s.collisions), "restarts": int(s.restarts),
-            "write_s": round(time.perf_counter() - t0, 3)}
+            "skipped": int(s.skipped), "write_s": round(time.perf_counter() - t0, 3)}
 
 
 def has_dieharder() -> bool:
@@ -483,7 +504,7 @@ def _figure_exact_cases(out: str, samples: int) -> str:
     import matplotlib.pyplot as plt
 
     cases = [c for c in stream_cases("exact") if c not in ("raw", "pair2d", "pair3d", "triple1d")
-             and not c.startswith("triple2d")]
+             and not c.startswith(("triple2d", "gas"))]
     fig, ax = plt.subplots(2, len(cases), figsize=(2.2 * len(cases), 4.4), constrained_layout=True)
     for col, case in enumerate(cases):
         for row, law in enumerate(("flux", "uniform")):
@@ -564,8 +585,10 @@ def table(runs: Sequence[dict], detail: bool = False) -> str:
         c = r["config"]
         weak = "; ".join(f"-d {t['test']}: {t['verdict']}" for t in r["tests"] if "rerun" in t) or "-"
         p = r["pvalues"]
+        lost = (f"{r['stream'].get('skipped', 0)} groups" if c["case"].startswith("gas")
+                else r["stream"]["restarts"])
         lines.append(f"| {c['case']} | {c['mode']} | {c['law']} | {c['rng']} | {r['words']:.2g} | "
-                     f"{r['stream']['restarts']} | {len(p)} | {min(p):.2g} | {max(p):.4f} | {r['ks_p']:.3f} | "
+                     f"{lost} | {len(p)} | {min(p):.2g} | {max(p):.4f} | {r['ks_p']:.3f} | "
                      f"{weak} | **{r['verdict']}** |")
     return "\n".join(lines)
 
@@ -590,7 +613,7 @@ def _tests(spec: str) -> list[int]:
 
 
 def _matrix_configs(cases: Sequence[str], modes: Sequence[str], laws: Sequence[str],
-                    rngs: Sequence[str]) -> list[dict]:
+                    rngs: Sequence[str], gas: Optional[dict] = None) -> list[dict]:
     out = []
     for mode in modes:
         known = stream_cases(mode)
@@ -599,8 +622,17 @@ def _matrix_configs(cases: Sequence[str], modes: Sequence[str], laws: Sequence[s
                 continue
             for law in (laws if mode == "exact" else ["uniform"]):
                 for rng in rngs:
-                    out.append({"case": case, "mode": mode, "law": law, "rng": rng, "seed": 1})
+                    out.append(_gas_options({"case": case, "mode": mode, "law": law, "rng": rng, "seed": 1}, gas))
     return out
+
+
+def _gas_options(cfg: dict, gas: Optional[dict]) -> dict:
+    """cfg with the gas options (particles, fraction, warmup) when its case is a gas."""
+    if not cfg["case"].startswith("gas"):
+        return cfg
+    g = {"particles": GAS_PARTICLES, "fraction": GAS_FRACTION, "warmup": GAS_WARMUP}
+    g.update({k: v for k, v in (gas or {}).items() if v is not None})
+    return dict(cfg, particles=int(g["particles"]), fraction=float(g["fraction"]), warmup=float(g["warmup"]))
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -615,19 +647,24 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     common.add_argument("--workdir", help="where the word files go (default: the temp dir)")
     common.add_argument("--defaults", action="store_true",
                         help="dieharder's default psamples (a long file); otherwise fit them to the file")
-    b = sub.add_parser("battery", parents=[common], help="one case")
+    gas_args = argparse.ArgumentParser(add_help=False)
+    gas_args.add_argument("--particles", type=int, help=f"gas cases: N (default {GAS_PARTICLES})")
+    gas_args.add_argument("--fraction", type=float, help=f"gas cases: packing fraction (default {GAS_FRACTION})")
+    gas_args.add_argument("--warmup", type=float,
+                          help=f"gas cases: collisions per particle before the first word (default {GAS_WARMUP})")
+    b = sub.add_parser("battery", parents=[common, gas_args], help="one case")
     b.add_argument("--case", default="pair2d")
     b.add_argument("--mode", default="exact")
     b.add_argument("--law", default="flux")
     b.add_argument("--rng", default="philox")
     b.add_argument("--seed", type=int, default=1)
     sub.add_parser("controls", parents=[common], help="the good and bad controls")
-    m = sub.add_parser("matrix", parents=[common], help="case x mode x law x rng")
+    m = sub.add_parser("matrix", parents=[common, gas_args], help="case x mode x law x rng")
     m.add_argument("--cases", default="pair2d,triple1d")
     m.add_argument("--modes", default="exact,paper")
     m.add_argument("--laws", default="flux,uniform")
     m.add_argument("--rngs", default="clcg4,philox")
-    w = sub.add_parser("words", help="write a raw word file (for dieharder by hand)")
+    w = sub.add_parser("words", parents=[gas_args], help="write a raw word file (for dieharder by hand)")
     w.add_argument("path")
     w.add_argument("--words", type=float, default=3e6)
     for k, v in (("--case", "pair2d"), ("--mode", "exact"), ("--law", "flux"), ("--rng", "philox")):
@@ -662,7 +699,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         res = []
         for f in a.files:
             for r in json.load(open(f))["runs"]:
-                res.append(marginals({k: r["config"][k] for k in ("case", "mode", "law", "rng", "seed")}, int(a.words)))
+                keys = ("case", "mode", "law", "rng", "seed", "particles", "fraction", "warmup")
+                res.append(marginals({k: r["config"][k] for k in keys if k in r["config"]}, int(a.words)))
                 c = res[-1]["config"]
                 ks = ", ".join(f"D={x['D']:.2g} p={x['p']:.2g}" for x in res[-1]["coordinates"])
                 print(f"| {c['case']} | {c['mode']} | {c['law']} | {c['rng']} | {ks} |", flush=True)
@@ -671,8 +709,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 json.dump(dict(_run_info(argv, t0), runs=res), f, indent=1)
                 f.write("\n")
         return 0
+    gas = {k: getattr(a, k, None) for k in ("particles", "fraction", "warmup")}
     if a.cmd == "words":
-        cfg = {"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}
+        cfg = _gas_options({"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}, gas)
         print(json.dumps(dict(write_words(a.path, int(a.words), **cfg), config=cfg)))
         return 0
     if not has_dieharder():
@@ -690,14 +729,14 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 f.write("\n")
 
     if a.cmd == "battery":
-        cfg = {"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}
+        cfg = _gas_options({"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}, gas)
         runs = [battery(cfg, int(a.words), tests, **kw)]
     elif a.cmd == "controls":
         runs = controls(int(a.words), tests, **kw)
     else:
         runs = []
         for cfg in _matrix_configs(a.cases.split(","), a.modes.split(","), a.laws.split(","),
-                                   a.rngs.split(",")):
+                                   a.rngs.split(","), gas):
             runs.append(battery(cfg, int(a.words), tests, **kw))
             print(_summary(runs[-1]), flush=True)
             save(runs, False)

@@ -3,7 +3,9 @@
 // case, both laws); mapped through the other law's CDF they fail it (the test can fail).
 // The exact chain is the torus shift itself (word_t - word_(t-1) = floor(G_t 2^32) up to
 // one unit); raw words are the generator's draws; the bad controls have their defects; a
-// stream is deterministic and resumable; bad configurations throw.
+// stream is deterministic and resumable; bad configurations throw. The engine's collisions
+// in a gas (gas2d, gas3d) pass KS through their law's CDF and fail through the other's;
+// a Newton's cradle starts from rest, so its words are not triple1d's.
 #include "revcol/randomness.hpp"
 
 #include <algorithm>
@@ -64,11 +66,13 @@ StreamConfig config(const std::string& name, Law law, Law cdf, const std::string
   return c;
 }
 
+bool is_gas(const std::string& name) { return name.rfind("gas", 0) == 0; }
+
 }  // namespace
 
 TEST_CASE("exact mode: every case, both laws: the words are uniform (KS, 1e5 words; CLCG4 too for the paper's cases)") {
   for (const std::string& name : randomness::stream_cases(Mode::exact)) {
-    if (name == "raw") continue;
+    if (name == "raw" || is_gas(name)) continue;  // the gas: its own test below
     const bool paper_case = name == "pair2d" || name == "triple1d" || name == "triple2d-c1";
     for (Law law : {Law::flux, Law::uniform})
       for (const char* rng : {"philox", "clcg4"}) {
@@ -86,7 +90,7 @@ TEST_CASE("exact mode: mapped through the other law's CDF the words fail KS (eve
   // With f = 0 free dimensions (triple1d, cradle1d, chain4-1d) the flux weight cos(eta) has
   // no eta to act on: the two laws are one, and so are their charts (checked here too).
   for (const std::string& name : randomness::stream_cases(Mode::exact)) {
-    if (name == "raw") continue;
+    if (name == "raw" || is_gas(name)) continue;
     if (exact_operator(named_case(name)).free_dim() == 0) {
       const StreamConfig c = config(name, Law::flux, Law::uniform);
       CHECK(take(c, 1000) == take(config(name, Law::uniform, Law::uniform), 1000));
@@ -169,6 +173,57 @@ TEST_CASE("paper mode: pair2d is uniform on the half circle; every paper case st
   }
 }
 
+TEST_CASE("the engine's collisions in a gas: uniform through the law's CDF, not through the other's (KS, 1e5 words)") {
+  for (const char* name : {"gas2d", "gas3d"})
+    for (Law law : {Law::flux, Law::uniform}) {
+      const Law other = law == Law::flux ? Law::uniform : Law::flux;
+      const char* rng = law == Law::flux ? "philox" : "clcg4";
+      StreamConfig c = config(name, law, law, rng);
+      c.gas_particles = 400;
+      WordStream s(c);
+      CHECK(s.width() == (name[3] == '2' ? 1 : 2));
+      std::vector<std::uint32_t> w(100000);
+      s.fill(w.data(), w.size());
+      const double k = worst_ks(w, s.width());
+      if (!(k < kPass)) std::fprintf(stderr, "%s %s %s: K = %g\n", name, to_string(law), rng, k);
+      CHECK(k < kPass);
+      CHECK(s.collisions() == w.size() / s.width());
+      c.cdf_law = other;  // the same collisions read through the other law's CDF
+      const double kw = worst_ks(take(c, w.size()), s.width());
+      if (!(kw > kFail)) std::fprintf(stderr, "%s %s read as %s: K = %g\n", name, to_string(law), to_string(other), kw);
+      CHECK(kw > kFail);
+    }
+}
+
+TEST_CASE("the gas stream is deterministic and resumable; the seed and the law change it") {
+  StreamConfig c = config("gas3d", Law::flux, Law::flux);
+  c.gas_particles = 200;
+  const std::vector<std::uint32_t> whole = take(c, 99999);
+  WordStream s(c);
+  std::vector<std::uint32_t> parts(99999);
+  s.fill(parts.data(), 1);
+  s.fill(parts.data() + 1, 70000);  // across an observation chunk (2^16 collisions)
+  s.fill(parts.data() + 70001, 29998);
+  CHECK(parts == whole);
+  CHECK(s.words() == 99999);
+  StreamConfig c2 = c;
+  c2.seed = 4;
+  CHECK(take(c2, 1000) != take(c, 1000));
+  c2 = c;
+  c2.law = Law::uniform;
+  CHECK(take(c2, 1000) != take(c, 1000));
+}
+
+TEST_CASE("cradles start from rest: cradle1d's words are not triple1d's (same geometry)") {
+  for (Law law : {Law::flux, Law::uniform}) {
+    const std::vector<std::uint32_t> cradle = take(config("cradle1d", law, law), 1000);
+    const std::vector<std::uint32_t> triple = take(config("triple1d", law, law), 1000);
+    int same = 0;
+    for (std::size_t k = 0; k < cradle.size(); ++k) same += cradle[k] == triple[k] ? 1 : 0;
+    CHECK(same < 10);
+  }
+}
+
 TEST_CASE("bad configurations throw InvalidArgument") {
   auto throws = [](StreamConfig c) {
     try {
@@ -196,6 +251,26 @@ TEST_CASE("bad configurations throw InvalidArgument") {
   c.bits = 60;
   CHECK(throws(c));
   c.bits = 40;
+  StreamConfig g = c;  // the gas
+  g.case_name = "gas2d";
+  g.gas_particles = 100;
+  g.rng = "randu";  // the engine's generators only
+  CHECK(throws(g));
+  g.rng = "philox";
+  g.mode = Mode::paper;
+  CHECK(throws(g));
+  g.mode = Mode::exact;
+  g.seed = std::uint64_t{1} << 32;
+  CHECK(throws(g));
+  g.seed = 1;
+  g.gas_particles = 1;
+  CHECK(throws(g));
+  g.gas_particles = 100;
+  g.gas_fraction = 0.95;  // above the densest packing
+  CHECK(throws(g));
+  g.gas_fraction = 0.2;
+  g.gas_warmup = -1.0;
+  CHECK(throws(g));
   WordStream s(c);
   bool threw = false;
   try {

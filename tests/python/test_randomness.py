@@ -1,8 +1,11 @@
 """revcol.randomness: the word stream (uniform under the right law, not under the wrong
-one), dieharder's output parser, the command line, and a reduced battery in which the good
-stream passes and the bad control fails (skipped only when the dieharder binary is absent;
+one; the engine's collisions in a gas too), dieharder's output parser, the command line,
+Ctrl-C during a word file (no partial file is left), and a reduced battery in which the good
+streams pass and the bad control fails (skipped only when the dieharder binary is absent;
 CI's setup installs it)."""
 import os
+import signal
+import threading
 
 import numpy as np
 import pytest
@@ -26,6 +29,44 @@ def test_words_uniform_under_the_law_and_not_under_the_other(case, width, law):
     other = "uniform" if law == "flux" else "flux"
     wrong = R.stream(case, mode="exact", law=law, rng="philox", seed=5, cdf_law=other).words(60000)
     assert min(ks_p(wrong.reshape(-1, width)[:, k]) for k in range(width)) < 1e-6
+
+
+@pytest.mark.parametrize("case,width", [("gas2d", 1), ("gas3d", 2)])
+@pytest.mark.parametrize("law", ["flux", "uniform"])
+def test_gas_words_uniform_under_the_law_and_not_under_the_other(case, width, law):
+    s = R.stream(case, law=law, rng="philox", seed=5, particles=300)
+    assert s.width == width
+    w = s.words(60000).reshape(-1, width)
+    assert s.collisions == 60000 // width
+    for k in range(width):
+        assert ks_p(w[:, k]) > 1e-3
+    other = "uniform" if law == "flux" else "flux"
+    wrong = R.stream(case, law=law, rng="philox", seed=5, particles=300, cdf_law=other).words(60000)
+    assert min(ks_p(wrong.reshape(-1, width)[:, k]) for k in range(width)) < 1e-6
+
+
+def test_gas_options_reach_the_engine():
+    a = R.stream("gas2d", seed=1, particles=200).words(500)
+    assert not np.array_equal(a, R.stream("gas2d", seed=1, particles=201).words(500))
+    assert not np.array_equal(a, R.stream("gas2d", seed=1, particles=200, fraction=0.3).words(500))
+    assert not np.array_equal(a, R.stream("gas2d", seed=1, particles=200, warmup=6).words(500))
+    assert np.array_equal(a, R.stream("gas2d", seed=1, particles=200).words(500))
+    for kw in ({"rng": "randu"}, {"mode": "paper"}, {"particles": 1}, {"fraction": 0.99}, {"warmup": -1},
+               {"seed": 2**32}):
+        with pytest.raises(ValueError):
+            R.stream("gas2d", **dict({"particles": 100}, **kw))
+
+
+def test_ctrl_c_during_write_words_leaves_no_file(tmp_path):
+    path = str(tmp_path / "w.bin")
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            R.write_words(path, 10**12, case="pair2d", seed=1)  # hours: only Ctrl-C ends it
+    finally:
+        timer.cancel()
+    assert os.listdir(tmp_path) == []  # neither the file nor its .part
 
 
 def test_stream_is_deterministic_and_resumable():
@@ -61,6 +102,8 @@ def test_words_file_and_cli(tmp_path):
     assert R.main(["words", str(path), "--words", "1000", "--case", "triple1d", "--seed", "4"]) == 0
     raw = np.fromfile(path, dtype="<u4")
     assert np.array_equal(raw, R.stream("triple1d", seed=4).words(1000))
+    assert R.main(["words", str(path), "--words", "1000", "--case", "gas3d", "--seed", "4", "--particles", "150"]) == 0
+    assert np.array_equal(np.fromfile(path, dtype="<u4"), R.stream("gas3d", seed=4, particles=150).words(1000))
 
 
 SAMPLE = """# The file file_input_raw was rewound 3 times
@@ -90,6 +133,15 @@ def test_reduced_battery_good_passes_bad_fails(tmp_path):
                     1_000_000, (12,), workdir=str(tmp_path))
     assert bad["verdict"] == "FAILED", bad
     assert not os.listdir(tmp_path)  # the word files are removed
+
+
+@pytest.mark.skipif(not R.has_dieharder(), reason="dieharder binary absent (scripts/setup.sh installs it)")
+def test_reduced_battery_gas_passes(tmp_path):
+    cfg = {"case": "gas2d", "mode": "exact", "law": "flux", "rng": "philox", "seed": 1, "particles": 500}
+    good = R.battery(cfg, 1_000_000, R.CI_TESTS, workdir=str(tmp_path))
+    assert good["verdict"] == "PASSED", good
+    assert good["stream"]["collisions"] == 1_000_000
+    assert not os.listdir(tmp_path)
 
 
 def test_revcol_study_randomness_forwards(tmp_path):

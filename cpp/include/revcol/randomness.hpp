@@ -26,6 +26,18 @@
 // "randu" (IBM's x <- 65539 x mod 2^31, whose triples lie on 15 planes) and
 // "philox-repeat100" (Philox, but every 100th draw repeats the one before it).
 // case "raw": the generator's own draws as words, floor(G 2^32) (the battery's controls).
+//
+// The engine's collisions in a gas ("gas2d", "gas3d"; exact mode, rng philox or clcg4): a
+// periodic cube of gas_particles spheres at gas_fraction (engine::random_state, seed), run
+// gas_warmup collisions per particle, then each pair collision gives d - 1 words from its
+// post relative velocity w about the contact normal a (the observer's collision record,
+// engine/observe.hpp). The operator's law does not depend on the pre state, so these CDF
+// values are uniform: 2D the signed angle eta from a, flux CDF (1 + sin eta) / 2, uniform
+// eta / pi + 1/2; 3D the polar angle eta about a and the azimuth phi (pair3d_exact.hpp's
+// frame), flux CDF sin^2(eta) (density cos(eta) sin(eta)), uniform 1 - cos(eta), phi / (2 pi)
+// for both. A group collision (three or more in contact) gives no word and is counted
+// (skipped()). `law` is the engine's, `cdf_law` the CDF's; the generator draws nothing here
+// (the engine's own streams do, keyed by seed).
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -48,6 +60,9 @@ struct StreamConfig {
   std::string rng = "philox";        ///< clcg4 | philox | randu | philox-repeat100
   std::uint64_t seed = 0;            ///< stream index / key / RANDU start (made odd)
   int bits = FixedPoint::default_bits;  ///< exact mode: K
+  std::size_t gas_particles = 1000;  ///< gas2d / gas3d: N
+  double gas_fraction = 0.2;         ///< gas2d / gas3d: packing fraction of the periodic cube
+  double gas_warmup = 5.0;           ///< gas2d / gas3d: collisions per particle before the first word
 };
 
 /// The cases stream_words knows for a mode ("raw" first).
@@ -80,6 +95,8 @@ class WordStream {
   std::uint64_t words() const;
   /// Paper mode: chain restarts after a failed step.
   std::uint64_t restarts() const;
+  /// Gas: group collisions seen (they give no word).
+  std::uint64_t skipped() const;
 
  private:
   struct Impl;

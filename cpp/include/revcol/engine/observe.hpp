@@ -74,6 +74,15 @@
 // speed and its bin, are recomputed by the same operations). A stopped observation is not
 // kept. Loading checks every size, that every real is finite, the times are ordered and
 // the segments' velocities are the particles' (InvalidArgument naming the first problem).
+//
+// The collision record (optional, ObserveConfig::collision_record; the randomness study's
+// gas streams, revcol/randomness.hpp). Per pair collision, in order: the unit contact
+// normal n = r / |r| (r = x_a - x_b from the observer's positions, nearest image) and the
+// post relative velocity w = v_a - v_b. In exact mode the direction of w about n has the
+// operator's law whatever the pre state (a torus shift of a measure-preserving chart,
+// DESIGN.md §3), so its CDF values are uniform words. Group collisions are not recorded.
+// It grows by 2 d doubles per pair collision: the reader restarts the observation to drain it.
+// Snapshots do not keep the record (a restored observation records nothing).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -91,6 +100,7 @@ struct ObserveConfig {
   double speed_max = 0.0;   ///< the histogram's upper edge; 0: 5 v_rms at the start
   int pair_bins = 0;        ///< pair-distance histogram bins over [0, pair_rmax] (0: none; N <= 64, walls on every axis)
   double pair_rmax = 0.0;   ///< its upper edge (> 0 when pair_bins > 0)
+  bool collision_record = false;  ///< keep each pair collision's normal and post relative velocity
 };
 
 /// A time average and its standard error from block averages.
@@ -208,6 +218,15 @@ class Observer {
   std::vector<Block> blocks_;   // complete blocks
   Block cur_;                   // the open block
   std::vector<double> msd_t_, msd_;
+
+  // --- the collision record (see the header comment) ---
+ public:
+  /// With collision_record: per pair collision, the unit normal n then w = v_a - v_b after (2 dim each).
+  const std::vector<double>& collision_record() const { return record_; }
+
+ private:
+  void record_pair(int a, int b, const double* va, const double* vb);  // appends one entry
+  std::vector<double> record_;
 };
 
 }  // namespace revcol::engine
