@@ -39,8 +39,11 @@ def _interrupt(tmp_path, code, args, ready_s=120, after_s=0.3, wait_s=60):
     script.write_text(code)
     out = tmp_path / "out.txt"
     with open(out, "w") as f:
+        # SIGINT at its default in the child, whatever this process inherited: a shell's
+        # background job (`cmd &`) starts with SIGINT ignored, and a Python started that way
+        # keeps ignoring it instead of raising KeyboardInterrupt
         child = subprocess.Popen([sys.executable, str(script), *args], stdout=f, stderr=subprocess.STDOUT,
-                                 env=dict(os.environ))
+                                 env=dict(os.environ), preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + ready_s
         while "ready" not in out.read_text():

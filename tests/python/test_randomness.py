@@ -59,6 +59,8 @@ def test_gas_options_reach_the_engine():
 
 def test_ctrl_c_during_write_words_leaves_no_file(tmp_path):
     path = str(tmp_path / "w.bin")
+    # Python's own handler, even when this process inherited SIGINT ignored (a background job)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
     timer.start()
     try:
@@ -66,6 +68,7 @@ def test_ctrl_c_during_write_words_leaves_no_file(tmp_path):
             R.write_words(path, 10**12, case="pair2d", seed=1)  # hours: only Ctrl-C ends it
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, before)
     assert os.listdir(tmp_path) == []  # neither the file nor its .part
 
 
