@@ -158,7 +158,10 @@ def test_ctrl_c_on_a_terminal_stops_keeps_and_resumes(small, tmp_path):
     points kept, no worker traceback; the same command again completes."""
     f, serial = small
     cmd = [sys.executable, "-m", "revcol", "sweep", str(f), "--workers", "2", "--out", str(tmp_path), "--no-progress"]
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    # SIGINT at its default in the child even if this process inherited it ignored (a
+    # background job does): otherwise the sweep never sees the Ctrl-C
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline and len(list((tmp_path / "points").glob("*.json"))) < 1:
