@@ -125,12 +125,11 @@ def build_peer(src: str, build: str, warmup: int, collisions: int) -> str:
 
 def write_sph(path: str, x: np.ndarray, box: np.ndarray, diameter: float = 1.0) -> None:
     """The peer's input format: N, the box, then ``a x y z radius`` per particle (atomically)."""
-    tmp = path + ".part"
-    with open(tmp, "w") as fh:
+    from revcol._io import atomic_open
+    with atomic_open(path) as fh:
         fh.write(f"{len(x)}\n{box[0]:.17g} {box[1]:.17g} {box[2]:.17g}\n")
         for p in x:
             fh.write(f"a {p[0]:.17g} {p[1]:.17g} {p[2]:.17g} {diameter / 2:.17g}\n")
-    os.replace(tmp, path)
 
 
 def read_sph(path: str) -> tuple[np.ndarray, np.ndarray]:
@@ -288,10 +287,9 @@ def measure(args, src: str) -> dict:
 
 
 def _write_json(path: str, res: dict) -> None:
-    tmp = path + ".part"
-    with open(tmp, "w") as fh:
+    from revcol._io import atomic_open
+    with atomic_open(path) as fh:
         json.dump(res, fh, indent=1)
-    os.replace(tmp, path)
 
 
 def main(argv: Optional[list] = None) -> int:
