@@ -33,6 +33,7 @@ void add_pair3d_benches(std::vector<Bench>& out);     ///< pair3d_bench.cpp: the
 void add_engine_benches(std::vector<Bench>& out);     ///< engine_bench.cpp: the event-driven engine
 void add_skip_benches(std::vector<Bench>& out);       ///< skip_bench.cpp: what a pair-only scene does not pay for
 void add_lattice_op_benches(std::vector<Bench>& out);  ///< lattice_op_bench.cpp: the exact lattice pair operator
+void add_lattice_op3_benches(std::vector<Bench>& out); ///< lattice_op3_bench.cpp: the 3D lattice pair operator, its design study
 void add_lattice_benches(std::vector<Bench>& out);     ///< lattice_engine_bench.cpp: the 2D lattice engine
 void add_tradeoff_benches(std::vector<Bench>& out);    ///< tradeoff_bench.cpp: run time against error per operator and knob
 
