@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "lattice_test_util.hpp"
 #include "revcol/error.hpp"
 #include "revcol/lattice/pair2d.hpp"
 
@@ -24,6 +25,10 @@ using revcol::InvalidArgument;
 using revcol::Law;
 
 namespace {
+
+using lattice_test::Rng;
+using lattice_test::ks_pvalue;
+using lattice_test::random_bits;
 
 long g_long = 0;  // --long N: samples per KS state (0: the CI sizes)
 
@@ -47,14 +52,6 @@ i128 norm2(const Vec2& v) { return sq(v[0]) + sq(v[1]); }
 Vec2 add(const Vec2& a, const Vec2& b) { return {a[0] + b[0], a[1] + b[1]}; }
 Vec2 sub(const Vec2& a, const Vec2& b) { return {a[0] - b[0], a[1] - b[1]}; }
 
-BitsBack random_bits(std::mt19937_64& rng, int bits) {
-  std::vector<std::uint64_t> w(static_cast<std::size_t>((bits + 63) / 64));
-  for (auto& x : w) x = rng();
-  w.back() |= 1ULL << ((bits - 1) % 64);
-  if (bits % 64) w.back() &= (1ULL << (bits % 64)) - 1;
-  return BitsBack(w);
-}
-
 // A pre state near the contact point at angle `ang`: -w makes the incidence angle `inc` with
 // the outward normal, speed |w| = speed, the phase a uniform fraction of w. Empty when the
 // rounding put it out of the contract (the caller draws again).
@@ -67,13 +64,6 @@ bool make_pre(i64 sigma, double ang, double inc, double speed, double frac, Vec2
        static_cast<i64>(s * std::sin(ang)) - static_cast<i64>(w[1] * frac)};
   return norm2(q) >= sq(sigma) && norm2(add(q, w)) < sq(sigma);
 }
-
-struct Rng {
-  std::mt19937_64 gen;
-  explicit Rng(std::uint64_t seed) : gen(seed) {}
-  double uni() { return std::uniform_real_distribution<double>(0.0, 1.0)(gen); }
-  std::uint64_t draw() { return gen() >> 16; }  // a 48-bit G
-};
 
 // Forward, post validity, reverse, and (for a refusal) that X_out == X. Returns the refusal.
 Refusal round_trip(const LatticePair2D& op, const Vec2& q, const Vec2& w, std::uint64_t g, BitsBack& X,
@@ -94,15 +84,6 @@ Refusal round_trip(const LatticePair2D& op, const Vec2& q, const Vec2& w, std::u
   if (!(qb == q && wb == w && Xb == X0)) ++bad;
   X = X2;
   return r;
-}
-
-// Kolmogorov's limiting p-value of the KS statistic d over n samples (Stephens' correction).
-double ks_pvalue(double d, std::size_t n) {
-  const double sn = std::sqrt(static_cast<double>(n));
-  const double lam = (sn + 0.12 + 0.11 / sn) * d;
-  double p = 0.0;
-  for (int k = 1; k <= 100; ++k) p += 2.0 * ((k & 1) ? 1.0 : -1.0) * std::exp(-2.0 * k * k * lam * lam);
-  return std::clamp(p, 0.0, 1.0);
 }
 
 // KS of the post angles theta (about the contact normal) against the CDF.
@@ -139,33 +120,20 @@ LawRun run_law(Law law, double phn, double inc_deg, long n, std::uint64_t seed, 
   const double pn = std::hypot(static_cast<double>(p[0]), static_cast<double>(p[1]));
   const double nx = static_cast<double>(p[0]) / pn, ny = static_cast<double>(p[1]) / pn;
   Rng rng(seed);
-  BitsBack X = random_bits(rng.gen, 256), X2;
-  out.bits_start = static_cast<double>(X.bit_length());
   std::vector<double> th;
   th.reserve(static_cast<std::size_t>(n));
   double sc = 0;
-  for (long k = 0; static_cast<long>(th.size()) < n; ++k) {
-    Vec2 q2, w2;
-    const std::uint64_t g = rng.draw();
-    if (op.forward(q, w, g, X, q2, w2, X2) != Refusal::none) {
-      ++out.refusals;
-      continue;
-    }
-    if (k % 997 == 0) {
-      BitsBack Xb = X2;
-      Vec2 qb, wb;
-      op.reverse(q2, w2, g, Xb, qb, wb);
-      if (!(qb == q && wb == w && Xb == X)) ++out.bad;
-    }
-    std::swap(X, X2);
-    const double bits = static_cast<double>(X.bit_length());
-    out.bits_min = std::min(out.bits_min, bits);
-    out.bits_max = std::max(out.bits_max, bits);
+  const lattice_test::ChainStats cs = lattice_test::fixed_pre_chain(op, q, w, n, rng, [&](const Vec2& w2) {
     const double dx = static_cast<double>(w2[0]), dy = static_cast<double>(w2[1]);
     th.push_back(std::atan2(-ny * dx + nx * dy, nx * dx + ny * dy));
     sc += std::cos(th.back());
-  }
-  out.bits_end = static_cast<double>(X.bit_length());
+  });
+  out.refusals = static_cast<int>(cs.refusals);
+  out.bad = cs.bad;
+  out.bits_start = cs.bits_start;
+  out.bits_min = cs.bits_min;
+  out.bits_max = cs.bits_max;
+  out.bits_end = cs.bits_end;
   out.mean_cos = sc / static_cast<double>(n);
   const double pi = std::numbers::pi;
   const double d = law == Law::flux ? ks_stat(th, [](double t) { return (1.0 + std::sin(t)) / 2.0; })
