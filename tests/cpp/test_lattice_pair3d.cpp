@@ -456,6 +456,19 @@ TEST_CASE("post law: KS of sin^2(theta) and of the azimuth at 4 fixed pre states
   CHECK(std::fabs(f.mean_cos - 0.5) > 0.1);
 }
 
+TEST_CASE("the rejected candidate (azimuth offset carried, a changed cell refused): exact, but refuses and biases") {
+  // docs/lattice.md "3D: the direction chart": carrying the offset y across a polar rotation
+  // moves the azimuth by y / x_a, so the post leaves its azimuth cell unless the polar angle grows;
+  // the refusals are redraws (rare-log entries) and select posts, which biases the law.
+  const long n = g_long > 0 ? std::min(g_long, 200000L) : 20000;
+  const LawRun r = run_law(Law::flux, AzimuthMode::carry, 0.9, 0.2, 30.0, n, 11);
+  const double refused = static_cast<double>(r.refusals) / static_cast<double>(r.refusals + n);
+  std::printf("  carry, incidence 30 deg, n %ld: refused %.4f of draws, KS p(sin^2 theta) = %.3g, p(phi) = %.3g, mean cos %.5f, "
+              "X bits %g -> %g\n", n, refused, r.p_theta, r.p_phi, r.mean_cos, r.bits_start, r.bits_end);
+  CHECK(r.bad == 0);
+  CHECK(refused > 0.1);  // the measured reason it is rejected: far above the 1e-5 log bar
+}
+
 TEST_CASE("X's size over a gas of pre states: bounded under flux, +0.7213 bit/collision under uniform") {
   // Random pre states with flux-law incidence (an equilibrium gas), X chained. Under the flux
   // law push and pop balance; under the uniform law X grows by E_flux[log2 cos] -

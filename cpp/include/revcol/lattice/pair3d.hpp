@@ -37,17 +37,22 @@
 //     when u_z > 0.
 //  4. Pre chart: Phi = azimuth cell of (u_x, u_y), 2^18 per turn (phi_bits). Align: (x_a, y) =
 //     the lifting rotation of (u_x, u_y) by minus the cell's centre, so x_a ~ |u_xy| and y is the
-//     offset across the cell. Polar cell a of the plane vector (u_z, x_a): 2^cell_bits cells per
-//     turn, a in [0, 2^cell_bits / 4) (else not_approaching). The row of (Phi, x_a): the integers
-//     y whose aligned point rotated back lies in cell Phi, [ylo, yhi] (found exactly; the pre's
-//     y must be on it, else out_of_domain). X <- X*(yhi - ylo + 1) + (y - ylo).
+//     offset across the cell (the pole, u_xy = 0, is Phi = 0, x_a = y = 0). Polar cell a of the
+//     plane vector (u_z, x_a), cells of angle D = 2 pi / 2^cell_bits CENTRED on multiples of D:
+//     cell j holds [(j - 1/2) D, (j + 1/2) D), j = 0 .. Q = 2^cell_bits / 4 (cells 0 and Q are
+//     half cells), so the pole is a cell's centre and a head-on pre state never rotates onto a
+//     boundary (u_z <= 0: not_approaching). The row of (Phi, x_a): the integers y whose aligned
+//     point rotated back lies in cell Phi, [ylo, yhi] (found exactly; the pre's y must be on it,
+//     else out_of_domain; row(0, 0) = {0}). X <- X*(yhi - ylo + 1) + (y - ylo).
 //  5. rANS push of the joint symbol (Phi, a): cumulative Phi*2^30 + cum(a), frequency f(a), where
-//     cum is the polar law's table with total 2^30: flux cum(b) = b + round((2^30 - Q) sin^2
-//     theta_b), uniform (in solid angle) cum(b) = b + round((2^30 - Q)(1 - cos theta_b)), Q the
-//     number of polar cells (the +b keeps every f >= 1 exactly; it moves the law by Q / 2^30).
+//     cum is the polar law's table with total 2^30 over the Q + 1 cells: with t_j = (j - 1/2) D
+//     the start of cell j, flux cum(j) = j + round((2^30 - Q - 1) sin^2 t_j), uniform (in solid
+//     angle) cum(j) = j + round((2^30 - Q - 1)(1 - cos t_j)), cum(0) = 0, cum(Q + 1) = 2^30 (the
+//     +j keeps every f >= 1 exactly; it moves the law by at most (Q + 1) / 2^30).
 //  6. Torus shift: the low 48 bits s of X become (s + G) mod 2^48.
 //  7. rANS pop of (Phi', b). Rotate (u_z, x_a) by b - a polar cells (lifting) to (u_z', x_a'); if
-//     that is not in cell b: cell_readback. Pop the post offset over the row of (Phi', x_a')
+//     that is not in cell b (or not in the quarter plane): cell_readback. (A post at the pole
+//     reads back as Phi' = 0; another Phi' there is cell_readback.) Pop the post offset over the row of (Phi', x_a')
 //     (no row: empty_post), rotate it back by the centre of Phi' to (u_x', u_y'), check its cell
 //     is Phi' (holes in a row, never seen; cell_readback). W2 = L^{-1}(u').
 //  8. Post phase: the inside points of the column whose point plus W2 is outside form [lo2, Zin]
