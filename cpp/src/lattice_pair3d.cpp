@@ -30,8 +30,23 @@ inline i128 cross(const IVec& b, const IVec& v) { return static_cast<i128>(b.x) 
 inline i64 wadd(i64 a, i64 b) { return static_cast<i64>(static_cast<std::uint64_t>(a) + static_cast<std::uint64_t>(b)); }
 inline i64 wsub(i64 a, i64 b) { return static_cast<i64>(static_cast<std::uint64_t>(a) - static_cast<std::uint64_t>(b)); }
 
-// The centre of azimuth cell phi as a rotation (fine cells 4 phi + 2).
-inline RotCoef phi_centre(std::int64_t phi) { return rot_coef((phi << kPhiShift) + (1LL << (kPhiShift - 1))); }
+// An azimuth cell: its centre as a rotation (fine cells 4 phi + 2) and its two boundaries.
+struct AzCell {
+  std::int64_t phi = 0;
+  RotCoef c{};
+  IVec b0{}, b1{};
+  // v (!= 0) lies in the cell (exact; the same decision as in_coarse_cell(v, phi, 2))
+  bool holds(const IVec& v) const {
+    const auto cr = [&](const IVec& b) { return static_cast<i128>(b.x) * v.y - static_cast<i128>(b.y) * v.x; };
+    return cr(b0) >= 0 && cr(b1) < 0;
+  }
+};
+AzCell az_cell(std::int64_t phi) {
+  phi &= kPhiMask;
+  return {phi, rot_coef((phi << kPhiShift) + (1LL << (kPhiShift - 1))), boundary((2 * phi) << kPhiShift),
+          boundary((2 * phi + 2) << kPhiShift)};
+}
+std::optional<std::array<i64, 2>> row_of(const AzCell& az, i64 xa);
 
 // A state's column in its face frame and the column's normal frame.
 struct Column {
@@ -118,6 +133,7 @@ bool in_polar_cell(const IVec& v, std::int64_t j, int shift) {
 
 // A direction u (normal frame, outward) in the chart: azimuth cell, aligned (xa, y), polar cell.
 struct Chart {
+  AzCell az;
   std::int64_t phi = 0, cell = 0;
   i64 xa = 0, y = 0, uz = 0;
 };
@@ -127,10 +143,12 @@ struct Chart {
 Refusal chart_of(const Vec3& u, int shift, Chart& ch) {
   if (u[0] == 0 && u[1] == 0) {
     ch.phi = 0;
+    ch.az = az_cell(0);
     ch.xa = ch.y = 0;
   } else {
     ch.phi = dir_cell(u[0], u[1]) >> kPhiShift;
-    const IVec al = rotate_inv({u[0], u[1]}, phi_centre(ch.phi));
+    ch.az = az_cell(ch.phi);
+    const IVec al = rotate_inv({u[0], u[1]}, ch.az.c);
     ch.xa = al.x;
     ch.y = al.y;
   }
@@ -172,16 +190,14 @@ Vec3 LatticePair3D::from_face(const Vec3& v, int f) {
   }
 }
 
-std::optional<std::array<i64, 2>> LatticePair3D::row(std::int64_t phi, i64 xa) {
-  phi &= kPhiMask;
+std::optional<std::array<i64, 2>> LatticePair3D::row(std::int64_t phi, i64 xa) { return row_of(az_cell(phi), xa); }
+
+namespace {
+
+std::optional<std::array<i64, 2>> row_of(const AzCell& az, i64 xa) {
   if (xa < 0 || xa >= kMaxComp) return std::nullopt;
-  if (xa == 0) return phi == 0 ? std::optional<std::array<i64, 2>>{{0, 0}} : std::nullopt;  // the pole
-  const RotCoef c = phi_centre(phi);
-  const IVec b0 = boundary((2 * phi) << kPhiShift), b1 = boundary((2 * phi + 2) << kPhiShift);
-  auto member = [&](i64 y) {
-    const IVec v = rotate({xa, y}, c);
-    return cross(b0, v) >= 0 && cross(b1, v) < 0;
-  };
+  if (xa == 0) return az.phi == 0 ? std::optional<std::array<i64, 2>>{{0, 0}} : std::nullopt;  // the pole
+  auto member = [&](i64 y) { return az.holds(rotate({xa, y}, az.c)); };
   constexpr int kSteps = 16;  // the lifting moves a point by about a unit: a guess is this close
   // The member farthest in direction dir from the guess `start`: outward while members. A guess
   // off the row is beyond the edge (the first member inward is the edge) or, for a short row
@@ -206,6 +222,8 @@ std::optional<std::array<i64, 2>> LatticePair3D::row(std::int64_t phi, i64 xa) {
   if (!lo || *lo > *hi) return std::nullopt;
   return std::array<i64, 2>{*lo, *hi};
 }
+
+}  // namespace
 
 LatticePair3D::LatticePair3D(std::int64_t sigma, Law law, int cell_bits, AzimuthMode mode)
     : sigma_(sigma), sigma2_(static_cast<i128>(sigma) * sigma), law_(law), shift_(kCellBits - cell_bits), mode_(mode) {
@@ -260,7 +278,7 @@ Refusal LatticePair3D::check_pre(const Vec3& q, const Vec3& w) const {
   const Refusal r = chart_of(neg(to_normal(W, col)), shift_, ch);
   if (r != Refusal::none) return r;
   if (mode_ == AzimuthMode::rows) {
-    const auto rw = row(ch.phi, ch.xa);
+    const auto rw = row_of(ch.az, ch.xa);
     if (!rw || ch.y < (*rw)[0] || ch.y > (*rw)[1]) return Refusal::out_of_domain;
   }
   return Refusal::none;
@@ -296,7 +314,7 @@ Refusal LatticePair3D::forward(const Vec3& q, const Vec3& w, std::uint64_t g, co
   tr.a = ch.cell;
   std::array<i64, 2> rw{ch.y, ch.y};
   if (mode_ == AzimuthMode::rows) {
-    const auto r = row(ch.phi, ch.xa);
+    const auto r = row_of(ch.az, ch.xa);
     if (!r || ch.y < (*r)[0] || ch.y > (*r)[1]) return refuse(Refusal::out_of_domain);
     rw = *r;
   }
@@ -317,16 +335,17 @@ Refusal LatticePair3D::forward(const Vec3& q, const Vec3& w, std::uint64_t g, co
   X_out.pop_rans((static_cast<std::uint64_t>(tr.phi2) << kTotBits) + cb, fb);
   const IVec t2 = rotate({ch.uz, ch.xa}, rot_coef((tr.b - ch.cell) << shift_));
   if (!in_polar_cell(t2, tr.b, shift_)) return refuse(Refusal::cell_readback);
+  const AzCell az2 = az_cell(tr.phi2);
   i64 y2 = ch.y;
   if (mode_ == AzimuthMode::rows) {
-    const auto r2 = row(tr.phi2, t2.y);
+    const auto r2 = row_of(az2, t2.y);
     if (!r2) return refuse(Refusal::empty_post);
     tr.row2 = (*r2)[1] - (*r2)[0] + 1;
     y2 = (*r2)[0] + static_cast<i64>(X_out.pop_uniform(static_cast<std::uint64_t>(tr.row2)));
   }
-  const IVec uxy = rotate({t2.y, y2}, phi_centre(tr.phi2));
+  const IVec uxy = rotate({t2.y, y2}, az2.c);
   const bool pole = uxy.x == 0 && uxy.y == 0;  // read back as azimuth cell 0
-  if (pole ? tr.phi2 != 0 : !in_coarse_cell(uxy.x, uxy.y, tr.phi2, kPhiShift)) return refuse(Refusal::cell_readback);
+  if (pole ? tr.phi2 != 0 : !az2.holds(uxy)) return refuse(Refusal::cell_readback);
   const Vec3 W2 = from_normal({uxy.x, uxy.y, t2.x}, col);
   if (!small(W2, kMaxComp)) return refuse(Refusal::out_of_domain);
   // 8. post phase
@@ -361,7 +380,7 @@ void LatticePair3D::reverse(const Vec3& q2, const Vec3& w2, std::uint64_t g, Bit
           "LatticePair3D::reverse: w2 is not outgoing about the normal (not a forward's output)");
   std::array<i64, 2> rw2{ch.y, ch.y};
   if (mode_ == AzimuthMode::rows) {
-    const auto r = row(ch.phi, ch.xa);
+    const auto r = row_of(ch.az, ch.xa);
     require(r && ch.y >= (*r)[0] && ch.y <= (*r)[1], "LatticePair3D::reverse: post azimuth off its row");
     rw2 = *r;
   }
@@ -389,16 +408,17 @@ void LatticePair3D::reverse(const Vec3& q2, const Vec3& w2, std::uint64_t g, Bit
   };
   const IVec t = rotate_inv({ch.uz, ch.xa}, rot_coef((ch.cell - a) << shift_));
   if (t.x <= 0 || t.y < 0) fail(0, 0, "LatticePair3D::reverse: no pre state maps to this post state (not a forward's output)");
+  const AzCell az = az_cell(phi);
   i64 y = ch.y;
   std::uint64_t row_len = 0, row_idx = 0;
   if (mode_ == AzimuthMode::rows) {
-    const auto r = row(phi, t.y);
+    const auto r = row_of(az, t.y);
     if (!r) fail(0, 0, "LatticePair3D::reverse: the pre azimuth row is empty (not a forward's output)");
     row_len = static_cast<std::uint64_t>((*r)[1] - (*r)[0] + 1);
     row_idx = X.pop_uniform(row_len);
     y = (*r)[0] + static_cast<i64>(row_idx);
   }
-  const IVec uxy = rotate({t.y, y}, phi_centre(phi));
+  const IVec uxy = rotate({t.y, y}, az.c);
   const Vec3 W = from_normal(neg(Vec3{uxy.x, uxy.y, t.x}), col);
   const auto lo = small(W, kMaxComp) ? lo_pre3(sigma2_, col, W) : std::nullopt;
   const i64 m = lo ? col.zin - *lo + 1 : 0;
