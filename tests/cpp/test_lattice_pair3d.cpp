@@ -274,6 +274,27 @@ TEST_CASE("round trip: 1.5e5 random pre states, sigma 2^20..2^60, speeds 2^20..2
   CHECK(done > 100000);
 }
 
+TEST_CASE("extremes: sigma 2^60 with speeds up to 2^59.6 (components near the 2^61 bound): exact or refused cleanly") {
+  Rng rng(31);
+  int bad = 0, done = 0, tried = 0;
+  for (const Law law : {Law::flux, Law::uniform}) {
+    const LatticePair3D op(1LL << 60, law);
+    for (int t = 0; t < 20000; ++t) {
+      const double speed = std::ldexp(1.0 + 0.5 * rng.uni(), static_cast<int>(rng.range(46, 59)));
+      Vec3 q, w;
+      if (!make_pre(op.sigma(), std::acos(2 * rng.uni() - 1), 2 * kPi * rng.uni(), std::asin(std::sqrt(rng.uni())), 2 * kPi * rng.uni(),
+                    speed, rng.uni(), q, w))
+        continue;
+      ++tried;
+      BitsBack X = random_bits(rng.gen, 256);
+      if (round_trip(op, q, w, rng.draw(), X, bad) == Refusal::none) ++done;
+    }
+  }
+  std::printf("  extremes: %d of %d pre states accepted\n", done, tried);
+  CHECK(bad == 0);
+  CHECK(done > tried / 2);
+}
+
 TEST_CASE("round trip at pair level: S-transform, positions wrapping mod 2^64") {
   Rng rng(4);
   const LatticePair3D op(1LL << 58);
