@@ -5,7 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
+#include <iterator>
 #include <random>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "revcol/error.hpp"
@@ -25,6 +29,20 @@ struct Rng {
     return lo + static_cast<std::int64_t>(gen() % static_cast<std::uint64_t>(hi - lo + 1));
   }
 };
+
+/// The rows of tests/data/lattice/<name> (known answers), split into words; '#' lines skipped.
+inline std::vector<std::vector<std::string>> load(const char* name) {
+  const std::string src = __FILE__;
+  std::ifstream in(src.substr(0, src.rfind('/')) + "/../data/lattice/" + name);
+  std::vector<std::vector<std::string>> out;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream words(line);
+    out.emplace_back(std::istream_iterator<std::string>(words), std::istream_iterator<std::string>());
+  }
+  return out;
+}
 
 /// A random X of exactly `bits` bits.
 inline revcol::lattice::BitsBack random_bits(std::mt19937_64& rng, int bits) {

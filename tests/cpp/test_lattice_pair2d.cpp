@@ -32,18 +32,7 @@ using lattice_test::random_bits;
 
 long g_long = 0;  // --long N: samples per KS state (0: the CI sizes)
 
-std::vector<std::vector<std::string>> load(const char* name) {
-  const std::string src = __FILE__;
-  std::ifstream in(src.substr(0, src.rfind('/')) + "/../data/lattice/" + name);
-  std::vector<std::vector<std::string>> out;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream words(line);
-    out.emplace_back(std::istream_iterator<std::string>(words), std::istream_iterator<std::string>());
-  }
-  return out;
-}
+using lattice_test::load;
 
 i64 num(const std::string& s) { return std::stoll(s); }
 std::uint64_t unum(const std::string& s) { return std::stoull(s); }

@@ -181,6 +181,38 @@ TEST_CASE("faces: to_face/from_face invert, the face frame holds p with z >= zmi
   CHECK(LatticePair3D::face_of({-3, 2, 1}) == 1);
 }
 
+TEST_CASE("whole operator = the Python implementation from the header's text (tests/data/lattice/op3.txt)") {
+  const auto rows = lattice_test::load("op3.txt");
+  REQUIRE(rows.size() >= 400);
+  int bad = 0, ok = 0;
+  for (const auto& r : rows) {
+    const Law law = r[0] == "flux" ? Law::flux : Law::uniform;
+    const LatticePair3D op(std::stoll(r[2]), law, std::stoi(r[1]));
+    const Vec3 q{std::stoll(r[3]), std::stoll(r[4]), std::stoll(r[5])}, w{std::stoll(r[6]), std::stoll(r[7]), std::stoll(r[8])};
+    const std::uint64_t g = std::stoull(r[9]);
+    const BitsBack X = BitsBack::from_hex(r[10]);
+    Vec3 q2, w2;
+    BitsBack Y;
+    const Refusal why = op.forward(q, w, g, X, q2, w2, Y);
+    if (r[11] != "ok") {
+      if (std::string(to_string(why)) != r[11]) ++bad;
+      continue;
+    }
+    ++ok;
+    const Vec3 q2e{std::stoll(r[12]), std::stoll(r[13]), std::stoll(r[14])}, w2e{std::stoll(r[15]), std::stoll(r[16]), std::stoll(r[17])};
+    if (why != Refusal::none || q2 != q2e || w2 != w2e || Y.to_hex() != r[18]) {
+      ++bad;
+      continue;
+    }
+    Vec3 qb, wb;
+    op.reverse(q2, w2, g, Y, qb, wb);
+    if (!(qb == q && wb == w && Y == X)) ++bad;
+  }
+  std::printf("  %zu known answers (%d accepted), %d differ\n", rows.size(), ok, bad);
+  CHECK(bad == 0);
+  CHECK(ok > 300);
+}
+
 TEST_CASE("azimuth rows = brute force: exactly the y whose aligned point lies in the cell") {
   Rng rng(2);
   int rows = 0;
