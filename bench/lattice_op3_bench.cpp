@@ -216,6 +216,34 @@ std::vector<Metric> run_study(std::uint64_t n) {
   return out;
 }
 
+// Refusals per draw at gas pre states by relative speed 2^e (e = 20, 23, ..., 35) and polar
+// cells 2^cb per turn (cb = 12, 16, 20): the read-back refusal falls as ~cells / |w| (the lifting
+// round-off crossing a polar boundary); empty rows appear only at the slowest speeds.
+std::vector<Metric> run_readback(std::uint64_t n) {
+  std::vector<Metric> out;
+  for (const int cb : {12, 16, 20}) {
+    const LatticePair3D op(1LL << 60, revcol::Law::flux, cb);
+    const BitsBack X = x256();
+    BitsBack x2 = X;
+    std::mt19937_64 rng(11);
+    for (int e = 20; e <= 35; e += 3) {
+      std::uint64_t tried = 0, readback = 0, empty = 0;
+      while (tried < n) {
+        Vec3 q, w, q2, w2;
+        if (!gas_pre(op, rng, e, q, w)) continue;
+        ++tried;
+        const Refusal r = op.forward(q, w, rng() >> 16, X, q2, w2, x2);
+        readback += r == Refusal::cell_readback;
+        empty += r == Refusal::empty_post;
+      }
+      const std::string tag = "_w2^" + std::to_string(e) + "_cells" + std::to_string(cb);
+      out.push_back({"readback" + tag, static_cast<double>(readback) / static_cast<double>(n)});
+      out.push_back({"empty_post" + tag, static_cast<double>(empty) / static_cast<double>(n)});
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void add_lattice_op3_benches(std::vector<Bench>& out) {
@@ -224,6 +252,7 @@ void add_lattice_op3_benches(std::vector<Bench>& out) {
   out.push_back({"lattice/pair3d/carry/forward", "calls", [](std::uint64_t n) { return run_forward(AzimuthMode::carry, n); }});
   out.push_back({"lattice/pair3d/pair2d_forward_same_speed", "calls", [](std::uint64_t n) { return run_forward2d(n); }});
   out.push_back({"lattice/pair3d/study", "collisions per candidate", [](std::uint64_t n) { return run_study(n); }});
+  out.push_back({"lattice/pair3d/readback", "draws per speed and cells", [](std::uint64_t n) { return run_readback(n); }});
 }
 
 }  // namespace revcol::bench
