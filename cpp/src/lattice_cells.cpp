@@ -131,11 +131,37 @@ inline i64 boundary_component(std::int64_t h, bool y) {
 i64 boundary_x(std::int64_t h) { return boundary_component(h, false); }
 i64 boundary_y(std::int64_t h) { return boundary_component(h, true); }
 
+namespace {
+
+// atan2(y, x) within 2.5e-7 rad for (x, y) != 0: an odd polynomial of degree 13 in t = min / max
+// on [0, 1] (fitted for this purpose, max error 2.5e-7), then the octant. A cell is 6e-6 rad, so
+// the guess is within a cell; it is only a guess, which the exact comparisons correct (any
+// rounding of it changes the number of correction steps, never the cell). About a fifth of the
+// instructions of libm's atan2f.
+inline double atan2_guess(double y, double x) {
+  const double ax = std::fabs(x), ay = std::fabs(y);
+  const bool steep = ay > ax;
+  const double t = steep ? ax / ay : ay / ax;
+  const double t2 = t * t;
+  double p = 0.0068117926046103588;
+  p = p * t2 - 0.03360421913636702;
+  p = p * t2 + 0.079623671866918211;
+  p = p * t2 - 0.13233342169370219;
+  p = p * t2 + 0.19807815630014494;
+  p = p * t2 - 0.33317368071638948;
+  p = p * t2 + 0.99999611156190982;
+  double a = t * p;
+  if (steep) a = std::numbers::pi / 2 - a;
+  if (x < 0) a = std::numbers::pi - a;
+  return y < 0 ? -a : a;
+}
+
+}  // namespace
+
 std::int64_t dir_cell(i64 wx, i64 wy) {
   require(wx != 0 || wy != 0, "dir_cell: the zero vector has no direction");
   constexpr std::int64_t mask = kCells - 1;
-  // single precision is enough for a guess within a cell or two (6e-6 rad)
-  const double a = std::atan2(static_cast<float>(wy), static_cast<float>(wx));
+  const double a = atan2_guess(static_cast<double>(wy), static_cast<double>(wx));
   std::int64_t k = static_cast<std::int64_t>(std::floor(a * kCellsPerRadian)) & mask;
   while (cross(boundary(2 * k), wx, wy) < 0) k = (k - 1) & mask;
   while (cross(boundary(2 * k + 2), wx, wy) >= 0) k = (k + 1) & mask;
