@@ -18,13 +18,20 @@ namespace {
 template <std::size_t D>
 [[gnu::always_inline]] inline bool overlap_at(const VecN<D>& r, const VecN<D>& w, std::int64_t tau, u128 sigma2) noexcept {
   constexpr i128 big = i128{1} << 61;
-  VecN<D> d;
-  for (std::size_t k = 0; k < D; ++k) {
-    const i128 dk = static_cast<i128>(r[k]) + static_cast<i128>(w[k]) * tau;
-    if (dk >= big || dk <= -big) return false;
-    d[k] = static_cast<std::int64_t>(dk);
+  if constexpr (D == 2) {  // the 2D engine's code as it was (measure before changing)
+    const i128 dx = static_cast<i128>(r[0]) + static_cast<i128>(w[0]) * tau;
+    const i128 dy = static_cast<i128>(r[1]) + static_cast<i128>(w[1]) * tau;
+    if (dx >= big || dx <= -big || dy >= big || dy <= -big) return false;
+    return norm2(static_cast<std::int64_t>(dx), static_cast<std::int64_t>(dy)) < sigma2;
+  } else {
+    VecN<D> d;
+    for (std::size_t k = 0; k < D; ++k) {
+      const i128 dk = static_cast<i128>(r[k]) + static_cast<i128>(w[k]) * tau;
+      if (dk >= big || dk <= -big) return false;
+      d[k] = static_cast<std::int64_t>(dk);
+    }
+    return norm2(d) < sigma2;
   }
-  return norm2(d) < sigma2;
 }
 
 // r . w and |w|^2 in double, summed from the first axis on (in 2D exactly r0 w0 + r1 w1, the

@@ -63,18 +63,22 @@ inline u128 norm2(std::int64_t rx, std::int64_t ry) noexcept {
 /// value as norm2(rx, ry) in 2D.
 template <std::size_t D>
 inline u128 norm2(const VecN<D>& r) noexcept {
-  u128 s = 0;
-  for (std::size_t k = 0; k < D; ++k) {
-    const u128 a = static_cast<u128>(r[k] < 0 ? -static_cast<i128>(r[k]) : static_cast<i128>(r[k]));
-    s += a * a;
+  if constexpr (D == 2) {
+    return norm2(r[0], r[1]);  // the 2D engine's code as it was (measure before changing)
+  } else {
+    u128 s = 0;
+    for (std::size_t k = 0; k < D; ++k) {
+      const u128 a = static_cast<u128>(r[k] < 0 ? -static_cast<i128>(r[k]) : static_cast<i128>(r[k]));
+      s += a * a;
+    }
+    return s;
   }
-  return s;
 }
 /// The dot product r . w in 128 bits (|r_k| < 2^62, |w_k| < 2^54).
 template <std::size_t D>
 inline i128 dot(const VecN<D>& r, const VecN<D>& w) noexcept {
-  i128 s = 0;
-  for (std::size_t k = 0; k < D; ++k) s += static_cast<i128>(r[k]) * w[k];
+  i128 s = static_cast<i128>(r[0]) * w[0];
+  for (std::size_t k = 1; k < D; ++k) s += static_cast<i128>(r[k]) * w[k];
   return s;
 }
 
