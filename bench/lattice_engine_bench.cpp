@@ -1,6 +1,7 @@
 // The lattice family of revcol-bench: the 2D lattice engine's collisions per second forward and
 // reverse (periodic, N = 10^4, area fractions 0.3 and 0.5; walls at 0.3), with the round trip's
-// bit-exactness and the rare counts. Run it beside engine/d2/... in one invocation to compare
+// bit-exactness and the rare counts; lattice3d/... the same for the 3D engine (spheres, volume
+// fractions 0.3 and 0.45) and lattice3d/float/... the float engine on the same 3D gases. Run it beside engine/d2/... in one invocation to compare
 // with the float engine (the machine is shared: never compare across runs). lattice/float/...
 // runs the float engine (2D, exact mode, flux law, periodic) with the same timing, so that one
 // invocation of --bench lattice/ carries both; the *_cpu_per_s metrics divide by the process's CPU
@@ -19,6 +20,7 @@
 #include <ctime>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "bench.hpp"
@@ -43,11 +45,17 @@ struct LatticeCase {
   double phi = 0.3;
   bool walls = false;
   std::uint64_t seed = 1;
+  int dim = 2;
 };
 
+// the initial placement: 2D as before; 3D: random_state's choice (rsa to 0.2, else FCC)
+const char* init_of(const LatticeCase& c) { return c.dim == 3 ? "auto" : c.phi > 0.35 ? "lattice" : "auto"; }
+
+template <std::size_t D>
 std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
-  la::LatticeConfig cfg;
-  cfg.wall = {c.walls, c.walls};
+  using Engine = std::conditional_t<D == 2, la::LatticeEngine, la::LatticeEngine3D>;
+  la::LatticeConfigN<D> cfg;
+  cfg.wall = la::filled<D>(c.walls);
   cfg.seed = static_cast<std::uint32_t>(c.seed);
   // REVCOL_LATTICE=tick_bits=20,cell_bits=20 runs the engine as before the automatic tick
   apply_settings("REVCOL_LATTICE", "tick_bits, cell_bits", [&](const std::string& k, const std::string& v) {
@@ -56,11 +64,11 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
     else return false;
     return true;
   });
-  const la::LatticeStart st = la::random_start(cfg, c.n, c.phi, c.seed, c.phi > 0.35 ? "lattice" : "auto");
-  la::LatticeEngine e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
+  const la::LatticeStartN<D> st = la::random_start(cfg, c.n, c.phi, c.seed, init_of(c));
+  Engine e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
   // warm up a collision per particle from the initialiser's lattice, then start the clock
   e.run(c.n, la::tick_limit - 1);
-  const la::Snapshot s0 = e.snapshot();
+  const la::SnapshotN<D> s0 = e.snapshot();
   const la::Counters k0 = e.counters();
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
@@ -68,7 +76,7 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
   const std::uint64_t done = e.run(nc, la::tick_limit - 1);
   const auto t1 = clock::now();
   const double c1 = cpu_seconds();
-  const la::Diagnostics d1 = la::diagnostics(e);
+  const la::DiagnosticsN<D> d1 = la::diagnostics(e);
   const la::Counters k1 = e.counters();
   e.run_back(s0.collisions, s0.origin);
   const auto t2 = clock::now();
@@ -97,9 +105,9 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
 // the float engine on the same kind of gas, timed the same way (its own family is engine/...)
 std::vector<Metric> run_float(const LatticeCase& c, std::uint64_t nc) {
   en::Config cfg;
-  cfg.dim = 2;
+  cfg.dim = c.dim;
   cfg.seed = static_cast<std::uint32_t>(c.seed);
-  const en::InitialState st = en::random_state(cfg, c.n, c.phi, c.seed, 0.0, c.phi > 0.35 ? "lattice" : "auto");
+  const en::InitialState st = en::random_state(cfg, c.n, c.phi, c.seed, 0.0, init_of(c));
   auto sim = en::make_simulation(st.config, st.x, st.v);
   const double inf = std::numeric_limits<double>::infinity();
   sim->run(c.n, inf);
@@ -138,7 +146,24 @@ void add_lattice_benches(std::vector<Bench>& out) {
                                 {"lattice/walls/n10000/phi0.5", {10000, 0.5, true, 1}}};
   for (const Named& m : named) {
     const LatticeCase c = m.c;
-    out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice(c, n); }});
+    out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice<2>(c, n); }});
+  }
+  // the 3D engine (spheres) at N = 1e4, volume fractions 0.3 and 0.45, and the float engine on
+  // the same 3D gases
+  static const Named named3[] = {{"lattice3d/periodic/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
+                                 {"lattice3d/periodic/n10000/phi0.45", {10000, 0.45, false, 1, 3}},
+                                 {"lattice3d/walls/n10000/phi0.3", {10000, 0.3, true, 1, 3}},
+                                 {"lattice3d/periodic/n1000/phi0.3", {1000, 0.3, false, 1, 3}}};
+  for (const Named& m : named3) {
+    const LatticeCase c = m.c;
+    out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice<3>(c, n); }});
+  }
+  static const Named floats3[] = {{"lattice3d/float/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
+                                  {"lattice3d/float/n10000/phi0.45", {10000, 0.45, false, 1, 3}},
+                                  {"lattice3d/float/n1000/phi0.3", {1000, 0.3, false, 1, 3}}};
+  for (const Named& m : floats3) {
+    const LatticeCase c = m.c;
+    out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_float(c, n); }});
   }
   static const Named floats[] = {{"lattice/float/n10000/phi0.3", {10000, 0.3, false, 1}},
                                  {"lattice/float/n10000/phi0.5", {10000, 0.5, false, 1}},

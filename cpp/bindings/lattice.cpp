@@ -1,5 +1,8 @@
-// Binding of the 2D lattice engine: numpy int64 arrays in and out, dicts for starts,
-// diagnostics and checkpoints. No physics here (revcol/lattice/engine.hpp).
+// Binding of the lattice engine, 2D (LatticeEngine) and 3D (LatticeEngine3D, issue 14): numpy
+// int64 arrays in and out, dicts for starts, diagnostics and checkpoints. No physics here
+// (revcol/lattice/engine.hpp). Every conversion is one template on the dimension D; the 2D
+// names, arguments, messages and checkpoint keys are as they were, and a 3D checkpoint carries
+// the same keys with (n, 3) arrays, three-entry L and wall, six momentum0 words, and dim = 3.
 //
 // Threads (issue 19): run and run_back release the GIL for the event loop and take it back for
 // the Ctrl-C poll only; while a run is under way, a call on the same engine from another thread
@@ -29,22 +32,32 @@ namespace la = revcol::lattice;
 using IArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 using FArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-// An (n, 2) integer entry: its dtype checked first (forcecast would take floats and NaN).
+// An (n, D) integer entry: its dtype checked first (forcecast would take floats and NaN).
 IArray int_array(py::handle obj, const char* what) {
   (void)checkpoint_array<std::int64_t>(obj, what);  // integers of int64 range, or a named error
   return IArray::ensure(obj);
 }
-std::vector<la::Vec2> vecs(const IArray& a, const char* what) {
-  require(static_cast<bool>(a), [&] { return std::string(what) + " must be an (n, 2) integer array"; });  // ensure() failed
-  require(a.ndim() == 2 && a.shape(1) == 2, [&] { return std::string(what) + " must be an (n, 2) integer array"; });
-  std::vector<la::Vec2> out(static_cast<std::size_t>(a.shape(0)));
-  if (!out.empty()) std::memcpy(out.data(), a.data(), out.size() * sizeof(la::Vec2));
+template <std::size_t D>
+std::vector<la::VecN<D>> vecs(const IArray& a, const char* what) {
+  const auto bad = [&] { return std::string(what) + " must be an (n, " + std::to_string(D) + ") integer array"; };
+  require(static_cast<bool>(a), bad);  // ensure() failed
+  require(a.ndim() == 2 && a.shape(1) == static_cast<py::ssize_t>(D), bad);
+  std::vector<la::VecN<D>> out(static_cast<std::size_t>(a.shape(0)));
+  if (!out.empty()) std::memcpy(out.data(), a.data(), out.size() * sizeof(la::VecN<D>));
   return out;
 }
-py::array_t<std::int64_t> vec_array(const std::vector<la::Vec2>& v) {
-  py::array_t<std::int64_t> out({static_cast<py::ssize_t>(v.size()), py::ssize_t{2}});
-  if (!v.empty()) std::memcpy(out.mutable_data(), v.data(), v.size() * sizeof(la::Vec2));
+template <std::size_t D>
+py::array_t<std::int64_t> vec_array(const std::vector<la::VecN<D>>& v) {
+  py::array_t<std::int64_t> out({static_cast<py::ssize_t>(v.size()), static_cast<py::ssize_t>(D)});
+  if (!v.empty()) std::memcpy(out.mutable_data(), v.data(), v.size() * sizeof(la::VecN<D>));
   return out;
+}
+// a tuple of the D entries of an array
+template <class T, std::size_t D>
+py::tuple tuple_of(const std::array<T, D>& a) {
+  py::tuple t(D);
+  for (std::size_t k = 0; k < D; ++k) t[k] = py::cast(a[k]);
+  return t;
 }
 template <class T>
 py::array_t<T> flat_array(const T* p, std::size_t n) {
@@ -63,12 +76,13 @@ T get(const py::dict& d, const char* key) {
   return checkpoint_field<T>(d[key], key);
 }
 
-py::dict units_dict(const la::Units& u) {
+template <std::size_t D>
+py::dict units_dict(const la::UnitsN<D>& u) {
   py::dict d;
   d["S"] = u.S;
   d["sigma"] = u.sigma;
-  d["L"] = py::make_tuple(u.L[0], u.L[1]);
-  d["wall"] = py::make_tuple(u.wall[0], u.wall[1]);
+  d["L"] = tuple_of(u.L);
+  d["wall"] = tuple_of(u.wall);
   d["vmax"] = u.vmax;
   d["length_unit"] = u.length_unit;
   d["tick"] = u.tick;
@@ -76,15 +90,19 @@ py::dict units_dict(const la::Units& u) {
   d["cell_bits"] = u.cell_bits;
   return d;
 }
-la::Units units_from(const py::dict& d) {
-  la::Units u;
+template <std::size_t D>
+la::UnitsN<D> units_from(const py::dict& d) {
+  la::UnitsN<D> u;
   u.S = get<int>(d, "S");
   u.sigma = get<std::int64_t>(d, "sigma");
   const auto L = get<std::vector<std::int64_t>>(d, "L");
   const auto w = get<std::vector<bool>>(d, "wall");
-  require(L.size() == 2 && w.size() == 2, "lattice units: L and wall need two entries each");
-  u.L = {L[0], L[1]};
-  u.wall = {w[0], w[1]};
+  require(L.size() == D && w.size() == D, D == 2 ? "lattice units: L and wall need two entries each"
+                                                 : "lattice units: L and wall need three entries each (3D)");
+  for (std::size_t k = 0; k < D; ++k) {
+    u.L[k] = L[k];
+    u.wall[k] = w[k];
+  }
   u.vmax = get<std::int64_t>(d, "vmax");
   u.length_unit = get<double>(d, "length_unit");
   u.tick = get<double>(d, "tick");
@@ -99,7 +117,8 @@ la::Units units_from(const py::dict& d) {
   return u;
 }
 
-py::dict start_dict(const la::LatticeStart& s) {
+template <std::size_t D>
+py::dict start_dict(const la::LatticeStartN<D>& s) {
   py::dict d;
   d["units"] = units_dict(s.units);
   d["x"] = vec_array(s.x);
@@ -128,9 +147,11 @@ py::dict counters_dict(const la::Counters& c) {
   return d;
 }
 
-py::dict snapshot_dict(const la::Snapshot& s, revcol::Law law) {
+template <std::size_t D>
+py::dict snapshot_dict(const la::SnapshotN<D>& s, revcol::Law law) {
   py::dict d;
   d["engine"] = "lattice";
+  if constexpr (D == 3) d["dim"] = 3;  // (a 2D checkpoint has no dim key, as before)
   d["units"] = units_dict(s.units);
   d["law"] = to_string(law);
   d["seed"] = s.seed;
@@ -150,7 +171,7 @@ py::dict snapshot_dict(const la::Snapshot& s, revcol::Law law) {
   d["log_redraws"] = flat_array(lr.data(), lr.size());
   std::vector<std::uint64_t> gi;
   std::vector<std::int64_t> gd, gs, gm, gk;
-  std::vector<la::Vec2> gv;
+  std::vector<la::VecN<D>> gv;
   for (const auto& g : s.groups) {
     gi.push_back(g.index);
     gd.push_back(g.drawer);
@@ -166,21 +187,23 @@ py::dict snapshot_dict(const la::Snapshot& s, revcol::Law law) {
   d["group_kind"] = flat_array(gk.data(), gk.size());  // 0 bounce, 1 resolve (pre velocities in group_v)
   d["group_v"] = vec_array(gv);
   d["energy0"] = flat_array(s.energy0.data(), 2);
-  d["momentum0"] = flat_array(s.momentum0.data(), 4);
+  d["momentum0"] = flat_array(s.momentum0.data(), 2 * D);
   return d;
 }
 
-la::Snapshot snapshot_from(const py::dict& d) {
-  la::Snapshot s;
-  s.units = units_from(get<py::dict>(d, "units"));
+template <std::size_t D>
+la::SnapshotN<D> snapshot_from(const py::dict& d) {
+  la::SnapshotN<D> s;
+  if constexpr (D == 3) require(get<int>(d, "dim") == 3, "lattice checkpoint: dim must be 3 for the 3D engine");
+  s.units = units_from<D>(get<py::dict>(d, "units"));
   s.seed = get<std::uint32_t>(d, "seed");
   s.clock = get<std::int64_t>(d, "clock");
   s.origin = get<std::int64_t>(d, "origin");
   s.collisions = get<std::uint64_t>(d, "collisions");
   for (const char* k : {"x", "v"})
     require(d.contains(k), [&] { return std::string("lattice checkpoint is missing '") + k + "'"; });
-  s.x = checkpoint_entry("x", [&] { return vecs(int_array(d["x"], "x"), "x"); });
-  s.v = checkpoint_entry("v", [&] { return vecs(int_array(d["v"], "v"), "v"); });
+  s.x = checkpoint_entry("x", [&] { return vecs<D>(int_array(d["x"], "x"), "x"); });
+  s.v = checkpoint_entry("v", [&] { return vecs<D>(int_array(d["v"], "v"), "v"); });
   s.streams = get_flat<std::uint64_t>(d, "streams");
   s.bits = get_flat<std::uint64_t>(d, "bits");
   const auto li = get_flat<std::uint64_t>(d, "log_index");
@@ -194,14 +217,14 @@ la::Snapshot snapshot_from(const py::dict& d) {
   require(gi.size() == gd.size() && gi.size() == gs.size(), "lattice checkpoint: group arrays differ in length");
   // group_kind and group_v arrived with the group resolve; a checkpoint without them holds bounces only
   const auto gk = d.contains("group_kind") ? get_flat<std::int64_t>(d, "group_kind") : std::vector<std::int64_t>(gi.size(), 0);
-  const auto gv = d.contains("group_v") ? checkpoint_entry("group_v", [&] { return vecs(int_array(d["group_v"], "group_v"), "group_v"); })
-                                        : std::vector<la::Vec2>{};
+  const auto gv = d.contains("group_v") ? checkpoint_entry("group_v", [&] { return vecs<D>(int_array(d["group_v"], "group_v"), "group_v"); })
+                                        : std::vector<la::VecN<D>>{};
   require(gk.size() == gi.size(), "lattice checkpoint: group_kind and group_index differ in length");
   std::size_t at = 0, atv = 0;
   for (std::size_t k = 0; k < gi.size(); ++k) {
     require(gs[k] >= 2 && at + static_cast<std::size_t>(gs[k]) <= gm.size(), "lattice checkpoint: group_members too short");
     require(gk[k] == 0 || gk[k] == 1, "lattice checkpoint: group_kind must be 0 (bounce) or 1 (resolve)");
-    la::GroupEntry e;
+    la::GroupEntryN<D> e;
     e.index = gi[k];
     e.drawer = static_cast<int>(gd[k]);
     e.members.assign(gm.begin() + static_cast<std::ptrdiff_t>(at), gm.begin() + static_cast<std::ptrdiff_t>(at + gs[k]));
@@ -216,30 +239,32 @@ la::Snapshot snapshot_from(const py::dict& d) {
   require(at == gm.size() && atv == gv.size(), "lattice checkpoint: group_members or group_v longer than the groups");
   const auto e0 = get_flat<std::uint64_t>(d, "energy0");
   const auto p0 = get_flat<std::int64_t>(d, "momentum0");
-  require(e0.size() == 2 && p0.size() == 4, "lattice checkpoint: energy0 needs 2 words and momentum0 4");
+  require(e0.size() == 2 && p0.size() == 2 * D, D == 2 ? "lattice checkpoint: energy0 needs 2 words and momentum0 4"
+                                                        : "lattice checkpoint: energy0 needs 2 words and momentum0 6 (3D)");
   s.energy0 = {e0[0], e0[1]};
-  s.momentum0 = {p0[0], p0[1], p0[2], p0[3]};
+  for (std::size_t k = 0; k < 2 * D; ++k) s.momentum0[k] = p0[k];
   return s;
 }
 
 /// The engine with the law it was made with (the operator's law is not in the snapshot struct).
+template <class Engine>
 struct PyLattice {
   revcol::Law law;
-  la::LatticeEngine e;
+  Engine e;
   std::optional<std::thread::id> runner{};  ///< the thread whose run/run_back is under way (GIL held to touch)
 
   /// The engine; a RuntimeError when a run is under way (its loop runs without the GIL).
-  la::LatticeEngine& engine() {
+  Engine& engine() {
     if (runner) throw std::runtime_error("this LatticeSimulation is running in another thread: wait for its run to return");
     return e;
   }
   /// As engine(), read-only.
-  const la::LatticeEngine& engine() const { return const_cast<PyLattice*>(this)->engine(); }
+  const Engine& engine() const { return const_cast<PyLattice*>(this)->engine(); }
 
   /// f(engine) with the GIL released, the Ctrl-C poll taking it back; others' calls raise meanwhile.
   template <class F>
   auto run_released(F&& f) {
-    la::LatticeEngine& eng = engine();
+    Engine& eng = engine();
     runner = std::this_thread::get_id();
     struct Clear {
       std::optional<std::thread::id>& r;
@@ -254,75 +279,76 @@ struct PyLattice {
   }
 };
 
-}  // namespace
+// lattice_random_start (2D) and lattice3d_random_start
+template <std::size_t D>
+py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<bool> wall, PyReal diameter_arg, PyInt seed_arg,
+                        const std::string& init, PyInt tick_bits_arg, PyInt cell_bits_arg) {
+  const auto n = to_int<std::size_t>(n_arg, "n");
+  const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
+  const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
+  const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
+  require(wall.size() == D, D == 2 ? "lattice: walls need one flag per axis (2D)" : "lattice: walls need one flag per axis (3D)");
+  la::LatticeConfigN<D> c;
+  for (std::size_t k = 0; k < D; ++k) c.wall[k] = wall[k];
+  c.diameter = diameter;
+  c.seed = static_cast<std::uint32_t>(seed);
+  c.tick_bits = tick_bits;
+  c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
+  return start_dict(la::random_start(c, n, phi, seed, init));
+}
 
-void register_lattice(py::module_& m) {
-  m.def(
-      "lattice_random_start",
-      [](PyInt n_arg, PyReal phi_arg, std::vector<bool> wall, PyReal diameter_arg, PyInt seed_arg, const std::string& init,
-         PyInt tick_bits_arg, PyInt cell_bits_arg) {
-        const auto n = to_int<std::size_t>(n_arg, "n");
-        const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
-        const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
-        const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
-        require(wall.size() == 2, "lattice: walls need one flag per axis (2D)");
-        la::LatticeConfig c;
-        c.wall = {wall[0], wall[1]};
-        c.diameter = diameter;
-        c.seed = static_cast<std::uint32_t>(seed);
-        c.tick_bits = tick_bits;
-        c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
-        return start_dict(la::random_start(c, n, phi, seed, init));
-      },
-      py::arg("n"), py::arg("phi"), py::arg("wall"), py::arg("diameter"), py::arg("seed"), py::arg("init"),
-      py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
-      "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
-  m.def(
-      "lattice_quantize",
-      [](const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, PyReal diameter_arg,
-         PyInt tick_bits_arg, PyInt cell_bits_arg) {
-        const double diameter = to_real(diameter_arg, "diameter");
-        const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
-        require(box.size() == 2 && wall.size() == 2, "lattice: box and walls need two entries (2D)");
-        require(x.ndim() == 2 && x.shape(1) == 2 && v.ndim() == 2 && v.shape(1) == 2, "lattice: positions and velocities must be (n, 2)");
-        la::LatticeConfig c;
-        c.box = {box[0], box[1]};
-        c.wall = {wall[0], wall[1]};
-        c.diameter = diameter;
-        c.tick_bits = tick_bits;
-        c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
-        return start_dict(la::quantize_start(c, std::vector<double>(x.data(), x.data() + x.size()),
-                                             std::vector<double>(v.data(), v.data() + v.size())));
-      },
-      py::arg("x"), py::arg("v"), py::arg("box"), py::arg("wall"), py::arg("diameter"),
-      py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
-      "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
+// lattice_quantize (2D) and lattice3d_quantize
+template <std::size_t D>
+py::dict quantize_d(const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, PyReal diameter_arg,
+                    PyInt tick_bits_arg, PyInt cell_bits_arg) {
+  const double diameter = to_real(diameter_arg, "diameter");
+  const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
+  require(box.size() == D && wall.size() == D,
+          D == 2 ? "lattice: box and walls need two entries (2D)" : "lattice: box and walls need three entries (3D)");
+  const auto nd = static_cast<py::ssize_t>(D);
+  require(x.ndim() == 2 && x.shape(1) == nd && v.ndim() == 2 && v.shape(1) == nd,
+          D == 2 ? "lattice: positions and velocities must be (n, 2)" : "lattice: positions and velocities must be (n, 3)");
+  la::LatticeConfigN<D> c;
+  for (std::size_t k = 0; k < D; ++k) {
+    c.box[k] = box[k];
+    c.wall[k] = wall[k];
+  }
+  c.diameter = diameter;
+  c.tick_bits = tick_bits;
+  c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
+  return start_dict(la::quantize_start(c, std::vector<double>(x.data(), x.data() + x.size()),
+                                       std::vector<double>(v.data(), v.data() + v.size())));
+}
 
-  py::class_<PyLattice>(m, "LatticeEngine", "The 2D lattice engine (revcol/lattice/engine.hpp).")
+// the engine class LatticeEngine (2D) or LatticeEngine3D
+template <class Engine>
+void register_engine(py::module_& m, const char* name, const char* doc) {
+  constexpr std::size_t D = Engine::D;
+  using P = PyLattice<Engine>;
+  py::class_<P>(m, name, doc)
       .def(py::init([](const py::dict& units, const IArray& x, const IArray& v, PyInt seed_arg, const std::string& law,
                        PyInt clock_arg) {
              const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
              const auto clock = to_int<std::int64_t>(clock_arg, "clock");
-             const la::Units u = units_from(units);
+             const la::UnitsN<D> u = units_from<D>(units);
              const revcol::Law lw = parse_law(law);
-             return PyLattice{lw, la::LatticeEngine(u, vecs(x, "x"), vecs(v, "v"), static_cast<std::uint32_t>(seed),
-                                                    la::operator_for(u, lw), clock)};
+             return P{lw, Engine(u, vecs<D>(x, "x"), vecs<D>(v, "v"), static_cast<std::uint32_t>(seed), la::operator_for(u, lw), clock)};
            }),
            py::arg("units"), py::arg("x"), py::arg("v"), py::arg("seed"), py::arg("law"), py::arg("clock") = 0)
       .def_static(
           "from_snapshot",
           [](const py::dict& d) {
-            const la::Snapshot s = snapshot_from(d);
+            const la::SnapshotN<D> s = snapshot_from<D>(d);
             const revcol::Law lw = parse_law(get<std::string>(d, "law"));
-            return PyLattice{lw, la::LatticeEngine(s, la::operator_for(s.units, lw))};
+            return P{lw, Engine(s, la::operator_for(s.units, lw))};
           },
           py::arg("snapshot"), "Rebuilds an engine from snapshot(); it resumes bit for bit.")
       .def(
           "run",
-          [](PyLattice& p, std::optional<PyInt> collisions_arg, std::optional<PyInt> until_arg) {
+          [](P& p, std::optional<PyInt> collisions_arg, std::optional<PyInt> until_arg) {
             const auto collisions = to_int<std::uint64_t>(collisions_arg, "collisions");
             const auto until = to_int<std::int64_t>(until_arg, "until");
-            const std::uint64_t done = p.run_released([&](la::LatticeEngine& e, const auto& poll) {
+            const std::uint64_t done = p.run_released([&](Engine& e, const auto& poll) {
               return e.run(collisions.value_or(std::numeric_limits<std::uint64_t>::max()),
                            until.value_or(la::tick_limit - 1), poll);
             });
@@ -333,11 +359,11 @@ void register_lattice(py::module_& m) {
           "Forward: until that many more collisions or the tick `until`; returns the collisions done.")
       .def(
           "run_back",
-          [](PyLattice& p, std::optional<PyInt> to_collisions_arg, std::optional<PyInt> to_tick_arg) {
+          [](P& p, std::optional<PyInt> to_collisions_arg, std::optional<PyInt> to_tick_arg) {
             const auto to_collisions = to_int<std::uint64_t>(to_collisions_arg, "to_collisions");
             const auto to_tick = to_int<std::int64_t>(to_tick_arg, "to_tick");
             const std::int64_t origin = p.engine().origin();
-            p.run_released([&](la::LatticeEngine& e, const auto& poll) {
+            p.run_released([&](Engine& e, const auto& poll) {
               e.run_back(to_collisions.value_or(0), to_tick.value_or(origin), poll);
               return 0;
             });
@@ -345,21 +371,21 @@ void register_lattice(py::module_& m) {
           },
           py::arg("to_collisions") = py::none(), py::arg("to_tick") = py::none(),
           "Back to collision count `to_collisions` or tick `to_tick` (default: the start).")
-      .def("snapshot", [](const PyLattice& p) { return snapshot_dict(p.engine().snapshot(), p.law); })
-      .def_property_readonly("positions", [](const PyLattice& p) { return vec_array(p.engine().positions()); })
-      .def_property_readonly("velocities", [](const PyLattice& p) { return vec_array(p.engine().velocities()); })
-      .def_property_readonly("clock", [](const PyLattice& p) { return p.engine().clock(); })
-      .def_property_readonly("origin", [](const PyLattice& p) { return p.engine().origin(); })
-      .def_property_readonly("collisions", [](const PyLattice& p) { return p.engine().collisions(); })
-      .def_property_readonly("units", [](const PyLattice& p) { return units_dict(p.engine().units()); })
-      .def_property_readonly("n", [](const PyLattice& p) { return p.engine().size(); })
-      .def_property_readonly("law", [](const PyLattice& p) { return std::string(to_string(p.law)); })
-      .def("diagnostics", [](const PyLattice& p) {
-        const la::Diagnostics g = la::diagnostics(p.engine());
+      .def("snapshot", [](const P& p) { return snapshot_dict(p.engine().snapshot(), p.law); })
+      .def_property_readonly("positions", [](const P& p) { return vec_array(p.engine().positions()); })
+      .def_property_readonly("velocities", [](const P& p) { return vec_array(p.engine().velocities()); })
+      .def_property_readonly("clock", [](const P& p) { return p.engine().clock(); })
+      .def_property_readonly("origin", [](const P& p) { return p.engine().origin(); })
+      .def_property_readonly("collisions", [](const P& p) { return p.engine().collisions(); })
+      .def_property_readonly("units", [](const P& p) { return units_dict(p.engine().units()); })
+      .def_property_readonly("n", [](const P& p) { return p.engine().size(); })
+      .def_property_readonly("law", [](const P& p) { return std::string(to_string(p.law)); })
+      .def("diagnostics", [](const P& p) {
+        const la::DiagnosticsN<D> g = la::diagnostics(p.engine());
         py::dict d = counters_dict(p.engine().counters());
         d["energy_drift"] = g.energy_drift;
         d["energy_drift_units"] = g.energy_drift_units;
-        d["momentum_drift"] = py::make_tuple(g.momentum_drift[0], g.momentum_drift[1]);
+        d["momentum_drift"] = tuple_of(g.momentum_drift);
         d["bits_length"] = g.bits_length;
         d["log_entries"] = g.log_entries;
         d["group_log_entries"] = p.engine().group_log_size();
@@ -369,6 +395,25 @@ void register_lattice(py::module_& m) {
         d["memory_bytes"] = g.memory_bytes;
         return d;
       });
+}
+
+}  // namespace
+
+void register_lattice(py::module_& m) {
+  m.def("lattice_random_start", &random_start_d<2>, py::arg("n"), py::arg("phi"), py::arg("wall"), py::arg("diameter"),
+        py::arg("seed"), py::arg("init"), py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
+        "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
+  m.def("lattice3d_random_start", &random_start_d<3>, py::arg("n"), py::arg("phi"), py::arg("wall"), py::arg("diameter"),
+        py::arg("seed"), py::arg("init"), py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
+        "A random 3D start (spheres) as engine_random_state, quantized once: {units, x, v, errors}.");
+  m.def("lattice_quantize", &quantize_d<2>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("wall"), py::arg("diameter"),
+        py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
+        "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
+  m.def("lattice3d_quantize", &quantize_d<3>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("wall"), py::arg("diameter"),
+        py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
+        "3D units from the box and rms speed, and one quantization of (n, 3) arrays: {units, x, v, errors}.");
+  register_engine<la::LatticeEngine>(m, "LatticeEngine", "The 2D lattice engine (revcol/lattice/engine.hpp).");
+  register_engine<la::LatticeEngine3D>(m, "LatticeEngine3D", "The 3D lattice engine, spheres (revcol/lattice/engine.hpp).");
 }
 
 }  // namespace revcol::bind

@@ -1,5 +1,6 @@
-// The 2D lattice engine (lattice/engine.hpp): the explicit instantiation over the exact pair
-// operator, starts from float states, snapshots and diagnostics.
+// The lattice engine (lattice/engine.hpp): the explicit instantiation of the 2D engine over the
+// exact pair operator (the 3D engine's is lattice_engine3d.cpp), starts from float states in 2D and
+// 3D, and diagnostics.
 #include "revcol/lattice/engine.hpp"
 
 #include <cmath>
@@ -23,24 +24,16 @@ std::vector<std::uint64_t> initial_bits(std::uint32_t seed) {
   return w;
 }
 
-bool same_state(const Snapshot& a, const Snapshot& b) {
-  const Units &u = a.units, &w = b.units;
-  return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.vmax == w.vmax &&
-         u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
-         a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
-         a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&
-         a.groups == b.groups &&
-         a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
-}
-
-LatticeStart quantize_start(const LatticeConfig& c, const std::vector<double>& x, const std::vector<double>& v) {
-  require(x.size() == v.size() && x.size() % 2 == 0 && !x.empty(), "lattice: positions and velocities must both be n x 2");
+template <std::size_t D>
+LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<double>& x, const std::vector<double>& v) {
+  require(x.size() == v.size() && x.size() % D == 0 && !x.empty(),
+          D == 2 ? "lattice: positions and velocities must both be n x 2" : "lattice: positions and velocities must both be n x 3");
   double s2 = 0.0;
   for (double a : v) s2 += a * a;
-  const double v_rms = std::sqrt(s2 / static_cast<double>(x.size() / 2));
-  LatticeStart s;
-  s.units = choose_units(c.box, c.diameter, v_rms, c.wall, c.tick_bits, c.cell_bits, x.size() / 2);
-  Quantized q = quantize(s.units, x, v);
+  const double v_rms = std::sqrt(s2 / static_cast<double>(x.size() / D));
+  LatticeStartN<D> s;
+  s.units = choose_units_d<D>(c.box, c.diameter, v_rms, c.wall, c.tick_bits, c.cell_bits, x.size() / D);
+  QuantizedN<D> q = quantize(s.units, x, v);
   s.x = std::move(q.x);
   s.v = std::move(q.v);
   s.max_position_error = q.max_position_error;
@@ -48,26 +41,34 @@ LatticeStart quantize_start(const LatticeConfig& c, const std::vector<double>& x
   return s;
 }
 
-LatticeStart random_start(const LatticeConfig& c, std::size_t n, double phi, std::uint64_t seed,
-                          const std::string& init) {
+template <std::size_t D>
+LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double phi, std::uint64_t seed,
+                              const std::string& init) {
   engine::Config fc;
-  fc.dim = 2;
+  fc.dim = static_cast<int>(D);
   fc.diameter = c.diameter;
-  for (int k = 0; k < 2; ++k) fc.boundary[k] = c.wall[k] ? engine::Boundary::wall : engine::Boundary::periodic;
+  for (std::size_t k = 0; k < D; ++k) fc.boundary[k] = c.wall[k] ? engine::Boundary::wall : engine::Boundary::periodic;
   const engine::InitialState st = engine::random_state(fc, n, phi, seed, 0.0, init);
-  LatticeConfig lc = c;
-  lc.box = {st.config.box[0], st.config.box[1]};
+  LatticeConfigN<D> lc = c;
+  for (std::size_t k = 0; k < D; ++k) lc.box[k] = st.config.box[k];
   return quantize_start(lc, st.x, st.v);
 }
 
-Diagnostics diagnostics(const LatticeEngine& e) {
-  Diagnostics d;
+template LatticeStartN<2> quantize_start(const LatticeConfigN<2>&, const std::vector<double>&, const std::vector<double>&);
+template LatticeStartN<3> quantize_start(const LatticeConfigN<3>&, const std::vector<double>&, const std::vector<double>&);
+template LatticeStartN<2> random_start(const LatticeConfigN<2>&, std::size_t, double, std::uint64_t, const std::string&);
+template LatticeStartN<3> random_start(const LatticeConfigN<3>&, std::size_t, double, std::uint64_t, const std::string&);
+
+namespace {
+template <class Eng>
+DiagnosticsN<Eng::D> diagnostics_of(const Eng& e) {
+  DiagnosticsN<Eng::D> d;
   const u128 E = kinetic2(e.velocities()), E0 = e.energy0();
   const double dE = E >= E0 ? static_cast<double>(E - E0) : -static_cast<double>(E0 - E);
   d.energy_drift_units = dE;
   d.energy_drift = E0 > 0 ? dE / static_cast<double>(E0) : 0.0;
-  const auto P = LatticeEngine::momentum_of(e.velocities());
-  for (int k = 0; k < 2; ++k) d.momentum_drift[k] = static_cast<double>(P[k] - e.momentum0(k));
+  const auto P = Eng::momentum_of(e.velocities());
+  for (std::size_t k = 0; k < Eng::D; ++k) d.momentum_drift[k] = static_cast<double>(P[k] - e.momentum0(static_cast<int>(k)));
   d.bits_length = e.bits().bit_length();
   d.log_entries = e.log_size();
   d.collisions = e.collisions();
@@ -76,5 +77,9 @@ Diagnostics diagnostics(const LatticeEngine& e) {
   d.memory_bytes = e.memory_bytes();
   return d;
 }
+}  // namespace
+
+Diagnostics diagnostics(const LatticeEngine& e) { return diagnostics_of(e); }
+DiagnosticsN<3> diagnostics(const LatticeEngine3D& e) { return diagnostics_of(e); }
 
 }  // namespace revcol::lattice

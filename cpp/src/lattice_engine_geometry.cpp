@@ -1,4 +1,4 @@
-// Exact predicates, units, quantization and the cell grid of the 2D lattice engine
+// Exact predicates, units, quantization and the cell grid of the lattice engine in 2D and 3D
 // (lattice/geometry.hpp, units.hpp, cell_grid.hpp).
 #include <algorithm>
 #include <cmath>
@@ -15,30 +15,44 @@ namespace revcol::lattice {
 
 namespace {
 // overlaps_at, inlined into first_overlap's search (it runs up to five times per prediction)
-[[gnu::always_inline]] inline bool overlap_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) noexcept {
+template <std::size_t D>
+[[gnu::always_inline]] inline bool overlap_at(const VecN<D>& r, const VecN<D>& w, std::int64_t tau, u128 sigma2) noexcept {
   constexpr i128 big = i128{1} << 61;
-  const i128 dx = static_cast<i128>(r[0]) + static_cast<i128>(w[0]) * tau;
-  const i128 dy = static_cast<i128>(r[1]) + static_cast<i128>(w[1]) * tau;
-  if (dx >= big || dx <= -big || dy >= big || dy <= -big) return false;
-  return norm2(static_cast<std::int64_t>(dx), static_cast<std::int64_t>(dy)) < sigma2;
+  if constexpr (D == 2) {  // the 2D engine's code as it was (measure before changing)
+    const i128 dx = static_cast<i128>(r[0]) + static_cast<i128>(w[0]) * tau;
+    const i128 dy = static_cast<i128>(r[1]) + static_cast<i128>(w[1]) * tau;
+    if (dx >= big || dx <= -big || dy >= big || dy <= -big) return false;
+    return norm2(static_cast<std::int64_t>(dx), static_cast<std::int64_t>(dy)) < sigma2;
+  } else {
+    VecN<D> d;
+    for (std::size_t k = 0; k < D; ++k) {
+      const i128 dk = static_cast<i128>(r[k]) + static_cast<i128>(w[k]) * tau;
+      if (dk >= big || dk <= -big) return false;
+      d[k] = static_cast<std::int64_t>(dk);
+    }
+    return norm2(d) < sigma2;
+  }
 }
-}  // namespace
 
-bool overlaps_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) noexcept {
-  return overlap_at(r, w, tau, sigma2);
+// r . w and |w|^2 in double, summed from the first axis on (in 2D exactly r0 w0 + r1 w1, the
+// order the 2D engine has always used: its guesses, hence its bits, stay the same)
+template <std::size_t D>
+inline double ddot(const VecN<D>& a, const VecN<D>& b) noexcept {
+  double s = static_cast<double>(a[0]) * static_cast<double>(b[0]);
+  for (std::size_t k = 1; k < D; ++k) s += static_cast<double>(a[k]) * static_cast<double>(b[k]);
+  return s;
 }
 
-std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept {
-  if (norm2(r[0], r[1]) < sigma2) return 0;
-  const i128 B = static_cast<i128>(r[0]) * w[0] + static_cast<i128>(r[1]) * w[1];
+template <std::size_t D>
+std::int64_t first_overlap_d(const VecN<D>& r, const VecN<D>& w, u128 sigma2) noexcept {
+  if (norm2(r) < sigma2) return 0;
+  const i128 B = dot(r, w);
   if (B >= 0) return -1;  // not approaching: f increases from f(0) >= 0
-  const i128 A = static_cast<i128>(w[0]) * w[0] + static_cast<i128>(w[1]) * w[1];
+  const i128 A = dot(w, w);
   // f is convex with its real minimum in [tv, tv + 1); the integer minimum is at tv or tv + 1.
   // tv = floor(-B / A): a double guess (from the 64-bit components: no 128-bit division or
-  // conversion), made exact by A tv <= -B < A (tv + 1) in 128 bits (|B| < 2^106, |tv| < 2^62)
-  const double r0 = static_cast<double>(r[0]), r1 = static_cast<double>(r[1]);
-  const double w0 = static_cast<double>(w[0]), w1 = static_cast<double>(w[1]);
-  const double a = w0 * w0 + w1 * w1, b = r0 * w0 + r1 * w1;
+  // conversion), made exact by A tv <= -B < A (tv + 1) in 128 bits (|B| < 2^118, |tv| < 2^62)
+  const double a = ddot(w, w), b = ddot(r, w);
   std::int64_t tv = static_cast<std::int64_t>(std::clamp(std::floor(-b / a), 0.0, 0x1p61));
   while (tv > 0 && A * tv > -B) --tv;
   while (A * (tv + 1) <= -B) ++tv;
@@ -46,7 +60,7 @@ std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept {
   if (!at_v) return overlap_at(r, w, tv + 1, sigma2) ? tv + 1 : -1;
   // f decreases on [0, tv]: the answer is the first tau in (0, tv] with f < 0 (f(0) >= 0).
   // First guess in double: the smaller root of A t^2 + 2 B t + C (C exact, then rounded once).
-  const double c = static_cast<double>(static_cast<i128>(norm2(r[0], r[1])) - static_cast<i128>(sigma2));
+  const double c = static_cast<double>(static_cast<i128>(norm2(r)) - static_cast<i128>(sigma2));
   const double disc = std::max(0.0, b * b - a * c);
   double g = c / (-b + std::sqrt(disc));  // cancellation-free form of (-b - sqrt(disc)) / a
   std::int64_t lo = 0, hi = tv;            // invariant: f(lo) >= 0, f(hi) < 0
@@ -69,12 +83,21 @@ std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept {
   }
   return hi;
 }
+}  // namespace
 
-void validate(const Units& u) {
+bool overlaps_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) noexcept { return overlap_at(r, w, tau, sigma2); }
+bool overlaps_at(const Vec3& r, const Vec3& w, std::int64_t tau, u128 sigma2) noexcept { return overlap_at(r, w, tau, sigma2); }
+std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept { return first_overlap_d(r, w, sigma2); }
+std::int64_t first_overlap(const Vec3& r, const Vec3& w, u128 sigma2) noexcept { return first_overlap_d(r, w, sigma2); }
+
+template <std::size_t Dim>
+void validate(const UnitsN<Dim>& u) {
   require(u.S >= 8 && u.S <= 60, "lattice units: S must be in [8, 60]");
   require(u.sigma == (std::int64_t{1} << u.S), "lattice units: sigma must be 2^S");
-  for (int k = 0; k < 2; ++k) {
-    require(u.L[k] > 0 && u.L[k] < max_box, "lattice units: a box length must be in (0, 2^63 - 2^56) lattice units");
+  for (std::size_t k = 0; k < Dim; ++k) {
+    require(u.L[k] > 0 && u.L[k] < max_box_of<Dim>,
+            Dim == 2 ? "lattice units: a box length must be in (0, 2^63 - 2^56) lattice units"
+                     : "lattice units: a box length must be in (0, 2^62) lattice units in 3D");
     if (u.wall[k]) {
       require(u.L[k] > u.sigma + 2, "lattice units: a walled axis must be longer than one diameter");
     } else {
@@ -88,8 +111,9 @@ void validate(const Units& u) {
           "lattice units: cell_bits must be in [12, 20]");
 }
 
-Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
-                   int tick_bits, int cell_bits, std::size_t n) {
+template <std::size_t Dim>
+UnitsN<Dim> choose_units_d(const std::array<double, Dim>& box, double D, double v_rms, const std::array<bool, Dim>& wall,
+                           int tick_bits, int cell_bits, std::size_t n) {
   require(tick_bits == auto_tick_bits || (tick_bits >= min_tick_bits && tick_bits <= max_tick_bits),
           "lattice: tick_bits must be in [16, 26] (a typical particle moves 2^-tick_bits diameters per tick), or 0 (automatic)");
   require(cell_bits >= min_units_cell_bits && cell_bits <= max_units_cell_bits,
@@ -114,11 +138,11 @@ Units choose_units(const std::array<double, 2>& box, double D, double v_rms, con
     while (n > 0 && static_cast<double>(n) > std::ldexp(1.0, 2 * (t_n - 9))) ++t_n;
     tick_bits = std::min(std::max(tick_bits, t_n), max_tick_bits);
   }
-  Units u;
+  UnitsN<Dim> u;
   u.S = S;
   u.sigma = std::int64_t{1} << S;
   u.wall = wall;
-  for (int k = 0; k < 2; ++k) u.L[k] = std::llround(std::ldexp(box[k] / D, S));
+  for (std::size_t k = 0; k < Dim; ++k) u.L[k] = std::llround(std::ldexp(box[k] / D, S));
   u.vmax = std::int64_t{1} << (S - 8);
   u.length_unit = std::ldexp(D, -S);
   u.tick = std::ldexp(D, -tick_bits) / v_rms;
@@ -128,20 +152,81 @@ Units choose_units(const std::array<double, 2>& box, double D, double v_rms, con
   return u;
 }
 
-u128 kinetic2(const std::vector<Vec2>& v) noexcept {
+template <std::size_t Dim>
+u128 kinetic2(const std::vector<VecN<Dim>>& v) noexcept {
   u128 e = 0;
-  for (const Vec2& a : v) e += norm2(a[0], a[1]);
+  for (const VecN<Dim>& a : v) {
+    const u128 s = e + norm2(a);
+    if (s < e) return ~u128{0};  // saturates (only a state far beyond vmax can reach 2^128)
+    e = s;
+  }
   return e;
 }
 
-void validate_state(const Units& u, const std::vector<Vec2>& x, const std::vector<Vec2>& v) {
+namespace {
+// the overlap check of validate_state: a hash grid of cells of one diameter (keys in unsigned
+// arithmetic: a collision of keys only adds candidates, every pair is decided exactly)
+template <std::size_t Dim>
+void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x) {
+  const u128 s2 = static_cast<u128>(u.sigma) * static_cast<u128>(u.sigma);
+  std::array<std::int64_t, Dim> nc{};
+  for (std::size_t k = 0; k < Dim; ++k) nc[k] = std::max<std::int64_t>(1, u.L[k] / u.sigma);
+  using Cell = std::array<std::int64_t, Dim>;
+  auto key = [&](const Cell& c) {
+    std::uint64_t h = 0;
+    for (std::size_t k = 0; k < Dim; ++k) h = h * static_cast<std::uint64_t>(nc[k]) + static_cast<std::uint64_t>(c[k]);
+    return h;
+  };
+  auto cell_of = [&](const VecN<Dim>& p) {
+    Cell c;
+    for (std::size_t k = 0; k < Dim; ++k)
+      c[k] = std::min<std::int64_t>(nc[k] - 1, static_cast<std::int64_t>(static_cast<i128>(p[k]) * nc[k] / u.L[k]));
+    return c;
+  };
+  std::unordered_map<std::uint64_t, std::vector<int>> grid;
+  for (std::size_t i = 0; i < x.size(); ++i) grid[key(cell_of(x[i]))].push_back(static_cast<int>(i));
+  int offsets = 1;
+  for (std::size_t k = 0; k < Dim; ++k) offsets *= 3;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Cell c0 = cell_of(x[i]);
+    for (int o = 0; o < offsets; ++o) {  // the 3^Dim neighbour cells, the last axis fastest
+      Cell c = c0;
+      bool skip = false;
+      for (int k = static_cast<int>(Dim) - 1, rest = o; k >= 0; --k, rest /= 3) {
+        c[k] += rest % 3 - 1;
+        if (c[k] < 0 || c[k] >= nc[k]) {
+          if (u.wall[k]) skip = true;
+          c[k] = (c[k] + nc[k]) % nc[k];
+        }
+      }
+      if (skip) continue;
+      auto it = grid.find(key(c));
+      if (it == grid.end()) continue;
+      for (int j : it->second) {
+        if (j <= static_cast<int>(i)) continue;
+        VecN<Dim> r;
+        for (std::size_t k = 0; k < Dim; ++k) {
+          const std::int64_t d = x[i][k] - x[j][k];
+          r[k] = u.wall[k] ? d : min_image(d, u.L[k]);
+        }
+        require(norm2(r) >= s2, [&] {
+          return "lattice: particles " + std::to_string(i) + " and " + std::to_string(j) + " overlap";
+        });
+      }
+    }
+  }
+}
+}  // namespace
+
+template <std::size_t Dim>
+void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v) {
   validate(u);
   require(x.size() == v.size(), "lattice: x (positions) and v (velocities) differ in length");
   require(!x.empty(), "lattice: no particles");
   require(x.size() < (std::size_t{1} << 30), "lattice: at most 2^30 particles");
   const std::int64_t h = u.sigma / 2;
   for (std::size_t i = 0; i < x.size(); ++i) {
-    for (int k = 0; k < 2; ++k) {
+    for (std::size_t k = 0; k < Dim; ++k) {
       require(x[i][k] >= 0 && x[i][k] < u.L[k], [&] {
         return "lattice: particle " + std::to_string(i) + " is outside the box [0, L)";
       });
@@ -158,44 +243,16 @@ void validate_state(const Units& u, const std::vector<Vec2>& x, const std::vecto
   const u128 e = kinetic2(v);
   require(e <= static_cast<u128>(u.vmax) * static_cast<u128>(u.vmax),
           "lattice: the total kinetic energy allows a speed beyond vmax (too many particles for the velocity scale)");
-  // overlaps, with a hash grid of cells of one diameter
-  const u128 s2 = static_cast<u128>(u.sigma) * static_cast<u128>(u.sigma);
-  std::array<std::int64_t, 2> nc{};
-  for (int k = 0; k < 2; ++k) nc[k] = std::max<std::int64_t>(1, u.L[k] / u.sigma);
-  auto key = [&](std::int64_t a, std::int64_t b) { return a * nc[1] + b; };
-  std::unordered_map<std::int64_t, std::vector<int>> grid;
-  auto cell = [&](int k, std::int64_t p) { return std::min<std::int64_t>(nc[k] - 1, static_cast<std::int64_t>(static_cast<i128>(p) * nc[k] / u.L[k])); };
-  for (std::size_t i = 0; i < x.size(); ++i) grid[key(cell(0, x[i][0]), cell(1, x[i][1]))].push_back(static_cast<int>(i));
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const std::int64_t c0 = cell(0, x[i][0]), c1 = cell(1, x[i][1]);
-    for (std::int64_t d0 = -1; d0 <= 1; ++d0) {
-      for (std::int64_t d1 = -1; d1 <= 1; ++d1) {
-        std::int64_t a = c0 + d0, b = c1 + d1;
-        if (a < 0 || a >= nc[0]) { if (u.wall[0]) continue; a = (a + nc[0]) % nc[0]; }
-        if (b < 0 || b >= nc[1]) { if (u.wall[1]) continue; b = (b + nc[1]) % nc[1]; }
-        auto it = grid.find(key(a, b));
-        if (it == grid.end()) continue;
-        for (int j : it->second) {
-          if (j <= static_cast<int>(i)) continue;
-          std::int64_t r[2];
-          for (int k = 0; k < 2; ++k) {
-            const std::int64_t d = x[i][k] - x[j][k];
-            r[k] = u.wall[k] ? d : min_image(d, u.L[k]);
-          }
-          require(norm2(r[0], r[1]) >= s2, [&] {
-            return "lattice: particles " + std::to_string(i) + " and " + std::to_string(j) + " overlap";
-          });
-        }
-      }
-    }
-  }
+  check_overlaps(u, x);
 }
 
-Quantized quantize(const Units& u, const std::vector<double>& x, const std::vector<double>& v) {
+template <std::size_t Dim>
+QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, const std::vector<double>& v) {
   validate(u);
-  require(x.size() == v.size() && x.size() % 2 == 0, "lattice: positions and velocities must both be n x 2");
-  const std::size_t n = x.size() / 2;
-  Quantized q;
+  require(x.size() == v.size() && x.size() % Dim == 0,
+          Dim == 2 ? "lattice: positions and velocities must both be n x 2" : "lattice: positions and velocities must both be n x 3");
+  const std::size_t n = x.size() / Dim;
+  QuantizedN<Dim> q;
   q.x.resize(n);
   q.v.resize(n);
   const double vunit = u.length_unit / u.tick;  // float velocity of one lattice unit per tick
@@ -203,8 +260,8 @@ Quantized quantize(const Units& u, const std::vector<double>& x, const std::vect
   for (double a : v) vr += a * a;
   vr = std::sqrt(vr / std::max<std::size_t>(n, 1));
   for (std::size_t i = 0; i < n; ++i) {
-    for (int k = 0; k < 2; ++k) {
-      const double xf = x[2 * i + k], vf = v[2 * i + k];
+    for (std::size_t k = 0; k < Dim; ++k) {
+      const double xf = x[Dim * i + k], vf = v[Dim * i + k];
       require(std::isfinite(xf) && std::isfinite(vf), "lattice: a position or velocity is not finite");
       const double xl = xf / u.length_unit, vl = vf / vunit;
       require(std::fabs(vl) <= static_cast<double>(u.vmax), [&] {
@@ -228,22 +285,25 @@ Quantized quantize(const Units& u, const std::vector<double>& x, const std::vect
 
 // ---- cells ----
 
-void CellGrid::build(const Units& u, std::size_t n) {
+template <std::size_t Dim>
+void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n) {
   const std::int64_t wmin = u.sigma + 2 * u.vmax + 2;
-  std::array<std::int64_t, 2> ncl{};
-  for (int k = 0; k < 2; ++k) {
+  std::array<std::int64_t, Dim> ncl{};
+  for (std::size_t k = 0; k < Dim; ++k) {
     L_[k] = u.L[k];
     wall_[k] = u.wall[k];
     ncl[k] = std::max<std::int64_t>(1, u.L[k] / wmin);
   }
   // at most ~4 cells per particle: a sparse gas takes wider cells (any width >= wmin works)
   const double cap = 4.0 * static_cast<double>(n) + 64.0;
-  const double total = static_cast<double>(ncl[0]) * static_cast<double>(ncl[1]);
+  double total = static_cast<double>(ncl[0]);
+  for (std::size_t k = 1; k < Dim; ++k) total *= static_cast<double>(ncl[k]);
   if (total > cap) {
-    const double f = std::sqrt(total / cap);
-    for (int k = 0; k < 2; ++k) ncl[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(static_cast<double>(ncl[k]) / f));
+    const double f = Dim == 2 ? std::sqrt(total / cap) : std::cbrt(total / cap);
+    for (std::size_t k = 0; k < Dim; ++k)
+      ncl[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(static_cast<double>(ncl[k]) / f));
   }
-  for (int k = 0; k < 2; ++k) {
+  for (std::size_t k = 0; k < Dim; ++k) {
     all_[k] = !u.wall[k] && ncl[k] < 5;
     nc_[k] = static_cast<int>(all_[k] ? 8 : ncl[k]);
     bounds_[k].resize(static_cast<std::size_t>(nc_[k]) + 1);
@@ -252,20 +312,24 @@ void CellGrid::build(const Units& u, std::size_t n) {
     nbr_[k].assign(static_cast<std::size_t>(nc_[k]) * 8, 0);
     nbrn_[k].assign(static_cast<std::size_t>(nc_[k]), 0);
     for (int c = 0; c < nc_[k]; ++c)
-      nbrn_[k][static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(axis_range(k, c, &nbr_[k][static_cast<std::size_t>(c) * 8]));
+      nbrn_[k][static_cast<std::size_t>(c)] =
+          static_cast<std::uint8_t>(axis_range(static_cast<int>(k), c, &nbr_[k][static_cast<std::size_t>(c) * 8]));
   }
   // disks with centres in a w0 x w1 cell, pairwise >= sigma apart: at most (ceil(w/sigma) + 1)^2
+  // (spheres in 3D: the product over three axes)
   std::int64_t per = 1;
-  for (int k = 0; k < 2; ++k) per *= (L_[k] / nc_[k] + u.sigma) / u.sigma + 1;
+  for (std::size_t k = 0; k < Dim; ++k) per *= (L_[k] / nc_[k] + u.sigma) / u.sigma + 1;
   cap_ = static_cast<std::size_t>(std::min<std::int64_t>(per + 2, 8));
-  const std::size_t cells = static_cast<std::size_t>(nc_[0]) * nc_[1];
+  std::size_t cells = 1;
+  for (std::size_t k = 0; k < Dim; ++k) cells *= static_cast<std::size_t>(nc_[k]);
   slots_.assign(cells * static_cast<std::size_t>(cap_), -1);
   count_.assign(cells, 0);
   where_.assign(n, -1);
   slot_.assign(n, -1);
 }
 
-std::int64_t CellGrid::exit_ticks(int k, int c, std::int64_t x0, std::int64_t v) const noexcept {
+template <std::size_t Dim>
+std::int64_t CellGridN<Dim>::exit_ticks(int k, int c, std::int64_t x0, std::int64_t v) const noexcept {
   if (v > 0) {
     if (wall_[k] && c + 1 == nc_[k]) return -1;  // the wall comes first
     return (boundary(k, c + 1) - x0 + v - 1) / v;
@@ -277,7 +341,8 @@ std::int64_t CellGrid::exit_ticks(int k, int c, std::int64_t x0, std::int64_t v)
   return -1;
 }
 
-int CellGrid::axis_range(int k, int c, int* out) const noexcept {
+template <std::size_t Dim>
+int CellGridN<Dim>::axis_range(int k, int c, int* out) const noexcept {
   const int nc = nc_[k];
   if (all_[k]) {
     for (int i = 0; i < nc; ++i) out[i] = i;
@@ -297,7 +362,8 @@ int CellGrid::axis_range(int k, int c, int* out) const noexcept {
   return n;
 }
 
-void CellGrid::grow() {
+template <std::size_t Dim>
+void CellGridN<Dim>::grow() {
   const std::size_t cap = 2 * cap_;
   std::vector<int> wider(count_.size() * cap, -1);
   for (std::size_t id = 0; id < count_.size(); ++id)
@@ -306,14 +372,16 @@ void CellGrid::grow() {
   cap_ = cap;
 }
 
-void CellGrid::insert(int p, int id) {
+template <std::size_t Dim>
+void CellGridN<Dim>::insert(int p, int id) {
   if (static_cast<std::size_t>(count_[id]) >= cap_) grow();
   where_[p] = id;
   slot_[p] = count_[id];
   slots_[static_cast<std::size_t>(id) * cap_ + count_[id]++] = p;
 }
 
-void CellGrid::remove(int p) {
+template <std::size_t Dim>
+void CellGridN<Dim>::remove(int p) {
   const int id = where_[p];
   const int s = slot_[p];
   const int last = slots_[static_cast<std::size_t>(id) * cap_ + --count_[id]];
@@ -322,9 +390,27 @@ void CellGrid::remove(int p) {
   where_[p] = -1;
 }
 
-std::size_t CellGrid::memory_bytes() const noexcept {
-  return (slots_.capacity() + where_.capacity() + slot_.capacity() + nbr_[0].capacity() + nbr_[1].capacity()) * sizeof(int) +
-         count_.capacity() * 4 + nbrn_[0].capacity() + nbrn_[1].capacity();
+template <std::size_t Dim>
+std::size_t CellGridN<Dim>::memory_bytes() const noexcept {
+  std::size_t b = (slots_.capacity() + where_.capacity() + slot_.capacity()) * sizeof(int) + count_.capacity() * 4;
+  for (std::size_t k = 0; k < Dim; ++k) b += nbr_[k].capacity() * sizeof(int) + nbrn_[k].capacity();
+  return b;
 }
+
+// ---- the two dimensions ----
+template void validate(const UnitsN<2>&);
+template void validate(const UnitsN<3>&);
+template UnitsN<2> choose_units_d<2>(const std::array<double, 2>&, double, double, const std::array<bool, 2>&, int, int,
+                                     std::size_t);
+template UnitsN<3> choose_units_d<3>(const std::array<double, 3>&, double, double, const std::array<bool, 3>&, int, int,
+                                     std::size_t);
+template u128 kinetic2(const std::vector<VecN<2>>&) noexcept;
+template u128 kinetic2(const std::vector<VecN<3>>&) noexcept;
+template void validate_state(const UnitsN<2>&, const std::vector<VecN<2>>&, const std::vector<VecN<2>>&);
+template void validate_state(const UnitsN<3>&, const std::vector<VecN<3>>&, const std::vector<VecN<3>>&);
+template QuantizedN<2> quantize(const UnitsN<2>&, const std::vector<double>&, const std::vector<double>&);
+template QuantizedN<3> quantize(const UnitsN<3>&, const std::vector<double>&, const std::vector<double>&);
+template class CellGridN<2>;
+template class CellGridN<3>;
 
 }  // namespace revcol::lattice

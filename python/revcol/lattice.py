@@ -1,5 +1,6 @@
-"""The 2D lattice engine: a randomized hard-disk gas reversed bit for bit, for any number of
-collisions, with memory that does not grow with them (revcol/lattice/engine.hpp, LATTICE.md).
+"""The lattice engine: a randomized hard-disk (2D, ``LatticeSimulation``) or hard-sphere (3D,
+``LatticeSimulation3D``) gas reversed bit for bit, for any number of collisions, with memory that
+does not grow with them (revcol/lattice/engine.hpp, LATTICE.md).
 
 Positions and velocities are integers: sigma = 2^S lattice units per diameter D, a tick moves a
 typical particle 2^-20 sigma. Free flight is exact; a pair collides on the transition into the
@@ -36,16 +37,18 @@ from ._attach import Attachable
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .engine import _real_array
 
-__all__ = ["LatticeSimulation"]
+__all__ = ["LatticeSimulation", "LatticeSimulation3D"]
 
 _Boundary = Union[str, Sequence[str]]
 
 
-def _walls(boundary: _Boundary) -> list:
+def _walls(boundary: _Boundary, dim: int = 2) -> list:
     given = names(boundary, "boundary")
-    given = given * 2 if isinstance(boundary, str) else given
-    if len(given) != 2:
-        raise ValueError("the lattice engine is 2D: boundary must be one name or two")
+    given = given * dim if isinstance(boundary, str) else given
+    if len(given) != dim:
+        if dim == 2:
+            raise ValueError("the lattice engine is 2D: boundary must be one name or two")
+        raise ValueError(f"a {dim}D lattice: boundary must be one name or {dim}")
     out = []
     for b in given:
         if b in ("wall", "walls"):
@@ -62,8 +65,15 @@ def _tick(tick_bits: Optional[int]) -> int:
     return 0 if tick_bits is None else integer(tick_bits, "tick_bits", 16, 26)
 
 
+# the binding's engine class and start functions per dimension
+_ENGINE = {2: "LatticeEngine", 3: "LatticeEngine3D"}
+_RANDOM_START = {2: "lattice_random_start", 3: "lattice3d_random_start"}
+_QUANTIZE = {2: "lattice_quantize", 3: "lattice3d_quantize"}
+
+
 class LatticeSimulation(Attachable):
-    """N hard disks on the integer lattice, run forward and back bit for bit (2D only).
+    """N hard disks on the integer lattice, run forward and back bit for bit (2D; spheres in 3D:
+    :class:`LatticeSimulation3D`, the same API).
 
     Build from float arrays (``LatticeSimulation(positions, velocities, box)``, quantized once)
     or at random (``LatticeSimulation.random(n, phi=...)``, the float engine's initialiser then
@@ -79,6 +89,8 @@ class LatticeSimulation(Attachable):
     the problem.
     """
 
+    _DIM = 2  # LatticeSimulation3D: 3
+
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
                  diameter: float = 1.0, law: str = "flux", seed: int = 1, tick_bits: Optional[int] = None,
                  cell_bits: int = 16, _engine=None,
@@ -90,33 +102,41 @@ class LatticeSimulation(Attachable):
         x = _real_array(positions, "positions")
         v = _real_array(velocities, "velocities")
         box = _real_array(box, "box")
-        if box.ndim > 1 or box.size not in (1, 2):
+        dim = self._DIM
+        if dim == 2 and (box.ndim > 1 or box.size not in (1, 2)):
             raise ValueError(f"box must be one length or two (2D), got shape {box.shape}")
-        start = _core.lattice_quantize(x, v, [float(b) for b in np.broadcast_to(box, (2,))],
-                                       _walls(boundary), diameter, _tick(tick_bits), cell_bits)
-        self._init_from_start(start, law, seed)
+        if dim == 3 and (box.ndim > 1 or box.size not in (1, 3)):
+            raise ValueError(f"box must be one length or three (3D), got shape {box.shape}")
+        start = getattr(_core, _QUANTIZE[dim])(x, v, [float(b) for b in np.broadcast_to(box, (dim,))],
+                                               _walls(boundary, dim), diameter, _tick(tick_bits), cell_bits)
+        self._init_from_start(start, law, seed, dim)
 
-    def _init_from_start(self, start: dict, law: str, seed: int) -> None:
-        self._e = _core.LatticeEngine(start["units"], start["x"], start["v"], seed, name(law, "law"))
+    def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2) -> None:
+        engine = getattr(_core, _ENGINE[dim])
+        self._e = engine(start["units"], start["x"], start["v"], seed, name(law, "law"))
         self._q = {"max_position_error": start["max_position_error"],
                    "max_velocity_error": start["max_velocity_error"]}
 
     @classmethod
-    def random(cls, n: int, dim: int = 2, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
+    def random(cls, n: int, dim: Optional[int] = None, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
                diameter: float = 1.0, seed: int = 1, init: str = "auto", law: str = "flux",
                tick_bits: Optional[int] = None, cell_bits: int = 16,
                packing_fraction: Optional[float] = None) -> "LatticeSimulation":
-        """n disks at area fraction ``phi`` (or ``packing_fraction=``; default 0.3) in a square
-        box (the float engine's ``random_state``:
-        random sequential addition or a jittered lattice, Gaussian velocities with zero momentum,
-        kT = 1), quantized once. The same ``seed`` keys the streams."""
+        """n disks (spheres for LatticeSimulation3D) at area (volume) fraction ``phi`` (or
+        ``packing_fraction=``; default 0.3) in a square (cubic) box (the float engine's
+        ``random_state``: random sequential addition or a jittered lattice (FCC in 3D), Gaussian
+        velocities with zero momentum, kT = 1), quantized once. The same ``seed`` keys the
+        streams. ``dim`` (default: the class's, 2 or 3) must be the class's."""
         phi = _packing_fraction(phi, packing_fraction)
-        if dim != 2:
-            raise ValueError(f"the lattice engine is 2D, got dim={dim}")
-        start = _core.lattice_random_start(n, phi, _walls(boundary), diameter, seed, name(init, "init"), _tick(tick_bits),
-                                            cell_bits)
+        dim = cls._DIM if dim is None else dim
+        if dim != cls._DIM:
+            if cls._DIM == 2:
+                raise ValueError(f"the lattice engine is 2D, got dim={dim} (spheres: LatticeSimulation3D)")
+            raise ValueError(f"LatticeSimulation3D is 3D, got dim={dim}")
+        start = getattr(_core, _RANDOM_START[dim])(n, phi, _walls(boundary, dim), diameter, seed, name(init, "init"),
+                                                   _tick(tick_bits), cell_bits)
         sim = cls.__new__(cls)
-        sim._init_from_start(start, law, seed)
+        sim._init_from_start(start, law, seed, dim)
         return sim
 
     # --- running ---------------------------------------------------------------------------
@@ -175,22 +195,22 @@ class LatticeSimulation(Attachable):
 
     @property
     def lattice_positions(self) -> np.ndarray:
-        """Integer positions at the clock, shape (n, 2), lattice units (a copy)."""
+        """Integer positions at the clock, shape (n, dim), lattice units (a copy)."""
         return self._e.positions
 
     @property
     def lattice_velocities(self) -> np.ndarray:
-        """Integer velocities, shape (n, 2), lattice units per tick (a copy)."""
+        """Integer velocities, shape (n, dim), lattice units per tick (a copy)."""
         return self._e.velocities
 
     @property
     def positions(self) -> np.ndarray:
-        """Positions at the clock in float units, shape (n, 2)."""
+        """Positions at the clock in float units, shape (n, dim)."""
         return self._e.positions.astype(float) * self._e.units["length_unit"]
 
     @property
     def velocities(self) -> np.ndarray:
-        """Velocities in float units, shape (n, 2)."""
+        """Velocities in float units, shape (n, dim)."""
         u = self._e.units
         return self._e.velocities.astype(float) * (u["length_unit"] / u["tick"])
 
@@ -216,8 +236,8 @@ class LatticeSimulation(Attachable):
 
     @property
     def dim(self) -> int:
-        """Dimension: 2."""
-        return 2
+        """Dimension: 2 (3 for LatticeSimulation3D)."""
+        return self._DIM
 
     @property
     def units(self) -> dict:
@@ -250,7 +270,8 @@ class LatticeSimulation(Attachable):
 
     @classmethod
     def from_snapshot(cls, snapshot: dict) -> "LatticeSimulation":
-        """Rebuilds from ``snapshot()``; the run resumes bit for bit."""
+        """Rebuilds from ``snapshot()``; the run resumes bit for bit. A 3D snapshot (``dim`` 3)
+        gives a LatticeSimulation3D whichever class is asked."""
         st = dict(snapshot)
         q = st.pop("quantization", None)
         engine = st.get("engine", "lattice")
@@ -269,7 +290,12 @@ class LatticeSimulation(Attachable):
                     raise ValueError(f"snapshot: quantization.{k} must be finite and >= 0, got {x!r}")
                 clean[str(k)] = x
             q = clean
-        return cls(None, None, None, _engine=_core.LatticeEngine.from_snapshot(st), _quantization=q)
+        dim = int(np.asarray(st.get("dim", 2)))
+        if dim not in (2, 3):
+            raise ValueError(f"snapshot: dim must be 2 or 3, got {dim}")
+        engine_class = getattr(_core, _ENGINE[dim])
+        out = LatticeSimulation3D if dim == 3 else LatticeSimulation
+        return out(None, None, None, _engine=engine_class.from_snapshot(st), _quantization=q)
 
     def state(self) -> dict:
         """Deprecated name of ``snapshot()``."""
@@ -314,4 +340,29 @@ class LatticeSimulation(Attachable):
         return (type(self).from_snapshot, (self.snapshot(),))
 
     def __repr__(self) -> str:
-        return f"LatticeSimulation(n={self.n}, collisions={self.collisions}, clock={self.clock})"
+        return f"{type(self).__name__}(n={self.n}, collisions={self.collisions}, clock={self.clock})"
+
+
+class LatticeSimulation3D(LatticeSimulation):
+    """N hard spheres on the integer lattice, run forward and back bit for bit: the 3D lattice
+    engine (``LatticeEngine3D``), with :class:`LatticeSimulation`'s API.
+
+    Build from (n, 3) float arrays and one or three box lengths
+    (``LatticeSimulation3D(positions, velocities, box)``) or at random
+    (``LatticeSimulation3D.random(n, phi=...)``: the float engine's 3D ``random_state``, random
+    sequential addition up to a volume fraction 0.2, else a jittered FCC lattice). ``boundary``:
+    one name or three. The pair operator is ``LatticePair3D`` (the polar angle by whole-cell
+    lifting rotations, the azimuth by bits-back over the exact rows of its cell;
+    docs/lattice.md); ``cell_bits`` sets its 2^cell_bits polar cells per turn. Snapshots carry
+    ``dim`` = 3 and (n, 3) arrays.
+
+        >>> from revcol.lattice import LatticeSimulation3D
+        >>> sim = LatticeSimulation3D.random(n=100, phi=0.3, seed=1)
+        >>> x0 = sim.lattice_positions
+        >>> _ = sim.run(collisions=1000)
+        >>> _ = sim.run_back()
+        >>> bool((sim.lattice_positions == x0).all())
+        True
+    """
+
+    _DIM = 3

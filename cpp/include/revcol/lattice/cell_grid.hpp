@@ -1,4 +1,4 @@
-// The integer cell grid of the 2D lattice engine and its flat walls (LATTICE.md §6).
+// The integer cell grid of the lattice engine (D = 2 or 3) and its flat walls (LATTICE.md §6).
 //
 // Cells. Per axis, nc cells with integer boundaries b(c) = floor(c L / nc); a particle belongs to
 // the cell holding its position at its last event, and leaves it at an exact integer tick (the
@@ -15,9 +15,11 @@
 // toward the lower wall, {x >= h, x + v < h}, are |v| integers, and so are the post phases at tick
 // a, {x' >= h, x' - v' < h} with v' = -v; the mirror x' = h + (|v| - 1 - (x - h)) maps one onto
 // the other, and read backwards (velocities negated) it is the same map. The upper wall is the
-// mirror image. Two walls within one tick (a corner) are the two axes' mirrors at once.
+// mirror image. Two walls within one tick (a corner) are the two axes' mirrors at once (in 3D,
+// up to three).
 #pragma once
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -48,11 +50,12 @@ inline std::int64_t wall_ticks(std::int64_t x0, std::int64_t v, std::int64_t h, 
   return -1;
 }
 
-/// The cell grid: geometry per axis and the members of each cell.
-class CellGrid {
+/// The cell grid in Dim dimensions: geometry per axis and the members of each cell.
+template <std::size_t Dim>
+class CellGridN {
  public:
   /// A grid for these units (cell width >= sigma + 2 vmax + 2) over n particles.
-  void build(const Units& u, std::size_t n);
+  void build(const UnitsN<Dim>& u, std::size_t n);
   /// Number of cells along axis k.
   int count(int k) const noexcept { return nc_[k]; }
   /// Lower boundary of cell c (0 <= c <= nc) on axis k: floor(c L / nc).
@@ -68,20 +71,49 @@ class CellGrid {
   }
   /// Ticks from an anchor x0 in cell c of axis k until the line x0 + v dt leaves the cell; -1 if never.
   std::int64_t exit_ticks(int k, int c, std::int64_t x0, std::int64_t v) const noexcept;
-  /// Flat cell id of a particle at position x.
-  int cell_id(const Vec2& x) const noexcept { return cell_of(0, x[0]) * nc_[1] + cell_of(1, x[1]); }
+  /// Flat cell id of a particle at position x (the last axis fastest).
+  int cell_id(const VecN<Dim>& x) const noexcept {
+    int id = cell_of(0, x[0]);
+    for (std::size_t k = 1; k < Dim; ++k) id = id * nc_[k] + cell_of(static_cast<int>(k), x[k]);
+    return id;
+  }
+  /// The per-axis cell indices of flat cell id.
+  std::array<int, Dim> coords(int id) const noexcept {
+    std::array<int, Dim> c{};
+    for (std::size_t k = Dim; k-- > 1;) {
+      c[k] = id % nc_[k];
+      id /= nc_[k];
+    }
+    c[0] = id;
+    return c;
+  }
   /// Calls f(member) for every particle in the cells neighbouring (and including) flat cell id.
   template <class F>
   void for_neighbours(int id, F&& f) const {
-    const int c0 = id / nc_[1], c1 = id % nc_[1];
     // the distinct neighbour cells per axis, tabulated by build (axis_range)
-    const int* a0 = &nbr_[0][static_cast<std::size_t>(c0) * 8];
-    const int* a1 = &nbr_[1][static_cast<std::size_t>(c1) * 8];
-    const int n0 = nbrn_[0][static_cast<std::size_t>(c0)], n1 = nbrn_[1][static_cast<std::size_t>(c1)];
-    for (int i = 0; i < n0; ++i)
-      for (int j = 0; j < n1; ++j)
-        for (std::size_t id2 = static_cast<std::size_t>(a0[i]) * nc_[1] + a1[j], k = 0, e = count_[id2]; k < e; ++k)
-          f(slots_[id2 * cap_ + k]);
+    if constexpr (Dim == 2) {
+      const int c0 = id / nc_[1], c1 = id % nc_[1];
+      const int* a0 = &nbr_[0][static_cast<std::size_t>(c0) * 8];
+      const int* a1 = &nbr_[1][static_cast<std::size_t>(c1) * 8];
+      const int n0 = nbrn_[0][static_cast<std::size_t>(c0)], n1 = nbrn_[1][static_cast<std::size_t>(c1)];
+      for (int i = 0; i < n0; ++i)
+        for (int j = 0; j < n1; ++j)
+          for (std::size_t id2 = static_cast<std::size_t>(a0[i]) * nc_[1] + a1[j], k = 0, e = count_[id2]; k < e; ++k)
+            f(slots_[id2 * cap_ + k]);
+    } else {
+      const std::array<int, Dim> c = coords(id);
+      const int* a0 = &nbr_[0][static_cast<std::size_t>(c[0]) * 8];
+      const int* a1 = &nbr_[1][static_cast<std::size_t>(c[1]) * 8];
+      const int* a2 = &nbr_[2][static_cast<std::size_t>(c[2]) * 8];
+      const int n0 = nbrn_[0][static_cast<std::size_t>(c[0])], n1 = nbrn_[1][static_cast<std::size_t>(c[1])];
+      const int n2 = nbrn_[2][static_cast<std::size_t>(c[2])];
+      for (int i = 0; i < n0; ++i)
+        for (int j = 0; j < n1; ++j) {
+          const std::size_t row = (static_cast<std::size_t>(a0[i]) * nc_[1] + a1[j]) * nc_[2];
+          for (int l = 0; l < n2; ++l)
+            for (std::size_t id2 = row + a2[l], k = 0, e = count_[id2]; k < e; ++k) f(slots_[id2 * cap_ + k]);
+        }
+    }
   }
   /// Puts particle p into flat cell id.
   void insert(int p, int id);
@@ -93,16 +125,17 @@ class CellGrid {
   std::size_t memory_bytes() const noexcept;
 
  private:
+  static_assert(Dim == 2 || Dim == 3, "the lattice cell grid is for 2 or 3 dimensions");
   // the distinct neighbour cells of c on axis k into out[8] (returns their count)
   int axis_range(int k, int c, int* out) const noexcept;
-  std::array<std::int64_t, 2> L_{};
-  std::array<int, 2> nc_{1, 1};
-  std::array<std::vector<std::int64_t>, 2> bounds_;  // b(c) = floor(c L / nc), c = 0..nc
-  std::array<double, 2> scale_{0.0, 0.0};             // nc / L: cell_of's first guess
-  std::array<std::vector<int>, 2> nbr_;               // per axis and cell: its neighbour cells (8 slots)
-  std::array<std::vector<std::uint8_t>, 2> nbrn_;     // per axis and cell: how many
-  std::array<bool, 2> all_{false, false};  // small periodic axis: every cell is a neighbour
-  std::array<bool, 2> wall_{false, false};
+  std::array<std::int64_t, Dim> L_{};
+  std::array<int, Dim> nc_{};
+  std::array<std::vector<std::int64_t>, Dim> bounds_;  // b(c) = floor(c L / nc), c = 0..nc
+  std::array<double, Dim> scale_{};                    // nc / L: cell_of's first guess
+  std::array<std::vector<int>, Dim> nbr_;              // per axis and cell: its neighbour cells (8 slots)
+  std::array<std::vector<std::uint8_t>, Dim> nbrn_;    // per axis and cell: how many
+  std::array<bool, Dim> all_{};  // small periodic axis: every cell is a neighbour
+  std::array<bool, Dim> wall_{};
   // members stored flat (measure before changing: the neighbour scan is bound by memory loads):
   // cell id's members are slots_[id * cap_ .. + count_[id]]; cap_ starts at min(8, the most disks
   // whose centres fit one cell without overlapping, plus 2) and doubles when a cell is full
@@ -112,5 +145,7 @@ class CellGrid {
   std::vector<std::int32_t> count_;
   std::vector<int> where_, slot_;
 };
+/// The 2D cell grid.
+using CellGrid = CellGridN<2>;
 
 }  // namespace revcol::lattice

@@ -1,5 +1,9 @@
-// The event machinery of the 2D lattice engine, generic over the exact pair operator
-// (LATTICE.md §2, §4; the concrete engine is lattice/engine.hpp).
+// The event machinery of the lattice engine, generic over the exact pair operator and, through
+// it, over the dimension D = 2 or 3 (LATTICE.md §2, §4; the concrete engines are in
+// lattice/engine.hpp). D is deduced from the operator's pair_forward (its vectors are VecN<D>):
+// LatticePair2D gives the disk gas, LatticePair3D the sphere gas; the event search, the
+// acceptance test, the redraws, the rare log, the group collisions, the counters and the
+// snapshots are one code for both (per-axis loops over D; a wall is a flat plane per axis).
 //
 // State: per particle an anchor position (integer, wrapped into the box) at an anchor tick, an
 // integer velocity, a line version (bumped when the line changes) and a Philox stream counter; the
@@ -89,34 +93,75 @@ struct Counters {
 /// either take the velocities of a specular resolution (pre_v holds their exact pre velocities,
 /// so the reverse restores them) or, when that post state would break the event rule, bounce
 /// back (every velocity negated, an involution: pre_v empty).
-struct GroupEntry {
-  std::uint64_t index = 0;    ///< collision index (1-based)
-  int drawer = 0;             ///< whose stream the tried draws came from
-  std::vector<int> members;   ///< ascending
-  std::vector<Vec2> pre_v;    ///< members' exact pre velocities (a resolve); empty: a bounce
-  bool operator==(const GroupEntry&) const = default;
+template <std::size_t D>
+struct GroupEntryN {
+  std::uint64_t index = 0;       ///< collision index (1-based)
+  int drawer = 0;                ///< whose stream the tried draws came from
+  std::vector<int> members;      ///< ascending
+  std::vector<VecN<D>> pre_v;    ///< members' exact pre velocities (a resolve); empty: a bounce
+  bool operator==(const GroupEntryN&) const = default;
 };
+/// A 2D group entry.
+using GroupEntry = GroupEntryN<2>;
 
-/// Everything that defines a lattice state, in the forward frame, positions at the clock.
-struct Snapshot {
-  Units units;                                 ///< units and box
+/// Everything that defines a lattice state in D dimensions, in the forward frame, positions at the clock.
+template <std::size_t D>
+struct SnapshotN {
+  UnitsN<D> units;                             ///< units and box
   std::uint32_t seed = 1;                      ///< Philox key {particle, seed}
   std::int64_t clock = 0;                      ///< the current tick
   std::int64_t origin = 0;                     ///< the tick of the initial state (no run back past it)
   std::uint64_t collisions = 0;                ///< collisions since the initial state
-  std::vector<Vec2> x;                         ///< positions at the clock
-  std::vector<Vec2> v;                         ///< velocities
+  std::vector<VecN<D>> x;                      ///< positions at the clock
+  std::vector<VecN<D>> v;                      ///< velocities
   std::vector<std::uint64_t> streams;          ///< per-particle Philox counters
   std::vector<std::uint64_t> bits;             ///< the bits-back integer X, 64-bit words, low first
   std::vector<std::pair<std::uint64_t, std::uint32_t>> log;  ///< rare log: collision index -> redraws
-  std::vector<GroupEntry> groups;              ///< rare log: group collisions (resolves and bounces)
+  std::vector<GroupEntryN<D>> groups;          ///< rare log: group collisions (resolves and bounces)
   std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
-  std::array<std::int64_t, 4> momentum0{};     ///< initial momentum per axis (128 bits: low, high)
+  std::array<std::int64_t, 2 * D> momentum0{};  ///< initial momentum per axis (128 bits: low, high)
   Counters counters;                           ///< statistics (not compared by same_state)
 };
+/// A 2D snapshot.
+using Snapshot = SnapshotN<2>;
+/// A 3D snapshot.
+using Snapshot3 = SnapshotN<3>;
 
 /// True when two snapshots hold the same physical state bit for bit (everything but counters).
-bool same_state(const Snapshot& a, const Snapshot& b);
+template <std::size_t D>
+bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
+  const UnitsN<D> &u = a.units, &w = b.units;
+  return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.vmax == w.vmax &&
+         u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
+         a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
+         a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&
+         a.groups == b.groups &&
+         a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
+}
+
+/// -a, per component.
+template <std::size_t D>
+inline VecN<D> neg(const VecN<D>& a) noexcept {
+  VecN<D> o;
+  for (std::size_t k = 0; k < D; ++k) o[k] = -a[k];
+  return o;
+}
+/// a - b, per component (no wrap).
+template <std::size_t D>
+inline VecN<D> sub(const VecN<D>& a, const VecN<D>& b) noexcept {
+  VecN<D> o;
+  for (std::size_t k = 0; k < D; ++k) o[k] = a[k] - b[k];
+  return o;
+}
+
+/// The dimension of a pair operator: that of the vectors its pair_forward takes.
+template <class R, class O, std::size_t D, class... A>
+constexpr std::size_t pair_dim(R (O::*)(const VecN<D>&, A...) const) noexcept {
+  return D;
+}
+/// The dimension an engine over Op runs in (2 or 3).
+template <class Op>
+inline constexpr std::size_t op_dim = pair_dim(&Op::pair_forward);
 
 /// The 48-bit draw k of particle p's stream: Philox4x32-10 block (lo32(k), hi32(k), 0, 0) under
 /// key {p, seed}, bits w0 (32) and the top 16 of w1.
@@ -128,12 +173,21 @@ inline std::uint64_t draw48(std::uint32_t p, std::uint32_t seed, std::uint64_t k
 std::vector<std::uint64_t> initial_bits(std::uint32_t seed);
 
 /// The lattice engine's event machinery over a pair operator Op (pair_forward / pair_reverse as
-/// LatticePair2D) and a bits-back integer Bits (BitsBack).
+/// LatticePair2D or LatticePair3D; the dimension is the operator's) and a bits-back integer Bits
+/// (BitsBack).
 template <class Op, class Bits, class Queue = engine::EventQueue<std::int64_t>>
 class BasicEngine {
  public:
+  /// The dimension (2 or 3), from the operator.
+  static constexpr std::size_t D = op_dim<Op>;
+  static_assert(D == 2 || D == 3, "the lattice engine runs in 2 or 3 dimensions");
+  using Vec = VecN<D>;              ///< a position, velocity or relative vector
+  using Units = UnitsN<D>;          ///< the units and box
+  using Snapshot = SnapshotN<D>;    ///< the state
+  using GroupEntry = GroupEntryN<D>;  ///< a group collision in the rare log
+
   /// An engine on a validated integer state at tick clock, X from initial_bits(seed).
-  BasicEngine(const Units& u, std::vector<Vec2> x, std::vector<Vec2> v, std::uint32_t seed, Op op,
+  BasicEngine(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, Op op,
               std::int64_t clock = 0)
       : op_(std::move(op)) {
     check_operator(u);
@@ -150,7 +204,7 @@ class BasicEngine {
     const u128 e = kinetic2(s.v);
     s.energy0 = {static_cast<std::uint64_t>(e), static_cast<std::uint64_t>(e >> 64)};
     const auto p = momentum_of(s.v);
-    for (int k = 0; k < 2; ++k) {
+    for (std::size_t k = 0; k < D; ++k) {
       s.momentum0[2 * k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(static_cast<u128>(p[k])));
       s.momentum0[2 * k + 1] = static_cast<std::int64_t>(p[k] >> 64);
     }
@@ -179,11 +233,11 @@ class BasicEngine {
       require(e.pre_v.empty() || e.pre_v.size() == e.members.size(),
               "lattice snapshot: a group entry needs one pre velocity per member (or none: a bounce)");
       for (int m : e.members) require(m >= 0 && static_cast<std::size_t>(m) < s.x.size(), "lattice snapshot: a group member out of range");
-      for (const Vec2& w : e.pre_v)
-        require(w[0] >= -s.units.vmax && w[0] <= s.units.vmax && w[1] >= -s.units.vmax && w[1] <= s.units.vmax,
-                "lattice snapshot: a group entry's pre velocity is faster than vmax");
+      for (const Vec& w : e.pre_v)
+        for (std::size_t k = 0; k < D; ++k)
+          require(w[k] >= -s.units.vmax && w[k] <= s.units.vmax, "lattice snapshot: a group entry's pre velocity is faster than vmax");
     }
-    require(s.origin <= s.clock && s.clock < tick_limit / 2 && s.origin > -tick_limit / 2,
+    require(s.origin <= s.clock && tick_limit / 2 > s.clock && s.origin > -tick_limit / 2,
             "lattice snapshot: origin <= clock within +-2^60 required");
     check_operator(s.units);
     load(s);
@@ -241,14 +295,14 @@ class BasicEngine {
     return s;
   }
   /// Positions at the clock, wrapped.
-  std::vector<Vec2> positions() const {
-    std::vector<Vec2> out(ln_.size());
+  std::vector<Vec> positions() const {
+    std::vector<Vec> out(ln_.size());
     for (std::size_t p = 0; p < ln_.size(); ++p) out[p] = pos(static_cast<int>(p), clock_);
     return out;
   }
   /// Velocities (a copy).
-  std::vector<Vec2> velocities() const {
-    std::vector<Vec2> out(ln_.size());
+  std::vector<Vec> velocities() const {
+    std::vector<Vec> out(ln_.size());
     for (std::size_t p = 0; p < ln_.size(); ++p) out[p] = ln_[p].v;
     return out;
   }
@@ -277,20 +331,21 @@ class BasicEngine {
   /// Bytes held by the engine's arrays, queue, grid and log.
   std::size_t memory_bytes() const noexcept {
     const std::size_t n = ln_.size();
-    return n * (2 * sizeof(Vec2) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec2) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
+    return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
            log_.size() * 48 + group_bytes() + X_.words().size() * 8 + undo_.capacity() * sizeof(Saved) +
            undo_epoch_.capacity() * sizeof(std::uint32_t);
   }
   /// Bytes held by the group entries of the rare log (map node, members, pre velocities).
   std::size_t group_bytes() const noexcept {
     std::size_t b = 0;
-    for (const auto& [k, g] : groups_) b += 80 + g.members.size() * sizeof(int) + g.pre_v.size() * sizeof(Vec2);
+    for (const auto& [k, g] : groups_) b += 80 + g.members.size() * sizeof(int) + g.pre_v.size() * sizeof(Vec);
     return b;
   }
   /// Momentum sum v per axis, 128 bits.
-  static std::array<i128, 2> momentum_of(const std::vector<Vec2>& v) noexcept {
-    std::array<i128, 2> p{};
-    for (const Vec2& a : v) p = {p[0] + a[0], p[1] + a[1]};
+  static std::array<i128, D> momentum_of(const std::vector<Vec>& v) noexcept {
+    std::array<i128, D> p{};
+    for (const Vec& a : v)
+      for (std::size_t k = 0; k < D; ++k) p[k] += a[k];
     return p;
   }
   /// Initial energy (sum |v|^2) and momentum, as recorded at construction.
@@ -335,10 +390,10 @@ class BasicEngine {
   }
 
   // ---- geometry of the lines ----
-  [[gnu::always_inline]] Vec2 pos(int p, std::int64_t t) const noexcept {
-    Vec2 out;
+  [[gnu::always_inline]] Vec pos(int p, std::int64_t t) const noexcept {
+    Vec out;
     const std::int64_t dt = t - ln_[p].ta;
-    for (int k = 0; k < 2; ++k) {
+    for (std::size_t k = 0; k < D; ++k) {
       std::int64_t m, y;
       // fast path (measure before changing): the displacement fits int64 and at most one wrap
       if (!__builtin_mul_overflow(ln_[p].v[k], dt, &m) && !__builtin_add_overflow(ln_[p].x[k], m, &y)) {
@@ -358,14 +413,14 @@ class BasicEngine {
     }
     return out;
   }
-  Vec2 diff(const Vec2& a, const Vec2& b) const noexcept {
-    Vec2 r;
-    for (int k = 0; k < 2; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
+  Vec diff(const Vec& a, const Vec& b) const noexcept {
+    Vec r;
+    for (std::size_t k = 0; k < D; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
     return r;
   }
-  bool overlap(const Vec2& a, const Vec2& b) const noexcept {
-    const Vec2 r = diff(a, b);
-    return norm2(r[0], r[1]) < sigma2_;
+  bool overlap(const Vec& a, const Vec& b) const noexcept {
+    const Vec r = diff(a, b);
+    return norm2(r) < sigma2_;
   }
   std::int64_t hhi(int k) const noexcept { return u_.L[k] - hlo_; }
 
@@ -408,27 +463,34 @@ class BasicEngine {
       }
     };
     const int cell = grid_.cell_of_particle(p);
-    const int c[2] = {cell / grid_.count(1), cell % grid_.count(1)};
-    for (int k = 0; k < 2; ++k) {
-      const std::int64_t dt = grid_.exit_ticks(k, c[k], ln_[p].x[k], ln_[p].v[k]);
+    const std::array<int, D> c = grid_.coords(cell);
+    for (std::size_t k = 0; k < D; ++k) {
+      const std::int64_t dt = grid_.exit_ticks(static_cast<int>(k), c[k], ln_[p].x[k], ln_[p].v[k]);
       if (dt > 0) offer(lo + dt, 0, cross, -1);
       if (u_.wall[k]) {
-        const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(k));
+        const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(static_cast<int>(k)));
         if (dw > 0) offer(lo + dw, wall_kind(), wall, -1);
       }
     }
     grid_.for_neighbours(cell, [&](int q) {
       if (q == p) return;
-      const Vec2 r = diff(ln_[p].x, pos(q, lo));
-      const Vec2 w{ln_[p].v[0] - ln_[q].v[0], ln_[p].v[1] - ln_[q].v[1]};
+      const Vec r = diff(ln_[p].x, pos(q, lo));
+      const Vec w = sub(ln_[p].v, ln_[q].v);
       // cheap exits before the exact search (measure before changing): separating and outside
       // (exact), or a closest approach beyond sigma by far more than double round-off
-      const i128 B = static_cast<i128>(r[0]) * w[0] + static_cast<i128>(r[1]) * w[1];
-      const u128 r2 = norm2(r[0], r[1]);
+      const i128 B = dot(r, w);
+      const u128 r2 = norm2(r);
       if (B >= 0 && r2 >= sigma2_) return;
-      const double r0 = static_cast<double>(r[0]), r1 = static_cast<double>(r[1]);
-      const double w0 = static_cast<double>(w[0]), w1 = static_cast<double>(w[1]);
-      const double rr = r0 * r0 + r1 * r1, bb = r0 * w0 + r1 * w1, aa = w0 * w0 + w1 * w1;
+      // the sums from the first axis on (the 2D engine's order: r0 r0 + r1 r1, ...)
+      double rr = static_cast<double>(r[0]) * static_cast<double>(r[0]);
+      double bb = static_cast<double>(r[0]) * static_cast<double>(w[0]);
+      double aa = static_cast<double>(w[0]) * static_cast<double>(w[0]);
+      for (std::size_t k = 1; k < D; ++k) {
+        const double rk = static_cast<double>(r[k]), wk = static_cast<double>(w[k]);
+        rr += rk * rk;
+        bb += rk * wk;
+        aa += wk * wk;
+      }
       if (rr - bb * (bb / aa) > sigma2d_ * (1.0 + 1e-9) + rr * 1e-12) return;
       const std::int64_t tau = first_overlap(r, w, sigma2_);
       if (tau >= 0) offer(lo + tau, coll_kind(p, q), coll, q);
@@ -463,7 +525,7 @@ class BasicEngine {
   }
   void flip() {
     for (Line& l : ln_) {
-      l.v = {-l.v[0], -l.v[1]};
+      l.v = neg(l.v);
       l.ta = -l.ta;
     }
     clock_ = -clock_;
@@ -536,13 +598,13 @@ class BasicEngine {
   // ---- walls ----
   void reflect(int p, std::int64_t a) {
     journal(p);
-    Vec2 x = pos(p, a - 1), v = ln_[p].v;
-    Vec2 old_line_at_a = pos(p, a);
-    for (int k = 0; k < 2; ++k) {
-      if (!(u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(k)))) x[k] += v[k];
+    Vec x = pos(p, a - 1), v = ln_[p].v;
+    Vec old_line_at_a = pos(p, a);
+    for (std::size_t k = 0; k < D; ++k) {
+      if (!(u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k))))) x[k] += v[k];
       if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
     }
-    const Vec2 ghost = wrapped(Vec2{x[0] - v[0], x[1] - v[1]});
+    const Vec ghost = wrapped(sub(x, v));
     const int cell = grid_.cell_of_particle(p);
     grid_.for_neighbours(cell, [&](int q) {
       if (q == p) return;
@@ -564,55 +626,55 @@ class BasicEngine {
 
   // ---- collisions ----
   // origin + d, wrapped on periodic axes (128-bit sum: no overflow whatever the box)
-  Vec2 shifted(const Vec2& origin, const Vec2& d) const noexcept {
-    Vec2 o;
-    for (int k = 0; k < 2; ++k) {
+  Vec shifted(const Vec& origin, const Vec& d) const noexcept {
+    Vec o;
+    for (std::size_t k = 0; k < D; ++k) {
       const i128 y = static_cast<i128>(origin[k]) + d[k];
       o[k] = u_.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u_.L[k]);
     }
     return o;
   }
-  Vec2 wrapped(const Vec2& x) const noexcept {
-    Vec2 o = x;
-    for (int k = 0; k < 2; ++k)
+  Vec wrapped(const Vec& x) const noexcept {
+    Vec o = x;
+    for (std::size_t k = 0; k < D; ++k)
       if (!u_.wall[k]) o[k] = wrap(x[k], u_.L[k]);
     return o;
   }
-  // why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none
   // why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none.
   // The same scan flags `multi` when a pre line (pre_a: i's and j's pre lines at tick a) overlaps
   // a third body at a: complete whenever 0 is returned (every neighbour was looked at).
-  int post_reason(int i, int j, const Vec2& xi, const Vec2& xj, const Vec2& vi, const Vec2& vj, std::int64_t a,
-                  const Vec2 (&pre_a)[2], bool& multi) const {
-    for (int k = 0; k < 2; ++k) {
-      for (const Vec2* vv : {&vi, &vj})
+  int post_reason(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a,
+                  const Vec (&pre_a)[2], bool& multi) const {
+    for (std::size_t k = 0; k < D; ++k) {
+      for (const Vec* vv : {&vi, &vj})
         if ((*vv)[k] > u_.vmax || (*vv)[k] < -u_.vmax) return redraw_outside;
       if (!u_.wall[k]) continue;
-      for (const Vec2* xx : {&xi, &xj})
-        if ((*xx)[k] < hlo_ || (*xx)[k] > hhi(k)) return redraw_outside;
+      for (const Vec* xx : {&xi, &xj})
+        if ((*xx)[k] < hlo_ || (*xx)[k] > hhi(static_cast<int>(k))) return redraw_outside;
     }
     int why = 0;
     multi = false;
     for (int s = 0; s < 2 && why == 0; ++s) {
-      const Vec2& x = s == 0 ? xi : xj;
-      const Vec2& v = s == 0 ? vi : vj;
-      const Vec2 ghost = wrapped(Vec2{x[0] - v[0], x[1] - v[1]});
+      const Vec& x = s == 0 ? xi : xj;
+      const Vec& v = s == 0 ? vi : vj;
+      const Vec ghost = wrapped(sub(x, v));
       grid_.for_neighbours(grid_.cell_id(x), [&](int q) {
         if (why != 0 || q == i || q == j) return;
-        const Vec2 qa = pos(q, a);
+        const Vec qa = pos(q, a);
         // exit (measure before changing): farther than sigma + 4 vmax, none of the three can hold
         // (the ghost and the pre point are within 2 vmax of x, q moves at most vmax per tick)
-        const Vec2 d = diff(x, qa);
-        const double dd = static_cast<double>(d[0]) * d[0] + static_cast<double>(d[1]) * d[1];
+        const Vec d = diff(x, qa);
+        double dd = static_cast<double>(d[0]) * d[0];
+        for (std::size_t k = 1; k < D; ++k) dd += static_cast<double>(d[k]) * d[k];
         if (dd > far2_) return;
         if (overlap(x, qa)) why = redraw_overlap_after;
-        else if (overlap(ghost, wrapped(Vec2{qa[0] - ln_[q].v[0], qa[1] - ln_[q].v[1]}))) why = redraw_ghost_tie;
+        else if (overlap(ghost, wrapped(sub(qa, ln_[q].v)))) why = redraw_ghost_tie;
         if (overlap(pre_a[s], qa)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
       });
     }
     return why;
   }
-  void apply(int i, int j, const Vec2& xi, const Vec2& xj, const Vec2& vi, const Vec2& vj, std::int64_t a) {
+  void apply(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a) {
     ln_[i].x = xi;
     ln_[j].x = xj;
     ln_[i].v = vi;
@@ -628,14 +690,14 @@ class BasicEngine {
     journal(i);
     journal(j);
     if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
-    const Vec2 pre_a[2] = {pos(i, a), pos(j, a)};
+    const Vec pre_a[2] = {pos(i, a), pos(j, a)};
     bool multi = false;
     const std::uint64_t ctr0 = ctr_[i];
     std::array<std::uint64_t, 8> reasons{};
     // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
     // values stay within a few sigma of 0 whatever the box
-    const Vec2 xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{0, 0};
-    Vec2 xi2, xj2, vi2, vj2;
+    const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+    Vec xi2, xj2, vi2, vj2;
     Bits out;
     std::uint32_t redraws = 0;
     for (;;) {
@@ -671,20 +733,20 @@ class BasicEngine {
       group_back(i, j, a, g);
       return;
     }
-    const Vec2 xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{0, 0};
+    const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
     std::uint32_t redraws = 0;
     const auto it = log_.find(ncoll_);
     if (it != log_.end()) redraws = it->second;
     if (ctr_[i] < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i] - 1);
-    Vec2 xi0, xj0, vi0, vj0;
-    op_.pair_reverse(xi, zero, Vec2{-ln_[i].v[0], -ln_[i].v[1]}, Vec2{-ln_[j].v[0], -ln_[j].v[1]}, g, X_, xi0, xj0, vi0, vj0);
+    Vec xi0, xj0, vi0, vj0;
+    op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, X_, xi0, xj0, vi0, vj0);
     xi0 = shifted(xj, xi0);
     xj0 = shifted(xj, xj0);
     ctr_[i] -= 1 + redraws;
     if (it != log_.end()) log_.erase(it);
     --ncoll_;
-    apply(i, j, xi0, xj0, Vec2{-vi0[0], -vi0[1]}, Vec2{-vj0[0], -vj0[1]}, a);
+    apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
   }
 
   // ---- a third body within one tick: group collisions (LATTICE.md §4, docs/lattice.md) ----
@@ -709,7 +771,7 @@ class BasicEngine {
     std::vector<int> g{i, j};
     auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
     for (std::size_t m = 0; m < g.size(); ++m) {
-      const Vec2 xa = pos(g[m], a);
+      const Vec xa = pos(g[m], a);
       grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
         if (!member(q) && overlap(xa, pos(q, a))) g.push_back(q);
       });
@@ -718,51 +780,70 @@ class BasicEngine {
   }
   // Post velocities of a resolve for the members g (positions at a-1: x): sequential specular
   // collisions of the pairs whose pre lines overlap at a, then integer rounding with the sum kept.
-  std::vector<Vec2> resolve_velocities(const std::vector<int>& g, const std::vector<Vec2>& x, std::int64_t a) const {
+  std::vector<Vec> resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const {
+    using VecD = std::array<double, D>;
+    // a . b, summed from the first axis on (the 2D engine's order)
+    auto ddot = [](const VecD& p, const VecD& q) {
+      double s = p[0] * q[0];
+      for (std::size_t k = 1; k < D; ++k) s += p[k] * q[k];
+      return s;
+    };
     const std::size_t n = g.size();
-    std::vector<std::array<double, 2>> v(n);
-    for (std::size_t m = 0; m < n; ++m) v[m] = {static_cast<double>(ln_[g[m]].v[0]), static_cast<double>(ln_[g[m]].v[1])};
+    std::vector<VecD> v(n);
+    for (std::size_t m = 0; m < n; ++m)
+      for (std::size_t k = 0; k < D; ++k) v[m][k] = static_cast<double>(ln_[g[m]].v[k]);
     struct Touch {
       std::size_t p, q;
-      double n0, n1;
+      VecD n;
     };
     std::vector<Touch> touch;
     for (std::size_t p = 0; p < n; ++p)
       for (std::size_t q = p + 1; q < n; ++q) {
-        const Vec2 r = diff(x[p], x[q]);
-        const double r0 = static_cast<double>(r[0]), r1 = static_cast<double>(r[1]), len = std::sqrt(r0 * r0 + r1 * r1);
-        const double w0 = v[p][0] - v[q][0], w1 = v[p][1] - v[q][1];
+        const Vec r = diff(x[p], x[q]);
+        VecD rd, w;
+        for (std::size_t k = 0; k < D; ++k) {
+          rd[k] = static_cast<double>(r[k]);
+          w[k] = v[p][k] - v[q][k];
+        }
+        const double len = std::sqrt(ddot(rd, rd));
         // touching: the pre lines overlap at a, or the pair is within one tick's relative travel at a-1
-        const bool near = len < static_cast<double>(u_.sigma) + std::sqrt(w0 * w0 + w1 * w1);
-        if (len > 0.0 && (near || overlap(pos(g[p], a), pos(g[q], a)))) touch.push_back({p, q, r0 / len, r1 / len});
+        const bool near = len < static_cast<double>(u_.sigma) + std::sqrt(ddot(w, w));
+        if (len > 0.0 && (near || overlap(pos(g[p], a), pos(g[q], a)))) {
+          for (std::size_t k = 0; k < D; ++k) rd[k] /= len;
+          touch.push_back({p, q, rd});
+        }
       }
     // a wall is met within the tick by a member whose line is beyond it at a: -1 lower, +1 upper
-    std::vector<std::array<int, 2>> wall(n, {0, 0});
+    std::vector<std::array<int, D>> wall(n, std::array<int, D>{});
     for (std::size_t m = 0; m < n; ++m) {
-      const Vec2 xa = pos(g[m], a);
-      for (int k = 0; k < 2; ++k)
-        if (u_.wall[k]) wall[m][k] = xa[k] < hlo_ ? -1 : xa[k] > hhi(k) ? 1 : 0;
+      const Vec xa = pos(g[m], a);
+      for (std::size_t k = 0; k < D; ++k)
+        if (u_.wall[k]) wall[m][k] = xa[k] < hlo_ ? -1 : xa[k] > hhi(static_cast<int>(k)) ? 1 : 0;
     }
     const double eps = 1e-12 * static_cast<double>(u_.vmax);
     for (int sweep = 0; sweep < 64; ++sweep) {
       bool any = false;
       for (std::size_t m = 0; m < n; ++m)
-        for (int k = 0; k < 2; ++k)
+        for (std::size_t k = 0; k < D; ++k)
           if (wall[m][k] * v[m][k] > 0.0) {  // approaching a wall it meets: specular, exact
             v[m][k] = -v[m][k];
             any = true;
           }
       for (const Touch& t : touch) {
-        const double wn = (v[t.p][0] - v[t.q][0]) * t.n0 + (v[t.p][1] - v[t.q][1]) * t.n1;
+        VecD w;
+        for (std::size_t k = 0; k < D; ++k) w[k] = v[t.p][k] - v[t.q][k];
+        const double wn = ddot(w, t.n);
         if (wn >= -eps) continue;  // not approaching along the normal
-        v[t.p] = {v[t.p][0] - wn * t.n0, v[t.p][1] - wn * t.n1};
-        v[t.q] = {v[t.q][0] + wn * t.n0, v[t.q][1] + wn * t.n1};
+        for (std::size_t k = 0; k < D; ++k) {
+          v[t.p][k] = v[t.p][k] - wn * t.n[k];
+          v[t.q][k] = v[t.q][k] + wn * t.n[k];
+        }
         any = true;
       }
       if (!any) break;
     }
-    std::vector<Vec2> out(n);
-    for (int k = 0; k < 2; ++k) {
+    std::vector<Vec> out(n);
+    for (std::size_t k = 0; k < D; ++k) {
       i128 before = 0, after = 0;
       std::size_t big = 0;
       for (std::size_t m = 0; m < n; ++m) {
@@ -779,26 +860,26 @@ class BasicEngine {
   // The post state of a group collision: positions at a (the a-1 points) and velocities, the
   // group grown by every body the post state would meet. False when it breaks the walls, vmax,
   // the 16-member cap or (a resolve) the reverse's view of it.
-  bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec2>& post, std::vector<Vec2>& vel) const {
+  bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec>& post, std::vector<Vec>& vel) const {
     auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
     for (;;) {
       if (g.size() > 16) return false;
       std::sort(g.begin(), g.end());
-      post.assign(g.size(), Vec2{});
+      post.assign(g.size(), Vec{});
       for (std::size_t m = 0; m < g.size(); ++m) post[m] = pos(g[m], a - 1);
       if (resolve) {
         vel = resolve_velocities(g, post, a);
       } else {
-        vel.assign(g.size(), Vec2{});
-        for (std::size_t m = 0; m < g.size(); ++m) vel[m] = Vec2{-ln_[g[m]].v[0], -ln_[g[m]].v[1]};
+        vel.assign(g.size(), Vec{});
+        for (std::size_t m = 0; m < g.size(); ++m) vel[m] = neg(ln_[g[m]].v);
       }
       bool grew = false;
       for (std::size_t m = 0; m < g.size() && !grew; ++m) {
-        for (int k = 0; k < 2; ++k) {
+        for (std::size_t k = 0; k < D; ++k) {
           if (vel[m][k] > u_.vmax || vel[m][k] < -u_.vmax) return false;
-          if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(k))) return false;
+          if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(static_cast<int>(k)))) return false;
         }
-        const Vec2 ghost = wrapped(Vec2{post[m][0] - vel[m][0], post[m][1] - vel[m][1]});  // the new line at a-1
+        const Vec ghost = wrapped(sub(post[m], vel[m]));  // the new line at a-1
         grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
           if (grew || member(q)) return;
           if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) {
@@ -813,8 +894,8 @@ class BasicEngine {
       // was taken back from a reflection at a)
       for (std::size_t p = 0; p < g.size(); ++p)
         for (std::size_t q = p + 1; q < g.size(); ++q) {
-          const Vec2 gp = wrapped(Vec2{post[p][0] - vel[p][0], post[p][1] - vel[p][1]});
-          const Vec2 gq = wrapped(Vec2{post[q][0] - vel[q][0], post[q][1] - vel[q][1]});
+          const Vec gp = wrapped(sub(post[p], vel[p]));
+          const Vec gq = wrapped(sub(post[q], vel[q]));
           if (overlap(gp, gq)) return true;  // the reverse meets this pair at a-1
         }
       return false;
@@ -835,7 +916,7 @@ class BasicEngine {
     }
     const std::vector<int> g0 = group_of(i, j, a);
     std::vector<int> g = g0;
-    std::vector<Vec2> post, vel;
+    std::vector<Vec> post, vel;
     bool resolve = group_resolve, ok = resolve && group_post(g, a, true, post, vel);
     if (!ok) {
       resolve = false;
@@ -853,7 +934,7 @@ class BasicEngine {
       for (int k = 1; k < 8; ++k) why += std::string(redraw_names[k]) + " " + std::to_string(reasons[k]) + (k < 7 ? ", " : ")");
       throw std::runtime_error(why);
     }
-    std::vector<Vec2> pre_v;
+    std::vector<Vec> pre_v;
     for (int q : g) journal(q);
     if (resolve)
       for (int q : g) pre_v.push_back(ln_[q].v);
@@ -886,12 +967,12 @@ class BasicEngine {
     const std::uint32_t draws = it == log_.end() ? 0 : it->second;
     const int drawer = entry->second.drawer;
     if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
-    const std::vector<Vec2>& pre_v = entry->second.pre_v;  // forward frame; empty: a bounce
-    std::vector<Vec2> pre(g.size());
+    const std::vector<Vec>& pre_v = entry->second.pre_v;  // forward frame; empty: a bounce
+    std::vector<Vec> pre(g.size());
     for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
     for (std::size_t m = 0; m < g.size(); ++m) {
       Line& l = ln_[g[m]];
-      const Vec2 v = pre_v.empty() ? Vec2{-l.v[0], -l.v[1]} : Vec2{-pre_v[m][0], -pre_v[m][1]};
+      const Vec v = pre_v.empty() ? neg(l.v) : neg(pre_v[m]);
       l = Line{pre[m], v, a};
       ++ver_[g[m]];
     }
@@ -915,8 +996,8 @@ class BasicEngine {
   std::uint32_t seed_ = 1;
   // one particle's line, together in memory (the prediction loop reads all three)
   struct Line {
-    Vec2 x;              // anchor position (wrapped)
-    Vec2 v;              // velocity
+    Vec x;               // anchor position (wrapped)
+    Vec v;               // velocity
     std::int64_t ta;     // anchor tick
   };
   std::vector<Line> ln_;
@@ -978,19 +1059,19 @@ class BasicEngine {
   struct Group {
     int drawer;                 // whose stream the tried draws came from
     std::vector<int> members;   // ascending
-    std::vector<Vec2> pre_v;    // exact pre velocities (a resolve) or empty (a bounce)
+    std::vector<Vec> pre_v;     // exact pre velocities (a resolve) or empty (a bounce)
   };
   std::map<std::uint64_t, Group> groups_;  // collision index -> group collision
   std::int64_t clock_ = 0, origin_ = 0;
   std::uint64_t ncoll_ = 0;
   std::array<std::uint64_t, 2> energy0_{};
-  std::array<std::int64_t, 4> momentum0_{};
+  std::array<std::int64_t, 2 * D> momentum0_{};
   Counters cnt_;
   bool reversed_ = false;
   u128 sigma2_ = 0;
   double sigma2d_ = 0.0, far2_ = 0.0;
   std::int64_t hlo_ = 0;
-  CellGrid grid_;
+  CellGridN<D> grid_;
   Queue queue_;
   std::pair<std::int64_t, std::int32_t> last_key_{};
 };

@@ -1,5 +1,7 @@
-// Units of the 2D lattice engine, chosen once from the box and the particles, and the one-time
-// quantization of a float state (LATTICE.md §1, §6).
+// Units of the lattice engine (D = 2 or 3 dimensions), chosen once from the box and the particles,
+// and the one-time quantization of a float state (LATTICE.md §1, §6). Every function is the same
+// for D = 2 and D = 3 (templates on the dimension, instantiated for both); the 2D names (Units,
+// Quantized, choose_units) are the dimension-2 instances, unchanged.
 //
 // Length: sigma = 2^S lattice units per diameter D. choose_units takes the largest S <= 60 with
 // every box length below 2^61 lattice units; any box below max_box (~2^63) is valid (minimum-image
@@ -19,6 +21,10 @@
 // tick per axis (1/256 sigma per tick): a relative move per tick below sigma/128, which the cell
 // grid (cell_grid.hpp) relies on. Because no particle can be faster than sqrt(total kinetic energy),
 // a state with sqrt(sum |v|^2) > vmax is refused (N > ~2^24 at the default scale).
+// 3D: the same rules per axis, except the box limit: every box length below max_box_of<3> = 2^62
+// lattice units, so that a difference on a wall axis (no minimum image) is below 2^62 and the
+// squares of three components sum below 3 * 2^124 < 2^126 (geometry.hpp). choose_units keeps
+// every length below 2^61 in both dimensions, so the units it picks are not affected.
 // Ticks: the clock and per-particle anchor ticks are int64; every event tick is kept below
 // tick_limit = 2^61 (about 2^41 mean free times of a typical particle); a run that would pass it
 // stops with an error, nothing changed past the last event.
@@ -37,22 +43,31 @@ namespace revcol::lattice {
 inline constexpr std::int64_t tick_limit = std::int64_t{1} << 61;
 /// Events between two polls of a run's stop request (Ctrl-C through the binding).
 inline constexpr std::uint32_t kPollEvents = 1u << 14;
-/// Largest allowed box length in lattice units (positions, their differences and a position
-/// plus or minus a velocity stay inside int64).
-inline constexpr std::int64_t max_box = INT64_MAX - (std::int64_t{1} << 56);
+/// Largest allowed box length in lattice units in D dimensions: in 2D positions, their
+/// differences and a position plus or minus a velocity stay inside int64; in 3D also the sum of
+/// three squared differences stays below 2^126 (see the header comment).
+template <std::size_t Dim>
+inline constexpr std::int64_t max_box_of = Dim == 2 ? INT64_MAX - (std::int64_t{1} << 56) : std::int64_t{1} << 62;
+/// Largest allowed box length of the 2D lattice.
+inline constexpr std::int64_t max_box = max_box_of<2>;
 
-/// The lattice's units and box: what integer state means physically.
-struct Units {
+/// The lattice's units and box in Dim dimensions: what integer state means physically.
+template <std::size_t Dim>
+struct UnitsN {
   int S = 60;                                ///< sigma = 2^S lattice units per diameter
   std::int64_t sigma = std::int64_t{1} << 60;  ///< lattice units per diameter
-  std::array<std::int64_t, 2> L{};           ///< box lengths in lattice units, per axis
-  std::array<bool, 2> wall{false, false};    ///< per axis: flat walls at 0 and L (else periodic)
+  std::array<std::int64_t, Dim> L{};         ///< box lengths in lattice units, per axis
+  std::array<bool, Dim> wall{};              ///< per axis: flat walls at 0 and L (else periodic)
   std::int64_t vmax = std::int64_t{1} << 52;  ///< largest |v| per axis, units per tick
   double length_unit = 0.0;                  ///< float length of one lattice unit (D / sigma)
   double tick = 0.0;                         ///< float time of one tick
   int tick_bits = 20;                        ///< T: a particle of rms speed moves 2^-T sigma per tick
   int cell_bits = 20;                        ///< the pair operator's 2^cell_bits direction cells per turn
 };
+/// The 2D units.
+using Units = UnitsN<2>;
+/// The 3D units.
+using Units3 = UnitsN<3>;
 
 /// Allowed range of tick_bits; the tick of units written before the automatic choice (20).
 inline constexpr int min_tick_bits = 16, max_tick_bits = 26, legacy_tick_bits = 20;
@@ -64,33 +79,51 @@ inline constexpr int velocity_bits = 30;
 inline constexpr int default_cell_bits = 16, min_units_cell_bits = 12, max_units_cell_bits = 20;
 
 /// Checks a Units value (box lengths, sigma, vmax); throws InvalidArgument naming the problem.
-void validate(const Units& u);
+template <std::size_t Dim>
+void validate(const UnitsN<Dim>& u);
 
 /// Units for a float box of lengths box (per axis) and diameter D holding n particles (0: not
 /// known) whose root-mean-square speed is v_rms; throws InvalidArgument if the lattice cannot
 /// hold it. The automatic tick is also at least 9 + ceil(log2(n) / 2), so that the total
 /// kinetic energy fits vmax with a bit to spare (sqrt(n) v_rms <= vmax / 2).
-Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
-                   int tick_bits = default_tick_bits, int cell_bits = default_cell_bits, std::size_t n = 0);
+template <std::size_t Dim>
+UnitsN<Dim> choose_units_d(const std::array<double, Dim>& box, double D, double v_rms, const std::array<bool, Dim>& wall,
+                           int tick_bits = default_tick_bits, int cell_bits = default_cell_bits, std::size_t n = 0);
+/// choose_units_d in 2D.
+inline Units choose_units(const std::array<double, 2>& box, double D, double v_rms, const std::array<bool, 2>& wall,
+                          int tick_bits = default_tick_bits, int cell_bits = default_cell_bits, std::size_t n = 0) {
+  return choose_units_d<2>(box, D, v_rms, wall, tick_bits, cell_bits, n);
+}
+/// choose_units_d in 3D.
+inline Units3 choose_units3(const std::array<double, 3>& box, double D, double v_rms, const std::array<bool, 3>& wall,
+                            int tick_bits = default_tick_bits, int cell_bits = default_cell_bits, std::size_t n = 0) {
+  return choose_units_d<3>(box, D, v_rms, wall, tick_bits, cell_bits, n);
+}
 
 /// A float state quantized to the lattice: integer positions and velocities, and the errors.
-struct Quantized {
-  std::vector<Vec2> x;         ///< positions, wrapped into [0, L) (periodic) or clamped inside walls
-  std::vector<Vec2> v;         ///< velocities
+template <std::size_t Dim>
+struct QuantizedN {
+  std::vector<VecN<Dim>> x;         ///< positions, wrapped into [0, L) (periodic) or clamped inside walls
+  std::vector<VecN<Dim>> v;         ///< velocities
   double max_position_error = 0.0;  ///< max |x_float - x_lattice * length_unit| / D
   double max_velocity_error = 0.0;  ///< max |v_float - v_lattice * length_unit / tick| / v_rms
 };
+/// A quantized 2D state.
+using Quantized = QuantizedN<2>;
 
-/// Quantizes n x 2 float positions and velocities (row-major) once. Refuses (InvalidArgument) a
+/// Quantizes n x Dim float positions and velocities (row-major) once. Refuses (InvalidArgument) a
 /// speed beyond vmax, a position outside the walls, or a pair overlapping after quantization.
-Quantized quantize(const Units& u, const std::vector<double>& x, const std::vector<double>& v);
+template <std::size_t Dim>
+QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, const std::vector<double>& v);
 
 /// Checks an integer state: positions inside [0, L) (and inside the walls), |v| <= vmax per axis,
 /// sqrt(sum |v|^2) <= vmax, and no pair overlapping (|r|^2 < sigma^2); throws InvalidArgument
 /// naming the first problem. O(N) with a hash grid.
-void validate_state(const Units& u, const std::vector<Vec2>& x, const std::vector<Vec2>& v);
+template <std::size_t Dim>
+void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v);
 
 /// Kinetic energy sum |v|^2 in 128 bits (lattice units).
-u128 kinetic2(const std::vector<Vec2>& v) noexcept;
+template <std::size_t Dim>
+u128 kinetic2(const std::vector<VecN<Dim>>& v) noexcept;
 
 }  // namespace revcol::lattice
