@@ -1,4 +1,5 @@
-"""The 2D lattice engine proven at scale (issue 13, "Done when"). Writes
+"""The lattice engine proven at scale (issue 13 in 2D, issue 14 in 3D: `--dim 3`, the sphere gas of
+LatticeSimulation3D, volume fractions instead of area fractions). Writes
 bench/results/lattice_validation_*.json.
 
     PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py matrix [--collisions 1e7]
@@ -62,6 +63,13 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
+DIM = 2  # --dim: 2 (disks, LatticeSimulation) or 3 (spheres, LatticeSimulation3D)
+
+
+def _sim_cls():
+    """The lattice simulation class of the dimension asked for."""
+    from revcol import lattice
+    return lattice.LatticeSimulation3D if DIM == 3 else lattice.LatticeSimulation
 
 # Snapshot entries that define the physical state, grouped as the issue names them.
 STATE_PARTS = {
@@ -126,8 +134,9 @@ def _write_atomic(path: str, obj) -> None:
 
 
 def _init_for(phi: float) -> str:
-    # random sequential addition jams near 0.55 in 2D: dense gases start from a jittered lattice
-    return "lattice" if phi > 0.35 else "auto"
+    # random sequential addition jams near 0.55 in 2D and 0.38 in 3D: dense gases start from a
+    # jittered lattice (square in 2D, FCC in 3D)
+    return "lattice" if phi > (0.35 if DIM == 2 else 0.2) else "auto"
 
 
 def _checkpoints(c: int) -> list:
@@ -145,7 +154,7 @@ def _drift_figures(d: dict, d0_energy: float, c: int, n: int, wall: list) -> dic
     de = float(d["energy_drift"])
     pair_energy = 2.0 * d0_energy / n  # mean energy of two particles, lattice units
     dp = [float(x) for x in d["momentum_drift"]]
-    periodic = [k for k in range(2) if not wall[k]]
+    periodic = [k for k in range(len(wall)) if not wall[k]]
     return {
         "energy_drift_relative": de,
         "energy_drift_units": float(d["energy_drift_units"]),
@@ -205,7 +214,7 @@ def _after_failure(sim, f: dict):
     """The engine failed on the way forward: try running back from where it stopped (recorded),
     then resume from the latest snapshot, whose midpoint is the C/2 snapshot if taken, else the
     one before. Returns the simulation to run back from."""
-    from revcol.lattice import LatticeSimulation
+    LatticeSimulation = _sim_cls()
     try:
         sim.run_back()
         f["run_back_from_failure"] = "ok"
@@ -224,7 +233,7 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     (compared). Returns the row (see the module doc). If the engine fails on the way forward, the
     row says so (``completed`` false, ``forward_error``) and the checks run on the collisions done,
     the midpoint being the latest snapshot before the failure."""
-    from revcol.lattice import LatticeSimulation
+    LatticeSimulation = _sim_cls()
     load0 = os.getloadavg()
     sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi), law=law,
                                    tick_bits=tick_bits or None, cell_bits=cell_bits)
@@ -252,7 +261,7 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     log_held = d_end["log_entries"]  # every entry, group bounces included (they are keyed in the same log)
     cc = max(c, 1)
     row = {
-        "n": n, "phi": phi, "boundary": boundary, "law": law, "seed": seed, "collisions_asked": int(collisions),
+        "dim": DIM, "n": n, "phi": phi, "boundary": boundary, "law": law, "seed": seed, "collisions_asked": int(collisions),
         "collisions": c, "completed": f["error"] is None, "forward_error": f["error"],
         "run_back_from_failure": f.get("run_back_from_failure"), "collisions_checked_back": checked,
         "collisions_per_particle": 2.0 * c / n,
@@ -296,7 +305,7 @@ def run_child(n: int, phi: float, boundary: str, collisions: int, seed: int = 1,
     """``run_gas`` in a fresh subprocess; adds the child's ru_maxrss (wait4) and exit status."""
     cmd = [sys.executable, os.path.abspath(__file__), "gas", "--n", str(n), "--phi", str(phi),
            "--boundary", boundary, "--collisions", str(int(collisions)), "--seed", str(seed),
-           "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits)]
+           "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits), "--dim", str(DIM)]
     t0 = time.time()
     with tempfile.TemporaryFile(mode="w+") as ferr:
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=ferr, text=True)
@@ -319,7 +328,7 @@ def matrix(args) -> dict:
     c = int(float(args.collisions))
     path = os.path.join(RESULTS, f"lattice_validation_{args.out}.json")
     res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
-           "build": _build_info(), "collisions": c, "law": "flux", "seed": args.seed, "tick_bits": args.tick_bits,
+           "build": _build_info(), "dim": DIM, "collisions": c, "law": "flux", "seed": args.seed, "tick_bits": args.tick_bits,
            "cell_bits": args.cell_bits, "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "rows": []}
     for phi in args.phi:  # in the order given: a run cut short still covers both N
         for n in args.n:
@@ -339,17 +348,28 @@ def matrix(args) -> dict:
 # --- equilibrium ------------------------------------------------------------------------------
 
 def equal_speed_start(n: int, phi: float, seed: int):
-    """A float 2D periodic start at area fraction phi with every speed equal (kT = 1)."""
+    """A float periodic start (dimension DIM) at packing fraction phi with every speed equal (kT = 1)."""
     from revcol import _core
-    x, v, box = _core.engine_random_state(2, int(n), float(phi), ["periodic"], 1.0, int(seed), 0.0,
+    x, v, box = _core.engine_random_state(DIM, int(n), float(phi), ["periodic"], 1.0, int(seed), 0.0,
                                           _init_for(phi), True)
     return np.asarray(x), np.asarray(v), np.asarray(box, dtype=float).ravel()
 
 
-def rayleigh_ks(speeds: np.ndarray, kT: float):
-    """KS of 2D speeds against Maxwell-Boltzmann, F(s) = 1 - exp(-s^2 / (2 kT))."""
+def maxwell_cdf(s, kT: float, dim: int):
+    """Maxwell-Boltzmann speed CDF, unit mass: 2D 1 - exp(-s^2 / 2kT); 3D erf(s / sqrt(2kT)) -
+    sqrt(2 / pi) (s / sqrt(kT)) exp(-s^2 / 2kT)."""
+    from scipy import special
+    s = np.asarray(s, dtype=float)
+    if dim == 2:
+        return 1.0 - np.exp(-s ** 2 / (2.0 * kT))
+    a = s / math.sqrt(kT)
+    return special.erf(a / math.sqrt(2.0)) - math.sqrt(2.0 / math.pi) * a * np.exp(-a * a / 2.0)
+
+
+def rayleigh_ks(speeds: np.ndarray, kT: float, dim: int = 2):
+    """KS of speeds against Maxwell-Boltzmann in dimension dim (2D: the Rayleigh law)."""
     from scipy import stats
-    r = stats.kstest(speeds, lambda s: 1.0 - np.exp(-np.asarray(s) ** 2 / (2.0 * kT)))
+    r = stats.kstest(speeds, lambda s: maxwell_cdf(s, kT, dim))
     return float(r.statistic), float(r.pvalue)
 
 
@@ -373,7 +393,7 @@ def equilibrium_gas(n: int, phi: float, seed: int, relax: float, gap: float, sna
     """One seed: lattice and float engines from the same equal-speed float state; relax, sample
     speeds (lattice) and measure collision rates by batches (both)."""
     import revcol
-    from revcol.lattice import LatticeSimulation
+    LatticeSimulation = _sim_cls()
     x, v, box = equal_speed_start(n, phi, seed)
     lat = LatticeSimulation(x, v, box, boundary="periodic", seed=seed)
     flt = revcol.Simulation(x, v, box, boundary="periodic", mode="exact", law="flux", seed=seed)
@@ -404,10 +424,10 @@ def _mean_se(vals) -> tuple:
 
 def equilibrium_summary(gases: list, n: int) -> dict:
     speeds = np.concatenate([g["speeds"] for g in gases])
-    kT = float(np.mean(speeds ** 2) / 2.0)  # 2D, unit mass: <|v|^2> = 2 kT
-    ks, p = rayleigh_ks(speeds, kT)
-    ks_last, p_last = rayleigh_ks(gases[0]["last_snapshot"], kT)
-    ks_start, p_start = rayleigh_ks(gases[0]["start_speeds"], kT)
+    kT = float(np.mean(speeds ** 2) / DIM)  # unit mass: <|v|^2> = dim kT
+    ks, p = rayleigh_ks(speeds, kT, DIM)
+    ks_last, p_last = rayleigh_ks(gases[0]["last_snapshot"], kT, DIM)
+    ks_start, p_start = rayleigh_ks(gases[0]["start_speeds"], kT, DIM)
     lat_seed = [float(np.mean(g["rates_lattice"])) for g in gases]
     flt_seed = [float(np.mean(g["rates_float"])) for g in gases]
     ml, sl = _mean_se(lat_seed)
@@ -443,7 +463,7 @@ def equilibrium(args) -> dict:
               f"float {np.mean(gases[-1]['rates_float']):.5f}", flush=True)
     summ = equilibrium_summary(gases, args.n)
     res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
-           "build": _build_info(), "n": args.n, "phi": args.phi, "boundary": "periodic",
+           "build": _build_info(), "dim": DIM, "n": args.n, "phi": args.phi, "boundary": "periodic",
            "start": "equal speeds (kT = 1), positions as engine_random_state", "seeds": args.seeds,
            "relax_per_particle": args.relax, "gap_per_particle": args.gap, "snapshots": args.snapshots,
            "batch_per_particle": args.batch, "batches": args.batches,
@@ -451,7 +471,7 @@ def equilibrium(args) -> dict:
                               "lattice time = clock * tick",
            "error_bar": "standard error of the per-seed means over independent gases",
            "wall_s": time.time() - t0, "loadavg_end": list(os.getloadavg()), **summ}
-    path = os.path.join(RESULTS, "lattice_validation_equilibrium.json")
+    path = os.path.join(RESULTS, "lattice_validation_equilibrium.json" if DIM == 2 else f"lattice_validation_{args.out}.json")
     _write_atomic(path, res)
     print(json.dumps({k: v for k, v in res.items() if not isinstance(v, list)}, indent=1))
     print("wrote", path)
@@ -472,12 +492,13 @@ def _third_bodies(sim, i: int, j: int, a: int) -> list:
     box = [int(v) for v in u["L"]]
     x = sim.lattice_positions.astype(object)
     v = sim.lattice_velocities.astype(object)
-    step = max(math.isqrt(int(v[p][0]) ** 2 + int(v[p][1]) ** 2) for p in (i, j))
+    d = len(box)
+    step = max(math.isqrt(sum(int(v[p][k]) ** 2 for k in range(d))) for p in (i, j))
 
     def gap(p, q, t):
-        r = [int(x[p][k] - x[q][k] + (v[p][k] - v[q][k]) * (t - sim.clock)) for k in range(2)]
+        r = [int(x[p][k] - x[q][k] + (v[p][k] - v[q][k]) * (t - sim.clock)) for k in range(d)]
         r = [rk if u["wall"][k] else (rk + box[k] // 2) % box[k] - box[k] // 2 for k, rk in enumerate(r)]
-        return (math.isqrt(r[0] ** 2 + r[1] ** 2) - sig) / step
+        return (math.isqrt(sum(rk * rk for rk in r)) - sig) / step
 
     out = []
     for q in range(sim.n):
@@ -514,7 +535,7 @@ def failure_scan(n: int, phi: float, boundary: str, seed: int, collisions: int, 
     """Forward only, up to `collisions`, in chunks with a snapshot before each: the first engine
     error (collision index, message) and, rebuilt from the snapshot just before it, the third
     bodies near the failing pair."""
-    from revcol.lattice import LatticeSimulation
+    LatticeSimulation = _sim_cls()
     sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi))
     row = {"n": n, "phi": phi, "boundary": boundary, "seed": seed, "collisions_asked": collisions,
            "failed_at": None, "error": None}
@@ -559,11 +580,11 @@ def failures(args) -> dict:
 def probe(args) -> dict:
     """Forward only: the rare log's entries and the redraws by reason for each tick T (--ticks,
     0: automatic) and cell resolution (--cells) on each gas: what chooses the defaults."""
-    from revcol.lattice import LatticeSimulation
+    LatticeSimulation = _sim_cls()
     c = int(float(args.collisions))
     path = os.path.join(RESULTS, f"lattice_validation_{args.out}.json")
     res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
-           "build": _build_info(), "collisions": c, "seed": args.seed, "rows": []}
+           "build": _build_info(), "dim": DIM, "collisions": c, "seed": args.seed, "rows": []}
     for phi in args.phi:
         for n in args.n:
             for b in args.boundary:
@@ -608,7 +629,10 @@ def main(argv=None) -> int:
     ap.add_argument("--snapshots", type=int, default=10)
     ap.add_argument("--batch", type=float, default=20.0, help="equilibrium: collisions per particle per batch")
     ap.add_argument("--batches", type=int, default=10)
+    ap.add_argument("--dim", type=int, default=2, choices=[2, 3], help="2: disks (area fraction); 3: spheres (volume fraction)")
     a = ap.parse_args(argv)
+    global DIM
+    DIM = a.dim
     if a.n is None:
         a.n = [1000] if a.what == "equilibrium" else [1000, 10000]
     if a.phi is None:

@@ -1,6 +1,7 @@
 """A gas scene on the lattice engine (``[collisions] engine = "lattice"``): forward N_c
 collisions (or to an end time), back to the start, and a report of what came back **bit for
-bit** (:class:`revcol.lattice.LatticeSimulation`, LATTICE.md, docs/lattice.md).
+bit** (:class:`revcol.lattice.LatticeSimulation` for disks, :class:`LatticeSimulation3D` for
+spheres; LATTICE.md, docs/lattice.md).
 
 The lattice engine's state is integers: positions and velocities in lattice units, the
 per-particle Philox stream counters, the bits-back integer X (which carries each collision's
@@ -31,7 +32,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import _core
-from .lattice import LatticeSimulation
+from .lattice import LatticeSimulation, LatticeSimulation3D
 from .progress import Bar, Interrupt, peak_rss
 from .report import version
 from .roundtrip import BAR, round_trip_errors
@@ -69,17 +70,18 @@ def build_lattice(scene: Scene, seed: int | None = None) -> LatticeSimulation:
     if seed is not None:
         opts["seed"] = int(seed)
     init = {"auto": "auto", "random": "rsa", "lattice": "lattice"}[scene.start]
+    cls = LatticeSimulation3D if scene.dimension == 3 else LatticeSimulation
     if scene.initial_state is not None:
         x, v = read_initial(scene.source, scene.initial_state, scene.dimension)
-        return _make(scene, "[system] initial_state", lambda: LatticeSimulation(x, v, scene.box, **opts))
+        return _make(scene, "[system] initial_state", lambda: cls(x, v, scene.box, **opts))
     if scene.packing_fraction is not None and scene.kinetic_energy is None:
-        return _make(scene, "[system] packing_fraction", lambda: LatticeSimulation.random(
-            scene.particles, 2, scene.packing_fraction, init=init, **opts))
+        return _make(scene, "[system] packing_fraction", lambda: cls.random(
+            scene.particles, scene.dimension, scene.packing_fraction, init=init, **opts))
 
     def make() -> LatticeSimulation:  # the float engine's start in the scene's box, quantized
         x, v = _core.engine_random_start(scene.particles, list(scene.box), list(scene.boundaries), scene.diameter,
                                          opts["seed"], scene.kinetic_energy or 0.0, init, False)
-        return LatticeSimulation(x, v, scene.box, **opts)
+        return cls(x, v, scene.box, **opts)
     return _make(scene, "[system] box" if scene.packing_fraction is None else "[system] kinetic_energy", make)
 
 
@@ -271,7 +273,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
     units = sim.units
     return {
         "kind": "gas", "engine": "lattice", "revcol_version": version(), "scene": scene.to_dict(),
-        "summary": scene.summary(), "particles": n, "dimension": 2, "box": run.box.tolist(),
+        "summary": scene.summary(), "particles": n, "dimension": sim.dim, "box": run.box.tolist(),
         "periodic": run.periodic.tolist(),
         "units": {"S": units["S"], "sigma": units["sigma"], "tick": units["tick"],
                   "tick_bits": units["tick_bits"], "cell_bits": units["cell_bits"],

@@ -5,8 +5,9 @@ A scene is one of three kinds (``[scene] kind``):
 - ``"gas"`` (the default): N hard spheres in a box, run forward N_c collisions (or to an
   end time) with the event-driven engine, then back to the start (``revcol run``); the
   float engine (``revcol.Simulation``, 1-3D, exact within a horizon) unless ``[collisions]
-  engine = "lattice"`` (``revcol.lattice.LatticeSimulation``: 2D, integer state, exact for
-  any number of collisions; exact mode, flux or uniform law, Philox per-particle streams);
+  engine = "lattice"`` (``revcol.lattice.LatticeSimulation``, 2D, or ``LatticeSimulation3D``,
+  3D: integer state, exact for any number of collisions; exact mode, flux or uniform law,
+  Philox per-particle streams);
 - ``"reversal"``: the paper's reversal illustration for a named case (2 or 3 particles,
   momentum and energy held, velocities only: no positions are built), ``revcol verify``'s
   machinery;
@@ -46,7 +47,7 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
 
     [collisions]
-    engine = "float"              # gas only: "float" | "lattice" (2D, exact mode, Philox
+    engine = "float"              # gas only: "float" | "lattice" (2D and 3D, exact mode, Philox
                                   # per_particle; its default generator is then "philox")
     mode = "exact"                # "exact" | "paper" (gas: 1D and 2D, the engine's limit)
     law = "flux"                  # exact mode: "flux" | "uniform"
@@ -511,11 +512,11 @@ def _observe(source: str, values: dict, d: int, n: int, bounds, engine: str) -> 
 
 
 def _check_lattice(source: str, d: int, mode: str, generator: str, streams: str, bits_given: bool) -> None:
-    """The combinations the lattice engine runs: 2D, exact mode (flux or uniform law), Philox
-    per-particle streams, no chart bits; anything else is a SceneError naming the field."""
+    """The combinations the lattice engine runs: 2D and 3D, exact mode (flux or uniform law),
+    Philox per-particle streams, no chart bits; anything else is a SceneError naming the field."""
     why = "engine = 'lattice'"
-    if d != 2:
-        raise _fail(source, "[system] dimension", f"{why} runs 2D gases only, got dimension {d}")
+    if d not in (2, 3):
+        raise _fail(source, "[system] dimension", f"{why} runs 2D and 3D gases, got dimension {d}")
     if mode != "exact":
         raise _fail(source, "[collisions] mode", f"{why} runs exact mode only (flux or uniform law), got {mode!r}")
     if generator != "philox":

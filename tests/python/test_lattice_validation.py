@@ -16,7 +16,7 @@ _spec.loader.exec_module(lv)
 N, C = 200, 20000
 
 
-def _check_row(row, boundary):
+def _check_row(row, boundary, dim=2):
     assert row["roundtrip"] == {k: True for k in row["roundtrip"]}, row["roundtrip"]
     assert row["midpoint"] == {k: True for k in row["midpoint"]}, row["midpoint"]
     assert row["completed"] and row["forward_error"] is None
@@ -32,7 +32,7 @@ def _check_row(row, boundary):
     assert dr["energy_error_per_collision_in_2^-40_of_pair_energy"] < 2.0 ** 10
     assert abs(dr["energy_drift_relative"]) < 1e-9
     # momentum: at most one lattice unit per component per collision on a periodic axis
-    periodic = [k for k in range(2) if boundary == "periodic"]
+    periodic = [k for k in range(dim) if boundary == "periodic"]
     assert dr["momentum_conserved_axes"] == periodic
     for k in periodic:
         assert abs(dr["momentum_drift_units"][k]) <= C
@@ -123,3 +123,46 @@ def test_group_census_finds_the_same_members_meeting_again():
     assert c["groups"] == 5 and c["resolves"] == 3 and c["bounces"] == 2 and c["distinct_groups"] == 3
     assert c["most_frequent"][0] == {"members": [7, 8, 9], "times": 3, "first": 200007, "last": 200011}
     assert c["most_groups_in_1e5_collisions"] == 3
+
+
+class _Dim3:
+    """lv's module-level dimension set to 3 for the block (the 3D sphere gas, issue 14)."""
+
+    def __enter__(self):
+        lv.DIM = 3
+
+    def __exit__(self, *exc):
+        lv.DIM = 2
+
+
+def test_3d_sphere_gases_round_trip_and_midpoint():
+    with _Dim3():
+        row = lv.run_gas(N, 0.45, "periodic", C, seed=3)
+        assert row["dim"] == 3 and len(row["units"]["L"]) == 3
+        _check_row(row, "periodic", dim=3)
+        row = lv.run_child(N, 0.3, "wall", C, seed=2)
+        assert row["child_exit"] == 0, row.get("error")
+        assert row["dim"] == 3 and "--dim 3" in row["command"]
+        _check_row(row, "wall", dim=3)
+        assert row["wall_reflections_forward"] > 0
+
+
+def test_maxwell_ks_in_3d_accepts_maxwell_rejects_the_2d_law_and_equal_speeds():
+    rng = np.random.default_rng(6)
+    s = np.linalg.norm(rng.normal(size=(4000, 3)) * math.sqrt(1.3), axis=1)
+    assert lv.rayleigh_ks(s, 1.3, 3)[1] > 1e-3
+    assert lv.rayleigh_ks(s, 1.3, 2)[1] < 1e-6  # the 2D law on 3D speeds: the test can fail
+    assert lv.rayleigh_ks(np.full(4000, math.sqrt(3 * 1.3)), 1.3, 3)[1] < 1e-6
+
+
+def test_dense_3d_lattice_gas_relaxes_to_maxwell_with_the_float_collision_rate():
+    n = 200
+    with _Dim3():
+        gases = [lv.equilibrium_gas(n, 0.3, seed, relax=30, gap=4, snapshots=10, batch=10, batches=5)
+                 for seed in (1, 2, 3)]
+        s = lv.equilibrium_summary(gases, n)
+    assert s["ks_p_equal_speed_start"] < 1e-6
+    assert s["ks_p"] > 1e-3, s
+    assert abs(s["kT"] - 1.0) < 0.01
+    assert abs(s["rate_difference"]) <= 4 * s["rate_difference_se"], s
+    assert abs(s["rate_relative_difference"]) < 0.05, s

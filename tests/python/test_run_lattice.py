@@ -153,8 +153,8 @@ def test_an_engine_error_is_reported_and_fails(tmp_path, capsys, monkeypatch):
 
 
 @pytest.mark.parametrize("text,needle", [
-    ("[system]\ndimension = 3\nparticles = 10\npacking_fraction = 0.1\n[collisions]\nengine = 'lattice'\n",
-     "[system] dimension: engine = 'lattice' runs 2D gases only, got dimension 3"),
+    ("[system]\ndimension = 1\nparticles = 10\npacking_fraction = 0.1\n[collisions]\nengine = 'lattice'\n",
+     "[system] dimension: engine = 'lattice' runs 2D and 3D gases, got dimension 1"),
     ("[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.1\n[collisions]\nengine = 'lattice'\nmode = 'paper'\n",
      "[collisions] mode: engine = 'lattice' runs exact mode only"),
     ("[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.1\n[collisions]\nengine = 'lattice'\n"
@@ -186,8 +186,10 @@ def test_engine_choice_and_override(tmp_path):
                              "rng": {"generator": "clcg4"}}, "g.toml")
     with pytest.raises(SceneError, match=r"\[rng\] generator: .* \(--engine lattice\)"):
         with_engine(named, "lattice")
-    with pytest.raises(SceneError, match="dimension 3"):
-        with_engine(scene_from_dict({"system": {"dimension": 3, "particles": 5, "packing_fraction": 0.1}}), "lattice")
+    with pytest.raises(SceneError, match="dimension 1"):
+        with_engine(scene_from_dict({"system": {"dimension": 1, "particles": 5, "packing_fraction": 0.1}}), "lattice")
+    spheres = with_engine(scene_from_dict({"system": {"dimension": 3, "particles": 5, "packing_fraction": 0.1}}), "lattice")
+    assert spheres.engine == "lattice" and spheres.dimension == 3
     back = with_engine(load_scene(None), "float")
     assert back.engine == "float" and back.generator == "philox" and back.bits == 40
 
@@ -301,6 +303,22 @@ def test_lattice_trajectory_replays_the_forward_frames_exactly(tmp_path, monkeyp
     start = lg.build_lattice(load_scene(small(tmp_path, collisions=1000)))
     sim.run_back()
     assert all(lg.restored(start.snapshot(), sim.snapshot()).values())
+
+
+def test_a_3d_lattice_scene_runs_spheres_bit_for_bit_with_figures(tmp_path):
+    p = tmp_path / "spheres.toml"
+    p.write_text("[system]\ndimension = 3\nparticles = 200\npacking_fraction = 0.3\nboundaries = ['wall', 'periodic', 'periodic']\n"
+                 "[collisions]\nengine = 'lattice'\n[rng]\nseed = 5\n[run]\ncollisions = 5000\n")
+    scene = load_scene(p)
+    sim = lg.build_lattice(scene)
+    assert type(sim).__name__ == "LatticeSimulation3D" and sim.lattice_positions.shape == (200, 3)
+    r = run_scene(scene, plot=tmp_path / "fig", json_path=tmp_path / "r.json", progress=False)
+    assert r["passed"] and r["bit_for_bit"] and all(r["restored"].values())
+    assert r["dimension"] == 3 and len(r["box"]) == 3 and r["periodic"] == [False, True, True]
+    assert r["collisions_forward"] == r["collisions_back"] == 5000
+    assert len(r["momentum_drift_end"]["lattice_units"]) == 2  # the two periodic axes
+    if (tmp_path / "fig").exists():  # matplotlib installed
+        assert (tmp_path / "fig" / "snapshots.png").read_bytes()[:8] == PNG
 
 
 def test_lattice_plot(tmp_path):
