@@ -1,7 +1,7 @@
 """Studies of the 2D lattice engine (revcol/lattice/engine.hpp, LATTICE.md). Writes
 bench/results/lattice_*.json.
 
-    python3 bench/lattice_study.py throughput [--bin build-dev/revcol-bench] [--collisions 2e5] [--rounds 5] [--cpu 1]
+    python3 bench/lattice_study.py throughput [--bin build-dev/revcol-bench] [--collisions 2e5] [--rounds 5] [--cpu 1] [--dim 3]
     PYTHONPATH=build-dev/pkg python3 bench/lattice_study.py roundtrip [--n 1000] [--phi 0.3] [--max 1e6] [--law flux] [--boundary both]
     python3 bench/lattice_study.py all
 
@@ -10,7 +10,10 @@ gases (N = 1e4 and 1e5, area fractions 0.3 and 0.5; revcol-bench lattice/periodi
 lattice/float/...), interleaved: every round runs each case once per engine, alternating which goes
 first, one process per run pinned to one core, the load average recorded before each run.
 Collisions per second forward and reverse (wall clock and CPU time), medians and ranges over
-rounds, and the lattice / float ratios of the medians. Writes lattice_throughput.json.
+rounds, and the lattice / float ratios of the medians. Writes lattice_throughput.json. With --dim 3:
+the 3D lattice engine and the float engine on the same sphere gases (N = 1e3 and 1e4, volume
+fractions 0.3 and 0.45; revcol-bench lattice3d/periodic/... and lattice3d/float/...), written to
+lattice_throughput3d.json.
 
 roundtrip: one gas (N, area fraction, periodic and walls) run forward in steps of 10x collisions up
 to --max and back to the start after each step, from Python: bit-for-bit restoration of positions,
@@ -37,6 +40,14 @@ RESULTS = os.path.join(HERE, "results")
 
 #: the gases of the issue's table: (N, area fraction); periodic, lattice and float side by side
 THROUGHPUT_CASES = [(10000, "0.3"), (10000, "0.5"), (100000, "0.3"), (100000, "0.5")]
+#: the 3D gases (N, volume fraction) with both engines in revcol-bench (lattice3d/...)
+THROUGHPUT_CASES_3D = [(1000, "0.3"), (10000, "0.3"), (10000, "0.45")]
+
+
+def _case_names(dim: int, n: int, phi: str) -> tuple[str, str]:
+    """revcol-bench names of (lattice, float) for a gas."""
+    fam = "lattice3d" if dim == 3 else "lattice"
+    return f"{fam}/periodic/n{n}/phi{phi}", f"{fam}/float/n{n}/phi{phi}"
 METRICS = ("forward_per_s", "reverse_per_s", "forward_cpu_per_s", "reverse_cpu_per_s")
 
 
@@ -62,11 +73,11 @@ def throughput(args) -> dict:
     raw: dict = {}
     loads = []
     t0 = time.time()
+    cases = THROUGHPUT_CASES_3D if args.dim == 3 else THROUGHPUT_CASES
     for r in range(args.rounds):
-        for n, phi in THROUGHPUT_CASES:
-            engines = ["lattice", "float"] if r % 2 == 0 else ["float", "lattice"]
-            for eng in engines:
-                name = f"lattice/{'periodic' if eng == 'lattice' else 'float'}/n{n}/phi{phi}"
+        for n, phi in cases:
+            names = _case_names(args.dim, n, phi)
+            for name in (names if r % 2 == 0 else names[::-1]):
                 loads.append(os.getloadavg()[0])
                 m = _bench_once(args, name, base if n <= 10000 else 2 * base)
                 raw.setdefault(name, []).append(m)
@@ -79,17 +90,17 @@ def throughput(args) -> dict:
         for m in ("bit_exact", "log_entries", "redraws_per_collision", "multi_body", "events_per_collision"):
             if m in runs[0]:
                 summary[name][m] = [x[m] for x in runs]
-    for n, phi in THROUGHPUT_CASES:
-        lat, flo = summary[f"lattice/periodic/n{n}/phi{phi}"], summary[f"lattice/float/n{n}/phi{phi}"]
+    for n, phi in cases:
+        lat, flo = (summary[name] for name in _case_names(args.dim, n, phi))
         ratios[f"n{n}/phi{phi}"] = {m: lat[m]["median"] / flo[m]["median"] for m in METRICS}
-    res = {"command": " ".join(sys.argv), "rounds": args.rounds, "collisions_per_run": base,
+    res = {"command": " ".join(sys.argv), "dim": args.dim, "rounds": args.rounds, "collisions_per_run": base,
            "collisions_per_run_n100000": 2 * base, "cpu": args.cpu, "wall_seconds": time.time() - t0,
            "load_before_runs": {"min": min(loads), "median": float(np.median(loads)), "max": max(loads)},
            "summary": summary, "lattice_over_float": ratios, "raw": raw,
            "commit": subprocess.run(["git", "-C", HERE, "rev-parse", "HEAD"], capture_output=True,
                                     text=True).stdout.strip()}
     print(json.dumps(ratios, indent=1))
-    path = os.path.join(RESULTS, "lattice_throughput.json")
+    path = os.path.join(RESULTS, "lattice_throughput3d.json" if args.dim == 3 else "lattice_throughput.json")
     with open(path + ".tmp", "w") as f:
         json.dump(res, f, indent=1)
     os.replace(path + ".tmp", path)
@@ -153,6 +164,7 @@ def main(argv=None) -> int:
     ap.add_argument("--max", default="1e5")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--law", default="flux", choices=["flux", "uniform"])
+    ap.add_argument("--dim", type=int, default=2, choices=[2, 3], help="throughput: 2D disks or 3D spheres")
     ap.add_argument("--boundary", default="both", choices=["both", "periodic", "wall"])
     a = ap.parse_args(argv)
     os.makedirs(RESULTS, exist_ok=True)
