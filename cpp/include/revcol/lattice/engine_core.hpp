@@ -476,6 +476,17 @@ class BasicEngine {
       if (q == p) return;
       const Vec r = diff(ln_[p].x, pos(q, lo));
       const Vec w = sub(ln_[p].v, ln_[q].v);
+      if constexpr (D == 3) {
+        // the horizon exit (3D, where 27 cells hold ~5 times the 2D candidates): an overlap at
+        // lo + tau needs |r_k + w_k tau| < sigma on every axis, so tau > (|r_k| - sigma) / |w_k|;
+        // a pair with |r_k| - sigma > |w_k| (bt - lo) on some axis cannot collide before the best
+        // event so far (bt, strictly later: never offered). Exact integers, so the same events.
+        if (btype != none)
+          for (std::size_t k = 0; k < D; ++k) {
+            const std::int64_t gap = (r[k] < 0 ? -r[k] : r[k]) - u_.sigma;
+            if (gap > 0 && static_cast<i128>(gap) > static_cast<i128>(w[k] < 0 ? -w[k] : w[k]) * (bt - lo)) return;
+          }
+      }
       // cheap exits before the exact search (measure before changing): separating and outside
       // (exact), or a closest approach beyond sigma by far more than double round-off
       const i128 B = dot(r, w);
