@@ -77,11 +77,13 @@ class Simulation(Attachable):
     """
 
     def __new__(cls, *args, engine: str = "float", **kwargs):
-        # engine="lattice" hands the whole call to the 2D lattice engine (revcol.lattice), which
-        # takes the same positions, velocities, box, boundary, diameter, law and seed
+        # engine="lattice" hands the whole call to the lattice engine (revcol.lattice: disks, or
+        # spheres for (n, 3) positions), which takes the same positions, velocities, box,
+        # boundary, diameter, law and seed
         if engine == "lattice":
-            from .lattice import LatticeSimulation
-            return LatticeSimulation(*args, **kwargs)
+            from .lattice import LatticeSimulation, LatticeSimulation3D
+            x = np.asarray(args[0] if args else kwargs.get("positions", ()))
+            return (LatticeSimulation3D if x.ndim == 2 and x.shape[1] == 3 else LatticeSimulation)(*args, **kwargs)
         if engine != "float":
             raise ValueError(f"engine must be 'float' or 'lattice', got {engine!r}")
         return super().__new__(cls)
@@ -116,16 +118,17 @@ class Simulation(Attachable):
         or a jittered lattice (square; face-centred cubic in 3D), Gaussian velocities with
         zero momentum scaled to kinetic ``energy`` (default n d / 2, kT = 1), or all of one
         speed (``equal_speeds``). Other keywords go to the constructor (mode, law, ...);
-        the same ``seed`` keys the collision streams. ``engine="lattice"``: the 2D lattice
-        engine's ``LatticeSimulation.random`` (reversed bit for bit; ``law`` and ``seed`` apply)."""
+        the same ``seed`` keys the collision streams. ``engine="lattice"``: the lattice engine's
+        ``LatticeSimulation.random`` (dim 2) or ``LatticeSimulation3D.random`` (dim 3), reversed
+        bit for bit (``law`` and ``seed`` apply)."""
         phi = _packing_fraction(phi, packing_fraction)
         if engine == "lattice":
-            from .lattice import LatticeSimulation
+            from .lattice import LatticeSimulation, LatticeSimulation3D
             if energy is not None or equal_speeds:
                 raise ValueError("engine='lattice' starts at kT = 1 with Gaussian velocities: energy and "
                                  "equal_speeds are not available")
-            return LatticeSimulation.random(n, dim, phi, boundary=boundary, diameter=diameter, seed=seed,
-                                            init=init, **kwargs)
+            lat = LatticeSimulation3D if dim == 3 else LatticeSimulation
+            return lat.random(n, dim, phi, boundary=boundary, diameter=diameter, seed=seed, init=init, **kwargs)
         if engine != "float":
             raise ValueError(f"engine must be 'float' or 'lattice', got {engine!r}")
         x, v, box = _core.engine_random_state(dim, n, phi, _boundary_list(boundary), diameter, seed,

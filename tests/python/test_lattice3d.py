@@ -109,3 +109,20 @@ def test_bad_input_is_refused_with_a_named_error():
         _core.LatticeEngine3D.from_snapshot({k: v for k, v in snap2.items() if k != "quantization"} | {"dim": 3})
     # the state is unchanged by the refusals
     assert sim.collisions == 0 and np.array_equal(sim.snapshot()["x"], snap["x"])
+
+
+def test_simulation_with_engine_lattice_builds_the_3d_lattice_for_spheres():
+    import revcol
+    sim = revcol.Simulation.random(n=80, dim=3, phi=0.3, seed=4, engine="lattice")
+    assert isinstance(sim, LatticeSimulation3D) and sim.lattice_positions.shape == (80, 3)
+    x, v = sim.positions, sim.velocities
+    box = float(np.asarray(sim.units["L"], dtype=float)[0] * sim.units["length_unit"])
+    arr = revcol.Simulation(x, v, box, engine="lattice", seed=4)
+    assert isinstance(arr, LatticeSimulation3D)
+    s0 = arr.snapshot()
+    arr.run(collisions=500)
+    arr.run_back()
+    assert np.array_equal(arr.snapshot()["x"], s0["x"]) and np.array_equal(arr.snapshot()["v"], s0["v"])
+    # disks still go to the 2D class
+    flat = revcol.Simulation.random(n=50, dim=2, phi=0.3, seed=4, engine="lattice")
+    assert type(flat) is LatticeSimulation
