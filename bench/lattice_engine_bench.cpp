@@ -57,15 +57,19 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
   la::LatticeConfigN<D> cfg;
   cfg.wall = la::filled<D>(c.walls);
   cfg.seed = static_cast<std::uint32_t>(c.seed);
-  // REVCOL_LATTICE=tick_bits=20,cell_bits=20 runs the engine as before the automatic tick
-  apply_settings("REVCOL_LATTICE", "tick_bits, cell_bits", [&](const std::string& k, const std::string& v) {
+  // REVCOL_LATTICE=tick_bits=20,cell_bits=20 runs the engine as before the automatic tick;
+  // shell=S sets the neighbour search (set_list_shell: 0 the cell grid, S > 0 lists, < 0 automatic)
+  double shell = -1.0;
+  apply_settings("REVCOL_LATTICE", "tick_bits, cell_bits, shell", [&](const std::string& k, const std::string& v) {
     if (k == "tick_bits") cfg.tick_bits = std::stoi(v);
     else if (k == "cell_bits") cfg.cell_bits = std::stoi(v);
+    else if (k == "shell") shell = std::stod(v);
     else return false;
     return true;
   });
   const la::LatticeStartN<D> st = la::random_start(cfg, c.n, c.phi, c.seed, init_of(c));
   Engine e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
+  if (shell >= 0.0) e.set_list_shell(shell);
   // warm up a collision per particle from the initialiser's lattice, then start the clock
   e.run(c.n, la::tick_limit - 1);
   const la::SnapshotN<D> s0 = e.snapshot();
@@ -91,6 +95,8 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
           {"reverse_cpu_per_s", coll / (c2 - c1)},
           {"bit_exact", exact ? 1.0 : 0.0},
           {"events_per_collision", static_cast<double>(k1.events - k0.events) / coll},
+          {"neutral_per_collision", static_cast<double>(k1.crossings - k0.crossings) / coll},
+          {"list_shell", e.list_shell()},
           {"log_entries", static_cast<double>(k1.log_entries - k0.log_entries)},
           {"redraws_per_collision", redraws / coll},
           {"multi_body", static_cast<double>(k1.multi_body - k0.multi_body)},

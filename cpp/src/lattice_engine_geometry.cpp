@@ -286,8 +286,8 @@ QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, con
 // ---- cells ----
 
 template <std::size_t Dim>
-void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n) {
-  const std::int64_t wmin = u.sigma + 2 * u.vmax + 2;
+void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin) {
+  if (wmin <= 0) wmin = u.sigma + 2 * u.vmax + 2;
   std::array<std::int64_t, Dim> ncl{};
   for (std::size_t k = 0; k < Dim; ++k) {
     L_[k] = u.L[k];

@@ -54,8 +54,9 @@ inline std::int64_t wall_ticks(std::int64_t x0, std::int64_t v, std::int64_t h, 
 template <std::size_t Dim>
 class CellGridN {
  public:
-  /// A grid for these units (cell width >= sigma + 2 vmax + 2) over n particles.
-  void build(const UnitsN<Dim>& u, std::size_t n);
+  /// A grid for these units over n particles, cells at least wmin wide (0: sigma + 2 vmax + 2,
+  /// the prediction's width; neighbour_lists.hpp asks for its reach).
+  void build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin = 0);
   /// Number of cells along axis k.
   int count(int k) const noexcept { return nc_[k]; }
   /// Lower boundary of cell c (0 <= c <= nc) on axis k: floor(c L / nc).

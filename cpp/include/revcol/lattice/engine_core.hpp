@@ -18,6 +18,13 @@
 // q's slot when it is earlier there, so a pair's collision sits in both slots; an event whose versions
 // are stale is recomputed when it comes up.
 //
+// Neighbour search (set_list_shell): the cell grid (a particle's 3^D cells, a cell crossing a
+// neutral event) or neighbour lists with a shell (neighbour_lists.hpp, a list renewal the neutral
+// event of kind 0 instead); 3D uses lists by default. A prediction drops with a double-precision
+// filter the candidates that provably have no overlap tick before its best event so far and sends
+// the others to the exact search. Neither the search nor the filter changes which collisions
+// happen: the trace and the bits are those of the exhaustive search (test_lattice_lists).
+//
 // Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
 // collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
 // lo descending (kind 1 + (N - 1 - lo)), then walls (kind N + 1). So the reverse undoes each tick's
@@ -43,6 +50,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -53,6 +61,7 @@
 #include "revcol/error.hpp"
 #include "revcol/lattice/cell_grid.hpp"
 #include "revcol/lattice/geometry.hpp"
+#include "revcol/lattice/neighbour_lists.hpp"
 #include "revcol/lattice/units.hpp"
 #include "revcol/rng/philox.hpp"
 
@@ -328,10 +337,42 @@ class BasicEngine {
   std::uint64_t throw_at_collision = 0;
   /// When set, every forward collision appends (tick, i, j), i < j (tests, studies).
   std::vector<std::array<std::int64_t, 3>>* trace = nullptr;
+  /// Tests only: every candidate pair of a prediction goes to the exact search (no double
+  /// filter); the events, hence the state and the bits, must be the same.
+  bool exhaustive_search = false;
+  /// The neighbour search: s = 0 scans the 3^D cells of the cell grid at each prediction; s > 0
+  /// keeps neighbour lists with a shell of s sigma (balls of radius s sigma / 2 about the list
+  /// centres, neighbour_lists.hpp), 0.02 <= s <= 2; s < 0 (the default) chooses: lists in 3D with
+  /// auto_list_shell(), cells in 2D. Either search finds the same collisions: the state, the
+  /// trace and the bits are the same; only the speed and the neutral-event counts differ.
+  void set_list_shell(double s) {
+    require(std::isfinite(s) && (s <= 0.0 || (s >= 0.02 && s <= 2.0)), "lattice: the list shell must be 0 (cells), negative (automatic) or in [0.02, 2] diameters");
+    list_shell_ = s;
+    rebuild();
+  }
+  /// The search in use: 0 the cell grid, 1 lists (the relative vector imaged per pair: a
+  /// periodic axis shorter than about 2 (R + 2 h)), 2 lists with the centre offsets.
+  int neighbour_search() const noexcept { return lists_ ? (direct_ ? 2 : 1) : 0; }
+  /// The shell in use, in diameters (0: the cell grid).
+  double list_shell() const noexcept { return lists_ ? 2.0 * static_cast<double>(nl_.radius()) / static_cast<double>(u_.sigma) : 0.0; }
+  /// The automatic shell for this gas, in diameters (0: cells; see set_list_shell).
+  double auto_list_shell() const noexcept {
+    if constexpr (D == 2) {
+      return 0.0;
+    } else {
+      double vol = 1.0;
+      for (std::size_t k = 0; k < D; ++k) vol *= static_cast<double>(u_.L[k]) / static_cast<double>(u_.sigma);
+      const double phi = static_cast<double>(ln_.size()) * (std::numbers::pi / 6.0) / vol;
+      // Enskog mean free path in diameters; the shell grows with it (docs/lattice.md, measured)
+      const double g = (1.0 - 0.5 * phi) / ((1.0 - phi) * (1.0 - phi) * (1.0 - phi));
+      const double lam = phi > 0.0 ? 1.0 / (6.0 * std::numbers::sqrt2 * phi * g) : 1e9;
+      return std::clamp(kShellBase + kShellSlope * lam, kShellMin, kShellMax);
+    }
+  }
   /// Bytes held by the engine's arrays, queue, grid and log.
   std::size_t memory_bytes() const noexcept {
     const std::size_t n = ln_.size();
-    return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() +
+    return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() + nl_.memory_bytes() +
            log_.size() * 48 + group_bytes() + X_.words().size() * 8 + undo_.capacity() * sizeof(Saved) +
            undo_epoch_.capacity() * sizeof(std::uint32_t);
   }
@@ -385,6 +426,11 @@ class BasicEngine {
     sigma2d_ = static_cast<double>(sigma2_);
     const double far = static_cast<double>(u_.sigma) + 4.0 * static_cast<double>(u_.vmax);
     far2_ = far * far * (1.0 + 1e-9);
+    for (std::size_t k = 0; k < D; ++k) {
+      Ld_[k] = static_cast<double>(u_.L[k]);
+      invL_[k] = 1.0 / Ld_[k];
+      edge_[k] = 0.5 * Ld_[k] * (1.0 - 1e-9) - 4096.0;
+    }
     hlo_ = u_.sigma / 2;
     rebuild();
   }
@@ -423,6 +469,12 @@ class BasicEngine {
     return norm2(r) < sigma2_;
   }
   std::int64_t hhi(int k) const noexcept { return u_.L[k] - hlo_; }
+  // f(q) for every q that may be near p: p's neighbour list, or the particles of its 3^D cells
+  template <class F>
+  void near(int p, F&& f) const {
+    if (lists_) nl_.for_each(p, f);
+    else grid_.for_neighbours(grid_.cell_of_particle(p), f);
+  }
 
   // ---- keys ----
   std::int32_t n32() const noexcept { return static_cast<std::int32_t>(ln_.size()); }
@@ -436,6 +488,11 @@ class BasicEngine {
   void reanchor(int p, std::int64_t t) {
     ln_[p].x = pos(p, t);
     ln_[p].ta = t;
+    if (lists_) {  // a post point outside the ball (a collision moves it by ~vmax): renew now
+      if (!nl_.inside(p, ln_[p].x)) nl_.renew(p, ln_[p].x);
+      sync(p);
+      return;
+    }
     const int id = grid_.cell_id(ln_[p].x);
     if (grid_.cell_of_particle(p) != id) {
       grid_.remove(p);
@@ -462,50 +519,92 @@ class BasicEngine {
         bt = t, bk = k, btype = ty, bq = q;
       }
     };
-    const int cell = grid_.cell_of_particle(p);
-    const std::array<int, D> c = grid_.coords(cell);
-    for (std::size_t k = 0; k < D; ++k) {
-      const std::int64_t dt = grid_.exit_ticks(static_cast<int>(k), c[k], ln_[p].x[k], ln_[p].v[k]);
+    std::array<int, D> c{};
+    if (lists_) {  // the renewal: when the line leaves the ball about p's list centre
+      const std::int64_t dt = nl_.exit_ticks(p, ln_[p].x, ln_[p].v);
       if (dt > 0) offer(lo + dt, 0, cross, -1);
+    } else {
+      c = grid_.coords(grid_.cell_of_particle(p));
+    }
+    for (std::size_t k = 0; k < D; ++k) {
+      if (!lists_) {
+        const std::int64_t dt = grid_.exit_ticks(static_cast<int>(k), c[k], ln_[p].x[k], ln_[p].v[k]);
+        if (dt > 0) offer(lo + dt, 0, cross, -1);
+      }
       if (u_.wall[k]) {
         const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(static_cast<int>(k)));
         if (dw > 0) offer(lo + dw, wall_kind(), wall, -1);
       }
     }
-    grid_.for_neighbours(cell, [&](int q) {
-      if (q == p) return;
-      const Vec r = diff(ln_[p].x, pos(q, lo));
-      const Vec w = sub(ln_[p].v, ln_[q].v);
-      if constexpr (D == 3) {
-        // the horizon exit (3D, where 27 cells hold ~5 times the 2D candidates): an overlap at
-        // lo + tau needs |r_k + w_k tau| < sigma on every axis, so tau > (|r_k| - sigma) / |w_k|;
-        // a pair with |r_k| - sigma > |w_k| (bt - lo) on some axis cannot collide before the best
-        // event so far (bt, strictly later: never offered). Exact integers, so the same events.
-        if (btype != none)
-          for (std::size_t k = 0; k < D; ++k) {
-            const std::int64_t gap = (r[k] < 0 ? -r[k] : r[k]) - u_.sigma;
-            if (gap > 0 && static_cast<i128>(gap) > static_cast<i128>(w[k] < 0 ? -w[k] : w[k]) * (bt - lo)) return;
-          }
-      }
-      // cheap exits before the exact search (measure before changing): separating and outside
-      // (exact), or a closest approach beyond sigma by far more than double round-off
-      const i128 B = dot(r, w);
-      const u128 r2 = norm2(r);
-      if (B >= 0 && r2 >= sigma2_) return;
-      // the sums from the first axis on (the 2D engine's order: r0 r0 + r1 r1, ...)
-      double rr = static_cast<double>(r[0]) * static_cast<double>(r[0]);
-      double bb = static_cast<double>(r[0]) * static_cast<double>(w[0]);
-      double aa = static_cast<double>(w[0]) * static_cast<double>(w[0]);
-      for (std::size_t k = 1; k < D; ++k) {
-        const double rk = static_cast<double>(r[k]), wk = static_cast<double>(w[k]);
-        rr += rk * rk;
-        bb += rk * wk;
-        aa += wk * wk;
-      }
-      if (rr - bb * (bb / aa) > sigma2d_ * (1.0 + 1e-9) + rr * 1e-12) return;
-      const std::int64_t tau = first_overlap(r, w, sigma2_);
+    // The candidates. A double-precision filter drops the pairs that cannot collide, or not
+    // before the best event so far; the others get the exact search (measure before changing).
+    // Rounding: a position is within 2^9 lattice units of its double (|x| < 2^62) and sigma >=
+    // 2^40 (units.hpp), so r is within ~2^-30 sigma of the exact relative vector and |r|^2,
+    // the closest approach and |r + w t|^2 within ~2^-29 (|r|^2 + sigma^2): the margins below
+    // are 1e-6 of that, so a filtered pair is one whose every integer tick is provably outside.
+    // The image is the exact search's unless |r_k| is within rounding of L_k / 2 (edge: no filter).
+    const Line& lp = ln_[p];
+    const double tb = btype != none ? static_cast<double>(bt - lo) : 0.0;
+    auto exact = [&](int q) {
+      const Vec r = diff(lp.x, pos(q, lo));
+      const std::int64_t tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_);
       if (tau >= 0) offer(lo + tau, coll_kind(p, q), coll, q);
-    });
+    };
+    // the filter's tests on r, w (doubles): true when the pair surely has no overlap tick before bt
+    auto beyond = [&](double rr, double bb, double aa) {
+      // never inside: the smallest |r + w t|^2 over t >= 0 is beyond sigma^2
+      if ((bb >= 0.0 ? rr : rr - bb * (bb / aa)) > sigma2d_ + 1e-6 * (rr + sigma2d_)) return true;
+      // not before the best: f(t) = |r + w t|^2 is still falling at tb and outside there
+      return btype != none && -bb >= aa * tb &&
+             rr + tb * (2.0 * bb + aa * tb) > sigma2d_ + 1e-6 * (rr + aa * tb * tb + sigma2d_);
+    };
+    if (direct_ && !exhaustive_search) {
+      // lists on a box wide enough: r = (c_p - c_q) + u_p - u_q(lo), no periodic image to find
+      // (the offsets and u are exact integers rounded once: errors ~2^-50 of a few sigma)
+      const LineD& dp = lnd_[static_cast<std::size_t>(p)];
+      const int* ids = nl_.ids(p);
+      const double* dc = nl_.offsets(p);
+      for (int e = 0, ne = nl_.size(p); e < ne; ++e, dc += D) {
+        const int q = ids[e];
+        const LineD& dq = lnd_[static_cast<std::size_t>(q)];
+        const double dtq = static_cast<double>(lo - dq.ta);
+        double rr = 0.0, bb = 0.0, aa = 0.0;
+        for (std::size_t k = 0; k < D; ++k) {
+          const double r = (dc[k] + dp.u[k]) - (dq.u[k] + dq.v[k] * dtq);
+          const double w = dp.v[k] - dq.v[k];
+          rr += r * r;
+          bb += r * w;
+          aa += w * w;
+        }
+        if (!beyond(rr, bb, aa)) exact(q);
+      }
+    } else {
+      std::array<double, D> xp{};
+      for (std::size_t k = 0; k < D; ++k) xp[k] = static_cast<double>(lp.x[k]);
+      near(p, [&](int q) {
+        if (q == p) return;
+        const Line& lq = ln_[q];
+        if (!exhaustive_search) {
+          const double dtq = static_cast<double>(lo - lq.ta);
+          double rr = 0.0, bb = 0.0, aa = 0.0;
+          bool edge = false;
+          for (std::size_t k = 0; k < D; ++k) {
+            double r = (xp[k] - static_cast<double>(lq.x[k])) - static_cast<double>(lq.v[k]) * dtq;
+            if (!u_.wall[k]) {  // the nearest image (an inline rounding: libm's is a call)
+              const double m = r * invL_[k];
+              r -= Ld_[k] * static_cast<double>(static_cast<std::int64_t>(m + (m >= 0.0 ? 0.5 : -0.5)));
+              edge = edge || std::fabs(r) > edge_[k];
+            }
+            const double w = static_cast<double>(lp.v[k] - lq.v[k]);
+            rr += r * r;
+            bb += r * w;
+            aa += w * w;
+          }
+          if (!edge && beyond(rr, bb, aa)) return;
+        }
+        exact(q);
+      });
+    }
     schedule(p, btype, bt, bk, bq);
     if (btype == coll) {  // write it into the partner's slot when earlier there
       if (!queue_.scheduled(bq) || std::make_pair(bt, bk) < std::make_pair(queue_.time(bq), queue_.kind(bq))) {
@@ -519,12 +618,31 @@ class BasicEngine {
     partner_.assign(n, -1);
     vself_.assign(n, 0);
     vpart_.assign(n, 0);
-    grid_.build(u_, n);
     for (std::size_t p = 0; p < n; ++p) {
       ln_[p].x = pos(static_cast<int>(p), clock_);
       ln_[p].ta = clock_;
-      grid_.insert(static_cast<int>(p), grid_.cell_id(ln_[p].x));
     }
+    const double shell = list_shell_ < 0.0 ? auto_list_shell() : list_shell_;
+    lists_ = shell > 0.0;
+    grid_ = CellGridN<D>{};
+    nl_ = NeighbourListsN<D>{};
+    direct_ = false;
+    if (lists_) {
+      const double h = std::max(1.0, std::round(0.5 * shell * static_cast<double>(u_.sigma)));
+      std::vector<Vec> centres(n);
+      for (std::size_t p = 0; p < n; ++p) centres[p] = ln_[p].x;
+      nl_.build(u_, static_cast<std::int64_t>(std::min(h, static_cast<double>(u_.sigma))), centres);
+      // the prediction takes r from the centre offsets when no periodic axis is short enough
+      // for a relative vector (< R + 2 h + 4 vmax) to reach half the box
+      direct_ = true;
+      for (std::size_t k = 0; k < D; ++k)
+        if (!u_.wall[k] && u_.L[k] / 2 - 4096 <= nl_.reach() + 2 * nl_.radius() + 4 * u_.vmax) direct_ = false;
+    } else {
+      grid_.build(u_, n);
+      for (std::size_t p = 0; p < n; ++p) grid_.insert(static_cast<int>(p), grid_.cell_id(ln_[p].x));
+    }
+    lnd_.resize(n);
+    for (std::size_t p = 0; p < n; ++p) sync(static_cast<int>(p));
     // first bucket width: ~2^tick_bits ticks per mean free time per particle, over N particles
     // (the queue adapts it; a speed setting only)
     queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << u_.tick_bits) / static_cast<std::int64_t>(n)));
@@ -578,6 +696,7 @@ class BasicEngine {
       }
       if (type_[p] == cross) {
         ++cnt_.crossings;
+        if (lists_) nl_.renew(p, pos(p, t));
         predict(p, t);
         continue;
       }
@@ -616,8 +735,7 @@ class BasicEngine {
       if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
     }
     const Vec ghost = wrapped(sub(x, v));
-    const int cell = grid_.cell_of_particle(p);
-    grid_.for_neighbours(cell, [&](int q) {
+    near(p, [&](int q) {
       if (q == p) return;
       if (overlap(ghost, pos(q, a - 1))) {
         throw std::runtime_error("lattice engine: a wall and a body within one tick that the rule cannot resolve (particle " +
@@ -629,6 +747,7 @@ class BasicEngine {
     ln_[p].x = x;
     ln_[p].v = v;
     ln_[p].ta = a;
+    sync(p);
     ++ver_[p];
     wall_tick_[p] = a;
     ++cnt_.walls;
@@ -669,7 +788,7 @@ class BasicEngine {
       const Vec& x = s == 0 ? xi : xj;
       const Vec& v = s == 0 ? vi : vj;
       const Vec ghost = wrapped(sub(x, v));
-      grid_.for_neighbours(grid_.cell_id(x), [&](int q) {
+      auto third = [&](int q) {
         if (why != 0 || q == i || q == j) return;
         const Vec qa = pos(q, a);
         // exit (measure before changing): farther than sigma + 4 vmax, none of the three can hold
@@ -681,7 +800,9 @@ class BasicEngine {
         if (overlap(x, qa)) why = redraw_overlap_after;
         else if (overlap(ghost, wrapped(sub(qa, ln_[q].v)))) why = redraw_ghost_tie;
         if (overlap(pre_a[s], qa)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
-      });
+      };
+      if (lists_) nl_.for_each(s == 0 ? i : j, third);  // x is within 2 vmax of its owner's line
+      else grid_.for_neighbours(grid_.cell_id(x), third);
     }
     return why;
   }
@@ -691,6 +812,8 @@ class BasicEngine {
     ln_[i].v = vi;
     ln_[j].v = vj;
     ln_[i].ta = ln_[j].ta = a;
+    sync(i);
+    sync(j);
     ++ver_[i];
     ++ver_[j];
     ++cnt_.collisions;
@@ -783,7 +906,7 @@ class BasicEngine {
     auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
     for (std::size_t m = 0; m < g.size(); ++m) {
       const Vec xa = pos(g[m], a);
-      grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
+      near(g[m], [&](int q) {
         if (!member(q) && overlap(xa, pos(q, a))) g.push_back(q);
       });
     }
@@ -891,7 +1014,7 @@ class BasicEngine {
           if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(static_cast<int>(k)))) return false;
         }
         const Vec ghost = wrapped(sub(post[m], vel[m]));  // the new line at a-1
-        grid_.for_neighbours(grid_.cell_of_particle(g[m]), [&](int q) {
+        near(g[m], [&](int q) {
           if (grew || member(q)) return;
           if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) {
             g.push_back(q);
@@ -963,6 +1086,7 @@ class BasicEngine {
     if (trace != nullptr) trace->push_back({a, i, j});
     for (std::size_t m = 0; m < g.size(); ++m) {
       ln_[g[m]] = Line{post[m], vel[m], a};
+      sync(g[m]);
       ++ver_[g[m]];
     }
     ++cnt_.collisions;
@@ -985,6 +1109,7 @@ class BasicEngine {
       Line& l = ln_[g[m]];
       const Vec v = pre_v.empty() ? neg(l.v) : neg(pre_v[m]);
       l = Line{pre[m], v, a};
+      sync(g[m]);
       ++ver_[g[m]];
     }
     ctr_[drawer] -= draws;
@@ -1012,6 +1137,27 @@ class BasicEngine {
     std::int64_t ta;     // anchor tick
   };
   std::vector<Line> ln_;
+  // the prediction's double mirror of each line (lists: the anchor's offset from the list
+  // centre, exact integers rounded once); sync(p) after every change of ln_[p]
+  struct LineD {
+    std::array<double, D> u;  // anchor minus list centre (minimum image); 0 with the cell grid
+    std::array<double, D> v;  // velocity
+    std::int64_t ta;          // anchor tick
+  };
+  std::vector<LineD> lnd_;
+  void sync(int p) noexcept {
+    LineD& d = lnd_[static_cast<std::size_t>(p)];
+    const Line& l = ln_[static_cast<std::size_t>(p)];
+    for (std::size_t k = 0; k < D; ++k) {
+      d.v[k] = static_cast<double>(l.v[k]);
+      d.u[k] = 0.0;
+      if (lists_) {
+        const std::int64_t c = nl_.centre(p)[k];
+        d.u[k] = static_cast<double>(u_.wall[k] ? l.x[k] - c : min_image(l.x[k] - c, u_.L[k]));
+      }
+    }
+    d.ta = l.ta;
+  }
   std::vector<std::int64_t> wall_tick_;
   std::vector<Line> pre_wall_;  // a particle's line before its reflection at wall_tick_ (that tick only)
   // ---- the forward run's undo journal (run(): an engine error restores the state) ----
@@ -1079,8 +1225,14 @@ class BasicEngine {
   std::array<std::int64_t, 2 * D> momentum0_{};
   Counters cnt_;
   bool reversed_ = false;
+  // the neighbour search (set_list_shell): the cell grid of the particles, or neighbour lists
+  static constexpr double kShellBase = 0.35, kShellSlope = 0.3, kShellMin = 0.4, kShellMax = 1.0;
+  double list_shell_ = -1.0;
+  bool lists_ = false, direct_ = false;
+  NeighbourListsN<D> nl_;
   u128 sigma2_ = 0;
   double sigma2d_ = 0.0, far2_ = 0.0;
+  std::array<double, D> Ld_{}, invL_{}, edge_{};  // the prediction's filter: L, 1 / L, L / 2 less rounding
   std::int64_t hlo_ = 0;
   CellGridN<D> grid_;
   Queue queue_;

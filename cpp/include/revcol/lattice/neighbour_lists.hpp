@@ -1,0 +1,95 @@
+// Neighbour lists with a shell for the lattice engine (D = 2 or 3), exact in integers.
+//
+// Each particle p keeps a list centre c_p (its position at its last renewal) and stays within a
+// ball of radius h about it: its line leaves the ball at an integer tick, the renewal tick, and
+// the engine then renews p (a neutral event, like a cell crossing; cell_grid.hpp). Lists are
+// symmetric (q on p's list iff p on q's) and a pure function of the centres: q is listed iff
+// |c_p - c_q|^2 < R^2 (minimum image on periodic axes, exact 128-bit integers), with the reach
+//   R = sigma + 2 h + margin,  margin = 8 vmax + 8.
+// Why that is enough. At every tick the engine looks at, each particle is within h of its centre
+// (a renewal event sorts before every collision and wall of its tick). Two particles that overlap
+// at tick a are closer than sigma, so their centres are closer than sigma + 2 h: each is on the
+// other's list at the later of their last predictions, which therefore saw the pair (the cell
+// grid's argument, with the list for the 3^D cells). The acceptance scan looks for third bodies
+// within sigma + 4 vmax of a post point, which is within 2 vmax of its owner's pre point
+// (engine_core.hpp, post_reason), so a third body it must see is within sigma + 2 h + 6 vmax of
+// the owner's centre: on the owner's list. The wall and group scans look at points within vmax of
+// the members' lines: covered by the same margin.
+// The renewal tick is conservative, not exact: a double root of |d + v tau|^2 = h^2 (d = the
+// anchor minus the centre), rounded down and checked with the exact integer predicate (halved
+// until it holds). An early renewal is harmless: renewals change no physical state, so the
+// collisions, the state and the bits are those of the cell grid's engine (tests compare them).
+// The centres live in a cell grid (cells at least R wide) read only by the renewals. The list test
+// |c_p - c_q|^2 < R^2 is taken in double from the exact minimum-image differences: symmetric and
+// deterministic (the same values in either order), and R's margin is far beyond its rounding.
+// Each entry also keeps the centre offset c_p - c_q, from which the engine's prediction builds
+// the relative vector without a periodic image (engine_core.hpp).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "revcol/lattice/cell_grid.hpp"
+#include "revcol/lattice/geometry.hpp"
+#include "revcol/lattice/units.hpp"
+
+namespace revcol::lattice {
+
+/// Symmetric neighbour lists over list centres, with integer ball renewals.
+template <std::size_t Dim>
+class NeighbourListsN {
+ public:
+  using Vec = VecN<Dim>;  ///< an integer position or velocity
+
+  /// Every list from the centres (construction, restore, reversal): ball radius h >= 1 lattice
+  /// units; the reach is sigma + 2 h + 8 vmax + 8.
+  void build(const UnitsN<Dim>& u, std::int64_t h, const std::vector<Vec>& centres);
+  /// Moves p's centre to c (a wrapped position) and renews p's list and its neighbours' entries.
+  void renew(int p, const Vec& c);
+  /// True when x (a wrapped position) is within h of p's centre, exactly.
+  bool inside(int p, const Vec& x) const noexcept;
+  /// Ticks tau >= 1 such that the line x + v t stays within h of p's centre for t in [0, tau - 1]
+  /// (x inside; conservative, see the header comment); -1 if v = 0 (never leaves).
+  std::int64_t exit_ticks(int p, const Vec& x, const Vec& v) const noexcept;
+  /// Calls f(q) for every q on p's list.
+  template <class F>
+  void for_each(int p, F&& f) const {
+    const int* a = &ids_[static_cast<std::size_t>(p) * cap_];
+    for (std::int32_t k = 0, e = count_[static_cast<std::size_t>(p)]; k < e; ++k) f(a[k]);
+  }
+  /// p's list: its size() entries.
+  const int* ids(int p) const noexcept { return &ids_[static_cast<std::size_t>(p) * cap_]; }
+  /// The centre offsets of p's list, Dim doubles per entry: c_p - c_q (the minimum image, exact
+  /// integers rounded once), in the order of ids(p).
+  const double* offsets(int p) const noexcept { return &dc_[static_cast<std::size_t>(p) * cap_ * Dim]; }
+  /// p's list centre.
+  const Vec& centre(int p) const noexcept { return c_[static_cast<std::size_t>(p)]; }
+  /// Entries on p's list.
+  int size(int p) const noexcept { return count_[static_cast<std::size_t>(p)]; }
+  /// The ball radius h and the reach R, lattice units.
+  std::int64_t radius() const noexcept { return h_; }
+  /// The reach R (lists hold centres closer than R), lattice units.
+  std::int64_t reach() const noexcept { return reach_; }
+  /// Bytes held by the lists and the grid of centres.
+  std::size_t memory_bytes() const noexcept;
+
+ private:
+  Vec diff(const Vec& a, const Vec& b) const noexcept;
+  void add(int p, int q, const double* d);  // q onto p's list, c_p - c_q = d
+  void drop(int p, int q);                   // q off p's list
+  void scan(int p, bool both);               // p's list from the grid (both: p onto its neighbours' too)
+  void grow();
+  std::array<std::int64_t, Dim> L_{};
+  std::array<bool, Dim> wall_{};
+  std::int64_t h_ = 0, reach_ = 0;
+  u128 h2_ = 0;
+  double reach2_ = 0.0;  // R^2 in double: a symmetric, deterministic test (R holds a margin)
+  CellGridN<Dim> grid_;       // of the centres, cells >= R wide
+  std::vector<Vec> c_;        // centres
+  std::size_t cap_ = 16;      // entries per list (doubles, for every list, when one is full)
+  std::vector<int> ids_;      // p's list: ids_[p * cap_ .. + count_[p]]
+  std::vector<double> dc_;    // their centre offsets c_p - c_q, Dim per entry
+  std::vector<std::int32_t> count_;
+};
+
+}  // namespace revcol::lattice

@@ -1,0 +1,265 @@
+// Tests of the lattice engine's neighbour lists (lattice/neighbour_lists.hpp) and of the engine's
+// neighbour search: the lists against brute force after random renewals (complete, symmetric,
+// their centre offsets exact), the ball's renewal tick against brute force (never late, rarely
+// early), and the engine with lists (several shells, both prediction paths) against the cell
+// grid with every candidate sent to the exact search: the same collisions (trace), the same
+// state bit for bit, in 2D and 3D, periodic, walled, dense with redraws and with groups forced.
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <set>
+#include <string>
+
+#include "check.hpp"
+#include "revcol/lattice/engine.hpp"
+
+using namespace revcol::lattice;
+
+namespace {
+
+// |a - b|^2 exactly (minimum image on periodic axes), as a long double for the band test
+template <std::size_t D>
+long double dist2(const UnitsN<D>& u, const VecN<D>& a, const VecN<D>& b) {
+  long double s = 0.0L;
+  for (std::size_t k = 0; k < D; ++k) {
+    const std::int64_t d = u.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u.L[k]);
+    s += static_cast<long double>(d) * static_cast<long double>(d);
+  }
+  return s;
+}
+
+template <std::size_t D>
+UnitsN<D> box_units(std::array<bool, D> wall, double length_sigma, int S) {
+  UnitsN<D> u;
+  u.S = S;
+  u.sigma = std::int64_t{1} << S;
+  u.vmax = std::int64_t{1} << (S - 8);
+  for (std::size_t k = 0; k < D; ++k) {
+    u.L[k] = static_cast<std::int64_t>(length_sigma * static_cast<double>(u.sigma));
+    u.wall[k] = wall[k];
+  }
+  return u;
+}
+
+// every list against brute force: complete outside a rounding band about R, symmetric, the
+// offsets the exact minimum-image differences of the centres
+template <std::size_t D>
+void check_lists(const UnitsN<D>& u, const NeighbourListsN<D>& nl, const std::vector<VecN<D>>& c, const char* what) {
+  const long double R2 = static_cast<long double>(nl.reach()) * static_cast<long double>(nl.reach());
+  int bad = 0;
+  for (std::size_t p = 0; p < c.size(); ++p) {
+    std::set<int> listed;
+    const int* ids = nl.ids(static_cast<int>(p));
+    const double* off = nl.offsets(static_cast<int>(p));
+    for (int e = 0; e < nl.size(static_cast<int>(p)); ++e) {
+      const int q = ids[e];
+      if (!listed.insert(q).second || q == static_cast<int>(p)) ++bad;  // no duplicates, not itself
+      for (std::size_t k = 0; k < D; ++k) {
+        const std::int64_t d = u.wall[k] ? c[p][k] - c[q][k] : min_image(c[p][k] - c[q][k], u.L[k]);
+        if (off[e * D + k] != static_cast<double>(d)) ++bad;
+      }
+      // symmetric: p on q's list
+      bool back = false;
+      nl.for_each(q, [&](int r) { back = back || r == static_cast<int>(p); });
+      if (!back) ++bad;
+    }
+    for (std::size_t q = 0; q < c.size(); ++q) {
+      if (q == p) continue;
+      const long double d2 = dist2(u, c[p], c[q]);
+      const bool in = listed.count(static_cast<int>(q)) > 0;
+      if (d2 < R2 * (1.0L - 1e-12L) && !in) ++bad;   // missing
+      if (d2 > R2 * (1.0L + 1e-12L) && in) ++bad;    // listed too far
+    }
+  }
+  if (bad != 0) std::fprintf(stderr, "%s: %d list defects\n", what, bad);
+  CHECK(bad == 0);
+}
+
+template <std::size_t D>
+void lists_case(std::array<bool, D> wall, double length, std::size_t n, double shell, std::uint64_t seed, const char* what) {
+  const UnitsN<D> u = box_units<D>(wall, length, 50);
+  std::mt19937_64 rng(seed);
+  std::vector<VecN<D>> c(n);
+  for (auto& x : c)
+    for (std::size_t k = 0; k < D; ++k)
+      x[k] = u.wall[k] ? u.sigma / 2 + static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(u.L[k] - u.sigma))
+                       : static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(u.L[k]));
+  NeighbourListsN<D> nl;
+  const std::int64_t h = static_cast<std::int64_t>(shell * 0.5 * static_cast<double>(u.sigma));
+  nl.build(u, h, c);
+  CHECK(nl.reach() == u.sigma + 2 * h + 8 * u.vmax + 8);
+  check_lists(u, nl, c, what);
+  // random renewals: a centre moves by up to a diameter (wrapped, inside the walls)
+  std::uniform_real_distribution<double> step(-1.0, 1.0);
+  for (int round = 0; round < 3; ++round) {
+    for (std::size_t m = 0; m < n; ++m) {
+      const int p = static_cast<int>(rng() % n);
+      for (std::size_t k = 0; k < D; ++k) {
+        std::int64_t y = c[p][k] + static_cast<std::int64_t>(step(rng) * static_cast<double>(u.sigma));
+        if (u.wall[k]) y = std::clamp(y, u.sigma / 2, u.L[k] - u.sigma / 2);
+        else y = wrap(y, u.L[k]);
+        c[p][k] = y;
+      }
+      nl.renew(p, c[p]);
+    }
+    check_lists(u, nl, c, what);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("neighbour lists: complete, symmetric and with exact offsets, built and after random renewals") {
+  lists_case<3>({false, false, false}, 9.0, 400, 0.3, 1, "3D periodic, shell 0.3");
+  lists_case<3>({true, true, true}, 8.0, 300, 0.8, 2, "3D walls, shell 0.8");
+  lists_case<3>({false, true, false}, 3.0, 40, 2.0, 3, "3D small periodic box, shell 2 (every cell a neighbour)");
+  lists_case<2>({false, false}, 20.0, 400, 0.5, 4, "2D periodic, shell 0.5");
+  lists_case<2>({true, false}, 15.0, 300, 0.1, 5, "2D slab, shell 0.1");
+}
+
+TEST_CASE("neighbour lists: the renewal tick is never late and rarely early (brute force over the ticks)") {
+  const UnitsN<3> u = box_units<3>({false, false, false}, 10.0, 50);
+  std::mt19937_64 rng(11);
+  const std::int64_t h = u.sigma / 8;
+  std::vector<VecN<3>> c(1, VecN<3>{u.L[0] / 2, u.L[1] / 2, u.L[2] / 2});
+  NeighbourListsN<3> nl;
+  nl.build(u, h, c);
+  auto inside_at = [&](const VecN<3>& x, const VecN<3>& v, std::int64_t t) {
+    VecN<3> y;
+    for (int k = 0; k < 3; ++k) y[k] = x[k] + v[k] * t;
+    return nl.inside(0, y);
+  };
+  int late = 0, early = 0, cases = 0;
+  std::uniform_int_distribution<std::int64_t> off(-h / 2, h / 2);
+  for (int m = 0; m < 2000; ++m) {
+    // speeds of 1..2^k units per tick: exits after ~10^2..10^5 ticks, brute-forced
+    const int bits = 1 + static_cast<int>(rng() % 10);
+    VecN<3> x{}, v{};
+    for (int k = 0; k < 3; ++k) {
+      x[k] = c[0][k] + off(rng);
+      v[k] = static_cast<std::int64_t>(rng() % (std::uint64_t{1} << bits)) - (std::int64_t{1} << (bits - 1));
+    }
+    if (!nl.inside(0, x)) continue;
+    // scale v so that the exit is within 10^5 ticks
+    std::int64_t vm = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+    if (vm == 0) {
+      CHECK(nl.exit_ticks(0, x, v) == -1);
+      continue;
+    }
+    const std::int64_t scale = std::max<std::int64_t>(1, h / (vm * 20000));
+    for (int k = 0; k < 3; ++k) v[k] *= scale;
+    const std::int64_t tau = nl.exit_ticks(0, x, v);
+    std::int64_t first_out = 0;
+    while (inside_at(x, v, first_out)) ++first_out;
+    ++cases;
+    if (tau < 1 || tau > first_out) ++late;           // inside on [0, tau - 1] is required
+    if (tau < first_out - 2 - first_out / 1000000) ++early;  // the double root is good to ~1e-9
+  }
+  std::printf("  %d lines: %d late, %d early by more than 2 ticks\n", cases, late, early);
+  CHECK(cases > 1000);
+  CHECK(late == 0);
+  CHECK(early == 0);
+}
+
+namespace {
+
+template <std::size_t D>
+struct Gas {
+  const char* what;
+  std::size_t n;
+  double phi;
+  std::array<bool, D> wall;
+  int tick_bits;
+  std::uint64_t collisions;
+  bool groups;  // every collision a group collision (max_redraws = -1)
+};
+
+// the reference: the cell grid, every candidate to the exact search
+template <std::size_t D, class Engine>
+void run_equivalence(const Gas<D>& g) {
+  LatticeConfigN<D> cfg;
+  cfg.wall = g.wall;
+  cfg.seed = 7;
+  if (g.tick_bits != 0) cfg.tick_bits = g.tick_bits;
+  const LatticeStartN<D> st = random_start(cfg, g.n, g.phi, 7);
+  auto make = [&](double shell, bool exhaustive) {
+    Engine e(st.units, st.x, st.v, 7, operator_for(st.units));
+    e.set_list_shell(shell);
+    e.exhaustive_search = exhaustive;
+    if (g.groups) e.max_redraws = -1;
+    return e;
+  };
+  std::vector<std::array<std::int64_t, 3>> ref_trace;
+  Engine ref = make(0.0, true);
+  ref.trace = &ref_trace;
+  const SnapshotN<D> s0 = ref.snapshot();
+  CHECK(ref.neighbour_search() == 0);
+  ref.run(g.collisions, tick_limit - 1);
+  const SnapshotN<D> s1 = ref.snapshot();
+  std::set<int> paths;
+  for (double shell : {0.0, 0.02, 0.3, -1.0, 2.0}) {
+    Engine e = make(shell, false);
+    std::vector<std::array<std::int64_t, 3>> trace;
+    e.trace = &trace;
+    paths.insert(e.neighbour_search());
+    e.run(g.collisions / 3, tick_limit - 1);  // a stop and a restart on the way
+    e.run(g.collisions - g.collisions / 3, tick_limit - 1);
+    const bool same = trace == ref_trace && same_state(e.snapshot(), s1);
+    if (!same) std::fprintf(stderr, "%s, shell %.2f (search %d): differs from the exhaustive cell search\n", g.what, shell, e.neighbour_search());
+    CHECK(same);
+    e.run_back(0, e.origin());
+    CHECK(same_state(e.snapshot(), s0));
+    if (shell == 0.3 || shell == 2.0) {
+      std::printf("  %s, shell %.2f: search %d, %llu neutral events for %llu collisions (both ways)\n", g.what, shell,
+                  e.neighbour_search(), static_cast<unsigned long long>(e.counters().crossings),
+                  static_cast<unsigned long long>(e.counters().collisions));
+    }
+  }
+  CHECK(paths.count(1) + paths.count(2) >= 1);
+}
+
+}  // namespace
+
+TEST_CASE("3D engine: lists (shells 0.02 .. 2, both paths) find exactly the exhaustive cell search's collisions, bit for bit") {
+  const std::array<bool, 3> per{false, false, false}, walls{true, true, true}, slab{false, false, true};
+  for (const Gas<3>& g : {Gas<3>{"N=1000 phi=0.3 periodic", 1000, 0.3, per, 0, 20000, false},
+                          Gas<3>{"N=64 phi=0.1 periodic (short box)", 64, 0.1, per, 0, 5000, false},
+                          Gas<3>{"N=500 phi=0.45 walls", 500, 0.45, walls, 0, 15000, false},
+                          Gas<3>{"N=500 phi=0.45 slab, T=16 (redraws)", 500, 0.45, slab, 16, 15000, false},
+                          Gas<3>{"N=200 phi=0.3 walls, groups forced", 200, 0.3, walls, 0, 2000, true}})
+    run_equivalence<3, LatticeEngine3D>(g);
+}
+
+TEST_CASE("2D engine: lists find exactly the exhaustive cell search's collisions, bit for bit") {
+  const std::array<bool, 2> per{false, false}, walls{true, true};
+  for (const Gas<2>& g : {Gas<2>{"2D N=1000 phi=0.5 periodic", 1000, 0.5, per, 0, 20000, false},
+                          Gas<2>{"2D N=400 phi=0.3 walls, T=16", 400, 0.3, walls, 16, 10000, false}})
+    run_equivalence<2, LatticeEngine>(g);
+}
+
+TEST_CASE("engine: the list shell is checked, and changing it keeps the state") {
+  LatticeConfigN<3> cfg;
+  const LatticeStartN<3> st = random_start(cfg, 100, 0.3, 3);
+  LatticeEngine3D e(st.units, st.x, st.v, 3, operator_for(st.units));
+  CHECK(e.neighbour_search() != 0);  // 3D: lists by default
+  CHECK(e.list_shell() > 0.0);
+  e.run(500, tick_limit - 1);
+  const Snapshot3 s = e.snapshot();
+  for (double bad : {0.01, 2.5, std::nan("")}) {
+    bool refused = false;
+    try {
+      e.set_list_shell(bad);
+    } catch (const revcol::InvalidArgument& ex) {
+      refused = std::string(ex.what()).find("list shell") != std::string::npos;
+    }
+    CHECK(refused);
+    CHECK(same_state(e.snapshot(), s));
+  }
+  e.set_list_shell(0.0);
+  CHECK(e.neighbour_search() == 0);
+  CHECK(same_state(e.snapshot(), s));
+  const LatticeStartN<2> st2 = random_start(LatticeConfigN<2>{}, 100, 0.3, 3);
+  LatticeEngine e2(st2.units, st2.x, st2.v, 3, operator_for(st2.units));
+  CHECK(e2.neighbour_search() == 0);  // 2D: the cell grid by default
+}
+
+int main() { return check::run_all(); }
