@@ -48,11 +48,23 @@ std::int64_t first_overlap_d(const VecN<D>& r, const VecN<D>& w, u128 sigma2) no
   if (norm2(r) < sigma2) return 0;
   const i128 B = dot(r, w);
   if (B >= 0) return -1;  // not approaching: f increases from f(0) >= 0
+  const double a = ddot(w, w), b = ddot(r, w);
+  {
+    // the common case, decided by two exact predicates: the double entry root's ceiling t with
+    // f(t) < 0 <= f(t - 1) is the answer (f convex and f(0) >= 0: nothing before t - 1 is inside)
+    const double c0 = ddot(r, r) - static_cast<double>(sigma2);
+    const double g = c0 / (std::sqrt(std::max(0.0, b * b - a * c0)) - b);
+    if (g > 0.0 && g < 0x1p61) {
+      std::int64_t t = static_cast<std::int64_t>(g);  // the ceiling, inline (g > 0)
+      if (static_cast<double>(t) < g) ++t;
+      t = std::max<std::int64_t>(1, t);
+      if (overlap_at(r, w, t, sigma2) && !overlap_at(r, w, t - 1, sigma2)) return t;
+    }
+  }
   const i128 A = dot(w, w);
   // f is convex with its real minimum in [tv, tv + 1); the integer minimum is at tv or tv + 1.
   // tv = floor(-B / A): a double guess (from the 64-bit components: no 128-bit division or
   // conversion), made exact by A tv <= -B < A (tv + 1) in 128 bits (|B| < 2^118, |tv| < 2^62)
-  const double a = ddot(w, w), b = ddot(r, w);
   std::int64_t tv = static_cast<std::int64_t>(std::clamp(std::floor(-b / a), 0.0, 0x1p61));
   while (tv > 0 && A * tv > -B) --tv;
   while (A * (tv + 1) <= -B) ++tv;

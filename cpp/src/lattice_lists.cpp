@@ -106,8 +106,14 @@ typename NeighbourListsN<Dim>::Vec NeighbourListsN<Dim>::diff(const Vec& a, cons
 template <std::size_t Dim>
 bool NeighbourListsN<Dim>::inside(int p, const Vec& x) const noexcept {
   const Vec d = diff(x, c_[static_cast<std::size_t>(p)]);
-  for (std::size_t k = 0; k < Dim; ++k)
+  double f = 0.0;
+  for (std::size_t k = 0; k < Dim; ++k) {
     if (d[k] > h_ || d[k] < -h_) return false;
+    f += static_cast<double>(d[k]) * static_cast<double>(d[k]);
+  }
+  const double h2d = static_cast<double>(h_) * static_cast<double>(h_);
+  if (f < h2d * (1.0 - 1e-9)) return true;  // surely (the double's error is ~1e-15 of h^2)
+  if (f > h2d * (1.0 + 1e-9)) return false;
   return norm2(d) <= h2_;
 }
 
@@ -129,7 +135,15 @@ std::int64_t NeighbourListsN<Dim>::exit_ticks(int p, const Vec& x, const Vec& v)
   // rounded down with room for the double's error, then made sure with the exact predicate:
   // inside at 0 (the caller's precondition) and at tg means inside on [0, tg] (a ball is convex)
   std::int64_t tg = static_cast<std::int64_t>(std::clamp(std::floor(root * (1.0 - 1e-9)) - 1.0, 0.0, 0x1p61));
+  const double h2d = static_cast<double>(h_) * static_cast<double>(h_);
   auto in_at = [&](std::int64_t t) {
+    // surely inside in double (its error is ~1e-15 of h^2), else decided exactly
+    double f = 0.0;
+    for (std::size_t k = 0; k < Dim; ++k) {
+      const double y = static_cast<double>(d[k]) + static_cast<double>(v[k]) * static_cast<double>(t);
+      f += y * y;
+    }
+    if (f < h2d * (1.0 - 1e-9)) return true;
     constexpr i128 big = i128{1} << 62;
     Vec y;
     for (std::size_t k = 0; k < Dim; ++k) {

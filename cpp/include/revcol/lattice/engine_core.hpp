@@ -544,19 +544,22 @@ class BasicEngine {
     // are 1e-6 of that, so a filtered pair is one whose every integer tick is provably outside.
     // The image is the exact search's unless |r_k| is within rounding of L_k / 2 (edge: no filter).
     const Line& lp = ln_[p];
-    const double tb = btype != none ? static_cast<double>(bt - lo) : 0.0;
+    constexpr double never = std::numeric_limits<double>::infinity();
+    double tb = btype != none ? static_cast<double>(bt - lo) : never;  // the best so far, ticks from lo
     auto exact = [&](int q) {
       const Vec r = diff(lp.x, pos(q, lo));
       const std::int64_t tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_);
-      if (tau >= 0) offer(lo + tau, coll_kind(p, q), coll, q);
+      if (tau >= 0) {
+        offer(lo + tau, coll_kind(p, q), coll, q);
+        tb = static_cast<double>(bt - lo);
+      }
     };
-    // the filter's tests on r, w (doubles): true when the pair surely has no overlap tick before bt
-    auto beyond = [&](double rr, double bb, double aa) {
+    // the filter's tests on r, w (doubles): true when the pair surely has no overlap tick <= t
+    auto beyond = [&](double rr, double bb, double aa, double t) {
       // never inside: the smallest |r + w t|^2 over t >= 0 is beyond sigma^2
       if ((bb >= 0.0 ? rr : rr - bb * (bb / aa)) > sigma2d_ + 1e-6 * (rr + sigma2d_)) return true;
-      // not before the best: f(t) = |r + w t|^2 is still falling at tb and outside there
-      return btype != none && -bb >= aa * tb &&
-             rr + tb * (2.0 * bb + aa * tb) > sigma2d_ + 1e-6 * (rr + aa * tb * tb + sigma2d_);
+      // not up to t: f(t) = |r + w t|^2 is still falling at t and outside there
+      return t != never && -bb >= aa * t && rr + t * (2.0 * bb + aa * t) > sigma2d_ + 1e-6 * (rr + aa * t * t + sigma2d_);
     };
     if (direct_ && !exhaustive_search) {
       // lists on a box wide enough: r = (c_p - c_q) + u_p - u_q(lo), no periodic image to find
@@ -576,7 +579,7 @@ class BasicEngine {
           bb += r * w;
           aa += w * w;
         }
-        if (!beyond(rr, bb, aa)) exact(q);
+        if (!beyond(rr, bb, aa, tb)) exact(q);
       }
     } else {
       std::array<double, D> xp{};
@@ -600,7 +603,7 @@ class BasicEngine {
             bb += r * w;
             aa += w * w;
           }
-          if (!edge && beyond(rr, bb, aa)) return;
+          if (!edge && beyond(rr, bb, aa, tb)) return;
         }
         exact(q);
       });
@@ -801,8 +804,30 @@ class BasicEngine {
         else if (overlap(ghost, wrapped(sub(qa, ln_[q].v)))) why = redraw_ghost_tie;
         if (overlap(pre_a[s], qa)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
       };
-      if (lists_) nl_.for_each(s == 0 ? i : j, third);  // x is within 2 vmax of its owner's line
-      else grid_.for_neighbours(grid_.cell_id(x), third);
+      if (direct_) {  // the owner's list (x is within 2 vmax of its line), far ones dropped in double
+        const int o = s == 0 ? i : j;
+        std::array<double, D> ux{};
+        for (std::size_t k = 0; k < D; ++k) {
+          const std::int64_t c = nl_.centre(o)[k];
+          ux[k] = static_cast<double>(u_.wall[k] ? x[k] - c : min_image(x[k] - c, u_.L[k]));
+        }
+        const int* ids = nl_.ids(o);
+        const double* dc = nl_.offsets(o);
+        for (int e = 0, ne = nl_.size(o); e < ne && why == 0; ++e, dc += D) {
+          const LineD& dq = lnd_[static_cast<std::size_t>(ids[e])];
+          const double dt = static_cast<double>(a - dq.ta);
+          double dd = 0.0;
+          for (std::size_t k = 0; k < D; ++k) {
+            const double r = (ux[k] + dc[k]) - (dq.u[k] + dq.v[k] * dt);
+            dd += r * r;
+          }
+          if (dd <= far2_ * (1.0 + 1e-6)) third(ids[e]);
+        }
+      } else if (lists_) {
+        nl_.for_each(s == 0 ? i : j, third);
+      } else {
+        grid_.for_neighbours(grid_.cell_id(x), third);
+      }
     }
     return why;
   }
@@ -1226,7 +1251,7 @@ class BasicEngine {
   Counters cnt_;
   bool reversed_ = false;
   // the neighbour search (set_list_shell): the cell grid of the particles, or neighbour lists
-  static constexpr double kShellBase = 0.35, kShellSlope = 0.3, kShellMin = 0.4, kShellMax = 1.0;
+  static constexpr double kShellBase = 0.55, kShellSlope = 0.3, kShellMin = 0.6, kShellMax = 1.2;
   double list_shell_ = -1.0;
   bool lists_ = false, direct_ = false;
   NeighbourListsN<D> nl_;
