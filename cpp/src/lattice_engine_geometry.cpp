@@ -298,8 +298,9 @@ QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, con
 // ---- cells ----
 
 template <std::size_t Dim>
-void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin) {
+void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin, int span) {
   if (wmin <= 0) wmin = u.sigma + 2 * u.vmax + 2;
+  span_ = span == 2 ? 2 : 1;
   std::array<std::int64_t, Dim> ncl{};
   for (std::size_t k = 0; k < Dim; ++k) {
     L_[k] = u.L[k];
@@ -316,7 +317,7 @@ void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmi
       ncl[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(static_cast<double>(ncl[k]) / f));
   }
   for (std::size_t k = 0; k < Dim; ++k) {
-    all_[k] = !u.wall[k] && ncl[k] < 5;
+    all_[k] = !u.wall[k] && ncl[k] < 2 * span_ + 3;
     nc_[k] = static_cast<int>(all_[k] ? 8 : ncl[k]);
     bounds_[k].resize(static_cast<std::size_t>(nc_[k]) + 1);
     for (int c = 0; c <= nc_[k]; ++c) bounds_[k][c] = static_cast<std::int64_t>(static_cast<i128>(c) * L_[k] / nc_[k]);
@@ -361,7 +362,7 @@ int CellGridN<Dim>::axis_range(int k, int c, int* out) const noexcept {
     return nc;
   }
   int n = 0;
-  for (int d = -1; d <= 1; ++d) {
+  for (int d = -span_; d <= span_; ++d) {
     int a = c + d;
     if (a < 0 || a >= nc) {
       if (wall_[k]) continue;

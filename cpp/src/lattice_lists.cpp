@@ -20,7 +20,7 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
   reach2_ = static_cast<double>(reach_) * static_cast<double>(reach_);
   const std::size_t n = centres.size();
   c_ = centres;
-  grid_.build(u, n, reach_);
+  grid_.build(u, n, (reach_ + 1) / 2, 2);  // 5^D cells of R/2: half the candidates of 3^D cells of R
   for (std::size_t p = 0; p < n; ++p) grid_.insert(static_cast<int>(p), grid_.cell_id(c_[p]));
   count_.assign(n, 0);
   ids_.assign(n * cap_, -1);

@@ -55,8 +55,10 @@ template <std::size_t Dim>
 class CellGridN {
  public:
   /// A grid for these units over n particles, cells at least wmin wide (0: sigma + 2 vmax + 2,
-  /// the prediction's width; neighbour_lists.hpp asks for its reach).
-  void build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin = 0);
+  /// the prediction's width) whose neighbours are the cells within `span` (1 or 2) per axis:
+  /// anything closer than span * wmin is in them (neighbour_lists.hpp asks for half its reach
+  /// and span 2: 5^D cells of (R/2)^D hold ~half the candidates of 3^D cells of R^D).
+  void build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin = 0, int span = 1);
   /// Number of cells along axis k.
   int count(int k) const noexcept { return nc_[k]; }
   /// Lower boundary of cell c (0 <= c <= nc) on axis k: floor(c L / nc).
@@ -136,6 +138,7 @@ class CellGridN {
   std::array<std::vector<int>, Dim> nbr_;              // per axis and cell: its neighbour cells (8 slots)
   std::array<std::vector<std::uint8_t>, Dim> nbrn_;    // per axis and cell: how many
   std::array<bool, Dim> all_{};  // small periodic axis: every cell is a neighbour
+  int span_ = 1;                 // neighbours: the cells within span_ per axis
   std::array<bool, Dim> wall_{};
   // members stored flat (measure before changing: the neighbour scan is bound by memory loads):
   // cell id's members are slots_[id * cap_ .. + count_[id]]; cap_ starts at min(8, the most disks

@@ -19,7 +19,8 @@
 // anchor minus the centre), rounded down and checked with the exact integer predicate (halved
 // until it holds). An early renewal is harmless: renewals change no physical state, so the
 // collisions, the state and the bits are those of the cell grid's engine (tests compare them).
-// The centres live in a cell grid (cells at least R wide) read only by the renewals. The list test
+// The centres live in a cell grid (cells at least R / 2 wide, 5^D of them scanned) read only by the
+// renewals. The list test
 // |c_p - c_q|^2 < R^2 is taken in double from the exact minimum-image differences: symmetric and
 // deterministic (the same values in either order), and R's margin is far beyond its rounding.
 // Each entry also keeps the centre offset c_p - c_q, from which the engine's prediction builds
@@ -84,7 +85,7 @@ class NeighbourListsN {
   std::int64_t h_ = 0, reach_ = 0;
   u128 h2_ = 0;
   double reach2_ = 0.0;  // R^2 in double: a symmetric, deterministic test (R holds a margin)
-  CellGridN<Dim> grid_;       // of the centres, cells >= R wide
+  CellGridN<Dim> grid_;       // of the centres, cells >= R / 2 wide, span 2
   std::vector<Vec> c_;        // centres
   std::size_t cap_ = 16;      // entries per list (doubles, for every list, when one is full)
   std::vector<int> ids_;      // p's list: ids_[p * cap_ .. + count_[p]]
