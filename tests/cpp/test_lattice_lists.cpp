@@ -108,6 +108,22 @@ void lists_case(std::array<bool, D> wall, double length, std::size_t n, double s
 
 }  // namespace
 
+TEST_CASE("min_image: (d mod L) folded at (L + 1) / 2, every d in (-L, L) of small L, the edges of large L") {
+  auto reference = [](std::int64_t d, std::int64_t L) {
+    i128 r = static_cast<i128>(d) % L;
+    if (r < 0) r += L;
+    return static_cast<std::int64_t>(r >= (L + 1) / 2 ? r - L : r);
+  };
+  int bad = 0;
+  for (std::int64_t L = 1; L <= 40; ++L)
+    for (std::int64_t d = -L + 1; d < L; ++d) bad += min_image(d, L) != reference(d, L);
+  for (std::int64_t L : {(std::int64_t{1} << 62) - 1, std::int64_t{1} << 62, max_box - 1, max_box})
+    for (std::int64_t d : {-L + 1, -L / 2 - 1, -L / 2, -L / 2 + 1, std::int64_t{-1}, std::int64_t{0}, std::int64_t{1}, L / 2 - 1, L / 2,
+                           L / 2 + 1, (L + 1) / 2, L - 1})
+      bad += min_image(d, L) != reference(d, L);
+  CHECK(bad == 0);
+}
+
 TEST_CASE("neighbour lists: complete, symmetric and with exact offsets, built and after random renewals") {
   lists_case<3>({false, false, false}, 9.0, 400, 0.3, 1, "3D periodic, shell 0.3");
   lists_case<3>({true, true, true}, 8.0, 300, 0.8, 2, "3D walls, shell 0.8");

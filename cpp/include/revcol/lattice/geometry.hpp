@@ -48,9 +48,10 @@ inline std::int64_t wrap(i128 x, std::int64_t L) noexcept {
 /// The minimum image of a difference d in (-L, L): r = d mod L, minus L when r >= (L + 1) / 2
 /// (so |result| <= L/2). The same integer function in both directions of time.
 inline std::int64_t min_image(std::int64_t d, std::int64_t L) noexcept {
-  if (d < 0) d += L;
-  if (d >= L) d -= L;
-  return d >= (L + 1) / 2 ? d - L : d;
+  // = (d mod L) - (L if that is >= (L + 1) / 2), written with branches that a near pair never
+  // takes (measure before changing: the scans call it three times per candidate)
+  const std::int64_t hu = (L + 1) / 2;
+  return d >= hu ? d - L : d < hu - L ? d + L : d;
 }
 
 /// |r|^2 in 128 bits (|r_k| < 2^62).
