@@ -86,7 +86,7 @@ struct Counters {
   std::uint64_t events = 0;              ///< queue pops
   std::uint64_t collisions = 0;          ///< collisions applied (forward and reverse)
   std::uint64_t walls = 0;               ///< wall reflections applied (both directions)
-  std::uint64_t crossings = 0;           ///< cell crossings
+  std::uint64_t crossings = 0;           ///< neutral events: cell crossings, or list renewals (set_list_shell)
   std::uint64_t stale = 0;               ///< stale events recomputed
   std::array<std::uint64_t, 8> redraws{};  ///< forward redraws by RedrawReason
   std::uint64_t log_entries = 0;         ///< rare-log entries written (forward)
