@@ -80,6 +80,17 @@ inline IVec boundary_octant(std::int64_t h) {
   return {static_cast<i64>((x + kHalf) >> kFixBits), static_cast<i64>((y + kHalf) >> kFixBits)};
 }
 
+// n / d for a quotient below 2^64 (n >> 64 < d): one divq on x86-64.
+inline std::uint64_t div_word(u128 n, std::uint64_t d) {
+#if defined(__x86_64__)
+  std::uint64_t q, r;
+  __asm__("divq %4" : "=a"(q), "=d"(r) : "a"(static_cast<std::uint64_t>(n)), "d"(static_cast<std::uint64_t>(n >> 64)), "rm"(d) : "cc");
+  return q;
+#else
+  return static_cast<std::uint64_t>(n / d);
+#endif
+}
+
 constexpr double kCellsPerRadian = static_cast<double>(kCells) / (2.0 * std::numbers::pi);
 
 inline i128 cross(const IVec& b, i64 wx, i64 wy) {
@@ -168,6 +179,36 @@ std::int64_t dir_cell(i64 wx, i64 wy) {
   return k;
 }
 
+std::int64_t half_cell(i64 wx, i64 wy) {
+  require(wx != 0 || wy != 0, "half_cell: the zero vector has no direction");
+  constexpr std::int64_t mask = 2 * kCells - 1;
+  const double a = atan2_guess(static_cast<double>(wy), static_cast<double>(wx));
+  std::int64_t h = static_cast<std::int64_t>(std::floor(a * (2.0 * kCellsPerRadian))) & mask;
+  while (cross(boundary(h), wx, wy) < 0) h = (h - 1) & mask;
+  while (cross(boundary(h + 1), wx, wy) >= 0) h = (h + 1) & mask;
+  return h;
+}
+
+std::int64_t coarse_cell(i64 wx, i64 wy, int shift, IVec& b0, IVec& b1) {
+  require(wx != 0 || wy != 0, "coarse_cell: the zero vector has no direction");
+  const std::int64_t mask = (kCells >> shift) - 1;
+  const double a = atan2_guess(static_cast<double>(wy), static_cast<double>(wx));
+  std::int64_t k = static_cast<std::int64_t>(std::floor(std::ldexp(a * kCellsPerRadian, -shift))) & mask;
+  b0 = boundary((2 * k) << shift);
+  b1 = boundary((2 * k + 2) << shift);
+  while (cross(b0, wx, wy) < 0) {
+    k = (k - 1) & mask;
+    b1 = b0;
+    b0 = boundary((2 * k) << shift);
+  }
+  while (cross(b1, wx, wy) >= 0) {
+    k = (k + 1) & mask;
+    b0 = b1;
+    b1 = boundary((2 * k + 2) << shift);
+  }
+  return k;
+}
+
 bool in_cell(i64 wx, i64 wy, std::int64_t k) {
   return cross(boundary(2 * k), wx, wy) >= 0 && cross(boundary(2 * k + 2), wx, wy) < 0;
 }
@@ -197,9 +238,11 @@ RotCoef rot_coef(std::int64_t k) {
   const std::int64_t qt = (k + kCells / 8) >> 18;  // nearest quarter turn, 0..4
   const std::int64_t r = k - qt * kQuarterTurn;   // residual in [-ND/8, ND/8)
   const IVec b = boundary(2 * r);
-  const u128 den = static_cast<u128>(kOne + b.x);
-  const u128 num = static_cast<u128>(b.y < 0 ? -static_cast<i128>(b.y) : static_cast<i128>(b.y)) << kFixBits;
-  const i64 mag = static_cast<i64>((num + den / 2) / den);
+  // mag = round(|S| 2^62 / (2^62 + C)): a 124-bit numerator over a 64-bit divisor whose quotient
+  // (< 2^61) fits a word, so one hardware division (libgcc's 128-bit division costs more)
+  const u64 den = static_cast<u64>(kOne + b.x);  // 2^62 + cos(a) 2^62 < 2^64
+  const u128 num = (static_cast<u128>(b.y < 0 ? -static_cast<i128>(b.y) : static_cast<i128>(b.y)) << kFixBits) + den / 2;
+  const i64 mag = static_cast<i64>(div_word(num, den));
   return {static_cast<int>(qt & 3), b.y >= 0 ? -mag : mag, b.y};
 }
 

@@ -41,10 +41,10 @@ struct AzCell {
     return cr(b0) >= 0 && cr(b1) < 0;
   }
 };
+inline RotCoef az_centre(std::int64_t phi) { return rot_coef((phi << kPhiShift) + (1LL << (kPhiShift - 1))); }
 AzCell az_cell(std::int64_t phi) {
   phi &= kPhiMask;
-  return {phi, rot_coef((phi << kPhiShift) + (1LL << (kPhiShift - 1))), boundary((2 * phi) << kPhiShift),
-          boundary((2 * phi + 2) << kPhiShift)};
+  return {phi, az_centre(phi), boundary((2 * phi) << kPhiShift), boundary((2 * phi + 2) << kPhiShift)};
 }
 std::optional<std::array<i64, 2>> row_of(const AzCell& az, i64 xa);
 
@@ -70,8 +70,8 @@ Column make_column(const Vec3& p, i128 sigma2, std::int64_t sigma) {
   c.zin = static_cast<i64>(isqrt(static_cast<u128>(sigma2 - r2 - 1)));
   std::int64_t kphi = 0, ktheta = 0;
   if (r2 != 0) {
-    kphi = dir_cell(c.xc, c.yc);  // the nearest fine cell to atan2(yc, xc)
-    if (cross(boundary(2 * kphi + 1), {c.xc, c.yc}) >= 0) kphi = (kphi + 1) & (kCells - 1);
+    // the nearest fine cell to atan2(yc, xc): the fine cell, or the next from its half-cell point on
+    kphi = ((half_cell(c.xc, c.yc) + 1) >> 1) & (kCells - 1);
     ktheta = kQuarterTurn - normal_cell(static_cast<i64>(isqrt(static_cast<u128>(r2))), sigma);
   }
   c.cphi = rot_coef(kphi);
@@ -121,8 +121,7 @@ std::optional<i64> lo_post3(i128 sigma2, const Column& c, const Vec3& W) {
 // cells.hpp), so the pole (xa = 0, angle 0) is the centre of cell 0 and a head-on pre state
 // rotates onto a cell's centre, never onto a boundary. Cells 0 and quarter are half cells.
 std::int64_t polar_cell(i64 uz, i64 xa, int shift) {
-  const std::int64_t fine = dir_cell(uz, xa);
-  const std::int64_t h = 2 * fine + (cross(boundary(2 * fine + 1), {uz, xa}) >= 0 ? 1 : 0);  // half-cell index
+  const std::int64_t h = half_cell(uz, xa);
   return (h + (std::int64_t{1} << shift)) >> (shift + 1);
 }
 // The plane vector (uz, xa) is in polar cell j (and in the quarter plane uz > 0, xa >= 0).
@@ -146,8 +145,9 @@ Refusal chart_of(const Vec3& u, int shift, Chart& ch) {
     ch.az = az_cell(0);
     ch.xa = ch.y = 0;
   } else {
-    ch.phi = dir_cell(u[0], u[1]) >> kPhiShift;
-    ch.az = az_cell(ch.phi);
+    ch.phi = coarse_cell(u[0], u[1], kPhiShift, ch.az.b0, ch.az.b1);  // dir_cell(u) >> kPhiShift
+    ch.az.phi = ch.phi;
+    ch.az.c = az_centre(ch.phi);
     const IVec al = rotate_inv({u[0], u[1]}, ch.az.c);
     ch.xa = al.x;
     ch.y = al.y;

@@ -74,6 +74,14 @@ i64 boundary_x(std::int64_t h);
 i64 boundary_y(std::int64_t h);
 /// The direction cell in [0, ND) of w != 0 (exact; see above).
 std::int64_t dir_cell(i64 wx, i64 wy);
+/// The half-cell h in [0, 2^21) of w != 0: cross(B(h), w) >= 0 > cross(B(h + 1), w), i.e.
+/// 2 dir_cell(w) + 1 when w is at or past its cell's half-cell point, else 2 dir_cell(w); two
+/// boundary evaluations when the first guess is right (dir_cell and that test take three).
+std::int64_t half_cell(i64 wx, i64 wy);
+/// The coarse cell k = dir_cell(w) >> shift of w != 0 (ND / 2^shift cells per turn), with its
+/// boundaries b0 = B((2k) << shift) and b1 = B((2k + 2) << shift) (the same bits as boundary()):
+/// two boundary evaluations when the first guess is right, and the caller needs no more.
+std::int64_t coarse_cell(i64 wx, i64 wy, int shift, IVec& b0, IVec& b1);
 /// dir_cell(wx, wy) == k, decided by two exact cross products (w != 0, 0 <= k < ND).
 bool in_cell(i64 wx, i64 wy, std::int64_t k);
 /// dir_cell(wx, wy) >> shift == k: w lies in the coarse cell k of ND / 2^shift cells per turn
