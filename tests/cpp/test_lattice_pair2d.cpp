@@ -193,6 +193,40 @@ TEST_CASE("cells: boundaries monotone, |B| = 2^62, close to cos/sin, exactly sym
   }
 }
 
+TEST_CASE("half_cell and coarse_cell agree with dir_cell, on random vectors and on the boundaries themselves") {
+  auto check_one = [](i64 wx, i64 wy) {
+    const std::int64_t k = dir_cell(wx, wy);
+    const std::int64_t h = half_cell(wx, wy);
+    const i128 mid = static_cast<i128>(boundary(2 * k + 1).x) * wy - static_cast<i128>(boundary(2 * k + 1).y) * wx;
+    const std::int64_t want = 2 * k + (mid >= 0 ? 1 : 0);
+    if (h != want) CHECK(h == want);
+    for (int shift : {0, 2, 4, 8}) {
+      IVec b0{}, b1{};
+      const std::int64_t c = coarse_cell(wx, wy, shift, b0, b1);
+      if (c != (k >> shift)) CHECK(c == (k >> shift));
+      const bool same = b0 == boundary((2 * c) << shift) && b1 == boundary((2 * c + 2) << shift);
+      if (!same) CHECK(same);
+    }
+  };
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 20000; ++i) {
+    const i64 wx = static_cast<i64>(rng() >> (2 + rng() % 60)) - static_cast<i64>(rng() >> (2 + rng() % 60));
+    const i64 wy = static_cast<i64>(rng() >> (2 + rng() % 60)) - static_cast<i64>(rng() >> (2 + rng() % 60));
+    if (wx == 0 && wy == 0) continue;
+    check_one(wx, wy);
+  }
+  // exactly on a boundary or a half-cell point (the >= / < ties), and one unit either side,
+  // at every octant and near the wrap at angle 0
+  for (std::int64_t h : {0LL, 1LL, 2LL, 7LL, 8LL, (1LL << 18) - 1, 1LL << 18, (1LL << 18) + 1, (1LL << 19) + 3,
+                         (1LL << 20) + 5, (1LL << 21) - 8, (1LL << 21) - 1}) {
+    const IVec b = boundary(h);
+    for (const IVec& v : {b, IVec{b.x >> 20, b.y >> 20}, IVec{b.x + 1, b.y}, IVec{b.x, b.y + 1}, IVec{b.x - 1, b.y}})
+      if (v.x != 0 || v.y != 0) check_one(v.x, v.y);
+    CHECK(half_cell(b.x, b.y) == (h & ((1LL << 21) - 1)));
+  }
+  CHECK_THROWS_AS(half_cell(0, 0), InvalidArgument);
+}
+
 TEST_CASE("flux table: every f >= 1, total 2^48, decode exact at every boundary") {
   CHECK(flux_cum(0) == 0);
   CHECK(flux_cum(kHalfTurn) == (1ULL << 48));
