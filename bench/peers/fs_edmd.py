@@ -236,6 +236,18 @@ def run_revcol(state_npz: str, warmup: int, collisions: int, cpu: int) -> dict:
     raise RuntimeError(f"the revcol child printed no REVCOL_SELF line:\n{out[-2000:]}")
 
 
+def peer_commit(src: str) -> str:
+    """The peer checkout's commit, or 'unknown (not a git checkout)'. Only a folder that is its
+    own repository's top level counts: git asked inside an unpacked archive (no .git) placed in
+    revcol's tree would answer with revcol's commit."""
+    def git(*a: str) -> str:
+        return subprocess.run(["git", "-C", src, *a], capture_output=True, text=True).stdout.strip()
+    top = git("rev-parse", "--show-toplevel")
+    if not top or os.path.realpath(top) != os.path.realpath(src):
+        return "unknown (not a git checkout)"
+    return git("rev-parse", "--short", "HEAD") or "unknown (not a git checkout)"
+
+
 def _summary(vals: list) -> dict:
     return {"median": float(np.median(vals)), "min": float(min(vals)), "max": float(max(vals)), "runs": vals}
 
@@ -245,8 +257,7 @@ def measure(args, src: str) -> dict:
     build = os.path.join(os.path.dirname(os.path.abspath(src)), "build-fs-single")
     exe = build_peer(src, build, wpeer, c)
     res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "peer": "FSmallenburg/EDMD Single",
-           "peer_commit": subprocess.run(["git", "-C", src, "rev-parse", "--short", "HEAD"], capture_output=True,
-                                         text=True).stdout.strip() or "unknown (not a git checkout)",
+           "peer_commit": peer_commit(src),
            "revcol_commit": subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
                                            text=True).stdout.strip(),
            "collisions_timed": c, "warmup_collisions": wpeer, "pairs": args.pairs, "cpu": args.cpu,

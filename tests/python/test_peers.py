@@ -2,6 +2,7 @@
 patches, the state file, the fluid check, and the clear message when the peer is absent."""
 import importlib.util
 import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -86,3 +87,26 @@ def test_missing_peer_says_where_its_source_goes_and_measures_nothing(tmp_path, 
     said = capsys.readouterr().out
     assert "git clone https://github.com/FSmallenburg/EDMD" in said and "2d0c862" in said
     assert not out.exists()
+
+
+def test_peer_commit_is_not_revcols_for_an_unpacked_archive_inside_its_tree(tmp_path):
+    # an archive unpacked inside a git repository (as bench/peers/src/EDMD inside revcol's)
+    repo = tmp_path / "outer"
+    inner = repo / "bench" / "peers" / "src" / "EDMD"
+    inner.mkdir(parents=True)
+    subprocess.run(["git", "init", "-q", str(repo)], check=True)
+    (repo / "f").write_text("x")
+    subprocess.run(["git", "-C", str(repo), "-c", "user.name=t", "-c", "user.email=t@t", "add", "f"], check=True)
+    subprocess.run(["git", "-C", str(repo), "-c", "user.name=t", "-c", "user.email=t@t", "commit", "-q", "-m", "m"],
+                   check=True)
+    assert fs.peer_commit(str(inner)) == "unknown (not a git checkout)"
+    # its own checkout: its own commit
+    subprocess.run(["git", "init", "-q", str(inner)], check=True)
+    (inner / "g").write_text("y")
+    subprocess.run(["git", "-C", str(inner), "-c", "user.name=t", "-c", "user.email=t@t", "add", "g"], check=True)
+    subprocess.run(["git", "-C", str(inner), "-c", "user.name=t", "-c", "user.email=t@t", "commit", "-q", "-m", "m"],
+                   check=True)
+    want = subprocess.run(["git", "-C", str(inner), "rev-parse", "--short", "HEAD"], capture_output=True,
+                          text=True).stdout.strip()
+    assert fs.peer_commit(str(inner)) == want
+    assert fs.peer_commit(str(tmp_path / "nowhere")) == "unknown (not a git checkout)"
