@@ -101,6 +101,15 @@ bool overlaps_at(const Vec2& r, const Vec2& w, std::int64_t tau, u128 sigma2) no
 bool overlaps_at(const Vec3& r, const Vec3& w, std::int64_t tau, u128 sigma2) noexcept { return overlap_at(r, w, tau, sigma2); }
 std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept { return first_overlap_d(r, w, sigma2); }
 std::int64_t first_overlap(const Vec3& r, const Vec3& w, u128 sigma2) noexcept { return first_overlap_d(r, w, sigma2); }
+std::int64_t first_overlap(const Vec3& r, const Vec3& w, u128 sigma2, double guess) noexcept {
+  if (guess > -1.0 && guess < 0x1p61) {  // false for NaN
+    std::int64_t t = static_cast<std::int64_t>(guess);  // truncation, then the ceiling
+    if (static_cast<double>(t) < guess) ++t;
+    t = std::max<std::int64_t>(1, t);
+    if (overlap_at(r, w, t, sigma2) && !overlap_at(r, w, t - 1, sigma2)) return t;
+  }
+  return first_overlap_d(r, w, sigma2);
+}
 
 template <std::size_t Dim>
 void validate(const UnitsN<Dim>& u) {

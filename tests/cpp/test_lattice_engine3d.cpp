@@ -5,6 +5,7 @@
 // rare log (printed), group collisions forced, and bad input refused with the state unchanged.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -82,6 +83,14 @@ TEST_CASE("3D first_overlap is the first integer tick with |r + w t| < sigma (br
       }
     }
     const std::int64_t got = first_overlap(r, w, s2);
+    // the overload with a caller's guess gives the same answer for any guess: right, off by
+    // one either way, far, negative, huge, infinite, NaN
+    const double b = static_cast<double>(brute);
+    for (double guess : {b, b - 0.5, b - 1.0, b + 1.0, b - 1.5, b + 7.0, -3.0, 0.0, 0.25, 1e30,
+                         std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+      const std::int64_t gg = first_overlap(r, w, s2, guess);
+      if (gg != brute) CHECK(gg == brute);
+    }
     if (brute >= 0) ++found;
     if (brute > 200) ++grazing;
     CHECK(got == brute);
@@ -120,6 +129,10 @@ TEST_CASE("3D first_overlap at full scale (sigma 2^60, |w| ~ 2^41): the tick bef
     }
     if (norm2(r) < s2) continue;
     const std::int64_t t = first_overlap(r, w, s2);
+    for (double guess : {static_cast<double>(t), static_cast<double>(t) + 1.0, static_cast<double>(t) - 2.0}) {
+      const std::int64_t gg = first_overlap(r, w, s2, guess);
+      if (gg != t) CHECK(gg == t);
+    }
     if (t < 0) continue;
     ++hits;
     CHECK(overlaps_at(r, w, t, s2));

@@ -546,9 +546,15 @@ class BasicEngine {
     const Line& lp = ln_[p];
     constexpr double never = std::numeric_limits<double>::infinity();
     double tb = btype != none ? static_cast<double>(bt - lo) : never;  // the best so far, ticks from lo
-    auto exact = [&](int q) {
+    auto exact = [&](int q, double guess) {
       const Vec r = diff(lp.x, pos(q, lo));
-      const std::int64_t tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_);
+      std::int64_t tau;
+      if constexpr (D == 3) {
+        tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_, guess);
+      } else {
+        (void)guess;
+        tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_);
+      }
       if (tau >= 0) {
         offer(lo + tau, coll_kind(p, q), coll, q);
         tb = static_cast<double>(bt - lo);
@@ -579,7 +585,11 @@ class BasicEngine {
           bb += r * w;
           aa += w * w;
         }
-        if (!beyond(rr, bb, aa, tb)) exact(q);
+        if (beyond(rr, bb, aa, tb)) continue;
+        // the entry root of aa t^2 + 2 bb t + rr - sigma^2 from these doubles: first_overlap's
+        // first guess (its exact predicates decide; any guess gives the same answer)
+        const double c0 = rr - sigma2d_;
+        exact(q, c0 / (std::sqrt(std::max(0.0, bb * bb - aa * c0)) - bb));
       }
     } else {
       std::array<double, D> xp{};
@@ -605,7 +615,7 @@ class BasicEngine {
           }
           if (!edge && beyond(rr, bb, aa, tb)) return;
         }
-        exact(q);
+        exact(q, std::numeric_limits<double>::quiet_NaN());
       });
     }
     schedule(p, btype, bt, bk, bq);

@@ -94,5 +94,11 @@ bool overlaps_at(const Vec3& r, const Vec3& w, std::int64_t tau, u128 sigma2) no
 std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept;
 /// The same in 3D (the same method: a double guess decided by the exact predicate).
 std::int64_t first_overlap(const Vec3& r, const Vec3& w, u128 sigma2) noexcept;
+/// first_overlap(r, w, sigma2) with the caller's double guess of the entry root: t = max(1,
+/// ceil(guess)) is the answer when f(t) < sigma2 <= f(t - 1) (f convex: its inside ticks form an
+/// interval, so none lies before t - 1), decided by two exact predicates; otherwise (a wrong or
+/// non-finite guess, a pair inside at 0 or never inside) the full search. The same result for
+/// every guess.
+std::int64_t first_overlap(const Vec3& r, const Vec3& w, u128 sigma2, double guess) noexcept;
 
 }  // namespace revcol::lattice
