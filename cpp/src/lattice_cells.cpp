@@ -193,7 +193,7 @@ std::int64_t coarse_cell(i64 wx, i64 wy, int shift, IVec& b0, IVec& b1) {
   require(wx != 0 || wy != 0, "coarse_cell: the zero vector has no direction");
   const std::int64_t mask = (kCells >> shift) - 1;
   const double a = atan2_guess(static_cast<double>(wy), static_cast<double>(wx));
-  std::int64_t k = static_cast<std::int64_t>(std::floor(std::ldexp(a * kCellsPerRadian, -shift))) & mask;
+  std::int64_t k = static_cast<std::int64_t>(std::floor(a * kCellsPerRadian * (1.0 / static_cast<double>(1LL << shift)))) & mask;
   b0 = boundary((2 * k) << shift);
   b1 = boundary((2 * k + 2) << shift);
   while (cross(b0, wx, wy) < 0) {
@@ -223,7 +223,7 @@ std::int64_t normal_cell(i64 xc, i64 sigma, int shift) {
   require(sigma >= 1 && xc > -sigma && xc < sigma, "normal_cell: needs |xc| < sigma");
   require(shift >= 0 && shift <= kCellBits - 4, "normal_cell: shift must be in [0, 16]");
   const double phi = std::acos(static_cast<float>(static_cast<double>(xc) / static_cast<double>(sigma)));
-  std::int64_t k = std::llround(std::ldexp(phi * kCellsPerRadian, -shift));
+  std::int64_t k = std::llround(phi * kCellsPerRadian * (1.0 / static_cast<double>(1LL << shift)));
   const i128 lhs = static_cast<i128>(xc) << kFixBits;
   // the coarse half-cell point h is the fine half-cell point h 2^shift
   auto bound = [&](std::int64_t h) { return static_cast<i128>(sigma) * boundary_x(h << shift); };
