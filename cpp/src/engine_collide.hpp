@@ -331,7 +331,12 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
   if (!group_operator(g, order, t, reversed, w1)) {
     // refused before any draw was consumed (validation comes first): undo the walls
     obs_ = nullptr;
-    for (int u = 0; u < n; ++u) flip_mask(ids[u], reversed ? w2[u] : w1[u]);
+    for (int u = 0; u < n; ++u) {
+      const Reflection m = reversed ? w2[u] : w1[u];
+      flip_mask(ids[u], m);
+      // neither the reflection nor its undoing happened: take both out of the counter
+      counters_.wall_events -= 2 * static_cast<std::uint64_t>(reflections(m));
+    }
     obs_ = obs;
     if (reversed && (std::any_of(w1, w1 + n, [](Reflection q) { return q != 0; }) ||
                      std::any_of(w2, w2 + n, [](Reflection q) { return q != 0; })))

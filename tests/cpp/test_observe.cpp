@@ -171,6 +171,10 @@ TEST_CASE("a refused group's wall reflections are not observed: impulses are tho
   CHECK(d.momentum[0] - p0 > 0.0);
   CHECK_NEAR(impulse, d.momentum[0] - p0, 1e-12);
   // (the refused W1 and its undoing add opposite virials x dv, so only the impulse shows it)
+  // the engine's counter counts the reflections that happened, as the observer does (the
+  // refused W1 and its undoing are not events; they once counted twice)
+  CHECK(o.wall_reflections >= 1);
+  CHECK(d.counters.wall_events == o.wall_reflections);
 }
 
 TEST_CASE("a closed 2D gas: K2 + W + W_wall -> 0; temperature from the energy; walls share the pressure") {
