@@ -347,10 +347,11 @@ def matrix(args) -> dict:
 
 # --- equilibrium ------------------------------------------------------------------------------
 
-def equal_speed_start(n: int, phi: float, seed: int):
-    """A float periodic start (dimension DIM) at packing fraction phi with every speed equal (kT = 1)."""
+def equal_speed_start(n: int, phi: float, seed: int, boundary: str = "periodic"):
+    """A float start (dimension DIM, every axis periodic or every axis walled) at packing fraction
+    phi with every speed equal (kT = 1)."""
     from revcol import _core
-    x, v, box = _core.engine_random_state(DIM, int(n), float(phi), ["periodic"], 1.0, int(seed), 0.0,
+    x, v, box = _core.engine_random_state(DIM, int(n), float(phi), [boundary], 1.0, int(seed), 0.0,
                                           _init_for(phi), True)
     return np.asarray(x), np.asarray(v), np.asarray(box, dtype=float).ravel()
 
@@ -389,14 +390,14 @@ def _rate_batches(run, clock, n: int, batch_collisions: int, batches: int) -> li
 
 
 def equilibrium_gas(n: int, phi: float, seed: int, relax: float, gap: float, snapshots: int,
-                    batch: float, batches: int) -> dict:
+                    batch: float, batches: int, boundary: str = "periodic") -> dict:
     """One seed: lattice and float engines from the same equal-speed float state; relax, sample
     speeds (lattice) and measure collision rates by batches (both)."""
     import revcol
     LatticeSimulation = _sim_cls()
-    x, v, box = equal_speed_start(n, phi, seed)
-    lat = LatticeSimulation(x, v, box, boundary="periodic", seed=seed)
-    flt = revcol.Simulation(x, v, box, boundary="periodic", mode="exact", law="flux", seed=seed)
+    x, v, box = equal_speed_start(n, phi, seed, boundary)
+    lat = LatticeSimulation(x, v, box, boundary=boundary, seed=seed)
+    flt = revcol.Simulation(x, v, box, boundary=boundary, mode="exact", law="flux", seed=seed)
     per = n // 2  # collisions per "collision per particle"
     s_start = np.linalg.norm(lat.velocities, axis=1)
     lat.run(collisions=int(relax * per))
@@ -458,12 +459,12 @@ def equilibrium(args) -> dict:
     gases = []
     for k in range(args.seeds):
         gases.append(equilibrium_gas(args.n, args.phi, args.seed + k, args.relax, args.gap, args.snapshots,
-                                     args.batch, args.batches))
+                                     args.batch, args.batches, args.eq_boundary))
         print(f"seed {args.seed + k}: lattice {np.mean(gases[-1]['rates_lattice']):.5f}, "
               f"float {np.mean(gases[-1]['rates_float']):.5f}", flush=True)
     summ = equilibrium_summary(gases, args.n)
     res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
-           "build": _build_info(), "dim": DIM, "n": args.n, "phi": args.phi, "boundary": "periodic",
+           "build": _build_info(), "dim": DIM, "n": args.n, "phi": args.phi, "boundary": args.eq_boundary,
            "start": "equal speeds (kT = 1), positions as engine_random_state", "seeds": args.seeds,
            "relax_per_particle": args.relax, "gap_per_particle": args.gap, "snapshots": args.snapshots,
            "batch_per_particle": args.batch, "batches": args.batches,
@@ -624,6 +625,8 @@ def main(argv=None) -> int:
     ap.add_argument("--cells", type=int, nargs="+", default=[16], help="probe: cell_bits to try")
     ap.add_argument("--out", default="matrix", help="matrix, probe, failures: writes lattice_validation_<out>.json")
     ap.add_argument("--seeds", type=int, default=4, help="equilibrium: independent gases")
+    ap.add_argument("--eq-boundary", default="periodic", choices=["periodic", "wall"],
+                    help="equilibrium: every axis periodic or every axis walled")
     ap.add_argument("--relax", type=float, default=50.0, help="equilibrium: collisions per particle")
     ap.add_argument("--gap", type=float, default=4.0, help="equilibrium: collisions per particle between snapshots")
     ap.add_argument("--snapshots", type=int, default=10)
