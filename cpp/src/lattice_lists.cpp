@@ -31,7 +31,8 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
 template <std::size_t Dim>
 void NeighbourListsN<Dim>::scan(int p, bool both) {
   const Vec& c = c_[static_cast<std::size_t>(p)];
-  grid_.for_neighbours(grid_.cell_of_particle(p), [&](int q) {
+  // only the cells that reach within R of c (the rest could hold no entry: the same lists)
+  grid_.for_neighbours_within(grid_.cell_of_particle(p), c, static_cast<double>(reach_), [&](int q) {
     if (q == p) return;
     const Vec& cq = c_[static_cast<std::size_t>(q)];
     double d[Dim], dd = 0.0;

@@ -108,6 +108,62 @@ void lists_case(std::array<bool, D> wall, double length, std::size_t n, double s
 
 }  // namespace
 
+// for_neighbours_within against for_neighbours: every member closer than r (in double, from the
+// exact nearest-image differences) is visited, in the same order, and the skipped cells held
+// nothing closer than r; periodic, walled and mixed boxes, small ones where every cell is a neighbour
+template <std::size_t D>
+void check_within(std::array<bool, D> wall, double length_sigma, int n, std::uint64_t seed) {
+  const UnitsN<D> u = box_units<D>(wall, length_sigma, 40);
+  const std::int64_t reach = u.sigma + 2 * (u.sigma / 3) + 8 * u.vmax + 8;
+  CellGridN<D> g;
+  g.build(u, static_cast<std::size_t>(n), (reach + 1) / 2, 2);
+  std::mt19937_64 rng(seed);
+  std::vector<VecN<D>> x(static_cast<std::size_t>(n));
+  for (int p = 0; p < n; ++p) {
+    for (std::size_t k = 0; k < D; ++k) x[p][k] = static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(u.L[k]));
+    g.insert(p, g.cell_id(x[p]));
+  }
+  const double r = static_cast<double>(reach), r2 = r * r;
+  int bad = 0, seen = 0, fewer = 0;
+  for (int p = 0; p < n; ++p) {
+    auto close = [&](int q) {
+      double dd = 0.0;
+      for (std::size_t k = 0; k < D; ++k) {
+        const double d = static_cast<double>(u.wall[k] ? x[p][k] - x[q][k] : min_image(x[p][k] - x[q][k], u.L[k]));
+        dd += d * d;
+      }
+      return dd < r2;
+    };
+    std::vector<int> all, within, all_close;
+    g.for_neighbours(g.cell_of_particle(p), [&](int q) { all.push_back(q); });
+    g.for_neighbours_within(g.cell_of_particle(p), x[p], r, [&](int q) { within.push_back(q); });
+    for (int q : all)
+      if (close(q)) all_close.push_back(q);
+    std::vector<int> within_close;
+    for (int q : within)
+      if (close(q)) within_close.push_back(q);
+    if (within_close != all_close) ++bad;
+    // and nothing closer than r outside the neighbour cells either (brute force)
+    int brute = 0;
+    for (int q = 0; q < n; ++q) brute += close(q) ? 1 : 0;
+    if (brute != static_cast<int>(all_close.size())) ++bad;
+    seen += static_cast<int>(all_close.size());
+    fewer += within.size() < all.size() ? 1 : 0;
+  }
+  CHECK(bad == 0);
+  CHECK(seen > n);  // the test saw neighbours
+  if (length_sigma > 12.0) CHECK(fewer > n / 2);  // and skipped cells (in boxes of more than 5 cells a side)
+}
+
+TEST_CASE("cell grid: for_neighbours_within visits what for_neighbours keeps within r, in order, and skips cells") {
+  check_within<3>({false, false, false}, 20.0, 3000, 1);
+  check_within<3>({true, true, true}, 20.0, 3000, 2);
+  check_within<3>({true, false, true}, 16.0, 2000, 3);
+  check_within<3>({false, false, false}, 6.0, 300, 4);  // every cell a neighbour
+  check_within<2>({false, false}, 40.0, 3000, 5);
+  check_within<2>({true, false}, 30.0, 2000, 6);
+}
+
 TEST_CASE("min_image: (d mod L) folded at (L + 1) / 2, every d in (-L, L) of small L, the edges of large L") {
   auto reference = [](std::int64_t d, std::int64_t L) {
     i128 r = static_cast<i128>(d) % L;

@@ -118,6 +118,62 @@ class CellGridN {
         }
     }
   }
+  /// As for_neighbours, but skips the neighbour cells that lie wholly beyond distance r of the
+  /// point x (a position in [0, L) of flat cell id): a cell is skipped only when its exact
+  /// integer bounds put every point of it at least r (1 + 1e-9) + 2 lattice units away (nearest
+  /// image on periodic axes), so a caller that keeps members closer than r (in double, from the
+  /// exact differences) sees exactly what for_neighbours would give it, in the same order.
+  template <class F>
+  void for_neighbours_within(int id, const VecN<Dim>& x, double r, F&& f) const {
+    const std::array<int, Dim> c = coords(id);
+    const double lim = r * (1.0 + 1e-9) + 2.0, lim2 = lim * lim;
+    // per axis: the squared distance from x to each neighbour cell (0 for its own cell)
+    std::array<std::array<double, 8>, Dim> d2{};
+    std::array<const int*, Dim> a{};
+    std::array<int, Dim> n{};
+    for (std::size_t k = 0; k < Dim; ++k) {
+      a[k] = &nbr_[k][static_cast<std::size_t>(c[k]) * 8];
+      n[k] = nbrn_[k][static_cast<std::size_t>(c[k])];
+      for (int i = 0; i < n[k]; ++i) {
+        const std::int64_t lo = bounds_[k][static_cast<std::size_t>(a[k][i])];
+        const std::int64_t hi = bounds_[k][static_cast<std::size_t>(a[k][i]) + 1];  // exclusive
+        std::int64_t gap = 0;  // the exact distance from x[k] to [lo, hi - 1], nearest image
+        if (x[k] < lo || x[k] >= hi) {
+          std::int64_t below = lo - x[k], above = x[k] - (hi - 1);  // one of them is > 0
+          if (!wall_[k]) {  // periodic: the other image may be nearer
+            below = below < 0 ? below + L_[k] : below;
+            above = above < 0 ? above + L_[k] : above;
+          }
+          gap = below > 0 && (above <= 0 || below < above) ? below : above;
+          if (gap < 0) gap = 0;
+        }
+        const double g = static_cast<double>(gap);
+        d2[k][static_cast<std::size_t>(i)] = g * g;
+      }
+    }
+    if constexpr (Dim == 2) {
+      for (int i = 0; i < n[0]; ++i)
+        for (int j = 0; j < n[1]; ++j) {
+          if (d2[0][static_cast<std::size_t>(i)] + d2[1][static_cast<std::size_t>(j)] >= lim2) continue;
+          for (std::size_t id2 = static_cast<std::size_t>(a[0][i]) * nc_[1] + a[1][j], k = 0, e = count_[id2]; k < e; ++k)
+            f(slots_[id2 * cap_ + k]);
+        }
+    } else {
+      for (int i = 0; i < n[0]; ++i) {
+        const double di = d2[0][static_cast<std::size_t>(i)];
+        if (di >= lim2) continue;
+        for (int j = 0; j < n[1]; ++j) {
+          const double dij = di + d2[1][static_cast<std::size_t>(j)];
+          if (dij >= lim2) continue;
+          const std::size_t row = (static_cast<std::size_t>(a[0][i]) * nc_[1] + a[1][j]) * nc_[2];
+          for (int l = 0; l < n[2]; ++l) {
+            if (dij + d2[2][static_cast<std::size_t>(l)] >= lim2) continue;
+            for (std::size_t id2 = row + a[2][l], k = 0, e = count_[id2]; k < e; ++k) f(slots_[id2 * cap_ + k]);
+          }
+        }
+      }
+    }
+  }
   /// Puts particle p into flat cell id.
   void insert(int p, int id);
   /// Removes particle p from its cell.
