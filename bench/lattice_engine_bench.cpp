@@ -154,9 +154,10 @@ void add_lattice_benches(std::vector<Bench>& out) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice<2>(c, n); }});
   }
-  // the 3D engine (spheres) at N = 1e4, volume fractions 0.3 and 0.45, and the float engine on
+  // the 3D engine (spheres) at N = 1e4, volume fractions 0.1, 0.3 and 0.45, and the float engine on
   // the same 3D gases
-  static const Named named3[] = {{"lattice3d/periodic/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
+  static const Named named3[] = {{"lattice3d/periodic/n10000/phi0.1", {10000, 0.1, false, 1, 3}},
+                                 {"lattice3d/periodic/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
                                  {"lattice3d/periodic/n10000/phi0.45", {10000, 0.45, false, 1, 3}},
                                  {"lattice3d/walls/n10000/phi0.3", {10000, 0.3, true, 1, 3}},
                                  {"lattice3d/periodic/n1000/phi0.3", {1000, 0.3, false, 1, 3}}};
@@ -164,7 +165,8 @@ void add_lattice_benches(std::vector<Bench>& out) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice<3>(c, n); }});
   }
-  static const Named floats3[] = {{"lattice3d/float/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
+  static const Named floats3[] = {{"lattice3d/float/n10000/phi0.1", {10000, 0.1, false, 1, 3}},
+                                  {"lattice3d/float/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
                                   {"lattice3d/float/n10000/phi0.45", {10000, 0.45, false, 1, 3}},
                                   {"lattice3d/float/n1000/phi0.3", {1000, 0.3, false, 1, 3}}};
   for (const Named& m : floats3) {

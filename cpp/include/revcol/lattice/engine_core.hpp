@@ -1261,7 +1261,7 @@ class BasicEngine {
   Counters cnt_;
   bool reversed_ = false;
   // the neighbour search (set_list_shell): the cell grid of the particles, or neighbour lists
-  static constexpr double kShellBase = 0.55, kShellSlope = 0.3, kShellMin = 0.6, kShellMax = 1.2;
+  static constexpr double kShellBase = 0.545, kShellSlope = 1.0, kShellMin = 0.6, kShellMax = 1.2;  // measured: docs/lattice.md
   double list_shell_ = -1.0;
   bool lists_ = false, direct_ = false;
   NeighbourListsN<D> nl_;
