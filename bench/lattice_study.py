@@ -41,7 +41,7 @@ RESULTS = os.path.join(HERE, "results")
 #: the gases of the issue's table: (N, area fraction); periodic, lattice and float side by side
 THROUGHPUT_CASES = [(10000, "0.3"), (10000, "0.5"), (100000, "0.3"), (100000, "0.5")]
 #: the 3D gases (N, volume fraction) with both engines in revcol-bench (lattice3d/...)
-THROUGHPUT_CASES_3D = [(1000, "0.3"), (10000, "0.3"), (10000, "0.45")]
+THROUGHPUT_CASES_3D = [(1000, "0.3"), (10000, "0.1"), (10000, "0.3"), (10000, "0.45")]
 
 
 def _case_names(dim: int, n: int, phi: str) -> tuple[str, str]:
