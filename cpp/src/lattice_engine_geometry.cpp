@@ -43,6 +43,18 @@ inline double ddot(const VecN<D>& a, const VecN<D>& b) noexcept {
   return s;
 }
 
+// The first overlap tick when the guess g (an estimate of the entry root) has it: t = max(1,
+// ceil(g)) with f(t) < sigma2 <= f(t - 1) (f convex: its inside ticks are an interval, so none
+// lies before t - 1); else -1. False for NaN and for g outside (-1, 2^61).
+template <std::size_t D>
+std::int64_t guessed_tick(const VecN<D>& r, const VecN<D>& w, u128 sigma2, double g) noexcept {
+  if (!(g > -1.0 && g < 0x1p61)) return -1;
+  std::int64_t t = static_cast<std::int64_t>(g);  // truncation, then the ceiling
+  if (static_cast<double>(t) < g) ++t;
+  t = std::max<std::int64_t>(1, t);
+  return overlap_at(r, w, t, sigma2) && !overlap_at(r, w, t - 1, sigma2) ? t : -1;
+}
+
 template <std::size_t D>
 std::int64_t first_overlap_d(const VecN<D>& r, const VecN<D>& w, u128 sigma2) noexcept {
   if (norm2(r) < sigma2) return 0;
@@ -54,11 +66,9 @@ std::int64_t first_overlap_d(const VecN<D>& r, const VecN<D>& w, u128 sigma2) no
     // f(t) < 0 <= f(t - 1) is the answer (f convex and f(0) >= 0: nothing before t - 1 is inside)
     const double c0 = ddot(r, r) - static_cast<double>(sigma2);
     const double g = c0 / (std::sqrt(std::max(0.0, b * b - a * c0)) - b);
-    if (g > 0.0 && g < 0x1p61) {
-      std::int64_t t = static_cast<std::int64_t>(g);  // the ceiling, inline (g > 0)
-      if (static_cast<double>(t) < g) ++t;
-      t = std::max<std::int64_t>(1, t);
-      if (overlap_at(r, w, t, sigma2) && !overlap_at(r, w, t - 1, sigma2)) return t;
+    if (g > 0.0) {
+      const std::int64_t t = guessed_tick(r, w, sigma2, g);
+      if (t > 0) return t;
     }
   }
   const i128 A = dot(w, w);
@@ -102,13 +112,8 @@ bool overlaps_at(const Vec3& r, const Vec3& w, std::int64_t tau, u128 sigma2) no
 std::int64_t first_overlap(const Vec2& r, const Vec2& w, u128 sigma2) noexcept { return first_overlap_d(r, w, sigma2); }
 std::int64_t first_overlap(const Vec3& r, const Vec3& w, u128 sigma2) noexcept { return first_overlap_d(r, w, sigma2); }
 std::int64_t first_overlap(const Vec3& r, const Vec3& w, u128 sigma2, double guess) noexcept {
-  if (guess > -1.0 && guess < 0x1p61) {  // false for NaN
-    std::int64_t t = static_cast<std::int64_t>(guess);  // truncation, then the ceiling
-    if (static_cast<double>(t) < guess) ++t;
-    t = std::max<std::int64_t>(1, t);
-    if (overlap_at(r, w, t, sigma2) && !overlap_at(r, w, t - 1, sigma2)) return t;
-  }
-  return first_overlap_d(r, w, sigma2);
+  const std::int64_t t = guessed_tick(r, w, sigma2, guess);
+  return t > 0 ? t : first_overlap_d(r, w, sigma2);
 }
 
 template <std::size_t Dim>
