@@ -24,50 +24,77 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
   for (std::size_t p = 0; p < n; ++p) grid_.insert(static_cast<int>(p), grid_.cell_id(c_[p]));
   count_.assign(n, 0);
   ids_.assign(n * cap_, -1);
-  dc_.assign(n * cap_ * Dim, 0.0);
-  for (std::size_t p = 0; p < n; ++p) scan(static_cast<int>(p), false);
+  codes_.assign(n * cap_, 0);
+  mark_.assign(n, Mark{});
+  stamp_ = 0;
+  for (std::size_t p = 0; p < n; ++p) scan(static_cast<int>(p), [&](int q, std::uint8_t code) { add(static_cast<int>(p), q, code); });
 }
 
 template <std::size_t Dim>
-void NeighbourListsN<Dim>::scan(int p, bool both) {
+template <class F>
+void NeighbourListsN<Dim>::scan(int p, F&& f) const {
   const Vec& c = c_[static_cast<std::size_t>(p)];
   // only the cells that reach within R of c (the rest could hold no entry: the same lists)
   grid_.for_neighbours_within(grid_.cell_of_particle(p), c, static_cast<double>(reach_), [&](int q) {
     if (q == p) return;
     const Vec& cq = c_[static_cast<std::size_t>(q)];
-    double d[Dim], dd = 0.0;
+    double dd = 0.0;
+    unsigned code = 0;
     for (std::size_t k = 0; k < Dim; ++k) {
-      d[k] = static_cast<double>(wall_[k] ? c[k] - cq[k] : min_image(c[k] - cq[k], L_[k]));
-      dd += d[k] * d[k];
+      const std::int64_t raw = c[k] - cq[k];
+      const std::int64_t m = wall_[k] ? raw : min_image(raw, L_[k]);
+      if (m != raw) code |= (m < raw ? 1u : 2u) << (2 * k);  // raw = m + L or m - L
+      const double d = static_cast<double>(m);
+      dd += d * d;
     }
-    if (dd >= reach2_) return;
-    add(p, q, d);
-    if (both) {
-      for (std::size_t k = 0; k < Dim; ++k) d[k] = -d[k];
-      add(q, p, d);
-    }
+    if (dd < reach2_) f(q, static_cast<std::uint8_t>(code));
   });
 }
 
 template <std::size_t Dim>
 void NeighbourListsN<Dim>::renew(int p, const Vec& c) {
-  for_each(p, [&](int q) { drop(q, p); });
-  count_[static_cast<std::size_t>(p)] = 0;
+  // mark the old list (the stamp tells this renewal's marks from older ones)
+  if (++stamp_ == 0) {
+    for (Mark& m : mark_) m.stamp = 0;
+    stamp_ = 1;
+  }
+  const std::size_t base = static_cast<std::size_t>(p) * cap_;
+  for (std::int32_t e = 0, ne = count_[static_cast<std::size_t>(p)]; e < ne; ++e)
+    mark_[static_cast<std::size_t>(ids_[base + e])] = Mark{stamp_, codes_[base + e], false};
   c_[static_cast<std::size_t>(p)] = c;
   const int id = grid_.cell_id(c);
   if (grid_.cell_of_particle(p) != id) {
     grid_.remove(p);
     grid_.insert(p, id);
   }
-  scan(p, true);
+  // the new list; a neighbour's own list changes only where p joins it, leaves it or changes code
+  fresh_.clear();
+  fresh_codes_.clear();
+  scan(p, [&](int q, std::uint8_t code) {
+    fresh_.push_back(q);
+    fresh_codes_.push_back(code);
+    Mark& m = mark_[static_cast<std::size_t>(q)];
+    if (m.stamp == stamp_) {
+      m.kept = true;
+      if (m.code != code) recode(q, p, mirror(code));
+    } else {
+      add(q, p, mirror(code));
+    }
+  });
+  for (std::int32_t e = 0, ne = count_[static_cast<std::size_t>(p)]; e < ne; ++e) {
+    const int q = ids_[static_cast<std::size_t>(p) * cap_ + e];
+    if (!mark_[static_cast<std::size_t>(q)].kept) drop(q, p);
+  }
+  count_[static_cast<std::size_t>(p)] = 0;
+  for (std::size_t e = 0; e < fresh_.size(); ++e) add(p, fresh_[e], fresh_codes_[e]);
 }
 
 template <std::size_t Dim>
-void NeighbourListsN<Dim>::add(int p, int q, const double* d) {
+void NeighbourListsN<Dim>::add(int p, int q, std::uint8_t code) {
   if (static_cast<std::size_t>(count_[static_cast<std::size_t>(p)]) == cap_) grow();
   const std::size_t slot = static_cast<std::size_t>(p) * cap_ + static_cast<std::size_t>(count_[static_cast<std::size_t>(p)]++);
   ids_[slot] = q;
-  std::copy_n(d, Dim, &dc_[slot * Dim]);
+  codes_[slot] = code;
 }
 
 template <std::size_t Dim>
@@ -78,7 +105,17 @@ void NeighbourListsN<Dim>::drop(int p, int q) {
     if (ids_[base + k] == q) {
       --n;
       ids_[base + k] = ids_[base + n];
-      std::copy_n(&dc_[(base + n) * Dim], Dim, &dc_[(base + k) * Dim]);
+      codes_[base + k] = codes_[base + n];
+      return;
+    }
+}
+
+template <std::size_t Dim>
+void NeighbourListsN<Dim>::recode(int p, int q, std::uint8_t code) {
+  const std::size_t base = static_cast<std::size_t>(p) * cap_;
+  for (std::int32_t k = 0, n = count_[static_cast<std::size_t>(p)]; k < n; ++k)
+    if (ids_[base + k] == q) {
+      codes_[base + k] = code;
       return;
     }
 }
@@ -87,13 +124,13 @@ template <std::size_t Dim>
 void NeighbourListsN<Dim>::grow() {
   const std::size_t cap = 2 * cap_;
   std::vector<int> wider(count_.size() * cap, -1);
-  std::vector<double> wider_dc(count_.size() * cap * Dim, 0.0);
+  std::vector<std::uint8_t> wider_codes(count_.size() * cap, 0);
   for (std::size_t p = 0; p < count_.size(); ++p) {
     std::copy_n(&ids_[p * cap_], count_[p], &wider[p * cap]);
-    std::copy_n(&dc_[p * cap_ * Dim], count_[p] * Dim, &wider_dc[p * cap * Dim]);
+    std::copy_n(&codes_[p * cap_], count_[p], &wider_codes[p * cap]);
   }
   ids_.swap(wider);
-  dc_.swap(wider_dc);
+  codes_.swap(wider_codes);
   cap_ = cap;
 }
 
@@ -160,8 +197,8 @@ std::int64_t NeighbourListsN<Dim>::exit_ticks(int p, const Vec& x, const Vec& v)
 
 template <std::size_t Dim>
 std::size_t NeighbourListsN<Dim>::memory_bytes() const noexcept {
-  return grid_.memory_bytes() + c_.capacity() * sizeof(Vec) + ids_.capacity() * sizeof(int) + dc_.capacity() * sizeof(double) +
-         count_.capacity() * 4;
+  return grid_.memory_bytes() + c_.capacity() * sizeof(Vec) + ids_.capacity() * sizeof(int) + codes_.capacity() +
+         count_.capacity() * 4 + mark_.capacity() * sizeof(Mark) + fresh_.capacity() * sizeof(int) + fresh_codes_.capacity();
 }
 
 template class NeighbourListsN<2>;

@@ -1,6 +1,6 @@
 // Tests of the lattice engine's neighbour lists (lattice/neighbour_lists.hpp) and of the engine's
 // neighbour search: the lists against brute force after random renewals (complete, symmetric,
-// their centre offsets exact), the ball's renewal tick against brute force (never late, rarely
+// their image codes exact and mirrored), the ball's renewal tick against brute force (never late, rarely
 // early), and the engine with lists (several shells, both prediction paths) against the cell
 // grid with every candidate sent to the exact search: the same collisions (trace), the same
 // state bit for bit, in 2D and 3D, periodic, walled, dense with redraws and with groups forced.
@@ -42,7 +42,7 @@ UnitsN<D> box_units(std::array<bool, D> wall, double length_sigma, int S) {
 }
 
 // every list against brute force: complete outside a rounding band about R, symmetric, the
-// offsets the exact minimum-image differences of the centres
+// codes the exact images of the centres' minimum-image differences, mirrored on the other list
 template <std::size_t D>
 void check_lists(const UnitsN<D>& u, const NeighbourListsN<D>& nl, const std::vector<VecN<D>>& c, const char* what) {
   const long double R2 = static_cast<long double>(nl.reach()) * static_cast<long double>(nl.reach());
@@ -50,18 +50,27 @@ void check_lists(const UnitsN<D>& u, const NeighbourListsN<D>& nl, const std::ve
   for (std::size_t p = 0; p < c.size(); ++p) {
     std::set<int> listed;
     const int* ids = nl.ids(static_cast<int>(p));
-    const double* off = nl.offsets(static_cast<int>(p));
+    const std::uint8_t* codes = nl.codes(static_cast<int>(p));
     for (int e = 0; e < nl.size(static_cast<int>(p)); ++e) {
       const int q = ids[e];
       if (!listed.insert(q).second || q == static_cast<int>(p)) ++bad;  // no duplicates, not itself
+      // the code's shift s: c_p - c_q - s is the exact minimum image (the raw difference on walls)
       for (std::size_t k = 0; k < D; ++k) {
-        const std::int64_t d = u.wall[k] ? c[p][k] - c[q][k] : min_image(c[p][k] - c[q][k], u.L[k]);
-        if (off[e * D + k] != static_cast<double>(d)) ++bad;
+        const std::int64_t raw = c[p][k] - c[q][k];
+        const std::int64_t d = u.wall[k] ? raw : min_image(raw, u.L[k]);
+        const unsigned ck = (codes[e] >> (2 * k)) & 3u;
+        const std::int64_t s = ck == 1 ? u.L[k] : ck == 2 ? -u.L[k] : 0;
+        if (ck == 3 || raw - s != d) ++bad;
       }
-      // symmetric: p on q's list
-      bool back = false;
-      nl.for_each(q, [&](int r) { back = back || r == static_cast<int>(p); });
-      if (!back) ++bad;
+      // symmetric: p on q's list, with the mirrored code
+      int back = 0;
+      const int* qids = nl.ids(q);
+      for (int f = 0; f < nl.size(q); ++f)
+        if (qids[f] == static_cast<int>(p)) {
+          ++back;
+          if (nl.codes(q)[f] != NeighbourListsN<D>::mirror(codes[e])) ++bad;
+        }
+      if (back != 1) ++bad;
     }
     for (std::size_t q = 0; q < c.size(); ++q) {
       if (q == p) continue;
@@ -180,7 +189,7 @@ TEST_CASE("min_image: (d mod L) folded at (L + 1) / 2, every d in (-L, L) of sma
   CHECK(bad == 0);
 }
 
-TEST_CASE("neighbour lists: complete, symmetric and with exact offsets, built and after random renewals") {
+TEST_CASE("neighbour lists: complete, symmetric and with exact image codes, built and after random renewals") {
   lists_case<3>({false, false, false}, 9.0, 400, 0.3, 1, "3D periodic, shell 0.3");
   lists_case<3>({true, true, true}, 8.0, 300, 0.8, 2, "3D walls, shell 0.8");
   lists_case<3>({false, true, false}, 3.0, 40, 2.0, 3, "3D small periodic box, shell 2 (every cell a neighbour)");

@@ -406,7 +406,7 @@ class BasicEngine {
     const std::size_t n = s.x.size();
     ln_.resize(n);
     for (std::size_t p = 0; p < n; ++p) ln_[p] = Line{s.x[p], s.v[p], s.clock};
-    ver_.assign(n, 0);
+    slot_.assign(n, Slot{});
     ctr_ = s.streams;
     X_ = Bits(s.bits);
     log_.clear();
@@ -431,6 +431,11 @@ class BasicEngine {
       invL_[k] = 1.0 / Ld_[k];
       edge_[k] = 0.5 * Ld_[k] * (1.0 - 1e-9) - 4096.0;
     }
+    for (unsigned code = 0; code < shift_.size(); ++code)
+      for (std::size_t k = 0; k < D; ++k) {
+        const unsigned ck = (code >> (2 * k)) & 3u;
+        shift_[code][k] = ck == 1 ? Ld_[k] : ck == 2 ? -Ld_[k] : 0.0;
+      }
     hlo_ = u_.sigma / 2;
     rebuild();
   }
@@ -500,10 +505,11 @@ class BasicEngine {
     }
   }
   void schedule(int p, Type type, std::int64_t t, std::int32_t kind, int partner) {
-    type_[p] = type;
-    partner_[p] = partner;
-    vself_[p] = ver_[p];
-    vpart_[p] = partner >= 0 ? ver_[partner] : 0;
+    Slot& b = slot_[static_cast<std::size_t>(p)];
+    b.type = type;
+    b.partner = partner;
+    b.vself = b.ver;
+    b.vpart = partner >= 0 ? slot_[static_cast<std::size_t>(partner)].ver : 0;
     if (type == none) queue_.erase(p); else queue_.set(p, t, kind);
   }
   void predict(int p, std::int64_t lo) {
@@ -538,10 +544,11 @@ class BasicEngine {
     }
     // The candidates. A double-precision filter drops the pairs that cannot collide, or not
     // before the best event so far; the others get the exact search (measure before changing).
-    // Rounding: a position is within 2^9 lattice units of its double (|x| < 2^62) and sigma >=
-    // 2^40 (units.hpp), so r is within ~2^-30 sigma of the exact relative vector and |r|^2,
-    // the closest approach and |r + w t|^2 within ~2^-29 (|r|^2 + sigma^2): the margins below
-    // are 1e-6 of that, so a filtered pair is one whose every integer tick is provably outside.
+    // Rounding: a position is within 2^10 lattice units of its double (|x| < 2^63; an unwrapped
+    // anchor, two such roundings) and sigma >= 2^40 (units.hpp), so r is within ~2^-27 sigma of
+    // the exact relative vector and |r|^2, the closest approach and |r + w t|^2 within ~2^-26
+    // (|r|^2 + sigma^2): the margins below are 1e-6 of that (~2^-20), so a filtered pair is one
+    // whose every integer tick is provably outside.
     // The image is the exact search's unless |r_k| is within rounding of L_k / 2 (edge: no filter).
     const Line& lp = ln_[p];
     constexpr double never = std::numeric_limits<double>::infinity();
@@ -568,18 +575,20 @@ class BasicEngine {
       return t != never && -bb >= aa * t && rr + t * (2.0 * bb + aa * t) > sigma2d_ + 1e-6 * (rr + aa * t * t + sigma2d_);
     };
     if (direct_ && !exhaustive_search) {
-      // lists on a box wide enough: r = (c_p - c_q) + u_p - u_q(lo), no periodic image to find
-      // (the offsets and u are exact integers rounded once: errors ~2^-50 of a few sigma)
+      // lists on a box wide enough: r = (a_p - a_q - s) - v_q (lo - t_q), with a the anchors
+      // unwrapped about their list centres and s the entry's image shift: no image to find
+      // (a and s are exact integers rounded once, as the positions of the other path)
       const LineD& dp = lnd_[static_cast<std::size_t>(p)];
       const int* ids = nl_.ids(p);
-      const double* dc = nl_.offsets(p);
-      for (int e = 0, ne = nl_.size(p); e < ne; ++e, dc += D) {
+      const std::uint8_t* codes = nl_.codes(p);
+      for (int e = 0, ne = nl_.size(p); e < ne; ++e) {
         const int q = ids[e];
         const LineD& dq = lnd_[static_cast<std::size_t>(q)];
         const double dtq = static_cast<double>(lo - dq.ta);
+        const double* sh = shift_[codes[e]].data();
         double rr = 0.0, bb = 0.0, aa = 0.0;
         for (std::size_t k = 0; k < D; ++k) {
-          const double r = (dc[k] + dp.u[k]) - (dq.u[k] + dq.v[k] * dtq);
+          const double r = ((dp.a[k] - dq.a[k]) - sh[k]) - dq.v[k] * dtq;
           const double w = dp.v[k] - dq.v[k];
           rr += r * r;
           bb += r * w;
@@ -627,10 +636,12 @@ class BasicEngine {
   }
   void rebuild() {
     const std::size_t n = ln_.size();
-    type_.assign(n, none);
-    partner_.assign(n, -1);
-    vself_.assign(n, 0);
-    vpart_.assign(n, 0);
+    slot_.resize(n);
+    for (Slot& b : slot_) {
+      b.type = none;
+      b.partner = -1;
+      b.vself = b.vpart = 0;
+    }
     for (std::size_t p = 0; p < n; ++p) {
       ln_[p].x = pos(static_cast<int>(p), clock_);
       ln_[p].ta = clock_;
@@ -678,8 +689,9 @@ class BasicEngine {
 
   // ---- the loop ----
   bool valid(int p) const noexcept {
-    if (ver_[p] != vself_[p]) return false;
-    return type_[p] != coll || ver_[partner_[p]] == vpart_[p];
+    const Slot& b = slot_[static_cast<std::size_t>(p)];
+    if (b.ver != b.vself) return false;
+    return b.type != coll || slot_[static_cast<std::size_t>(b.partner)].ver == b.vpart;
   }
   void check_order(std::int64_t t, std::int32_t k) {
     if (std::make_pair(t, k) < last_key_) throw std::logic_error("lattice engine: events out of order (a bug)");
@@ -707,18 +719,19 @@ class BasicEngine {
         predict(p, t);
         continue;
       }
-      if (type_[p] == cross) {
+      const Slot& sp = slot_[static_cast<std::size_t>(p)];
+      if (sp.type == cross) {
         ++cnt_.crossings;
         if (lists_) nl_.renew(p, pos(p, t));
         predict(p, t);
         continue;
       }
       check_order(t, queue_.kind(p));
-      if (type_[p] == wall) {
+      if (sp.type == wall) {
         reflect(p, t);
         continue;
       }
-      const int i = std::min(p, partner_[p]), j = std::max(p, partner_[p]);
+      const int i = std::min(p, sp.partner), j = std::max(p, sp.partner);
       if (throw_at_collision != 0 && (back ? ncoll_ : ncoll_ + 1) == throw_at_collision)
         throw std::runtime_error("lattice engine: test hook at collision " + std::to_string(throw_at_collision));
       if (back) {
@@ -761,7 +774,7 @@ class BasicEngine {
     ln_[p].v = v;
     ln_[p].ta = a;
     sync(p);
-    ++ver_[p];
+    ++slot_[static_cast<std::size_t>(p)].ver;
     wall_tick_[p] = a;
     ++cnt_.walls;
     predict(p, a);
@@ -816,19 +829,16 @@ class BasicEngine {
       };
       if (direct_) {  // the owner's list (x is within 2 vmax of its line), far ones dropped in double
         const int o = s == 0 ? i : j;
-        std::array<double, D> ux{};
-        for (std::size_t k = 0; k < D; ++k) {
-          const std::int64_t c = nl_.centre(o)[k];
-          ux[k] = static_cast<double>(u_.wall[k] ? x[k] - c : min_image(x[k] - c, u_.L[k]));
-        }
+        const std::array<double, D> ax = unwrapped_about(o, x);
         const int* ids = nl_.ids(o);
-        const double* dc = nl_.offsets(o);
-        for (int e = 0, ne = nl_.size(o); e < ne && why == 0; ++e, dc += D) {
+        const std::uint8_t* codes = nl_.codes(o);
+        for (int e = 0, ne = nl_.size(o); e < ne && why == 0; ++e) {
           const LineD& dq = lnd_[static_cast<std::size_t>(ids[e])];
           const double dt = static_cast<double>(a - dq.ta);
+          const double* sh = shift_[codes[e]].data();
           double dd = 0.0;
           for (std::size_t k = 0; k < D; ++k) {
-            const double r = (ux[k] + dc[k]) - (dq.u[k] + dq.v[k] * dt);
+            const double r = ((ax[k] - dq.a[k]) - sh[k]) - dq.v[k] * dt;
             dd += r * r;
           }
           if (dd <= far2_ * (1.0 + 1e-6)) third(ids[e]);
@@ -849,8 +859,8 @@ class BasicEngine {
     ln_[i].ta = ln_[j].ta = a;
     sync(i);
     sync(j);
-    ++ver_[i];
-    ++ver_[j];
+    ++slot_[static_cast<std::size_t>(i)].ver;
+    ++slot_[static_cast<std::size_t>(j)].ver;
     ++cnt_.collisions;
     predict(i, a);
     predict(j, a);
@@ -1122,7 +1132,7 @@ class BasicEngine {
     for (std::size_t m = 0; m < g.size(); ++m) {
       ln_[g[m]] = Line{post[m], vel[m], a};
       sync(g[m]);
-      ++ver_[g[m]];
+      ++slot_[static_cast<std::size_t>(g[m])].ver;
     }
     ++cnt_.collisions;
     for (int q : g) predict(q, a);
@@ -1145,7 +1155,7 @@ class BasicEngine {
       const Vec v = pre_v.empty() ? neg(l.v) : neg(pre_v[m]);
       l = Line{pre[m], v, a};
       sync(g[m]);
-      ++ver_[g[m]];
+      ++slot_[static_cast<std::size_t>(g[m])].ver;
     }
     ctr_[drawer] -= draws;
     if (it != log_.end()) log_.erase(it);
@@ -1172,25 +1182,35 @@ class BasicEngine {
     std::int64_t ta;     // anchor tick
   };
   std::vector<Line> ln_;
-  // the prediction's double mirror of each line (lists: the anchor's offset from the list
-  // centre, exact integers rounded once); sync(p) after every change of ln_[p]
+  // the prediction's double mirror of each line (lists: the anchor unwrapped about the list
+  // centre, an exact integer rounded once); sync(p) after every change of ln_[p]
   struct LineD {
-    std::array<double, D> u;  // anchor minus list centre (minimum image); 0 with the cell grid
+    std::array<double, D> a;  // c_p + min_image(x_p - c_p) (x_p on wall axes); x_p with the cell grid
     std::array<double, D> v;  // velocity
     std::int64_t ta;          // anchor tick
   };
   std::vector<LineD> lnd_;
+  // a position x (wrapped) unwrapped about p's list centre: c_p + min_image(x - c_p), in
+  // (-L/2, 3L/2), as doubles (two roundings, each within 2^10 lattice units: no integer sum,
+  // which could overflow a 2D box near 2^63). In exact arithmetic, two of them less the pair's
+  // image shift (neighbour_lists.hpp) are the minimum-image difference of the two positions.
+  std::array<double, D> unwrapped_about(int p, const Vec& x) const noexcept {
+    std::array<double, D> a{};
+    const Vec& c = nl_.centre(p);
+    for (std::size_t k = 0; k < D; ++k)
+      a[k] = u_.wall[k] ? static_cast<double>(x[k])
+                        : static_cast<double>(c[k]) + static_cast<double>(min_image(x[k] - c[k], u_.L[k]));
+    return a;
+  }
   void sync(int p) noexcept {
     LineD& d = lnd_[static_cast<std::size_t>(p)];
     const Line& l = ln_[static_cast<std::size_t>(p)];
-    for (std::size_t k = 0; k < D; ++k) {
-      d.v[k] = static_cast<double>(l.v[k]);
-      d.u[k] = 0.0;
-      if (lists_) {
-        const std::int64_t c = nl_.centre(p)[k];
-        d.u[k] = static_cast<double>(u_.wall[k] ? l.x[k] - c : min_image(l.x[k] - c, u_.L[k]));
-      }
+    if (lists_) {
+      d.a = unwrapped_about(p, l.x);
+    } else {
+      for (std::size_t k = 0; k < D; ++k) d.a[k] = static_cast<double>(l.x[k]);
     }
+    for (std::size_t k = 0; k < D; ++k) d.v[k] = static_cast<double>(l.v[k]);
     d.ta = l.ta;
   }
   std::vector<std::int64_t> wall_tick_;
@@ -1232,7 +1252,7 @@ class BasicEngine {
       pre_wall_[sv.p] = sv.pre_wall;
       ctr_[sv.p] = sv.ctr;
       wall_tick_[sv.p] = sv.wall_tick;
-      ++ver_[sv.p];
+      ++slot_[static_cast<std::size_t>(sv.p)].ver;
     }
     undo_.clear();
     X_ = undo_X_;
@@ -1243,9 +1263,16 @@ class BasicEngine {
     ncoll_ = undo_ncoll_;
     rebuild();
   }
-  std::vector<std::uint64_t> ver_, ctr_, vself_, vpart_;
-  std::vector<Type> type_;
-  std::vector<int> partner_;
+  std::vector<std::uint64_t> ctr_;
+  // one particle's event bookkeeping, together in memory (the loop reads it per event, and the
+  // partner's version): its version (bumped at every change of its line), its scheduled event's
+  // type and partner, and the versions both had when it was scheduled (stale if either moved on)
+  struct alignas(32) Slot {
+    std::uint64_t ver = 0, vself = 0, vpart = 0;
+    int partner = -1;
+    Type type = none;
+  };
+  std::vector<Slot> slot_;
   Bits X_;
   std::map<std::uint64_t, std::uint32_t> log_;
   struct Group {
@@ -1268,6 +1295,7 @@ class BasicEngine {
   u128 sigma2_ = 0;
   double sigma2d_ = 0.0, far2_ = 0.0;
   std::array<double, D> Ld_{}, invL_{}, edge_{};  // the prediction's filter: L, 1 / L, L / 2 less rounding
+  std::array<std::array<double, D>, 1u << (2 * D)> shift_{};  // a list entry's image shift by code (neighbour_lists.hpp)
   std::int64_t hlo_ = 0;
   CellGridN<D> grid_;
   Queue queue_;

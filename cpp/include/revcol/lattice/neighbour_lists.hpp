@@ -23,8 +23,11 @@
 // renewals. The list test
 // |c_p - c_q|^2 < R^2 is taken in double from the exact minimum-image differences: symmetric and
 // deterministic (the same values in either order), and R's margin is far beyond its rounding.
-// Each entry also keeps the centre offset c_p - c_q, from which the engine's prediction builds
-// the relative vector without a periodic image (engine_core.hpp).
+// Each entry also keeps the image code of the pair (one byte): the periodic shift s with
+// c_p - c_q = (its minimum image) + s, from which the engine's prediction builds the relative
+// vector without looking for an image (engine_core.hpp). A renewal touches a neighbour's list
+// only where the neighbour joins, leaves or changes its code (rare), not at every neighbour:
+// the lists are a memory-bound part of the engine (measure before changing).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -60,9 +63,13 @@ class NeighbourListsN {
   }
   /// p's list: its size() entries.
   const int* ids(int p) const noexcept { return &ids_[static_cast<std::size_t>(p) * cap_]; }
-  /// The centre offsets of p's list, Dim doubles per entry: c_p - c_q (the minimum image, exact
-  /// integers rounded once), in the order of ids(p).
-  const double* offsets(int p) const noexcept { return &dc_[static_cast<std::size_t>(p) * cap_ * Dim]; }
+  /// The image codes of p's list, one per entry in the order of ids(p): bits 2k, 2k + 1 give the
+  /// shift s_k of axis k in c_p - c_q = min_image(c_p - c_q) + s (0: none, 1: +L_k, 2: -L_k).
+  const std::uint8_t* codes(int p) const noexcept { return &codes_[static_cast<std::size_t>(p) * cap_]; }
+  /// The code of the mirrored pair (q, p): +L and -L swapped on every axis.
+  static constexpr std::uint8_t mirror(std::uint8_t code) noexcept {
+    return static_cast<std::uint8_t>(((code & 0x15u) << 1) | ((code >> 1) & 0x15u));
+  }
   /// p's list centre.
   const Vec& centre(int p) const noexcept { return c_[static_cast<std::size_t>(p)]; }
   /// Entries on p's list.
@@ -76,9 +83,11 @@ class NeighbourListsN {
 
  private:
   Vec diff(const Vec& a, const Vec& b) const noexcept;
-  void add(int p, int q, const double* d);  // q onto p's list, c_p - c_q = d
-  void drop(int p, int q);                   // q off p's list
-  void scan(int p, bool both);               // p's list from the grid (both: p onto its neighbours' too)
+  void add(int p, int q, std::uint8_t code);     // q onto p's list
+  void drop(int p, int q);                         // q off p's list
+  void recode(int p, int q, std::uint8_t code);   // q's code on p's list
+  template <class F>
+  void scan(int p, F&& f) const;                   // f(q, code) for every q within R of p's centre
   void grow();
   std::array<std::int64_t, Dim> L_{};
   std::array<bool, Dim> wall_{};
@@ -89,8 +98,18 @@ class NeighbourListsN {
   std::vector<Vec> c_;        // centres
   std::size_t cap_ = 16;      // entries per list (doubles, for every list, when one is full)
   std::vector<int> ids_;      // p's list: ids_[p * cap_ .. + count_[p]]
-  std::vector<double> dc_;    // their centre offsets c_p - c_q, Dim per entry
+  std::vector<std::uint8_t> codes_;  // their image codes
   std::vector<std::int32_t> count_;
+  // renew's scratch: p's new list, and per particle the renewal that last saw it on p's old list
+  struct Mark {
+    std::uint32_t stamp = 0;
+    std::uint8_t code = 0;
+    bool kept = false;
+  };
+  std::vector<Mark> mark_;
+  std::uint32_t stamp_ = 0;
+  std::vector<int> fresh_;
+  std::vector<std::uint8_t> fresh_codes_;
 };
 
 }  // namespace revcol::lattice
