@@ -312,7 +312,7 @@ QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, con
 // ---- cells ----
 
 template <std::size_t Dim>
-void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin, int span) {
+void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin, int span, bool members) {
   if (wmin <= 0) wmin = u.sigma + 2 * u.vmax + 2;
   span_ = span == 2 ? 2 : 1;
   std::array<std::int64_t, Dim> ncl{};
@@ -349,6 +349,7 @@ void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmi
   cap_ = static_cast<std::size_t>(std::min<std::int64_t>(per + 2, 8));
   std::size_t cells = 1;
   for (std::size_t k = 0; k < Dim; ++k) cells *= static_cast<std::size_t>(nc_[k]);
+  if (!members) cells = 0, n = 0;
   slots_.assign(cells * static_cast<std::size_t>(cap_), -1);
   count_.assign(cells, 0);
   where_.assign(n, -1);

@@ -19,9 +19,15 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
   h2_ = static_cast<u128>(h) * static_cast<u128>(h);
   reach2_ = static_cast<double>(reach_) * static_cast<double>(reach_);
   const std::size_t n = centres.size();
-  c_ = centres;
-  grid_.build(u, n, (reach_ + 1) / 2, 2);  // 5^D cells of R/2: half the candidates of 3^D cells of R
-  for (std::size_t p = 0; p < n; ++p) grid_.insert(static_cast<int>(p), grid_.cell_id(c_[p]));
+  grid_.build(u, n, (reach_ + 1) / 2, 2, false);  // 5^D cells of R/2: half the candidates of 3^D cells of R
+  std::size_t cells = 1;
+  for (std::size_t k = 0; k < Dim; ++k) cells *= static_cast<std::size_t>(grid_.count(static_cast<int>(k)));
+  head_.assign(cells, -1);
+  node_.assign(n, Node{});
+  for (std::size_t p = 0; p < n; ++p) {
+    node_[p].c = centres[p];
+    link(static_cast<int>(p), grid_.cell_id(centres[p]));
+  }
   count_.assign(n, 0);
   ids_.assign(n * cap_, -1);
   codes_.assign(n * cap_, 0);
@@ -33,21 +39,26 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
 template <std::size_t Dim>
 template <class F>
 void NeighbourListsN<Dim>::scan(int p, F&& f) const {
-  const Vec& c = c_[static_cast<std::size_t>(p)];
+  const Node& np = node_[static_cast<std::size_t>(p)];
+  const Vec& c = np.c;
   // only the cells that reach within R of c (the rest could hold no entry: the same lists)
-  grid_.for_neighbours_within(grid_.cell_of_particle(p), c, static_cast<double>(reach_), [&](int q) {
-    if (q == p) return;
-    const Vec& cq = c_[static_cast<std::size_t>(q)];
-    double dd = 0.0;
-    unsigned code = 0;
-    for (std::size_t k = 0; k < Dim; ++k) {
-      const std::int64_t raw = c[k] - cq[k];
-      const std::int64_t m = wall_[k] ? raw : min_image(raw, L_[k]);
-      if (m != raw) code |= (m < raw ? 1u : 2u) << (2 * k);  // raw = m + L or m - L
-      const double d = static_cast<double>(m);
-      dd += d * d;
+  grid_.for_cells_within(np.cell, c, static_cast<double>(reach_), [&](std::size_t cell) {
+    for (int q = head_[cell]; q >= 0;) {
+      const Node& nq = node_[static_cast<std::size_t>(q)];
+      if (q != p) {
+        double dd = 0.0;
+        unsigned code = 0;
+        for (std::size_t k = 0; k < Dim; ++k) {
+          const std::int64_t raw = c[k] - nq.c[k];
+          const std::int64_t m = wall_[k] ? raw : min_image(raw, L_[k]);
+          if (m != raw) code |= (m < raw ? 1u : 2u) << (2 * k);  // raw = m + L or m - L
+          const double d = static_cast<double>(m);
+          dd += d * d;
+        }
+        if (dd < reach2_) f(q, static_cast<std::uint8_t>(code));
+      }
+      q = nq.next;
     }
-    if (dd < reach2_) f(q, static_cast<std::uint8_t>(code));
   });
 }
 
@@ -61,11 +72,11 @@ void NeighbourListsN<Dim>::renew(int p, const Vec& c) {
   const std::size_t base = static_cast<std::size_t>(p) * cap_;
   for (std::int32_t e = 0, ne = count_[static_cast<std::size_t>(p)]; e < ne; ++e)
     mark_[static_cast<std::size_t>(ids_[base + e])] = Mark{stamp_, codes_[base + e], false};
-  c_[static_cast<std::size_t>(p)] = c;
+  node_[static_cast<std::size_t>(p)].c = c;
   const int id = grid_.cell_id(c);
-  if (grid_.cell_of_particle(p) != id) {
-    grid_.remove(p);
-    grid_.insert(p, id);
+  if (node_[static_cast<std::size_t>(p)].cell != id) {
+    unlink(p);
+    link(p, id);
   }
   // the new list; a neighbour's own list changes only where p joins it, leaves it or changes code
   fresh_.clear();
@@ -87,6 +98,23 @@ void NeighbourListsN<Dim>::renew(int p, const Vec& c) {
   }
   count_[static_cast<std::size_t>(p)] = 0;
   for (std::size_t e = 0; e < fresh_.size(); ++e) add(p, fresh_[e], fresh_codes_[e]);
+}
+
+template <std::size_t Dim>
+void NeighbourListsN<Dim>::link(int p, int cell) {
+  Node& n = node_[static_cast<std::size_t>(p)];
+  n.cell = cell;
+  n.next = head_[static_cast<std::size_t>(cell)];
+  head_[static_cast<std::size_t>(cell)] = p;
+}
+
+template <std::size_t Dim>
+void NeighbourListsN<Dim>::unlink(int p) {
+  Node& n = node_[static_cast<std::size_t>(p)];
+  int* at = &head_[static_cast<std::size_t>(n.cell)];  // the link that points at p
+  while (*at != p) at = &node_[static_cast<std::size_t>(*at)].next;
+  *at = n.next;
+  n.next = n.cell = -1;
 }
 
 template <std::size_t Dim>
@@ -143,7 +171,7 @@ typename NeighbourListsN<Dim>::Vec NeighbourListsN<Dim>::diff(const Vec& a, cons
 
 template <std::size_t Dim>
 bool NeighbourListsN<Dim>::inside(int p, const Vec& x) const noexcept {
-  const Vec d = diff(x, c_[static_cast<std::size_t>(p)]);
+  const Vec d = diff(x, node_[static_cast<std::size_t>(p)].c);
   double f = 0.0;
   for (std::size_t k = 0; k < Dim; ++k) {
     if (d[k] > h_ || d[k] < -h_) return false;
@@ -157,7 +185,7 @@ bool NeighbourListsN<Dim>::inside(int p, const Vec& x) const noexcept {
 
 template <std::size_t Dim>
 std::int64_t NeighbourListsN<Dim>::exit_ticks(int p, const Vec& x, const Vec& v) const noexcept {
-  const Vec d = diff(x, c_[static_cast<std::size_t>(p)]);
+  const Vec d = diff(x, node_[static_cast<std::size_t>(p)].c);
   double A = 0.0, B = 0.0, C = 0.0;
   for (std::size_t k = 0; k < Dim; ++k) {
     const double dk = static_cast<double>(d[k]), vk = static_cast<double>(v[k]);
@@ -197,7 +225,7 @@ std::int64_t NeighbourListsN<Dim>::exit_ticks(int p, const Vec& x, const Vec& v)
 
 template <std::size_t Dim>
 std::size_t NeighbourListsN<Dim>::memory_bytes() const noexcept {
-  return grid_.memory_bytes() + c_.capacity() * sizeof(Vec) + ids_.capacity() * sizeof(int) + codes_.capacity() +
+  return grid_.memory_bytes() + node_.capacity() * sizeof(Node) + head_.capacity() * sizeof(int) + ids_.capacity() * sizeof(int) + codes_.capacity() +
          count_.capacity() * 4 + mark_.capacity() * sizeof(Mark) + fresh_.capacity() * sizeof(int) + fresh_codes_.capacity();
 }
 

@@ -58,7 +58,9 @@ class CellGridN {
   /// the prediction's width) whose neighbours are the cells within `span` (1 or 2) per axis:
   /// anything closer than span * wmin is in them (neighbour_lists.hpp asks for half its reach
   /// and span 2: 5^D cells of (R/2)^D hold ~half the candidates of 3^D cells of R^D).
-  void build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin = 0, int span = 1);
+  /// members = false: the geometry and the neighbour cells only, no member storage (insert,
+  /// remove, for_neighbours* and cell_of_particle are then not to be used: the caller keeps its own).
+  void build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin = 0, int span = 1, bool members = true);
   /// Number of cells along axis k.
   int count(int k) const noexcept { return nc_[k]; }
   /// Lower boundary of cell c (0 <= c <= nc) on axis k: floor(c L / nc).
@@ -125,6 +127,15 @@ class CellGridN {
   /// exact differences) sees exactly what for_neighbours would give it, in the same order.
   template <class F>
   void for_neighbours_within(int id, const VecN<Dim>& x, double r, F&& f) const {
+    for_cells_within(id, x, r, [&](std::size_t id2) {
+      for (std::size_t k = 0, e = static_cast<std::size_t>(count_[id2]); k < e; ++k) f(slots_[id2 * cap_ + k]);
+    });
+  }
+  /// The cells of for_neighbours_within, in its order: f(flat cell id) for each neighbour cell of
+  /// flat cell id that is not wholly beyond distance r of x (for a caller that keeps its own
+  /// members per cell).
+  template <class F>
+  void for_cells_within(int id, const VecN<Dim>& x, double r, F&& f) const {
     const std::array<int, Dim> c = coords(id);
     const double lim = r * (1.0 + 1e-9) + 2.0, lim2 = lim * lim;
     // per axis: the squared distance from x to each neighbour cell (0 for its own cell)
@@ -155,8 +166,7 @@ class CellGridN {
       for (int i = 0; i < n[0]; ++i)
         for (int j = 0; j < n[1]; ++j) {
           if (d2[0][static_cast<std::size_t>(i)] + d2[1][static_cast<std::size_t>(j)] >= lim2) continue;
-          for (std::size_t id2 = static_cast<std::size_t>(a[0][i]) * nc_[1] + a[1][j], k = 0, e = count_[id2]; k < e; ++k)
-            f(slots_[id2 * cap_ + k]);
+          f(static_cast<std::size_t>(a[0][i]) * nc_[1] + a[1][j]);
         }
     } else {
       for (int i = 0; i < n[0]; ++i) {
@@ -168,7 +178,7 @@ class CellGridN {
           const std::size_t row = (static_cast<std::size_t>(a[0][i]) * nc_[1] + a[1][j]) * nc_[2];
           for (int l = 0; l < n[2]; ++l) {
             if (dij + d2[2][static_cast<std::size_t>(l)] >= lim2) continue;
-            for (std::size_t id2 = row + a[2][l], k = 0, e = count_[id2]; k < e; ++k) f(slots_[id2 * cap_ + k]);
+            f(row + a[2][l]);
           }
         }
       }

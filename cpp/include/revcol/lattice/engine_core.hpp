@@ -1184,7 +1184,7 @@ class BasicEngine {
   std::vector<Line> ln_;
   // the prediction's double mirror of each line (lists: the anchor unwrapped about the list
   // centre, an exact integer rounded once); sync(p) after every change of ln_[p]
-  struct LineD {
+  struct alignas(64) LineD {  // one cache line each (56 bytes in 3D would straddle two mostly)
     std::array<double, D> a;  // c_p + min_image(x_p - c_p) (x_p on wall axes); x_p with the cell grid
     std::array<double, D> v;  // velocity
     std::int64_t ta;          // anchor tick

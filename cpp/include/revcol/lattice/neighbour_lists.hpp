@@ -20,7 +20,9 @@
 // until it holds). An early renewal is harmless: renewals change no physical state, so the
 // collisions, the state and the bits are those of the cell grid's engine (tests compare them).
 // The centres live in a cell grid (cells at least R / 2 wide, 5^D of them scanned) read only by the
-// renewals. The list test
+// renewals; a cell's members are a chain through the particles' nodes (a node holds the centre
+// and the next member: one cache line per candidate, and a few bytes per cell for the sparse
+// cells of R / 2, where flat member slots took 1 MB at N = 10^4). The list test
 // |c_p - c_q|^2 < R^2 is taken in double from the exact minimum-image differences: symmetric and
 // deterministic (the same values in either order), and R's margin is far beyond its rounding.
 // Each entry also keeps the image code of the pair (one byte): the periodic shift s with
@@ -71,7 +73,7 @@ class NeighbourListsN {
     return static_cast<std::uint8_t>(((code & 0x15u) << 1) | ((code >> 1) & 0x15u));
   }
   /// p's list centre.
-  const Vec& centre(int p) const noexcept { return c_[static_cast<std::size_t>(p)]; }
+  const Vec& centre(int p) const noexcept { return node_[static_cast<std::size_t>(p)].c; }
   /// Entries on p's list.
   int size(int p) const noexcept { return count_[static_cast<std::size_t>(p)]; }
   /// The ball radius h and the reach R, lattice units.
@@ -94,8 +96,16 @@ class NeighbourListsN {
   std::int64_t h_ = 0, reach_ = 0;
   u128 h2_ = 0;
   double reach2_ = 0.0;  // R^2 in double: a symmetric, deterministic test (R holds a margin)
-  CellGridN<Dim> grid_;       // of the centres, cells >= R / 2 wide, span 2
-  std::vector<Vec> c_;        // centres
+  void link(int p, int cell);    // p at the head of cell's chain
+  void unlink(int p);            // p out of its cell's chain
+  CellGridN<Dim> grid_;          // the geometry of the centres' cells, >= R / 2 wide, span 2
+  struct alignas(32) Node {
+    Vec c;          // p's centre
+    int next = -1;  // the next member of p's cell, -1 at the end
+    int cell = -1;  // p's cell
+  };
+  std::vector<Node> node_;
+  std::vector<int> head_;        // per cell: its first member, -1 if empty
   std::size_t cap_ = 16;      // entries per list (doubles, for every list, when one is full)
   std::vector<int> ids_;      // p's list: ids_[p * cap_ .. + count_[p]]
   std::vector<std::uint8_t> codes_;  // their image codes
