@@ -581,6 +581,9 @@ class BasicEngine {
       const LineD& dp = lnd_[static_cast<std::size_t>(p)];
       const int* ids = nl_.ids(p);
       const std::uint8_t* codes = nl_.codes(p);
+      // every partner's line requested first: the filter's branches are unpredictable, and a
+      // mispredicted one would otherwise serialize the cache misses (as the float engine does)
+      for (int e = 0, ne = nl_.size(p); e < ne; ++e) __builtin_prefetch(&lnd_[static_cast<std::size_t>(ids[e])]);
       for (int e = 0, ne = nl_.size(p); e < ne; ++e) {
         const int q = ids[e];
         const LineD& dq = lnd_[static_cast<std::size_t>(q)];
@@ -832,6 +835,7 @@ class BasicEngine {
         const std::array<double, D> ax = unwrapped_about(o, x);
         const int* ids = nl_.ids(o);
         const std::uint8_t* codes = nl_.codes(o);
+        for (int e = 0, ne = nl_.size(o); e < ne; ++e) __builtin_prefetch(&lnd_[static_cast<std::size_t>(ids[e])]);
         for (int e = 0, ne = nl_.size(o); e < ne && why == 0; ++e) {
           const LineD& dq = lnd_[static_cast<std::size_t>(ids[e])];
           const double dt = static_cast<double>(a - dq.ta);
