@@ -52,6 +52,29 @@ std::int64_t guessed_tick(const VecN<D>& r, const VecN<D>& w, u128 sigma2, doubl
   std::int64_t t = static_cast<std::int64_t>(g);  // truncation, then the ceiling
   if (static_cast<double>(t) < g) ++t;
   t = std::max<std::int64_t>(1, t);
+  if constexpr (D == 3) {
+    // overlap_at's answers, decided in double when surely on one side (the common case: f moves
+    // by ~1/64 of sigma^2 per tick near contact), else exactly. With u = 2^-53, a_k = |r_k| +
+    // |w_k t| and m = sum a_k^2: each y_k = r_k + w_k t is within ~4u a_k, so f = |y|^2 is
+    // within ~12u m of the exact value; the band is 1e-12 (m + sigma^2), ~800 times that. A
+    // component beyond overlap_at's 2^61 range gives f >> sigma^2: "no overlap" either way.
+    const double s2 = static_cast<double>(sigma2);  // 2^(2S): exact
+    auto at = [&](std::int64_t tau) {
+      const double td = static_cast<double>(tau);
+      double f = 0.0, m = 0.0;
+      for (std::size_t k = 0; k < D; ++k) {
+        const double rk = static_cast<double>(r[k]), wt = static_cast<double>(w[k]) * td;
+        const double y = rk + wt, a = std::fabs(rk) + std::fabs(wt);
+        f += y * y;
+        m += a * a;
+      }
+      const double band = 1e-12 * (m + s2);
+      if (f < s2 - band) return true;
+      if (f > s2 + band) return false;
+      return overlap_at(r, w, tau, sigma2);
+    };
+    return at(t) && !at(t - 1) ? t : -1;
+  }
   return overlap_at(r, w, t, sigma2) && !overlap_at(r, w, t - 1, sigma2) ? t : -1;
 }
 
