@@ -569,8 +569,11 @@ class BasicEngine {
     };
     // the filter's tests on r, w (doubles): true when the pair surely has no overlap tick <= t
     auto beyond = [&](double rr, double bb, double aa, double t) {
-      // never inside: the smallest |r + w t|^2 over t >= 0 is beyond sigma^2
-      if ((bb >= 0.0 ? rr : rr - bb * (bb / aa)) > sigma2d_ + 1e-6 * (rr + sigma2d_)) return true;
+      // never inside: the smallest |r + w t|^2 over t >= 0 (rr - bb^2 / aa when approaching, here
+      // times aa: no division on the loop's path; its rounding, ~4u rr aa by Cauchy-Schwarz, is far
+      // inside the margin) is beyond sigma^2
+      const double lim = sigma2d_ + 1e-6 * (rr + sigma2d_);
+      if (bb >= 0.0 ? rr > lim : rr * aa - bb * bb > lim * aa) return true;
       // not up to t: f(t) = |r + w t|^2 is still falling at t and outside there
       return t != never && -bb >= aa * t && rr + t * (2.0 * bb + aa * t) > sigma2d_ + 1e-6 * (rr + aa * t * t + sigma2d_);
     };
