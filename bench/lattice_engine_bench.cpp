@@ -15,6 +15,8 @@
 // clock are restored bit for bit), events_per_collision, log_entries, redraws_per_collision,
 // multi_body, wall_body, bits_length (X after the forward run), energy_drift (relative, after the
 // forward run), engine_bytes, n, phi.
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <ctime>
@@ -109,6 +111,44 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
 }
 
 // the float engine on the same kind of gas, timed the same way (its own family is engine/...)
+// The cell grid (shell 0) and the automatic lists run in lockstep from the same start, their
+// collision traces (tick, i, j) compared chunk by chunk: `first_difference` is the index of the
+// first collision where they part (-1: none in the collisions asked). The searches must never
+// decide anything, so anything but -1 is a bug (docs/lattice.md "Session 11").
+template <std::size_t D>
+std::vector<Metric> run_lockstep(const LatticeCase& c, std::uint64_t nc) {
+  using Engine = std::conditional_t<D == 2, la::LatticeEngine, la::LatticeEngine3D>;
+  la::LatticeConfigN<D> cfg;
+  cfg.wall = la::filled<D>(c.walls);
+  cfg.seed = static_cast<std::uint32_t>(c.seed);
+  const la::LatticeStartN<D> st = la::random_start(cfg, c.n, c.phi, c.seed, init_of(c));
+  Engine a(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
+  Engine b(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
+  a.set_list_shell(0.0);
+  const double shell = b.list_shell();
+  std::vector<std::array<std::int64_t, 3>> ta, tb;
+  a.trace = &ta;
+  b.trace = &tb;
+  double first = -1.0;
+  std::uint64_t done = 0;
+  const std::uint64_t chunk = 100000;
+  while (done < nc && first < 0.0) {
+    const std::uint64_t k = std::min(chunk, nc - done);
+    ta.clear();
+    tb.clear();
+    a.run(k, la::tick_limit - 1);
+    b.run(k, la::tick_limit - 1);
+    for (std::size_t e = 0; e < std::max(ta.size(), tb.size()); ++e)
+      if (e >= ta.size() || e >= tb.size() || ta[e] != tb[e]) {
+        first = static_cast<double>(done + e);
+        break;
+      }
+    done += k;
+  }
+  return {{"first_difference", first}, {"collisions_compared", static_cast<double>(first < 0.0 ? done : first)},
+          {"list_shell", shell}, {"n", static_cast<double>(c.n)}, {"phi", c.phi}};
+}
+
 std::vector<Metric> run_float(const LatticeCase& c, std::uint64_t nc) {
   en::Config cfg;
   cfg.dim = c.dim;
@@ -164,6 +204,13 @@ void add_lattice_benches(std::vector<Bench>& out) {
   for (const Named& m : named3) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice<3>(c, n); }});
+  }
+  // the cell grid against lists in lockstep (run_lockstep): the first collision where they part
+  static const Named lock3[] = {{"lattice3d/lockstep/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
+                                {"lattice3d/lockstep/n1000/phi0.45", {1000, 0.45, false, 1, 3}}};
+  for (const Named& m : lock3) {
+    const LatticeCase c = m.c;
+    out.push_back({m.name, "first differing collision", [c](std::uint64_t n) { return run_lockstep<3>(c, n); }});
   }
   static const Named floats3[] = {{"lattice3d/float/n10000/phi0.1", {10000, 0.1, false, 1, 3}},
                                   {"lattice3d/float/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
