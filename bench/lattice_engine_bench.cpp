@@ -114,7 +114,8 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
 // The cell grid (shell 0) and the automatic lists run in lockstep from the same start, their
 // collision traces (tick, i, j) compared chunk by chunk: `first_difference` is the index of the
 // first collision where they part (-1: none in the collisions asked). The searches must never
-// decide anything, so anything but -1 is a bug (docs/lattice.md "Session 11").
+// decide anything, so anything but -1 is a bug (one is known and open: a same-tick tie,
+// docs/lattice.md "Session 11").
 template <std::size_t D>
 std::vector<Metric> run_lockstep(const LatticeCase& c, std::uint64_t nc) {
   using Engine = std::conditional_t<D == 2, la::LatticeEngine, la::LatticeEngine3D>;

@@ -23,7 +23,9 @@
 // event of kind 0 instead); 3D uses lists by default. A prediction drops with a double-precision
 // filter the candidates that provably have no overlap tick before its best event so far and sends
 // the others to the exact search. Neither the search nor the filter changes which collisions
-// happen: the trace and the bits are those of the exhaustive search (test_lattice_lists).
+// happen: the trace and the bits are those of the exhaustive search (test_lattice_lists), except
+// at a same-tick tie of two partners of one particle, which the order of re-predictions decides
+// (docs/lattice.md "Session 11"; open).
 //
 // Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
 // collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
