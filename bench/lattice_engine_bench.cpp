@@ -54,11 +54,21 @@ struct LatticeCase {
 const char* init_of(const LatticeCase& c) { return c.dim == 3 ? "auto" : c.phi > 0.35 ? "lattice" : "auto"; }
 
 template <std::size_t D>
-std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
-  using Engine = std::conditional_t<D == 2, la::LatticeEngine, la::LatticeEngine3D>;
+using EngineOf = std::conditional_t<D == 2, la::LatticeEngine, la::LatticeEngine3D>;
+
+// the lattice configuration of a case: its walls and seed (the rest the units' defaults)
+template <std::size_t D>
+la::LatticeConfigN<D> config_of(const LatticeCase& c) {
   la::LatticeConfigN<D> cfg;
   cfg.wall = la::filled<D>(c.walls);
   cfg.seed = static_cast<std::uint32_t>(c.seed);
+  return cfg;
+}
+
+template <std::size_t D>
+std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
+  using Engine = EngineOf<D>;
+  la::LatticeConfigN<D> cfg = config_of<D>(c);
   // REVCOL_LATTICE=tick_bits=20,cell_bits=20 runs the engine as before the automatic tick;
   // shell=S sets the neighbour search (set_list_shell: 0 the cell grid, S > 0 lists, < 0 automatic)
   double shell = -1.0;
@@ -110,7 +120,6 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
           {"phi", c.phi}};
 }
 
-// the float engine on the same kind of gas, timed the same way (its own family is engine/...)
 // The cell grid (shell 0) and the automatic lists run in lockstep from the same start, their
 // collision traces (tick, i, j) compared chunk by chunk: `first_difference` is the index of the
 // first collision where they part (-1: none in the collisions asked). The searches must never
@@ -118,10 +127,8 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
 // docs/lattice.md "Session 11").
 template <std::size_t D>
 std::vector<Metric> run_lockstep(const LatticeCase& c, std::uint64_t nc) {
-  using Engine = std::conditional_t<D == 2, la::LatticeEngine, la::LatticeEngine3D>;
-  la::LatticeConfigN<D> cfg;
-  cfg.wall = la::filled<D>(c.walls);
-  cfg.seed = static_cast<std::uint32_t>(c.seed);
+  using Engine = EngineOf<D>;
+  const la::LatticeConfigN<D> cfg = config_of<D>(c);
   const la::LatticeStartN<D> st = la::random_start(cfg, c.n, c.phi, c.seed, init_of(c));
   Engine a(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
   Engine b(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
@@ -150,6 +157,7 @@ std::vector<Metric> run_lockstep(const LatticeCase& c, std::uint64_t nc) {
           {"list_shell", shell}, {"n", static_cast<double>(c.n)}, {"phi", c.phi}};
 }
 
+// the float engine on the same kind of gas, timed the same way (its own family is engine/...)
 std::vector<Metric> run_float(const LatticeCase& c, std::uint64_t nc) {
   en::Config cfg;
   cfg.dim = c.dim;
