@@ -310,6 +310,45 @@ TEST_CASE("3D engine: back by time to a tick between collisions equals forward t
   CHECK(same_state(e.snapshot(), s0));
 }
 
+TEST_CASE("3D walls: a collision right after a reflection on one tick; back to the tick before equals forward there") {
+  // The reverse undoes such a collision at the forward's tick a - 1 and restores the reflected
+  // line, whose point there is beyond the wall: its reflection belongs to that tick (after the
+  // tick's collisions), not to the next (where it was once scheduled: the state at a - 1 held a
+  // centre beyond the wall, and a collision of the same pair one tick earlier came out of order).
+  LatticeConfig3 c;
+  c.wall = {true, true, true};
+  c.tick_bits = 16;  // coarse ticks: a reflection and a collision on one tick ~ every 30 000 collisions
+  LatticeStart3 s = random_start(c, 256, 0.45, 1);
+  LatticeEngine3D e(s.units, s.x, s.v, 1, operator_for(s.units));
+  const Snapshot3 s0 = e.snapshot();
+  std::vector<std::int64_t> ticks;  // the ticks a of such collisions
+  for (int k = 0; k < 100000; ++k) {
+    const std::uint64_t before = e.counters().wall_body;
+    e.run(1, tick_limit - 1);
+    if (e.counters().wall_body != before) ticks.push_back(e.clock());
+  }
+  std::printf("  N = 256, 0.45, walls, T = 16: %zu collisions right after a reflection in 10^5\n", ticks.size());
+  CHECK(ticks.size() >= 2);
+  const std::int64_t h = s0.units.sigma / 2;
+  LatticeEngine3D f(s0, operator_for(s0.units));
+  std::vector<Snapshot3> fwd;
+  for (std::int64_t a : ticks) {
+    f.run(UINT64_MAX, a - 1);
+    fwd.push_back(f.snapshot());
+  }
+  for (std::size_t m = ticks.size(); m-- > 0;) {
+    e.run_back(0, ticks[m] - 1);
+    const Snapshot3 st = e.snapshot();
+    bool inside = true;
+    for (const Vec3& x : st.x)
+      for (std::size_t k = 0; k < 3; ++k) inside = inside && x[k] >= h && x[k] <= st.units.L[k] - h;
+    CHECK(inside);
+    CHECK(same_state(st, fwd[m]));
+  }
+  e.run_back(0, e.origin());
+  CHECK(same_state(e.snapshot(), s0));
+}
+
 TEST_CASE("3D group collisions forced on every collision (resolve and bounce), periodic and walled, bit for bit") {
   for (bool resolve : {true, false})
     for (bool walls : {false, true}) {

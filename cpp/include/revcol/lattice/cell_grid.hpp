@@ -43,10 +43,14 @@ inline bool wall_mirror(std::int64_t& x, std::int64_t& v, std::int64_t h, std::i
   return false;
 }
 
-/// Ticks from an anchor x0 in [h, H] until the line x0 + v dt first leaves [h, H]; -1 if never.
+/// Ticks from an anchor x0 until the line x0 + v dt is first beyond [h, H] on its way out; -1 if
+/// never. An anchor already beyond, moving out, gives 0: the reverse meets such a line when it
+/// undoes a collision that came right after a reflection on the same tick (the restored pre line
+/// is the reflected one, whose point at the reverse's tick is beyond the wall), and its
+/// reflection belongs to that tick, after the tick's collisions, as the forward's came before them.
 inline std::int64_t wall_ticks(std::int64_t x0, std::int64_t v, std::int64_t h, std::int64_t H) noexcept {
-  if (v < 0) return (x0 - h) / -v + 1;
-  if (v > 0) return (H - x0) / v + 1;
+  if (v < 0) return x0 < h ? 0 : (x0 - h) / -v + 1;
+  if (v > 0) return x0 > H ? 0 : (H - x0) / v + 1;
   return -1;
 }
 

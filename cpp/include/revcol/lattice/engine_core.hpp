@@ -541,7 +541,7 @@ class BasicEngine {
       }
       if (u_.wall[k]) {
         const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(static_cast<int>(k)));
-        if (dw > 0) offer(lo + dw, wall_kind(), wall, -1);
+        if (dw >= 0) offer(lo + dw, wall_kind(), wall, -1);
       }
     }
     // The candidates. A double-precision filter drops the pairs that cannot collide, or not
@@ -702,7 +702,10 @@ class BasicEngine {
     return b.type != coll || slot_[static_cast<std::size_t>(b.partner)].ver == b.vpart;
   }
   void check_order(std::int64_t t, std::int32_t k) {
-    if (std::make_pair(t, k) < last_key_) throw std::logic_error("lattice engine: events out of order (a bug)");
+    if (std::make_pair(t, k) < last_key_)
+      throw std::logic_error("lattice engine: events out of order (a bug): (tick " + std::to_string(t) + ", kind " +
+                             std::to_string(k) + ") after (tick " + std::to_string(last_key_.first) + ", kind " +
+                             std::to_string(last_key_.second) + "), collision " + std::to_string(ncoll_));
     last_key_ = {t, k};
   }
   std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target,
@@ -771,7 +774,10 @@ class BasicEngine {
     const Vec ghost = wrapped(sub(x, v));
     near(p, [&](int q) {
       if (q == p) return;
-      if (overlap(ghost, pos(q, a - 1))) {
+      // the forward's guard (its reverse would meet q first); the reverse replays the forward, and
+      // its ghost is the forward's pre-wall line at a, beyond the wall (right after a collision
+      // undone on this tick, a body may well overlap it there)
+      if (!reversed_ && overlap(ghost, pos(q, a - 1))) {
         throw std::runtime_error("lattice engine: a wall and a body within one tick that the rule cannot resolve (particle " +
                                  std::to_string(p) + ", tick " + std::to_string(a) + "); not supported yet");
       }
