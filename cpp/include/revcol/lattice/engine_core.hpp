@@ -636,8 +636,14 @@ class BasicEngine {
       });
     }
     schedule(p, btype, bt, bk, bq);
-    if (btype == coll) {  // write it into the partner's slot when earlier there
-      if (!queue_.scheduled(bq) || std::make_pair(bt, bk) < std::make_pair(queue_.time(bq), queue_.kind(bq))) {
+    if (btype == coll) {  // write it into the partner's slot when before the event there
+      // in offer's order (tick, kind, other particle): with (tick, kind) alone, a tie (two pairs of
+      // one particle at one tick and one kind, i.e. the same lower index) went to whichever
+      // prediction wrote the slot first, so the search's neutral events (crossings or renewals,
+      // which re-predict) could choose the partner; measured once in 6.6 x 10^6 collisions
+      const Slot& sq = slot_[static_cast<std::size_t>(bq)];
+      if (!queue_.scheduled(bq) ||
+          std::tie(bt, bk, p) < std::tuple<std::int64_t, std::int32_t, int>(queue_.time(bq), queue_.kind(bq), sq.partner)) {
         schedule(bq, coll, bt, bk, p);
       }
     }
