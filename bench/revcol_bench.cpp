@@ -6,11 +6,13 @@
 //   revcol-bench [--bench NAME_OR_PREFIX ...] [--repeats R] [--collisions N] [--json F] [--csv F]
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -114,6 +116,20 @@ int usage(int code) {
   return code;
 }
 
+// A count: digits, or an exact integer in float notation (1e7, 2.5e6); anything else (a trailing
+// word, a fraction, a sign) throws. std::stoull alone read "1.2e7" as 1.
+std::uint64_t parse_count(const std::string& s) {
+  std::size_t used = 0;
+  if (s.find_first_not_of("0123456789") == std::string::npos && !s.empty()) {
+    const std::uint64_t n = std::stoull(s, &used);
+    if (used == s.size()) return n;
+  } else if (!s.empty() && s[0] != '-' && s[0] != '+') {
+    const double d = std::stod(s, &used);
+    if (used == s.size() && d >= 0.0 && d < 1.8e19 && d == std::floor(d)) return static_cast<std::uint64_t>(d);
+  }
+  throw std::invalid_argument("not a count: " + s);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -134,8 +150,12 @@ int main(int argc, char** argv) {
     try {
       if (arg == "--list") list = true;
       else if (arg == "--bench") selected.push_back(value());
-      else if (arg == "--repeats") repeats = std::stoi(value());
-      else if (arg == "--collisions") n = std::stoull(value());
+      else if (arg == "--repeats") {
+        const std::uint64_t r = parse_count(value());
+        if (r > 1000000) throw std::invalid_argument("too many repeats");
+        repeats = static_cast<int>(r);
+      }
+      else if (arg == "--collisions") n = parse_count(value());
       else if (arg == "--json") json_path = value();
       else if (arg == "--csv") csv_path = value();
       else if (arg == "-h" || arg == "--help") return usage(0);
@@ -144,7 +164,7 @@ int main(int argc, char** argv) {
         return usage(2);
       }
     } catch (const std::exception&) {
-      std::fprintf(stderr, "revcol-bench: bad value for %s\n", arg.c_str());
+      std::fprintf(stderr, "revcol-bench: bad value %s for %s (a count: 1000000 or 1e6)\n", argv[a], arg.c_str());
       return 2;
     }
   }
