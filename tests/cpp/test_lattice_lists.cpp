@@ -317,6 +317,52 @@ TEST_CASE("2D engine: lists find exactly the exhaustive cell search's collisions
     run_equivalence<2, LatticeEngine>(g);
 }
 
+TEST_CASE("a same-tick tie of two partners with one lower index goes to the smaller partner, whatever order the predictions came in") {
+  // 2D, walls, sigma 2^44. Particle 0 rests at the centre; 2 comes at it from x = H along
+  // y = c + 0.7 sigma; 1 starts a little inside x = H moving out along y = c - 0.35 sigma,
+  // reflects, and comes back behind 2, by so much that both pairs first overlap at one tick
+  // (found below): the same lower index 0, so the same (tick, kind). 0 is far from both at
+  // first; 2, ahead, finds it first (a cell crossing or list renewal brings 0 into its search)
+  // and writes 0's slot; 1 finds the tie later. A slot write compared on (tick, kind) alone
+  // kept 2 (the first writer); a particle's own prediction orders (tick, kind, other) and would
+  // choose 1, and so must the write, or the search's re-predictions (which differ between the
+  // cell grid and the lists) would decide the trajectory.
+  const UnitsN<2> u = box_units<2>({true, true}, 20.0, 44);
+  const std::int64_t sg = u.sigma, H = u.L[0] - sg / 2, c = 10 * sg, speed = u.vmax / 2;
+  const std::int64_t d2 = sg / 10 * 7, d1 = sg / 100 * 35;
+  const u128 s2 = static_cast<u128>(sg) * static_cast<u128>(sg);
+  const std::int64_t t2 = first_overlap(VecN<2>{H - c, d2}, VecN<2>{-speed, 0}, s2);
+  // 1 starts at H - e moving out, reflects at tick e / speed + 1 onto x = H + 1 + e - speed t;
+  // e from the contact distances, then stepped until its first overlap tick is t2
+  auto t1_of = [&](std::int64_t e) {
+    const std::int64_t w = e / speed + 1;  // the reflection tick
+    return w + first_overlap(VecN<2>{H + 1 + e - speed * w - c, -d1}, VecN<2>{-speed, 0}, s2);
+  };
+  std::int64_t e = static_cast<std::int64_t>((std::sqrt(1.0 - 0.35 * 0.35) - std::sqrt(1.0 - 0.7 * 0.7)) * static_cast<double>(sg));
+  for (int k = 0; k < 64 && t1_of(e) != t2; ++k) e += t1_of(e) < t2 ? speed / 2 : -speed / 3;
+  CHECK(t1_of(e) == t2);
+  CHECK(e > 50 * speed);  // 1 lags by tens of ticks: 2 finds 0 first
+  const std::vector<VecN<2>> x{{c, c}, {H - e, c - d1}, {H, c + d2}};
+  const std::vector<VecN<2>> v{{0, 0}, {speed, 0}, {-speed, 0}};
+  for (double shell : {0.0, -1.0, 0.3}) {
+    LatticeEngine e2(u, x, v, 5, operator_for(u));
+    e2.set_list_shell(shell);
+    std::vector<std::array<std::int64_t, 3>> trace;
+    e2.trace = &trace;
+    const Snapshot s0 = e2.snapshot();
+    e2.run(1, tick_limit - 1);
+    CHECK(trace.size() == 1);
+    if (trace.size() != 1) continue;
+    if (trace[0][2] != 1) std::fprintf(stderr, "shell %.1f: 0 met %lld at tick %lld\n", shell, (long long)trace[0][2], (long long)trace[0][0]);
+    CHECK(trace[0][0] == t2);
+    CHECK(trace[0][1] == 0);
+    CHECK(trace[0][2] == 1);
+    e2.run(10, tick_limit - 1);
+    e2.run_back(0, e2.origin());
+    CHECK(same_state(e2.snapshot(), s0));
+  }
+}
+
 TEST_CASE("engine: the list shell is checked, and changing it keeps the state") {
   LatticeConfigN<3> cfg;
   const LatticeStartN<3> st = random_start(cfg, 100, 0.3, 3);
