@@ -13,7 +13,9 @@
 // Event rule. Invariant: no pair overlaps at any integer tick, and every centre is inside [h, H] on
 // wall axes. A pair collides on the transition a-1 -> a where a is the first tick at which its
 // incoming lines overlap; a wall reflects on the transition into the first tick beyond it
-// (cell_grid.hpp); a cell crossing is neutral. One event per particle in the queue (its earliest:
+// (cell_grid.hpp; in the reverse, a line restored beyond a wall, by the undo of a collision that
+// came right after a reflection on the same tick, reflects on that tick after its collisions);
+// a cell crossing is neutral. One event per particle in the queue (its earliest:
 // crossing, wall, or collision with a neighbour); a collision found by p with q is also written into
 // q's slot when it is earlier there, so a pair's collision sits in both slots; an event whose versions
 // are stale is recomputed when it comes up.
@@ -23,9 +25,12 @@
 // event of kind 0 instead); 3D uses lists by default. A prediction drops with a double-precision
 // filter the candidates that provably have no overlap tick before its best event so far and sends
 // the others to the exact search. Neither the search nor the filter changes which collisions
-// happen: the trace and the bits are those of the exhaustive search (test_lattice_lists), except
-// at a same-tick tie of two partners of one particle, which the order of re-predictions decides
-// (docs/lattice.md "Session 11"; open).
+// happen: the trace and the bits are those of the exhaustive search (test_lattice_lists). That
+// needs one order for a particle's slot whoever writes it: (tick, kind, other particle), in its
+// own prediction and in a partner's write alike, so a same-tick tie of two partners of one
+// particle (same lower index, same kind) goes to the smaller partner whatever order the
+// predictions came in (with (tick, kind) alone the first writer kept it, and the searches'
+// re-predictions differ: docs/lattice.md "Session 12").
 //
 // Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
 // collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
