@@ -518,7 +518,7 @@ void EngineImpl<Dim, Op>::note_wall(int i) {
 }
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::note_pair(int a, int b) {
-  obs_->pair(clock_, a, b, p_[a].v, p_[b].v);
+  obs_->template pair_d<Dim>(clock_, a, b, p_[a].v, p_[b].v);
 }
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::stop_observing() {

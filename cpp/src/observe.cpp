@@ -120,7 +120,7 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
     s.t0 = t;
     s.v2 = s.speed = 0.0;
     if (c.slabs > 0) set_cell(s, std::floor(s.x[c.slab_axis] / slab_w_));
-    set_velocity(static_cast<int>(i), &v[i * dim]);
+    set_velocity<0>(static_cast<int>(i), &v[i * dim]);
   }
   start_ = x;
   if (c.pair_bins > 0) pair_t_.assign(n_ * n_, t);
@@ -147,10 +147,13 @@ Observer::Block Observer::empty_block(double t0) const {
   return b;
 }
 
+// K: the dimension known at compile time (the pair hook's fast path), 0: dim_ at run time.
+// The same sums in the same order either way (same bits).
+template <int K>
 [[gnu::always_inline]] inline void Observer::set_velocity(int i, const double* v) {
   Segment& s = seg_[i];
   double v2 = 0.0;
-  for (int k = 0; k < dim_; ++k) {
+  for (int k = 0; k < (K > 0 ? K : dim_); ++k) {
     s.v[k] = v[k];
     v2 += v[k] * v[k];
   }
@@ -258,7 +261,7 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
               "snapshot: observer: a segment's slab cell must be a whole number (in [0, slabs) between walls)");
       set_cell(s, cell);
     }
-    set_velocity(static_cast<int>(i), &v[i * d]);
+    set_velocity<0>(static_cast<int>(i), &v[i * d]);
   }
   auto take = [&](std::vector<double>& out, std::size_t m) {
     out.assign(reals.begin() + static_cast<std::ptrdiff_t>(u), reals.begin() + static_cast<std::ptrdiff_t>(u + m));
@@ -294,6 +297,9 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
 // Closes i's segment at t: its duration weights its speed bin and its slabs (credited to
 // the open block); its position moves to t. (Components beyond dim are 0: the loops run
 // over 3, unrolled, with no test of dim.)
+// K: the position components advanced (the pair hook's fast path: the dimension; elsewhere 3,
+// the components beyond d being 0 whatever dt).
+template <int K>
 [[gnu::always_inline]] inline void Observer::close(int i, double t) {
   Segment& s = seg_[i];
   const double dt = t - s.t0;
@@ -307,7 +313,7 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
       slab_cross(s, t, end);
     }
   }
-  for (int k = 0; k < 3; ++k) s.x[k] += s.v[k] * dt;
+  for (int k = 0; k < K; ++k) s.x[k] += s.v[k] * dt;
   s.t0 = t;
 }
 
@@ -411,7 +417,7 @@ void Observer::end_block() {
   accumulate(te);
   if (cfg_.pair_bins > 0)
     for (std::size_t i = 0; i < n_; ++i) {
-      close(static_cast<int>(i), te);
+      close<3>(static_cast<int>(i), te);
       close_pairs(static_cast<int>(i), te);
     }
   double msd = 0.0;
@@ -442,12 +448,21 @@ void Observer::end_block() {
 }
 
 void Observer::pair(double t, int a, int b, const double* va, const double* vb) {
+  if (dim_ == 1) pair_d<1>(t, a, b, va, vb);
+  else if (dim_ == 2) pair_d<2>(t, a, b, va, vb);
+  else pair_d<3>(t, a, b, va, vb);
+}
+
+// The pair hook with the dimension at compile time: the loops unrolled, positions advanced
+// in d components only (measured: docs/physics.md).
+template <int Dim>
+void Observer::pair_d(double t, int a, int b, const double* va, const double* vb) {
   reach(t);
-  close(a, t);
-  close(b, t);
+  close<Dim>(a, t);
+  close<Dim>(b, t);
   if (cfg_.collision_record) [[unlikely]] record_pair(a, b, va, vb);
   double w = 0.0;
-  for (int k = 0; k < dim_; ++k) {
+  for (int k = 0; k < Dim; ++k) {
     // the nearest image (|r| = D < L / 2; fold_ is 0 on walled axes), rounding q to the
     // nearest whole number by adding and subtracting 1.5 2^52 (|q| < 2^51; no branch)
     const double r0 = seg_[a].x[k] - seg_[b].x[k], q = r0 * inv_box_[k];
@@ -457,28 +472,31 @@ void Observer::pair(double t, int a, int b, const double* va, const double* vb) 
   cur_.w += w;
   close_pairs(a, t);
   close_pairs(b, t);
-  set_velocity(a, va);
-  set_velocity(b, vb);
+  set_velocity<Dim>(a, va);
+  set_velocity<Dim>(b, vb);
   ++cur_.pairs;
   cur_.parts += 2;
 }
+template void Observer::pair_d<1>(double, int, int, const double*, const double*);
+template void Observer::pair_d<2>(double, int, int, const double*, const double*);
+template void Observer::pair_d<3>(double, int, int, const double*, const double*);
 
 void Observer::group(double t, int n, const int* ids, const double* x, const double* v) {
   reach(t);
   for (int u = 0; u < n; ++u) {
     const int i = ids[u];
     for (int k = 0; k < dim_; ++k) cur_.w += x[u * dim_ + k] * (v[u * dim_ + k] - seg_[i].v[k]);
-    close(i, t);
+    close<3>(i, t);
     close_pairs(i, t);
   }
-  for (int u = 0; u < n; ++u) set_velocity(ids[u], v + u * dim_);
+  for (int u = 0; u < n; ++u) set_velocity<0>(ids[u], v + u * dim_);
   ++cur_.groups;
   cur_.parts += static_cast<std::uint64_t>(n);
 }
 
 void Observer::wall(double t, int i, const double* v) {
   reach(t);
-  close(i, t);
+  close<3>(i, t);
   close_pairs(i, t);
   const double r = 0.5 * diameter_, tol = 1e-6 * diameter_;
   for (int k = 0; k < dim_; ++k) {
@@ -488,14 +506,14 @@ void Observer::wall(double t, int i, const double* v) {
     cur_.wall_dp[k] += std::fabs(dv);
     cur_.w_wall += xk * dv;
   }
-  set_velocity(i, v);
+  set_velocity<0>(i, v);
   ++cur_.walls;
 }
 
 void Observer::sync(double t) {
   reach(t);
   for (std::size_t i = 0; i < n_; ++i) {
-    close(static_cast<int>(i), t);
+    close<3>(static_cast<int>(i), t);
     close_pairs(static_cast<int>(i), t);
   }
 }

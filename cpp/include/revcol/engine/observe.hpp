@@ -165,6 +165,9 @@ class Observer {
   /// from the observer's own positions, folded to the nearest image on periodic axes (at
   /// contact |r| = D < L / 2: the image the engine collided).
   void pair(double t, int a, int b, const double* va, const double* vb);
+  /// pair() for an observer of dimension Dim (= d; the engine's hook: loops unrolled).
+  template <int Dim>
+  void pair_d(double t, int a, int b, const double* va, const double* vb);
   /// A group collision at t: n members, ids, image-consistent positions and velocities after (n x dim).
   void group(double t, int n, const int* ids, const double* x, const double* v);
   /// A wall reflection of particle i at t (also at a collision's instant): its velocity after.
@@ -192,7 +195,9 @@ class Observer {
   };
   void reach(double t);  // closes every block that ends at or before t
   void accumulate(double t);
+  template <int K>
   void close(int i, double t);
+  template <int K>
   void set_velocity(int i, const double* v);
   void close_pairs(int i, double t);
   [[gnu::noinline]] void pairs_to(int i, double t);
