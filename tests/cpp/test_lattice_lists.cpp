@@ -363,6 +363,50 @@ TEST_CASE("a same-tick tie of two partners with one lower index goes to the smal
   }
 }
 
+TEST_CASE("2D walls: a collision right after a reflection on one tick (built); back to the tick before equals forward there") {
+  // The 2D form of test_lattice_engine3d's case, built rather than found. Particle 0 runs at
+  // (u, -u) and reflects on the wall x = H at tick 4 (half a step from it at tick 3); 1 rests
+  // below and to the left, its distance at tick 3 just over sigma, so the pair overlaps at tick
+  // 4: the reflection comes first, then the collision. Here a neutral event of 0 (a cell crossing
+  // or a renewal, kind 0) also falls on tick 4 and re-anchors 0 beyond the wall before its
+  // reflection (kind 1): wall_ticks once gave 1 tick from there, so the forward collided 0
+  // unreflected (no wall counted) and the trajectory hung on where the search's neutral events
+  // fell. And the reverse restores 0's reflected line, whose point at tick 3 is beyond the wall:
+  // it was reflected a tick late, so run_back to tick 3 held a centre beyond the wall.
+  const UnitsN<2> u = box_units<2>({true, true}, 20.0, 44);
+  const std::int64_t sg = u.sigma, H = u.L[0] - sg / 2, c = 10 * sg, w = u.vmax / 4;
+  const std::int64_t dx = sg / 10;
+  auto dist2 = [](std::int64_t a, std::int64_t b) { return static_cast<u128>(a) * static_cast<u128>(a) + static_cast<u128>(b) * static_cast<u128>(b); };
+  const u128 s2 = dist2(sg, 0);
+  std::int64_t D = static_cast<std::int64_t>(std::sqrt(static_cast<double>(sg) * static_cast<double>(sg) - static_cast<double>(dx) * static_cast<double>(dx)));
+  while (dist2(dx, D) < s2) ++D;  // at tick 3 the pair is just apart
+  const std::vector<VecN<2>> x{{H - 3 * w - w / 2, c + 3 * w}, {H - w / 2 - dx, c - D}};
+  const std::vector<VecN<2>> v{{w, -w}, {0, 0}};
+  // tick 3: 0 at (H - w/2, c), apart; reflected at tick 4: (H + 1 - w/2, c - w), inside
+  CHECK(dist2(dx + 1, D - w) < s2);
+  for (double shell : {0.0, -1.0}) {
+    LatticeEngine e(u, x, v, 9, operator_for(u));
+    e.set_list_shell(shell);
+    const Snapshot s0 = e.snapshot();
+    e.run(1, tick_limit - 1);
+    CHECK(e.clock() == 4);
+    CHECK(e.counters().walls == 1);
+    CHECK(e.counters().wall_body >= 1);
+    const Snapshot s1 = e.snapshot();
+    LatticeEngine f(s0, operator_for(u));
+    f.run(UINT64_MAX, 3);
+    const Snapshot f3 = f.snapshot();
+    e.run_back(0, 3);
+    const Snapshot b3 = e.snapshot();
+    CHECK(b3.x[0][0] <= H);
+    CHECK(same_state(b3, f3));
+    e.run_back(0, e.origin());
+    CHECK(same_state(e.snapshot(), s0));
+    e.run(1, tick_limit - 1);
+    CHECK(same_state(e.snapshot(), s1));
+  }
+}
+
 TEST_CASE("engine: the list shell is checked, and changing it keeps the state") {
   LatticeConfigN<3> cfg;
   const LatticeStartN<3> st = random_start(cfg, 100, 0.3, 3);

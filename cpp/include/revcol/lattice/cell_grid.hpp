@@ -44,10 +44,13 @@ inline bool wall_mirror(std::int64_t& x, std::int64_t& v, std::int64_t h, std::i
 }
 
 /// Ticks from an anchor x0 until the line x0 + v dt is first beyond [h, H] on its way out; -1 if
-/// never. An anchor already beyond, moving out, gives 0: the reverse meets such a line when it
-/// undoes a collision that came right after a reflection on the same tick (the restored pre line
-/// is the reflected one, whose point at the reverse's tick is beyond the wall), and its
-/// reflection belongs to that tick, after the tick's collisions, as the forward's came before them.
+/// never. An anchor already beyond, moving out, gives 0: its reflection belongs to this very
+/// tick. Such anchors arise (1) in the forward, when a neutral event (cell crossing, list
+/// renewal: kind 0) falls on the reflection's tick and re-anchors the line before the wall event
+/// (kind 1), and (2) in the reverse, when it undoes a collision that came right after a
+/// reflection on the same tick (the restored pre line is the reflected one, whose point at the
+/// reverse's tick is beyond the wall; its reflection comes after the tick's collisions, as the
+/// forward's came before them). Giving 1 there delayed the reflection by a tick.
 inline std::int64_t wall_ticks(std::int64_t x0, std::int64_t v, std::int64_t h, std::int64_t H) noexcept {
   if (v < 0) return x0 < h ? 0 : (x0 - h) / -v + 1;
   if (v > 0) return x0 > H ? 0 : (H - x0) / v + 1;

@@ -13,9 +13,9 @@
 // Event rule. Invariant: no pair overlaps at any integer tick, and every centre is inside [h, H] on
 // wall axes. A pair collides on the transition a-1 -> a where a is the first tick at which its
 // incoming lines overlap; a wall reflects on the transition into the first tick beyond it
-// (cell_grid.hpp; in the reverse, a line restored beyond a wall, by the undo of a collision that
-// came right after a reflection on the same tick, reflects on that tick after its collisions);
-// a cell crossing is neutral. One event per particle in the queue (its earliest:
+// (cell_grid.hpp; a line anchored beyond a wall, by a neutral event of the reflection's tick or,
+// in the reverse, by the undo of a collision that came right after a reflection on the same
+// tick, reflects on that tick); a cell crossing is neutral. One event per particle in the queue (its earliest:
 // crossing, wall, or collision with a neighbour); a collision found by p with q is also written into
 // q's slot when it is earlier there, so a pair's collision sits in both slots; an event whose versions
 // are stale is recomputed when it comes up.
