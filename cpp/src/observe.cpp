@@ -295,10 +295,9 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
 }
 
 // Closes i's segment at t: its duration weights its speed bin and its slabs (credited to
-// the open block); its position moves to t. (Components beyond dim are 0: the loops run
-// over 3, unrolled, with no test of dim.)
-// K: the position components advanced (the pair hook's fast path: the dimension; elsewhere 3,
-// the components beyond d being 0 whatever dt).
+// the open block); its position moves to t. K: the position components advanced, the
+// dimension on the pair hook's path, elsewhere 3 with no test of dim (the components beyond
+// d are 0 whatever dt).
 template <int K>
 [[gnu::always_inline]] inline void Observer::close(int i, double t) {
   Segment& s = seg_[i];
@@ -445,12 +444,6 @@ void Observer::end_block() {
 [[gnu::always_inline]] inline void Observer::reach(double t) {
   while (t >= cur_.t0 + block_time_) end_block();
   accumulate(t);
-}
-
-void Observer::pair(double t, int a, int b, const double* va, const double* vb) {
-  if (dim_ == 1) pair_d<1>(t, a, b, va, vb);
-  else if (dim_ == 2) pair_d<2>(t, a, b, va, vb);
-  else pair_d<3>(t, a, b, va, vb);
 }
 
 // The pair hook with the dimension at compile time: the loops unrolled, positions advanced

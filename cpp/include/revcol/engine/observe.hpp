@@ -161,11 +161,10 @@ class Observer {
   /// Integers among the reals are exact (all far below 2^53).
   void save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const;
 
-  /// A pair collision at t: the velocities after (va, vb). The separation r = x_a - x_b comes
-  /// from the observer's own positions, folded to the nearest image on periodic axes (at
-  /// contact |r| = D < L / 2: the image the engine collided).
-  void pair(double t, int a, int b, const double* va, const double* vb);
-  /// pair() for an observer of dimension Dim (= d; the engine's hook: loops unrolled).
+  /// A pair collision at t: the velocities after (va, vb); Dim is the observer's d (the
+  /// engine's hook knows it at compile time). The separation r = x_a - x_b comes from the
+  /// observer's own positions, folded to the nearest image on periodic axes (at contact
+  /// |r| = D < L / 2: the image the engine collided).
   template <int Dim>
   void pair_d(double t, int a, int b, const double* va, const double* vb);
   /// A group collision at t: n members, ids, image-consistent positions and velocities after (n x dim).
