@@ -86,9 +86,9 @@ Observation Observer::results() const {
   };
   if (cfg_.slabs > 0) {
     const double w = box_[cfg_.slab_axis] / cfg_.slabs, vol = volume_ / cfg_.slabs;
-    o.slab_density = profile(cfg_.slabs, w, [&](const Block& b, double tau, int u) { return b.slab_t[u] / (tau * vol); });
+    o.slab_density = profile(cfg_.slabs, w, [&](const Block& b, double tau, int u) { return b.slab[2 * u] / (tau * vol); });
     o.slab_temperature =
-        profile(cfg_.slabs, w, [&](const Block& b, double, int u) { return ratio(b.slab_k2[u], d * b.slab_t[u]); });
+        profile(cfg_.slabs, w, [&](const Block& b, double, int u) { return ratio(b.slab[2 * u + 1], d * b.slab[2 * u]); });
   }
   if (cfg_.speed_bins > 0) {
     const double h = speed_max_ / cfg_.speed_bins;

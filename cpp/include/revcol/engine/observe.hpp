@@ -180,8 +180,8 @@ class Observer {
   struct Segment {
     double x[3], v[3];
     double t0, v2, speed;
-    double lo;  // slabs: the lower edge of its cell along the slab axis (unwrapped)
-    int bin;    // speed bin, -1 outside or no histogram
+    double lo, hi;  // slabs: the edges of its cell along the slab axis (unwrapped), hi = lo + width
+    int bin;    // speed bin (speed_bins: beyond speed_max, or no histogram)
     int slab;   // slabs: cell mod slabs
   };
   struct Block {
@@ -189,13 +189,21 @@ class Observer {
     double k2 = 0.0, w = 0.0, w_wall = 0.0, dist = 0.0;
     std::array<double, 3> wall_dp{};
     std::uint64_t pairs = 0, groups = 0, parts = 0, walls = 0;
-    std::vector<double> slab_t, slab_k2, speed, pair;
+    std::vector<double> slab;  // per slab its time, then its v^2 time (interleaved: one address)
+    std::vector<double> speed, pair;
     void add(const Block& b);
   };
   void reach(double t);  // closes every block that ends at or before t
   void accumulate(double t);
   template <int K>
   void close(int i, double t);
+  void add_slab(const Segment& s, double dt);
+  template <int K>
+  void fly(Segment& s, double t, double dt);
+  template <int Dim>
+  void virial(int a, int b, const double* va);
+  template <int Dim>
+  [[gnu::noinline]] void pair_general(double t, int a, int b, const double* va, const double* vb);
   template <int K>
   void set_velocity(int i, const double* v);
   void close_pairs(int i, double t);
@@ -214,6 +222,10 @@ class Observer {
   std::array<double, 3> box_, inv_box_, fold_;  // fold_: L on periodic axes, 0 on walled ones
   std::array<bool, 3> walls_;
   double diameter_, volume_, block_time_, t_start_, t_now_, speed_max_, bin_scale_;
+  double bin_cap_;  // speed_bins: the overflow bin's index
+  bool extras_ = false;  // pair distances or the collision record: every pair hook takes pair_general
+  double fast_until_ = 0.0;  // the pair hook's fast path runs before it (set_fast_until)
+  void set_fast_until();
   double v2_sum_ = 0.0, speed_sum_ = 0.0;  // sum v^2 and sum |v|, integrated up to t_now_
   double slab_w_ = 0.0;                    // the slabs' width
   std::vector<Segment> seg_;
