@@ -19,6 +19,11 @@ study's reference) and, for two laws, with each other.
 Each run is a child process (`revcol.physics dense`, pinned with taskset to one of `--cores`
 when given; runs on different cores go side by side). The JSON is written atomically, and
 rewritten after every run (a stopped study keeps what it finished).
+
+    python3 bench/eos_replicas.py --fit STUDY_N1.json STUDY_N2.json ... --json FIT.json
+
+fits Z(N) = Z(inf) + a / N through the studies' replica means (one point at several N), per law
+and pooled, and sets Z(inf) against Liu's form in its own error.
 """
 from __future__ import annotations
 
@@ -109,18 +114,72 @@ def summarize(runs: list[dict]) -> dict:
     return out
 
 
+def _line_fit(points: list[tuple[float, float, float]]) -> dict:
+    """Weighted least squares of y = y_inf + a x over (x, y, error): y_inf, a, their errors, chi2 / dof."""
+    w = [1.0 / (e * e) for _, _, e in points]
+    sw = sum(w)
+    sx = sum(wi * x for wi, (x, _, _) in zip(w, points))
+    sy = sum(wi * y for wi, (_, y, _) in zip(w, points))
+    sxx = sum(wi * x * x for wi, (x, _, _) in zip(w, points))
+    sxy = sum(wi * x * y for wi, (x, y, _) in zip(w, points))
+    det = sw * sxx - sx * sx
+    y_inf = (sxx * sy - sx * sxy) / det
+    a = (sw * sxy - sx * sy) / det
+    chi2 = sum(wi * (y - y_inf - a * x) ** 2 for wi, (x, y, _) in zip(w, points))
+    dof = len(points) - 2
+    return {"z_inf": y_inf, "z_inf_error": math.sqrt(sxx / det), "a": a, "a_error": math.sqrt(sw / det),
+            "chi2": chi2, "dof": dof}
+
+
+def fit(paths: list[str]) -> dict:
+    """Z(N) = Z(inf) + a / N through the replica means of several sizes (their errors from the
+    spread), per law and for the laws pooled (one Z(inf) and one a for both: equilibrium says
+    they share them); Z(inf) against Liu's form in its own errors."""
+    studies = []
+    for p in paths:
+        with open(p) as f:
+            studies.append(json.load(f))
+    laws = sorted({law for s in studies for law in s["summary"] if " - " not in law})
+    out = {"sizes": sorted(s["n"] for s in studies), "files": [os.path.basename(p) for p in paths], "fits": {}}
+    pooled = []
+    for law in laws:
+        pts = [(1.0 / s["n"], s["summary"][law]["mean"], s["summary"][law]["error_from_spread"])
+               for s in studies if law in s["summary"]]
+        pooled += pts
+        if len(pts) >= 2:
+            out["fits"][law] = _line_fit(pts)
+    if len(laws) > 1 and len(pooled) >= 3:
+        out["fits"]["pooled"] = _line_fit(pooled)
+    ref = studies[0]["summary"][laws[0]]["z_ref_liu"]
+    for f in out["fits"].values():
+        f["z_ref_liu"] = ref
+        f["sigmas_from_liu"] = (f["z_inf"] - ref) / f["z_inf_error"]
+        f["relative_to_liu"] = f["z_inf"] / ref - 1.0
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--dim", type=int, choices=(2, 3), required=True)
-    ap.add_argument("--phi", type=float, required=True)
-    ap.add_argument("--n", type=int, required=True)
+    ap.add_argument("--dim", type=int, choices=(2, 3))
+    ap.add_argument("--phi", type=float)
+    ap.add_argument("--n", type=int)
     ap.add_argument("--laws", nargs="+", default=["specular", "flux"], choices=["specular", "flux", "uniform", "paper"])
     ap.add_argument("--per-particle", type=int, default=20000, help="observed collisions per particle per run")
     ap.add_argument("--seeds", type=int, default=8, help="independent runs per law (>= 2)")
     ap.add_argument("--first-seed", type=int, default=1)
     ap.add_argument("--cores", type=int, nargs="*", default=None, help="pin runs to these cores, one run per core at a time")
     ap.add_argument("--json", required=True)
+    ap.add_argument("--fit", nargs="+", metavar="STUDY_JSON",
+                    help="no runs: fit Z(N) = Z(inf) + a / N through these studies' replica means (sizes of one point)")
     args = ap.parse_args(argv)
+    if args.fit:
+        res = fit(args.fit)
+        res["command"] = " ".join([os.path.basename(sys.executable)] + sys.argv)
+        _write_atomic(args.json, res)
+        print(json.dumps(res["fits"], indent=1))
+        return 0
+    if args.dim is None or args.phi is None or args.n is None:
+        ap.error("--dim, --phi and --n are needed to run a study (or --fit)")
     if args.seeds < 2:
         ap.error("--seeds must be >= 2 (the spread needs two runs)")
     if args.n < 2 or args.per_particle < 1 or not (0.0 < args.phi < 1.0):

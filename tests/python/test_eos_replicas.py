@@ -54,4 +54,31 @@ def test_bad_arguments_are_named(tmp_path, capsys):
     with pytest.raises(SystemExit):
         er.main(["--dim", "2", "--phi", "1.5", "--n", "200", "--json", str(tmp_path / "x.json")])
     assert "--phi" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        er.main(["--json", str(tmp_path / "x.json")])  # neither a study nor --fit
+    assert "--dim" in capsys.readouterr().err
     assert not (tmp_path / "x.json").exists()
+
+
+def test_fit_in_one_over_n(tmp_path):
+    """Three sizes on an exact line Z = 6.45 + 6 / N: the fit returns it, per law and pooled;
+    an intercept 2 errors from Liu's value is 2 sigmas."""
+    files = []
+    for n in (1000, 4000, 16000):
+        z = 6.45 + 6.0 / n
+        summary = {law: {"mean": z + dz, "error_from_spread": 0.001, "z_ref_liu": 6.448} for law, dz in
+                   (("specular", 0.0), ("flux", 0.0))}
+        p = tmp_path / f"s{n}.json"
+        p.write_text(json.dumps({"n": n, "summary": summary}))
+        files.append(str(p))
+    out_path = tmp_path / "fit.json"
+    assert er.main(["--fit", *files, "--json", str(out_path)]) == 0
+    res = json.loads(out_path.read_text())
+    assert res["sizes"] == [1000, 4000, 16000]
+    for key in ("specular", "flux", "pooled"):
+        f = res["fits"][key]
+        assert f["z_inf"] == pytest.approx(6.45, abs=1e-12) and f["a"] == pytest.approx(6.0, rel=1e-9)
+        assert f["chi2"] == pytest.approx(0.0, abs=1e-12)
+        assert f["sigmas_from_liu"] == pytest.approx(0.002 / f["z_inf_error"])
+    assert res["fits"]["pooled"]["dof"] == 4 and res["fits"]["flux"]["dof"] == 1
+    assert res["fits"]["pooled"]["z_inf_error"] < res["fits"]["flux"]["z_inf_error"]
