@@ -41,11 +41,10 @@ from concurrent.futures import ThreadPoolExecutor
 
 
 def _write_atomic(path: str, obj) -> None:
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
+    from revcol._io import atomic_open  # the package's atomic writer (the package under test)
+    with atomic_open(path) as f:
         json.dump(obj, f, indent=1)
         f.write("\n")
-    os.replace(tmp, path)
 
 
 def _git_commit() -> str:

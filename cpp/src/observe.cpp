@@ -110,7 +110,6 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   speed_max_ = c.speed_max > 0.0 ? c.speed_max : 5.0 * vrms;
   bin_scale_ = c.speed_bins / speed_max_;
   bin_cap_ = c.speed_bins;
-  extras_ = c.pair_bins > 0 || c.collision_record;
   set_geometry(box);
   slab_w_ = c.slabs > 0 ? box_[c.slab_axis] / c.slabs : 0.0;
   t_start_ = t_now_ = t;
@@ -133,7 +132,8 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
 // The pair hook's fast path runs while t < fast_until_: the open block's end, or -inf
 // with pair distances or the collision record (every hook then takes pair_general).
 void Observer::set_fast_until() {
-  fast_until_ = extras_ ? -std::numeric_limits<double>::infinity() : cur_.t0 + block_time_;
+  const bool extras = cfg_.pair_bins > 0 || cfg_.collision_record;
+  fast_until_ = extras ? -std::numeric_limits<double>::infinity() : cur_.t0 + block_time_;
 }
 
 void Observer::set_geometry(const std::array<double, 3>& box) {
@@ -251,7 +251,6 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
   bin_scale_ = cfg_.speed_bins / speed_max_;
   bin_cap_ = cfg_.speed_bins;
-  extras_ = cfg_.pair_bins > 0 || cfg_.collision_record;
   set_geometry(box);
   slab_w_ = cfg_.slabs > 0 ? box_[cfg_.slab_axis] / cfg_.slabs : 0.0;
   std::size_t u = kHeader;
@@ -321,13 +320,19 @@ template <int K>
   cur_.speed[s.bin] += dt;
   if (cfg_.slabs > 0) {
     const double end = s.x[cfg_.slab_axis] + s.v[cfg_.slab_axis] * dt;
-    if (end >= s.lo && end < s.hi) {
+    if (in_cell(s, end)) {
       add_slab(s, dt);
     } else {
       slab_cross(s, t, end);
     }
   }
   fly<K>(s, t, dt);
+}
+
+// Slabs: whether s's position on the slab axis at its end is still in its cell (then the
+// segment never left it: the motion is linear).
+[[gnu::always_inline]] inline bool Observer::in_cell(const Segment& s, double end) {
+  return end >= s.lo && end < s.hi;
 }
 
 // A segment that ends in its cell: its duration (and v^2 times it) to its slab.
@@ -490,7 +495,7 @@ void Observer::pair_d(double t, int a, int b, const double* va, const double* vb
   if (cfg_.slabs > 0) {
     const int x = cfg_.slab_axis;
     const double ea = sa.x[x] + sa.v[x] * da, eb = sb.x[x] + sb.v[x] * db;
-    rare |= !(ea >= sa.lo && ea < sa.hi) | !(eb >= sb.lo && eb < sb.hi);
+    rare |= !in_cell(sa, ea) | !in_cell(sb, eb);
   }
   if (rare) [[unlikely]] {
     pair_general<Dim>(t, a, b, va, vb);

@@ -197,6 +197,7 @@ class Observer {
   void accumulate(double t);
   template <int K>
   void close(int i, double t);
+  static bool in_cell(const Segment& s, double end);
   void add_slab(const Segment& s, double dt);
   template <int K>
   void fly(Segment& s, double t, double dt);
@@ -223,7 +224,6 @@ class Observer {
   std::array<bool, 3> walls_;
   double diameter_, volume_, block_time_, t_start_, t_now_, speed_max_, bin_scale_;
   double bin_cap_;  // speed_bins: the overflow bin's index
-  bool extras_ = false;  // pair distances or the collision record: every pair hook takes pair_general
   double fast_until_ = 0.0;  // the pair hook's fast path runs before it (set_fast_until)
   void set_fast_until();
   double v2_sum_ = 0.0, speed_sum_ = 0.0;  // sum v^2 and sum |v|, integrated up to t_now_
