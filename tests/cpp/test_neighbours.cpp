@@ -41,12 +41,14 @@ int brute_count(const Config& c, const std::vector<double>& x, int i, double rea
   return m;
 }
 
+// L = 12: 7 cells per axis, so a renewal takes each candidate's image code from its cell
+// (scan_cells<true>); L = 4.5: 2 cells, the general nearest-image path.
 template <int Dim>
-void check_gas(Boundary b0, Boundary b1, Boundary b2, std::uint32_t seed) {
-  const double L = 12.0, reach = 1.6;
+void check_gas(Boundary b0, Boundary b1, Boundary b2, std::uint32_t seed, double L = 12.0) {
+  const double reach = 1.6;
   const Config c = box_config<Dim>(b0, b1, b2, L);
   const Boundaries<Dim> box(c);
-  const int n = Dim == 3 ? 400 : 150;
+  const int n = L < 6.0 ? (Dim == 3 ? 12 : 6) : (Dim == 3 ? 400 : 150);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.0, L);
   std::vector<double> x(n * Dim);
@@ -98,6 +100,14 @@ TEST_CASE("3D: lists equal the brute-force neighbourhoods, periodic, walls and m
   check_gas<3>(Boundary::periodic, Boundary::periodic, Boundary::periodic, 4);
   check_gas<3>(Boundary::wall, Boundary::wall, Boundary::wall, 5);
   check_gas<3>(Boundary::periodic, Boundary::wall, Boundary::periodic, 6);
+}
+
+TEST_CASE("a periodic axis of 2 cells: renewals find the nearest image without the cells' codes") {
+  for (std::uint32_t seed = 7; seed <= 9; ++seed) {
+    check_gas<2>(Boundary::periodic, Boundary::periodic, Boundary::periodic, seed, 4.5);
+    check_gas<2>(Boundary::periodic, Boundary::wall, Boundary::periodic, seed, 4.5);
+    check_gas<3>(Boundary::periodic, Boundary::periodic, Boundary::periodic, seed, 4.5);
+  }
 }
 
 TEST_CASE("image codes mirror: near(i, j) and near(j, i) agree, codes 1 <-> 2") {

@@ -49,10 +49,12 @@ class NeighbourLists {
     list_r2_ = reach * reach;
     adj_ = Dim == 1 && adjacent;
     total_cells_ = 1;
+    cells_code_images_ = true;
     for (int k = 0; k < Dim; ++k) {
       const double L = box.length(k);
       nc_[k] = std::max(1, static_cast<int>(std::floor(L / reach)));
       cw_[k] = L / nc_[k];
+      if (box.periodic(k) && nc_[k] < 3) cells_code_images_ = false;
       stride_[k] = total_cells_;
       total_cells_ *= nc_[k];
       shift_tab_[k][0] = 0.0;
@@ -248,7 +250,17 @@ class NeighbourLists {
   // (every cell of a periodic axis with fewer than 3, each once).
   template <class F>
   void for_cells(int i, F&& f) const {
+    scan_cells<false>(i, f);
+  }
+  // The same scan; Coded: f(j, code) with the image code of j's cell seen from i's (a
+  // neighbouring cell reached across a periodic axis's end: j + L or j - L). With at least 3
+  // cells on every periodic axis (cells_code_images_) this is the code of j's nearest image
+  // whenever j is within reach of i: that image lies in one of the 3 cells around i's,
+  // which are then distinct.
+  template <bool Coded, class F>
+  void scan_cells(int i, F&& f) const {
     int idx[3][3];
+    unsigned icode[3][3] = {};
     int cnt[3] = {1, 1, 1};
     idx[1][0] = idx[2][0] = 0;
     for (int k = 0; k < Dim; ++k) {
@@ -261,35 +273,59 @@ class NeighbourLists {
       }
       for (int off = -1; off <= 1; ++off) {
         int ck = c0 + off;
+        unsigned code = 0;
         if (ck < 0 || ck >= nc_[k]) {
           if (!per) continue;
+          code = ck < 0 ? 2u : 1u;  // below 0: j's image at x_j - L; past the end: x_j + L
           ck += ck < 0 ? nc_[k] : -nc_[k];
         }
+        icode[k][cnt[k]] = code << (2 * k);
         idx[k][cnt[k]++] = ck * stride_[k];
       }
     }
     // the chains are walked side by side, one link of each per round: their loads are
     // independent, so the cache misses overlap (measured faster than one chain at a time)
     int cur[27];
+    unsigned cur_code[27];
     int m = 0;
     for (int c = 0; c < cnt[2]; ++c)
       for (int b = 0; b < cnt[1]; ++b) {
         const int base = idx[1][b] + idx[2][c];
+        const unsigned code_bc = icode[1][b] | icode[2][c];
         for (int a = 0; a < cnt[0]; ++a) {
           const int h = head_[idx[0][a] + base];
-          if (h >= 0) cur[m++] = h;
+          if (h >= 0) {
+            cur_code[m] = code_bc | icode[0][a];
+            cur[m++] = h;
+          }
         }
       }
     while (m > 0) {
       int live = 0;
       for (int q = 0; q < m; ++q) {
         const int j = cur[q];
-        if (j != i) f(j);
+        if (j != i) {
+          if constexpr (Coded) f(j, cur_code[q]);
+          else f(j);
+        }
         const int nx = cn_[j].next;
-        if (nx >= 0) cur[live++] = nx;
+        if (nx >= 0) {
+          cur_code[live] = cur_code[q];
+          cur[live++] = nx;
+        }
       }
       m = live;
     }
+  }
+  // near() for a pair whose image code is known (scan_cells<true>): the same separations,
+  // bit for bit (d - L, d + L or d - 0 = d), with no test of the axis kind.
+  bool near_coded(int i, int j, unsigned code) const {
+    double d2 = 0.0;
+    for (int k = 0; k < Dim; ++k) {
+      const double d = (cn_[i].c[k] - cn_[j].c[k]) - shift_tab_[k][(code >> (2 * k)) & 3u];
+      d2 += d * d;
+    }
+    return d2 < list_r2_;
   }
 
   void list_insert(int i, int j, unsigned code) {
@@ -380,9 +416,7 @@ class NeighbourLists {
     unsigned char fcode[kMaxList];
     int nf = 0;
     bool spill = false;
-    for_cells(i, [&](int j) {
-      unsigned code;
-      if (!near(i, j, code)) return;
+    const auto listed = [&](int j, unsigned code) {
       if (nf == kMaxList) {
         spill = true;
         return;
@@ -395,7 +429,17 @@ class NeighbourLists {
       }
       fresh[m] = j;
       fcode[m] = static_cast<unsigned char>(code);
-    });
+    };
+    if (cells_code_images_) {
+      scan_cells<true>(i, [&](int j, unsigned code) {
+        if (near_coded(i, j, code)) listed(j, code);
+      });
+    } else {
+      for_cells(i, [&](int j) {
+        unsigned code;
+        if (near(i, j, code)) listed(j, code);
+      });
+    }
     if (spill) {  // beyond kMaxList (not reached, see there): the slow way
       for (int u = 0; u < nbn_[i]; ++u) list_erase(nb_[static_cast<std::size_t>(i) * nbcap_ + u], i);
       nbn_[i] = 0;
@@ -438,6 +482,7 @@ class NeighbourLists {
   std::array<double, Dim> cw_{};
   std::array<int, Dim> nc_{}, stride_{};
   int total_cells_ = 1;
+  bool cells_code_images_ = true;        // every periodic axis has >= 3 cells (scan_cells<true>)
   double shift_tab_[Dim][4] = {};        // image code -> shift
   std::vector<int> cell_, head_;         // cells of the list centres, heads of their chains
   std::vector<Centre> cn_;
