@@ -325,16 +325,12 @@ class EngineImpl final : public Simulation {
     }
     double first = kInf, second = kInf;  // the two earliest collision times (the group gate)
     bool touch = false;
+    const Particle<Dim>& pi = p_[i];
+    double limit = prune_limit(best.t);
     for_neighbours(i, [&](int j, const Vec& sh) {
       double t;
-      bool hit, tj = false;
-      if (i < j) {
-        hit = Kin::pair_time(p_[i], p_[j], sh, sigma2_, contact_tol_, t, tj);
-      } else {
-        Vec s;
-        for (int k = 0; k < Dim; ++k) s[k] = -sh[k];
-        hit = Kin::pair_time(p_[j], p_[i], s, sigma2_, contact_tol_, t, tj);
-      }
+      bool tj = false;
+      const bool hit = Kin::pair_time(pi, p_[j], sh, sigma2_, contact_tol_, t, tj, limit);
       if (tj) {
         touch = true;
         touching_[j] = 1;
@@ -347,11 +343,23 @@ class EngineImpl final : public Simulation {
       } else if (t < second) {
         second = t;
       }
-      if (earlier(t, kColl, j, best)) best = Ev{t, kColl, j, p_[j].stamp};
+      if (earlier(t, kColl, j, best)) {
+        best = Ev{t, kColl, j, p_[j].stamp};
+        limit = prune_limit(best.t);
+      }
     });
     ev_[i] = best;
     second_[i] = second;
     touching_[i] = touch ? 1 : 0;
+  }
+
+  // Candidates provably later than this are skipped before their square root. The margin,
+  // 2e-9 (max(|t|, |clock|) + 1), is twice the group gate's window (collide): a collision
+  // time the gate compares (second_) is never skipped, and rounding in the test (a few
+  // ulps) is far inside it.
+  double prune_limit(double t) const {
+    if (t == kInf) return kInf;
+    return t + 2e-9 * (std::max(std::fabs(t), std::fabs(clock_)) + 1.0);
   }
 
   // ---- the event queue (revcol/engine/event_queue.hpp), key (t, kind, id) ----------------
