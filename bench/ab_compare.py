@@ -3,15 +3,22 @@ figures: throughput of `revcol-bench --bench engine/<case>`, and the horizon and
 studies of bench/engine_study.py run against each build's staged package.
 
     python3 bench/ab_compare.py throughput OLD_BUILD NEW_BUILD [--rounds 5] [--cpu 1]
+        [--case engine/d3/n10000/phi0.45 ...] [--custom "d=3,n=10976,phi=0.45,warm=30" ...]
+        [--json bench/results/ab_throughput.json]
     python3 bench/ab_compare.py studies    OLD_BUILD NEW_BUILD
 
 A build directory is one made by scripts/dev_build.sh (it holds revcol-bench and pkg/).
 Throughput: each round runs every case once per build, alternating which build goes first,
 one process per run pinned to one core (`taskset -c CPU`), and records the load average
 before each run; the report gives per build and case the median and the range over rounds,
-and new/old of the medians. Studies: engine_study.py horizon and memory, once per build,
-with each build's package on PYTHONPATH; their JSON goes to a temporary folder and the
-report keeps both. Writes bench/results/ab_<what>.json.
+new/old of the medians, and the paired ratios: new/old of the two runs of each round (taken
+minutes apart at most, so a slow phase of a shared host hits both), their median and
+quartiles, which resolve a few per cent where the medians of either build swing by 10%.
+`--case` chooses named cases (default: all five below); `--custom SPEC` adds an
+`engine/custom` case with REVCOL_ENGINE=SPEC (any number of each). Studies:
+engine_study.py horizon and memory, once per build, with each build's package on
+PYTHONPATH; their JSON goes to a temporary folder and the report keeps both. Writes
+bench/results/ab_<what>.json (or --json).
 """
 from __future__ import annotations
 
@@ -38,16 +45,26 @@ def _load() -> float:
 
 
 def _bench(build: str, case: str, collisions: int, cpu: int | None) -> dict:
+    """One run; `case` is a named bench or "engine/custom:SPEC" (REVCOL_ENGINE=SPEC)."""
+    name, _, spec = case.partition(":")
+    env = dict(os.environ, REVCOL_ENGINE=spec) if spec else None
     with tempfile.TemporaryDirectory() as tmp:
         js = os.path.join(tmp, "b.json")
-        cmd = [os.path.join(build, "revcol-bench"), "--bench", case, "--collisions", str(collisions),
+        cmd = [os.path.join(build, "revcol-bench"), "--bench", name, "--collisions", str(collisions),
                "--repeats", "1", "--json", js]
         if cpu is not None and shutil.which("taskset"):
             cmd = ["taskset", "-c", str(cpu)] + cmd
-        subprocess.run(cmd, check=True, capture_output=True)
+        subprocess.run(cmd, check=True, capture_output=True, env=env)
         with open(js) as f:
             data = json.load(f)
-    return {r["metric"]: r["median"] for r in data["results"] if r["bench"] == case}
+    return {r["metric"]: r["median"] for r in data["results"] if r["bench"] == name}
+
+
+def _paired(new: list[float], old: list[float]) -> dict:
+    """new/old per round: median and quartiles (the middle half) of the ratios."""
+    ratios = [a / b for a, b in zip(new, old)]
+    q = statistics.quantiles(ratios, n=4, method="inclusive") if len(ratios) > 1 else [ratios[0]] * 3
+    return dict(median=statistics.median(ratios), quartiles=[q[0], q[2]], ratios=ratios)
 
 
 def _summary(values: list[float]) -> dict:
@@ -56,11 +73,12 @@ def _summary(values: list[float]) -> dict:
 
 def throughput(args) -> dict:
     builds = {"old": args.old, "new": args.new}
-    raw = {b: {c: [] for c in CASES} for b in builds}
+    cases = (args.case or ([] if args.custom else CASES)) + [f"engine/custom:{c}" for c in (args.custom or [])]
+    raw = {b: {c: [] for c in cases} for b in builds}
     loads = []
     for k in range(args.rounds):
         order = ["old", "new"] if k % 2 == 0 else ["new", "old"]
-        for case in CASES:
+        for case in cases:
             nc = 2 * args.collisions if "n100000" in case else args.collisions
             for b in order:
                 loads.append(_load())
@@ -69,22 +87,29 @@ def throughput(args) -> dict:
                 print(f"round {k} {b:3s} {case:28s} forward {r['forward_per_s']:.3g}/s "
                       f"reverse {r['reverse_per_s']:.3g}/s (load {loads[-1]:.2f})", flush=True)
     rows = []
-    for case in CASES:
+    for case in cases:
         row = dict(case=case)
         for b in builds:
             for m in ("forward_per_s", "reverse_per_s"):
                 row[f"{b}_{m}"] = _summary([r[m] for r in raw[b][case]])
         for m in ("forward_per_s", "reverse_per_s"):
             row[f"new_over_old_{m}"] = row[f"new_{m}"]["median"] / row[f"old_{m}"]["median"]
+            row[f"paired_new_over_old_{m}"] = _paired([r[m] for r in raw["new"][case]],
+                                                       [r[m] for r in raw["old"][case]])
         rows.append(row)
     for r in rows:
         print(f"{r['case']:28s} forward old {r['old_forward_per_s']['median']:.3g} "
               f"[{r['old_forward_per_s']['min']:.3g}, {r['old_forward_per_s']['max']:.3g}] "
               f"new {r['new_forward_per_s']['median']:.3g} "
               f"[{r['new_forward_per_s']['min']:.3g}, {r['new_forward_per_s']['max']:.3g}] "
-              f"new/old {r['new_over_old_forward_per_s']:.3f} | reverse new/old {r['new_over_old_reverse_per_s']:.3f}")
+              f"new/old {r['new_over_old_forward_per_s']:.3f} (paired {_fmt(r['paired_new_over_old_forward_per_s'])}) | "
+              f"reverse new/old {r['new_over_old_reverse_per_s']:.3f} (paired {_fmt(r['paired_new_over_old_reverse_per_s'])})")
     return dict(rows=rows, load_avg=_summary(loads), rounds=args.rounds, cpu=args.cpu,
                 collisions=args.collisions)
+
+
+def _fmt(p: dict) -> str:
+    return f"{p['median']:.3f} [{p['quartiles'][0]:.3f}, {p['quartiles'][1]:.3f}]"
 
 
 def _study(build: str, study: str, extra: list[str]) -> dict:
@@ -133,6 +158,9 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--collisions", type=int, default=1_000_000, help="per run (twice that at N = 1e5)")
     ap.add_argument("--cpu", type=int, default=1, help="core to pin each run to (taskset); -1: no pinning")
+    ap.add_argument("--case", action="append", help="a named engine bench (repeatable; default: all five)")
+    ap.add_argument("--custom", action="append", help="an engine/custom case: its REVCOL_ENGINE (repeatable)")
+    ap.add_argument("--json", help="where the report goes (default bench/results/ab_<what>.json)")
     args = ap.parse_args()
     if args.cpu is not None and args.cpu < 0:
         args.cpu = None
@@ -140,7 +168,7 @@ def main() -> None:
     report.update(command=" ".join(sys.argv), date=time.strftime("%Y-%m-%d %H:%M:%S %Z"), machine=os.uname().nodename,
                   old=os.path.abspath(args.old), new=os.path.abspath(args.new))
     os.makedirs(RESULTS, exist_ok=True)
-    path = os.path.join(RESULTS, f"ab_{args.what}.json")
+    path = args.json or os.path.join(RESULTS, f"ab_{args.what}.json")
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
         json.dump(report, f, indent=1)

@@ -110,3 +110,25 @@ def test_peer_commit_is_not_revcols_for_an_unpacked_archive_inside_its_tree(tmp_
                           text=True).stdout.strip()
     assert fs.peer_commit(str(inner)) == want
     assert fs.peer_commit(str(tmp_path / "nowhere")) == "unknown (not a git checkout)"
+
+
+BSPEC = importlib.util.spec_from_file_location(
+    "fs_edmd_builds", os.path.join(HERE, "..", "..", "bench", "peers", "fs_edmd_builds.py"))
+builds = importlib.util.module_from_spec(BSPEC)
+BSPEC.loader.exec_module(builds)
+
+
+def test_builds_benchmark_without_the_peer_says_where_it_goes_and_measures_nothing(tmp_path, capsys):
+    out = tmp_path / "builds.json"
+    assert builds.main(["--src", str(tmp_path / "nowhere"), "--build", "installed=", "--json", str(out)]) == 0
+    assert "git clone https://github.com/FSmallenburg/EDMD" in capsys.readouterr().out
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("arg, said", [("nameonly", "NAME=PATH"), ("=somewhere", "NAME=PATH"),
+                                       ("old=/no/such/folder", "no revcol package in /no/such/folder")])
+def test_builds_benchmark_names_a_bad_build_argument(tmp_path, capsys, arg, said):
+    with pytest.raises(SystemExit) as e:
+        builds.main(["--src", str(tmp_path / "nowhere"), "--build", arg])
+    assert e.value.code == 2
+    assert said in capsys.readouterr().err

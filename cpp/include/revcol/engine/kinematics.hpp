@@ -7,14 +7,15 @@
 // x(t) = x_i + v_i (t - t_i). Moving the stored state to t (advance) changes the stamp,
 // which invalidates every prediction made with the old state.
 //
-// Pair contact. For the pair (a, b), a < b, with image shift s (r = x_a - x_b - s), from the
-// later of the two local times t_r: with b = r.w (w = v_a - v_b), c = r^2 - D^2 and
+// Pair contact. For a particle a and its listed b with image shift s (r = x_a - x_b - s),
+// from the later of the two local times t_r: with b = r.w (w = v_a - v_b), c = r^2 - D^2 and
 // disc = b^2 - w^2 c, an approaching pair (b < 0) meets at
 //     t = t_r + c / (-b + sqrt(disc))
 // the cancellation-free root (the textbook (-b - sqrt(disc)) / w^2 loses digits when
-// c << b^2 / w^2). Ordering by id and starting from the later local time make both
-// partners compute the same bits. A pair closer than D (1 + group_tol) and not separating
-// is "touching" (the engine's group gate).
+// c << b^2 / w^2). Seen from b's side (shift -s) r and w are negated exactly, so both
+// partners compute the same bits; starting from the later local time keeps that true
+// whichever was moved last. A pair closer than D (1 + group_tol) and not separating is
+// "touching" (the engine's group gate).
 //
 // List renewal. A particle leaves the sphere of radius h around its list centre c at the
 // later root of |x_i + v (t - t_i) - c| = h, again in cancellation-free form.
