@@ -222,11 +222,12 @@ print("REVCOL_SELF " + json.dumps({"forward": c / (t1 - t0), "reverse": c / (t2 
 """
 
 
-def run_revcol(state_npz: str, warmup: int, collisions: int, cpu: int) -> dict:
+def run_revcol(state_npz: str, warmup: int, collisions: int, cpu: int, env: Optional[dict] = None) -> dict:
     """One revcol process (the float engine, exact mode, flux law, Philox): forward and reverse
-    collisions per second of the timed run after an untimed warm-up."""
+    collisions per second of the timed run after an untimed warm-up. ``env``: the child's
+    environment (default: this process's), e.g. a PYTHONPATH naming another build."""
     p = subprocess.run(_pin([sys.executable, "-c", _REVCOL_CHILD, state_npz, str(warmup), str(collisions)], cpu),
-                       capture_output=True, text=True)
+                       capture_output=True, text=True, env=env)
     if p.returncode != 0:
         raise RuntimeError(f"the revcol child failed ({p.returncode}):\n{p.stderr[-3000:]}")
     out = p.stdout

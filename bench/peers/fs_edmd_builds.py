@@ -15,10 +15,8 @@ not comparable: the same binary's rate moves by 20% between sessions on a shared
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -30,19 +28,13 @@ sys.path.insert(0, HERE)
 import fs_edmd  # noqa: E402
 
 
-def _child(path: str, npz: str, warmup: int, collisions: int, cpu: int) -> dict:
+def _env(path: str) -> dict:
+    """The environment of a child that imports the build at ``path`` ('' : the installed one)."""
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)
     if path:
         env["PYTHONPATH"] = os.path.abspath(path)
-    p = subprocess.run(fs_edmd._pin([sys.executable, "-c", fs_edmd._REVCOL_CHILD, npz, str(warmup), str(collisions)],
-                                    cpu), capture_output=True, text=True, env=env)
-    if p.returncode != 0:
-        raise RuntimeError(f"the revcol child ({path or 'installed'}) failed:\n{p.stderr[-3000:]}")
-    line = [x for x in p.stdout.splitlines() if x.startswith("REVCOL_SELF ")]
-    if not line:
-        raise RuntimeError(f"the revcol child printed no REVCOL_SELF line:\n{p.stdout[-2000:]}")
-    return json.loads(line[0][len("REVCOL_SELF "):])
+    return env
 
 
 def main(argv: list | None = None) -> int:
@@ -90,7 +82,7 @@ def main(argv: list | None = None) -> int:
                 if who == "peer":
                     runs["peer"].append(fs_edmd.run_peer(exe, sph, args.cpu))
                 else:
-                    d = _child(paths[who], npz, wpeer, c, args.cpu)
+                    d = fs_edmd.run_revcol(npz, wpeer, c, args.cpu, env=_env(paths[who]))
                     runs[who]["forward"].append(d["forward"])
                     runs[who]["reverse"].append(d["reverse"])
     peer = statistics.median(runs["peer"])

@@ -179,8 +179,8 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
   const Vec s = nl_.pair_shift(a, b);
   // The gather scans two neighbourhoods; it runs only when a group is possible: a
   // neighbour was within the contact tolerance at a prediction (resting contacts), or a
-  // second collision of a or b was predicted within a relative 1e-9 of t (ties).
-  const double window = t + 1e-9 * (std::fabs(t) + 1.0);
+  // second collision of a or b was predicted within a relative kTieWindow of t (ties).
+  const double window = t + kTieWindow * (std::fabs(t) + 1.0);
   const bool maybe = cfg_.force_group_search || touching_[a] || touching_[b] || second_[a] <= window ||
                      second_[b] <= window;
   if (cfg_.groups && maybe) {

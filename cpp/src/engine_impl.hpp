@@ -37,6 +37,9 @@ namespace revcol::engine::detail {
 
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 inline constexpr int kMaxGroup = 8;  // particles in one group collision
+// The group gate's window: a second collision within a relative kTieWindow of t (collide)
+// may make a group; a prediction never skips a candidate within twice that (prune_limit).
+inline constexpr double kTieWindow = 1e-9;
 
 enum Kind : std::int32_t { kWall = 0, kRenew = 1, kColl = 2, kNone = 3 };  // kRenew: neighbour-list renewal
 
@@ -354,12 +357,12 @@ class EngineImpl final : public Simulation {
   }
 
   // Candidates provably later than this are skipped before their square root. The margin,
-  // 2e-9 (max(|t|, |clock|) + 1), is twice the group gate's window (collide): a collision
+  // 2 kTieWindow (max(|t|, |clock|) + 1), is twice the group gate's window (collide): a collision
   // time the gate compares (second_) is never skipped, and rounding in the test (a few
   // ulps) is far inside it.
   double prune_limit(double t) const {
     if (t == kInf) return kInf;
-    return t + 2e-9 * (std::max(std::fabs(t), std::fabs(clock_)) + 1.0);
+    return t + 2.0 * kTieWindow * (std::max(std::fabs(t), std::fabs(clock_)) + 1.0);
   }
 
   // ---- the event queue (revcol/engine/event_queue.hpp), key (t, kind, id) ----------------
