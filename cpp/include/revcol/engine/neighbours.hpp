@@ -308,11 +308,12 @@ class NeighbourLists {
           if constexpr (Coded) f(j, cur_code[q]);
           else f(j);
         }
+        // kept without a branch (live <= q: the slot is read already): chains are ~2 links
+        // long, so whether one goes on is a coin toss a branch predictor loses
         const int nx = cn_[j].next;
-        if (nx >= 0) {
-          cur_code[live] = cur_code[q];
-          cur[live++] = nx;
-        }
+        cur_code[live] = cur_code[q];
+        cur[live] = nx;
+        live += nx >= 0 ? 1 : 0;
       }
       m = live;
     }
