@@ -30,6 +30,7 @@ void add_exact_benches(std::vector<Bench>& out);      ///< exact_bench.cpp: the 
 void add_paper_benches(std::vector<Bench>& out);      ///< paper_bench.cpp: paper-mode 3D pair, triples
 void add_statesave_benches(std::vector<Bench>& out);  ///< statesave_bench.cpp: SS1/SS2/RC study
 void add_pair3d_benches(std::vector<Bench>& out);     ///< pair3d_bench.cpp: the fast exact 3D pair operator
+void add_floor_benches(std::vector<Bench>& out);      ///< floor_bench.cpp: exact-flux pair operators against their bare floor
 void add_engine_benches(std::vector<Bench>& out);     ///< engine_bench.cpp: the event-driven engine
 void add_skip_benches(std::vector<Bench>& out);       ///< skip_bench.cpp: what a pair-only scene does not pay for
 void add_lattice_op_benches(std::vector<Bench>& out);  ///< lattice_op_bench.cpp: the exact lattice pair operator

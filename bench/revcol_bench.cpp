@@ -94,6 +94,7 @@ std::vector<Bench> all_benches() {
   revcol::bench::add_paper_benches(out);
   revcol::bench::add_statesave_benches(out);
   revcol::bench::add_pair3d_benches(out);
+  revcol::bench::add_floor_benches(out);
   revcol::bench::add_engine_benches(out);
   revcol::bench::add_skip_benches(out);
   revcol::bench::add_lattice_op_benches(out);

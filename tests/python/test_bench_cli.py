@@ -29,3 +29,21 @@ def test_float_notation_is_the_count():
     assert r.returncode == 0, r.stderr
     got = {line.split()[1]: line.split()[2] for line in r.stdout.splitlines() if len(line.split()) == 3}
     assert got["first_difference"] == "-1" and int(float(got["collisions_compared"])) == 2000
+
+
+def test_floor_bench_reverses_and_reports_both_operators():
+    # the floor is a real operator (it runs backwards to round-off) and both are timed; its
+    # figures are benchmarks, never judged here
+    r = subprocess.run([_bench_binary(), "--bench", "floor", "--collisions", "3000", "--repeats", "1"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    got = {}
+    for line in r.stdout.splitlines():
+        f = line.split()
+        if len(f) == 3 and f[0].startswith("floor/"):
+            got[(f[0], f[1])] = float(f[2])
+    for case in ("floor/pair2d", "floor/pair3d"):
+        for key in ("exact_forward_ns", "exact_reverse_ns", "floor_forward_ns", "floor_reverse_ns",
+                    "ratio_forward", "ratio_reverse"):
+            assert got[(case, key)] > 0.0, (case, key)
+        assert got[(case, "floor_roundtrip_rel_err")] < 1e-9

@@ -25,6 +25,7 @@ class FixedPoint {
     require(bits >= min_bits && bits <= max_bits, [&] { return std::string("bits must be in [" + std::to_string(min_bits) + ", " + std::to_string(max_bits) +
                 "], got " + std::to_string(bits)); });
     cells_ = std::ldexp(1.0, bits);
+    inv_cells_ = std::ldexp(1.0, -bits);
     mask_ = (std::uint64_t{1} << bits) - 1;
   }
   /// K.
@@ -33,8 +34,11 @@ class FixedPoint {
   double cells() const { return cells_; }
   /// Cell of c in [0,1]: floor(c 2^K), clamped to [0, 2^K - 1] (c = 1 can come from rounding).
   std::uint64_t encode(double c) const {
-    const double s = std::floor(c * cells_);
+    const double s = c * cells_;
     if (!(s > 0.0)) return 0;  // also catches a NaN, which validation rules out earlier
+    if (!(s < 0x1.0p+62)) return mask_;
+    // floor(s) for s > 0 is the conversion's truncation: the same bits, without floor's
+    // rounding-mode sequence (baseline x86-64 has no roundsd)
     const auto u = static_cast<std::uint64_t>(s);
     return u > mask_ ? mask_ : u;
   }
@@ -43,8 +47,9 @@ class FixedPoint {
     const double s = c * cells_;
     return s - std::floor(s);
   }
-  /// Centre of cell U: (U + 1/2) 2^-K, exact in double.
-  double decode(std::uint64_t u) const { return (static_cast<double>(u) + 0.5) / cells_; }
+  /// Centre of cell U: (U + 1/2) 2^-K, exact in double (a product by 2^-K: the quotient's
+  /// bits, without a division on the operators' hot path).
+  double decode(std::uint64_t u) const { return (static_cast<double>(u) + 0.5) * inv_cells_; }
   /// A random number G in (0,1) as a K-bit shift.
   std::uint64_t shift(double g) const { return encode(g); }
   /// (U + G) mod 2^K.
@@ -54,7 +59,7 @@ class FixedPoint {
 
  private:
   int bits_;
-  double cells_;
+  double cells_, inv_cells_;  // 2^K, 2^-K
   std::uint64_t mask_;
 };
 
