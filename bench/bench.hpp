@@ -1,6 +1,8 @@
 // Shared types of the revcol-bench binary. Each family of benchmarks lives in its own
 // bench/<family>_bench.cpp and appends to the list in add_<family>_benches().
 #pragma once
+#include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <functional>
@@ -37,6 +39,18 @@ void add_lattice_op_benches(std::vector<Bench>& out);  ///< lattice_op_bench.cpp
 void add_lattice_op3_benches(std::vector<Bench>& out); ///< lattice_op3_bench.cpp: the 3D lattice pair operator, its design study
 void add_lattice_benches(std::vector<Bench>& out);     ///< lattice_engine_bench.cpp: the 2D lattice engine
 void add_tradeoff_benches(std::vector<Bench>& out);    ///< tradeoff_bench.cpp: run time against error per operator and knob
+
+/// Seconds of the steady clock since t0.
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Median of a non-empty list (the mean of the middle two for an even count).
+inline double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
 
 /// Applies the environment variable `var`'s comma-separated key=value list: set(key, value)
 /// for each entry (it returns false for an unknown key). A malformed entry, an unknown key

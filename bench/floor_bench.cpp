@@ -21,10 +21,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include "bench.hpp"
+#include "pair_pool.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
 #include "revcol/collide/pair3d_exact.hpp"
 
@@ -35,35 +35,6 @@ using Clock = std::chrono::steady_clock;
 constexpr double kPi = 3.141592653589793238462643383279502884;
 constexpr double kTwoPi = 2.0 * kPi;
 constexpr int kRounds = 6;  // interleaved rounds per repeat
-
-template <int D>
-struct State {
-  PairV<D> pre;
-  std::array<double, D> n;
-  std::array<double, D - 1> g;
-};
-
-template <int D>
-std::vector<State<D>> make_pool(std::size_t P) {
-  std::mt19937_64 rng(20261125);
-  std::normal_distribution<double> N(0.0, 1.0);
-  std::uniform_real_distribution<double> U(0.0, 1.0);
-  std::vector<State<D>> pool(P);
-  for (State<D>& s : pool) {
-    for (;;) {
-      double p = 0.0;
-      for (int k = 0; k < D; ++k) {
-        s.pre.i[k] = N(rng);
-        s.pre.j[k] = N(rng);
-        s.n[k] = N(rng);
-        p += (s.pre.i[k] - s.pre.j[k]) * s.n[k];
-      }
-      if (p < 0.0) break;
-    }
-    for (double& g : s.g) g = U(rng);
-  }
-  return pool;
-}
 
 double wrap_add(double c, double g) {
   c += g;
@@ -138,19 +109,13 @@ PairV<3> floor3(const PairV<3>& v, const std::array<double, 3>& n, const std::ar
   return out;
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
-
 // One exact operator (Op: Pair2DExact or Pair3DExact, flux) and its floor on one pool.
 template <int D, class Op, class Floor>
 std::vector<Metric> run_floor(std::uint64_t n, Floor&& floor_op) {
   const std::size_t P = static_cast<std::size_t>(std::min<std::uint64_t>(std::max<std::uint64_t>(n, 1), 1 << 16));
-  const std::vector<State<D>> pool = make_pool<D>(P);
+  const std::vector<PairState<D>> pool = approaching_pool<D>(P, 20261125);
   const Op op(Law::flux);
-  const auto draws = [](const State<D>& s) {
+  const auto draws = [](const PairState<D>& s) {
     if constexpr (D == 2) return s.g[0];
     else return s.g;
   };
@@ -170,10 +135,10 @@ std::vector<Metric> run_floor(std::uint64_t n, Floor&& floor_op) {
     RareLog l;
     const auto t0 = Clock::now();
     for (std::uint64_t k = 0; k < n; ++k) {
-      const State<D>& s = pool[k % P];
+      const PairState<D>& s = pool[k % P];
       post[k % P] = op.forward(s.pre, s.n, draws(s), l);
     }
-    return std::chrono::duration<double>(Clock::now() - t0).count() / static_cast<double>(n);
+    return seconds_since(t0) / static_cast<double>(n);
   };
   const auto exact_rev = [&] {
     RareLog l;
@@ -184,15 +149,15 @@ std::vector<Metric> run_floor(std::uint64_t n, Floor&& floor_op) {
         for (std::uint64_t c : cells[i]) l.push(c);
       sink += op.reverse(post[i], pool[i].n, draws(pool[i]), l).i[0];
     }
-    return std::chrono::duration<double>(Clock::now() - t0).count() / static_cast<double>(n);
+    return seconds_since(t0) / static_cast<double>(n);
   };
   const auto floor_fwd = [&] {
     const auto t0 = Clock::now();
     for (std::uint64_t k = 0; k < n; ++k) {
-      const State<D>& s = pool[k % P];
+      const PairState<D>& s = pool[k % P];
       fpost[k % P] = floor_op(s.pre, s.n, draws(s), true);
     }
-    return std::chrono::duration<double>(Clock::now() - t0).count() / static_cast<double>(n);
+    return seconds_since(t0) / static_cast<double>(n);
   };
   const auto floor_rev = [&] {
     const auto t0 = Clock::now();
@@ -200,7 +165,7 @@ std::vector<Metric> run_floor(std::uint64_t n, Floor&& floor_op) {
       const std::size_t i = k % P;
       sink += floor_op(fpost[i], pool[i].n, draws(pool[i]), false).i[0];
     }
-    return std::chrono::duration<double>(Clock::now() - t0).count() / static_cast<double>(n);
+    return seconds_since(t0) / static_cast<double>(n);
   };
   std::vector<double> ef, er, ff, fr, rf, rr;
   for (int r = 0; r < kRounds; ++r) {

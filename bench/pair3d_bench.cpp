@@ -10,10 +10,10 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
-#include <random>
 #include <vector>
 
 #include "bench.hpp"
+#include "pair_pool.hpp"
 #include "revcol/collide/exact.hpp"
 #include "revcol/collide/pair3d_exact.hpp"
 
@@ -21,41 +21,11 @@ namespace revcol::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-struct State {
-  PairV<3> pre;
-  std::array<double, 3> n;
-  std::array<double, 2> g;
-};
-
-// A fixed pool of states (the same in every repeat and for both operators).
-std::vector<State> make_pool(std::size_t P) {
-  std::mt19937_64 rng(20240917);
-  std::normal_distribution<double> N(0.0, 1.0);
-  std::uniform_real_distribution<double> U(0.0, 1.0);
-  std::vector<State> pool(P);
-  for (State& s : pool) {
-    for (;;) {
-      double p = 0.0;
-      for (int k = 0; k < 3; ++k) {
-        s.pre.i[k] = N(rng);
-        s.pre.j[k] = N(rng);
-        s.n[k] = N(rng);
-        p += (s.pre.i[k] - s.pre.j[k]) * s.n[k];
-      }
-      if (p < 0.0) break;
-    }
-    s.g = {U(rng), U(rng)};
-  }
-  return pool;
-}
+using State = PairState<3>;
 
 std::vector<Metric> run_pair3d(Law law, std::uint64_t n) {
   const std::size_t P = static_cast<std::size_t>(std::min<std::uint64_t>(n, 1 << 16));
-  const std::vector<State> pool = make_pool(P);
+  const std::vector<State> pool = approaching_pool<3>(P, 20240917);
   const Pair3DExact op(law);
   std::vector<PairV<3>> post(P);
   RareLog log;

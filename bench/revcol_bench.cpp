@@ -104,12 +104,6 @@ std::vector<Bench> all_benches() {
   return out;
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
-
 int usage(int code) {
   std::fprintf(code ? stderr : stdout,
                "usage: revcol-bench [--list] [--bench NAME_OR_PREFIX]... [--repeats R]\n"
@@ -198,7 +192,7 @@ int main(int argc, char** argv) {
     for (std::size_t m = 0; m < reps[0].size(); ++m) {
       std::vector<double> vals;
       for (const auto& rep : reps) vals.push_back(rep[m].value);
-      const double med = median(vals);
+      const double med = revcol::bench::median(vals);
       std::printf("%-28s %-16s %14.6g\n", b->name.c_str(), reps[0][m].name.c_str(), med);
       std::string list_s;
       for (std::size_t k = 0; k < vals.size(); ++k) {

@@ -32,8 +32,6 @@ namespace {
 namespace en = revcol::engine;
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
 std::vector<Metric> pair_scene(std::uint64_t n, bool force_groups) {
   en::Config c;
   c.dim = 2;
