@@ -1,6 +1,7 @@
 #include "revcol/collide/pair2d_exact.hpp"
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <random>
 
@@ -195,6 +196,28 @@ TEST_CASE("chart edges: cells 0 and 2^K-1, grazing pre states, g next to 0 and 1
     }
     CHECK(log.size() == 0);
   }
+}
+
+TEST_CASE("the frame is the normal's direction whatever its magnitude (tiny, huge, subnormal)") {
+  // Frame2 normalizes by a square root and a reciprocal; a normal whose squares would
+  // underflow or overflow is first scaled by its largest component
+  const std::array<double, 2> dir{0.6, -0.8};  // unit to rounding
+  for (double m : {5e-324 / 0.6, 1e-300, 1e-160, 1e-5, 1.0, 3e7, 1e160, 1e300}) {
+    const Frame2 f({dir[0] * m, dir[1] * m});
+    const double tol = m < 1e-300 ? 0.5 : 4e-16;  // a subnormal normal keeps a few bits only
+    CHECK(std::fabs(f.a[0] - 0.6) <= tol && std::fabs(f.a[1] + 0.8) <= tol);
+    CHECK(std::fabs(f.a[0] * f.a[0] + f.a[1] * f.a[1] - 1.0) <= 4.0 * 2.3e-16);
+    CHECK(f.t[0] == -f.a[1] && f.t[1] == f.a[0]);
+  }
+  const Pair2DExact op;
+  RareLog log;
+  const V pre{{-0.3, 1.0}, {0.5, -0.2}};  // w = (-0.8, 1.2): approaches along (0.6, -0.8)
+  for (double m : {1e-300, 1.0, 1e300}) {
+    const std::array<double, 2> n{0.6 * m, -0.8 * m};
+    CHECK(round_trip(op, pre, n, 0.37, log));
+  }
+  CHECK_THROWS_AS(Frame2({0.0, 0.0}), InvalidArgument);
+  CHECK_THROWS_AS(Frame2({1e308, std::numeric_limits<double>::infinity()}), InvalidArgument);
 }
 
 TEST_CASE("bad input is rejected with a clear error and nothing changes") {

@@ -56,13 +56,26 @@ struct Frame2 {
   double t[2];  ///< unit tangent, a rotated by +90 degrees
 
   /// Builds the frame from any non-zero finite normal; throws InvalidArgument otherwise.
+  /// |a| is 1 to a few roundings, not exactly: the operators take |a|^2 - 1 into account
+  /// (Pair2DExact's scale), and t = (-a_y, a_x) has |t| = |a| and a.t = 0 exactly.
   explicit Frame2(const std::array<double, 2>& normal) {
     require(std::isfinite(normal[0]) && std::isfinite(normal[1]),
             "contact normal must be finite");
-    const double n = std::hypot(normal[0], normal[1]);
-    require(n > 0.0, "contact normal is zero");
-    a[0] = normal[0] / n;
-    a[1] = normal[1] / n;
+    double x0 = normal[0], x1 = normal[1];
+    double s2 = x0 * x0 + x1 * x1;
+    // a square root and one reciprocal (std::hypot cost ~11 ns, a fifth of the exact
+    // operator); a normal whose squares would underflow or overflow is first scaled by its
+    // largest component
+    if (!(s2 >= 0x1.0p-900 && s2 <= 0x1.0p+900)) [[unlikely]] {
+      const double m = std::fmax(std::fabs(x0), std::fabs(x1));
+      require(m > 0.0, "contact normal is zero");
+      x0 /= m;
+      x1 /= m;
+      s2 = x0 * x0 + x1 * x1;
+    }
+    const double r = 1.0 / std::sqrt(s2);
+    a[0] = x0 * r;
+    a[1] = x1 * r;
     t[0] = -a[1];
     t[1] = a[0];
   }

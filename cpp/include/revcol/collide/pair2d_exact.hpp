@@ -49,7 +49,10 @@ class Pair2DExact {
 
   /// An operator for the given law with K-bit chart coordinates.
   explicit Pair2DExact(Law law = Law::flux, int bits = FixedPoint::default_bits)
-      : law_(law), fp_(bits) {}
+      : law_(law), fp_(bits) {
+    const double lim = 1.0 / (8.0 * kUnitRoundoff * fp_.cells());
+    log_lim2_ = lim > 10.0 ? (lim - 10.0) * (lim - 10.0) : 0.0;
+  }
 
   /// The target law.
   Law law() const { return law_; }
@@ -144,10 +147,11 @@ class Pair2DExact {
     const double norm2 = w0 * w0 + w1 * w1;
     const double sum = std::fabs(post.i[0]) + std::fabs(post.i[1]) + std::fabs(post.j[0]) +
                        std::fabs(post.j[1]);
-    // 2 u 2^K (sum/|w| + 10) > 1/4  <=>  (sum + 10|w|)^2 > |w|^2 (1 / (8 u 2^K))^2
-    const double lim = 1.0 / (8.0 * kUnitRoundoff * fp_.cells());
-    const double lhs = sum + 10.0 * std::sqrt(norm2);
-    return !(lhs * lhs <= norm2 * lim * lim);  // also true for a zero or non-finite norm
+    // 2 u 2^K (sum/|w| + 10) > 1/4  <=>  sum > |w| (L - 10), L = 1 / (8 u 2^K)
+    //                               <=>  sum^2 > |w|^2 (L - 10)^2  (for L > 10: K <= 46),
+    // without a square root; for K >= 47 (L <= 10) every state logs.
+    if (!(log_lim2_ > 0.0)) return true;
+    return !(sum * sum <= norm2 * log_lim2_);  // also true for a zero (moving pair) or non-finite norm
   }
 
  private:
@@ -159,6 +163,7 @@ class Pair2DExact {
     double p, q;     // w . a, w . t
     double norm;     // |w| from the velocities
     dd::DD R;        // |w|^2 to build the output with (held, or from the velocities exactly)
+    double rho;      // sqrt(R.hi) (= norm when R comes from the velocities)
     double cm[2];    // centre-of-mass velocity (held or computed)
   };
 
@@ -188,6 +193,7 @@ class Pair2DExact {
     if (inv) {
       checked_relative_speed(*inv, s.norm);
       s.R = {relative_speed2(*inv), 0.0};
+      s.rho = std::sqrt(s.R.hi);
       s.cm[0] = 0.5 * inv->momentum[0];
       s.cm[1] = 0.5 * inv->momentum[1];
     } else {
@@ -195,6 +201,7 @@ class Pair2DExact {
       // sum would repeat collision after collision (see double_double.hpp); the roundings of
       // the squares vary with the direction of w and average out
       s.R = dd::two_sum(w[0] * w[0], w[1] * w[1]);
+      s.rho = s.norm;  // the same sum's square root
       s.cm[0] = 0.5 * (v.i[0] + v.j[0]);
       s.cm[1] = 0.5 * (v.i[1] + v.j[1]);
     }
@@ -225,7 +232,7 @@ class Pair2DExact {
     //   exactly), so the direction cn a + ct t is divided by |a| = 1 + da/2.
     // What remains varies with the direction and the cell: a random walk (~1e-16 sqrt(N)).
     // Cheaper than full double-double (which halved this operator's throughput).
-    const double rho = std::sqrt(s.R.hi);
+    const double rho = s.rho;
     const dd::DD rr = dd::two_prod(rho, rho);
     const double e = ((s.R.hi - rr.hi) - rr.lo) + s.R.lo;
     const dd::DD a2 = dd::add(dd::two_prod(f.a[0], f.a[0]), dd::two_prod(f.a[1], f.a[1]));
@@ -243,6 +250,7 @@ class Pair2DExact {
 
   Law law_;
   FixedPoint fp_;
+  double log_lim2_;  // (L - 10)^2 of needs_log, 0 when every state logs
 };
 
 }  // namespace revcol

@@ -80,23 +80,24 @@ class Pair3DExact {
         x2 /= m;
         s2 = x0 * x0 + x1 * x1 + x2 * x2;
       }
-      const double len = std::sqrt(s2);
-      a[0] = x0 / len;
-      a[1] = x1 / len;
-      a[2] = x2 / len;
+      // one square root and one reciprocal per unit vector: two divisions instead of six
+      const double rl = 1.0 / std::sqrt(s2);
+      a[0] = x0 * rl;
+      a[1] = x1 * rl;
+      a[2] = x2 * rl;
       const double b0 = std::fabs(a[0]), b1 = std::fabs(a[1]), b2 = std::fabs(a[2]);
       axis = (b0 <= b1 && b0 <= b2) ? 0 : (b1 <= b2 ? 1 : 2);
       // e_axis x a has the other two components of a, swapped, one negated; its length is
       // sqrt(1 - a_axis^2) >= sqrt(2/3), so nothing cancels
       if (axis == 0) {
-        const double r = std::sqrt(a[1] * a[1] + a[2] * a[2]);
-        t1[0] = 0.0; t1[1] = -a[2] / r; t1[2] = a[1] / r;
+        const double r = 1.0 / std::sqrt(a[1] * a[1] + a[2] * a[2]);
+        t1[0] = 0.0; t1[1] = -a[2] * r; t1[2] = a[1] * r;
       } else if (axis == 1) {
-        const double r = std::sqrt(a[0] * a[0] + a[2] * a[2]);
-        t1[0] = a[2] / r; t1[1] = 0.0; t1[2] = -a[0] / r;
+        const double r = 1.0 / std::sqrt(a[0] * a[0] + a[2] * a[2]);
+        t1[0] = a[2] * r; t1[1] = 0.0; t1[2] = -a[0] * r;
       } else {
-        const double r = std::sqrt(a[0] * a[0] + a[1] * a[1]);
-        t1[0] = -a[1] / r; t1[1] = a[0] / r; t1[2] = 0.0;
+        const double r = 1.0 / std::sqrt(a[0] * a[0] + a[1] * a[1]);
+        t1[0] = -a[1] * r; t1[1] = a[0] * r; t1[2] = 0.0;
       }
       t2[0] = a[1] * t1[2] - a[2] * t1[1];
       t2[1] = a[2] * t1[0] - a[0] * t1[2];
@@ -112,7 +113,11 @@ class Pair3DExact {
 
   /// An operator for the given law with K-bit chart coordinates.
   explicit Pair3DExact(Law law = Law::flux, int bits = FixedPoint::default_bits)
-      : law_(law), fp_(bits), ucells_(kUnitRoundoff * fp_.cells()) {}
+      : law_(law), fp_(bits), ucells_(kUnitRoundoff * fp_.cells()) {
+    const double a0 = 0.125 / ucells_ - 4.0 - kErr, a1 = 0.125 / ucells_ - 8.0;
+    lim0_ = a0 > 0.0 ? a0 : 0.0;
+    lim1_ = a1 > 0.0 ? (kTwoPi * a1) * (kTwoPi * a1) : 0.0;
+  }
 
   /// The target law.
   Law law() const { return law_; }
@@ -236,8 +241,14 @@ class Pair3DExact {
   /// Whether a post state (in the frame) is too close to rounding trouble for its cells to
   /// be recovered: the rare-log condition, from the velocities alone (both directions agree).
   bool needs_log(const Proj& x) const {
-    const std::array<double, 2> b = bound(x);
-    return !(b[0] <= 0.125 && b[1] <= 0.125);  // also true for NaN (zero or non-finite norms)
+    // recovery_bound() <= 1/8 in both coordinates, solved for the velocities (no division,
+    // one square root): with err = S + kErr N,
+    //   u 2^K (err / N + 4) <= 1/8             <=>  S <= lim0_ N,
+    //   u 2^K (err / (2 pi sqrt(T)) + 8) <= 1/8 <=>  err^2 <= lim1_ T.
+    if (!(x.n2 > 0.0 && lim0_ > 0.0 && lim1_ > 0.0)) return true;  // zero or NaN norm, or K too large
+    const double N = std::sqrt(x.n2);
+    const double err = x.S + kErr * N;
+    return !(x.S <= lim0_ * N && err * err <= lim1_ * x.T);  // also true for NaN
   }
 
  private:
@@ -245,6 +256,7 @@ class Pair3DExact {
   static constexpr double kTwoPi = 2.0 * kPi;
   static constexpr double kInvTwoPi = 1.0 / kTwoPi;
   static constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
+  static constexpr double kErr = 40.0;  // the bound's multiple of |w| (see bound())
 
   using DD = dd::DD;
 
@@ -262,18 +274,19 @@ class Pair3DExact {
     //     cm's own rounding cancels in the difference);
     //   - decoding: sqrt / sincos / the products of the direction: <= 3; the world vector
     //     (3 products, 2 sums) <= 3; the double-double scale hi u + lo u: 1.5;
-    //   - the frame is orthonormal only to rounding, F F^T = I + E with |E| <= 16 u (a: 5,
-    //     t1: 4, t2 = a x t1: 13 on the diagonal, <= 3 off it), and encode projects on the
+    //   - the frame is orthonormal only to rounding, F F^T = I + E with |E| <= 24 u (a: 7,
+    //     t1: 6, t2 = a x t1: 17 on the diagonal, <= 3 off it; each unit vector is scaled by
+    //     a reciprocal square root, 2 u more than a division), and encode projects on the
     //     same F that decode built with;
     //   - w = v_i - v_j: 1; the three projections: 4.5.
-    // Total: u (S + 29 |w|), taken as u (S + 32 N). A perturbation delta of w moves eta by
+    // Total: u (S + 37 |w|), taken as u (S + kErr N), kErr = 40. A perturbation delta of w moves eta by
     // <= delta / N, and c0 by <= delta / N (dc0/deta = sin 2eta or sin eta, <= 1), plus 4 u
     // for c0's own formula; it moves phi by <= delta / |w_t| = delta / sqrt(T), that is c1 by
     // delta / (2 pi sqrt(T)), plus 8 u for atan2, the wrap, the scaling and the decoder's
     // 2 pi c1. (The tests measure actual errors against this bound.) Measure before
     // changing: this runs twice per collision and decides the rare log's size.
     const double N = std::sqrt(x.n2);
-    const double err = x.S + 32.0 * N;
+    const double err = x.S + kErr * N;
     return {ucells_ * (err / N + 4.0), ucells_ * (err / (kTwoPi * std::sqrt(x.T)) + 8.0)};
   }
 
@@ -370,9 +383,17 @@ class Pair3DExact {
     // by the frame's rounding, so a plain scale by |w| would bias the energy by the same
     // u.E u every collision with this normal (a linear drift). hi u + lo u has |.|^2 = R/|u|^2
     // |u|^2 to double-double accuracy; only the final roundings remain, and they vary.
+    // The scale sqrt(R / |u|^2) by its two first-order parts, as Pair2DExact does (a
+    // double-double division and square root cost 3 divisions more): sqrt(R) = rho + e /
+    // (2 rho) with e = R - rho^2 exactly, and 1 / |u| = 1 - dU / 2 with |u|^2 = 1 + dU
+    // (U.hi - 1 is exact: Sterbenz). The terms left out are of order u^2 |w|.
     const DD U = dd::add(dd::add(dd::two_prod(u[0], u[0]), dd::two_prod(u[1], u[1])), dd::two_prod(u[2], u[2]));
-    const DD sc = dd::sqrt(dd::div(s.R, U));
-    const double hi = sign * 0.5 * sc.hi, lo = sign * 0.5 * sc.lo;  // v = cm +- w/2
+    const double dU = (U.hi - 1.0) + U.lo;
+    const double rho = std::sqrt(s.R.hi);
+    const DD rr = dd::two_prod(rho, rho);
+    const double e = ((s.R.hi - rr.hi) - rr.lo) + s.R.lo;
+    const double hi = sign * 0.5 * rho;  // v = cm +- w/2
+    const double lo = sign * 0.5 * (e / (2.0 * rho) - 0.5 * rho * dU);
     PairV<3> out;
     for (int k = 0; k < 3; ++k) {
       const double h = hi * u[k] + lo * u[k];
@@ -385,6 +406,7 @@ class Pair3DExact {
   Law law_;
   FixedPoint fp_;
   double ucells_;  // u 2^K: an error of k u in a coordinate is k ucells_ cells
+  double lim0_, lim1_;  // needs_log's limits (0: every state logs)
 };
 
 }  // namespace revcol
