@@ -14,7 +14,8 @@ before each run; the report gives per build and case the median and the range ov
 new/old of the medians, and the paired ratios: new/old of the two runs of each round (taken
 minutes apart at most, so a slow phase of a shared host hits both), their median and
 quartiles, which resolve a few per cent where the medians of either build swing by 10%.
-`--case` chooses named cases (default: all five below); `--custom SPEC` adds an
+`--case` chooses named cases (default: all five below; `floor/pair2d` and `floor/pair3d`
+report the operator's ns per collision and its ratio to the floor instead of throughput); `--custom SPEC` adds an
 `engine/custom` case with REVCOL_ENGINE=SPEC (any number of each). Studies:
 engine_study.py horizon and memory, once per build, with each build's package on
 PYTHONPATH; their JSON goes to a temporary folder and the report keeps both. Writes
@@ -60,6 +61,14 @@ def _bench(build: str, case: str, collisions: int, cpu: int | None) -> dict:
     return {r["metric"]: r["median"] for r in data["results"] if r["bench"] == name}
 
 
+def _metrics(case: str) -> tuple[str, ...]:
+    """What a case reports: throughput for engine cases; the operator's time and its ratio to
+    the bare floor for `floor/...` cases (lower is better there)."""
+    if case.startswith("floor/"):
+        return ("exact_forward_ns", "exact_reverse_ns", "ratio_forward", "ratio_reverse")
+    return ("forward_per_s", "reverse_per_s")
+
+
 def _paired(new: list[float], old: list[float]) -> dict:
     """new/old per round: median and quartiles (the middle half) of the ratios."""
     ratios = [a / b for a, b in zip(new, old)]
@@ -84,20 +93,25 @@ def throughput(args) -> dict:
                 loads.append(_load())
                 r = _bench(builds[b], case, nc, args.cpu)
                 raw[b][case].append(r)
-                print(f"round {k} {b:3s} {case:28s} forward {r['forward_per_s']:.3g}/s "
-                      f"reverse {r['reverse_per_s']:.3g}/s (load {loads[-1]:.2f})", flush=True)
+                shown = " ".join(f"{m} {r[m]:.4g}" for m in _metrics(case))
+                print(f"round {k} {b:3s} {case:28s} {shown} (load {loads[-1]:.2f})", flush=True)
     rows = []
     for case in cases:
         row = dict(case=case)
         for b in builds:
-            for m in ("forward_per_s", "reverse_per_s"):
+            for m in _metrics(case):
                 row[f"{b}_{m}"] = _summary([r[m] for r in raw[b][case]])
-        for m in ("forward_per_s", "reverse_per_s"):
+        for m in _metrics(case):
             row[f"new_over_old_{m}"] = row[f"new_{m}"]["median"] / row[f"old_{m}"]["median"]
             row[f"paired_new_over_old_{m}"] = _paired([r[m] for r in raw["new"][case]],
                                                        [r[m] for r in raw["old"][case]])
         rows.append(row)
     for r in rows:
+        if r["case"].startswith("floor/"):
+            print(f"{r['case']:28s} " + " | ".join(
+                f"{m} old {r[f'old_{m}']['median']:.4g} new {r[f'new_{m}']['median']:.4g} "
+                f"(paired new/old {_fmt(r[f'paired_new_over_old_{m}'])})" for m in _metrics(r["case"])))
+            continue
         print(f"{r['case']:28s} forward old {r['old_forward_per_s']['median']:.3g} "
               f"[{r['old_forward_per_s']['min']:.3g}, {r['old_forward_per_s']['max']:.3g}] "
               f"new {r['new_forward_per_s']['median']:.3g} "
