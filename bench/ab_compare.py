@@ -15,9 +15,9 @@ new/old of the medians, and the paired ratios: new/old of the two runs of each r
 minutes apart at most, so a slow phase of a shared host hits both), their median and
 quartiles, which resolve a few per cent where the medians of either build swing by 10%.
 `--case` chooses named cases (default: all five below; `floor/pair2d` and `floor/pair3d`
-report the operator's ns per collision and its ratio to the floor instead of throughput); `--custom SPEC` adds an
-`engine/custom` case with REVCOL_ENGINE=SPEC (any number of each). Studies:
-engine_study.py horizon and memory, once per build, with each build's package on
+report the operator's ns per collision and its ratio to the floor instead of throughput);
+`--custom SPEC` adds an `engine/custom` case with REVCOL_ENGINE=SPEC (any number of each).
+Studies: engine_study.py horizon and memory, once per build, with each build's package on
 PYTHONPATH; their JSON goes to a temporary folder and the report keeps both. Writes
 bench/results/ab_<what>.json (or --json).
 """
@@ -172,7 +172,7 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--collisions", type=int, default=1_000_000, help="per run (twice that at N = 1e5)")
     ap.add_argument("--cpu", type=int, default=1, help="core to pin each run to (taskset); -1: no pinning")
-    ap.add_argument("--case", action="append", help="a named engine bench (repeatable; default: all five)")
+    ap.add_argument("--case", action="append", help="a named engine bench, or floor/pair2d, floor/pair3d (repeatable; default: the five engine cases)")
     ap.add_argument("--custom", action="append", help="an engine/custom case: its REVCOL_ENGINE (repeatable)")
     ap.add_argument("--json", help="where the report goes (default bench/results/ab_<what>.json)")
     args = ap.parse_args()

@@ -47,3 +47,23 @@ def test_floor_bench_reverses_and_reports_both_operators():
                     "ratio_forward", "ratio_reverse"):
             assert got[(case, key)] > 0.0, (case, key)
         assert got[(case, "floor_roundtrip_rel_err")] < 1e-9
+
+
+def test_ab_compare_pairs_floor_cases(tmp_path):
+    # bench/ab_compare.py on one build against itself: a floor case reports the operator's time
+    # and its ratio to the floor per build, and the per-round paired ratios
+    import json
+    build = Path(_bench_binary()).parent
+    out = tmp_path / "ab.json"
+    script = Path(__file__).resolve().parents[2] / "bench" / "ab_compare.py"
+    r = subprocess.run([sys.executable, str(script), "throughput", str(build), str(build), "--rounds", "2",
+                        "--collisions", "2000", "--cpu", "-1", "--case", "floor/pair2d", "--json", str(out)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    row = json.loads(out.read_text())["rows"][0]
+    assert row["case"] == "floor/pair2d"
+    for m in ("exact_forward_ns", "exact_reverse_ns", "ratio_forward", "ratio_reverse"):
+        assert len(row[f"old_{m}"]["runs"]) == 2 and len(row[f"new_{m}"]["runs"]) == 2
+        assert all(v > 0 for v in row[f"new_{m}"]["runs"])
+        assert len(row[f"paired_new_over_old_{m}"]["ratios"]) == 2
+    assert "forward_per_s" not in " ".join(row)
