@@ -61,6 +61,28 @@ inline DD sqrt(DD x) {
   const DD p = two_prod(r, r);
   return quick_two_sum(r, ((x.hi - p.hi) - p.lo + x.lo) / (2.0 * r));
 }
+/// |w|^2 of a short vector with its additions compensated (the squares rounded): what the
+/// pair operators scale to. The rounding of a plain sum would repeat collision after
+/// collision (|w| is conserved); the squares' roundings vary with the direction of w.
+template <int N>
+inline DD compensated_norm2(const double* w) {
+  DD s{w[0] * w[0], 0.0};
+  for (int k = 1; k < N; ++k) {
+    const DD t = two_sum(s.hi, w[k] * w[k]);
+    s = {t.hi, s.lo + t.lo};
+  }
+  return quick_two_sum(s.hi, s.lo);
+}
+/// The scale sqrt(R) / sqrt(1 + d) for R > 0 and a tiny d (a direction's |u|^2 - 1), as
+/// hi + lo by its two first-order parts: sqrt(R) = rho + e / (2 rho) with rho = sqrt(R.hi)
+/// (passed in) and e = R - rho^2 exactly, and 1 / sqrt(1 + d) = 1 - d / 2. What is left out
+/// is of order u^2 sqrt(R); a double-double division and square root would cost 3 divisions
+/// more.
+inline DD first_order_scale(DD R, double rho, double d) {
+  const DD rr = two_prod(rho, rho);
+  const double e = ((R.hi - rr.hi) - rr.lo) + R.lo;
+  return {rho, e / (2.0 * rho) - 0.5 * rho * d};
+}
 /// |u|^2 of a short vector, to double-double accuracy.
 template <int N>
 inline DD norm2(const double* u) {

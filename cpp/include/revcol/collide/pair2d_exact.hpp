@@ -200,7 +200,7 @@ class Pair2DExact {
       // |w|^2 with its last addition compensated: |w| is conserved, so the rounding of that
       // sum would repeat collision after collision (see double_double.hpp); the roundings of
       // the squares vary with the direction of w and average out
-      s.R = dd::two_sum(w[0] * w[0], w[1] * w[1]);
+      s.R = dd::compensated_norm2<2>(w.data());
       s.rho = s.norm;  // the same sum's square root
       s.cm[0] = 0.5 * (v.i[0] + v.j[0]);
       s.cm[1] = 0.5 * (v.i[1] + v.j[1]);
@@ -232,13 +232,10 @@ class Pair2DExact {
     //   exactly), so the direction cn a + ct t is divided by |a| = 1 + da/2.
     // What remains varies with the direction and the cell: a random walk (~1e-16 sqrt(N)).
     // Cheaper than full double-double (which halved this operator's throughput).
-    const double rho = s.rho;
-    const dd::DD rr = dd::two_prod(rho, rho);
-    const double e = ((s.R.hi - rr.hi) - rr.lo) + s.R.lo;
     const dd::DD a2 = dd::add(dd::two_prod(f.a[0], f.a[0]), dd::two_prod(f.a[1], f.a[1]));
     const double da = (a2.hi - 1.0) + a2.lo;  // a2.hi - 1 is exact (Sterbenz)
-    const double hi = sign * 0.5 * rho;         // half of w: v = cm +- w/2
-    const double lo = sign * 0.5 * (e / (2.0 * rho) - 0.5 * rho * da);
+    const dd::DD sc = dd::first_order_scale(s.R, s.rho, da);
+    const double hi = sign * 0.5 * sc.hi, lo = sign * 0.5 * sc.lo;  // half of w: v = cm +- w/2
     const double u[2] = {cn * f.a[0] + ct * f.t[0], cn * f.a[1] + ct * f.t[1]};
     const double h0 = hi * u[0] + lo * u[0];
     const double h1 = hi * u[1] + lo * u[1];

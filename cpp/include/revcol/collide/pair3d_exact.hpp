@@ -352,19 +352,13 @@ class Pair3DExact {
       s.R = {relative_speed2(*inv), 0.0};
       for (int k = 0; k < 3; ++k) s.cm[k] = 0.5 * inv->momentum[k];
     } else {
-      // |w|^2 with its two additions compensated, as Pair2DExact does. A plain double sum is
-      // not enough when outputs are chained: |w| is conserved, so the rounding of that sum
-      // repeats at the same place of the double grid collision after collision, a bias that
-      // grows linearly (measured 3.8e-12 in energy over 1e5 collisions with a fixed normal;
-      // the general operator found the same, exact.cpp). The roundings of the differences
-      // and squares vary with the direction of w and average out: over 1e6 chained
-      // collisions the energy walks to ~1e-13 with fixed and random normals alike, as with
-      // the exact double-double |w|^2 this replaced (which cost 6% of the forward operator
-      // and 15% of the reverse).
-      const double w0 = v.i[0] - v.j[0], w1 = v.i[1] - v.j[1], w2 = v.i[2] - v.j[2];
-      const DD s1 = dd::two_sum(w0 * w0, w1 * w1);
-      const DD s2 = dd::two_sum(s1.hi, w2 * w2);
-      s.R = dd::quick_two_sum(s2.hi, s1.lo + s2.lo);
+      // |w|^2 with its additions compensated, as Pair2DExact's (dd::compensated_norm2). A
+      // plain double sum drifts the energy linearly when outputs are chained (3.8e-12 over
+      // 1e5 collisions with a fixed normal, measured; exact.cpp found the same). Over 1e6
+      // chained collisions the energy walks to ~1e-13 with fixed and random normals alike, as
+      // with the exact double-double |w|^2 this replaced (6% of the forward operator, 15% of
+      // the reverse).
+      s.R = dd::compensated_norm2<3>(relative(v).data());
       for (int k = 0; k < 3; ++k) s.cm[k] = 0.5 * (v.i[k] + v.j[k]);
     }
     return s;
@@ -388,17 +382,11 @@ class Pair3DExact {
     // by the frame's rounding, so a plain scale by |w| would bias the energy by the same
     // u.E u every collision with this normal (a linear drift). hi u + lo u has |.|^2 = R/|u|^2
     // |u|^2 to double-double accuracy; only the final roundings remain, and they vary.
-    // The scale sqrt(R / |u|^2) by its two first-order parts, as Pair2DExact does (a
-    // double-double division and square root cost 3 divisions more): sqrt(R) = rho + e /
-    // (2 rho) with e = R - rho^2 exactly, and 1 / |u| = 1 - dU / 2 with |u|^2 = 1 + dU
-    // (U.hi - 1 is exact: Sterbenz). The terms left out are of order u^2 |w|.
+    // The scale sqrt(R / |u|^2) by its two first-order parts (dd::first_order_scale, as
+    // Pair2DExact), with |u|^2 = 1 + dU (U.hi - 1 is exact: Sterbenz).
     const DD U = dd::add(dd::add(dd::two_prod(u[0], u[0]), dd::two_prod(u[1], u[1])), dd::two_prod(u[2], u[2]));
-    const double dU = (U.hi - 1.0) + U.lo;
-    const double rho = std::sqrt(s.R.hi);
-    const DD rr = dd::two_prod(rho, rho);
-    const double e = ((s.R.hi - rr.hi) - rr.lo) + s.R.lo;
-    const double hi = sign * 0.5 * rho;  // v = cm +- w/2
-    const double lo = sign * 0.5 * (e / (2.0 * rho) - 0.5 * rho * dU);
+    const DD sc = dd::first_order_scale(s.R, std::sqrt(s.R.hi), (U.hi - 1.0) + U.lo);
+    const double hi = sign * 0.5 * sc.hi, lo = sign * 0.5 * sc.lo;  // v = cm +- w/2
     PairV<3> out;
     for (int k = 0; k < 3; ++k) {
       const double h = hi * u[k] + lo * u[k];
