@@ -35,17 +35,21 @@ inline void require_finite(const PairV<Dim>& v) {
           "velocities must be finite (got a NaN or infinity)");
 }
 
-/// Throws InvalidArgument unless the pair's speeds lie in the operators' range (check_speed_range).
+/// Throws InvalidArgument unless every velocity component is finite (require_finite's
+/// message) and the pair's speeds lie in the operators' range (check_speed_range).
 template <int Dim>
 inline void require_speed_range(const PairV<Dim>& v, const std::type_identity_t<std::array<double, Dim>>& w) {
   // fast path (hot in the engine): sum v^2 <= 2^900 bounds every |component| by 2^450, and
-  // |w|^2 >= 2^-958 makes the largest |w_k| at least 2^-958 / Dim >= 2^-960 squared: both limits hold
+  // |w|^2 >= 2^-958 makes the largest |w_k| at least 2^-958 / Dim >= 2^-960 squared: both limits hold.
+  // It also proves every component finite (an infinity makes the sum infinite, a NaN makes the
+  // comparison false), so the finiteness test runs only on the cold path.
   double e2 = 0.0, n2 = 0.0;
   for (int k = 0; k < Dim; ++k) {
     e2 += v.i[k] * v.i[k] + v.j[k] * v.j[k];
     n2 += w[k] * w[k];
   }
   if (e2 <= 0x1.0p+900 && n2 >= 0x1.0p-958) [[likely]] return;
+  require_finite(v);
   check_speed_range(std::fmax(max_abs(v.i.data(), Dim), max_abs(v.j.data(), Dim)), max_abs(w.data(), Dim));
 }
 
@@ -59,14 +63,13 @@ struct Frame2 {
   /// |a| is 1 to a few roundings, not exactly: the operators take |a|^2 - 1 into account
   /// (Pair2DExact's scale), and t = (-a_y, a_x) has |t| = |a| and a.t = 0 exactly.
   explicit Frame2(const std::array<double, 2>& normal) {
-    require(std::isfinite(normal[0]) && std::isfinite(normal[1]),
-            "contact normal must be finite");
     double x0 = normal[0], x1 = normal[1];
     double s2 = x0 * x0 + x1 * x1;
     // a square root and one reciprocal (std::hypot cost ~11 ns, a fifth of the exact
     // operator); a normal whose squares would underflow or overflow is first scaled by its
-    // largest component
+    // largest component. An s2 inside the range also proves the normal finite.
     if (!(s2 >= 0x1.0p-900 && s2 <= 0x1.0p+900)) [[unlikely]] {
+      require(std::isfinite(x0) && std::isfinite(x1), "contact normal must be finite");
       const double m = std::fmax(std::fabs(x0), std::fabs(x1));
       require(m > 0.0, "contact normal is zero");
       x0 /= m;

@@ -176,12 +176,11 @@ class Pair2DExact {
   // unless the rare log serves it) state.
   Split split(const PairV<2>& v, const Frame2& f, const Invariants<2>* inv, bool post,
               bool logged = false) const {
-    require_finite(v);
     const std::array<double, 2> w = relative(v);
     Split s;
     s.p = f.normal_part(w);
     s.q = f.tangent_part(w);
-    require_speed_range(v, w);
+    require_speed_range(v, w);  // also rejects a NaN or infinite velocity
     s.norm = std::sqrt(w[0] * w[0] + w[1] * w[1]);
     if (post) {
       require(s.p > 0.0 || logged, [&] { return std::string("post-collision state does not separate along the contact normal "

@@ -67,12 +67,13 @@ class Pair3DExact {
 
     /// Builds the frame from any non-zero finite normal; throws InvalidArgument otherwise.
     explicit Frame(const std::array<double, 3>& normal) {
-      require(std::isfinite(normal[0]) && std::isfinite(normal[1]) && std::isfinite(normal[2]),
-              "contact normal must be finite");
       double x0 = normal[0], x1 = normal[1], x2 = normal[2];
       double s2 = x0 * x0 + x1 * x1 + x2 * x2;
-      if (!(s2 >= 0x1.0p-900 && s2 <= 0x1.0p+900)) {
-        // tiny or huge normals: rescale by the largest component first (cold path)
+      if (!(s2 >= 0x1.0p-900 && s2 <= 0x1.0p+900)) [[unlikely]] {
+        // tiny, huge or non-finite normals (an s2 in the range proves all three finite):
+        // rescale by the largest component first (cold path)
+        require(std::isfinite(x0) && std::isfinite(x1) && std::isfinite(x2),
+                "contact normal must be finite");
         const double m = std::fmax(std::fabs(x0), std::fmax(std::fabs(x1), std::fabs(x2)));
         require(m > 0.0, "contact normal is zero");
         x0 /= m;
@@ -326,14 +327,18 @@ class Pair3DExact {
   Split split(const PairV<3>& v, const Frame& f, const Proj& x, const Invariants<3>* inv,
               bool post, bool logged) const {
     (void)f;
-    require_finite(v);
     // |v| bounded so that v_i + v_j and cm +- w/2 cannot overflow
-    require(x.S <= (post ? 0x1.0p+1021 : 0x1.0p+1020),
-            "velocities too large (sum of |components| above 2^1020, about 1e307)");
+    const double smax = post ? 0x1.0p+1021 : 0x1.0p+1020;
     const double lo = post ? 0x1.0p-1001 : 0x1.0p-1000, hi = post ? 0x1.0p+1001 : 0x1.0p+1000;
-    require(x.n2 > 0.0, "zero relative speed: the particles cannot collide");
-    require(x.n2 >= lo, "relative speed too small (below 2^-500, about 3e-151)");
-    require(x.n2 <= hi, "relative speed too large (above 2^500, about 3e150)");
+    // one test on the hot path: S in range also proves every component finite (an infinity
+    // makes S infinite, a NaN makes the comparison false); the cold path names the problem
+    if (!(x.S <= smax && x.n2 >= lo && x.n2 <= hi)) [[unlikely]] {
+      require_finite(v);
+      require(x.S <= smax, "velocities too large (sum of |components| above 2^1020, about 1e307)");
+      require(x.n2 > 0.0, "zero relative speed: the particles cannot collide");
+      require(x.n2 >= lo, "relative speed too small (below 2^-500, about 3e-151)");
+      require(x.n2 <= hi, "relative speed too large (above 2^500, about 3e150)");
+    }
     if (post) {
       require(x.p > 0.0 || logged, [&] {
         return std::string("post-collision state does not separate along the contact normal "
