@@ -4,7 +4,8 @@
 // The floor, per collision: the contact frame from the normal (normalized; in 3D the tangent
 // from the least aligned axis, as Pair3DExact::Frame), the chart of the relative velocity in
 // plain doubles (flux: c = (1 + q/|w|)/2 in 2D; c0 = T/|w|^2 and c1 = atan2(q2, q1)/(2 pi) in
-// 3D), the shift by the draws mod 1 in doubles, the inverse chart (sqrt, sincos) and the scale
+// 3D, with the operator's own trigonometry in turns, trig.hpp), the shift by the draws mod 1
+// in doubles, the inverse chart (sqrt, sincos) and the scale
 // by a plain sqrt(|w|^2). It runs backwards too, to round-off only: no validation, no fixed
 // point cells, no double-double |w|^2 or scale, no rare-log bound. That is the least a
 // randomized reversible collision of this law computes; what the exact operator adds on top
@@ -27,13 +28,12 @@
 #include "pair_pool.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
 #include "revcol/collide/pair3d_exact.hpp"
+#include "revcol/trig.hpp"
 
 namespace revcol::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kPi = 3.141592653589793238462643383279502884;
-constexpr double kTwoPi = 2.0 * kPi;
 constexpr int kRounds = 6;  // interleaved rounds per repeat
 
 double wrap_add(double c, double g) {
@@ -90,14 +90,13 @@ PairV<3> floor3(const PairV<3>& v, const std::array<double, 3>& n, const std::ar
   const double q1 = w[0] * t1[0] + w[1] * t1[1] + w[2] * t1[2];
   const double q2 = w[0] * t2[0] + w[1] * t2[1] + w[2] * t2[2];
   const double T = q1 * q1 + q2 * q2, n2 = p * p + T;
-  double phi = std::atan2(q2, q1);
-  if (phi < 0.0) phi += kTwoPi;
-  double c0 = T / n2, c1 = phi / kTwoPi;
+  double c0 = T / n2, c1 = trig::atan2_turns(q2, q1);  // the operator's own trigonometry
   c0 = forward ? wrap_add(c0, g[0]) : wrap_sub(c0, g[0]);
   c1 = forward ? wrap_add(c1, g[1]) : wrap_sub(c1, g[1]);
   const double sn = std::sqrt(c0), cn = std::sqrt(1.0 - c0);
-  const double ph = kTwoPi * c1;
-  const double d1 = sn * std::cos(ph), d2 = sn * std::sin(ph);
+  double sph, cph;
+  trig::sincos_turns(c1, sph, cph);
+  const double d1 = sn * cph, d2 = sn * sph;
   const double h = (forward ? 0.5 : -0.5) * std::sqrt(n2);
   PairV<3> out;
   for (int k = 0; k < 3; ++k) {

@@ -48,6 +48,7 @@
 #include "revcol/collide/pair.hpp"
 #include "revcol/double_double.hpp"
 #include "revcol/fixed_point.hpp"
+#include "revcol/trig.hpp"
 
 namespace revcol {
 
@@ -255,7 +256,6 @@ class Pair3DExact {
  private:
   static constexpr double kPi = 3.141592653589793238462643383279502884;
   static constexpr double kTwoPi = 2.0 * kPi;
-  static constexpr double kInvTwoPi = 1.0 / kTwoPi;
   static constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
   static constexpr double kErr = 40.0;  // the bound's multiple of |w| (see bound())
 
@@ -283,8 +283,9 @@ class Pair3DExact {
     // Total: u (S + 37 |w|), taken as u (S + kErr N), kErr = 40. A perturbation delta of w moves eta by
     // <= delta / N, and c0 by <= delta / N (dc0/deta = sin 2eta or sin eta, <= 1), plus 4 u
     // for c0's own formula; it moves phi by <= delta / |w_t| = delta / sqrt(T), that is c1 by
-    // delta / (2 pi sqrt(T)), plus 8 u for atan2, the wrap, the scaling and the decoder's
-    // 2 pi c1. (The tests measure actual errors against this bound.) Measure before
+    // delta / (2 pi sqrt(T)), plus 8 u for atan2_turns (< 1 u, tests/cpp/test_trig.cpp) and
+    // the decoder's sincos_turns (< 1.5 u). (The tests measure actual errors against this
+    // bound.) Measure before
     // changing: this runs twice per collision and decides the rare log's size.
     const double N = std::sqrt(x.n2);
     const double err = x.S + kErr * N;
@@ -306,9 +307,7 @@ class Pair3DExact {
       const double N = std::sqrt(n2);
       c0 = T / (N * (N + p));  // 1 - cos(eta) = sin^2 / (1 + cos)
     }
-    double phi = std::atan2(q2, q1);
-    if (phi < 0.0) phi += kTwoPi;
-    return {c0, phi * kInvTwoPi};
+    return {c0, trig::atan2_turns(q2, q1)};  // phi / (2 pi) in [0, 1] (trig.hpp)
   }
   std::array<std::uint64_t, 2> encode(double p, double q1, double q2, double T) const {
     const std::array<double, 2> c = chart(p, q1, q2, T);
@@ -379,8 +378,9 @@ class Pair3DExact {
       cn = 1.0 - c0;
       sn = std::sqrt(c0 * (2.0 - c0));
     }
-    const double phi = kTwoPi * c1;
-    const double d1 = sn * std::cos(phi), d2 = sn * std::sin(phi);
+    double sphi, cphi;  // sin and cos of phi = 2 pi c1, reduced exactly in turns (trig.hpp)
+    trig::sincos_turns(c1, sphi, cphi);
+    const double d1 = sn * cphi, d2 = sn * sphi;
     double u[3];  // the unit direction in the world frame (to rounding)
     for (int k = 0; k < 3; ++k) u[k] = cn * f.a[k] + d1 * f.t1[k] + d2 * f.t2[k];
     // Scale u to |w| = sqrt(R) in double-double: |u|^2 = 1 + u.E u with E = F F^T - I fixed
