@@ -330,15 +330,7 @@ class EngineImpl final : public Simulation {
     bool touch = false;
     const Particle<Dim>& pi = p_[i];
     double limit = prune_limit(best.t);
-    for_neighbours(i, [&](int j, const Vec& sh) {
-      double t;
-      bool tj = false;
-      const bool hit = Kin::pair_time(pi, p_[j], sh, sigma2_, contact_tol_, t, tj, limit);
-      if (tj) {
-        touch = true;
-        touching_[j] = 1;
-      }
-      if (!hit) return;
+    const auto record = [&](int j, double t) {  // a hit: the gate's two earliest, and the best
       if (t < clock_) t = clock_;
       if (t < first) {
         second = first;
@@ -350,7 +342,35 @@ class EngineImpl final : public Simulation {
         best = Ev{t, kColl, j, p_[j].stamp};
         limit = prune_limit(best.t);
       }
-    });
+    };
+    const auto one = [&](int j, const Vec& sh) {
+      double t;
+      bool tj = false;
+      const bool hit = Kin::pair_time(pi, p_[j], sh, sigma2_, contact_tol_, t, tj, limit);
+      if (tj) {
+        touch = true;
+        touching_[j] = 1;
+      }
+      if (hit) record(j, t);
+    };
+    // two list entries per step in two-lane vectors, with pair_time's bits lane by lane; the
+    // second lane's limit test is redone when the first lane's hit lowered the limit, so the
+    // scan decides exactly as one entry at a time would
+    const auto two = [&](int j0, const Vec& s0, int j1, const Vec& s1) {
+      typename Kin::Pair2 q;
+      Kin::pair_test2(pi, p_[j0], p_[j1], s0, s1, sigma2_, contact_tol_, limit, q);
+      if (q.touching[0]) {
+        touch = true;
+        touching_[j0] = 1;
+      }
+      if (q.hit[0]) record(j0, q.finish(0));
+      if (q.touching[1]) {
+        touch = true;
+        touching_[j1] = 1;
+      }
+      if (q.still_hit(1, limit)) record(j1, q.finish(1));
+    };
+    nl_.for_neighbour_pairs(i, two, one, [&](int j) { __builtin_prefetch(&p_[j]); });
     ev_[i] = best;
     second_[i] = second;
     touching_[i] = touch ? 1 : 0;

@@ -97,6 +97,62 @@ struct FloatKinematics {
     return true;
   }
 
+  /// pair_time's tests for two partners at once (b0 with shift s0, b1 with s1), in two-lane
+  /// vectors (GCC/Clang vector extensions: SSE2 on x86-64, NEON on arm64, plain code
+  /// elsewhere). Each lane runs pair_time's operations in pair_time's order, so every value
+  /// below has pair_time's bits; what is left per lane is the square root of a hit
+  /// (finish()). Lane l: touching[l], hit[l] (with `limit`), and tr, c, bb, disc.
+  struct Pair2 {
+    bool touching[2], hit[2];
+    double tr[2], c[2], bb[2], disc[2];
+    /// Lane l's contact time, for a hit (pair_time's last lines).
+    double finish(int l) const {
+      double dt = c[l] / (-bb[l] + std::sqrt(disc[l]));
+      if (dt < 0.0) dt = 0.0;
+      return tr[l] + dt;
+    }
+    /// Lane l's hit test with a lower limit than the one tested (the scan's best improved
+    /// in lane 0): pair_time's limit term, the same bits.
+    bool still_hit(int l, double limit) const { return hit[l] && !(c[l] > -2.0 * bb[l] * (limit - tr[l])); }
+  };
+  [[gnu::always_inline]] static void pair_test2(const Particle<Dim>& a, const Particle<Dim>& b0,
+                                                const Particle<Dim>& b1, const Vec& s0, const Vec& s1,
+                                                double sigma2, double contact_tol, double limit, Pair2& out) {
+    typedef double v2d __attribute__((vector_size(16)));
+    typedef long long v2l __attribute__((vector_size(16)));
+    const v2d ta = {a.t, a.t}, tb = {b0.t, b1.t};
+    const v2d tr = ta > tb ? ta : tb;  // lane-wise: pair_time's tr
+    const v2d da = tr - ta, db = tr - tb;
+    v2d r[Dim], w[Dim];
+    v2d bb = {0.0, 0.0};
+    for (int k = 0; k < Dim; ++k) {
+      const v2d va = {a.v[k], a.v[k]}, vb = {b0.v[k], b1.v[k]};
+      const v2d ax = {a.x[k], a.x[k]}, bx = {b0.x[k], b1.x[k]}, sk = {s0[k], s1[k]};
+      r[k] = ((ax + va * da) - (bx + vb * db)) - sk;
+      w[k] = va - vb;
+      bb += r[k] * w[k];
+    }
+    v2d r2 = {0.0, 0.0}, w2 = {0.0, 0.0};
+    for (int k = 0; k < Dim; ++k) {
+      r2 += r[k] * r[k];
+      w2 += w[k] * w[k];
+    }
+    const v2d sig = {sigma2, sigma2}, tol = {contact_tol, contact_tol}, lim = {limit, limit};
+    const v2d zero = {0.0, 0.0}, m2 = {-2.0, -2.0};
+    const v2d c = r2 - sig;
+    const v2d disc = bb * bb - w2 * c;
+    const v2l touching = ~(bb > zero) & (c <= tol);
+    const v2l hit = (bb < zero) & ~(c > m2 * bb * (lim - tr)) & ~(disc < zero);
+    for (int l = 0; l < 2; ++l) {
+      out.touching[l] = touching[l] != 0;
+      out.hit[l] = hit[l] != 0;
+      out.tr[l] = tr[l];
+      out.c[l] = c[l];
+      out.bb[l] = bb[l];
+      out.disc[l] = disc[l];
+    }
+  }
+
   /// Time after p's local time at which p leaves the sphere of radius h (h2 = h^2) around
   /// the centre c; false when p is at rest. Outside and not entering (round-off at the
   /// surface): 0, renew now.

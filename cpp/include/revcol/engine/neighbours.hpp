@@ -62,6 +62,8 @@ class NeighbourLists {
       shift_tab_[k][2] = -L;
       shift_tab_[k][3] = 0.0;
     }
+    for (unsigned code = 0; code < shift_vec_.size(); ++code)
+      for (int k = 0; k < Dim; ++k) shift_vec_[code][k] = shift_tab_[k][(code >> (2 * k)) & 3u];
   }
 
   /// Whether the lists are 1D's rods-beside-each-other (a constant false in 2D and 3D).
@@ -124,6 +126,21 @@ class NeighbourLists {
     for (int u = 0; u < m; ++u) f(ids[u], shift_of(codes[u]));
   }
 
+  /// for_neighbours two entries at a time, in list order: f2(j0, s0, j1, s1) for each
+  /// consecutive pair of entries and f(j, s) for an odd last one (the prediction's two-lane
+  /// scan, FloatKinematics::pair_test2).
+  template <class F2, class F, class Prefetch>
+  void for_neighbour_pairs(int i, F2&& f2, F&& f, Prefetch&& prefetch) const {
+    const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
+    const int* ids = nb_.data() + base;
+    const unsigned char* codes = nbc_.data() + base;
+    const int m = nbn_[i];
+    for (int u = 0; u < m; ++u) prefetch(ids[u]);
+    int u = 0;
+    for (; u + 1 < m; u += 2) f2(ids[u], shift_of(codes[u]), ids[u + 1], shift_of(codes[u + 1]));
+    if (u < m) f(ids[u], shift_of(codes[u]));
+  }
+
   /// Image shift s of the pair (a, b), with r = x_a - x_b - s, from the centres (or, in 1D's
   /// adjacent mode, from a's list).
   Vec pair_shift(int a, int b) const {
@@ -165,11 +182,7 @@ class NeighbourLists {
   /// The code of the mirrored pair (1 <-> 2 on every axis).
   static unsigned mirror(unsigned code) { return ((code & 0x15u) << 1) | ((code >> 1) & 0x15u); }
   /// The image offset of a code.
-  Vec shift_of(unsigned code) const {
-    Vec s;
-    for (int k = 0; k < Dim; ++k) s[k] = shift_tab_[k][(code >> (2 * k)) & 3u];
-    return s;
-  }
+  Vec shift_of(unsigned code) const { return shift_vec_[code & (shift_vec_.size() - 1)]; }
 
   /// Number of particles on i's list.
   int count(int i) const { return nbn_[i]; }
@@ -484,7 +497,10 @@ class NeighbourLists {
   std::array<int, Dim> nc_{}, stride_{};
   int total_cells_ = 1;
   bool cells_code_images_ = true;        // every periodic axis has >= 3 cells (scan_cells<true>)
-  double shift_tab_[Dim][4] = {};        // image code -> shift
+  double shift_tab_[Dim][4] = {};        // one axis's 2-bit image code -> shift
+  // the whole code -> the shift vector, one load per neighbour in the prediction scan instead
+  // of an unpacking per axis (4^Dim entries: 1.5 KB in 3D)
+  std::array<Vec, (1u << (2 * Dim))> shift_vec_{};
   std::vector<int> cell_, head_;         // cells of the list centres, heads of their chains
   std::vector<Centre> cn_;
   bool adj_ = false;                     // 1D: rods beside each other, no cell grid
