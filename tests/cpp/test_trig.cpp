@@ -167,4 +167,4 @@ TEST_CASE("atan2_turns inverts sincos_turns to 3e-16 of a turn") {
   CHECK(worst < 3e-16);
 }
 
-int main() { return check::run_all(); }
+CHECK_MAIN()
