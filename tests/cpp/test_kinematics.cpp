@@ -5,6 +5,7 @@
 // prediction scan's two-lane pair_test2 gives pair_time's answers lane by lane.
 #include "revcol/engine/kinematics.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -19,6 +20,36 @@ namespace {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
+// A random partner b of a (positions in a 4-wide cube around 10, standard normal velocity):
+// seen across an image (stored at x - L, shift -L on axis 0) when `image`; touching a, at
+// distance D (1 + 1e-12) along a random direction, when `touch`; its local time a's when
+// `same_time`, else random in [2.5, 3.5].
+template <int Dim, class Rng>
+void random_partner(Rng& rng, const Particle<Dim>& a, bool image, bool touch, bool same_time, Particle<Dim>& b,
+                    std::array<double, Dim>& s) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const double L = 20.0;
+  s = {};
+  for (int k = 0; k < Dim; ++k) {
+    b.x[k] = 10.0 + 2.0 * u(rng);
+    b.v[k] = g(rng);
+  }
+  if (image) {
+    b.x[0] -= L;
+    s[0] = -L;
+  }
+  if (touch) {
+    double n2 = 0.0, d[Dim];
+    for (int k = 0; k < Dim; ++k) {
+      d[k] = g(rng);
+      n2 += d[k] * d[k];
+    }
+    for (int k = 0; k < Dim; ++k) b.x[k] = a.x[k] - s[k] - d[k] / std::sqrt(n2) * (1.0 + 1e-12);
+  }
+  b.t = same_time ? a.t : 3.0 + 0.5 * u(rng);
+}
+
 template <int Dim>
 void check_sides(std::uint64_t seed) {
   using Kin = FloatKinematics<Dim>;
@@ -26,32 +57,17 @@ void check_sides(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> g(0.0, 1.0);
-  const double sigma2 = 1.0, tol = 2e-10, L = 20.0;
+  const double sigma2 = 1.0, tol = 2e-10;
   int hits = 0, pruned = 0, kept = 0, touching = 0;
   for (int trial = 0; trial < 200000; ++trial) {
     Particle<Dim> a, b;
     Vec s{};
     for (int k = 0; k < Dim; ++k) {
       a.x[k] = 10.0 + 2.0 * u(rng);
-      b.x[k] = 10.0 + 2.0 * u(rng);
       a.v[k] = g(rng);
-      b.v[k] = g(rng);
-    }
-    if (trial % 5 == 0) {  // b seen across an image: stored at x + L, offset -L
-      b.x[0] -= L;
-      s[0] = -L;
-    }
-    if (trial % 7 == 0) {  // touching: b at distance D (1 + 1e-12) along a random direction
-      double n2 = 0.0;
-      double d[Dim];
-      for (int k = 0; k < Dim; ++k) {
-        d[k] = g(rng);
-        n2 += d[k] * d[k];
-      }
-      for (int k = 0; k < Dim; ++k) b.x[k] = a.x[k] - s[k] - d[k] / std::sqrt(n2) * (1.0 + 1e-12);
     }
     a.t = 3.0 + 0.5 * u(rng);
-    b.t = trial % 3 == 0 ? a.t : 3.0 + 0.5 * u(rng);
+    random_partner<Dim>(rng, a, trial % 5 == 0, trial % 7 == 0, trial % 3 == 0, b, s);
     // from a's side with offset s, and from b's side with -s
     Vec ms;
     for (int k = 0; k < Dim; ++k) ms[k] = -s[k];
@@ -99,7 +115,7 @@ void check_two_lanes(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> g(0.0, 1.0);
-  const double sigma2 = 1.0, tol = 2e-10, L = 20.0;
+  const double sigma2 = 1.0, tol = 2e-10;
   int hits = 0, touching = 0, lowered = 0;
   for (int trial = 0; trial < 100000; ++trial) {
     Particle<Dim> a, b[2];
@@ -109,25 +125,8 @@ void check_two_lanes(std::uint64_t seed) {
       a.v[k] = g(rng);
     }
     a.t = 3.0 + 0.5 * u(rng);
-    for (int l = 0; l < 2; ++l) {
-      for (int k = 0; k < Dim; ++k) {
-        b[l].x[k] = 10.0 + 2.0 * u(rng);
-        b[l].v[k] = g(rng);
-      }
-      if ((trial + l) % 5 == 0) {  // across an image
-        b[l].x[0] -= L;
-        s[l][0] = -L;
-      }
-      if ((trial + 3 * l) % 7 == 0) {  // touching: at D (1 + 1e-12)
-        double n2 = 0.0, d[Dim];
-        for (int k = 0; k < Dim; ++k) {
-          d[k] = g(rng);
-          n2 += d[k] * d[k];
-        }
-        for (int k = 0; k < Dim; ++k) b[l].x[k] = a.x[k] - s[l][k] - d[k] / std::sqrt(n2) * (1.0 + 1e-12);
-      }
-      b[l].t = (trial + l) % 3 == 0 ? a.t : 3.0 + 0.5 * u(rng);
-    }
+    for (int l = 0; l < 2; ++l)
+      random_partner<Dim>(rng, a, (trial + l) % 5 == 0, (trial + 3 * l) % 7 == 0, (trial + l) % 3 == 0, b[l], s[l]);
     // limits: none, then around lane 0's contact when it has one
     double t0 = 0.0;
     bool touch0 = false;

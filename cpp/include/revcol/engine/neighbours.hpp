@@ -118,12 +118,8 @@ class NeighbourLists {
   /// This is the engine's inner loop: measure before changing.
   template <class F, class Prefetch>
   void for_neighbours(int i, F&& f, Prefetch&& prefetch) const {
-    const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
-    const int* ids = nb_.data() + base;
-    const unsigned char* codes = nbc_.data() + base;
-    const int m = nbn_[i];
-    for (int u = 0; u < m; ++u) prefetch(ids[u]);
-    for (int u = 0; u < m; ++u) f(ids[u], shift_of(codes[u]));
+    for_neighbour_pairs(
+        i, [&](int j0, const Vec& s0, int j1, const Vec& s1) { f(j0, s0), f(j1, s1); }, f, prefetch);
   }
 
   /// for_neighbours two entries at a time, in list order: f2(j0, s0, j1, s1) for each
