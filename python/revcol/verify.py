@@ -11,6 +11,10 @@ them with the generator stepping back, and compares with the start:
   centre) bit for bit; paper mode is compared with the start itself;
 - ``passed``: generator restored, log empty, error <= 1e-9, and bit_exact where promised.
 
+Case "pair3d-fast" (exact mode) is the same illustration in 3D for the engine's closed-form
+operator (Pair3DExact, normal (1, 1, 1), 2 draws per collision); exact mode's "pair3d" runs
+the general operator on the same geometry.
+
     >>> import revcol
     >>> r = revcol.verify(case="pair2d", collisions=1000)
     >>> r["passed"], r["bit_exact"]

@@ -190,6 +190,24 @@ def test_named_verify_cases_exact():
         assert r["passed"] and r["bit_exact"], (c["name"], r["error"])
 
 
+def test_verify_pair3d_fast_is_the_engine_operator_and_bit_exact():
+    """'pair3d-fast' runs Pair3DExact (the engine's 3D operator), 2 draws per collision,
+    both laws and generators: bit exact back to the quantized start; bad starts are refused."""
+    assert "pair3d-fast" in revcol.verify_cases("exact")
+    assert "pair3d-fast" not in revcol.verify_cases("paper")
+    for law in ("flux", "uniform"):
+        for rng in ("clcg4", "philox"):
+            r = revcol.verify("pair3d-fast", collisions=5000, law=law, rng=rng, seed=2)
+            assert r["passed"] and r["bit_exact"] and r["rng_restored"], (law, rng, r["error"])
+            assert r["max_rel_error"] < 1e-9
+    with pytest.raises(ValueError, match="6 initial velocity components"):
+        revcol.verify("pair3d-fast", collisions=10, velocities=[1.0, 0.0])
+    with pytest.raises(ValueError, match="not approaching"):
+        revcol.verify("pair3d-fast", collisions=10, velocities=[1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="unknown case"):
+        revcol.verify("pair3d-fast", collisions=10, mode="paper")
+
+
 def test_batch_validates_every_entry_and_its_draws_before_anything_moves():
     """The one batch template (batch.hpp): entry and draw checks name the entry, and a bad
     batch moves no generator and writes no log; a good one draws d_n per entry and back."""
