@@ -343,14 +343,15 @@ class EngineImpl final : public Simulation {
         limit = prune_limit(best.t);
       }
     };
+    const auto touched = [&](int j) {  // j within the contact tolerance: the group gate
+      touch = true;
+      touching_[j] = 1;
+    };
     const auto one = [&](int j, const Vec& sh) {
       double t;
       bool tj = false;
       const bool hit = Kin::pair_time(pi, p_[j], sh, sigma2_, contact_tol_, t, tj, limit);
-      if (tj) {
-        touch = true;
-        touching_[j] = 1;
-      }
+      if (tj) touched(j);
       if (hit) record(j, t);
     };
     // two list entries per step in two-lane vectors, with pair_time's bits lane by lane; the
@@ -359,15 +360,9 @@ class EngineImpl final : public Simulation {
     const auto two = [&](int j0, const Vec& s0, int j1, const Vec& s1) {
       typename Kin::Pair2 q;
       Kin::pair_test2(pi, p_[j0], p_[j1], s0, s1, sigma2_, contact_tol_, limit, q);
-      if (q.touching[0]) {
-        touch = true;
-        touching_[j0] = 1;
-      }
+      if (q.touching[0]) touched(j0);
       if (q.hit[0]) record(j0, q.finish(0));
-      if (q.touching[1]) {
-        touch = true;
-        touching_[j1] = 1;
-      }
+      if (q.touching[1]) touched(j1);
       if (q.still_hit(1, limit)) record(j1, q.finish(1));
     };
     nl_.for_neighbour_pairs(i, two, one, [&](int j) { __builtin_prefetch(&p_[j]); });

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <string>
 
 #include "revcol/collide/pair1d.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
@@ -39,29 +40,23 @@ struct PairChain {
   std::vector<double> flat(const State& v) const { return revcol::flat(v); }
 };
 
-// The 2-particle 2D illustration (the paper's Procedure for "Reversal Illustration for
-// 2-Particle Collisions in 2 Dimensions") for either 2D pair operator, momentum and energy held.
+// The paper's reversal illustration of 2 particles ("Reversal Illustration for 2-Particle
+// Collisions in 2 Dimensions", and the same in 3D) for a pair operator with momentum and energy
+// held: either 2D pair operator (one draw) or Pair3DExact (two).
 template <class Op>
-struct Pair2DChain : PairChain<2> {
+struct HeldPairChain : PairChain<Op::dim> {
+  using State = PairV<Op::dim>;
   static constexpr bool stops_early = false;
   const Op& op;
-  std::array<double, 2> n;
-  Invariants<2> inv;
-  std::size_t draws() const { return 1; }
-  void forward(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.forward(v, n, g[0], log, &inv); }
-  void reverse(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.reverse(v, n, g[0], log, &inv); }
-};
-
-// The same illustration in 3D for Pair3DExact, the engine's closed-form 3D operator (case
-// "pair3d-fast"; exact mode's "pair3d" runs the general ExactCollision): 2 draws per collision.
-struct Pair3DChain : PairChain<3> {
-  static constexpr bool stops_early = false;
-  const Pair3DExact& op;
-  std::array<double, 3> n;
-  Invariants<3> inv;
-  std::size_t draws() const { return 2; }
-  void forward(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.forward(v, n, {g[0], g[1]}, log, &inv); }
-  void reverse(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.reverse(v, n, {g[0], g[1]}, log, &inv); }
+  std::array<double, Op::dim> n;
+  Invariants<Op::dim> inv;
+  std::size_t draws() const { return Op::draws; }
+  static auto draw(const double* g) {
+    if constexpr (Op::draws == 1) return g[0];
+    else return std::array<double, 2>{g[0], g[1]};
+  }
+  void forward(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.forward(v, n, draw(g), log, &inv); }
+  void reverse(State& v, const double* g, RareLog& log, std::uint64_t) const { v = op.reverse(v, n, draw(g), log, &inv); }
 };
 
 // The 1D pair: no free parameter and no random number, the exchange is exact in floating point.
@@ -74,65 +69,58 @@ struct Pair1DChain : PairChain<1> {
   void reverse(State& v, const double*, RareLog&, std::uint64_t) const { v = op.reverse(v, n); }
 };
 
+// Case `name`: start v along normal n (VerifyConfig's velocities and normal override them),
+// momentum and energy computed once and held, compared at the end with reference(v, n, inv).
 template <class Op, class Gen, class Reference>
-void run_pair2d(const Op& op, Gen& gen, const VerifyConfig& c, VerifyResult& r, Reference reference) {
-  PairV<2> v{{0.25, -0.5}, {1.0, 0.75}};  // default start: approaches along (1, 1)
+void run_held_pair(const char* name, const Op& op, PairV<Op::dim> v, std::array<double, Op::dim> n, Gen& gen,
+                   const VerifyConfig& c, VerifyResult& r, Reference reference) {
+  constexpr int D = Op::dim;
   if (!c.velocities.empty()) {
-    require(c.velocities.size() == 4, "pair2d needs 4 initial velocity components");
-    v.i = {c.velocities[0], c.velocities[1]};
-    v.j = {c.velocities[2], c.velocities[3]};
+    require(c.velocities.size() == 2 * D,
+            std::string(name) + " needs " + std::to_string(2 * D) + " initial velocity components");
+    for (int k = 0; k < D; ++k) {
+      v.i[k] = c.velocities[k];
+      v.j[k] = c.velocities[D + k];
+    }
   }
-  std::array<double, 2> n{1.0, 1.0};
   if (!c.normal.empty()) {
-    require(c.normal.size() == 2, "pair2d needs a 2-component normal");
-    n = {c.normal[0], c.normal[1]};
+    require(c.normal.size() == D, std::string(name) + " needs a " + std::to_string(D) + "-component normal");
+    for (int k = 0; k < D; ++k) n[k] = c.normal[k];
   }
-  const Invariants<2> inv{{v.i[0] + v.j[0], v.i[1] + v.j[1]},
-                          v.i[0] * v.i[0] + v.i[1] * v.i[1] + v.j[0] * v.j[0] + v.j[1] * v.j[1]};
+  Invariants<D> inv{};
+  for (int k = 0; k < D; ++k) inv.momentum[k] = v.i[k] + v.j[k];
+  inv.energy = 0.0;  // |v_i|^2 then |v_j|^2, one square at a time
+  for (int k = 0; k < D; ++k) inv.energy += v.i[k] * v.i[k];
+  for (int k = 0; k < D; ++k) inv.energy += v.j[k] * v.j[k];
   op.check_pre(v, n, &inv);  // a bad start throws here, before anything runs
   r.initial = flat(v);
   r.reference = flat(reference(v, n, inv));
-  detail::reversal_chain(Pair2DChain<Op>{{}, op, n, inv}, v, gen, c, r);
+  detail::reversal_chain(HeldPairChain<Op>{{}, op, n, inv}, v, gen, c, r);
 }
 
 template <class Gen>
 bool run_pair_case(const VerifyConfig& c, Gen& gen, VerifyResult& r) {
+  // the exact operators come back to their quantized start (the first collision's cells)
+  const auto quantized = [](const auto& op) {
+    return [&op](const auto& v, const auto& n, const auto& inv) { return op.quantize(v, n, &inv); };
+  };
   if (c.case_name == "pair2d") {
+    const PairV<2> start{{0.25, -0.5}, {1.0, 0.75}};  // approaches along (1, 1)
     if (c.mode == Mode::exact) {
       const Pair2DExact op(c.law, c.bits);
-      run_pair2d(op, gen, c, r, [&](const PairV<2>& v, const std::array<double, 2>& n,
-                                    const Invariants<2>& inv) { return op.quantize(v, n, &inv); });
+      run_held_pair("pair2d", op, start, {1.0, 1.0}, gen, c, r, quantized(op));
     } else {
       const Pair2DPaper op(c.printed_reverse);
-      run_pair2d(op, gen, c, r, [](const PairV<2>& v, const std::array<double, 2>&,
-                                   const Invariants<2>&) { return v; });
+      run_held_pair("pair2d", op, start, {1.0, 1.0}, gen, c, r, [](const auto& v, const auto&, const auto&) { return v; });
     }
     return true;
   }
   if (c.case_name == "pair3d-fast") {
+    // Pair3DExact, the engine's closed-form 3D operator (exact mode's "pair3d" runs the general
+    // ExactCollision), from the paper study's pair3d start, approaching along (1, 1, 1)
     if (c.mode != Mode::exact) return false;
-    // the paper study's pair3d start, approaching along (1, 1, 1)
-    PairV<3> v{{0.25, -0.5, 0.1}, {1.0, 0.75, 0.6}};
-    if (!c.velocities.empty()) {
-      require(c.velocities.size() == 6, "pair3d-fast needs 6 initial velocity components");
-      v.i = {c.velocities[0], c.velocities[1], c.velocities[2]};
-      v.j = {c.velocities[3], c.velocities[4], c.velocities[5]};
-    }
-    std::array<double, 3> n{1.0, 1.0, 1.0};
-    if (!c.normal.empty()) {
-      require(c.normal.size() == 3, "pair3d-fast needs a 3-component normal");
-      n = {c.normal[0], c.normal[1], c.normal[2]};
-    }
-    Invariants<3> inv{{0.0, 0.0, 0.0}, 0.0};
-    for (int k = 0; k < 3; ++k) {
-      inv.momentum[k] = v.i[k] + v.j[k];
-      inv.energy += v.i[k] * v.i[k] + v.j[k] * v.j[k];
-    }
     const Pair3DExact op(c.law, c.bits);
-    op.check_pre(v, n, &inv);  // a bad start throws here, before anything runs
-    r.initial = flat(v);
-    r.reference = flat(op.quantize(v, n, &inv));
-    detail::reversal_chain(Pair3DChain{{}, op, n, inv}, v, gen, c, r);
+    run_held_pair("pair3d-fast", op, {{0.25, -0.5, 0.1}, {1.0, 0.75, 0.6}}, {1.0, 1.0, 1.0}, gen, c, r, quantized(op));
     return true;
   }
   if (c.case_name != "pair1d") return false;

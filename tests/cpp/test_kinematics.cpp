@@ -20,21 +20,30 @@ namespace {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-// A random partner b of a (positions in a 4-wide cube around 10, standard normal velocity):
-// seen across an image (stored at x - L, shift -L on axis 0) when `image`; touching a, at
-// distance D (1 + 1e-12) along a random direction, when `touch`; its local time a's when
-// `same_time`, else random in [2.5, 3.5].
+// A random particle: position in a 4-wide cube around 10, standard normal velocity, local
+// time in [2.5, 3.5].
+template <int Dim, class Rng>
+void random_particle(Rng& rng, Particle<Dim>& a) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (int k = 0; k < Dim; ++k) {
+    a.x[k] = 10.0 + 2.0 * u(rng);
+    a.v[k] = g(rng);
+  }
+  a.t = 3.0 + 0.5 * u(rng);
+}
+
+// A random partner b of a (as random_particle): seen across an image (stored at x - L, shift
+// -L on axis 0) when `image`; touching a, at distance D (1 + 1e-12) along a random direction,
+// when `touch`; its local time a's when `same_time`.
 template <int Dim, class Rng>
 void random_partner(Rng& rng, const Particle<Dim>& a, bool image, bool touch, bool same_time, Particle<Dim>& b,
                     std::array<double, Dim>& s) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> g(0.0, 1.0);
   const double L = 20.0;
   s = {};
-  for (int k = 0; k < Dim; ++k) {
-    b.x[k] = 10.0 + 2.0 * u(rng);
-    b.v[k] = g(rng);
-  }
+  random_particle<Dim>(rng, b);
+  if (same_time) b.t = a.t;
   if (image) {
     b.x[0] -= L;
     s[0] = -L;
@@ -47,7 +56,6 @@ void random_partner(Rng& rng, const Particle<Dim>& a, bool image, bool touch, bo
     }
     for (int k = 0; k < Dim; ++k) b.x[k] = a.x[k] - s[k] - d[k] / std::sqrt(n2) * (1.0 + 1e-12);
   }
-  b.t = same_time ? a.t : 3.0 + 0.5 * u(rng);
 }
 
 template <int Dim>
@@ -55,18 +63,12 @@ void check_sides(std::uint64_t seed) {
   using Kin = FloatKinematics<Dim>;
   using Vec = typename Kin::Vec;
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
   const double sigma2 = 1.0, tol = 2e-10;
   int hits = 0, pruned = 0, kept = 0, touching = 0;
   for (int trial = 0; trial < 200000; ++trial) {
     Particle<Dim> a, b;
     Vec s{};
-    for (int k = 0; k < Dim; ++k) {
-      a.x[k] = 10.0 + 2.0 * u(rng);
-      a.v[k] = g(rng);
-    }
-    a.t = 3.0 + 0.5 * u(rng);
+    random_particle<Dim>(rng, a);
     random_partner<Dim>(rng, a, trial % 5 == 0, trial % 7 == 0, trial % 3 == 0, b, s);
     // from a's side with offset s, and from b's side with -s
     Vec ms;
@@ -114,17 +116,12 @@ void check_two_lanes(std::uint64_t seed) {
   using Vec = typename Kin::Vec;
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
   const double sigma2 = 1.0, tol = 2e-10;
   int hits = 0, touching = 0, lowered = 0;
   for (int trial = 0; trial < 100000; ++trial) {
     Particle<Dim> a, b[2];
     Vec s[2]{};
-    for (int k = 0; k < Dim; ++k) {
-      a.x[k] = 10.0 + 2.0 * u(rng);
-      a.v[k] = g(rng);
-    }
-    a.t = 3.0 + 0.5 * u(rng);
+    random_particle<Dim>(rng, a);
     for (int l = 0; l < 2; ++l)
       random_partner<Dim>(rng, a, (trial + l) % 5 == 0, (trial + 3 * l) % 7 == 0, (trial + l) % 3 == 0, b[l], s[l]);
     // limits: none, then around lane 0's contact when it has one
