@@ -15,4 +15,5 @@ void register_engine(pybind11::module_& m);     ///< engine.cpp: the event-drive
 void register_engine_init(pybind11::module_& m);  ///< engine_init.cpp: the engine's random start and limits
 void register_lattice(pybind11::module_& m);     ///< lattice.cpp: the 2D lattice engine
 void register_randomness(pybind11::module_& m);  ///< randomness.cpp: the randomness study's word stream
+void register_ecmc(pybind11::module_& m);        ///< ecmc.cpp: the event-chain Monte Carlo sampler
 }  // namespace revcol::bind

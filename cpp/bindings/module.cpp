@@ -42,4 +42,5 @@ PYBIND11_MODULE(_core, m) {
   revcol::bind::register_engine_init(m);
   revcol::bind::register_lattice(m);
   revcol::bind::register_randomness(m);
+  revcol::bind::register_ecmc(m);
 }

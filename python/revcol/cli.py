@@ -9,7 +9,7 @@
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
     revcol bench tradeoff [--reduced] [--repeats 3] --json bench/results/tradeoff.json --plot docs/figures/tradeoff
     revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.randomness ...)
-    revcol study equilibrium small|dense|figures|table ...   (= python -m revcol.physics ...)
+    revcol study equilibrium small|dense|walls|mc|mc-compare|figures|table ...   (= python -m revcol.physics ...)
     revcol study stability [--full] [--json FILE] [--markdown]   (= python -m revcol.stability ...)
     revcol sweep SWEEP.toml|NAME [--out DIR] [--workers K | --scheduler tcp://HOST:PORT | --scheduler-file F]
     revcol --version
@@ -162,7 +162,8 @@ def _parser() -> argparse.ArgumentParser:
     rnd.add_argument("rest", nargs=argparse.REMAINDER)
     eq = stsub.add_parser("equilibrium", add_help=False,
                           help="does a collision law keep equilibrium (two particles exactly, dense gases against "
-                          "the equations of state): python -m revcol.physics")
+                          "the equations of state and against event-chain Monte Carlo of the same N): "
+                          "python -m revcol.physics")
     eq.add_argument("rest", nargs=argparse.REMAINDER)
     stab = stsub.add_parser("stability", add_help=False,
                             help="the numerical stress suite, every class for every operator: python -m revcol.stability")

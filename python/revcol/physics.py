@@ -13,6 +13,10 @@ value g(sigma) = (Z - 1) / (2^(d-1) phi) it implies, the collision rate against 
 with that g(sigma), the speeds against the Maxwell-Boltzmann law (chi^2 of the time-weighted
 histogram), and the temperature across slabs.
 
+(c) The same N without dynamics: event-chain Monte Carlo (``revcol.ecmc``) samples the
+equilibrium of the engine's own N and box and gives its pressure exactly at that N, so the
+engine's Z is tested with no equation of state and no extrapolation (``mc``, ``mc-compare``).
+
 Every law runs from the same start: ``flux`` (the default), ``specular`` (deterministic
 reflection: the textbook hard-sphere gas), ``uniform`` and ``paper`` (2D). docs/physics.md has
 the derivations, the tables and the figures.
@@ -20,6 +24,8 @@ the derivations, the tables and the figures.
     python -m revcol.physics small --collisions 4000000 --json bench/results/equilibrium_small.json
     python -m revcol.physics dense --dim 2 --phi 0.3 0.5 0.6 0.7 --json bench/results/equilibrium_dense2d.json
     python -m revcol.physics walls --dim 2 --phi 0.5 --json bench/results/equilibrium_walls2d.json
+    python -m revcol.physics mc --dim 2 --phi 0.6 --n 1000 --seeds 8 --per-particle 20000 --json bench/results/ecmc_2d_phi0.6_n1000.json
+    python -m revcol.physics mc-compare --mc bench/results/ecmc_*.json --md bench/results/eos_replicas_2d_phi0.6_n1000.json
     python -m revcol.physics figures --out docs/figures/physics bench/results/equilibrium_*.json
     revcol study equilibrium ...   (the same)
 """
@@ -509,6 +515,8 @@ def figures(paths: Sequence[str], out: str) -> list[str]:
     docs = [json.load(open(p)) for p in paths]
     dense_runs = [r for d in docs for r in d.get("dense", [])]
     small = [d["small"] for d in docs if "small" in d]
+    from .ecmc import summarize
+    mc_rows = summarize([r for d in docs for r in d.get("mc", [])])
     os.makedirs(out, exist_ok=True)
     written = []
     colours = {"flux": "C0", "specular": "k", "uniform": "C3", "paper": "C1"}
@@ -537,6 +545,14 @@ def figures(paths: Sequence[str], out: str) -> list[str]:
                 zr = [reference_z(d, r["phi"]) for r in sel]
                 dev.errorbar(x, [100 * (r["z"][0] / z - 1) for r, z in zip(sel, zr)],
                              yerr=[100 * r["z"][1] / z for r, z in zip(sel, zr)], fmt="o", ms=3, color=colours[law])
+            same_n = [m for m in mc_rows if m["dim"] == d and m["n"] == rs[0]["n"]]
+            if same_n:  # the equilibrium of the same N and box (event chains), in the engine's convention
+                x = [m["phi"] + 0.008 for m in same_n]
+                ax.errorbar(x, [m["z_md"][0] for m in same_n], yerr=[m["z_md"][1] for m in same_n], fmt="s", ms=4,
+                            mfc="none", color="C2", label="event chains, same N")
+                dev.errorbar(x, [100 * (m["z_md"][0] / reference_z(d, m["phi"]) - 1) for m in same_n],
+                             yerr=[100 * m["z_md"][1] / reference_z(d, m["phi"]) for m in same_n], fmt="s", ms=4,
+                             mfc="none", color="C2", label="event chains, same N")
             ax.set_ylabel("Z = PV / NkT"), ax.set_title(f"{d}D, N = {rs[0]['n']}, periodic")
             dev.set_xlabel("packing fraction"), dev.set_ylabel(f"Z / {eos} - 1 (%)")
             ax.legend(fontsize=7)
@@ -658,8 +674,25 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     fs = sub.add_parser("finite-size", help="Z(N -> infinity) from dense runs at several N against Liu")
     fs.add_argument("runs", nargs="+", help="JSON files of `dense` runs (any sizes, laws, densities)")
     fs.add_argument("--json")
+    mc = sub.add_parser("mc", help="the equilibrium Z at the engine's own N by event-chain Monte Carlo (revcol.ecmc)")
+    mc.add_argument("--dim", type=int, choices=(1, 2, 3), required=True)
+    mc.add_argument("--phi", type=float, nargs="+", required=True)
+    mc.add_argument("--n", type=int, nargs="+", default=[1000])
+    mc.add_argument("--seeds", type=int, default=4, help="independent starts per point (each its own random state)")
+    mc.add_argument("--first-seed", type=int, default=1)
+    mc.add_argument("--per-particle", type=float, default=2000.0, help="observed chain displacement per sphere, in D")
+    mc.add_argument("--warmup", type=float, default=200.0, help="chain displacement per sphere before observing, in D")
+    mc.add_argument("--blocks", type=int, default=32)
+    mc.add_argument("--chain-length", type=float, help="default: ecmc.default_chain_length (about 100 lifts)")
+    mc.add_argument("--json")
+    cmp_ = sub.add_parser("mc-compare", help="engine runs against event chains of the same N, and Z(inf) from the chains")
+    cmp_.add_argument("--mc", nargs="+", required=True, help="JSON files of `mc` runs")
+    cmp_.add_argument("--md", nargs="*", default=[], help="JSON files of `dense` runs or bench/eos_replicas.py studies")
+    cmp_.add_argument("--json")
     args = ap.parse_args(argv)
     t0 = time.time()
+    if args.what in ("mc", "mc-compare"):
+        return _mc_main(args, argv, t0)
     if args.what == "figures":
         print("\n".join(figures(args.json, args.out)))
         return 0
@@ -687,6 +720,46 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 for phi in args.phi for law in laws]
         doc = {args.what: runs}
         print(dense_table(runs) if args.what == "dense" else walls_table(runs))
+    if args.json:
+        doc.update(_run_info(argv, t0))
+        with atomic_open(args.json) as fh:
+            json.dump(doc, fh, indent=1)
+    return 0
+
+
+def _mc_main(args: argparse.Namespace, argv: Sequence[str], t0: float) -> int:
+    """The `mc` and `mc-compare` subcommands (revcol.ecmc)."""
+    from . import ecmc
+    if args.what == "mc":
+        if args.seeds < 1 or any(n < 2 for n in args.n):
+            raise SystemExit("mc: --seeds must be >= 1 and every --n >= 2")
+        runs = []
+        for phi in args.phi:
+            for n in args.n:
+                for seed in range(args.first_seed, args.first_seed + args.seeds):
+                    r = ecmc.sample(args.dim, phi, n=n, seed=seed, per_particle=args.per_particle,
+                                    blocks=args.blocks, warmup=args.warmup, chain_length=args.chain_length)
+                    runs.append(r)
+                    print(f"  {args.dim}D phi {phi:.2f} N {n} seed {seed}: Z_mc {r['z_mc'][0]:.5f}+-{r['z_mc'][1]:.5f} "
+                          f"({r['lifts']:.3g} lifts, {r['cpu_s']:.0f} s)", file=sys.stderr)
+        rows = ecmc.summarize(runs)
+        print(ecmc.summary_table(rows))
+        doc: dict[str, Any] = {"mc": runs, "summary": rows}
+    else:
+        runs = [r for p in args.mc for r in json.load(open(p))["mc"]]
+        rows = ecmc.summarize(runs)
+        md = [e for p in args.md for e in ecmc.md_estimates(json.load(open(p)))]
+        cmp_rows = ecmc.compare(rows, md)
+        inf = ecmc.infinite_size(rows)
+        print(ecmc.summary_table(rows))
+        if cmp_rows:
+            print()
+            print(ecmc.compare_table(cmp_rows))
+        for r in inf:
+            print(f"\n{r['dim']}D phi {r['phi']:.2f}: Z(inf) from the chains at N = {r['n']}: "
+                  f"{r['z_inf'][0]:.5f} +- {r['z_inf'][1]:.5f} (a = {r['slope']:+.3g}, chi2 {r['chi2']:.2f} / {r['dof']}); "
+                  f"Liu {r['z_ref_liu']:.5f}: {100 * r['liu_relative']:+.3f}%, {r['liu_sigmas']:+.1f} sd")
+        doc = {"summary": rows, "compare": cmp_rows, "infinite_size": inf, "inputs": {"mc": args.mc, "md": args.md}}
     if args.json:
         doc.update(_run_info(argv, t0))
         with atomic_open(args.json) as fh:

@@ -1,0 +1,220 @@
+// Event-chain Monte Carlo of hard spheres: see revcol/ecmc.hpp.
+#include "revcol/ecmc.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "revcol/error.hpp"
+
+namespace revcol::ecmc {
+
+namespace {
+constexpr double kPi = 3.141592653589793238462643383279502884;
+/// Cells are at least D (1 + kCellMargin) wide, so that a position a rounding off its cell's
+/// face still has every sphere it can touch in the 3^d cells around.
+constexpr double kCellMargin = 1e-9;
+/// A pair closer than D (1 - kOverlapTol) is refused as an overlap.
+constexpr double kOverlapTol = 1e-9;
+/// Philox key word of the chains' stream (the engine's start uses 0xFFFFFF00 and 0xFFFFFF01).
+constexpr std::uint32_t kStreamWord = 0xFFFFFF10u;
+}  // namespace
+
+EventChain::EventChain(std::vector<double> box, std::vector<double> x, double diameter, std::uint64_t seed)
+    : dim_(static_cast<int>(box.size())), n_(0), diameter_(diameter), rng_({kStreamWord, 0}) {
+  require(dim_ >= 1 && dim_ <= 3, [&] { return "box must have 1, 2 or 3 lengths, got " + std::to_string(dim_); });
+  require(std::isfinite(diameter) && diameter > 0, [&] { return "diameter must be positive and finite, got " + num(diameter); });
+  require(seed <= 0xFFFFFFFFull, [&] { return "seed must be below 2^32, got " + std::to_string(seed); });
+  for (int k = 0; k < dim_; ++k) {
+    const double L = box[static_cast<std::size_t>(k)];
+    require(std::isfinite(L) && L >= 3.0 * diameter, [&] {
+      return "box length " + std::to_string(k) + " must be finite and at least 3 diameters, got " + num(L);
+    });
+    require(L / diameter <= 1e7, [&] { return "box length " + std::to_string(k) + " is over 1e7 diameters: " + num(L); });
+    box_[k] = L;
+    m_[k] = static_cast<int>(std::floor(L / (diameter * (1.0 + kCellMargin))));
+    w_[k] = L / m_[k];
+  }
+  require(x.size() % static_cast<std::size_t>(dim_) == 0,
+          [&] { return "positions must hold n x " + std::to_string(dim_) + " numbers, got " + std::to_string(x.size()); });
+  n_ = x.size() / static_cast<std::size_t>(dim_);
+  require(n_ <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "too many particles");
+  std::size_t cells = 1;
+  for (int k = 0; k < dim_; ++k) cells *= static_cast<std::size_t>(m_[k]);
+  require(cells <= (std::size_t{1} << 28), "the box has more than 2^28 cells of one diameter");
+  cell_.resize(n_);
+  for (std::size_t i = 0; i < n_; ++i)
+    for (int k = 0; k < dim_; ++k) {
+      const double v = x[i * dim_ + k];
+      require(std::isfinite(v) && v >= 0.0 && v < box_[k], [&] {
+        return "position " + std::to_string(i) + " axis " + std::to_string(k) + " = " + num(v) +
+               " is outside [0, " + num(box_[k]) + ")";
+      });
+      cell_[i][k] = std::min(static_cast<int>(v / w_[k]), m_[k] - 1);
+    }
+  x_ = std::move(x);
+  members_.assign(cells, {});
+  slot_.resize(n_);
+  for (std::size_t i = 0; i < n_; ++i) {
+    auto& cell = members_[cell_index(cell_[i])];
+    slot_[i] = static_cast<int>(cell.size());
+    cell.push_back(static_cast<int>(i));
+  }
+  const double md = min_distance();
+  require(md >= 1.0 - kOverlapTol, [&] { return "two spheres overlap: the closest pair is " + num(md) + " D apart"; });
+  rng_ = rng::Philox({kStreamWord, static_cast<std::uint32_t>(seed)});
+}
+
+std::size_t EventChain::cell_index(const std::array<int, 3>& c) const {
+  return (static_cast<std::size_t>(c[2]) * m_[1] + c[1]) * m_[0] + c[0];
+}
+
+double EventChain::packing_fraction() const {
+  const double v = dim_ == 1 ? diameter_ : dim_ == 2 ? kPi * diameter_ * diameter_ / 4 : kPi * diameter_ * diameter_ * diameter_ / 6;
+  double vol = 1.0;
+  for (int k = 0; k < dim_; ++k) vol *= box_[k];
+  return static_cast<double>(n_) * v / vol;
+}
+
+std::size_t EventChain::around(const std::array<int, 3>& c, int s, std::array<double, 3>& shift) const {
+  std::array<int, 3> nc{0, 0, 0};
+  for (int a = 0; a < dim_; ++a) {
+    nc[a] = c[a] + s % 3 - 1;
+    s /= 3;
+    shift[a] = 0.0;
+    if (nc[a] < 0) {
+      nc[a] += m_[a];
+      shift[a] = -box_[a];
+    } else if (nc[a] >= m_[a]) {
+      nc[a] -= m_[a];
+      shift[a] = box_[a];
+    }
+  }
+  return cell_index(nc);
+}
+
+double EventChain::min_distance() const {
+  double best = std::numeric_limits<double>::infinity();
+  const int stencil = dim_ == 1 ? 3 : dim_ == 2 ? 9 : 27;
+  std::array<double, 3> shift{0, 0, 0};
+  for (std::size_t i = 0; i < n_; ++i)
+    for (int s = 0; s < stencil; ++s)
+      for (const int j : members_[around(cell_[i], s, shift)]) {
+        if (static_cast<std::size_t>(j) <= i) continue;
+        double r2 = 0;
+        for (int k = 0; k < dim_; ++k) {
+          const double r = x_[j * dim_ + k] + shift[k] - x_[i * dim_ + k];
+          r2 += r * r;
+        }
+        best = std::min(best, std::sqrt(r2) / diameter_);
+      }
+  return best;
+}
+
+ChainSums EventChain::run(std::uint64_t chains, double ell, const InterruptCheck& check) {
+  double lmax = 0;
+  for (int k = 0; k < dim_; ++k) lmax = std::max(lmax, box_[k]);
+  require(std::isfinite(ell) && ell > 0 && ell <= 1e6 * lmax,
+          [&] { return "chain length must be positive, finite and at most 1e6 box lengths, got " + num(ell); });
+  ChainSums sums;
+  InterruptPoll poll(check, 256);
+  for (std::uint64_t c = 0; c < chains && n_ > 0; ++c) {
+    poll.tick();  // between chains: totals() always counts whole chains
+    const ChainSums one = dim_ == 1 ? run_chain<1>(ell) : dim_ == 2 ? run_chain<2>(ell) : run_chain<3>(ell);
+    for (ChainSums* t : {&sums, &totals_}) {
+      t->chains += one.chains;
+      t->displacement += one.displacement;
+      t->lift_dx += one.lift_dx;
+      t->lifts += one.lifts;
+      t->crossings += one.crossings;
+    }
+  }
+  return sums;
+}
+
+// One chain along axis axis_ % d: measure before changing (this loop is the whole cost).
+template <int Dim>
+ChainSums EventChain::run_chain(double ell) {
+  const int k = static_cast<int>(axis_ % Dim);
+  int i = std::min(static_cast<int>(rng_.next() * static_cast<double>(n_)), static_cast<int>(n_) - 1);
+  const double length = ell * (0.5 + rng_.next());
+  ++axis_;
+  const double D2 = diameter_ * diameter_, half = 0.5 * diameter_;
+  int prev = -1;
+  double remaining = length;
+  double lift_dx = 0.0;
+  std::uint64_t lifts = 0, crossings = 0;
+  while (remaining > 0) {
+    std::array<int, 3>& c = cell_[i];
+    double* xi = &x_[static_cast<std::size_t>(i) * Dim];
+    const double face = std::max((c[k] + 1) * w_[k] - xi[k], 0.0);
+    const bool to_face = face <= remaining;
+    double best = to_face ? face : remaining;
+    int hit = -1;
+    double hit_dx = 0.0;
+    // the 3^Dim cells around c, each with the image shift of its wrap
+    constexpr int kStencil = Dim == 1 ? 3 : Dim == 2 ? 9 : 27;
+    std::array<double, 3> shift{0, 0, 0};
+    for (int s = 0; s < kStencil; ++s) {
+      for (const int j : members_[around(c, s, shift)]) {
+        if (j == i) continue;
+        const double* xj = &x_[static_cast<std::size_t>(j) * Dim];
+        const double rk = xj[k] + shift[k] - xi[k];
+        if (rk <= 0.0 || (j == prev && rk < half)) continue;
+        double b2 = 0.0;
+        for (int a = 0; a < Dim; ++a) {
+          if (a == k) continue;
+          const double r = xj[a] + shift[a] - xi[a];
+          b2 += r * r;
+        }
+        if (b2 >= D2) continue;
+        const double step = std::max(rk - std::sqrt(D2 - b2), 0.0);
+        if (step < best) {
+          best = step;
+          hit = j;
+          hit_dx = rk - step;
+        }
+      }
+    }
+    remaining -= best;
+    if (hit >= 0) {
+      xi[k] += best;
+      lift_dx += hit_dx;
+      ++lifts;
+      prev = i;
+      i = hit;
+    } else if (to_face) {
+      // on the face: into the next cell along k (wrapping the coordinate at the box's end)
+      const std::size_t from = cell_index(c);
+      ++crossings;
+      if (c[k] + 1 == m_[k]) {
+        c[k] = 0;
+        xi[k] = 0.0;
+      } else {
+        c[k] += 1;
+        xi[k] = c[k] * w_[k];
+      }
+      auto& old_cell = members_[from];
+      const int back = old_cell.back();
+      old_cell[static_cast<std::size_t>(slot_[i])] = back;
+      slot_[back] = slot_[i];
+      old_cell.pop_back();
+      auto& new_cell = members_[cell_index(c)];
+      slot_[i] = static_cast<int>(new_cell.size());
+      new_cell.push_back(i);
+    } else {
+      xi[k] += best;
+      remaining = 0.0;
+    }
+  }
+  ChainSums one;
+  one.chains = 1;
+  one.displacement = length;
+  one.lift_dx = lift_dx;
+  one.lifts = lifts;
+  one.crossings = crossings;
+  return one;
+}
+
+}  // namespace revcol::ecmc

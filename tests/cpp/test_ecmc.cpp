@@ -1,0 +1,147 @@
+// Event-chain Monte Carlo (revcol/ecmc.hpp): its pressure against the exact finite-N answers
+// (rods on a ring, two disks, two spheres), no overlaps in dense gases, determinism, errors
+// that change nothing, and an interrupt between chains.
+#include "revcol/ecmc.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+#include "check.hpp"
+#include "revcol/engine/engine.hpp"
+#include "revcol/engine/init.hpp"
+#include "revcol/error.hpp"
+
+using revcol::ecmc::EventChain;
+
+namespace {
+
+constexpr double kPi = 3.141592653589793238462643383279502884;
+
+struct Estimate {
+  double z, error;
+};
+
+/// Z over `blocks` blocks of `chains` chains each: the mean and its standard error.
+Estimate blocks_of(EventChain& s, int blocks, std::uint64_t chains, double ell) {
+  std::vector<double> z;
+  for (int b = 0; b < blocks; ++b) z.push_back(s.run(chains, ell).compressibility());
+  const double mean = std::accumulate(z.begin(), z.end(), 0.0) / blocks;
+  double var = 0;
+  for (const double v : z) var += (v - mean) * (v - mean);
+  return {mean, std::sqrt(var / (blocks - 1) / blocks)};
+}
+
+/// A random start of n spheres at packing fraction phi in a periodic cube (the engine's).
+EventChain start(int d, std::size_t n, double phi, std::uint64_t seed) {
+  revcol::engine::Config c;
+  c.dim = d;
+  for (int k = 0; k < d; ++k) c.boundary[k] = revcol::engine::Boundary::periodic;
+  const auto s = revcol::engine::random_state(c, n, phi, seed);
+  return EventChain(std::vector<double>(s.config.box.begin(), s.config.box.begin() + d), s.x, 1.0, seed);
+}
+
+}  // namespace
+
+// N rods on a ring of length L: Z = L (L - N D)^(N-1), beta P = 1/L + (N-1)/(L - N D).
+TEST_CASE("rods on a ring: the exact finite-N pressure of Tonks' gas") {
+  const int n = 10;
+  const double L = 20.0;
+  std::vector<double> x;
+  for (int i = 0; i < n; ++i) x.push_back(2.0 * i + 0.5);
+  EventChain s({L}, x, 1.0, 7);
+  s.run(2000, 5.0);  // forget the lattice
+  const Estimate e = blocks_of(s, 40, 5000, 5.0);
+  const double exact = (L / n) * (1.0 / L + (n - 1) / (L - n));  // 1.9
+  CHECK(e.error < 0.003);  // the test can fail: the estimate is sharp
+  CHECK(std::fabs(e.z - exact) < 4.0 * e.error);
+  CHECK(s.min_distance() >= 1.0 - 1e-9);
+}
+
+// Two spheres in a periodic box whose sides all exceed 2 D: Z = V (V - v_ex).
+TEST_CASE("two disks and two spheres: Z = V (V - v_ex) gives the exact pressure") {
+  struct Case {
+    std::vector<double> box, x;
+    double v_ex;
+  };
+  const Case cases[] = {{{3.0, 3.0}, {0.5, 0.5, 2.0, 1.7}, kPi},
+                        {{3.0, 4.5}, {0.5, 0.5, 2.0, 3.1}, kPi},
+                        {{3.0, 3.0, 3.0}, {0.5, 0.5, 0.5, 2.0, 1.7, 2.2}, 4.0 * kPi / 3.0}};
+  for (const Case& c : cases) {
+    EventChain s(c.box, c.x, 1.0, 3);
+    s.run(1000, 1.0);
+    const Estimate e = blocks_of(s, 40, 10000, 1.0);
+    double V = 1.0;
+    for (const double L : c.box) V *= L;
+    const double exact = 0.5 * (1.0 + V / (V - c.v_ex));
+    CHECK(e.error < 0.002);
+    CHECK(std::fabs(e.z - exact) < 4.0 * e.error);
+  }
+}
+
+TEST_CASE("dense gases: no pair overlaps after many chains, every sphere still in its box") {
+  for (const auto& [d, n, phi] : {std::tuple{2, 400, 0.7}, std::tuple{3, 256, 0.45}, std::tuple{1, 50, 0.8}}) {
+    EventChain s = start(d, static_cast<std::size_t>(n), phi, 11);
+    const auto sums = s.run(20000, 0.5 * s.box()[0]);
+    CHECK(sums.lifts > 20000u);
+    CHECK(sums.crossings > 0u);
+    CHECK(s.min_distance() >= 1.0 - 1e-9);
+    const auto& x = s.positions();
+    for (std::size_t i = 0; i < x.size(); ++i) CHECK(x[i] >= 0.0 && x[i] < s.box()[i % d]);
+    CHECK(std::fabs(s.packing_fraction() - phi) < 1e-12);
+  }
+}
+
+TEST_CASE("the same seed gives the same bits; another seed another chain") {
+  EventChain a = start(2, 200, 0.5, 5), b = start(2, 200, 0.5, 5);
+  const auto sa = a.run(3000, 4.0), sb = b.run(3000, 4.0);
+  CHECK(a.positions() == b.positions());
+  CHECK(sa.lift_dx == sb.lift_dx);
+  CHECK(sa.lifts == sb.lifts);
+  revcol::engine::Config c;
+  c.dim = 2;
+  c.boundary[0] = c.boundary[1] = revcol::engine::Boundary::periodic;
+  const auto st = revcol::engine::random_state(c, 200, 0.5, 5);
+  EventChain other({st.config.box[0], st.config.box[1]}, st.x, 1.0, 6);
+  other.run(3000, 4.0);
+  CHECK(other.positions() != a.positions());
+}
+
+TEST_CASE("bad input names the problem and changes nothing") {
+  using revcol::InvalidArgument;
+  CHECK_THROWS_AS(EventChain({}, {}, 1.0, 1), InvalidArgument);
+  CHECK_THROWS_AS(EventChain({3, 3, 3, 3}, {}, 1.0, 1), InvalidArgument);
+  CHECK_THROWS_AS(EventChain({2.5, 3.0}, {0.5, 0.5}, 1.0, 1), InvalidArgument);             // < 3 D
+  CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 0.5, 1.2, 0.5}, 1.0, 1), InvalidArgument);   // overlap
+  CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 0.5, 2.9, 0.5}, 1.0, 1), InvalidArgument);   // overlap across the wrap
+  CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 3.0}, 1.0, 1), InvalidArgument);             // outside [0, L)
+  CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, NAN}, 1.0, 1), InvalidArgument);
+  CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 0.5, 1.0}, 1.0, 1), InvalidArgument);        // not n x d
+  CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 0.5}, 0.0, 1), InvalidArgument);
+  CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 0.5}, 1.0, std::uint64_t{1} << 32), InvalidArgument);
+  EventChain s = start(2, 50, 0.3, 2);
+  const auto before = s.positions();
+  CHECK_THROWS_AS(s.run(10, 0.0), InvalidArgument);
+  CHECK_THROWS_AS(s.run(10, INFINITY), InvalidArgument);
+  CHECK_THROWS_AS(s.run(10, -1.0), InvalidArgument);
+  CHECK(s.positions() == before);
+  CHECK(s.totals().chains == 0u);
+}
+
+TEST_CASE("an interrupt stops between chains: totals count whole chains") {
+  EventChain s = start(2, 100, 0.5, 4);
+  int calls = 0;
+  const revcol::InterruptCheck stop = [&] { return ++calls >= 3; };
+  CHECK_THROWS_AS(s.run(100000, 3.0, stop), revcol::Interrupted);
+  CHECK(s.totals().chains == 3u * 256u - 1u);
+  const double mean = s.totals().displacement / static_cast<double>(s.totals().chains);
+  CHECK(mean > 2.8 && mean < 3.2);  // lengths uniform in [1.5, 4.5]
+  CHECK(s.min_distance() >= 1.0 - 1e-9);
+  // the run goes on from there as from any other state
+  EventChain t = start(2, 100, 0.5, 4);
+  t.run(3u * 256u - 1u, 3.0);
+  CHECK(t.positions() == s.positions());
+}
+
+CHECK_MAIN()
