@@ -42,7 +42,10 @@ EventChain::EventChain(std::vector<double> box, std::vector<double> x, double di
   require(n_ <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "too many particles");
   std::size_t cells = 1;
   for (int k = 0; k < dim_; ++k) cells *= static_cast<std::size_t>(m_[k]);
-  require(cells <= (std::size_t{1} << 28), "the box has more than 2^28 cells of one diameter");
+  require(cells <= (std::size_t{1} << 24), [&] {
+    return "the box holds " + std::to_string(cells) + " cells of one diameter, more than 2^24: the sampler keeps one "
+           "list per cell, so a box this large for its diameter is refused";
+  });
   cell_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i)
     for (int k = 0; k < dim_; ++k) {

@@ -225,7 +225,10 @@ def liu_spheres(phi: float) -> float:
 def reference_z(d: int, phi: float) -> float:
     """The reference equation of state of the fluid: Liu's for disks (2D) and spheres (3D),
     both within about 0.05% of modern simulation data where Henderson's (2D) drifts to +1% at
-    0.6 and Carnahan-Starling's (3D) is 0.2-0.3% low at 0.3-0.45."""
+    0.6 and Carnahan-Starling's (3D) is 0.2-0.3% low at 0.3-0.45. In 1D, Tonks' exact
+    1 / (1 - phi)."""
+    if d == 1:
+        return 1.0 / (1.0 - phi)
     return liu_disks(phi) if d == 2 else liu_spheres(phi)
 
 

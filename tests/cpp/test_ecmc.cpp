@@ -120,6 +120,7 @@ TEST_CASE("bad input names the problem and changes nothing") {
   CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 0.5, 1.0}, 1.0, 1), InvalidArgument);        // not n x d
   CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 0.5}, 0.0, 1), InvalidArgument);
   CHECK_THROWS_AS(EventChain({3.0, 3.0}, {0.5, 0.5}, 1.0, std::uint64_t{1} << 32), InvalidArgument);
+  CHECK_THROWS_AS(EventChain({300.0, 300.0, 300.0}, {0.5, 0.5, 0.5}, 1.0, 1), InvalidArgument);  // 2.7e7 cells
   EventChain s = start(2, 50, 0.3, 2);
   const auto before = s.positions();
   CHECK_THROWS_AS(s.run(10, 0.0), InvalidArgument);

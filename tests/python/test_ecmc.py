@@ -61,6 +61,14 @@ def test_bad_input_names_the_problem_and_changes_nothing():
         ecmc.sample(2, 0.3, n=50, blocks=1)
 
 
+def test_rods_give_tonks_in_the_engine_convention():
+    # 1D: the chains' Z_mc is Tonks' finite-N value, and md_equivalent turns it into 1 / (1 - phi)
+    r = ecmc.sample(1, 0.5, n=50, seed=1, per_particle=500, blocks=16, warmup=20)
+    assert r["z_md"][1] < 0.005
+    assert abs(r["z_md"][0] - 2.0) < 4 * r["z_md"][1]
+    assert P.reference_z(1, 0.5) == 2.0
+
+
 def test_temperature_conventions():
     # Tonks: Z_mc - 1 = (N - 1) D / (L - N D) and Z_md = L / (L - N D): md_equivalent maps one onto the other
     n, L = 10, 20.0

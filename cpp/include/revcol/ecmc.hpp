@@ -74,7 +74,8 @@ class EventChain {
   /// n = x.size() / box.size() spheres of diameter `diameter` at positions x (n x d, row-major,
   /// each coordinate in [0, L_k)) in the periodic box `box` (d = 1..3 lengths, each >= 3 D).
   /// Throws InvalidArgument naming the problem: a bad d, box, diameter or position, a pair
-  /// closer than D (1 - 1e-9), a seed of 2^32 or more.
+  /// closer than D (1 - 1e-9), a seed of 2^32 or more, more than 2^24 cells (floor(L_k / D)
+  /// per axis).
   EventChain(std::vector<double> box, std::vector<double> x, double diameter, std::uint64_t seed);
 
   /// Runs `chains` chains of mean length `ell` (> 0, finite, at most 1e6 L_max) and returns their
