@@ -42,9 +42,9 @@ EventChain::EventChain(std::vector<double> box, std::vector<double> x, double di
   require(n_ <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "too many particles");
   std::size_t cells = 1;
   for (int k = 0; k < dim_; ++k) cells *= static_cast<std::size_t>(m_[k]);
-  require(cells <= (std::size_t{1} << 24), [&] {
-    return "the box holds " + std::to_string(cells) + " cells of one diameter, more than 2^24: the sampler keeps one "
-           "list per cell, so a box this large for its diameter is refused";
+  require(cells <= (std::size_t{1} << 22), [&] {
+    return "the box holds " + std::to_string(cells) + " cells of one diameter, more than 2^22: the sampler keeps "
+           "slots per cell, so a box this large for its diameter is refused";
   });
   cell_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i)
@@ -57,13 +57,11 @@ EventChain::EventChain(std::vector<double> box, std::vector<double> x, double di
       cell_[i][k] = std::min(static_cast<int>(v / w_[k]), m_[k] - 1);
     }
   x_ = std::move(x);
-  members_.assign(cells, {});
+  count_.assign(cells, 0);
+  cap_ = dim_ == 1 ? 2 : dim_ == 2 ? 4 : 8;
+  members_.assign(cells * static_cast<std::size_t>(cap_), -1);
   slot_.resize(n_);
-  for (std::size_t i = 0; i < n_; ++i) {
-    auto& cell = members_[cell_index(cell_[i])];
-    slot_[i] = static_cast<int>(cell.size());
-    cell.push_back(static_cast<int>(i));
-  }
+  for (std::size_t i = 0; i < n_; ++i) insert(static_cast<int>(i), cell_index(cell_[i]));
   const double md = min_distance();
   require(md >= 1.0 - kOverlapTol, [&] { return "two spheres overlap: the closest pair is " + num(md) + " D apart"; });
   rng_ = rng::Philox({kStreamWord, static_cast<std::uint32_t>(seed)});
@@ -97,13 +95,33 @@ std::size_t EventChain::around(const std::array<int, 3>& c, int s, std::array<do
   return cell_index(nc);
 }
 
+void EventChain::insert(int i, std::size_t cell) {
+  if (count_[cell] == cap_) {  // a full cell: every cell's capacity doubles, members kept in order
+    const int cap = 2 * cap_;
+    std::vector<int> wider(count_.size() * static_cast<std::size_t>(cap), -1);
+    for (std::size_t c = 0; c < count_.size(); ++c)
+      std::copy_n(&members_[c * cap_], count_[c], &wider[c * cap]);
+    members_ = std::move(wider);
+    cap_ = cap;
+  }
+  slot_[i] = count_[cell];
+  members_[cell * cap_ + count_[cell]++] = i;
+}
+
+void EventChain::remove(int i, std::size_t cell) {
+  int* mem = &members_[cell * cap_];
+  const int back = mem[--count_[cell]];
+  mem[slot_[i]] = back;
+  slot_[back] = slot_[i];
+}
+
 double EventChain::min_distance() const {
   double best = std::numeric_limits<double>::infinity();
   const int stencil = dim_ == 1 ? 3 : dim_ == 2 ? 9 : 27;
   std::array<double, 3> shift{0, 0, 0};
   for (std::size_t i = 0; i < n_; ++i)
     for (int s = 0; s < stencil; ++s)
-      for (const int j : members_[around(cell_[i], s, shift)]) {
+      for (const int j : members(around(cell_[i], s, shift))) {
         if (static_cast<std::size_t>(j) <= i) continue;
         double r2 = 0;
         for (int k = 0; k < dim_; ++k) {
@@ -156,27 +174,46 @@ ChainSums EventChain::run_chain(double ell) {
     double best = to_face ? face : remaining;
     int hit = -1;
     double hit_dx = 0.0;
-    // the 3^Dim cells around c, each with the image shift of its wrap
-    constexpr int kStencil = Dim == 1 ? 3 : Dim == 2 ? 9 : 27;
+    // the 3^Dim cells around c in around()'s order (x fastest), each with the image shift of
+    // its wrap: per axis the coordinates c - 1, c, c + 1 (wrapped) and their shifts
+    std::array<std::array<int, 3>, 3> nc{};
+    std::array<std::array<double, 3>, 3> ns{};
+    for (int a = 0; a < Dim; ++a) {
+      const int lo = c[a] - 1, hi = c[a] + 1;
+      nc[a] = {lo < 0 ? lo + m_[a] : lo, c[a], hi >= m_[a] ? hi - m_[a] : hi};
+      ns[a] = {lo < 0 ? -box_[a] : 0.0, 0.0, hi >= m_[a] ? box_[a] : 0.0};
+    }
+    constexpr int n1 = Dim >= 2 ? 3 : 1, n2 = Dim >= 3 ? 3 : 1;
     std::array<double, 3> shift{0, 0, 0};
-    for (int s = 0; s < kStencil; ++s) {
-      for (const int j : members_[around(c, s, shift)]) {
-        if (j == i) continue;
-        const double* xj = &x_[static_cast<std::size_t>(j) * Dim];
-        const double rk = xj[k] + shift[k] - xi[k];
-        if (rk <= 0.0 || (j == prev && rk < half)) continue;
-        double b2 = 0.0;
-        for (int a = 0; a < Dim; ++a) {
-          if (a == k) continue;
-          const double r = xj[a] + shift[a] - xi[a];
-          b2 += r * r;
-        }
-        if (b2 >= D2) continue;
-        const double step = std::max(rk - std::sqrt(D2 - b2), 0.0);
-        if (step < best) {
-          best = step;
-          hit = j;
-          hit_dx = rk - step;
+    for (int o2 = 0; o2 < n2; ++o2) {
+      shift[2] = ns[2][o2];
+      for (int o1 = 0; o1 < n1; ++o1) {
+        shift[1] = ns[1][o1];
+        const std::size_t row = (static_cast<std::size_t>(nc[2][o2]) * m_[1] + nc[1][o1]) * m_[0];
+        for (int o0 = 0; o0 < 3; ++o0) {
+          shift[0] = ns[0][o0];
+          const std::size_t cell = row + nc[0][o0];
+          const int* mem = &members_[cell * cap_];
+          for (int t = 0, count = count_[cell]; t < count; ++t) {
+            const int j = mem[t];
+            if (j == i) continue;
+            const double* xj = &x_[static_cast<std::size_t>(j) * Dim];
+            const double rk = xj[k] + shift[k] - xi[k];
+            if (rk <= 0.0 || (j == prev && rk < half)) continue;
+            double b2 = 0.0;
+            for (int a = 0; a < Dim; ++a) {
+              if (a == k) continue;
+              const double r = xj[a] + shift[a] - xi[a];
+              b2 += r * r;
+            }
+            if (b2 >= D2) continue;
+            const double step = std::max(rk - std::sqrt(D2 - b2), 0.0);
+            if (step < best) {
+              best = step;
+              hit = j;
+              hit_dx = rk - step;
+            }
+          }
         }
       }
     }
@@ -198,14 +235,8 @@ ChainSums EventChain::run_chain(double ell) {
         c[k] += 1;
         xi[k] = c[k] * w_[k];
       }
-      auto& old_cell = members_[from];
-      const int back = old_cell.back();
-      old_cell[static_cast<std::size_t>(slot_[i])] = back;
-      slot_[back] = slot_[i];
-      old_cell.pop_back();
-      auto& new_cell = members_[cell_index(c)];
-      slot_[i] = static_cast<int>(new_cell.size());
-      new_cell.push_back(i);
+      remove(i, from);
+      insert(i, cell_index(c));
     } else {
       xi[k] += best;
       remaining = 0.0;

@@ -93,6 +93,22 @@ TEST_CASE("dense gases: no pair overlaps after many chains, every sphere still i
   }
 }
 
+TEST_CASE("a cell of more than 8 spheres (a body-centred cube) widens every cell's slots") {
+  // box 4 D: 3 cells of 4/3 D per axis; 8 spheres on the corners of a cube of side 1.31 D and
+  // one at its centre (1.13 D from each corner), all in cell (0, 0, 0)
+  std::vector<double> x;
+  for (int c = 0; c < 8; ++c)
+    for (int a = 0; a < 3; ++a) x.push_back((c >> a & 1) ? 1.32 : 0.01);
+  for (int a = 0; a < 3; ++a) x.push_back(0.665);
+  x.insert(x.end(), {2.7, 2.7, 2.7});
+  EventChain s({4.0, 4.0, 4.0}, x, 1.0, 8);
+  CHECK(s.min_distance() >= 1.0);
+  const auto sums = s.run(3000, 2.0);
+  CHECK(sums.lifts > 0u && sums.crossings > 0u);
+  CHECK(s.min_distance() >= 1.0 - 1e-9);
+  CHECK(s.positions().size() == x.size());
+}
+
 TEST_CASE("the same seed gives the same bits; another seed another chain") {
   EventChain a = start(2, 200, 0.5, 5), b = start(2, 200, 0.5, 5);
   const auto sa = a.run(3000, 4.0), sb = b.run(3000, 4.0);

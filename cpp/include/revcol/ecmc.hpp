@@ -74,7 +74,7 @@ class EventChain {
   /// n = x.size() / box.size() spheres of diameter `diameter` at positions x (n x d, row-major,
   /// each coordinate in [0, L_k)) in the periodic box `box` (d = 1..3 lengths, each >= 3 D).
   /// Throws InvalidArgument naming the problem: a bad d, box, diameter or position, a pair
-  /// closer than D (1 - 1e-9), a seed of 2^32 or more, more than 2^24 cells (floor(L_k / D)
+  /// closer than D (1 - 1e-9), a seed of 2^32 or more, more than 2^22 cells (floor(L_k / D)
   /// per axis).
   EventChain(std::vector<double> box, std::vector<double> x, double diameter, std::uint64_t seed);
 
@@ -117,8 +117,23 @@ class EventChain {
   std::array<double, 3> w_{1.0, 1.0, 1.0};  ///< cell sides
   std::vector<double> x_;                   ///< n x dim
   std::vector<std::array<int, 3>> cell_;    ///< each sphere's cell coordinates
-  std::vector<std::vector<int>> members_;   ///< spheres per cell
+  /// The spheres of cell c: members_[c cap_ .. c cap_ + count_[c]), in insertion order with
+  /// removals filled from the back. cap_ starts at 2, 4, 8 (1D, 2D, 3D) and doubles for all
+  /// cells when one is full (a cell of side < 4 D / 3 holds few centres D apart).
+  std::vector<int> members_;
+  std::vector<int> count_;                  ///< spheres per cell
+  int cap_ = 1;                             ///< slots per cell
   std::vector<int> slot_;                   ///< each sphere's index in its cell's members
+  void insert(int i, std::size_t cell);     ///< appends sphere i to cell
+  void remove(int i, std::size_t cell);     ///< takes sphere i out of cell (the last member fills its slot)
+  /// The members of a cell, as a range.
+  struct Members {
+    const int* b;
+    const int* e;
+    const int* begin() const { return b; }
+    const int* end() const { return e; }
+  };
+  Members members(std::size_t cell) const { return {&members_[cell * cap_], &members_[cell * cap_] + count_[cell]}; }
   rng::Philox rng_;
   std::uint64_t axis_ = 0;                  ///< chains started: the next chain's axis is axis_ % d
   ChainSums totals_;
