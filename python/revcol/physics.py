@@ -25,7 +25,7 @@ the derivations, the tables and the figures.
     python -m revcol.physics dense --dim 2 --phi 0.3 0.5 0.6 0.7 --json bench/results/equilibrium_dense2d.json
     python -m revcol.physics walls --dim 2 --phi 0.5 --json bench/results/equilibrium_walls2d.json
     python -m revcol.physics mc --dim 2 --phi 0.6 --n 1000 --seeds 8 --per-particle 20000 --json bench/results/ecmc_2d_phi0.6_n1000.json
-    python -m revcol.physics mc-compare --mc bench/results/ecmc_*.json --md bench/results/eos_replicas_2d_phi0.6_n1000.json
+    python -m revcol.physics mc-compare --mc bench/results/ecmc_[23]d_*.json --md bench/results/eos_replicas_2d_phi0.6_n1000.json
     python -m revcol.physics figures --out docs/figures/physics bench/results/equilibrium_*.json
     revcol study equilibrium ...   (the same)
 """
@@ -749,7 +749,12 @@ def _mc_main(args: argparse.Namespace, argv: Sequence[str], t0: float) -> int:
         print(ecmc.summary_table(rows))
         doc: dict[str, Any] = {"mc": runs, "summary": rows}
     else:
-        runs = [r for p in args.mc for r in json.load(open(p))["mc"]]
+        runs = []
+        for p in args.mc:
+            doc_mc = json.load(open(p))
+            if "mc" not in doc_mc:
+                raise SystemExit(f"mc-compare: {p} holds no `mc` runs (a JSON of `python -m revcol.physics mc` has an 'mc' list)")
+            runs += doc_mc["mc"]
         rows = ecmc.summarize(runs)
         md = [e for p in args.md for e in ecmc.md_estimates(json.load(open(p)))]
         cmp_rows = ecmc.compare(rows, md)

@@ -113,5 +113,7 @@ def test_study_command_line(tmp_path, capsys):
     assert len(doc["compare"]) == 1 and len(doc["infinite_size"]) == 1
     assert P.main(["figures", str(dense_json), str(mc_json), "--out", str(tmp_path / "fig")]) == 0
     assert (tmp_path / "fig" / "z_vs_phi.png").stat().st_size > 1000
+    with pytest.raises(SystemExit, match="holds no `mc` runs"):
+        P.main(["mc-compare", "--mc", str(cmp_json)])
     with pytest.raises(ValueError, match="neither"):
         ecmc.md_estimates({"walls": []})
