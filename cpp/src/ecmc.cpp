@@ -6,12 +6,12 @@
 #include <limits>
 #include <string>
 
+#include "revcol/engine/limits.hpp"
 #include "revcol/error.hpp"
 
 namespace revcol::ecmc {
 
 namespace {
-constexpr double kPi = 3.141592653589793238462643383279502884;
 /// Cells are at least D (1 + kCellMargin) wide, so that a position a rounding off its cell's
 /// face still has every sphere it can touch in the 3^d cells around.
 constexpr double kCellMargin = 1e-9;
@@ -72,27 +72,36 @@ std::size_t EventChain::cell_index(const std::array<int, 3>& c) const {
 }
 
 double EventChain::packing_fraction() const {
-  const double v = dim_ == 1 ? diameter_ : dim_ == 2 ? kPi * diameter_ * diameter_ / 4 : kPi * diameter_ * diameter_ * diameter_ / 6;
   double vol = 1.0;
   for (int k = 0; k < dim_; ++k) vol *= box_[k];
-  return static_cast<double>(n_) * v / vol;
+  return static_cast<double>(n_) * engine::limits::particle_volume(dim_, diameter_) / vol;
 }
 
-std::size_t EventChain::around(const std::array<int, 3>& c, int s, std::array<double, 3>& shift) const {
-  std::array<int, 3> nc{0, 0, 0};
-  for (int a = 0; a < dim_; ++a) {
-    nc[a] = c[a] + s % 3 - 1;
-    s /= 3;
-    shift[a] = 0.0;
-    if (nc[a] < 0) {
-      nc[a] += m_[a];
-      shift[a] = -box_[a];
-    } else if (nc[a] >= m_[a]) {
-      nc[a] -= m_[a];
-      shift[a] = box_[a];
+template <int Dim, class F>
+[[gnu::always_inline]] inline void EventChain::for_around(const std::array<int, 3>& c, F&& f) const {
+  // per axis the coordinates c - 1, c, c + 1 (wrapped) and the image shifts of their wraps
+  std::array<std::array<int, 3>, 3> nc{};
+  std::array<std::array<double, 3>, 3> ns{};
+  for (int a = 0; a < Dim; ++a) {
+    const int lo = c[a] - 1, hi = c[a] + 1;
+    nc[a] = {lo < 0 ? lo + m_[a] : lo, c[a], hi >= m_[a] ? hi - m_[a] : hi};
+    ns[a] = {lo < 0 ? -box_[a] : 0.0, 0.0, hi >= m_[a] ? box_[a] : 0.0};
+  }
+  constexpr int n1 = Dim >= 2 ? 3 : 1, n2 = Dim >= 3 ? 3 : 1;
+  std::array<double, 3> shift{0, 0, 0};
+  for (int o2 = 0; o2 < n2; ++o2) {
+    shift[2] = ns[2][o2];
+    for (int o1 = 0; o1 < n1; ++o1) {
+      shift[1] = ns[1][o1];
+      const std::size_t row = (static_cast<std::size_t>(nc[2][o2]) * m_[1] + nc[1][o1]) * m_[0];
+      for (int o0 = 0; o0 < 3; ++o0) {
+        shift[0] = ns[0][o0];
+        const std::size_t cell = row + nc[0][o0];
+        const int* mem = &members_[cell * cap_];
+        for (int t = 0, count = count_[cell]; t < count; ++t) f(mem[t], shift);
+      }
     }
   }
-  return cell_index(nc);
 }
 
 void EventChain::insert(int i, std::size_t cell) {
@@ -115,22 +124,24 @@ void EventChain::remove(int i, std::size_t cell) {
   slot_[back] = slot_[i];
 }
 
-double EventChain::min_distance() const {
+template <int Dim>
+double EventChain::min_distance_d() const {
   double best = std::numeric_limits<double>::infinity();
-  const int stencil = dim_ == 1 ? 3 : dim_ == 2 ? 9 : 27;
-  std::array<double, 3> shift{0, 0, 0};
   for (std::size_t i = 0; i < n_; ++i)
-    for (int s = 0; s < stencil; ++s)
-      for (const int j : members(around(cell_[i], s, shift))) {
-        if (static_cast<std::size_t>(j) <= i) continue;
-        double r2 = 0;
-        for (int k = 0; k < dim_; ++k) {
-          const double r = x_[j * dim_ + k] + shift[k] - x_[i * dim_ + k];
-          r2 += r * r;
-        }
-        best = std::min(best, std::sqrt(r2) / diameter_);
+    for_around<Dim>(cell_[i], [&](int j, const std::array<double, 3>& shift) {
+      if (static_cast<std::size_t>(j) <= i) return;
+      double r2 = 0;
+      for (int k = 0; k < Dim; ++k) {
+        const double r = x_[j * Dim + k] + shift[k] - x_[i * Dim + k];
+        r2 += r * r;
       }
+      best = std::min(best, std::sqrt(r2) / diameter_);
+    });
   return best;
+}
+
+double EventChain::min_distance() const {
+  return dim_ == 1 ? min_distance_d<1>() : dim_ == 2 ? min_distance_d<2>() : min_distance_d<3>();
 }
 
 ChainSums EventChain::run(std::uint64_t chains, double ell, const InterruptCheck& check) {
@@ -143,13 +154,8 @@ ChainSums EventChain::run(std::uint64_t chains, double ell, const InterruptCheck
   for (std::uint64_t c = 0; c < chains && n_ > 0; ++c) {
     poll.tick();  // between chains: totals() always counts whole chains
     const ChainSums one = dim_ == 1 ? run_chain<1>(ell) : dim_ == 2 ? run_chain<2>(ell) : run_chain<3>(ell);
-    for (ChainSums* t : {&sums, &totals_}) {
-      t->chains += one.chains;
-      t->displacement += one.displacement;
-      t->lift_dx += one.lift_dx;
-      t->lifts += one.lifts;
-      t->crossings += one.crossings;
-    }
+    sums += one;
+    totals_ += one;
   }
   return sums;
 }
@@ -174,49 +180,25 @@ ChainSums EventChain::run_chain(double ell) {
     double best = to_face ? face : remaining;
     int hit = -1;
     double hit_dx = 0.0;
-    // the 3^Dim cells around c in around()'s order (x fastest), each with the image shift of
-    // its wrap: per axis the coordinates c - 1, c, c + 1 (wrapped) and their shifts
-    std::array<std::array<int, 3>, 3> nc{};
-    std::array<std::array<double, 3>, 3> ns{};
-    for (int a = 0; a < Dim; ++a) {
-      const int lo = c[a] - 1, hi = c[a] + 1;
-      nc[a] = {lo < 0 ? lo + m_[a] : lo, c[a], hi >= m_[a] ? hi - m_[a] : hi};
-      ns[a] = {lo < 0 ? -box_[a] : 0.0, 0.0, hi >= m_[a] ? box_[a] : 0.0};
-    }
-    constexpr int n1 = Dim >= 2 ? 3 : 1, n2 = Dim >= 3 ? 3 : 1;
-    std::array<double, 3> shift{0, 0, 0};
-    for (int o2 = 0; o2 < n2; ++o2) {
-      shift[2] = ns[2][o2];
-      for (int o1 = 0; o1 < n1; ++o1) {
-        shift[1] = ns[1][o1];
-        const std::size_t row = (static_cast<std::size_t>(nc[2][o2]) * m_[1] + nc[1][o1]) * m_[0];
-        for (int o0 = 0; o0 < 3; ++o0) {
-          shift[0] = ns[0][o0];
-          const std::size_t cell = row + nc[0][o0];
-          const int* mem = &members_[cell * cap_];
-          for (int t = 0, count = count_[cell]; t < count; ++t) {
-            const int j = mem[t];
-            if (j == i) continue;
-            const double* xj = &x_[static_cast<std::size_t>(j) * Dim];
-            const double rk = xj[k] + shift[k] - xi[k];
-            if (rk <= 0.0 || (j == prev && rk < half)) continue;
-            double b2 = 0.0;
-            for (int a = 0; a < Dim; ++a) {
-              if (a == k) continue;
-              const double r = xj[a] + shift[a] - xi[a];
-              b2 += r * r;
-            }
-            if (b2 >= D2) continue;
-            const double step = std::max(rk - std::sqrt(D2 - b2), 0.0);
-            if (step < best) {
-              best = step;
-              hit = j;
-              hit_dx = rk - step;
-            }
-          }
-        }
+    for_around<Dim>(c, [&](int j, const std::array<double, 3>& shift) [[gnu::always_inline]] {
+      if (j == i) return;
+      const double* xj = &x_[static_cast<std::size_t>(j) * Dim];
+      const double rk = xj[k] + shift[k] - xi[k];
+      if (rk <= 0.0 || (j == prev && rk < half)) return;
+      double b2 = 0.0;
+      for (int a = 0; a < Dim; ++a) {
+        if (a == k) continue;
+        const double r = xj[a] + shift[a] - xi[a];
+        b2 += r * r;
       }
-    }
+      if (b2 >= D2) return;
+      const double step = std::max(rk - std::sqrt(D2 - b2), 0.0);
+      if (step < best) {
+        best = step;
+        hit = j;
+        hit_dx = rk - step;
+      }
+    });
     remaining -= best;
     if (hit >= 0) {
       xi[k] += best;

@@ -66,6 +66,15 @@ struct ChainSums {
   std::uint64_t crossings = 0; ///< cell faces the active spheres crossed
   /// beta P V / N of these chains: 1 + lift_dx / displacement (1 when nothing ran).
   double compressibility() const { return displacement > 0 ? 1.0 + lift_dx / displacement : 1.0; }
+  /// Adds another run's sums.
+  ChainSums& operator+=(const ChainSums& o) {
+    chains += o.chains;
+    displacement += o.displacement;
+    lift_dx += o.lift_dx;
+    lifts += o.lifts;
+    crossings += o.crossings;
+    return *this;
+  }
 };
 
 /// The event-chain sampler: see the header comment.
@@ -105,9 +114,10 @@ class EventChain {
  private:
   template <int Dim> ChainSums run_chain(double ell);  ///< one chain along axis axis_ % d
   std::size_t cell_index(const std::array<int, 3>& c) const;
-  /// Cell s (0 <= s < 3^d, base-3 digits per axis: -1, 0, +1) of the 3^d around cell c: its
-  /// index, and in `shift` the image shift that its wrap puts on the positions it holds.
-  std::size_t around(const std::array<int, 3>& c, int s, std::array<double, 3>& shift) const;
+  /// Calls f(j, shift) for every sphere j of the 3^Dim cells around cell c (x fastest, then y,
+  /// z; each cell's members in order), shift the image shift of that cell's wrap.
+  template <int Dim, class F> void for_around(const std::array<int, 3>& c, F&& f) const;
+  template <int Dim> double min_distance_d() const;  ///< min_distance for this Dim
 
   int dim_;
   std::size_t n_;
@@ -126,14 +136,6 @@ class EventChain {
   std::vector<int> slot_;                   ///< each sphere's index in its cell's members
   void insert(int i, std::size_t cell);     ///< appends sphere i to cell
   void remove(int i, std::size_t cell);     ///< takes sphere i out of cell (the last member fills its slot)
-  /// The members of a cell, as a range.
-  struct Members {
-    const int* b;
-    const int* e;
-    const int* begin() const { return b; }
-    const int* end() const { return e; }
-  };
-  Members members(std::size_t cell) const { return {&members_[cell * cap_], &members_[cell * cap_] + count_[cell]}; }
   rng::Philox rng_;
   std::uint64_t axis_ = 0;                  ///< chains started: the next chain's axis is axis_ % d
   ChainSums totals_;
