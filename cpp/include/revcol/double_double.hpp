@@ -38,6 +38,21 @@ inline DD two_prod(double a, double b) {
   const double bh = cb - (cb - b), bl = b - bh;
   return {p, ((ah * bh - p) + ah * bl + al * bh) + al * bl};
 }
+/// x * x exactly: two_prod(x, x) with one split instead of two and the two equal cross
+/// products as one, (xh + xh) xl. The same bits as two_prod(x, x): in Dekker's product
+/// every operation after the split is exact, so the sum of the cross terms is the same
+/// representable number whether added as xh xl + xl xh or as 2 xh xl (xh + xh is exact,
+/// and 2 xh xl has at most 53 significant bits). That holds while no partial result
+/// underflows (|x| above about 2^-484, x^2 above 2^-969); below, neither form is exact and
+/// their last bits may differ. tests/cpp/test_double_double.cpp compares the two bit for
+/// bit. The operators' scales square three or four numbers per collision.
+inline DD two_square(double x) {
+  constexpr double kSplit = 134217729.0;  // 2^27 + 1
+  const double p = x * x;
+  const double c = kSplit * x;
+  const double xh = c - (c - x), xl = x - xh;
+  return {p, ((xh * xh - p) + (xh + xh) * xl) + xl * xl};
+}
 /// x + y to double-double accuracy.
 inline DD add(DD x, DD y) {
   const DD s = two_sum(x.hi, y.hi);
@@ -45,7 +60,7 @@ inline DD add(DD x, DD y) {
 }
 /// x^2 to double-double accuracy.
 inline DD square(DD x) {
-  const DD p = two_prod(x.hi, x.hi);
+  const DD p = two_square(x.hi);
   return quick_two_sum(p.hi, p.lo + 2.0 * x.hi * x.lo);
 }
 /// a / b to double-double accuracy.
@@ -58,7 +73,7 @@ inline DD div(DD a, DD b) {
 /// sqrt(x) for x > 0, to double-double accuracy.
 inline DD sqrt(DD x) {
   const double r = std::sqrt(x.hi);
-  const DD p = two_prod(r, r);
+  const DD p = two_square(r);
   return quick_two_sum(r, ((x.hi - p.hi) - p.lo + x.lo) / (2.0 * r));
 }
 /// |w|^2 of a short vector with its additions compensated (the squares rounded): what the
@@ -79,7 +94,7 @@ inline DD compensated_norm2(const double* w) {
 /// is of order u^2 sqrt(R); a double-double division and square root would cost 3 divisions
 /// more.
 inline DD first_order_scale(DD R, double rho, double d) {
-  const DD rr = two_prod(rho, rho);
+  const DD rr = two_square(rho);
   const double e = ((R.hi - rr.hi) - rr.lo) + R.lo;
   return {rho, e / (2.0 * rho) - 0.5 * rho * d};
 }
@@ -87,7 +102,7 @@ inline DD first_order_scale(DD R, double rho, double d) {
 template <int N>
 inline DD norm2(const double* u) {
   DD s{0.0, 0.0};
-  for (int k = 0; k < N; ++k) s = add(s, two_prod(u[k], u[k]));
+  for (int k = 0; k < N; ++k) s = add(s, two_square(u[k]));
   return s;
 }
 

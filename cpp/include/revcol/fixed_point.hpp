@@ -34,12 +34,17 @@ class FixedPoint {
   double cells() const { return cells_; }
   /// Cell of c in [0,1]: floor(c 2^K), clamped to [0, 2^K - 1] (c = 1 can come from rounding).
   std::uint64_t encode(double c) const {
-    const double s = c * cells_;
-    if (!(s > 0.0)) return 0;  // also catches a NaN, which validation rules out earlier
-    if (!(s < 0x1.0p+62)) return mask_;
-    // floor(s) for s > 0 is the conversion's truncation: the same bits, without floor's
-    // rounding-mode sequence (baseline x86-64 has no roundsd)
-    const auto u = static_cast<std::uint64_t>(s);
+    // Without branches (the operators encode two to four coordinates per collision): clamp
+    // s to [0, 2^62] first, a NaN to 0 (a comparison with a NaN is false; validation rules
+    // NaNs out earlier anyway). floor(s) for s >= 0 is then the conversion's truncation: the
+    // same bits, without floor's rounding-mode sequence (baseline x86-64 has no roundsd).
+    // 0 <= s <= 2^62 fits a signed 64-bit integer, whose conversion is one instruction; the
+    // unsigned one is a branch and a fix-up on baseline x86-64 (no AVX-512). Every c maps
+    // where the branchy form (0 below the cells, mask_ above) mapped it.
+    double s = c * cells_;
+    s = s > 0.0 ? s : 0.0;
+    s = s < 0x1.0p+62 ? s : 0x1.0p+62;
+    const auto u = static_cast<std::uint64_t>(static_cast<std::int64_t>(s));
     return u > mask_ ? mask_ : u;
   }
   /// Position of c inside its cell, in [0,1): 1/2 at the centre. Used to detect round-trip error.
@@ -49,7 +54,10 @@ class FixedPoint {
   }
   /// Centre of cell U: (U + 1/2) 2^-K, exact in double (a product by 2^-K: the quotient's
   /// bits, without a division on the operators' hot path).
-  double decode(std::uint64_t u) const { return (static_cast<double>(u) + 0.5) * inv_cells_; }
+  /// U < 2^52 converts exactly through a signed integer (one instruction, as in encode).
+  double decode(std::uint64_t u) const {
+    return (static_cast<double>(static_cast<std::int64_t>(u)) + 0.5) * inv_cells_;
+  }
   /// A random number G in (0,1) as a K-bit shift.
   std::uint64_t shift(double g) const { return encode(g); }
   /// (U + G) mod 2^K.

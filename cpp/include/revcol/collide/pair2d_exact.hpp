@@ -174,7 +174,7 @@ class Pair2DExact {
 
   // Validates and splits a pre (post = false: must approach) or post (must separate,
   // unless the rare log serves it) state.
-  Split split(const PairV<2>& v, const Frame2& f, const Invariants<2>* inv, bool post,
+  [[gnu::always_inline]] Split split(const PairV<2>& v, const Frame2& f, const Invariants<2>* inv, bool post,
               bool logged = false) const {
     const std::array<double, 2> w = relative(v);
     Split s;
@@ -231,7 +231,7 @@ class Pair2DExact {
     //   exactly), so the direction cn a + ct t is divided by |a| = 1 + da/2.
     // What remains varies with the direction and the cell: a random walk (~1e-16 sqrt(N)).
     // Cheaper than full double-double (which halved this operator's throughput).
-    const dd::DD a2 = dd::add(dd::two_prod(f.a[0], f.a[0]), dd::two_prod(f.a[1], f.a[1]));
+    const dd::DD a2 = dd::add(dd::two_square(f.a[0]), dd::two_square(f.a[1]));
     const double da = (a2.hi - 1.0) + a2.lo;  // a2.hi - 1 is exact (Sterbenz)
     const dd::DD sc = dd::first_order_scale(s.R, s.rho, da);
     const double hi = sign * 0.5 * sc.hi, lo = sign * 0.5 * sc.lo;  // half of w: v = cm +- w/2

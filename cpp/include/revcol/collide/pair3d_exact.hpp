@@ -389,7 +389,7 @@ class Pair3DExact {
     // |u|^2 to double-double accuracy; only the final roundings remain, and they vary.
     // The scale sqrt(R / |u|^2) by its two first-order parts (dd::first_order_scale, as
     // Pair2DExact), with |u|^2 = 1 + dU (U.hi - 1 is exact: Sterbenz).
-    const DD U = dd::add(dd::add(dd::two_prod(u[0], u[0]), dd::two_prod(u[1], u[1])), dd::two_prod(u[2], u[2]));
+    const DD U = dd::add(dd::add(dd::two_square(u[0]), dd::two_square(u[1])), dd::two_square(u[2]));
     const DD sc = dd::first_order_scale(s.R, std::sqrt(s.R.hi), (U.hi - 1.0) + U.lo);
     const double hi = sign * 0.5 * sc.hi, lo = sign * 0.5 * sc.lo;  // v = cm +- w/2
     PairV<3> out;
