@@ -2,7 +2,7 @@
 on identical equilibrated hard-sphere fluids (issue 21). Writes bench/results/peer_fs_edmd.json.
 
     python bench/peers/fs_edmd.py [--n 10976 97556] [--phi 0.05 0.10 0.30 0.45]
-        [--collisions 1e6] [--pairs 3] [--cpu 1] [--src bench/peers/src/EDMD]
+        [--collisions 1e6] [--pairs 3] [--cpu 1] [--lattice] [--src bench/peers/src/EDMD]
 
 The peer's source is never part of revcol (MIT licence, a separate project): put it at
 ``bench/peers/src/EDMD`` (git-ignored) or pass ``--src``:
@@ -38,6 +38,12 @@ What it does, per workload (N, packing fraction; 3D, periodic, unit diameter, kT
    untimed warm-up of the same length as the peer's. The 1-minute load is recorded before each run.
 4. **The table**: per workload, median collisions per second of each (forward and reverse for
    revcol) with min..max over pairs, and the ratios revcol / peer of the medians.
+5. **With ``--lattice``**, revcol's lattice engine (``LatticeSimulation3D``: integer state, the
+   bits-back pair operator) runs in the same rounds as a third code (peer, float, lattice; then
+   lattice, float, peer; ...), built from the same equilibrated positions and velocities
+   (quantized once, the automatic tick, flux law, seed 1), with the same untimed warm-up and the
+   same timed forward and reverse runs. Its run back must end on the bits it started from
+   (``lattice_bit_exact``; the script stops otherwise), so the figure is of a real reversal.
 
 The issue's bar is a ratio >= 1.0 forward and reverse at every workload; this script measures,
 it does not decide. Run it on a quiet machine: a figure taken under load is not a finding.
@@ -237,6 +243,35 @@ def run_revcol(state_npz: str, warmup: int, collisions: int, cpu: int, env: Opti
     raise RuntimeError(f"the revcol child printed no REVCOL_SELF line:\n{out[-2000:]}")
 
 
+_LATTICE_CHILD = """
+import json, sys, time, numpy as np
+from revcol.lattice import LatticeSimulation3D
+d = np.load(sys.argv[1])
+sim = LatticeSimulation3D(d["x"], d["v"], d["box"], seed=1)
+w, c = int(sys.argv[2]), int(sys.argv[3])
+sim.run(collisions=w)
+x0, v0 = sim.lattice_positions.copy(), sim.lattice_velocities.copy()
+t0 = time.perf_counter(); sim.run(collisions=c); t1 = time.perf_counter()
+sim.run_back(collisions=c); t2 = time.perf_counter()
+exact = bool(np.array_equal(x0, sim.lattice_positions) and np.array_equal(v0, sim.lattice_velocities))
+print("REVCOL_LATTICE " + json.dumps({"forward": c / (t1 - t0), "reverse": c / (t2 - t1), "bit_exact": exact}))
+"""
+
+
+def run_lattice(state_npz: str, warmup: int, collisions: int, cpu: int, env: Optional[dict] = None) -> dict:
+    """One process of revcol's lattice engine (3D, periodic, flux, seed 1) on the state's
+    positions and velocities: forward and reverse collisions per second of the timed run after
+    an untimed warm-up, and whether the run back ended on the bits the timed run started from."""
+    p = subprocess.run(_pin([sys.executable, "-c", _LATTICE_CHILD, state_npz, str(warmup), str(collisions)], cpu),
+                       capture_output=True, text=True, env=env)
+    if p.returncode != 0:
+        raise RuntimeError(f"the lattice child failed ({p.returncode}):\n{p.stderr[-3000:]}")
+    for line in p.stdout.splitlines():
+        if line.startswith("REVCOL_LATTICE "):
+            return json.loads(line[len("REVCOL_LATTICE "):])
+    raise RuntimeError(f"the lattice child printed no REVCOL_LATTICE line:\n{p.stdout[-2000:]}")
+
+
 def peer_commit(src: str) -> str:
     """The peer checkout's commit, or 'unknown (not a git checkout)'. Only a folder that is its
     own repository's top level counts: git asked inside an unpacked archive (no .git) placed in
@@ -274,16 +309,24 @@ def measure(args, src: str) -> dict:
                 sph, npz = os.path.join(tmp, "init.sph"), os.path.join(tmp, "state.npz")
                 write_sph(sph, st["x"], st["box"])
                 np.savez(npz, x=st["x"], v=st["v"], box=st["box"])
-                peer, fwd, rev, loads = [], [], [], []
+                peer, fwd, rev, loads, lfwd, lrev = [], [], [], [], [], []
+                codes = ("peer", "revcol", "lattice") if args.lattice else ("peer", "revcol")
                 for p in range(args.pairs):
-                    for who in (("peer", "revcol") if p % 2 == 0 else ("revcol", "peer")):
+                    for who in (codes if p % 2 == 0 else codes[::-1]):
                         loads.append(os.getloadavg()[0])
                         if who == "peer":
                             peer.append(run_peer(exe, sph, args.cpu))
-                        else:
+                        elif who == "revcol":
                             r = run_revcol(npz, wpeer, c, args.cpu)
                             fwd.append(r["forward"])
                             rev.append(r["reverse"])
+                        else:
+                            r = run_lattice(npz, wpeer, c, args.cpu)
+                            if not r["bit_exact"]:
+                                raise RuntimeError(f"N = {n}, phi = {phi}: the lattice engine's run back did not "
+                                                   "end on the bits it started from")
+                            lfwd.append(r["forward"])
+                            lrev.append(r["reverse"])
                 row = {"n": n, "phi": phi, "s_bragg_start": st["s_bragg_start"], "s_bragg_after": st["s_bragg_after"],
                        "warmup_per_particle": st["warmup_per_particle"],
                        "peer_per_s": _summary(peer), "revcol_forward_per_s": _summary(fwd),
@@ -291,9 +334,16 @@ def measure(args, src: str) -> dict:
                        "ratio_forward": float(np.median(fwd) / np.median(peer)),
                        "ratio_reverse": float(np.median(rev) / np.median(peer)),
                        "load_before_runs": loads}
+                if args.lattice:
+                    row.update({"lattice_forward_per_s": _summary(lfwd), "lattice_reverse_per_s": _summary(lrev),
+                                "lattice_bit_exact": True,
+                                "ratio_lattice_forward": float(np.median(lfwd) / np.median(peer)),
+                                "ratio_lattice_reverse": float(np.median(lrev) / np.median(peer))})
                 res["workloads"].append(row)
                 _write_json(args.json, res)  # after every workload: a run cut short keeps what it measured
-                print(json.dumps({k: row[k] for k in ("n", "phi", "ratio_forward", "ratio_reverse")}), flush=True)
+                print(json.dumps({k: row[k] for k in ("n", "phi", "ratio_forward", "ratio_reverse",
+                                                      "ratio_lattice_forward", "ratio_lattice_reverse") if k in row}),
+                      flush=True)
     res["finished_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
     return res
 
@@ -316,6 +366,8 @@ def main(argv: Optional[list] = None) -> int:
                     help="collisions per particle at most, in steps of --warmup, until the start lattice has melted")
     ap.add_argument("--pairs", type=int, default=3, help="interleaved (peer, revcol) pairs per workload")
     ap.add_argument("--cpu", type=int, default=1, help="core each run is pinned to (-1: none)")
+    ap.add_argument("--lattice", action="store_true",
+                    help="also run revcol's lattice engine (3D, integer state) in the same rounds")
     ap.add_argument("--json", default=os.path.join(RESULTS, "peer_fs_edmd.json"))
     args = ap.parse_args(argv)
     try:

@@ -132,3 +132,29 @@ def test_builds_benchmark_names_a_bad_build_argument(tmp_path, capsys, arg, said
         builds.main(["--src", str(tmp_path / "nowhere"), "--build", arg])
     assert e.value.code == 2
     assert said in capsys.readouterr().err
+
+
+def test_lattice_and_float_children_run_a_small_fluid_forward_and_back(tmp_path):
+    """The children the table runs, on a 256-sphere fluid (the benchmark's own state maker):
+    rates are positive, and the lattice engine's run back ends on its starting bits."""
+    st = fs.equilibrated_state(256, 0.3, 20.0)
+    assert st["fluid"]
+    npz = tmp_path / "state.npz"
+    np.savez(npz, x=st["x"], v=st["v"], box=st["box"])
+    lat = fs.run_lattice(str(npz), 500, 2000, -1)
+    assert lat["bit_exact"] is True
+    assert lat["forward"] > 0 and lat["reverse"] > 0
+    flo = fs.run_revcol(str(npz), 500, 2000, -1)
+    assert flo["forward"] > 0 and flo["reverse"] > 0
+
+
+def test_lattice_child_reports_a_bad_state_by_name(tmp_path):
+    """An overlapping start is refused by the lattice engine's own check, and the harness says
+    which child failed instead of printing a rate."""
+    x = np.array([[1.0, 1.0, 1.0], [1.5, 1.0, 1.0]] + [[3.0 + 1.2 * i, 5.0, 5.0] for i in range(4)])
+    v = np.zeros_like(x)
+    v[:, 0] = 1.0
+    npz = tmp_path / "bad.npz"
+    np.savez(npz, x=x, v=v, box=np.full(3, 10.0))
+    with pytest.raises(RuntimeError, match=r"lattice child failed[\s\S]*particles 0 and 1 overlap"):
+        fs.run_lattice(str(npz), 10, 10, -1)
