@@ -67,7 +67,7 @@ class Pair3DExact {
     int axis;      ///< the coordinate axis t1 is built from (smallest |a_k|, first on ties)
 
     /// Builds the frame from any non-zero finite normal; throws InvalidArgument otherwise.
-    explicit Frame(const std::array<double, 3>& normal) {
+    [[gnu::always_inline]] explicit Frame(const std::array<double, 3>& normal) {
       double x0 = normal[0], x1 = normal[1], x2 = normal[2];
       double s2 = x0 * x0 + x1 * x1 + x2 * x2;
       if (!(s2 >= 0x1.0p-900 && s2 <= 0x1.0p+900)) [[unlikely]] {
@@ -319,11 +319,11 @@ class Pair3DExact {
   // (its square in [2^-1000, 2^1000]: a normal double whose squares neither underflow nor
   // overflow); post states get a factor 2 more room, so that every post state forward
   // produces passes.
-  Split split(const PairV<3>& v, const Frame& f, const Invariants<3>* inv, bool post,
+  [[gnu::always_inline]] Split split(const PairV<3>& v, const Frame& f, const Invariants<3>* inv, bool post,
               bool logged = false) const {
     return split(v, f, project(v, f), inv, post, logged);
   }
-  Split split(const PairV<3>& v, const Frame& f, const Proj& x, const Invariants<3>* inv,
+  [[gnu::always_inline]] Split split(const PairV<3>& v, const Frame& f, const Proj& x, const Invariants<3>* inv,
               bool post, bool logged) const {
     (void)f;
     // |v| bounded so that v_i + v_j and cm +- w/2 cannot overflow
@@ -369,7 +369,7 @@ class Pair3DExact {
   }
 
   // Velocities from decoded chart coordinates; sign -1 gives the pre state (-chart^-1).
-  PairV<3> assemble(const Frame& f, const Split& s, double c0, double c1, double sign) const {
+  [[gnu::always_inline]] PairV<3> assemble(const Frame& f, const Split& s, double c0, double c1, double sign) const {
     double cn, sn;  // cos(eta), sin(eta); 1 - c0 and 2 - c0 are exact (c0 is a cell centre)
     if (law_ == Law::flux) {
       sn = std::sqrt(c0);
