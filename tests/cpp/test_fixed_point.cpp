@@ -43,6 +43,12 @@ TEST_CASE("encode at the edges: cell 0, cell 2^K - 1, clamping and NaN") {
     CHECK(fp.encode(1.0 - cell) == last);                // the last edge opens the last cell
     CHECK(fp.encode(std::nextafter(1.0 - cell, 0.0)) == last - 1);
     CHECK(fp.encode(2.0) == last);
+    // far outside [0, 1]: the branch-free clamp (encode's [0, 2^62] before the conversion)
+    CHECK(fp.encode(1e300) == last);
+    CHECK(fp.encode(std::numeric_limits<double>::infinity()) == last);
+    CHECK(fp.encode(-std::numeric_limits<double>::infinity()) == 0);
+    CHECK(fp.encode(-1e300) == 0);
+    CHECK(fp.encode(std::ldexp(1.0, 62 - K)) == last);  // s = 2^62 exactly: the clamp's edge
   }
 }
 
