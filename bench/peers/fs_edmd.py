@@ -228,19 +228,26 @@ print("REVCOL_SELF " + json.dumps({"forward": c / (t1 - t0), "reverse": c / (t2 
 """
 
 
+def _run_child(who: str, script: str, tag: str, state_npz: str, warmup: int, collisions: int, cpu: int,
+               env: Optional[dict]) -> dict:
+    """Runs a timing child (``python -c script state warmup collisions``) pinned to ``cpu`` and
+    returns the JSON it prints after ``tag``; a failure or a missing line is a RuntimeError
+    naming ``who``."""
+    p = subprocess.run(_pin([sys.executable, "-c", script, state_npz, str(warmup), str(collisions)], cpu),
+                       capture_output=True, text=True, env=env)
+    if p.returncode != 0:
+        raise RuntimeError(f"the {who} child failed ({p.returncode}):\n{p.stderr[-3000:]}")
+    for line in p.stdout.splitlines():
+        if line.startswith(tag + " "):
+            return json.loads(line[len(tag) + 1:])
+    raise RuntimeError(f"the {who} child printed no {tag} line:\n{p.stdout[-2000:]}")
+
+
 def run_revcol(state_npz: str, warmup: int, collisions: int, cpu: int, env: Optional[dict] = None) -> dict:
     """One revcol process (the float engine, exact mode, flux law, Philox): forward and reverse
     collisions per second of the timed run after an untimed warm-up. ``env``: the child's
     environment (default: this process's), e.g. a PYTHONPATH naming another build."""
-    p = subprocess.run(_pin([sys.executable, "-c", _REVCOL_CHILD, state_npz, str(warmup), str(collisions)], cpu),
-                       capture_output=True, text=True, env=env)
-    if p.returncode != 0:
-        raise RuntimeError(f"the revcol child failed ({p.returncode}):\n{p.stderr[-3000:]}")
-    out = p.stdout
-    for line in out.splitlines():
-        if line.startswith("REVCOL_SELF "):
-            return json.loads(line[len("REVCOL_SELF "):])
-    raise RuntimeError(f"the revcol child printed no REVCOL_SELF line:\n{out[-2000:]}")
+    return _run_child("revcol", _REVCOL_CHILD, "REVCOL_SELF", state_npz, warmup, collisions, cpu, env)
 
 
 _LATTICE_CHILD = """
@@ -262,14 +269,7 @@ def run_lattice(state_npz: str, warmup: int, collisions: int, cpu: int, env: Opt
     """One process of revcol's lattice engine (3D, periodic, flux, seed 1) on the state's
     positions and velocities: forward and reverse collisions per second of the timed run after
     an untimed warm-up, and whether the run back ended on the bits the timed run started from."""
-    p = subprocess.run(_pin([sys.executable, "-c", _LATTICE_CHILD, state_npz, str(warmup), str(collisions)], cpu),
-                       capture_output=True, text=True, env=env)
-    if p.returncode != 0:
-        raise RuntimeError(f"the lattice child failed ({p.returncode}):\n{p.stderr[-3000:]}")
-    for line in p.stdout.splitlines():
-        if line.startswith("REVCOL_LATTICE "):
-            return json.loads(line[len("REVCOL_LATTICE "):])
-    raise RuntimeError(f"the lattice child printed no REVCOL_LATTICE line:\n{p.stdout[-2000:]}")
+    return _run_child("lattice", _LATTICE_CHILD, "REVCOL_LATTICE", state_npz, warmup, collisions, cpu, env)
 
 
 def peer_commit(src: str) -> str:
