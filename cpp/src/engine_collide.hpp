@@ -191,6 +191,8 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
       ++counters_.group_fallbacks;
     }
   }
+  nl_.prefetch_list(a);  // both are predicted after the operator, whose work hides the loads
+  nl_.prefetch_list(b);
   advance(a, t);
   advance(b, t);
   const std::int64_t wkey = reversed ? netc_[a] - 1 : netc_[a];

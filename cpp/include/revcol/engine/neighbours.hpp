@@ -181,6 +181,16 @@ class NeighbourLists {
   Vec shift_of(unsigned code) const { return shift_vec_[code & (shift_vec_.size() - 1)]; }
 
   /// Number of particles on i's list.
+  /// Starts loading i's list (ids, codes, count) into the cache; for_neighbour_pairs would
+  /// otherwise wait on its first line.
+  void prefetch_list(int i) const {
+    const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
+    const char* ids = reinterpret_cast<const char*>(nb_.data() + base);
+    const std::size_t bytes = static_cast<std::size_t>(nbcap_) * sizeof(int);
+    for (std::size_t off = 0; off < bytes; off += 64) __builtin_prefetch(ids + off);
+    __builtin_prefetch(nbc_.data() + base);
+    __builtin_prefetch(nbn_.data() + i);
+  }
   int count(int i) const { return nbn_[i]; }
   /// Bytes held.
   std::size_t memory_bytes() const {
