@@ -79,7 +79,7 @@ void EngineImpl<Dim, Op>::gather(int a, int b, const Vec& s, double t, Group& g)
 
 // ---- random numbers ------------------------------------------------------------------------
 
-// CLCG4 only: each stream's state, from the family and the draws taken (rng_): a
+// CLCG4 only: each stream's state, from the family and the draws taken (drawn): a
 // modular power of the multipliers per stream.
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::make_generators() {
@@ -87,11 +87,11 @@ void EngineImpl<Dim, Op>::make_generators() {
   if (cfg_.generator != Generator::clcg4) return;
   clcg_ = rng::generator_traits<rng::CLCG4>::family(cfg_.seed, stream_count());
   for (std::size_t i = 0; i < clcg_.size(); ++i) {
-    if (rng_[i] == 0) continue;
+    if (drawn(static_cast<int>(i)) == 0) continue;
     rng::CLCG4::State st = clcg_[i].state();
     for (int j = 0; j < 4; ++j)
       st[j] = rng::clcg4_detail::mulmod(
-          st[j], rng::clcg4_detail::powmod(rng::CLCG4::multiplier[j], rng_[i], rng::CLCG4::modulus[j]),
+          st[j], rng::clcg4_detail::powmod(rng::CLCG4::multiplier[j], drawn(static_cast<int>(i)), rng::CLCG4::modulus[j]),
           rng::CLCG4::modulus[j]);
     clcg_[i].set_state(st);
   }
@@ -102,15 +102,15 @@ template <int Dim, PairOperator Op>
 double EngineImpl<Dim, Op>::draw(int stream, bool reversed) {
   if (cfg_.generator == Generator::clcg4) {
     if (reversed) {
-      --rng_[stream];
+      --drawn(stream);
       return clcg_[stream].prev();
     }
-    ++rng_[stream];
+    ++drawn(stream);
     return clcg_[stream].next();
   }
   const rng::Philox p({static_cast<std::uint32_t>(stream), cfg_.seed}, 0);
-  if (reversed) return p.at(--rng_[stream]);
-  return p.at(rng_[stream]++);
+  if (reversed) return p.at(--drawn(stream));
+  return p.at(drawn(stream)++);
 }
 
 // ---- walls at a collision's instant (the wall-mask log) -----------------------------------
@@ -181,8 +181,9 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
   // neighbour was within the contact tolerance at a prediction (resting contacts), or a
   // second collision of a or b was predicted within a relative kTieWindow of t (ties).
   const double window = t + kTieWindow * (std::fabs(t) + 1.0);
-  const bool maybe = cfg_.force_group_search || touching_[a] || touching_[b] || second_[a] <= window ||
-                     second_[b] <= window;
+  const Book &ba = bk_[a], &bb = bk_[b];
+  const bool maybe = cfg_.force_group_search || ba.touching || bb.touching || ba.second <= window ||
+                     bb.second <= window;
   if (cfg_.groups && maybe) {
     Group g;
     gather(a, b, s, t, g);
@@ -195,7 +196,7 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
   nl_.prefetch_list(b);
   advance(a, t);
   advance(b, t);
-  const std::int64_t wkey = reversed ? netc_[a] - 1 : netc_[a];
+  const std::int64_t wkey = reversed ? bk_[a].netc - 1 : bk_[a].netc;
   Reflection w1[2] = {0, 0}, w2[2] = {0, 0};
   if (reversed) {
     wlog_.pop(a, wkey, 2, w1, w2);
@@ -248,7 +249,8 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
     w2[1] = touch_walls(b);
     if (w1[0] | w1[1] | w2[0] | w2[1] || touches_wall(a) || touches_wall(b)) {
       const int ids[2] = {a, b};
-      wlog_.push(a, wkey, t, 2, ids, netc_.data(), w1, w2);
+      const std::int64_t nc[2] = {bk_[a].netc, bk_[b].netc};
+      wlog_.push(a, wkey, t, 2, ids, nc, w1, w2);
     }
   }
   finish_collision(a, reversed);
@@ -282,7 +284,7 @@ PairV<Dim> EngineImpl<Dim, Op>::apply_pair(const PairV<Dim>& in, const Vec& r, i
   PairV<Dim> out;
   if (reversed) {
     out = op_.reverse(arg, r, g.data(), log_);
-    if constexpr (Op::needs_exact_pre_log) pre_.pop(stream, rng_[stream], out.i.data(), out.j.data());
+    if constexpr (Op::needs_exact_pre_log) pre_.pop(stream, drawn(stream), out.i.data(), out.j.data());
     for (int k = 0; k < Dim; ++k) {
       out.i[k] = -out.i[k];
       out.j[k] = -out.j[k];
@@ -294,7 +296,7 @@ PairV<Dim> EngineImpl<Dim, Op>::apply_pair(const PairV<Dim>& in, const Vec& r, i
       if (op_.singular(arg, r)) {
         const PairV<Dim> q = op_.quantize(arg, r);
         if (ExactPreLog::off_by(arg.i.data(), q.i.data(), Dim) || ExactPreLog::off_by(arg.j.data(), q.j.data(), Dim))
-          pre_.push(stream, rng_[stream] - Op::draws, arg.i.data(), arg.j.data(), Dim);
+          pre_.push(stream, drawn(stream) - Op::draws, arg.i.data(), arg.j.data(), Dim);
       }
     }
   }
@@ -314,7 +316,7 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
     for (int w = u; w > 0 && g.id[order[w]] < g.id[order[w - 1]]; --w) std::swap(order[w], order[w - 1]);
   const int n = g.n;
   const int first = g.id[order[0]];
-  const std::int64_t wkey = reversed ? netc_[first] - 1 : netc_[first];
+  const std::int64_t wkey = reversed ? bk_[first].netc - 1 : bk_[first].netc;
   Reflection w1[kMaxGroup] = {}, w2[kMaxGroup] = {};
   for (int u = 0; u < n; ++u) advance(g.id[order[u]], t);
   // W1 reaches the observer only once the operator accepts the group (group_operator tells
@@ -328,7 +330,11 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
     for (int u = 0; u < n; ++u) w1[u] = touch_walls(g.id[order[u]]);
   }
   int ids[kMaxGroup];
-  for (int u = 0; u < n; ++u) ids[u] = g.id[order[u]];
+  std::int64_t nc[kMaxGroup];  // the members' net counts before this collision (wall-log keys)
+  for (int u = 0; u < n; ++u) {
+    ids[u] = g.id[order[u]];
+    nc[u] = bk_[ids[u]].netc;
+  }
   obs_ = obs;
   if (!group_operator(g, order, t, reversed, w1)) {
     // refused before any draw was consumed (validation comes first): undo the walls
@@ -342,7 +348,7 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
     obs_ = obs;
     if (reversed && (std::any_of(w1, w1 + n, [](Reflection q) { return q != 0; }) ||
                      std::any_of(w2, w2 + n, [](Reflection q) { return q != 0; })))
-      wlog_.push(first, wkey, t, n, ids, netc_.data(), w1, w2);  // put the masks back
+      wlog_.push(first, wkey, t, n, ids, nc, w1, w2);  // put the masks back
     return false;
   }
   for (int u = 0; u < n; ++u) {
@@ -354,10 +360,7 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
     bool any = false;
     for (int u = 0; u < n; ++u) any = any || w1[u] != 0 || w2[u] != 0 || touches_wall(ids[u]);
     if (any) {
-      // the keys must be the counts before this collision: undo finish_collision's step
-      for (int u = 0; u < n; ++u) --netc_[ids[u]];
-      wlog_.push(first, wkey, t, n, ids, netc_.data(), w1, w2);
-      for (int u = 0; u < n; ++u) ++netc_[ids[u]];
+      wlog_.push(first, wkey, t, n, ids, nc, w1, w2);  // the counts before this collision
     }
   }
   ++counters_.group_collisions;
@@ -414,10 +417,10 @@ bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, b
       op.check_post(pre.data());
       for (int k = m - 1; k >= 0; --k) gs[k] = draw(stream, true);
       op.reverse(pre.data(), gs.data(), post.data(), log_);
-      pre_.pop(stream, rng_[stream], post.data(), nullptr);
+      pre_.pop(stream, drawn(stream), post.data(), nullptr);
     } else {
       op.check_pre(pre.data());
-      const std::uint64_t key = rng_[stream];
+      const std::uint64_t key = drawn(stream);
       for (int k = 0; k < m; ++k) gs[k] = draw(stream, false);
       op.forward(pre.data(), gs.data(), post.data(), log_);
       // resting contacts and aligned velocities put the pre state on a singular set of

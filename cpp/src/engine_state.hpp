@@ -30,7 +30,7 @@ Diagnostics EngineImpl<Dim, Op>::diagnostics() const {
   d.exact_pre_pushed = pre_.pushed();
   d.exact_pre_entries = pre_.entries();
   std::uint64_t parts = 0;
-  for (auto c : ncoll_) parts += c;
+  for (const Book& b : bk_) parts += b.ncoll;
   d.collisions_per_particle = static_cast<double>(parts) / static_cast<double>(n_);
   d.net_collisions = net_;
   d.divergence = trace_.reason();
@@ -61,6 +61,10 @@ Snapshot EngineImpl<Dim, Op>::snapshot() const {
   s.ev_kind.resize(n_);
   s.ev_partner.resize(n_);
   s.ev_stamp.resize(n_);
+  s.ncoll.resize(n_);
+  s.netc.resize(n_);
+  s.second.resize(n_);
+  s.touching.resize(n_);
   for (std::size_t i = 0; i < n_; ++i) {
     for (int k = 0; k < Dim; ++k) {
       s.x[i * Dim + k] = p_[i].x[k];
@@ -69,19 +73,21 @@ Snapshot EngineImpl<Dim, Op>::snapshot() const {
     }
     s.t_local[i] = p_[i].t;
     s.stamp[i] = p_[i].stamp;
-    s.ev_t[i] = ev_[i].t;
-    s.ev_kind[i] = ev_[i].kind;
-    s.ev_partner[i] = ev_[i].partner;
-    s.ev_stamp[i] = ev_[i].stamp;
+    const Book& b = bk_[i];
+    s.ev_t[i] = b.ev.t;
+    s.ev_kind[i] = b.ev.kind;
+    s.ev_partner[i] = b.ev.partner;
+    s.ev_stamp[i] = b.ev.stamp;
+    s.ncoll[i] = b.ncoll;
+    s.netc[i] = b.netc;
+    s.second[i] = b.second;
+    s.touching[i] = b.touching;
   }
   s.cell.assign(nl_.cells().begin(), nl_.cells().end());
-  s.ncoll = ncoll_;
-  s.rng = rng_;
-  s.second = second_;
-  s.touching.assign(touching_.begin(), touching_.end());
+  s.rng.resize(stream_count());
+  for (std::size_t k = 0; k < s.rng.size(); ++k) s.rng[k] = drawn(static_cast<int>(k));
   s.log_cells = log_.cells();
   s.log_pushed = log_.pushed() + log_offset_;
-  s.netc = netc_;
   WallLog::fields(wlog_, [&](const char* key, const auto& field) { s.field(key, field); });
   ExactPreLog::fields(pre_, [&](const char* key, const auto& field) { s.field(key, field); });
   s.trace = trace_.save();

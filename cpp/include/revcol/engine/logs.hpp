@@ -34,7 +34,7 @@ class WallLog {
  public:
   /// Forward: keeps the masks of a collision at a wall: its smallest id, that id's net
   /// count before (key), its time, and per member (in the collision's order) the id, its
-  /// net count before (netc[id]) and the masks.
+  /// net count before (netc[u] for member u) and the masks.
   void push(int id, std::int64_t key, double t, int n, const int* ids, const std::int64_t* netc, const unsigned* w1,
             const unsigned* w2) {
     keys_.push_back(static_cast<std::uint64_t>(id));
@@ -43,7 +43,7 @@ class WallLog {
     sizes_.push_back(static_cast<std::uint64_t>(n));
     for (int u = 0; u < n; ++u) {
       ids_.push_back(static_cast<std::uint64_t>(ids[u]));
-      netc_.push_back(netc[ids[u]]);
+      netc_.push_back(netc[u]);
       masks_.push_back(w1[u] | (w2[u] << 8));
     }
   }
