@@ -54,7 +54,7 @@ struct Ev {
 /// One particle's bookkeeping beside its Particle, one cache line: its scheduled event and
 /// what a collision of it reads and writes (the group gate, its counts, its stream's draws).
 /// One record instead of six arrays: the event loop and a collision touch one line per
-/// particle, not six (cachegrind, 3D N = 10 976 phi 0.45: 37.8 -> 30.6 misses of a 1 MiB
+/// particle, not six (cachegrind, 3D N = 10 976 phi 0.45: 37.8 -> 29.3 misses of a 1 MiB
 /// cache per collision, docs/peers.md "Session 20").
 struct alignas(64) Book {
   Ev ev;                          ///< the scheduled event

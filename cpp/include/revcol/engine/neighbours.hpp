@@ -180,7 +180,6 @@ class NeighbourLists {
   /// The image offset of a code.
   Vec shift_of(unsigned code) const { return shift_vec_[code & (shift_vec_.size() - 1)]; }
 
-  /// Number of particles on i's list.
   /// Starts loading i's list (ids, codes, count) into the cache; for_neighbour_pairs would
   /// otherwise wait on its first line.
   void prefetch_list(int i) const {
@@ -191,6 +190,7 @@ class NeighbourLists {
     __builtin_prefetch(nbc_.data() + base);
     __builtin_prefetch(nbn_.data() + i);
   }
+  /// Number of particles on i's list.
   int count(int i) const { return nbn_[i]; }
   /// Bytes held.
   std::size_t memory_bytes() const {
