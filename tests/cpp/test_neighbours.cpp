@@ -110,6 +110,49 @@ TEST_CASE("a periodic axis of 2 cells: renewals find the nearest image without t
   }
 }
 
+// A renewal skips the cells out of reach of the centre (scan_cells), from the gaps between
+// the centre and the cell faces. The tightest case: j just across a cell corner, edge or face
+// from i (one ulp past the grid point q, on the far side from i) and i at reach (1 - 1e-9)
+// from q. j's cell then comes within 1.6e-9 of being out of reach, so a cull that
+// overestimated a gap by 1e-6 would drop the pair (checked by hand: this test then fails).
+TEST_CASE("3D: renewals skip no cell that holds a centre within reach (pairs across cell corners, edges, faces)") {
+  const double L = 12.0, reach = 1.6, cw = L / 7.0;  // 7 cells per axis
+  for (Boundary b : {Boundary::periodic, Boundary::wall}) {
+    const Config c = box_config<3>(b, b, b, L);
+    const Boundaries<3> box(c);
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int trial = 0; trial < 300; ++trial) {
+      const int axes = 1 + trial % 3;  // q on a face (1 axis on the grid), an edge (2), a corner (3)
+      double q[3], dir[3], sgn[3], dn = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const bool on_grid = k < axes;
+        q[k] = on_grid ? (1 + std::floor(u(rng) * 6)) * cw : cw + u(rng) * 5 * cw;
+        dir[k] = on_grid ? 0.2 + u(rng) : 0.0;
+        sgn[k] = u(rng) < 0.5 ? -1.0 : 1.0;
+        dn += dir[k] * dir[k];
+      }
+      dn = std::sqrt(dn);
+      const double r = reach * (1.0 - 1e-9);
+      std::vector<double> x(6);
+      for (int k = 0; k < 3; ++k) {
+        x[k] = q[k] - sgn[k] * r * dir[k] / dn;  // i
+        x[3 + k] = k < axes ? std::nextafter(q[k], q[k] + sgn[k]) : q[k];  // j, across q from i
+      }
+      NeighbourLists<3> nl;
+      nl.setup(2, box, reach, false);
+      nl.set_centres(x);
+      nl.build([](int) { return 0.0; });
+      CHECK(nl.count(0) == 1);
+      nl.renew(0);  // the renewal's (coded) scan, from each side
+      nl.renew(1);
+      CHECK(nl.valid());
+      CHECK(nl.count(0) == 1);
+      CHECK(nl.count(1) == 1);
+    }
+  }
+}
+
 TEST_CASE("image codes mirror: near(i, j) and near(j, i) agree, codes 1 <-> 2") {
   const Config c = box_config<2>(Boundary::periodic, Boundary::periodic, Boundary::periodic, 10.0);
   NeighbourLists<2> nl;
