@@ -7,7 +7,8 @@
 // The engine renews i's list when i is h = (shell - 1e-3 D) / 2 from its centre, so a pair
 // off each other's lists is more than D (1 + 1e-3) apart and a prediction scans the list
 // alone. The cell grid (cells at least (D + shell) / kSub wide) holds the centres and is
-// read by the renewals only. Ids on a list are sorted: a canonical order, the same after a restore.
+// read by the renewals only. Ids on a list are sorted: a canonical order, the same after a
+// restore.
 //
 // Image codes: 2 bits per axis, 0: x_j, 1: x_j + L, 2: x_j - L (the nearest image of j's
 // centre seen from i's; Boundaries::image). With L >= 2 (D + shell) each listed pair has one
@@ -285,15 +286,16 @@ class NeighbourLists {
     scan_cells<false>(i, f);
   }
   // The same scan; Coded: f(j, code) with the image code of j's cell seen from i's (a
-  // neighbouring cell reached across a periodic axis's end: j + L or j - L). With at least 3
-  // cells on every periodic axis (cells_code_images_) this is the code of j's nearest image
+  // neighbouring cell reached across a periodic axis's end: j + L or j - L). With at least
+  // kSpan cells on every periodic axis (cells_code_images_) this is the code of j's nearest image
   // whenever j is within reach of i: that image lies in one of the kSpan cells around i's,
   // which are then distinct.
   //
   // In 3D (kCull), a cell none of whose points is within reach of i's centre is skipped
-  // (about a quarter of the 27 at kSub = 1): its distance from the centre is summed from the gaps per
-  // axis between the centre and the cell's faces, each less a margin far above the rounding
-  // of cell_of's placement, so that no centre near() would list is ever in a skipped cell.
+  // (about a quarter of the 27 at kSub = 1). Its distance from the centre is summed from the
+  // per-axis gaps between the centre and the cell's faces, each less a margin (1e-9 L) far
+  // above the rounding of cell_of's placement and of nc cells of L / nc: no centre near()
+  // would list is ever in a skipped cell (tests/cpp/test_neighbours.cpp).
   template <bool Coded, class F>
   void scan_cells(int i, F&& f) const {
     int idx[3][kSpan];
