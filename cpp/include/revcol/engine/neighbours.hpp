@@ -6,9 +6,8 @@
 // pure function of the centres (a snapshot keeps the centres, a restore rebuilds the lists).
 // The engine renews i's list when i is h = (shell - 1e-3 D) / 2 from its centre, so a pair
 // off each other's lists is more than D (1 + 1e-3) apart and a prediction scans the list
-// alone. The cell grid (cells at least (D + shell) / kSub wide) holds the centres and is
-// read by the renewals only. Ids on a list are sorted: a canonical order, the same after a
-// restore.
+// alone. The cell grid (cells at least D + shell wide) holds the centres and is read by
+// the renewals only. Ids on a list are sorted: a canonical order, the same after a restore.
 //
 // Image codes: 2 bits per axis, 0: x_j, 1: x_j + L, 2: x_j - L (the nearest image of j's
 // centre seen from i's; Boundaries::image). With L >= 2 (D + shell) each listed pair has one
@@ -41,17 +40,12 @@ class NeighbourLists {
   /// of phi 0.3 (1.1 D). A sparse gas takes a wider shell, and a dense cluster in it can
   /// overflow: the slower path for more is the safety net.
   static constexpr int kMaxList = 128;
-  /// Cells per list reach on each axis: a renewal scans the (2 kSub + 1)^d cells around its
-  /// centre's, less those out of reach. Finer cells cover less space beyond the reach (in
-  /// 3D at phi 0.3, ~17 centres per renewal at kSub = 2 against ~32 at 1) but have more
-  /// heads to read (~84 against ~21), mostly empty: kSub = 2 measured 16% more instructions
-  /// per collision at phi 0.3 and 55% more at 0.05 (cachegrind, docs/peers.md, session 21).
-  static constexpr int kSub = 1;
-  static constexpr int kSpan = 2 * kSub + 1;  ///< cells scanned per axis
   /// Whether a renewal skips the cells out of reach (scan_cells). In 3D it reads a quarter
   /// fewer centres: at phi 0.05, 389 -> 332 L1 misses and 315 -> 229 mispredicted branches
   /// per collision for 5% more instructions. In 2D it skips little and cost 2% more
-  /// instructions at phi 0.5 (cachegrind; docs/peers.md, session 21).
+  /// instructions at phi 0.5 (cachegrind; docs/peers.md, session 21). Cells half the reach
+  /// wide (5^d scanned, fewer centres but ~84 mostly empty heads) measured 16% more
+  /// instructions at phi 0.3 and 55% more at 0.05.
   static constexpr bool kCull = Dim == 3;
 
   /// Sets the geometry: n particles, the box, and the list reach D + shell; `adjacent`
@@ -65,9 +59,9 @@ class NeighbourLists {
     cells_code_images_ = true;
     for (int k = 0; k < Dim; ++k) {
       const double L = box.length(k);
-      nc_[k] = std::max(1, static_cast<int>(std::floor(kSub * L / reach)));
+      nc_[k] = std::max(1, static_cast<int>(std::floor(L / reach)));
       cw_[k] = L / nc_[k];
-      if (box.periodic(k) && nc_[k] < kSpan) cells_code_images_ = false;
+      if (box.periodic(k) && nc_[k] < 3) cells_code_images_ = false;
       stride_[k] = total_cells_;
       total_cells_ *= nc_[k];
       shift_tab_[k][0] = 0.0;
@@ -278,36 +272,36 @@ class NeighbourLists {
     if (cn_[i].next >= 0) cn_[cn_[i].next].prev = cn_[i].prev;
   }
 
-  // Calls f(j) for every particle j != i whose centre is in the kSpan^d cells around i's
-  // (every cell of a periodic axis with fewer than kSpan, each once), but for cells out of
+  // Calls f(j) for every particle j != i whose centre is in the 3^d cells around i's
+  // (every cell of a periodic axis with fewer than 3, each once), but for cells out of
   // reach (see scan_cells).
   template <class F>
   void for_cells(int i, F&& f) const {
     scan_cells<false>(i, f);
   }
   // The same scan; Coded: f(j, code) with the image code of j's cell seen from i's (a
-  // neighbouring cell reached across a periodic axis's end: j + L or j - L). With at least
-  // kSpan cells on every periodic axis (cells_code_images_) this is the code of j's nearest image
-  // whenever j is within reach of i: that image lies in one of the kSpan cells around i's,
+  // neighbouring cell reached across a periodic axis's end: j + L or j - L). With at least 3
+  // cells on every periodic axis (cells_code_images_) this is the code of j's nearest image
+  // whenever j is within reach of i: that image lies in one of the 3 cells around i's,
   // which are then distinct.
   //
   // In 3D (kCull), a cell none of whose points is within reach of i's centre is skipped
-  // (about a quarter of the 27 at kSub = 1). Its distance from the centre is summed from the
+  // (about a quarter of the 27). Its distance from the centre is summed from the
   // per-axis gaps between the centre and the cell's faces, each less a margin (1e-9 L) far
   // above the rounding of cell_of's placement and of nc cells of L / nc: no centre near()
   // would list is ever in a skipped cell (tests/cpp/test_neighbours.cpp).
   template <bool Coded, class F>
   void scan_cells(int i, F&& f) const {
-    int idx[3][kSpan];
-    unsigned icode[3][kSpan] = {};
-    double gap2[3][kSpan] = {};
+    int idx[3][3];
+    unsigned icode[3][3] = {};
+    double gap2[3][3] = {};
     int cnt[3] = {1, 1, 1};
     idx[1][0] = idx[2][0] = 0;
     for (int k = 0; k < Dim; ++k) {
       const int c0 = cell_[i * Dim + k];
       const bool per = box_.periodic(k);
       cnt[k] = 0;
-      if (per && nc_[k] < kSpan) {
+      if (per && nc_[k] < 3) {
         for (int c = 0; c < nc_[k]; ++c) idx[k][cnt[k]++] = c * stride_[k];
         continue;
       }
@@ -318,7 +312,7 @@ class NeighbourLists {
         below = std::max(0.0, x - c0 * cw_[k] - margin);
         above = std::max(0.0, (c0 + 1) * cw_[k] - x - margin);
       }
-      for (int off = -kSub; off <= kSub; ++off) {
+      for (int off = -1; off <= 1; ++off) {
         int ck = c0 + off;
         unsigned code = 0;
         if (ck < 0 || ck >= nc_[k]) {
@@ -326,18 +320,15 @@ class NeighbourLists {
           code = ck < 0 ? 2u : 1u;  // below 0: j's image at x_j - L; past the end: x_j + L
           ck += ck < 0 ? nc_[k] : -nc_[k];
         }
-        if constexpr (kCull) {
-          const double gap = off < 0 ? below + (-off - 1) * cw_[k] : off > 0 ? above + (off - 1) * cw_[k] : 0.0;
-          gap2[k][cnt[k]] = gap * gap;
-        }
+        if constexpr (kCull) gap2[k][cnt[k]] = off < 0 ? below * below : off > 0 ? above * above : 0.0;
         icode[k][cnt[k]] = code << (2 * k);
         idx[k][cnt[k]++] = ck * stride_[k];
       }
     }
     // the chains are walked side by side, one link of each per round: their loads are
     // independent, so the cache misses overlap (measured faster than one chain at a time)
-    int cur[kSpan * kSpan * kSpan];
-    unsigned cur_code[kSpan * kSpan * kSpan];
+    int cur[27];
+    unsigned cur_code[27];
     int m = 0;
     for (int c = 0; c < cnt[2]; ++c)
       for (int b = 0; b < cnt[1]; ++b) {
@@ -546,7 +537,7 @@ class NeighbourLists {
   std::array<double, Dim> cw_{};
   std::array<int, Dim> nc_{}, stride_{};
   int total_cells_ = 1;
-  bool cells_code_images_ = true;        // every periodic axis has >= kSpan cells (scan_cells<true>)
+  bool cells_code_images_ = true;        // every periodic axis has >= 3 cells (scan_cells<true>)
   double shift_tab_[Dim][4] = {};        // one axis's 2-bit image code -> shift
   // the whole code -> the shift vector, one load per neighbour in the prediction scan instead
   // of an unpacking per axis (4^Dim entries: 1.5 KB in 3D)
