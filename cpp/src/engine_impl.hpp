@@ -275,6 +275,7 @@ class EngineImpl final : public Simulation {
     sigma2_ = cfg_.diameter * cfg_.diameter;
     contact_tol_ = 2.0 * cfg_.group_tol * sigma2_;
     box_ = Boundaries<Dim>(cfg_);
+    walled_ = box_.any_walls();
     double vol = 1.0;  // in diameters^d
     for (int k = 0; k < Dim; ++k) vol *= cfg_.box[k] / cfg_.diameter;
     const double phi = static_cast<double>(n_) * particle_volume(Dim, 1.0) / vol;
@@ -304,7 +305,7 @@ class EngineImpl final : public Simulation {
   void predict(int i) {
     Ev best;
     const double ti = p_[i].t;
-    for (int k = 0; k < Dim; ++k) {
+    for (int k = 0; k < (walled_ ? Dim : 0); ++k) {  // a periodic box: no wall to test
       const double vk = p_[i].v[k];
       if (vk == 0.0 || !box_.walls(k)) continue;
       const int up = vk > 0.0 ? 1 : 0;
@@ -600,6 +601,7 @@ class EngineImpl final : public Simulation {
   std::size_t n_;
   Op op_;                                  // the pair operator, chosen once (make_engine)
   Boundaries<Dim> box_;
+  bool walled_ = true;                     // box_.any_walls(): predict tests no wall without
   double sigma2_ = 1.0, contact_tol_ = 0.0;
   double shell_ = 0.0, renew_h_ = 0.0, renew_h2_ = 0.0;  // the neighbour lists
   std::vector<Particle<Dim>> p_;

@@ -4,6 +4,7 @@
 // brute-force count written here; the 1D rods-beside mode lists the two neighbours.
 #include "revcol/engine/neighbours.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -42,7 +43,7 @@ int brute_count(const Config& c, const std::vector<double>& x, int i, double rea
 }
 
 // L = 12: 7 cells per axis, so a renewal takes each candidate's image code from its cell
-// (scan_cells<true>); L = 4.5: 2 cells, the general nearest-image path.
+// (for_near_coded); L = 4.5: 2 cells, the general nearest-image path.
 template <int Dim>
 void check_gas(Boundary b0, Boundary b1, Boundary b2, std::uint32_t seed, double L = 12.0) {
   const double reach = 1.6;
@@ -110,7 +111,7 @@ TEST_CASE("a periodic axis of 2 cells: renewals find the nearest image without t
   }
 }
 
-// A renewal skips the cells out of reach of the centre (scan_cells), from the gaps between
+// A renewal skips the cells out of reach of the centre (cells_around), from the gaps between
 // the centre and the cell faces. The tightest case: j just across a cell corner, edge or face
 // from i (one ulp past the grid point q, on the far side from i) and i at reach (1 - 1e-9)
 // from q. j's cell then comes within 1.6e-9 of being out of reach, so a cull that
@@ -151,6 +152,66 @@ TEST_CASE("3D: renewals skip no cell that holds a centre within reach (pairs acr
       CHECK(nl.count(1) == 1);
     }
   }
+}
+
+// Centres crowd into two cells (dozens to a cell, lists of up to ~100) and go back where
+// they were, by renewals: the lists stay exact and the store does not grow from one cycle to
+// the next. (Written for the cell blocks tried in session 22, which chained blocks in a
+// crowded cell and reused the freed ones; it holds for any cell store.)
+template <int Dim>
+void check_crowding(Boundary b, std::uint32_t seed) {
+  const double L = 12.0, reach = 1.6, cw = L / 7.0;  // 7 cells per axis
+  const Config c = box_config<Dim>(b, b, b, L);
+  const Boundaries<Dim> box(c);
+  const int n = Dim == 3 ? 300 : 120;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> x(n * Dim);
+  for (double& q : x) q = u(rng) * L;
+  NeighbourLists<Dim> nl;
+  nl.setup(n, box, reach, false);
+  nl.set_centres(x);
+  nl.build([](int) { return 0.0; });
+  CHECK(nl.valid());
+  // each centre's place in the crowd: in cell 3 (4 on the last axis for odd i)
+  const std::vector<double> x0 = x;
+  std::vector<double> xc(n * Dim);
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < Dim; ++k) xc[i * Dim + k] = (k == Dim - 1 && i % 2 ? 4.0 : 3.0) * cw + u(rng) * cw * 0.999;
+  const auto move = [&](int i, bool crowd) {
+    double* ci = nl.centre(i);
+    for (int k = 0; k < Dim; ++k) {
+      const double q = crowd ? xc[i * Dim + k] : x0[i * Dim + k];
+      ci[k] = q;
+      x[i * Dim + k] = q;
+    }
+    nl.renew(i);
+  };
+  // a third of the centres crowds into two cells and goes back where it was, in one order
+  // each cycle: every cycle passes through the same states, so it needs no more store than
+  // the first
+  std::vector<int> crowd(n);
+  for (int i = 0; i < n; ++i) crowd[i] = i;
+  std::shuffle(crowd.begin(), crowd.end(), rng);
+  crowd.resize(n / 3);
+  std::size_t bytes_after_first = 0;
+  for (int cycle = 0; cycle < 4; ++cycle) {
+    for (int i : crowd) move(i, true);
+    CHECK(nl.valid());
+    for (int i = 0; i < n; ++i) CHECK(nl.count(i) == brute_count<Dim>(c, x, i, reach));
+    for (int i : crowd) move(i, false);
+    CHECK(nl.valid());
+    for (int i = 0; i < n; ++i) CHECK(nl.count(i) == brute_count<Dim>(c, x, i, reach));
+    if (cycle == 0) bytes_after_first = nl.memory_bytes();
+    else CHECK(nl.memory_bytes() == bytes_after_first);
+  }
+}
+
+TEST_CASE("crowded cells: lists stay exact as dozens of centres crowd into two cells and leave (2D and 3D)") {
+  check_crowding<2>(Boundary::periodic, 21);
+  check_crowding<2>(Boundary::wall, 22);
+  check_crowding<3>(Boundary::periodic, 23);
+  check_crowding<3>(Boundary::wall, 24);
 }
 
 TEST_CASE("image codes mirror: near(i, j) and near(j, i) agree, codes 1 <-> 2") {

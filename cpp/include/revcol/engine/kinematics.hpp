@@ -71,15 +71,16 @@ struct FloatKinematics {
     const double tr = ta > tb ? ta : tb;
     const double da = tr - ta, db = tr - tb;
     double r[Dim], w[Dim];
-    double bb = 0.0;
     for (int k = 0; k < Dim; ++k) {
       const double va = a.v[k], vb = b.v[k];
       r[k] = ((a.x[k] + va * da) - (b.x[k] + vb * db)) - s[k];
       w[k] = va - vb;
-      bb += r[k] * w[k];
     }
-    double r2 = 0.0, w2 = 0.0;
-    for (int k = 0; k < Dim; ++k) {
+    // the sums start from their first term, not from 0.0 + it: the same values but for the
+    // sign of a zero bb, which no test below and no hit's time can see (a hit has bb < 0)
+    double bb = r[0] * w[0], r2 = r[0] * r[0], w2 = w[0] * w[0];
+    for (int k = 1; k < Dim; ++k) {
+      bb += r[k] * w[k];
       r2 += r[k] * r[k];
       w2 += w[k] * w[k];
     }
@@ -124,16 +125,15 @@ struct FloatKinematics {
     const v2d tr = ta > tb ? ta : tb;  // lane-wise: pair_time's tr
     const v2d da = tr - ta, db = tr - tb;
     v2d r[Dim], w[Dim];
-    v2d bb = {0.0, 0.0};
     for (int k = 0; k < Dim; ++k) {
       const v2d va = {a.v[k], a.v[k]}, vb = {b0.v[k], b1.v[k]};
       const v2d ax = {a.x[k], a.x[k]}, bx = {b0.x[k], b1.x[k]}, sk = {s0[k], s1[k]};
       r[k] = ((ax + va * da) - (bx + vb * db)) - sk;
       w[k] = va - vb;
-      bb += r[k] * w[k];
     }
-    v2d r2 = {0.0, 0.0}, w2 = {0.0, 0.0};
-    for (int k = 0; k < Dim; ++k) {
+    v2d bb = r[0] * w[0], r2 = r[0] * r[0], w2 = w[0] * w[0];  // as pair_time: from the first term
+    for (int k = 1; k < Dim; ++k) {
+      bb += r[k] * w[k];
       r2 += r[k] * r[k];
       w2 += w[k] * w[k];
     }
