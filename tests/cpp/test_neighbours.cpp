@@ -43,7 +43,7 @@ int brute_count(const Config& c, const std::vector<double>& x, int i, double rea
 }
 
 // L = 12: 7 cells per axis, so a renewal takes each candidate's image code from its cell
-// (for_near_coded); L = 4.5: 2 cells, the general nearest-image path.
+// (scan_cells<true>); L = 4.5: 2 cells, the general nearest-image path.
 template <int Dim>
 void check_gas(Boundary b0, Boundary b1, Boundary b2, std::uint32_t seed, double L = 12.0) {
   const double reach = 1.6;
@@ -111,7 +111,7 @@ TEST_CASE("a periodic axis of 2 cells: renewals find the nearest image without t
   }
 }
 
-// A renewal skips the cells out of reach of the centre (cells_around), from the gaps between
+// A renewal skips the cells out of reach of the centre (scan_cells), from the gaps between
 // the centre and the cell faces. The tightest case: j just across a cell corner, edge or face
 // from i (one ulp past the grid point q, on the far side from i) and i at reach (1 - 1e-9)
 // from q. j's cell then comes within 1.6e-9 of being out of reach, so a cull that
@@ -154,7 +154,7 @@ TEST_CASE("3D: renewals skip no cell that holds a centre within reach (pairs acr
   }
 }
 
-// Centres crowd into two cells (dozens to a cell, lists of up to ~100) and go back where
+// Centres crowd into two cells (dozens to a cell, and long lists) and go back where
 // they were, by renewals: the lists stay exact and the store does not grow from one cycle to
 // the next. (Written for the cell blocks tried in session 22, which chained blocks in a
 // crowded cell and reused the freed ones; it holds for any cell store.)
