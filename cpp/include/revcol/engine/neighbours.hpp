@@ -418,7 +418,7 @@ class NeighbourLists {
   }
   // Every list's capacity, to hold `least` (at least one more than now), in steps of 8: the
   // longest list sets the stride of all, and it is a tail of the density's fluctuations
-  // (3D, phi 0.3, shell 0.6 D: ~10 listed on average, the longest just over 32), so
+  // (3D, phi 0.3, shell 0.6 D: ~9.4 listed on average, the longest past 16), so
   // doubling would leave most of the store empty.
   void grow_lists(int least = 0) {
     const int cap = (std::max(least, nbcap_ + 1) + 7) / 8 * 8;
