@@ -6,10 +6,13 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "check.hpp"
+#include "revcol/trig.hpp"
 
 using namespace revcol;
 
@@ -108,3 +111,55 @@ TEST_CASE("the torus shift wraps at 2^K and is undone exactly by sub") {
 }
 
 CHECK_MAIN()
+
+namespace {
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+// cells 0, 1, 2, around the quarters and halves, 2^K - 2, 2^K - 1, and random ones
+std::vector<std::uint64_t> test_cells(int K, std::mt19937_64& rng) {
+  const std::uint64_t M = (std::uint64_t{1} << K) - 1, Q = (M + 1) / 4, H = (M + 1) / 2;
+  std::vector<std::uint64_t> u = {0, 1, 2, Q - 1, Q, Q + 1, H - 1, H, H + 1, 3 * Q - 1, 3 * Q, 3 * Q + 1,
+                                  M / 8, M / 8 + 1, 3 * (M / 8) + 1, M - 1, M};
+  for (int k = 0; k < 20000; ++k) u.push_back(rng() & M);
+  return u;
+}
+}  // namespace
+
+// The operators decode straight from the integers where that is shorter; each shortcut must
+// give the bits of the plain decode-then-compute form, at every K.
+TEST_CASE("integer shortcuts give the bits of decoding first: encode_half, centered, roots, quarters") {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> Y(-1.0, 1.0);
+  int checked = 0;
+  for (int K = FixedPoint::min_bits; K <= FixedPoint::max_bits; ++K) {
+    const FixedPoint fp(K);
+    for (const std::uint64_t U : test_cells(K, rng)) {
+      const double c = fp.decode(U);
+      // 2 c - 1 and the roots sqrt(c), sqrt(1 - c)
+      CHECK(same_bits(static_cast<double>(fp.centered(U)) * fp.inv_cells(), 2.0 * c - 1.0));
+      double s, co;
+      fp.roots(U, s, co);
+      CHECK(same_bits(s, std::sqrt(c)));
+      CHECK(same_bits(co, std::sqrt(1.0 - c)));
+      // the quarter-turn reduction: exact, and sincos_turns' bits
+      const FixedPoint::Quarters qr = fp.quarters(U);
+      CHECK(qr.q >= 0 && qr.q <= 4 && std::fabs(qr.r) <= 0.125);
+      CHECK(0.25 * static_cast<double>(qr.q) + qr.r == c);
+      double s1, c1, s2, c2;
+      trig::sincos_turns(c, s1, c1);
+      trig::sincos_quarters(qr.q, qr.r, s2, c2);
+      CHECK(same_bits(s1, s2) && same_bits(c1, c2));
+      ++checked;
+    }
+    // encode_half(y) = encode(0.5 + 0.5 y): random y, the ends, signed zeros, tiny, beyond, NaN
+    std::vector<double> ys = {-1.0, 1.0, 0.0, -0.0, 1e-300, -1e-300, 0x1.0p-60, -0x1.0p-60,
+                              std::nextafter(-1.0, 0.0), std::nextafter(1.0, 0.0), -1.5, 1.5,
+                              std::numeric_limits<double>::quiet_NaN()};
+    for (int k = 0; k < 20000; ++k) ys.push_back(Y(rng));
+    for (int k = 0; k < 200; ++k) {  // on and beside cell edges: (1 + y) / 2 = U 2^-K
+      const double y = 2.0 * std::ldexp(static_cast<double>(rng() & ((std::uint64_t{1} << K) - 1)), -K) - 1.0;
+      ys.insert(ys.end(), {y, std::nextafter(y, -2.0), std::nextafter(y, 2.0)});
+    }
+    for (const double y : ys) CHECK(fp.encode_half(y) == fp.encode(0.5 + 0.5 * y));
+  }
+  std::printf("  %d cells over K = %d..%d\n", checked, FixedPoint::min_bits, FixedPoint::max_bits);
+}

@@ -386,6 +386,55 @@ TEST_CASE("rare-log honesty: recovery_bound >= measured recovery error") {
   }
 }
 
+TEST_CASE("forward's log shortcut decides as the exact test, at every K and near the edge") {
+  // forward skips the post projection when surely_unlogged() proves the exact test finds no
+  // log; reverse always runs the exact test. They must agree on every state: push iff logs().
+  std::mt19937_64 rng(21);
+  for (int K : {8, 9, 12, 16, 24, 32, 40, 44, 46, 47, 52}) {
+    const FixedPoint fp(K);
+    const std::uint64_t M = (std::uint64_t{1} << K) - 1;
+    for (Law law : {Law::flux, Law::uniform}) {
+      const Pair3DExact op(law, K);
+      RareLog log;
+      int disagree = 0, logged = 0, near = 0;
+      const int n = 20000;
+      for (int k = 0; k < n; ++k) {
+        // a drift across the edge of the S/|w| test (its limit is ~2^-K / 8u), or a moderate
+        // one with the post cell near the pole (the phi test's edge)
+        const double cms[] = {0.0, 1.0, 30.0, 300.0};
+        const double edge_cm = 0.125 / (kU * fp.cells()) * std::pow(10.0, 4.0 * uniform01(rng) - 2.0);
+        const Sample s = random_pre(rng, k % 2 ? edge_cm : cms[k / 2 % 4]);
+        const auto pc = op.pre_cell(s.v, s.n);
+        // post cells: c0 log-uniform from the pole (the log's edge in phi), c1 uniform
+        const double e = uniform01(rng) * K;
+        std::uint64_t t0 = std::min<std::uint64_t>(static_cast<std::uint64_t>(std::ldexp(1.0, static_cast<int>(e))), M);
+        if (k % 8 == 7) t0 = M - t0;
+        const std::uint64_t t1 = static_cast<std::uint64_t>(uniform01(rng) * fp.cells()) & M;
+        const G2 g{((fp.sub(t0, pc[0])) + 0.5) / fp.cells(), ((fp.sub(t1, pc[1])) + 0.5) / fp.cells()};
+        const std::size_t before = log.size();
+        const V post = op.forward(s.v, s.n, g, log);
+        const bool pushed = log.size() != before;
+        disagree += pushed == op.logs(post, s.n) ? 0 : 1;
+        logged += pushed ? 1 : 0;
+        const std::array<double, 2> b = op.recovery_bound(post, s.n);
+        const double worst = std::max(b[0], b[1]);
+        near += worst > 0.125 / 1.5 && worst < 0.125 * 1.5 ? 1 : 0;  // within 50% of the edge
+        log.clear();
+      }
+      std::printf("  K = %d, %s: %d of %d logged, %d near the edge, %d disagree\n", K, to_string(law), logged, n,
+                  near, disagree);
+      CHECK(disagree == 0);
+      if (K <= 44) {  // both sides of the edge are exercised, and the edge itself
+        CHECK(logged > n / 100);
+        CHECK(logged < n - n / 100);
+        CHECK(near > n / 200);
+      } else {
+        CHECK(logged == n);  // K >= 46: every state logs (lim0 <= 0)
+      }
+    }
+  }
+}
+
 TEST_CASE("chart edges: cells 0, 1, 2^K-2, 2^K-1, g = 0 and 1, grazing and head-on states, special normals") {
   const FixedPoint fp;
   const std::uint64_t M = (std::uint64_t{1} << fp.bits()) - 1;

@@ -49,6 +49,8 @@ inline constexpr double kAtanPoly[4] = {0x1.45f306dc9c883p-3, -0x1.b2995e7b7b604
                                         0x1.04c26be3b06cfp-5, -0x1.7483758e69c03p-6};
 }  // namespace detail
 
+inline void sincos_quarters(std::int64_t q, double r, double& s, double& co);
+
 /// sin(2 pi c) and cos(2 pi c) for c in [0, 1] (absolute error < 2.5e-16; outside [0, 1]
 /// the result is unspecified). Same bits on every IEEE double platform.
 inline void sincos_turns(double c, double& s, double& co) {
@@ -57,7 +59,13 @@ inline void sincos_turns(double c, double& s, double& co) {
   // rounds up: then r is off by at most 2^-57, a 4e-17 error in the result
   const double c4 = 4.0 * c;
   const auto q = static_cast<std::int64_t>(c4 + 0.5);
-  const double r = 0.25 * (c4 - static_cast<double>(q));
+  sincos_quarters(q, 0.25 * (c4 - static_cast<double>(q)), s, co);
+}
+
+/// sin and cos of 2 pi (q/4 + r) for an integer q and |r| <= 1/8: sincos_turns after its
+/// argument reduction, for callers that have the reduction exactly at hand (Pair3DExact
+/// reduces its K-bit cells in integers).
+inline void sincos_quarters(std::int64_t q, double r, double& s, double& co) {
   const double z = r * r;
   using detail::kCos;
   using detail::kSin;

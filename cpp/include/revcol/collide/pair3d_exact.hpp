@@ -119,6 +119,8 @@ class Pair3DExact {
     const double a0 = 0.125 / ucells_ - 4.0 - kErr, a1 = 0.125 / ucells_ - 8.0;
     lim0_ = a0 > 0.0 ? a0 : 0.0;
     lim1_ = a1 > 0.0 ? (kTwoPi * a1) * (kTwoPi * a1) : 0.0;
+    fast0_ = 0.99 * lim0_;
+    fast1_ = 0.9 * lim1_;
   }
 
   /// The target law.
@@ -140,8 +142,9 @@ class Pair3DExact {
     const std::array<std::uint64_t, 2> pre_cells = encode(-s.x.p, -s.x.q1, -s.x.q2, s.x.T);
     const std::uint64_t c0 = fp_.add(pre_cells[0], fp_.shift(g[0]));
     const std::uint64_t c1 = fp_.add(pre_cells[1], fp_.shift(g[1]));
-    PairV<3> post = assemble(f, s, fp_.decode(c0), fp_.decode(c1), +1.0);
-    if (needs_log(project(post, f))) {
+    const double c0d = fp_.decode(c0);
+    PairV<3> post = assemble(f, s, c0, c1, +1.0);
+    if (!surely_unlogged(post, s.R.hi, c0d) && needs_log(project(post, f))) {
       log.push(pre_cells[0]);
       log.push(pre_cells[1]);
     }
@@ -171,7 +174,7 @@ class Pair3DExact {
       c0 = fp_.sub(post_cells[0], fp_.shift(g[0]));
       c1 = fp_.sub(post_cells[1], fp_.shift(g[1]));
     }
-    return assemble(f, s, fp_.decode(c0), fp_.decode(c1), -1.0);
+    return assemble(f, s, c0, c1, -1.0);
   }
 
   /// Throws InvalidArgument unless `post` is a valid post-collision state (whether the log
@@ -200,7 +203,7 @@ class Pair3DExact {
     const Frame f(normal);
     const Split s = split(pre, f, inv, /*post=*/false);
     const std::array<std::uint64_t, 2> u = encode(-s.x.p, -s.x.q1, -s.x.q2, s.x.T);
-    return assemble(f, s, fp_.decode(u[0]), fp_.decode(u[1]), -1.0);
+    return assemble(f, s, u[0], u[1], -1.0);
   }
 
   /// The K-bit chart cells of a pre-collision state (what reversal restores exactly).
@@ -292,6 +295,29 @@ class Pair3DExact {
     return {ucells_ * (err / N + 4.0), ucells_ * (err / (kTwoPi * std::sqrt(x.T)) + 8.0)};
   }
 
+  // Forward's shortcut to needs_log(project(post, f)) == false, from quantities at hand: the
+  // post state's relative speed is sqrt(R) and its tangential part sqrt(R sin^2(eta)), with
+  // sin^2(eta) = c0 (flux) or c0 (2 - c0) (uniform) at the decoded cell centre c0, up to the
+  // recovery error that bound() derives, |delta| <= u (S + 37 |w|) per frame coordinate.
+  // True only when the exact test surely finds no log:
+  //   - N (reverse's |w|) is within u (lim0 + 40) <= 2^-K / 8 relative of sqrt(R), so
+  //     S <= 0.99 lim0 sqrt(R) gives S <= lim0 N, and err = S + 40 N <= S + 40.4 sqrt(R);
+  //   - where (S + 40.4 sqrt(R))^2 <= 0.9 lim1 R sin^2, sqrt(R sin^2) >= err / sqrt(lim1),
+  //     so the recovery error 2 u err moves sqrt(T) by at most 2 u sqrt(lim1) <= pi 2^-K / 2
+  //     (<= 0.7% for K >= 8) of itself: T >= 0.9 R sin^2 and err^2 <= lim1 T.
+  // Otherwise (about as rare as the log itself, and always when K is too large for any
+  // state to go unlogged) the exact test decides: forward and reverse agree bit for bit either
+  // way. S is the very sum project() takes. (Saves the forward step a projection and a
+  // square root; tests/cpp/test_pair3d_exact.cpp checks the implication near the edges.)
+  bool surely_unlogged(const PairV<3>& post, double R, double c0) const {
+    const double S = std::fabs(post.i[0]) + std::fabs(post.i[1]) + std::fabs(post.i[2]) +
+                     std::fabs(post.j[0]) + std::fabs(post.j[1]) + std::fabs(post.j[2]);
+    const double rho = std::sqrt(R);
+    const double sin2 = law_ == Law::flux ? c0 : c0 * (2.0 - c0);
+    const double err = S + (kErr + 0.4) * rho;
+    return S <= fast0_ * rho && err * err <= fast1_ * (R * sin2);  // false for NaN
+  }
+
   void check_draws(const std::array<double, 2>& g) const {
     require(g[0] >= 0.0 && g[0] <= 1.0 && g[1] >= 0.0 && g[1] <= 1.0,
             "random numbers must be in [0,1]");
@@ -368,18 +394,23 @@ class Pair3DExact {
     return s;
   }
 
-  // Velocities from decoded chart coordinates; sign -1 gives the pre state (-chart^-1).
-  [[gnu::always_inline]] PairV<3> assemble(const Frame& f, const Split& s, double c0, double c1, double sign) const {
-    double cn, sn;  // cos(eta), sin(eta); 1 - c0 and 2 - c0 are exact (c0 is a cell centre)
+  // Velocities from chart cells (U0, U1), decoded at their centres c0, c1; sign -1 gives the
+  // pre state (-chart^-1). The flux law's roots and phi's reduction come straight from the
+  // integers (FixedPoint::roots, quarters: the same bits as from c0 and c1, shorter).
+  [[gnu::always_inline]] PairV<3> assemble(const Frame& f, const Split& s, std::uint64_t U0, std::uint64_t U1,
+                                           double sign) const {
+    double cn, sn;  // cos(eta), sin(eta)
     if (law_ == Law::flux) {
-      sn = std::sqrt(c0);
-      cn = std::sqrt(1.0 - c0);
+      fp_.roots(U0, sn, cn);  // sqrt(c0), sqrt(1 - c0)
     } else {
+      const double c0 = fp_.decode(U0);  // 1 - c0 and 2 - c0 are exact (c0 is a cell centre)
       cn = 1.0 - c0;
       sn = std::sqrt(c0 * (2.0 - c0));
     }
-    double sphi, cphi;  // sin and cos of phi = 2 pi c1, reduced exactly in turns (trig.hpp)
-    trig::sincos_turns(c1, sphi, cphi);
+    // sin and cos of phi = 2 pi c1 (trig.hpp), reduced to quarter turns in integers
+    double sphi, cphi;
+    const FixedPoint::Quarters qr = fp_.quarters(U1);
+    trig::sincos_quarters(qr.q, qr.r, sphi, cphi);
     const double d1 = sn * cphi, d2 = sn * sphi;
     double u[3];  // the unit direction in the world frame (to rounding)
     for (int k = 0; k < 3; ++k) u[k] = cn * f.a[k] + d1 * f.t1[k] + d2 * f.t2[k];
@@ -405,6 +436,7 @@ class Pair3DExact {
   FixedPoint fp_;
   double ucells_;  // u 2^K: an error of k u in a coordinate is k ucells_ cells
   double lim0_, lim1_;  // needs_log's limits (0: every state logs)
+  double fast0_, fast1_;  // surely_unlogged's: 0.99 lim0_, 0.9 lim1_
 };
 
 }  // namespace revcol
