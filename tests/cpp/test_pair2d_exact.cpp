@@ -175,6 +175,47 @@ TEST_CASE("a fast centre of mass triggers the rare log, and reversal stays exact
   }
 }
 
+TEST_CASE("forward's log shortcut decides as needs_log, at every K and near the edge") {
+  // forward skips needs_log when surely_unlogged() proves it false; reverse always runs it.
+  // They must agree on every state: push iff logs(). Drifts across the edge (the log's limit
+  // on sum |v| / |w| is L = 2^-K / 8u) exercise both sides.
+  std::mt19937_64 rng(22);
+  for (int K : {8, 9, 12, 16, 24, 32, 40, 44, 46, 47, 52}) {
+    const FixedPoint fp(K);
+    for (Law law : {Law::flux, Law::uniform}) {
+      const Pair2DExact op(law, K);
+      RareLog log;
+      int disagree = 0, logged = 0, near = 0;
+      const int n = 20000;
+      const double L = 1.0 / (8.0 * 0x1.0p-53 * fp.cells());
+      for (int k = 0; k < n; ++k) {
+        const Sample s = random_pre(rng, k % 4 == 0 ? 1.0 : L * std::pow(10.0, 2.0 * uniform01(rng) - 1.5));
+        const double g = uniform01(rng);
+        const std::size_t before = log.size();
+        const V post = op.forward(s.v, s.n, g, log);
+        const bool pushed = log.size() != before;
+        disagree += pushed == op.logs(post, s.n) ? 0 : 1;
+        logged += pushed ? 1 : 0;
+        double sum = 0.0;
+        for (int a = 0; a < 2; ++a) sum += std::fabs(post.i[a]) + std::fabs(post.j[a]);
+        const double w = std::hypot(post.i[0] - post.j[0], post.i[1] - post.j[1]);
+        near += sum > w * L / 1.5 && sum < w * L * 1.5 ? 1 : 0;  // within 50% of the edge
+        log.clear();
+      }
+      std::printf("  K = %d, %s: %d of %d logged, %d near the edge, %d disagree\n", K, to_string(law), logged, n,
+                  near, disagree);
+      CHECK(disagree == 0);
+      if (K <= 46) {  // both sides of the edge are exercised, and the edge itself
+        CHECK(logged > n / 100);
+        CHECK(logged < n - n / 100);
+        CHECK(near > n / 200);
+      } else {
+        CHECK(logged == n);  // K >= 47: every state logs (L <= 10)
+      }
+    }
+  }
+}
+
 TEST_CASE("chart edges: cells 0 and 2^K-1, grazing pre states, g next to 0 and 1") {
   for (Law law : {Law::flux, Law::uniform}) {
     const Pair2DExact op(law);

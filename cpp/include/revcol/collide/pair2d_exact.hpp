@@ -52,6 +52,7 @@ class Pair2DExact {
       : law_(law), fp_(bits) {
     const double lim = 1.0 / (8.0 * kUnitRoundoff * fp_.cells());
     log_lim2_ = lim > 10.0 ? (lim - 10.0) * (lim - 10.0) : 0.0;
+    fast_lim2_ = 0.99 * log_lim2_;
   }
 
   /// The target law.
@@ -71,7 +72,7 @@ class Pair2DExact {
     const std::uint64_t cell_pre = cell(-s.p, -s.q, s.norm);
     const std::uint64_t cell_post = fp_.add(cell_pre, shift(g));
     PairV<2> post = assemble(f, s, cell_post, +1.0);
-    if (needs_log(post, f)) log.push(cell_pre);
+    if (!surely_unlogged(s) && needs_log(post, f)) log.push(cell_pre);
     return post;
   }
 
@@ -174,6 +175,21 @@ class Pair2DExact {
     return fp_.encode_half(q / norm);
   }
 
+  // Forward's shortcut to needs_log(post) == false, from quantities known before the post
+  // state is (off the end of the critical path): post = cm +- h with |h| = sqrt(R)/2, so its
+  // sum of |components| is at most 2 (|cm_0| + |cm_1|) + 2 (|h_0| + |h_1|) <= B = 2 (|cm_0| +
+  // |cm_1|) + 1.5 sqrt(R) (sqrt(2) with room for roundings). Where B^2 <= 0.99 R (L - 10)^2,
+  // the post state's |w|^2 is within 4 u (L + 10) <= 2^-K / 2 relative of R (twice
+  // needs_log's own error budget at sum <= L |w|; <= 0.2% for K >= 8), so
+  // sum^2 <= B^2 <= norm2 (L - 10)^2: needs_log is false.
+  // Otherwise (rarely: a centre of mass within a factor ~2 of the log's edge, or a K too
+  // large for any state to go unlogged) needs_log decides, as reverse does: both agree bit for
+  // bit either way (tests/cpp/test_pair2d_exact.cpp checks the implication at every K).
+  bool surely_unlogged(const Split& s) const {
+    const double B = 2.0 * (std::fabs(s.cm[0]) + std::fabs(s.cm[1])) + 1.5 * s.rho;
+    return B * B <= fast_lim2_ * s.R.hi;  // false for NaN and when every state logs
+  }
+
   std::uint64_t shift(double g) const {
     require(g >= 0.0 && g <= 1.0, "random number must be in [0,1]");
     return fp_.shift(g);
@@ -261,6 +277,7 @@ class Pair2DExact {
   Law law_;
   FixedPoint fp_;
   double log_lim2_;  // (L - 10)^2 of needs_log, 0 when every state logs
+  double fast_lim2_;  // 0.99 log_lim2_: surely_unlogged's
 };
 
 }  // namespace revcol

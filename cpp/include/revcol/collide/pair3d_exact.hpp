@@ -142,9 +142,8 @@ class Pair3DExact {
     const std::array<std::uint64_t, 2> pre_cells = encode(-s.x.p, -s.x.q1, -s.x.q2, s.x.T);
     const std::uint64_t c0 = fp_.add(pre_cells[0], fp_.shift(g[0]));
     const std::uint64_t c1 = fp_.add(pre_cells[1], fp_.shift(g[1]));
-    const double c0d = fp_.decode(c0);
     PairV<3> post = assemble(f, s, c0, c1, +1.0);
-    if (!surely_unlogged(post, s.R.hi, c0d) && needs_log(project(post, f))) {
+    if (!surely_unlogged(s, fp_.decode(c0)) && needs_log(project(post, f))) {
       log.push(pre_cells[0]);
       log.push(pre_cells[1]);
     }
@@ -295,27 +294,29 @@ class Pair3DExact {
     return {ucells_ * (err / N + 4.0), ucells_ * (err / (kTwoPi * std::sqrt(x.T)) + 8.0)};
   }
 
-  // Forward's shortcut to needs_log(project(post, f)) == false, from quantities at hand: the
-  // post state's relative speed is sqrt(R) and its tangential part sqrt(R sin^2(eta)), with
-  // sin^2(eta) = c0 (flux) or c0 (2 - c0) (uniform) at the decoded cell centre c0, up to the
-  // recovery error that bound() derives, |delta| <= u (S + 37 |w|) per frame coordinate.
-  // True only when the exact test surely finds no log:
+  // Forward's shortcut to needs_log(project(post, f)) == false, from quantities known before
+  // the post state is (so the test is off the end of the operator's critical path): the post
+  // state's relative speed is sqrt(R), its tangential part sqrt(R sin^2(eta)) with sin^2(eta)
+  // = c0 (flux) or c0 (2 - c0) (uniform) at the decoded cell centre c0, and its sum of
+  // |components| S <= 2 sum |cm_k| + 2 sum |h_k| <= 2 sum |cm_k| + sqrt(3) sqrt(R), taken as
+  // B = 2 sum |cm_k| + 1.8 sqrt(R) (post = cm +- h, |h| = sqrt(R)/2), all up to the recovery
+  // error that bound() derives, |delta| <= u (S + 37 |w|) per frame coordinate. True only when
+  // the exact test surely finds no log (both of its conditions only tighten as S grows):
   //   - N (reverse's |w|) is within u (lim0 + 40) <= 2^-K / 8 relative of sqrt(R), so
-  //     S <= 0.99 lim0 sqrt(R) gives S <= lim0 N, and err = S + 40 N <= S + 40.4 sqrt(R);
-  //   - where (S + 40.4 sqrt(R))^2 <= 0.9 lim1 R sin^2, sqrt(R sin^2) >= err / sqrt(lim1),
+  //     B <= 0.99 lim0 sqrt(R) gives S <= lim0 N, and err = S + 40 N <= B + 40.4 sqrt(R);
+  //   - where (B + 40.4 sqrt(R))^2 <= 0.9 lim1 R sin^2, sqrt(R sin^2) >= err / sqrt(lim1),
   //     so the recovery error 2 u err moves sqrt(T) by at most 2 u sqrt(lim1) <= pi 2^-K / 2
   //     (<= 0.7% for K >= 8) of itself: T >= 0.9 R sin^2 and err^2 <= lim1 T.
-  // Otherwise (about as rare as the log itself, and always when K is too large for any
-  // state to go unlogged) the exact test decides: forward and reverse agree bit for bit either
-  // way. S is the very sum project() takes. (Saves the forward step a projection and a
-  // square root; tests/cpp/test_pair3d_exact.cpp checks the implication near the edges.)
-  bool surely_unlogged(const PairV<3>& post, double R, double c0) const {
-    const double S = std::fabs(post.i[0]) + std::fabs(post.i[1]) + std::fabs(post.i[2]) +
-                     std::fabs(post.j[0]) + std::fabs(post.j[1]) + std::fabs(post.j[2]);
-    const double rho = std::sqrt(R);
+  // Otherwise (rarely: near the log's own edge, and always when K is too large for any state
+  // to go unlogged) the exact test decides: forward and reverse agree bit for bit either way.
+  // (Saves the forward step a projection and a square root; tests/cpp/test_pair3d_exact.cpp
+  // checks the implication across the edge at every K.)
+  bool surely_unlogged(const Split& s, double c0) const {
+    const double R = s.R.hi, rho = std::sqrt(R);
+    const double B = 2.0 * (std::fabs(s.cm[0]) + std::fabs(s.cm[1]) + std::fabs(s.cm[2])) + 1.8 * rho;
     const double sin2 = law_ == Law::flux ? c0 : c0 * (2.0 - c0);
-    const double err = S + (kErr + 0.4) * rho;
-    return S <= fast0_ * rho && err * err <= fast1_ * (R * sin2);  // false for NaN
+    const double err = B + (kErr + 0.4) * rho;
+    return B <= fast0_ * rho && err * err <= fast1_ * (R * sin2);  // false for NaN
   }
 
   void check_draws(const std::array<double, 2>& g) const {
