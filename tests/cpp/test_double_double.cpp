@@ -132,3 +132,40 @@ TEST_CASE("add, square, div, sqrt and norm2 reach double-double accuracy") {
 }
 
 CHECK_MAIN()
+
+// The operators' shortcuts leave out a QuickTwoSum that cannot change anything; each must give
+// the full form's bits, signed zeros included, on random, tied and near-unit inputs.
+TEST_CASE("compensated_norm2<2>, compensated_norm2_minus_one and add_minus_one: the full forms' bits") {
+  const auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; };
+  std::mt19937_64 rng(31);
+  std::normal_distribution<double> N(0.0, 1.0);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  int bad = 0;
+  for (int k = 0; k < 2000000; ++k) {
+    // 2D |w|^2: random scales, exact ties (small integers), and zeros
+    double w[2];
+    if (k % 4 == 0) {
+      w[0] = static_cast<double>(static_cast<int>(U(rng) * 3e7)), w[1] = static_cast<double>(static_cast<int>(U(rng) * 3e7));
+    } else if (k % 1000 == 1) {
+      w[0] = 0.0, w[1] = k % 3 ? -0.0 : 0.0;
+    } else {
+      w[0] = N(rng) * std::ldexp(1.0, static_cast<int>(U(rng) * 60)), w[1] = N(rng);
+    }
+    dd::DD s{w[0] * w[0], 0.0};
+    const dd::DD t = dd::two_sum(s.hi, w[1] * w[1]);
+    s = {t.hi, s.lo + t.lo};
+    const dd::DD full = dd::quick_two_sum(s.hi, s.lo), fast = dd::compensated_norm2<2>(w);
+    bad += same(full.hi, fast.hi) && same(full.lo, fast.lo) ? 0 : 1;
+    // a unit vector to rounding, in 3D and 2D
+    double u[3] = {N(rng), N(rng), N(rng)};
+    const double r = 1.0 / std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (double& x : u) x *= r;
+    const dd::DD U3 = dd::compensated_norm2<3>(u);
+    bad += same((U3.hi - 1.0) + U3.lo, dd::compensated_norm2_minus_one<3>(u)) ? 0 : 1;
+    const double r2 = 1.0 / std::sqrt(u[0] * u[0] + u[1] * u[1]);
+    const double a0 = u[0] * r2, a1 = u[1] * r2;
+    const dd::DD A = dd::add(dd::two_square(a0), dd::two_square(a1));
+    bad += same((A.hi - 1.0) + A.lo, dd::add_minus_one(dd::two_square(a0), dd::two_square(a1))) ? 0 : 1;
+  }
+  CHECK(bad == 0);
+}

@@ -79,6 +79,9 @@ inline DD sqrt(DD x) {
 /// |w|^2 of a short vector with its additions compensated (the squares rounded): what the
 /// pair operators scale to. The rounding of a plain sum would repeat collision after
 /// collision (|w| is conserved); the squares' roundings vary with the direction of w.
+/// For N = 2 the sum is one TwoSum, whose result is already normalized: the final
+/// QuickTwoSum would give it back bit for bit (|lo| <= ulp(hi)/2, and where that is a tie
+/// the rounding had already chosen the even hi), so it is left out.
 template <int N>
 inline DD compensated_norm2(const double* w) {
   DD s{w[0] * w[0], 0.0};
@@ -86,7 +89,28 @@ inline DD compensated_norm2(const double* w) {
     const DD t = two_sum(s.hi, w[k] * w[k]);
     s = {t.hi, s.lo + t.lo};
   }
+  if constexpr (N == 2) return s;
   return quick_two_sum(s.hi, s.lo);
+}
+/// (U.hi - 1) + U.lo for U = compensated_norm2<N>(u), bit for bit, where U.hi is in
+/// [1/2, 2] (a unit vector to rounding): U.hi + U.lo is the unnormalized sum's hi + lo
+/// exactly, and both hi - 1 are exact (Sterbenz), so the one rounding left sees the same
+/// number. Skips the QuickTwoSum: |u|^2 - 1 of the operators' scales.
+template <int N>
+inline double compensated_norm2_minus_one(const double* u) {
+  DD s{u[0] * u[0], 0.0};
+  for (int k = 1; k < N; ++k) {
+    const DD t = two_sum(s.hi, u[k] * u[k]);
+    s = {t.hi, s.lo + t.lo};
+  }
+  return (s.hi - 1.0) + s.lo;
+}
+/// (S.hi - 1) + S.lo for S = add(x, y), bit for bit, where x.hi + y.hi rounds into
+/// [1/2, 2]: add's QuickTwoSum keeps hi + lo, and both hi - 1 are exact (Sterbenz). The
+/// 2D frame's |a|^2 - 1 from the squares of a unit vector's components.
+inline double add_minus_one(DD x, DD y) {
+  const DD s = two_sum(x.hi, y.hi);
+  return (s.hi - 1.0) + (s.lo + (x.lo + y.lo));
 }
 /// The scale sqrt(R) / sqrt(1 + d) for R > 0 and a tiny d (a direction's |u|^2 - 1), as
 /// hi + lo by its two first-order parts: sqrt(R) = rho + e / (2 rho) with rho = sqrt(R.hi)

@@ -261,8 +261,7 @@ class Pair2DExact {
     //   exactly), so the direction cn a + ct t is divided by |a| = 1 + da/2.
     // What remains varies with the direction and the cell: a random walk (~1e-16 sqrt(N)).
     // Cheaper than full double-double (which halved this operator's throughput).
-    const dd::DD a2 = dd::add(dd::two_square(f.a[0]), dd::two_square(f.a[1]));
-    const double da = (a2.hi - 1.0) + a2.lo;  // a2.hi - 1 is exact (Sterbenz)
+    const double da = dd::add_minus_one(dd::two_square(f.a[0]), dd::two_square(f.a[1]));  // |a|^2 - 1
     const dd::DD sc = dd::first_order_scale(s.R, s.rho, da);
     const double hi = sign * 0.5 * sc.hi, lo = sign * 0.5 * sc.lo;  // half of w: v = cm +- w/2
     const double u[2] = {cn * f.a[0] + ct * f.t[0], cn * f.a[1] + ct * f.t[1]};

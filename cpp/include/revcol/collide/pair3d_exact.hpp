@@ -420,14 +420,13 @@ class Pair3DExact {
     // u.E u every collision with this normal (a linear drift). hi u + lo u has |.|^2 = R/|u|^2
     // |u|^2 to double-double accuracy; only the final roundings remain, and they vary.
     // The scale sqrt(R / |u|^2) by its two first-order parts (dd::first_order_scale, as
-    // Pair2DExact), with |u|^2 = 1 + dU (U.hi - 1 is exact: Sterbenz). |u|^2 has its additions
+    // Pair2DExact), with |u|^2 = 1 + dU (dd::compensated_norm2_minus_one). |u|^2 has its additions
     // compensated (their rounding would repeat: the sum is always ~1) but its squares rounded,
     // as |w|^2: u is a new random direction every collision, even with one normal, so those
     // roundings vary and average out. (Exact squares cost ~30 instructions a collision, 8% of
     // the operator; the drift over 2e6 chained collisions, fixed or random normals, stays the
     // same random walk, ~1e-13: tests/cpp/test_pair3d_exact.cpp bounds it at 1e5.)
-    const DD U = dd::compensated_norm2<3>(u);
-    const DD sc = dd::first_order_scale(s.R, std::sqrt(s.R.hi), (U.hi - 1.0) + U.lo);
+    const DD sc = dd::first_order_scale(s.R, std::sqrt(s.R.hi), dd::compensated_norm2_minus_one<3>(u));
     const double hi = sign * 0.5 * sc.hi, lo = sign * 0.5 * sc.lo;  // v = cm +- w/2
     PairV<3> out;
     for (int k = 0; k < 3; ++k) {
