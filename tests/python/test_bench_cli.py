@@ -67,3 +67,18 @@ def test_ab_compare_pairs_floor_cases(tmp_path):
         assert all(v > 0 for v in row[f"new_{m}"]["runs"])
         assert len(row[f"paired_new_over_old_{m}"]["ratios"]) == 2
     assert "forward_per_s" not in " ".join(row)
+
+
+def test_op_ab_times_two_revisions_in_one_binary():
+    # bench/op_ab/run.sh: HEAD's operator headers renamed beside the working tree's, both timed
+    # in interleaved rounds; skipped outside a git checkout or without g++
+    import shutil
+    root = Path(__file__).resolve().parents[2]
+    if not (root / ".git").exists() or shutil.which("g++") is None or shutil.which("git") is None:
+        pytest.skip("bench/op_ab needs a git checkout and g++")
+    r = subprocess.run(["bash", str(root / "bench" / "op_ab" / "run.sh"), "HEAD", "2"], capture_output=True,
+                       text=True, timeout=600, env={**os.environ, "OP_AB_CPU": "0"})
+    assert r.returncode == 0, r.stderr
+    for op in ("pair2d", "pair3d"):
+        line = next(x for x in r.stdout.splitlines() if x.startswith(op + " fwd"))
+        assert "paired" in line and "| rev old" in line
