@@ -76,6 +76,18 @@ inline DD sqrt(DD x) {
   const DD p = two_square(r);
   return quick_two_sum(r, ((x.hi - p.hi) - p.lo + x.lo) / (2.0 * r));
 }
+namespace detail {
+// compensated_norm2's sum before its final QuickTwoSum: hi + lo, lo not yet normalized
+template <int N>
+inline DD compensated_sum_of_squares(const double* w) {
+  DD s{w[0] * w[0], 0.0};
+  for (int k = 1; k < N; ++k) {
+    const DD t = two_sum(s.hi, w[k] * w[k]);
+    s = {t.hi, s.lo + t.lo};
+  }
+  return s;
+}
+}  // namespace detail
 /// |w|^2 of a short vector with its additions compensated (the squares rounded): what the
 /// pair operators scale to. The rounding of a plain sum would repeat collision after
 /// collision (|w| is conserved); the squares' roundings vary with the direction of w.
@@ -84,11 +96,7 @@ inline DD sqrt(DD x) {
 /// the rounding had already chosen the even hi), so it is left out.
 template <int N>
 inline DD compensated_norm2(const double* w) {
-  DD s{w[0] * w[0], 0.0};
-  for (int k = 1; k < N; ++k) {
-    const DD t = two_sum(s.hi, w[k] * w[k]);
-    s = {t.hi, s.lo + t.lo};
-  }
+  const DD s = detail::compensated_sum_of_squares<N>(w);
   if constexpr (N == 2) return s;
   return quick_two_sum(s.hi, s.lo);
 }
@@ -98,11 +106,7 @@ inline DD compensated_norm2(const double* w) {
 /// number. Skips the QuickTwoSum: |u|^2 - 1 of the operators' scales.
 template <int N>
 inline double compensated_norm2_minus_one(const double* u) {
-  DD s{u[0] * u[0], 0.0};
-  for (int k = 1; k < N; ++k) {
-    const DD t = two_sum(s.hi, u[k] * u[k]);
-    s = {t.hi, s.lo + t.lo};
-  }
+  const DD s = detail::compensated_sum_of_squares<N>(u);
   return (s.hi - 1.0) + s.lo;
 }
 /// (S.hi - 1) + S.lo for S = add(x, y), bit for bit, where x.hi + y.hi rounds into
