@@ -126,7 +126,7 @@ std::vector<std::uint64_t> test_cells(int K, std::mt19937_64& rng) {
 
 // The operators decode straight from the integers where that is shorter; each shortcut must
 // give the bits of the plain decode-then-compute form, at every K.
-TEST_CASE("integer shortcuts give the bits of decoding first: encode_half, centered, roots, quarters") {
+TEST_CASE("shortcuts give the bits of the plain forms: encode_half, shift, centered, roots, quarters") {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> Y(-1.0, 1.0);
   int checked = 0;
@@ -160,6 +160,14 @@ TEST_CASE("integer shortcuts give the bits of decoding first: encode_half, cente
       ys.insert(ys.end(), {y, std::nextafter(y, -2.0), std::nextafter(y, 2.0)});
     }
     for (const double y : ys) CHECK(fp.encode_half(y) == fp.encode(0.5 + 0.5 * y));
+    // shift(g) = encode(g) for every g in [0, 1]: the ends, next to them, cell edges, random
+    std::vector<double> gs = {0.0, 1.0, std::nextafter(1.0, 0.0), 0x1.0p-1074, 0x1.0p-60, 0.5};
+    for (int k = 0; k < 20000; ++k) gs.push_back(0.5 * (Y(rng) + 1.0));
+    for (int k = 0; k < 200; ++k) {
+      const double g = std::ldexp(static_cast<double>(rng() & ((std::uint64_t{1} << K) - 1)), -K);
+      gs.insert(gs.end(), {g, std::nextafter(g, 0.0), std::nextafter(g, 1.0)});
+    }
+    for (const double g : gs) CHECK(fp.shift(g) == fp.encode(g));
   }
   std::printf("  %d cells over K = %d..%d\n", checked, FixedPoint::min_bits, FixedPoint::max_bits);
 }

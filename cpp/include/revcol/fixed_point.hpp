@@ -51,7 +51,13 @@ class FixedPoint {
   /// Cell of (1 + y) / 2 for y in [-1, 1]: encode(0.5 + 0.5 * y) bit for bit, one product
   /// shorter (the scale by 2^K is exact, so it commutes with the sum's rounding:
   /// 2^K fl(1/2 + y/2) = fl(2^(K-1) + 2^(K-1) y)). The 2D flux chart's coordinate.
-  std::uint64_t encode_half(double y) const { return encode_scaled(half_cells_ + half_cells_ * y); }
+  /// For |y| <= 2 (a NaN goes to cell 0): 2^(K-1) (1 + y) < 2^62 needs no upper clamp.
+  std::uint64_t encode_half(double y) const {
+    double s = half_cells_ + half_cells_ * y;
+    s = s > 0.0 ? s : 0.0;
+    const auto u = static_cast<std::uint64_t>(static_cast<std::int64_t>(s));
+    return u > mask_ ? mask_ : u;
+  }
   /// 2 U + 1 - 2^K: 2 decode(U) - 1 is exactly this times 2^-K (the centre of cell U mapped
   /// to [-1, 1]; |.| <= 2^K <= 2^52, so its conversion to double is exact too).
   std::int64_t centered(std::uint64_t u) const {
@@ -93,8 +99,13 @@ class FixedPoint {
     const auto m = static_cast<std::int64_t>(2 * u + 1) - static_cast<std::int64_t>(q << (bits_ - 1));
     return {static_cast<std::int64_t>(q), static_cast<double>(m) * half_inv_cells_};
   }
-  /// A random number G in (0,1) as a K-bit shift.
-  std::uint64_t shift(double g) const { return encode(g); }
+  /// A random number G in [0, 1] as a K-bit shift: encode(g) bit for bit, without its clamps,
+  /// which cannot act on g in [0, 1] (every caller validates g first; outside, the result is
+  /// unspecified).
+  std::uint64_t shift(double g) const {
+    const auto u = static_cast<std::uint64_t>(static_cast<std::int64_t>(g * cells_));
+    return u > mask_ ? mask_ : u;
+  }
   /// (U + G) mod 2^K.
   std::uint64_t add(std::uint64_t u, std::uint64_t g) const { return (u + g) & mask_; }
   /// (U - G) mod 2^K.

@@ -53,6 +53,22 @@ inline void require_speed_range(const PairV<Dim>& v, const std::type_identity_t<
   check_speed_range(std::fmax(max_abs(v.i.data(), Dim), max_abs(v.j.data(), Dim)), max_abs(w.data(), Dim));
 }
 
+/// require_speed_range for a caller that has |w|^2 (n2) and the half sum cm = (v_i + v_j) / 2
+/// at hand: the same acceptance and messages (the cold path is the same), a cheaper hot path.
+/// |v_k| <= |cm| + |w| / 2, so |cm|^2 <= 2^898 and |w|^2 <= 2^898 bound every component by
+/// 2^449 + 2^448 < 2^450, and |w|^2 >= 2^-958 keeps the largest |w_k| above 2^-480; any
+/// state passing here passes require_speed_range's own hot path too (|v_i|^2 + |v_j|^2 =
+/// 2 |cm|^2 + |w|^2 / 2 <= 2^900). An infinity or NaN anywhere makes cm or n2 fail.
+template <int Dim>
+inline void require_speed_range(const PairV<Dim>& v, const std::type_identity_t<std::array<double, Dim>>& w,
+                                double n2, const double* cm) {
+  double m2 = 0.0;
+  for (int k = 0; k < Dim; ++k) m2 += cm[k] * cm[k];
+  if (m2 <= 0x1.0p+898 && n2 <= 0x1.0p+898 && n2 >= 0x1.0p-958) [[likely]] return;
+  require_finite(v);
+  check_speed_range(std::fmax(max_abs(v.i.data(), Dim), max_abs(v.j.data(), Dim)), max_abs(w.data(), Dim));
+}
+
 /// Unit contact normal a and, in 2D, its tangent t = (-a_y, a_x): an orthonormal frame
 /// decided by the contact geometry alone.
 struct Frame2 {

@@ -203,8 +203,10 @@ class Pair2DExact {
     Split s;
     s.p = f.normal_part(w);
     s.q = f.tangent_part(w);
-    require_speed_range(v, w);  // also rejects a NaN or infinite velocity
-    s.norm = std::sqrt(w[0] * w[0] + w[1] * w[1]);
+    const double n2 = w[0] * w[0] + w[1] * w[1];
+    const double vcm[2] = {0.5 * (v.i[0] + v.j[0]), 0.5 * (v.i[1] + v.j[1])};
+    require_speed_range(v, w, n2, vcm);  // also rejects a NaN or infinite velocity
+    s.norm = std::sqrt(n2);
     if (post) {
       require(s.p > 0.0 || logged, [&] { return std::string("post-collision state does not separate along the contact normal "
               "(normal relative velocity " + std::to_string(s.p) + " <= 0)"); });
@@ -224,8 +226,8 @@ class Pair2DExact {
       // the squares vary with the direction of w and average out
       s.R = dd::compensated_norm2<2>(w.data());
       s.rho = s.norm;  // the same sum's square root
-      s.cm[0] = 0.5 * (v.i[0] + v.j[0]);
-      s.cm[1] = 0.5 * (v.i[1] + v.j[1]);
+      s.cm[0] = vcm[0];
+      s.cm[1] = vcm[1];
     }
     return s;
   }
