@@ -255,9 +255,9 @@ class Pair2DExact {
       // sin(eta) = 2c - 1 exactly (c is a cell centre); cos(eta) from the factored form
       // sqrt((1 - sn)(1 + sn)). Both straight from the integer cell, with the same bits:
       // sn = m 2^-K with m = 2U + 1 - 2^K, 1 -+ sn = (2^K -+ m) 2^-K, all exact (|m| <= 2^K
-      // <= 2^52, 2^K -+ m <= 2^53); scaling by 2^-2K commutes with the product's rounding and by an even power
-      // of two with the square root's, so cn = sqrt((2^K - m)(2^K + m)) 2^-K. (Five
-      // operations shorter on the critical path than decoding c first.)
+      // <= 2^52, 2^K -+ m <= 2^53); scaling by 2^-2K commutes with the product's rounding,
+      // and by an even power of two with the square root's, so cn = sqrt((2^K - m)(2^K + m))
+      // 2^-K. (Five operations shorter on the critical path than decoding c first.)
       const double m = static_cast<double>(fp_.centered(U)), k = fp_.cells();
       cn = std::sqrt((k - m) * (k + m)) * fp_.inv_cells();
       ct = m * fp_.inv_cells();
