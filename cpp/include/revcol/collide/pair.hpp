@@ -74,6 +74,8 @@ inline void require_speed_range(const PairV<Dim>& v, const std::type_identity_t<
 struct Frame2 {
   double a[2];  ///< unit normal, from j to i
   double t[2];  ///< unit tangent, a rotated by +90 degrees
+  double x[2];  ///< the normal as given (scaled by its largest component on the cold path)
+  double len;   ///< |x|, its square root rounded once: a = x / len up to the reciprocal's rounding
 
   /// Builds the frame from any non-zero finite normal; throws InvalidArgument otherwise.
   /// |a| is 1 to a few roundings, not exactly: the operators take |a|^2 - 1 into account
@@ -92,7 +94,10 @@ struct Frame2 {
       x1 /= m;
       s2 = x0 * x0 + x1 * x1;
     }
-    const double r = 1.0 / std::sqrt(s2);
+    x[0] = x0;
+    x[1] = x1;
+    len = std::sqrt(s2);
+    const double r = 1.0 / len;
     a[0] = x0 * r;
     a[1] = x1 * r;
     t[0] = -a[1];

@@ -69,7 +69,7 @@ class Pair2DExact {
     const Frame2 f(normal);
     const Split s = split(pre, f, inv, /*post=*/false);
     // chart of -w_pre, which lies in P because w_pre approaches
-    const std::uint64_t cell_pre = cell(-s.p, -s.q, s.norm);
+    const std::uint64_t cell_pre = cell(-s.p, -s.q, -s.y, s.norm);
     const std::uint64_t cell_post = fp_.add(cell_pre, shift(g));
     PairV<2> post = assemble(f, s, cell_post, +1.0);
     if (!surely_unlogged(s) && needs_log(post, f)) log.push(cell_pre);
@@ -88,7 +88,7 @@ class Pair2DExact {
     if (logged) {
       cell_pre = log.pop();
     } else {
-      cell_pre = fp_.sub(cell(s.p, s.q, s.norm), shift(g));
+      cell_pre = fp_.sub(cell(s.p, s.q, s.y, s.norm), shift(g));
     }
     return assemble(f, s, cell_pre, -1.0);
   }
@@ -116,18 +116,19 @@ class Pair2DExact {
                     const Invariants<2>* inv = nullptr) const {
     const Frame2 f(normal);
     const Split s = split(pre, f, inv, /*post=*/false);
-    return assemble(f, s, cell(-s.p, -s.q, s.norm), -1.0);
+    return assemble(f, s, cell(-s.p, -s.q, -s.y, s.norm), -1.0);
   }
 
   /// The K-bit chart cell of a pre-collision state (what reversal restores exactly).
   std::uint64_t pre_cell(const PairV<2>& pre, const std::array<double, 2>& normal) const {
     const Frame2 f(normal);
     const Split s = split(pre, f, nullptr, /*post=*/false);
-    return cell(-s.p, -s.q, s.norm);
+    return cell(-s.p, -s.q, -s.y, s.norm);
   }
 
   /// The chart coordinate in [0,1] of a separating relative velocity with normal part
-  /// p > 0, tangent part q and norm |w| (exposed for coverage tests).
+  /// p > 0, tangent part q and norm |w| (exposed for coverage tests; the operator's flux
+  /// cells take q/|w| from the normal as given, split(), the same value to a few roundings).
   double chart(double p, double q, double norm) const {
     if (law_ == Law::uniform) return std::atan2(q, p) / kPi + 0.5;
     return 0.5 + 0.5 * (q / norm);
@@ -163,16 +164,17 @@ class Pair2DExact {
   struct Split {
     double p, q;     // w . a, w . t
     double norm;     // |w| from the velocities
+    double y;        // q / |w| as the flux chart takes it: (x x w) / (|x| |w|)
     dd::DD R;        // |w|^2 to build the output with (held, or from the velocities exactly)
     double rho;      // sqrt(R.hi) (= norm when R comes from the velocities)
     double cm[2];    // centre-of-mass velocity (held or computed)
   };
 
-  // The K-bit cell of chart(p, q, norm), bit for bit; the flux law's (1 + q/|w|)/2 through
-  // FixedPoint::encode_half (one product shorter on the operator's critical path).
-  std::uint64_t cell(double p, double q, double norm) const {
+  // The K-bit cell of the chart: uniform law encode(chart(p, q, norm)); flux law the cell of
+  // (1 + y)/2 (FixedPoint::encode_half), y = q/|w| as split() computes it.
+  std::uint64_t cell(double p, double q, double y, double norm) const {
     if (law_ == Law::uniform) return fp_.encode(chart(p, q, norm));
-    return fp_.encode_half(q / norm);
+    return fp_.encode_half(y);
   }
 
   // Forward's shortcut to needs_log(post) == false, from quantities known before the post
@@ -207,6 +209,11 @@ class Pair2DExact {
     const double vcm[2] = {0.5 * (v.i[0] + v.j[0]), 0.5 * (v.i[1] + v.j[1])};
     require_speed_range(v, w, n2, vcm);  // also rejects a NaN or infinite velocity
     s.norm = std::sqrt(n2);
+    // The flux chart's q / |w| straight from the normal as given, (w_1 x_0 - w_0 x_1) / (|x|
+    // |w|): the frame's reciprocal and the products by a leave the operator's critical path
+    // (one division after the square roots instead of two). About as many roundings of
+    // order u as w . t / |w| had: inside the chart's share of needs_log()'s budget.
+    s.y = law_ == Law::flux ? (w[1] * f.x[0] - w[0] * f.x[1]) / (f.len * s.norm) : 0.0;
     if (post) {
       require(s.p > 0.0 || logged, [&] { return std::string("post-collision state does not separate along the contact normal "
               "(normal relative velocity " + std::to_string(s.p) + " <= 0)"); });
