@@ -31,8 +31,9 @@ py::array_t<double> rows(const std::vector<double>& v, std::size_t n, int d) {
 
 py::dict engine_limits() {
   py::dict d;
-  py::dict maxf, rsaf;
+  py::dict maxf, rsaf, maxn;
   for (int k = lim::kMinDim; k <= lim::kMaxDim; ++k) {
+    maxn[py::int_(k)] = lim::max_particles(k);
     maxf[py::int_(k)] = lim::max_fraction(k);
     rsaf[py::int_(k)] = lim::rsa_fraction(k);
   }
@@ -40,6 +41,7 @@ py::dict engine_limits() {
   for (int k = lim::kMinDim; k <= lim::kMaxDim; ++k)
     if (lim::paper_mode_allowed(k)) paper.append(k);
   d["dimensions"] = py::make_tuple(lim::kMinDim, lim::kMaxDim);
+  d["max_particles"] = maxn;
   d["max_fraction"] = maxf;
   d["rsa_fraction"] = rsaf;
   d["min_periodic_cells"] = lim::kMinPeriodicCells;
@@ -61,7 +63,7 @@ py::dict engine_limits() {
 
 void register_engine_init(py::module_& m) {
   m.def("engine_limits", &engine_limits,
-        "The engine's limits (revcol/engine/limits.hpp) as a dict: dimensions, max_fraction and "
+        "The engine's limits (revcol/engine/limits.hpp) as a dict: dimensions, max_particles, max_fraction and "
         "rsa_fraction per d, min_periodic_cells, bits, max_seed, max_group_tol, wall_margin, "
         "paper_mode_dimensions, and the names of boundaries, generators and streams.");
   m.def("engine_particle_volume", &lim::particle_volume, py::arg("dim"), py::arg("diameter"),

@@ -606,6 +606,8 @@ class EngineImpl final : public Simulation {
   double shell_ = 0.0, renew_h_ = 0.0, renew_h2_ = 0.0;  // the neighbour lists
   std::vector<Particle<Dim>> p_;
   NeighbourLists<Dim> nl_;
+  static_assert(limits::max_particles(Dim) <= NeighbourLists<Dim>::kMaxIds,
+                "the engine's limit on N must fit the lists' packed ids");
   EventQueue<double> queue_;               // one event per particle, key (t, kind, id)
   std::vector<Book> bk_;                   // per particle: its event, group gate, counts and draws
   std::uint64_t drawn1_ = 0;               // draws taken from the single stream (StreamPolicy::single)

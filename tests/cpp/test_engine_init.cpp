@@ -126,6 +126,20 @@ TEST_CASE("random_start: default energy N d / 2, equal speeds, one particle") {
   CHECK(one.x.size() == 1 && std::abs(energy(one.v) - 2.0) < 1e-15);
 }
 
+TEST_CASE("random_start refuses more particles than a list entry's id holds, before allocating") {
+  // a list entry packs an id above 2 d bits of image code in 32 bits (revcol/engine/neighbours.hpp)
+  CHECK(limits::max_particles(1) == (std::uint64_t{1} << 30));
+  CHECK(limits::max_particles(2) == (std::uint64_t{1} << 28));
+  CHECK(limits::max_particles(3) == (std::uint64_t{1} << 26));
+  for (int d = 1; d <= 3; ++d) {
+    const Config c = box_config(std::vector<double>(d, 1e6), {Boundary::periodic});
+    const std::size_t n = limits::max_particles(d) + 1;  // a few GB if it were allocated
+    const std::string e = error_of([&] { random_start(c, n, 1); });
+    CHECK(e == "too many particles in " + std::to_string(d) + "D (N must be at most " +
+                   std::to_string(limits::max_particles(d)) + ", got " + std::to_string(n) + ")");
+  }
+}
+
 TEST_CASE("random_start: same seed same bits; another seed another start") {
   const Config c = box_config({9.0, 7.0, 11.0}, {Boundary::periodic, Boundary::wall, Boundary::periodic});
   for (const char* init : {"rsa", "lattice"}) {

@@ -67,6 +67,13 @@ trajectory_every = 10
     ("[system]\ndimension = 2\nparticles = 'ten'\npacking_fraction = 0.1\n", "[system] particles: must be an integer"),
     ("[system]\ndimension = 2\nparticles = -5\npacking_fraction = 0.1\n", "[system] particles: must be 1..2147483647, got -5"),
     ("[system]\ndimension = 4\nparticles = 5\npacking_fraction = 0.1\n", "[system] dimension: must be 1..3"),
+    # the float engine's neighbour-list entries pack an id and its image code in 32 bits
+    ("[system]\ndimension = 3\nparticles = 67108865\npacking_fraction = 0.1\n",
+     "[system] particles: must be at most 67,108,864 in 3D for the float engine"),
+    ("[system]\ndimension = 2\nparticles = 268435457\npacking_fraction = 0.1\n",
+     "[system] particles: must be at most 268,435,456 in 2D"),
+    ("[system]\ndimension = 1\nparticles = 1073741825\npacking_fraction = 0.1\n",
+     "[system] particles: must be at most 1,073,741,824 in 1D"),
     ("[system]\ndimension = 2\nparticles = 5\nbox = [0.5, 3.0]\n", "[system] box: axis 0 length 0.5 is not larger than the diameter"),
     ("[system]\ndimension = 2\nparticles = 5\nbox = [3.0]\n", "[system] box: needs 2 lengths"),
     ("[system]\ndimension = 2\nparticles = 5\n", "[system] box: give box"),

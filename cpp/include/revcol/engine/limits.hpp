@@ -56,6 +56,11 @@ constexpr double particle_volume(int d, double D) {
   return d == 1 ? D : d == 2 ? kPi * D * D / 4.0 : kPi * D * D * D / 6.0;
 }
 
+/// Largest N in d dimensions: a neighbour-list entry packs an id and its image code (2 bits
+/// per axis) in 32 bits (revcol/engine/neighbours.hpp), so ids stay below 2^(32 - 2d):
+/// N <= 2^30 (1D), 2^28 (2D), 2^26 = 67 108 864 (3D; ~25 GB of engine at ~370 bytes each).
+constexpr std::uint64_t max_particles(int d) { return std::uint64_t{1} << (32 - 2 * d); }
+
 /// Largest box length in diameters per axis: cell and list indices stay within int, and a
 /// position keeps ~1e-7 D of resolution (issue 17: L / D past int made the cell count overflow).
 inline constexpr double kMaxBoxDiameters = 1073741824.0;  // 2^30

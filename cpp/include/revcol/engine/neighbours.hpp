@@ -11,7 +11,10 @@
 //
 // Image codes: 2 bits per axis, 0: x_j, 1: x_j + L, 2: x_j - L (the nearest image of j's
 // centre seen from i's; Boundaries::image). With L >= 2 (D + shell) each listed pair has one
-// nearest image (the engine keeps the shell below L / 2 - D).
+// nearest image (the engine keeps the shell below L / 2 - D). A list entry is one 32-bit
+// word, j << 2d | code (kCodeBits): one load per neighbour, 4 bytes a slot instead of an id
+// and a code byte in two arrays. It holds ids below 2^(32 - 2d) (2^26 in 3D), the engine's
+// limit on N (limits::max_particles). Entries sort as their ids do.
 //
 // 1D (walls, or a periodic ring of 3 rods or more): rods keep their order, so each lists
 // the rods beside it for the whole run ("adjacent" mode: no cell grid, no renewals; on a
@@ -47,6 +50,10 @@ class NeighbourLists {
   /// wide (5^d scanned, fewer centres but ~84 mostly empty heads) measured 16% more
   /// instructions at phi 0.3 and 55% more at 0.05.
   static constexpr bool kCull = Dim == 3;
+  /// Low bits of a list entry that hold the image code (2 per axis); the id is above them.
+  static constexpr int kCodeBits = 2 * Dim;
+  /// Ids a list entry can hold: 0 .. kMaxIds - 1.
+  static constexpr std::uint64_t kMaxIds = std::uint64_t{1} << (32 - kCodeBits);
 
   /// Sets the geometry: n particles, the box, and the list reach D + shell; `adjacent`
   /// chooses the 1D mode. Lists are empty until build().
@@ -101,14 +108,13 @@ class NeighbourLists {
     link_all();
     nbcap_ = 16;
     nb_.assign(n_ * nbcap_, 0);
-    nbc_.assign(n_ * nbcap_, 0);
     nbn_.assign(n_, 0);
     for (std::size_t i = 0; i < n_; ++i)
       for_cells(static_cast<int>(i), [&](int j) {
         unsigned code;
         if (near(static_cast<int>(i), j, code)) list_insert(static_cast<int>(i), j, code);
       });
-    // one step of room above the longest list: a run's fluctuations pass the start's longest
+    // 8 slots of room above the longest list: a run's fluctuations pass the start's longest
     // soon, and a capacity grown then would grow the store (and the peak memory) mid-run
     const int longest = n_ > 0 ? *std::max_element(nbn_.begin(), nbn_.end()) : 0;
     if (nbcap_ < longest + 8) grow_lists(longest + 8);
@@ -138,14 +144,12 @@ class NeighbourLists {
   /// scan, FloatKinematics::pair_test2).
   template <class F2, class F, class Prefetch>
   void for_neighbour_pairs(int i, F2&& f2, F&& f, Prefetch&& prefetch) const {
-    const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
-    const int* ids = nb_.data() + base;
-    const unsigned char* codes = nbc_.data() + base;
+    const std::uint32_t* e = nb_.data() + static_cast<std::size_t>(i) * nbcap_;
     const int m = nbn_[i];
-    for (int u = 0; u < m; ++u) prefetch(ids[u]);
+    for (int u = 0; u < m; ++u) prefetch(id_of(e[u]));
     int u = 0;
-    for (; u + 1 < m; u += 2) f2(ids[u], shift_of(codes[u]), ids[u + 1], shift_of(codes[u + 1]));
-    if (u < m) f(ids[u], shift_of(codes[u]));
+    for (; u + 1 < m; u += 2) f2(id_of(e[u]), shift_of(e[u]), id_of(e[u + 1]), shift_of(e[u + 1]));
+    if (u < m) f(id_of(e[u]), shift_of(e[u]));
   }
 
   /// Image shift s of the pair (a, b), with r = x_a - x_b - s, from the centres (or, in 1D's
@@ -154,7 +158,7 @@ class NeighbourLists {
     if (adjacent()) {
       const std::size_t base = static_cast<std::size_t>(a) * nbcap_;
       for (int u = 0; u < nbn_[a]; ++u)
-        if (nb_[base + u] == b) return shift_of(nbc_[base + u]);
+        if (id_of(nb_[base + u]) == b) return shift_of(nb_[base + u]);
     }
     unsigned code;
     near(a, b, code);
@@ -188,17 +192,16 @@ class NeighbourLists {
   }
   /// The code of the mirrored pair (1 <-> 2 on every axis).
   static unsigned mirror(unsigned code) { return ((code & 0x15u) << 1) | ((code >> 1) & 0x15u); }
-  /// The image offset of a code.
-  Vec shift_of(unsigned code) const { return shift_vec_[code & (shift_vec_.size() - 1)]; }
+  /// The image offset of a code (or of a list entry: its low kCodeBits).
+  Vec shift_of(std::uint32_t code) const { return shift_vec_[code & (shift_vec_.size() - 1)]; }
 
   /// Starts loading i's list (ids, codes, count) into the cache; for_neighbour_pairs would
   /// otherwise wait on its first line.
   void prefetch_list(int i) const {
     const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
     const char* ids = reinterpret_cast<const char*>(nb_.data() + base);
-    const std::size_t bytes = static_cast<std::size_t>(nbcap_) * sizeof(int);
+    const std::size_t bytes = static_cast<std::size_t>(nbcap_) * sizeof(std::uint32_t);
     for (std::size_t off = 0; off < bytes; off += 64) __builtin_prefetch(ids + off);
-    __builtin_prefetch(nbc_.data() + base);
     __builtin_prefetch(nbn_.data() + i);
   }
   /// Number of particles on i's list.
@@ -206,7 +209,7 @@ class NeighbourLists {
   /// Bytes held.
   std::size_t memory_bytes() const {
     return cell_.capacity() * sizeof(int) + head_.capacity() * sizeof(int) + cn_.capacity() * sizeof(Centre) +
-           nbn_.capacity() * sizeof(int) + nb_.capacity() * (sizeof(int) + 1) +
+           nbn_.capacity() * sizeof(int) + nb_.capacity() * sizeof(std::uint32_t) +
            (left_.capacity() + right_.capacity()) * sizeof(int);
   }
 
@@ -217,12 +220,12 @@ class NeighbourLists {
     for (std::size_t i = 0; i < n_; ++i) {
       const std::size_t base = i * nbcap_;
       for (int u = 0; u < nbn_[i]; ++u) {
-        const int j = nb_[base + u];
-        if (u > 0 && nb_[base + u - 1] >= j) return false;
+        const int j = id_of(nb_[base + u]);
+        if (u > 0 && id_of(nb_[base + u - 1]) >= j) return false;
         const std::size_t bj = static_cast<std::size_t>(j) * nbcap_;
         int w = 0;
-        while (w < nbn_[j] && nb_[bj + w] != static_cast<int>(i)) ++w;
-        if (w == nbn_[j] || nbc_[bj + w] != mirror(nbc_[base + u])) return false;
+        while (w < nbn_[j] && id_of(nb_[bj + w]) != static_cast<int>(i)) ++w;
+        if (w == nbn_[j] || code_of(nb_[bj + w]) != mirror(code_of(nb_[base + u]))) return false;
       }
       if (adjacent()) continue;
       int listed = 0;
@@ -232,8 +235,8 @@ class NeighbourLists {
         if (!near(static_cast<int>(i), static_cast<int>(j), code)) continue;
         ++listed;
         int u = 0;
-        while (u < nbn_[i] && nb_[base + u] != static_cast<int>(j)) ++u;
-        if (u == nbn_[i] || nbc_[base + u] != code) return false;
+        while (u < nbn_[i] && id_of(nb_[base + u]) != static_cast<int>(j)) ++u;
+        if (u == nbn_[i] || code_of(nb_[base + u]) != code) return false;
       }
       if (listed != nbn_[i]) return false;
     }
@@ -241,6 +244,10 @@ class NeighbourLists {
   }
 
  private:
+  static int id_of(std::uint32_t e) { return static_cast<int>(e >> kCodeBits); }
+  static unsigned code_of(std::uint32_t e) { return e & ((1u << kCodeBits) - 1); }
+  static std::uint32_t entry(int j, unsigned code) { return (static_cast<std::uint32_t>(j) << kCodeBits) | code; }
+
   // A list centre with the links of its cell's chain: the renewal's scan reads one line each.
   struct alignas(Dim == 3 ? 32 : 8) Centre {
     double c[Dim] = {};
@@ -390,47 +397,39 @@ class NeighbourLists {
   void list_insert(int i, int j, unsigned code) {
     if (nbn_[i] == nbcap_) grow_lists();
     const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
+    const std::uint32_t e = entry(j, code);
     int m = nbn_[i]++;
-    while (m > 0 && nb_[base + m - 1] > j) {
+    while (m > 0 && nb_[base + m - 1] > e) {  // entries sort as their ids
       nb_[base + m] = nb_[base + m - 1];
-      nbc_[base + m] = nbc_[base + m - 1];
       --m;
     }
-    nb_[base + m] = j;
-    nbc_[base + m] = static_cast<unsigned char>(code);
+    nb_[base + m] = e;
   }
   void list_recode(int i, int j, unsigned code) {
     const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
     int u = 0;
-    while (nb_[base + u] != j) ++u;
-    nbc_[base + u] = static_cast<unsigned char>(code);
+    while (id_of(nb_[base + u]) != j) ++u;
+    nb_[base + u] = entry(j, code);
   }
   void list_erase(int i, int j) {
     const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
     const int m = nbn_[i];
     int u = 0;
-    while (u < m && nb_[base + u] != j) ++u;
-    for (; u + 1 < m; ++u) {
-      nb_[base + u] = nb_[base + u + 1];
-      nbc_[base + u] = nbc_[base + u + 1];
-    }
+    while (u < m && id_of(nb_[base + u]) != j) ++u;
+    for (; u + 1 < m; ++u) nb_[base + u] = nb_[base + u + 1];
     --nbn_[i];
   }
-  // Every list's capacity, to hold `least` (at least one more than now), in steps of 8: the
+  // Every list's capacity, to hold `least` (at least one more than now), in steps of 4: the
   // longest list sets the stride of all, and it is a tail of the density's fluctuations
-  // (3D, phi 0.3, shell 0.6 D: ~9.4 listed on average, the longest past 16), so
-  // doubling would leave most of the store empty.
+  // (3D, phi 0.3, shell 0.6 D: ~9.4 listed on average, the longest past 16 in a long run;
+  // a stride of 20, 8 above the start's longest, held 10^7 collisions at N = 10^4 without
+  // growing), so doubling would leave most of the store empty. Steps of 8 made it 24.
   void grow_lists(int least = 0) {
-    const int cap = (std::max(least, nbcap_ + 1) + 7) / 8 * 8;
-    std::vector<int> nb(n_ * cap);
-    std::vector<unsigned char> nbc(n_ * cap);
+    const int cap = (std::max(least, nbcap_ + 1) + 3) / 4 * 4;
+    std::vector<std::uint32_t> nb(n_ * cap);
     for (std::size_t i = 0; i < n_; ++i)
-      for (int u = 0; u < nbn_[i]; ++u) {
-        nb[i * cap + u] = nb_[i * nbcap_ + u];
-        nbc[i * cap + u] = nbc_[i * nbcap_ + u];
-      }
+      for (int u = 0; u < nbn_[i]; ++u) nb[i * cap + u] = nb_[i * nbcap_ + u];
     nb_.swap(nb);
-    nbc_.swap(nbc);
     nbcap_ = cap;
   }
 
@@ -440,7 +439,6 @@ class NeighbourLists {
   void build_adjacent(Pos& pos) {
     nbcap_ = 2;
     nb_.assign(n_ * nbcap_, 0);
-    nbc_.assign(n_ * nbcap_, 0);
     nbn_.assign(n_, 0);
     left_.assign(n_, -1);
     right_.assign(n_, -1);
@@ -503,7 +501,7 @@ class NeighbourLists {
       });
     }
     if (spill) {  // beyond kMaxList (not reached, see there): the slow way
-      for (int u = 0; u < nbn_[i]; ++u) list_erase(nb_[static_cast<std::size_t>(i) * nbcap_ + u], i);
+      for (int u = 0; u < nbn_[i]; ++u) list_erase(id_of(nb_[static_cast<std::size_t>(i) * nbcap_ + u]), i);
       nbn_[i] = 0;
       for_cells(i, [&](int j) {
         unsigned code;
@@ -517,7 +515,7 @@ class NeighbourLists {
     const int no = nbn_[i];
     while (u < no || w < nf) {
       const std::size_t base = static_cast<std::size_t>(i) * nbcap_;  // list_insert may grow the lists
-      const int jo = u < no ? nb_[base + u] : std::numeric_limits<int>::max();
+      const int jo = u < no ? id_of(nb_[base + u]) : std::numeric_limits<int>::max();
       const int jn = w < nf ? fresh[w] : std::numeric_limits<int>::max();
       if (jo < jn) {
         list_erase(jo, i);
@@ -526,15 +524,14 @@ class NeighbourLists {
         list_insert(jn, i, mirror(fcode[w]));
         ++w;
       } else {
-        if (nbc_[base + u] != fcode[w]) list_recode(jn, i, mirror(fcode[w]));
+        if (code_of(nb_[base + u]) != fcode[w]) list_recode(jn, i, mirror(fcode[w]));
         ++u;
         ++w;
       }
     }
     if (nf > nbcap_) grow_lists(nf);
     const std::size_t b2 = static_cast<std::size_t>(i) * nbcap_;
-    std::copy(fresh, fresh + nf, nb_.begin() + b2);
-    std::copy(fcode, fcode + nf, nbc_.begin() + b2);
+    for (int w2 = 0; w2 < nf; ++w2) nb_[b2 + w2] = entry(fresh[w2], fcode[w2]);
     nbn_[i] = nf;
   }
 
@@ -553,8 +550,8 @@ class NeighbourLists {
   std::vector<Centre> cn_;
   bool adj_ = false;                     // 1D: rods beside each other, no cell grid
   std::vector<int> left_, right_;        // 1D: the rods beside, -1 at a wall
-  std::vector<int> nb_, nbn_;            // lists (nbcap_ slots each), lengths
-  std::vector<unsigned char> nbc_;       // their image codes
+  std::vector<std::uint32_t> nb_;        // lists (nbcap_ entries each: id << kCodeBits | image code)
+  std::vector<int> nbn_;                 // their lengths
   int nbcap_ = 16;
 };
 
