@@ -169,10 +169,7 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
   require(x.size() % d == 0, "positions must have n x dim entries");
   require(v.size() == x.size(), "velocities must have the same shape as positions");
   const std::size_t n = x.size() / d;
-  require(n <= limits::max_particles(d), [&] {
-    return "too many particles in " + std::to_string(d) + "D (N must be at most " + std::to_string(limits::max_particles(d)) +
-           ", got " + std::to_string(n) + ")";
-  });
+  require(n <= limits::max_particles(d), [&] { return limits::too_many_particles(d, n); });
   const double r = 0.5 * c.diameter;
   double e = 0.0;
   for (std::size_t i = 0; i < n; ++i)

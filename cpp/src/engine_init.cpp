@@ -264,10 +264,8 @@ void check_energy(double energy) {
 void check_common(const Config& c, std::size_t n, std::uint64_t seed) {
   require(c.dim >= limits::kMinDim && c.dim <= limits::kMaxDim, "dim must be 1, 2 or 3");
   require(n > 0, "no particles (N = 0)");
-  require(n <= limits::max_particles(c.dim), [&] {  // before anything n-sized is allocated
-    return "too many particles in " + std::to_string(c.dim) + "D (N must be at most " +
-           std::to_string(limits::max_particles(c.dim)) + ", got " + std::to_string(n) + ")";
-  });
+  // before anything n-sized is allocated
+  require(n <= limits::max_particles(c.dim), [&] { return limits::too_many_particles(c.dim, n); });
   require(std::isfinite(c.diameter) && c.diameter > 0.0, "diameter must be finite and > 0");
   require(seed <= limits::kMaxSeed, "seed must be < 2^32");
 }

@@ -418,10 +418,10 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         n = int(arrays[0].shape[0])
     if n is None:
         raise _fail(source, "[system] particles", "is required (a positive integer) unless initial_state gives it")
-    if n > LIMITS["max_particles"][d] and get("collisions", "engine", "float") == "float":
-        raise _fail(source, "[system] particles",
-                    f"must be at most {LIMITS['max_particles'][d]:,} in {d}D for the float engine (a neighbour-list "
-                    f"entry packs an id and its image in 32 bits), got {n:,}")
+    top_n = LIMITS["max_particles"][d]
+    if n > top_n and get("collisions", "engine", "float") == "float":
+        raise _fail(source, "[system] particles", f"must be at most {top_n:,} in {d}D for the float engine "
+                    f"(a neighbour-list entry packs an id and its image in 32 bits), got {n:,}")
     sigma = get("system", "diameter", 1.0)
 
     box = get("system", "box")

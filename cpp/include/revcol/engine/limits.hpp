@@ -23,6 +23,7 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 #include "revcol/fixed_point.hpp"
 
@@ -58,8 +59,13 @@ constexpr double particle_volume(int d, double D) {
 
 /// Largest N in d dimensions: a neighbour-list entry packs an id and its image code (2 bits
 /// per axis) in 32 bits (revcol/engine/neighbours.hpp), so ids stay below 2^(32 - 2d):
-/// N <= 2^30 (1D), 2^28 (2D), 2^26 = 67 108 864 (3D; ~25 GB of engine at ~370 bytes each).
+/// N <= 2^30 (1D), 2^28 (2D), 2^26 = 67 108 864 (3D; ~20 GB of engine at ~290 bytes each).
 constexpr std::uint64_t max_particles(int d) { return std::uint64_t{1} << (32 - 2 * d); }
+/// The error for N > max_particles(d): one wording wherever N is checked.
+inline std::string too_many_particles(int d, std::uint64_t n) {
+  return "too many particles in " + std::to_string(d) + "D (N must be at most " + std::to_string(max_particles(d)) +
+         ", got " + std::to_string(n) + ")";
+}
 
 /// Largest box length in diameters per axis: cell and list indices stay within int, and a
 /// position keeps ~1e-7 D of resolution (issue 17: L / D past int made the cell count overflow).
