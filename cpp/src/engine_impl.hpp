@@ -28,6 +28,7 @@
 #include "revcol/engine/logs.hpp"
 #include "revcol/engine/neighbours.hpp"
 #include "revcol/engine/observe.hpp"
+#include "revcol/engine/prefetch.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
@@ -551,7 +552,7 @@ class EngineImpl final : public Simulation {
       // the next top is among the bucket's other events 88% of the time (3D, phi 0.45): its
       // Book arrives while this event runs. The wait on the top's Book fell from 8% of the
       // run's samples to 1% (perf, docs/peers.md "Session 28")
-      queue_.for_next(kPrefetchNext, [&](int j) { __builtin_prefetch(&bk_[j]); });
+      queue_.for_next(kPrefetchNext, [&](int j) { prefetch(&bk_[j]); });
       if (done_count) {
         // finish the instant of the last collision, then stop half way to the next event
         if (e.t > t_last || e.t == kInf) {

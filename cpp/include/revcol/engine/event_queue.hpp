@@ -114,13 +114,11 @@ class EventQueue {
 
   /// Calls f(id) for the current bucket's other events, heap_[1 .. k] (those after the top in
   /// heap order, not in key order): the likely next tops, for the caller to prefetch what it
-  /// will read of them. (The loop runs to the constant k and tests the size inside: GCC 12 at
-  /// -O3 deleted the same loop bounded by the heap's size when f was a prefetch alone.)
+  /// will read of them (with revcol::engine::prefetch: see there).
   template <class F>
   void for_next(int k, F&& f) const {
-    const int m = static_cast<int>(heap_.size());
-    for (int p = 1; p <= k; ++p)
-      if (p < m) f(heap_[p].id);
+    const int m = std::min(k + 1, static_cast<int>(heap_.size()));
+    for (int p = 1; p < m; ++p) f(heap_[p].id);
   }
 
   /// id's scheduled time (never() when unscheduled).

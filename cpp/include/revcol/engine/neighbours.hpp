@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "revcol/engine/boundary.hpp"
+#include "revcol/engine/prefetch.hpp"
 
 namespace revcol::engine {
 
@@ -201,8 +202,8 @@ class NeighbourLists {
     const std::size_t base = static_cast<std::size_t>(i) * nbcap_;
     const char* ids = reinterpret_cast<const char*>(nb_.data() + base);
     const std::size_t bytes = static_cast<std::size_t>(nbcap_) * sizeof(std::uint32_t);
-    for (std::size_t off = 0; off < bytes; off += 64) __builtin_prefetch(ids + off);
-    __builtin_prefetch(nbn_.data() + i);
+    for (std::size_t off = 0; off < bytes; off += 64) prefetch(ids + off);
+    prefetch(nbn_.data() + i);
   }
   /// Number of particles on i's list.
   int count(int i) const { return nbn_[i]; }
