@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <vector>
@@ -178,6 +179,40 @@ TEST_CASE("an empty queue returns -1, takes events again, and unscheduled ids re
   t.set(0, 11, 0);
   CHECK(t.top() == 1);
   CHECK(t.valid());
+}
+
+TEST_CASE("for_next names at most k scheduled events other than the top, and the next top when the bucket holds it") {
+  std::mt19937_64 rng(7);
+  EventQueue<double> q;
+  const int n = 500;
+  q.reset(n, 0.0, 0.01);
+  std::vector<double> t(n);
+  for (int i = 0; i < n; ++i) {
+    t[i] = std::uniform_real_distribution<double>(0.0, 10.0)(rng);
+    q.set(i, t[i], 2);
+  }
+  int named = 0, next_named = 0, steps = 0;
+  for (int s = 0; s < 5000; ++s) {
+    const int top = q.top();
+    std::vector<int> ids;
+    q.for_next(6, [&](int j) { ids.push_back(j); });
+    CHECK(ids.size() <= 6);
+    for (int j : ids) {
+      CHECK(j != top);
+      CHECK(q.scheduled(j));
+      CHECK(q.time(j) >= q.time(top));
+    }
+    named += static_cast<int>(ids.size());
+    t[top] += std::uniform_real_distribution<double>(0.0, 10.0)(rng);  // the top moves on, as after its event
+    q.set(top, t[top], 2);
+    const int next = q.top();
+    for (int j : ids) next_named += j == next ? 1 : 0;
+    ++steps;
+  }
+  std::printf("  for_next: %.2f ids per top, the next top among them %.0f%% of the time\n",
+              static_cast<double>(named) / steps, 100.0 * next_named / steps);
+  CHECK(named > 0);
+  CHECK(next_named > steps / 4);  // a heap of the bucket's events holds the next top often
 }
 
 CHECK_MAIN()
