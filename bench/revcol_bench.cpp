@@ -183,7 +183,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::string json = "{\"collisions\": " + std::to_string(n) +
-                     ", \"repeats\": " + std::to_string(repeats) + ", \"results\": [";
+                     ", \"repeats\": " + std::to_string(repeats) +
+                     ", \"isa\": \"" REVCOL_ISA_NAME "\", \"results\": [";
   std::string csv = "bench,metric,median,repeats\n";
   bool first = true;
   for (const Bench* b : run) {

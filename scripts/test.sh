@@ -15,8 +15,11 @@ cmake -S . -B build-test -G Ninja -DREVCOL_BUILD_TESTS=ON -DREVCOL_BUILD_PYTHON=
 cmake --build build-test -j"$jobs"
 ctest --test-dir build-test -L cpp --output-on-failure -j"$jobs"
 
-echo "== C++ tests under ASan + UBSan =="
-cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREVCOL_SANITIZE=ON \
+echo "== C++ tests under ASan + UBSan, built for the baseline instruction set =="
+# the first build is for this machine's level (REVCOL_ISA=auto: x86-64-v3 where it runs);
+# this one is for the baseline, so test_engine_hash checks its constants both ways: the
+# instruction set must not change a bit (CMakeLists.txt, revcol/eigen.hpp)
+cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREVCOL_SANITIZE=ON -DREVCOL_ISA=baseline \
   -DREVCOL_BUILD_TESTS=ON -DREVCOL_BUILD_PYTHON=ON -DREVCOL_BUILD_BENCH=OFF \
   -DPython_EXECUTABLE="$PWD/.venv/bin/python" -Dpybind11_DIR="$(.venv/bin/python -m pybind11 --cmakedir)" >/dev/null
 cmake --build build-sanitize -j"$jobs"

@@ -31,6 +31,8 @@ PYBIND11_MODULE(_core, m) {
 #else
       ", debug";
 #endif
+  // the instruction set it was compiled for (CMake REVCOL_ISA): speed only, the same bits
+  m.attr("isa") = REVCOL_ISA_NAME;
   revcol::bind::register_rng(m);
   revcol::bind::register_collide(m);
   revcol::bind::register_verify(m);

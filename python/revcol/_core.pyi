@@ -35,6 +35,9 @@ class InvalidArgument(ValueError):
 
 #: what built the module: compiler, pybind11, release/debug (stamped into checkpoints)
 build: str
+#: the instruction set it was compiled for: "x86-64-v3" or "baseline" (CMake REVCOL_ISA; the
+#: same bits either way)
+isa: str
 
 
 # ---- cpp/bindings/rng.cpp: the reversible generators.

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <random>
 
@@ -93,12 +94,47 @@ TEST_CASE("two_square is two_prod(x, x) bit for bit, and exact") {
     const double a = random_int(rng, 1 + static_cast<int>(rng() % 53));
     const dd::DD s = dd::two_square(a);
     CHECK(same(s, dd::two_prod(a, a)));
+    CHECK(same(dd::two_square_dekker(a), dd::two_prod_dekker(a, a)));
     CHECK(as_int(s.hi) + as_int(s.lo) == as_int(a) * as_int(a));
     const double x = std::ldexp(unit(rng), static_cast<int>(rng() % 980) - 480);
     CHECK(same(dd::two_square(x), dd::two_prod(x, x)));
+    CHECK(same(dd::two_square_dekker(x), dd::two_prod_dekker(x, x)));
     const double y = 1.0 + std::ldexp(unit(rng), -static_cast<int>(rng() % 60));
     CHECK(same(dd::two_square(y), dd::two_prod(y, y)));
+    CHECK(same(dd::two_square_dekker(y), dd::two_prod_dekker(y, y)));
   }
+}
+
+TEST_CASE("the fused multiply-add's products are Dekker's bit for bit (a host build's bits are a baseline build's)") {
+  // two_prod and two_square take their error term from one fma where the build has FMA
+  // (CMake REVCOL_ISA=x86-64-v3), from Dekker's split otherwise. Both are exact over the
+  // operators' range, so they must agree to the last bit; where they would not, a host
+  // build's collisions would differ from a baseline build's. In a baseline build both sides
+  // are Dekker's (the comparison then holds trivially; .ci/run builds both ways, and
+  // test_engine_hash checks the same constants in each).
+  std::printf("  two_prod here: %s\n", dd::kFusedProducts ? "fused multiply-add" : "Dekker's split");
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto same = [](dd::DD a, dd::DD b) {
+    return std::memcmp(&a.hi, &b.hi, sizeof(double)) == 0 && std::memcmp(&a.lo, &b.lo, sizeof(double)) == 0;
+  };
+  int bad = 0;
+  for (int t = 0; t < 400000; ++t) {
+    // exponents as the operators see them: speeds in [2^-480, 2^450], frame components near 1,
+    // products of a speed and a component (products above 2^-969: see two_prod)
+    const double a = std::ldexp(unit(rng), static_cast<int>(rng() % 930) - 480);
+    const double b = std::ldexp(unit(rng), static_cast<int>(rng() % 40) - 20);
+    const double c = 1.0 + std::ldexp(unit(rng), -static_cast<int>(rng() % 60));
+    bad += same(dd::two_prod(a, b), dd::two_prod_dekker(a, b)) ? 0 : 1;
+    bad += same(dd::two_prod(c, b), dd::two_prod_dekker(c, b)) ? 0 : 1;
+    bad += same(dd::two_square(a), dd::two_square_dekker(a)) ? 0 : 1;
+    bad += same(dd::two_square(c), dd::two_square_dekker(c)) ? 0 : 1;
+    // integer-valued: both exact by construction, whatever the exponent
+    const double i = random_int(rng, 1 + static_cast<int>(rng() % 53));
+    const double j = random_int(rng, 1 + static_cast<int>(rng() % 53));
+    bad += same(dd::two_prod(i, j), dd::two_prod_dekker(i, j)) ? 0 : 1;
+  }
+  CHECK(bad == 0);
 }
 
 TEST_CASE("add, square, div, sqrt and norm2 reach double-double accuracy") {

@@ -31,6 +31,19 @@ def test_float_notation_is_the_count():
     assert got["first_difference"] == "-1" and int(float(got["collisions_compared"])) == 2000
 
 
+def test_bench_json_and_module_name_their_instruction_set(tmp_path):
+    # CMake's REVCOL_ISA (auto: x86-64-v3 where the machine runs it): a speed setting that the
+    # benchmark's JSON records beside its figures, and the module reports
+    import json
+    import revcol
+    out = tmp_path / "b.json"
+    r = subprocess.run([_bench_binary(), "--bench", "floor/pair2d", "--collisions", "2000", "--repeats", "1",
+                        "--json", str(out)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(out.read_text())["isa"] in ("x86-64-v3", "baseline")
+    assert revcol._core.isa in ("x86-64-v3", "baseline")
+
+
 def test_floor_bench_reverses_and_reports_both_operators():
     # the floor is a real operator (it runs backwards to round-off) and both are timed; its
     # figures are benchmarks, never judged here

@@ -1,6 +1,8 @@
 // Double-double arithmetic: a value hi + lo with |lo| <= ulp(hi)/2, from error-free
-// transformations (Knuth's TwoSum, Dekker's TwoProd), plain IEEE operations that
-// -ffp-contract=off keeps exactly as written, so the bits are the same everywhere.
+// transformations (Knuth's TwoSum, Dekker's TwoProd or one fused multiply-add), plain IEEE
+// operations that -ffp-contract=off keeps exactly as written. Each transformation is exact,
+// so its result is the same two numbers however it is computed: the bits are the same
+// everywhere, in a baseline build and in a build for the host's FMA alike.
 //
 // Used where a double is not enough: the operators scale their post states to the relative
 // kinetic energy. That energy is conserved, so it sits at the same place on the double grid
@@ -27,10 +29,9 @@ inline DD two_sum(double a, double b) {
   const double s = a + b, bb = s - a;
   return {s, (a - (s - bb)) + (b - bb)};
 }
-/// a * b exactly (Dekker's product with Veltkamp's split: plain IEEE operations, inlined;
-/// no fma, whose call into libm cost more than the rest of a pair collision without
-/// -mfma). Exact unless a * b overflows or underflows, far outside the validated range.
-inline DD two_prod(double a, double b) {
+/// a * b exactly by Dekker's product with Veltkamp's split: plain IEEE operations. Exact
+/// unless a * b overflows or a partial result underflows, far outside the validated range.
+inline DD two_prod_dekker(double a, double b) {
   constexpr double kSplit = 134217729.0;  // 2^27 + 1
   const double p = a * b;
   const double ca = kSplit * a, cb = kSplit * b;
@@ -38,20 +39,51 @@ inline DD two_prod(double a, double b) {
   const double bh = cb - (cb - b), bl = b - bh;
   return {p, ((ah * bh - p) + ah * bl + al * bh) + al * bl};
 }
-/// x * x exactly: two_prod(x, x) with one split instead of two and the two equal cross
-/// products as one, (xh + xh) xl. The same bits as two_prod(x, x): in Dekker's product
+/// x * x exactly by Dekker's product: two_prod_dekker(x, x) with one split instead of two
+/// and the two equal cross products as one, (xh + xh) xl. The same bits as
+/// two_prod_dekker(x, x): in Dekker's product
 /// every operation after the split is exact, so the sum of the cross terms is the same
 /// representable number whether added as xh xl + xl xh or as 2 xh xl (xh + xh is exact,
 /// and 2 xh xl has at most 53 significant bits). That holds while no partial result
 /// underflows (|x| above about 2^-484, x^2 above 2^-969); below, neither form is exact and
 /// their last bits may differ. tests/cpp/test_double_double.cpp compares the two bit for
-/// bit. The operators' scales square three or four numbers per collision.
-inline DD two_square(double x) {
+/// bit.
+inline DD two_square_dekker(double x) {
   constexpr double kSplit = 134217729.0;  // 2^27 + 1
   const double p = x * x;
   const double c = kSplit * x;
   const double xh = c - (c - x), xl = x - xh;
   return {p, ((xh * xh - p) + (xh + xh) * xl) + xl * xl};
+}
+/// Whether two_prod and two_square take the hardware fused multiply-add (a build with FMA).
+#ifdef __FMA__
+inline constexpr bool kFusedProducts = true;
+#else
+inline constexpr bool kFusedProducts = false;
+#endif
+/// a * b exactly. A build for a host with FMA (CMake REVCOL_ISA, __FMA__ defined) takes the
+/// error from one fused multiply-add, fma(a, b, -p), two instructions instead of seventeen;
+/// a baseline build takes Dekker's (no fma call: libm's software fma costs more than a pair
+/// collision). Both are exact, so both give the same two numbers, hence the same bits in
+/// either build, while the error term is representable: a * b above about 2^-969 (Dekker's
+/// split needs the same headroom). tests/cpp/test_double_double.cpp compares them bit for bit.
+inline DD two_prod(double a, double b) {
+#ifdef __FMA__
+  const double p = a * b;
+  return {p, __builtin_fma(a, b, -p)};
+#else
+  return two_prod_dekker(a, b);
+#endif
+}
+/// x * x exactly: two_prod(x, x), the same way (one fused multiply-add, or Dekker's with
+/// one split).
+inline DD two_square(double x) {
+#ifdef __FMA__
+  const double p = x * x;
+  return {p, __builtin_fma(x, x, -p)};
+#else
+  return two_square_dekker(x);
+#endif
 }
 /// x + y to double-double accuracy.
 inline DD add(DD x, DD y) {

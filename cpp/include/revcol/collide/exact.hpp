@@ -32,7 +32,7 @@
 #include <cstdint>
 #include <vector>
 
-#include <Eigen/Dense>
+#include "revcol/eigen.hpp"
 
 #include "revcol/collide/common.hpp"
 #include "revcol/collide/trig_cdf.hpp"

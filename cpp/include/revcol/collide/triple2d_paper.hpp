@@ -59,7 +59,7 @@
 #include <cmath>
 #include <string>
 
-#include <Eigen/Dense>
+#include "revcol/eigen.hpp"
 
 #include "revcol/collide/calotte.hpp"
 #include "revcol/collide/common.hpp"
