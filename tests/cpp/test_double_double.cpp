@@ -26,6 +26,10 @@ double random_int(std::mt19937_64& rng, int bits) {
 i128 as_int(double x) { return static_cast<i128>(x); }  // exact for integer-valued |x| < 2^127
 // Half an ulp of x (for |x| >= 2^52 this is an integer or 1/2).
 double half_ulp(double x) { return 0.5 * (std::nextafter(std::fabs(x), INFINITY) - std::fabs(x)); }
+// the same two doubles, bit for bit (signed zeros included)
+bool same(dd::DD a, dd::DD b) {
+  return std::memcmp(&a.hi, &b.hi, sizeof(double)) == 0 && std::memcmp(&a.lo, &b.lo, sizeof(double)) == 0;
+}
 }  // namespace
 
 TEST_CASE("two_sum is exact: s + e == a + b, |e| <= ulp(s)/2") {
@@ -83,9 +87,6 @@ TEST_CASE("two_prod is exact: p + e == a * b to the last of 106 bits") {
 TEST_CASE("two_square is two_prod(x, x) bit for bit, and exact") {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const auto same = [](dd::DD a, dd::DD b) {
-    return std::memcmp(&a.hi, &b.hi, sizeof(double)) == 0 && std::memcmp(&a.lo, &b.lo, sizeof(double)) == 0;
-  };
   for (int t = 0; t < 200000; ++t) {
     // integer-valued, checked exactly; then random reals over a wide exponent range, as the
     // operators square them (frame components near 1, speeds up to 2^500). Below |x| ~
@@ -115,9 +116,6 @@ TEST_CASE("the fused multiply-add's products are Dekker's bit for bit (a host bu
   std::printf("  two_prod here: %s\n", dd::kFusedProducts ? "fused multiply-add" : "Dekker's split");
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const auto same = [](dd::DD a, dd::DD b) {
-    return std::memcmp(&a.hi, &b.hi, sizeof(double)) == 0 && std::memcmp(&a.lo, &b.lo, sizeof(double)) == 0;
-  };
   int bad = 0;
   for (int t = 0; t < 400000; ++t) {
     // exponents as the operators see them: speeds in [2^-480, 2^450], frame components near 1,

@@ -79,8 +79,7 @@ inline DD two_prod(double a, double b) {
 /// one split).
 inline DD two_square(double x) {
 #ifdef __FMA__
-  const double p = x * x;
-  return {p, __builtin_fma(x, x, -p)};
+  return two_prod(x, x);
 #else
   return two_square_dekker(x);
 #endif

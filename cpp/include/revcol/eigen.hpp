@@ -6,7 +6,7 @@
 // four lanes instead of two, and with FMA its products are fused: other roundings, other
 // bits. revcol's own arithmetic gives the same bits on any x86-64 level (-ffp-contract=off,
 // no reassociation, double_double.hpp's exact products either way), so a build for the host
-// (CMake REVCOL_ISA=host) would differ from the baseline build only through Eigen. Hiding
+// (CMake REVCOL_ISA=auto or x86-64-v3) would differ from the baseline build only through Eigen. Hiding
 // the macros while Eigen/Core configures itself keeps its code paths those of a baseline
 // build; the surrounding code still compiles for the host (Eigen's SSE2 intrinsics are
 // valid there). test_engine_hash's group cases go through Eigen (ExactCollision) and hold
