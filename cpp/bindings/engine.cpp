@@ -211,6 +211,7 @@ class PyEngine {
     d["trace_stride"] = g.trace_stride;
     d["trace_points"] = g.trace_points;
     d["clock_deviation"] = g.clock_deviation;
+    d["storage_resorts"] = g.storage_resorts;
     d["memory_bytes"] = sim().memory_bytes();
     d["events"] = counters_dict(g.counters);
     return d;

@@ -76,6 +76,7 @@ void validate_config(const Config& c) {
   require(std::isfinite(c.group_tol) && c.group_tol >= 0.0 && c.group_tol < limits::kMaxGroupTol,
           "group_tol must be finite and in [0, 1e-3)");
   require(std::isfinite(c.shell) && c.shell >= 0.0, "shell must be finite and >= 0 (0: from the packing fraction)");
+  require(c.resort >= -1, "resort must be >= -1 (-1: chosen from N, 0: never)");
   require(c.mode != Mode::paper || limits::paper_mode_allowed(c.dim),
           "paper mode has no invertible 3D pair operator (Pair3DPaper is not a bijection): use exact mode in 3D");
   for (int k = 0; k < c.dim; ++k) {

@@ -13,10 +13,10 @@ namespace revcol::engine::detail {
 template <int Dim, PairOperator Op>
 struct EngineImpl<Dim, Op>::Group {
   int n = 0;
-  int id[kMaxGroup];
+  int id[kMaxGroup];  // the members' slots (bk_[slot].id their ids)
   Vec off[kMaxGroup];
   int ne = 0;
-  int ea[3 * kMaxGroup], eb[3 * kMaxGroup];  // edges as member indices, ids ea < eb by id
+  int ea[3 * kMaxGroup], eb[3 * kMaxGroup];  // edges as member indices
   bool overflow = false;
 };
 
@@ -99,18 +99,18 @@ void EngineImpl<Dim, Op>::make_generators() {
 
 // One number from a stream: Philox at the stream's counter, or CLCG4 next / prev.
 template <int Dim, PairOperator Op>
-double EngineImpl<Dim, Op>::draw(int stream, bool reversed) {
+double EngineImpl<Dim, Op>::draw(int stream, std::uint64_t& count, bool reversed) {
   if (cfg_.generator == Generator::clcg4) {
     if (reversed) {
-      --drawn(stream);
+      --count;
       return clcg_[stream].prev();
     }
-    ++drawn(stream);
+    ++count;
     return clcg_[stream].next();
   }
   const rng::Philox p({static_cast<std::uint32_t>(stream), cfg_.seed}, 0);
-  if (reversed) return p.at(--drawn(stream));
-  return p.at(drawn(stream)++);
+  if (reversed) return p.at(--count);
+  return p.at(count++);
 }
 
 // ---- walls at a collision's instant (the wall-mask log) -----------------------------------
@@ -175,7 +175,7 @@ bool EngineImpl<Dim, Op>::touches_wall(int i) const {
 // A collision of a and b predicted at t (stamps checked). Returns whether one happened.
 template <int Dim, PairOperator Op>
 bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
-  if (a > b) std::swap(a, b);
+  if (bk_[a].id > bk_[b].id) std::swap(a, b);  // a: the smaller id (slots a, b)
   const Vec s = nl_.pair_shift(a, b);
   // The gather scans two neighbourhoods; it runs only when a group is possible: a
   // neighbour was within the contact tolerance at a prediction (resting contacts), or a
@@ -199,7 +199,7 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
   const std::int64_t wkey = reversed ? bk_[a].netc - 1 : bk_[a].netc;
   Reflection w1[2] = {0, 0}, w2[2] = {0, 0};
   if (reversed) {
-    wlog_.pop(a, wkey, 2, w1, w2);
+    wlog_.pop(bk_[a].id, wkey, 2, w1, w2);
     flip_mask(a, w2[0]);
     flip_mask(b, w2[1]);
   } else {
@@ -225,7 +225,7 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
   }
   PairV<Dim> out;
   try {
-    out = apply_pair(in, r, stream_of(a), reversed);
+    out = apply_pair(in, r, a, reversed);
   } catch (const InvalidArgument&) {
     // Only a reversed run can get here: a post state this operator cannot reverse (the
     // rare log is empty, or the state fails validation) means the reversed trajectory has
@@ -248,28 +248,31 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
     w2[0] = touch_walls(a);
     w2[1] = touch_walls(b);
     if (w1[0] | w1[1] | w2[0] | w2[1] || touches_wall(a) || touches_wall(b)) {
-      const int ids[2] = {a, b};
+      const int ids[2] = {bk_[a].id, bk_[b].id};
       const std::int64_t nc[2] = {bk_[a].netc, bk_[b].netc};
-      wlog_.push(a, wkey, t, 2, ids, nc, w1, w2);
+      wlog_.push(ids[0], wkey, t, 2, ids, nc, w1, w2);
     }
   }
   finish_collision(a, reversed);
   finish_collision(b, reversed);
   ++counters_.pair_collisions;
-  const int ids[2] = {a, b};
+  const int ids[2] = {bk_[a].id, bk_[b].id};
   trace_collision(ids, 2, reversed);
-  validate_collision(ids, 2);
+  const int slots[2] = {a, b};
+  validate_collision(slots, 2);
   repredict(a);
   repredict(b);
   return true;
 }
 
 // Forward: Op's forward; reversed (velocities negated): -Op.reverse(-v), its draws stepped
-// back in the opposite order. An operator that needs the exact-pre log keeps a singular pre
-// state whose cell centre is off by more than 1e-10, keyed by (stream, counter before the
-// draws), and the reversed collision restores it.
+// back in the opposite order, from the stream of the particle in slot s. An operator that
+// needs the exact-pre log keeps a singular pre state whose cell centre is off by more than
+// 1e-10, keyed by (stream, counter before the draws), and the reversed collision restores it.
 template <int Dim, PairOperator Op>
-PairV<Dim> EngineImpl<Dim, Op>::apply_pair(const PairV<Dim>& in, const Vec& r, int stream, bool reversed) {
+PairV<Dim> EngineImpl<Dim, Op>::apply_pair(const PairV<Dim>& in, const Vec& r, int s, bool reversed) {
+  const int stream = stream_of(s);
+  std::uint64_t& count = drawn_at(s);
   PairV<Dim> arg = in;
   if (reversed)
     for (int k = 0; k < Dim; ++k) {
@@ -278,13 +281,13 @@ PairV<Dim> EngineImpl<Dim, Op>::apply_pair(const PairV<Dim>& in, const Vec& r, i
     }
   std::array<double, (Op::draws > 0 ? Op::draws : 1)> g{};
   if (reversed)
-    for (int k = Op::draws - 1; k >= 0; --k) g[k] = draw(stream, true);
+    for (int k = Op::draws - 1; k >= 0; --k) g[k] = draw(stream, count, true);
   else
-    for (int k = 0; k < Op::draws; ++k) g[k] = draw(stream, false);
+    for (int k = 0; k < Op::draws; ++k) g[k] = draw(stream, count, false);
   PairV<Dim> out;
   if (reversed) {
     out = op_.reverse(arg, r, g.data(), log_);
-    if constexpr (Op::needs_exact_pre_log) pre_.pop(stream, drawn(stream), out.i.data(), out.j.data());
+    if constexpr (Op::needs_exact_pre_log) pre_.pop(stream, count, out.i.data(), out.j.data());
     for (int k = 0; k < Dim; ++k) {
       out.i[k] = -out.i[k];
       out.j[k] = -out.j[k];
@@ -296,7 +299,7 @@ PairV<Dim> EngineImpl<Dim, Op>::apply_pair(const PairV<Dim>& in, const Vec& r, i
       if (op_.singular(arg, r)) {
         const PairV<Dim> q = op_.quantize(arg, r);
         if (ExactPreLog::off_by(arg.i.data(), q.i.data(), Dim) || ExactPreLog::off_by(arg.j.data(), q.j.data(), Dim))
-          pre_.push(stream, drawn(stream) - Op::draws, arg.i.data(), arg.j.data(), Dim);
+          pre_.push(stream, count - Op::draws, arg.i.data(), arg.j.data(), Dim);
       }
     }
   }
@@ -313,9 +316,10 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
   int order[kMaxGroup] = {};
   for (int u = 0; u < g.n; ++u) order[u] = u;
   for (int u = 1; u < g.n; ++u)  // insertion sort by id (n <= 8)
-    for (int w = u; w > 0 && g.id[order[w]] < g.id[order[w - 1]]; --w) std::swap(order[w], order[w - 1]);
+    for (int w = u; w > 0 && bk_[g.id[order[w]]].id < bk_[g.id[order[w - 1]]].id; --w) std::swap(order[w], order[w - 1]);
   const int n = g.n;
-  const int first = g.id[order[0]];
+  const int first = g.id[order[0]];  // the slot of the smallest id
+  const int first_id = bk_[first].id;
   const std::int64_t wkey = reversed ? bk_[first].netc - 1 : bk_[first].netc;
   Reflection w1[kMaxGroup] = {}, w2[kMaxGroup] = {};
   for (int u = 0; u < n; ++u) advance(g.id[order[u]], t);
@@ -324,16 +328,17 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
   Observer* const obs = obs_;
   obs_ = nullptr;
   if (reversed) {
-    wlog_.pop(first, wkey, n, w1, w2);
+    wlog_.pop(first_id, wkey, n, w1, w2);
     for (int u = 0; u < n; ++u) flip_mask(g.id[order[u]], w2[u]);
   } else {
     for (int u = 0; u < n; ++u) w1[u] = touch_walls(g.id[order[u]]);
   }
-  int ids[kMaxGroup];
+  int sl[kMaxGroup], ids[kMaxGroup];  // the members' slots and ids, in id order
   std::int64_t nc[kMaxGroup];  // the members' net counts before this collision (wall-log keys)
   for (int u = 0; u < n; ++u) {
-    ids[u] = g.id[order[u]];
-    nc[u] = bk_[ids[u]].netc;
+    sl[u] = g.id[order[u]];
+    ids[u] = bk_[sl[u]].id;
+    nc[u] = bk_[sl[u]].netc;
   }
   obs_ = obs;
   if (!group_operator(g, order, t, reversed, w1)) {
@@ -341,32 +346,32 @@ bool EngineImpl<Dim, Op>::group_collide(Group& g, double t, bool reversed) {
     obs_ = nullptr;
     for (int u = 0; u < n; ++u) {
       const Reflection m = reversed ? w2[u] : w1[u];
-      flip_mask(ids[u], m);
+      flip_mask(sl[u], m);
       // neither the reflection nor its undoing happened: take both out of the counter
       counters_.wall_events -= 2 * static_cast<std::uint64_t>(reflections(m));
     }
     obs_ = obs;
     if (reversed && (std::any_of(w1, w1 + n, [](Reflection q) { return q != 0; }) ||
                      std::any_of(w2, w2 + n, [](Reflection q) { return q != 0; })))
-      wlog_.push(first, wkey, t, n, ids, nc, w1, w2);  // put the masks back
+      wlog_.push(first_id, wkey, t, n, ids, nc, w1, w2);  // put the masks back
     return false;
   }
   for (int u = 0; u < n; ++u) {
-    if (reversed) flip_mask(ids[u], w1[u]);
-    else w2[u] = touch_walls(ids[u]);
-    finish_collision(ids[u], reversed);
+    if (reversed) flip_mask(sl[u], w1[u]);
+    else w2[u] = touch_walls(sl[u]);
+    finish_collision(sl[u], reversed);
   }
   if (!reversed) {
     bool any = false;
-    for (int u = 0; u < n; ++u) any = any || w1[u] != 0 || w2[u] != 0 || touches_wall(ids[u]);
+    for (int u = 0; u < n; ++u) any = any || w1[u] != 0 || w2[u] != 0 || touches_wall(sl[u]);
     if (any) {
-      wlog_.push(first, wkey, t, n, ids, nc, w1, w2);  // the counts before this collision
+      wlog_.push(first_id, wkey, t, n, ids, nc, w1, w2);  // the counts before this collision
     }
   }
   ++counters_.group_collisions;
   counters_.group_particles += static_cast<std::uint64_t>(n);
   trace_collision(ids, n, reversed);
-  validate_collision(ids, n);
+  validate_collision(sl, n);
   for (int u = 0; u < n; ++u) repredict(g.id[u]);
   return true;
 }
@@ -388,7 +393,7 @@ bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, b
   edges.reserve(g.ne);
   for (int e = 0; e < g.ne; ++e) {
     int p = g.ea[e], q = g.eb[e];
-    if (g.id[p] > g.id[q]) std::swap(p, q);
+    if (bk_[g.id[p]].id > bk_[g.id[q]].id) std::swap(p, q);
     edges.push_back({rank[p], rank[q], p, q});
   }
   std::sort(edges.begin(), edges.end(), [](const E& x, const E& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
@@ -409,19 +414,20 @@ bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, b
       pre[u * Dim + k] = reversed ? -vk : vk;
     }
   const int stream = stream_of(g.id[order[0]]);
+  std::uint64_t& count = drawn_at(g.id[order[0]]);
   try {
     const ExactCollision op(n, Dim, contacts, normals, cfg_.law, cfg_.bits);
     const int m = op.draws();
     std::vector<double> gs(m);
     if (reversed) {
       op.check_post(pre.data());
-      for (int k = m - 1; k >= 0; --k) gs[k] = draw(stream, true);
+      for (int k = m - 1; k >= 0; --k) gs[k] = draw(stream, count, true);
       op.reverse(pre.data(), gs.data(), post.data(), log_);
-      pre_.pop(stream, drawn(stream), post.data(), nullptr);
+      pre_.pop(stream, count, post.data(), nullptr);
     } else {
       op.check_pre(pre.data());
-      const std::uint64_t key = drawn(stream);
-      for (int k = 0; k < m; ++k) gs[k] = draw(stream, false);
+      const std::uint64_t key = count;
+      for (int k = 0; k < m; ++k) gs[k] = draw(stream, count, false);
       op.forward(pre.data(), gs.data(), post.data(), log_);
       // resting contacts and aligned velocities put the pre state on a singular set of
       // the chart (a vertex of T, eta = 0), where its cell spans ~2^-K/2: keep it exactly
@@ -438,8 +444,8 @@ bool EngineImpl<Dim, Op>::group_operator(Group& g, const int* order, double t, b
     for (int u = 0; u < n; ++u)
       if (w1[u] != 0) note_wall(g.id[order[u]]);  // the velocities are still those after W1
     for (int u = 0; u < n; ++u) {
-      ids[u] = g.id[order[u]];
-      for (int k = 0; k < Dim; ++k) xs[u * Dim + k] = pos_at(ids[u], k, t) + g.off[order[u]][k];
+      ids[u] = bk_[g.id[order[u]]].id;
+      for (int k = 0; k < Dim; ++k) xs[u * Dim + k] = pos_at(g.id[order[u]], k, t) + g.off[order[u]][k];
     }
     obs_->group(t, n, ids, xs, post.data());
   }
@@ -480,10 +486,11 @@ void EngineImpl<Dim, Op>::check_conservation() {
   if (trace_.reason() != Divergence::none || !(e0_ > 0.0)) return;
   double e = 0.0;
   std::array<double, Dim> p{};
-  for (std::size_t i = 0; i < n_; ++i)
+  for (std::size_t i = 0; i < n_; ++i)  // in id order: the sums' bits do not depend on storage
     for (int k = 0; k < Dim; ++k) {
-      e += 0.5 * p_[i].v[k] * p_[i].v[k];
-      p[k] += p_[i].v[k];
+      const double vk = p_[slot_[i]].v[k];
+      e += 0.5 * vk * vk;
+      p[k] += vk;
     }
   if (!(std::fabs(e - e0_) <= CollisionTrace::kConserveTol * e0_)) {
     trace_.diverge(net_, Divergence::energy);
@@ -519,11 +526,11 @@ void EngineImpl<Dim, Op>::observe(const ObserveConfig& c) {
 // does not observe pays the pointer test only (measured: docs/physics.md).
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::note_wall(int i) {
-  obs_->wall(clock_, i, p_[i].v);
+  obs_->wall(clock_, bk_[i].id, p_[i].v);
 }
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::note_pair(int a, int b) {
-  obs_->template pair_d<Dim>(clock_, a, b, p_[a].v, p_[b].v);
+  obs_->template pair_d<Dim>(clock_, bk_[a].id, bk_[b].id, p_[a].v, p_[b].v);
 }
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::stop_observing() {
@@ -535,10 +542,10 @@ void EngineImpl<Dim, Op>::stop_observing() {
 // neighbour (beyond round-off), every list is symmetric (small systems) and the queue
 // keeps its invariants. Throws std::logic_error on a violation. A no-op otherwise.
 template <int Dim, PairOperator Op>
-void EngineImpl<Dim, Op>::validate_collision(const int* ids, int n) const {
+void EngineImpl<Dim, Op>::validate_collision(const int* slots, int n) const {
 #ifdef REVCOL_VALIDATE
   for (int u = 0; u < n; ++u) {
-    const int i = ids[u];
+    const int i = slots[u];
     for_neighbours(i, [&](int j, const Vec& sh) {
       double r2 = 0.0;
       for (int k = 0; k < Dim; ++k) {
@@ -546,7 +553,7 @@ void EngineImpl<Dim, Op>::validate_collision(const int* ids, int n) const {
         r2 += d * d;
       }
       if (!(r2 >= sigma2_ * (1.0 - 1e-6)))
-        throw std::logic_error("REVCOL_VALIDATE: particles " + std::to_string(i) + " and " + std::to_string(j) +
+        throw std::logic_error("REVCOL_VALIDATE: particles " + std::to_string(bk_[i].id) + " and " + std::to_string(bk_[j].id) +
                                " overlap after a collision: |r| / D = " + std::to_string(std::sqrt(r2 / sigma2_)) +
                                (rev_ ? " (reversed run)" : " (forward run)") + " at t = " + std::to_string(clock_));
     });
@@ -554,7 +561,7 @@ void EngineImpl<Dim, Op>::validate_collision(const int* ids, int n) const {
   if (!queue_.valid()) throw std::logic_error("REVCOL_VALIDATE: event queue invariants broken");
   if (n_ <= 2000 && !nl_.valid()) throw std::logic_error("REVCOL_VALIDATE: neighbour lists not symmetric");
 #else
-  (void)ids;
+  (void)slots;
   (void)n;
 #endif
 }

@@ -41,6 +41,10 @@ inline constexpr int kMaxGroup = 8;  // particles in one group collision
 // The group gate's window: a second collision within a relative kTieWindow of t (collide)
 // may make a group; a prediction never skips a candidate within twice that (prune_limit).
 inline constexpr double kTieWindow = 1e-9;
+// The spatial re-sort of the particles' storage (sort_storage): by default from this many
+// particles, after every kResortEvery list renewals per particle (Config::resort overrides).
+inline constexpr std::size_t kResortMinN = 32768;
+inline constexpr int kResortEvery = 16;
 
 enum Kind : std::int32_t { kWall = 0, kRenew = 1, kColl = 2, kNone = 3 };  // kRenew: neighbour-list renewal
 
@@ -48,12 +52,13 @@ enum Kind : std::int32_t { kWall = 0, kRenew = 1, kColl = 2, kNone = 3 };  // kR
 struct Ev {
   double t = kInf;              ///< time
   std::int32_t kind = kNone;    ///< Kind
-  std::int32_t partner = -1;    ///< particle (collision), 2 axis + (v > 0) (wall) or 0 (renewal)
+  std::int32_t partner = -1;    ///< particle's slot (collision), 2 axis + (v > 0) (wall) or 0 (renewal)
   std::uint64_t stamp = 0;      ///< the partner's stamp at prediction
 };
 
 /// One particle's bookkeeping beside its Particle, one cache line: its scheduled event and
-/// what a collision of it reads and writes (the group gate, its counts, its stream's draws).
+/// what a collision of it reads and writes (the group gate, its counts, its stream's draws),
+/// and its id (the particle's storage slot is not its id once sorted, see sort_storage).
 /// One record instead of six arrays: the event loop and a collision touch one line per
 /// particle, not six (cachegrind, 3D N = 10 976 phi 0.45: 37.8 -> 29.3 misses of a 1 MiB
 /// cache per collision, docs/peers.md "Session 20").
@@ -64,10 +69,12 @@ struct alignas(64) Book {
   std::int64_t netc = 0;          ///< net collisions, forward minus reverse (wall-log keys)
   std::uint64_t drawn = 0;        ///< draws taken from this particle's stream (per_particle streams)
   unsigned char touching = 0;     ///< a neighbour within the contact tolerance (the group gate)
+  std::int32_t id = 0;            ///< the particle's id (its storage slot's occupant)
 };
 static_assert(sizeof(Book) == 64, "a Book is one cache line");
 
-/// Lexicographic (t, kind, partner): a canonical earliest candidate whatever the scan order.
+/// Lexicographic (t, kind, partner) for a wall or a renewal: a canonical earliest candidate
+/// whatever the scan order (a collision candidate compares partners by id: EngineImpl::predict).
 inline bool earlier(double t, std::int32_t kind, std::int32_t partner, const Ev& e) {
   if (t != e.t) return t < e.t;
   if (kind != e.kind) return kind < e.kind;
@@ -107,8 +114,11 @@ class EngineImpl final : public Simulation {
     clock_ = t0;
     start_ = t0;
     bk_.assign(n_, Book{});
+    number_slots();
     make_generators();
     nl_.set_centres(x);  // list centres: where the particles start
+    resort_at_ = static_cast<std::uint64_t>(resort_every_) * n_;
+    if (resort_every_ > 0) sort_storage();
     build_lists();
     const Diagnostics d = diagnostics();
     e0_ = d.energy;
@@ -132,6 +142,7 @@ class EngineImpl final : public Simulation {
     start_ = s.start_time;
     net_ = s.net_collisions;
     bk_.assign(n_, Book{});
+    number_slots();
     for (std::size_t i = 0; i < n_; ++i) {
       bk_[i].ncoll = s.ncoll[i];
       bk_[i].netc = s.netc[i];
@@ -174,6 +185,8 @@ class EngineImpl final : public Simulation {
     p0_ = s.momentum0;
     // absent in checkpoints written before the trace: a new one (nothing below is checked)
     trace_ = s.trace.empty() ? CollisionTrace(n_, s.net_collisions == 0) : CollisionTrace::load(s.trace, n_);
+    resort_at_ = counters_.list_renewals + static_cast<std::uint64_t>(resort_every_) * n_;
+    if (resort_every_ > 0) sort_storage();  // the snapshot's ids (ev_partner too) become slots here
     build_lists();
     if (old_format) rebuild_events();
     else build_queue();
@@ -230,21 +243,22 @@ class EngineImpl final : public Simulation {
     return r;
   }
 
+  // (every per-particle output is in id order: slot_[id] is where particle id is stored)
   std::vector<double> positions() const override {
     std::vector<double> out(n_ * Dim);
     for (std::size_t i = 0; i < n_; ++i)
-      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = Kin::pos_at(p_[i], k, clock_);
+      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = Kin::pos_at(p_[slot_[i]], k, clock_);
     return out;
   }
   std::vector<double> velocities() const override {
     std::vector<double> out(n_ * Dim);
     for (std::size_t i = 0; i < n_; ++i)
-      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = p_[i].v[k];
+      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = p_[slot_[i]].v[k];
     return out;
   }
   std::vector<std::uint64_t> collision_counts() const override {
     std::vector<std::uint64_t> out(n_);
-    for (std::size_t i = 0; i < n_; ++i) out[i] = bk_[i].ncoll;
+    for (std::size_t i = 0; i < n_; ++i) out[i] = bk_[slot_[i]].ncoll;
     return out;
   }
   double time() const override { return clock_; }
@@ -262,7 +276,7 @@ class EngineImpl final : public Simulation {
   [[gnu::noinline, gnu::cold]] void note_pair(int a, int b);
 
   std::size_t memory_bytes() const override {
-    return n_ * (sizeof(Particle<Dim>) + sizeof(Book)) +
+    return n_ * (sizeof(Particle<Dim>) + sizeof(Book) + sizeof(std::int32_t)) +
            nl_.memory_bytes() + queue_.memory_bytes() + log_.bytes() + pre_.bytes() + wlog_.bytes() + trace_.bytes() +
            clcg_.size() * sizeof(rng::CLCG4);
   }
@@ -286,6 +300,8 @@ class EngineImpl final : public Simulation {
     renew_h_ = 0.5 * (shell_ - 1e-3 * cfg_.diameter);
     renew_h2_ = renew_h_ * renew_h_;
     nl_.setup(n_, box_, cfg_.diameter + shell_, Dim == 1 && (!box_.periodic(0) || n_ >= 3));
+    // 1D keeps its rods in id order: lists of the rods beside, no cells to sort by
+    resort_every_ = Dim == 1 ? 0 : cfg_.resort >= 0 ? cfg_.resort : (n_ >= kResortMinN ? kResortEvery : 0);
   }
   bool adjacent() const { return nl_.adjacent(); }  // a constant false in 2D and 3D
   void build_lists() {
@@ -355,7 +371,8 @@ class EngineImpl final : public Simulation {
       } else if (t < second) {
         second = t;
       }
-      if (earlier(t, kColl, j, best)) {
+      // (t, kind, partner's id): ids, not slots, so that the choice does not depend on storage
+      if (t < best.t || (t == best.t && (kColl < best.kind || (kColl == best.kind && bk_[j].id < bk_[best.partner].id)))) {
         best = Ev{t, kColl, j, p_[j].stamp};
         limit = prune_limit(best.t);
       }
@@ -385,7 +402,11 @@ class EngineImpl final : public Simulation {
     nl_.for_neighbour_pairs(i, two, one, [&](int j) { __builtin_prefetch(&p_[j]); });
     Book& bi = bk_[i];
     bi.ev = best;
-    bi.second = second;
+    // a second time beyond the final limit is one the scan kept only because it came before
+    // the best: which such times it kept depends on the list's order, and no decision reads
+    // them (the gate's window lies inside the limit), so they all read +inf and the stored
+    // state does not depend on that order (nor on where particles are stored)
+    bi.second = second <= limit ? second : kInf;
     bi.touching = touch ? 1 : 0;
   }
 
@@ -399,6 +420,8 @@ class EngineImpl final : public Simulation {
   }
 
   // ---- the event queue (revcol/engine/event_queue.hpp), key (t, kind, id) ----------------
+  // The queue is indexed by slot, and each slot's particle id breaks its ties: the order does
+  // not depend on where particles are stored. A re-sort of the storage rebuilds it.
 
   // Every event into the queue (construction, restore, reversal): the window starts at the
   // clock, ~8 events per bucket from the median distance of the events ahead.
@@ -417,7 +440,7 @@ class EngineImpl final : public Simulation {
     queue_.reset(n_, clock_, width);
     for (std::size_t i = 0; i < n_; ++i) update(static_cast<int>(i));
   }
-  void update(int i) { queue_.set(i, bk_[i].ev.t, bk_[i].ev.kind); }
+  void update(int i) { queue_.set(i, bk_[i].ev.t, bk_[i].ev.kind, bk_[i].id); }
   void rebuild_events() {
     for (std::size_t i = 0; i < n_; ++i) predict(static_cast<int>(i));
     build_queue();
@@ -425,6 +448,62 @@ class EngineImpl final : public Simulation {
   void repredict(int i) {
     predict(i);
     update(i);
+  }
+
+  // ---- storage order --------------------------------------------------------------------
+  // Particle id is stored in slot slot_[id] (its Particle, Book and list centre); the Book
+  // names its id back. Every array of the engine's state is per slot, and everything that
+  // decides the trajectory reads ids: the queue's key (t, kind, id), a prediction's choice
+  // between equal times, the pair's order and its stream, a group's order, the logs' keys,
+  // the collision trace, the observer. Lists list slots, sorted: a scan's order is not an
+  // input (a prediction's choice is canonical). So where a particle is stored changes no bit
+  // of a run, and the storage can follow the particles through space: a gas that diffused
+  // from a sorted start scans lists whose entries lie all over memory.
+
+  // Slots in id order (construction, restore).
+  void number_slots() {
+    slot_.resize(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      slot_[i] = static_cast<std::int32_t>(i);
+      bk_[i].id = static_cast<std::int32_t>(i);
+    }
+  }
+
+  // Stores the particles in the order of their list centres' cells (the grid's row-major
+  // order; ids within a cell): a list scan then reads a few runs of nearby slots. Moves
+  // Particles, Books (a scheduled collision's partner slot follows its particle) and centres;
+  // the caller rebuilds the lists and the queue.
+  void sort_storage() {
+    const std::size_t cells = nl_.cell_count();
+    std::vector<std::uint32_t> start(cells + 1, 0);
+    std::vector<std::uint32_t> key(n_);
+    for (std::size_t j = 0; j < n_; ++j) {
+      key[j] = static_cast<std::uint32_t>(nl_.cell_key(static_cast<int>(j)));
+      ++start[key[j] + 1];
+    }
+    for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+    std::vector<std::int32_t> to(n_);  // old slot -> new slot
+    for (std::size_t id = 0; id < n_; ++id) {
+      const std::size_t j = static_cast<std::size_t>(slot_[id]);
+      to[j] = static_cast<std::int32_t>(start[key[j]]++);
+    }
+    permute_in_place(p_, to);
+    permute_in_place(bk_, to);
+    for (std::size_t j = 0; j < n_; ++j) {
+      Book& q = bk_[j];
+      if (q.ev.kind == kColl) q.ev.partner = to[static_cast<std::size_t>(q.ev.partner)];
+      slot_[static_cast<std::size_t>(q.id)] = static_cast<std::int32_t>(j);
+    }
+    nl_.permute_centres(to);
+  }
+
+  // The periodic re-sort (every resort_every_ renewals per particle), between two events.
+  [[gnu::noinline, gnu::cold]] void resort() {
+    sort_storage();
+    build_lists();
+    build_queue();  // the same keys in new slots: the same order (the keys are distinct)
+    resort_at_ = counters_.list_renewals + static_cast<std::uint64_t>(resort_every_) * n_;
+    ++resorts_;
   }
 
   // ---- state changes ------------------------------------------------------------------
@@ -490,27 +569,30 @@ class EngineImpl final : public Simulation {
   // ---- random numbers -----------------------------------------------------------------
 
   std::size_t stream_count() const { return cfg_.streams == rng::StreamPolicy::single ? 1 : n_; }
-  // The stream a collision whose smallest particle id is `id` draws from.
-  int stream_of(int id) const { return cfg_.streams == rng::StreamPolicy::single ? 0 : id; }
+  // The stream a collision whose particle of smallest id is stored in slot `s` draws from.
+  int stream_of(int s) const { return cfg_.streams == rng::StreamPolicy::single ? 0 : bk_[s].id; }
+  // Draws taken from that stream: in the slot's Book, or the single stream's count.
+  std::uint64_t& drawn_at(int s) { return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[s].drawn; }
 
-  // Draws taken from a stream: in its particle's Book, or the single stream's count.
+  // Draws taken from stream k (its particle's Book, or the single stream's count).
   std::uint64_t& drawn(int stream) {
-    return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[stream].drawn;
+    return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[slot_[stream]].drawn;
   }
   std::uint64_t drawn(int stream) const {
-    return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[stream].drawn;
+    return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[slot_[stream]].drawn;
   }
   // CLCG4 only: each stream's state, from the family and the draws taken (drawn).
   void make_generators();
-  // One number from a stream, forward (the next) or reversed (the last one, stepped back).
-  double draw(int stream, bool reversed);
+  // One number from a stream whose draw count is `count`, forward (the next) or reversed
+  // (the last one, stepped back).
+  double draw(int stream, std::uint64_t& count, bool reversed);
 
   // ---- collisions (engine_collide.hpp) --------------------------------------------------
 
   struct Group;  // members of a contact component, with image offsets and edges
   void gather(int a, int b, const Vec& s, double t, Group& g) const;
   bool collide(int a, int b, double t, bool reversed);
-  PairV<Dim> apply_pair(const PairV<Dim>& in, const Vec& r, int stream, bool reversed);
+  PairV<Dim> apply_pair(const PairV<Dim>& in, const Vec& r, int s, bool reversed);
   bool group_collide(Group& g, double t, bool reversed);
   bool group_operator(Group& g, const int* order, double t, bool reversed, const Reflection* w1);
   Reflection touch_walls(int i);
@@ -519,13 +601,13 @@ class EngineImpl final : public Simulation {
   Reflection wall_mask(int i, int k, double t) const;
   bool w2_covers(long m, Reflection mask) const;
   bool touches_wall(int i) const;
-  long wall_entry(int i) const { return wlog_.entry(i, bk_[i].netc, rev_ ? -clock_ : clock_); }
+  long wall_entry(int i) const { return wlog_.entry(bk_[i].id, bk_[i].netc, rev_ ? -clock_ : clock_); }
   void finish_collision(int i, bool reversed) {
     ++bk_[i].ncoll;
     ++p_[i].stamp;
     bk_[i].netc += reversed ? -1 : 1;
   }
-  void validate_collision(const int* ids, int n) const;
+  void validate_collision(const int* slots, int n) const;
   void trace_collision(const int* ids, int n, bool reversed);
   void trace_point(bool reversed);
   void check_conservation();
@@ -572,6 +654,7 @@ class EngineImpl final : public Simulation {
         wall_event(i, e);
       } else if (e.kind == kRenew) {
         renew_event(i, e);
+        if (counters_.list_renewals >= resort_at_ && resort_every_ > 0) [[unlikely]] resort();
       } else if (e.kind == kColl) {
         if (p_[e.partner].stamp != e.stamp) {
           ++counters_.invalid_events;
@@ -614,8 +697,12 @@ class EngineImpl final : public Simulation {
   NeighbourLists<Dim> nl_;
   static_assert(limits::max_particles(Dim) <= NeighbourLists<Dim>::kMaxIds,
                 "the engine's limit on N must fit the lists' packed ids");
-  EventQueue<double> queue_;               // one event per particle, key (t, kind, id)
-  std::vector<Book> bk_;                   // per particle: its event, group gate, counts and draws
+  EventQueue<double> queue_;               // one event per slot, key (t, kind, the slot's particle id)
+  std::vector<Book> bk_;                   // per slot: its event, group gate, counts, draws and id
+  std::vector<std::int32_t> slot_;         // per id: the slot its Particle and Book are stored in
+  int resort_every_ = 0;                   // list renewals per particle between re-sorts (0: never)
+  std::uint64_t resort_at_ = 0;            // the renewal count of the next re-sort
+  std::uint64_t resorts_ = 0;              // re-sorts done by run / run_back
   std::uint64_t drawn1_ = 0;               // draws taken from the single stream (StreamPolicy::single)
   std::vector<rng::CLCG4> clcg_;             // CLCG4 only: one generator per stream
   double clock_ = 0.0, start_ = 0.0;

@@ -13,9 +13,9 @@ template <int Dim, PairOperator Op>
 Diagnostics EngineImpl<Dim, Op>::diagnostics() const {
   Diagnostics d;
   double e = 0.0;
-  for (std::size_t i = 0; i < n_; ++i)
+  for (std::size_t i = 0; i < n_; ++i)  // in id order: the sums' bits do not depend on storage
     for (int k = 0; k < Dim; ++k) {
-      const double vk = p_[i].v[k];
+      const double vk = p_[slot_[i]].v[k];
       e += 0.5 * vk * vk;
       d.momentum[k] += vk;
     }
@@ -40,6 +40,7 @@ Diagnostics EngineImpl<Dim, Op>::diagnostics() const {
   d.trace_stride = trace_.stride();
   d.trace_points = trace_.points();
   d.clock_deviation = trace_.clock_deviation();
+  d.storage_resorts = resorts_;
   d.counters = counters_;
   return d;
 }
@@ -65,25 +66,27 @@ Snapshot EngineImpl<Dim, Op>::snapshot() const {
   s.netc.resize(n_);
   s.second.resize(n_);
   s.touching.resize(n_);
-  for (std::size_t i = 0; i < n_; ++i) {
+  s.cell.resize(nl_.cells().size());
+  for (std::size_t i = 0; i < n_; ++i) {  // per id: particle i is in slot j
+    const auto j = static_cast<std::size_t>(slot_[i]);
     for (int k = 0; k < Dim; ++k) {
-      s.x[i * Dim + k] = p_[i].x[k];
-      s.v[i * Dim + k] = p_[i].v[k];
-      s.centre[i * Dim + k] = nl_.centre(static_cast<int>(i))[k];
+      s.x[i * Dim + k] = p_[j].x[k];
+      s.v[i * Dim + k] = p_[j].v[k];
+      s.centre[i * Dim + k] = nl_.centre(static_cast<int>(j))[k];
+      s.cell[i * Dim + k] = nl_.cells()[j * Dim + k];
     }
-    s.t_local[i] = p_[i].t;
-    s.stamp[i] = p_[i].stamp;
-    const Book& b = bk_[i];
+    s.t_local[i] = p_[j].t;
+    s.stamp[i] = p_[j].stamp;
+    const Book& b = bk_[j];
     s.ev_t[i] = b.ev.t;
     s.ev_kind[i] = b.ev.kind;
-    s.ev_partner[i] = b.ev.partner;
+    s.ev_partner[i] = b.ev.kind == kColl ? bk_[static_cast<std::size_t>(b.ev.partner)].id : b.ev.partner;
     s.ev_stamp[i] = b.ev.stamp;
     s.ncoll[i] = b.ncoll;
     s.netc[i] = b.netc;
     s.second[i] = b.second;
     s.touching[i] = b.touching;
   }
-  s.cell.assign(nl_.cells().begin(), nl_.cells().end());
   s.rng.resize(stream_count());
   for (std::size_t k = 0; k < s.rng.size(); ++k) s.rng[k] = drawn(static_cast<int>(k));
   s.log_cells = log_.cells();

@@ -4,6 +4,7 @@
 // invariants checked along the way.
 #include "revcol/engine/event_queue.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -17,18 +18,22 @@ using revcol::engine::EventQueue;
 
 namespace {
 
-// The reference: a flat array, top() by a full scan.
+// The reference: a flat array, top() by a full scan; ties broken by tie[i] (the id, or a
+// permutation of the ids).
 template <class Time>
 struct Brute {
   std::vector<Time> t;
   std::vector<std::int32_t> k;
   std::vector<bool> on;
-  explicit Brute(std::size_t n) : t(n), k(n), on(n, false) {}
+  std::vector<std::int32_t> tie;
+  explicit Brute(std::size_t n) : t(n), k(n), on(n, false), tie(n) {
+    for (std::size_t i = 0; i < n; ++i) tie[i] = static_cast<std::int32_t>(i);
+  }
   int top() const {
     int best = -1;
     for (int i = 0; i < static_cast<int>(t.size()); ++i) {
       if (!on[i]) continue;
-      if (best < 0 || t[i] < t[best] || (t[i] == t[best] && (k[i] < k[best] || (k[i] == k[best] && i < best))))
+      if (best < 0 || t[i] < t[best] || (t[i] == t[best] && (k[i] < k[best] || (k[i] == k[best] && tie[i] < tie[best]))))
         best = i;
     }
     return best;
@@ -37,16 +42,20 @@ struct Brute {
 
 // An event-driven pattern: pop the top, reschedule it (and a few others) later than now,
 // sometimes at exactly now or at the same time as another (ties), sometimes at never(), and
-// sometimes erase; times drawn by `draw(now, rng)`.
+// sometimes erase; times drawn by `draw(now, rng)`. With `permuted_ties`, set() passes each
+// id a tie breaker from a random permutation of the ids (the float engine's slots and ids).
 template <class Time, class Draw>
-int run_pattern(std::size_t n, Time now, Time width, int steps, std::uint32_t seed, Draw draw) {
+int run_pattern(std::size_t n, Time now, Time width, int steps, std::uint32_t seed, Draw draw,
+                bool permuted_ties = false) {
   std::mt19937_64 rng(seed);
   EventQueue<Time> q;
   Brute<Time> b(n);
+  if (permuted_ties) std::shuffle(b.tie.begin(), b.tie.end(), rng);
   q.reset(n, now, width);
   int bad = 0;
   auto set = [&](int id, Time t, std::int32_t kind) {
-    q.set(id, t, kind);
+    if (permuted_ties) q.set(id, t, kind, b.tie[static_cast<std::size_t>(id)]);
+    else q.set(id, t, kind);
     b.t[id] = t;
     b.k[id] = kind;
     b.on[id] = true;
@@ -81,7 +90,7 @@ int run_pattern(std::size_t n, Time now, Time width, int steps, std::uint32_t se
       q.erase(other);
       b.on[other] = false;
     } else if (r2 == 1 && b.on[want]) {
-      set(other, b.t[want], b.k[want]);  // the same (time, kind): only the id decides
+      set(other, b.t[want], b.k[want]);  // the same (time, kind): only the tie decides
     } else if (r2 < 5) {
       set(other, draw(now, rng), static_cast<std::int32_t>(rng() % 3));
     }
@@ -216,3 +225,13 @@ TEST_CASE("for_next names at most k scheduled events other than the top, and the
 }
 
 CHECK_MAIN()
+
+TEST_CASE("a tie breaker other than the id: equal (time, kind) leave in the order of the ties") {
+  // coarse times, so that many events share a time and a kind
+  const auto coarse = [](double now, std::mt19937_64& rng) { return now + static_cast<double>(rng() % 4); };
+  const auto coarse64 = [](std::int64_t now, std::mt19937_64& rng) { return now + static_cast<std::int64_t>(rng() % 4); };
+  for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+    CHECK(run_pattern<double>(200, 0.0, 0.5, 20000, seed, coarse, /*permuted_ties=*/true) == 0);
+    CHECK(run_pattern<std::int64_t>(200, 0, 1, 20000, seed, coarse64, /*permuted_ties=*/true) == 0);
+  }
+}

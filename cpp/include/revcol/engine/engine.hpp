@@ -80,6 +80,14 @@
 // counter), and the reversed collision restores them. In a gas this is a few entries per
 // million collisions (measured: 7 KB after 1e7 collisions at N = 1e4, docs/engine.md).
 //
+// Storage. Particle ids name the particles everywhere above; where the engine stores a
+// particle (its slot) is its own affair. From 32 768 particles in 2D and 3D (Config::resort)
+// it stores them in the order of their list centres' cells, at construction and restore and
+// again after every 16 list renewals per particle, so that a gas diffused far from its start
+// still scans lists that lie close in memory. No decision reads a slot (queue ties, the
+// choice between equal times, pair order, streams, groups, logs, sums and outputs all go by
+// id), so a run's bits do not depend on it (tests/cpp/test_engine_hash.cpp).
+//
 // A state at an event (a particle touching a wall or another particle at the start time)
 // is ambiguous for a run back to that time: start between events (random_state keeps
 // 1e-6 D from the walls).
@@ -155,6 +163,10 @@ struct Config {
                                     ///< engine without the gate would (not saved in snapshots)
   double shell = 0.0;  ///< benchmarks only: the neighbour-list shell in diameters; 0 (the default)
                        ///< chooses it from the packing fraction (not saved in snapshots)
+  int resort = -1;  ///< speed only: the particles' storage is re-sorted in space after every
+                    ///< `resort` list renewals per particle (2D, 3D); 0 never; -1 (the default)
+                    ///< chooses (engine_impl.hpp, kResortEvery and kResortMinN). The trajectory
+                    ///< does not depend on it, to the bit (not saved in snapshots)
 };
 
 /// visit(f): calls f(name, field) for each field of a struct that lists them in a static
@@ -345,6 +357,7 @@ struct Diagnostics {
   std::uint64_t trace_stride = 0;         ///< the trace's grid stride now (collisions)
   std::size_t trace_points = 0;           ///< grid points kept
   double clock_deviation = 0.0;           ///< largest |t - t_forward| at the trace's points in the last reversed pass
+  std::uint64_t storage_resorts = 0;      ///< spatial re-sorts of the particles' storage since construction or restore (Config::resort)
   Counters counters;
 };
 

@@ -1,5 +1,7 @@
 // The event queue of an event-driven engine: one scheduled event per id, keyed by
-// (time, kind, id), popped in key order.
+// (time, kind, tie), popped in key order. The tie is the id unless set() is given another
+// (the float engine stores particles in slots and passes each slot's particle id, so that
+// the order does not depend on where a particle is stored); ties must be distinct.
 //
 // Paul's O(1) queue (G. Paul, J. Comput. Phys. 221, 615 (2007)): the events of the current
 // time bucket in a binary heap (the key copied into the node, so that sifting reads the heap
@@ -8,7 +10,7 @@
 // next window when this one is used up. Insert and update are O(1) outside the current
 // bucket, O(log b) inside it (b ~ kPerBucket events), and a pop moves on bucket by bucket.
 //
-// The keys are distinct (the id breaks every tie), so events leave in key order whatever the
+// The keys are distinct (the tie breaks every tie), so events leave in key order whatever the
 // bucket width: the width is a speed setting only. It is set for ~kPerBucket events per
 // bucket: `reset` takes a first width, and each new window takes one from the rate of top()
 // calls in the last (an event-driven engine calls top() once per event), within a factor 8
@@ -45,6 +47,7 @@ class EventQueue {
   void reset(std::size_t n, Time now, Time bucket_width) {
     time_.assign(n, never());
     kind_.assign(n, 0);
+    tie_.assign(n, 0);
     hpos_.assign(n, 0);
     next_.assign(n, -1);
     prev_.assign(n, -1);
@@ -68,14 +71,19 @@ class EventQueue {
     cur_ = 0;
   }
 
-  /// (Re)schedules id's one event at time t with a kind (smaller kinds first at equal t).
-  void set(int id, Time t, std::int32_t kind) {
+  /// (Re)schedules id's one event at time t with a kind (smaller kinds first at equal t), the
+  /// id breaking ties.
+  void set(int id, Time t, std::int32_t kind) { set(id, t, kind, id); }
+  /// The same with another tie breaker (distinct over the ids; the smaller first at equal t
+  /// and kind).
+  void set(int id, Time t, std::int32_t kind, std::int32_t tie) {
     if (loc_[id] == kInHeap) {
       const int p = hpos_[id];
       const Node old = heap_[p];
-      const Node e{t, kind, id};
+      const Node e{t, kind, tie, id};
       time_[id] = t;
       kind_[id] = kind;
+      tie_[id] = tie;
       const int b = bucket_of(t);
       if (!only_never_ && b != kOverflow && b <= cur_) {  // stays in the current bucket
         heap_[p] = e;
@@ -89,6 +97,7 @@ class EventQueue {
     }
     time_[id] = t;
     kind_[id] = kind;
+    tie_[id] = tie;
     insert(id);
   }
 
@@ -103,7 +112,7 @@ class EventQueue {
     kind_[id] = 0;
   }
 
-  /// The id with the smallest (time, kind, id), or -1 when nothing is scheduled; not removed.
+  /// The id with the smallest (time, kind, tie), or -1 when nothing is scheduled; not removed.
   /// Moves on to the next non-empty bucket, and to the next window, while the current
   /// bucket is empty.
   [[gnu::always_inline]] int top() {
@@ -137,7 +146,7 @@ class EventQueue {
       if (++cur_ < nbuckets_) {
         for (int i = bhead_[cur_]; i >= 0;) {
           const int nx = next_[i];
-          heap_.push_back(Node{time_[i], kind_[i], i});
+          heap_.push_back(Node{time_[i], kind_[i], tie_[i], i});
           hpos_[i] = static_cast<int>(heap_.size()) - 1;
           loc_[i] = kInHeap;
           i = nx;
@@ -154,7 +163,7 @@ class EventQueue {
  public:
   /// Bytes held by the queue's arrays.
   std::size_t memory_bytes() const {
-    return time_.capacity() * sizeof(Time) + kind_.capacity() * sizeof(std::int32_t) +
+    return time_.capacity() * sizeof(Time) + (kind_.capacity() + tie_.capacity()) * sizeof(std::int32_t) +
            (hpos_.capacity() + next_.capacity() + prev_.capacity() + loc_.capacity() + bhead_.capacity()) *
                sizeof(int) +
            heap_.capacity() * sizeof(Node);
@@ -169,7 +178,7 @@ class EventQueue {
     for (int p = 0; p < static_cast<int>(heap_.size()); ++p) {
       const Node& e = heap_[p];
       if (e.id < 0 || e.id >= n || loc_[e.id] != kInHeap || hpos_[e.id] != p) return false;
-      if (e.t != time_[e.id] || e.kind != kind_[e.id]) return false;
+      if (e.t != time_[e.id] || e.kind != kind_[e.id] || e.tie != tie_[e.id]) return false;
       if (p > 0 && less(e, heap_[(p - 1) / 2])) return false;
       ++seen[e.id];
     }
@@ -196,12 +205,13 @@ class EventQueue {
   struct Node {
     Time t;
     std::int32_t kind;
+    std::int32_t tie;
     std::int32_t id;
   };
   static bool less(const Node& a, const Node& b) {
     if (a.t != b.t) return a.t < b.t;
     if (a.kind != b.kind) return a.kind < b.kind;
-    return a.id < b.id;
+    return a.tie < b.tie;
   }
   static constexpr int kInHeap = -1, kOverflow = -2, kUnscheduled = -3;
   static constexpr double kPerBucket = 8.0;  // measured: 2 to 16 within the noise
@@ -271,7 +281,7 @@ class EventQueue {
     if (next_[i] >= 0) prev_[next_[i]] = prev_[i];
   }
   void heap_push(int i) {
-    heap_.push_back(Node{time_[i], kind_[i], i});
+    heap_.push_back(Node{time_[i], kind_[i], tie_[i], i});
     loc_[i] = kInHeap;
     sift_up(static_cast<int>(heap_.size()) - 1);
   }
@@ -373,7 +383,7 @@ class EventQueue {
   }
 
   std::vector<Time> time_;             // each id's key: time and kind
-  std::vector<std::int32_t> kind_;
+  std::vector<std::int32_t> kind_, tie_;
   std::vector<int> hpos_, next_, prev_, loc_, bhead_;  // heap positions; bucket and overflow lists; where
   std::vector<Node> heap_;             // the current bucket's heap
   int ohead_ = -1, nbuckets_ = 64, cur_ = 0;  // overflow list, buckets in the window, current bucket

@@ -8,6 +8,8 @@
 // off each other's lists is more than D (1 + 1e-3) apart and a prediction scans the list
 // alone. The cell grid (cells at least D + shell wide) holds the centres and is read by
 // the renewals only. Ids on a list are sorted: a canonical order, the same after a restore.
+// (The float engine's "ids" here are its storage slots: it may re-sort them in space,
+// permute_centres, and build the lists again; see EngineImpl::sort_storage.)
 //
 // Image codes: 2 bits per axis, 0: x_j, 1: x_j + L, 2: x_j - L (the nearest image of j's
 // centre seen from i's; Boundaries::image). With L >= 2 (D + shell) each listed pair has one
@@ -31,6 +33,25 @@
 #include "revcol/engine/prefetch.hpp"
 
 namespace revcol::engine {
+
+/// Moves a[i] to a[to[i]] for every i (`to` a permutation of 0 .. a.size() - 1) in place: one
+/// element held at a time, each cycle of the permutation followed once (no copy of the array:
+/// a re-sort of a large engine's storage does not raise its peak memory).
+template <class T>
+void permute_in_place(std::vector<T>& a, const std::vector<std::int32_t>& to) {
+  std::vector<bool> done(a.size(), false);
+  for (std::size_t j = 0; j < a.size(); ++j) {
+    if (done[j]) continue;
+    T held = a[j];
+    std::size_t k = j;
+    do {
+      const auto d = static_cast<std::size_t>(to[k]);
+      done[k] = true;
+      std::swap(held, a[d]);
+      k = d;
+    } while (k != j);
+  }
+}
 
 /// Symmetric neighbour lists over list centres, per dimension d.
 template <int Dim>
@@ -95,6 +116,16 @@ class NeighbourLists {
   double* centre(int i) { return cn_[i].c; }
   /// Cell coordinates of every centre (n x dim; zeros in 1D's adjacent mode).
   const std::vector<int>& cells() const { return cell_; }
+  /// Cells in the grid.
+  std::size_t cell_count() const { return static_cast<std::size_t>(total_cells_); }
+  /// The grid's (row-major) index of the cell of i's centre, from the centre (lists or not).
+  int cell_key(int i) const {
+    int c = 0;
+    for (int k = 0; k < Dim; ++k) c += cell_of(cn_[i].c[k], k) * stride_[k];
+    return c;
+  }
+  /// Moves centre i to slot to[i] (the engine re-sorts its storage); build() follows.
+  void permute_centres(const std::vector<std::int32_t>& to) { permute_in_place(cn_, to); }
 
   /// Every list from the centres (construction, restore). pos(j): rod j's position now
   /// (1D's adjacent mode only).
@@ -107,7 +138,10 @@ class NeighbourLists {
     }
     for (std::size_t i = 0; i < n_; ++i) place(static_cast<int>(i));
     link_all();
-    nbcap_ = 16;
+    // a rebuild (the engine's storage re-sort) keeps the lists' capacity: the store is not
+    // allocated again beside the old one, and the peak memory stays where it was
+    const bool rebuild = !nb_.empty() && nb_.size() == n_ * static_cast<std::size_t>(nbcap_);
+    if (!rebuild) nbcap_ = 16;
     nb_.assign(n_ * nbcap_, 0);
     nbn_.assign(n_, 0);
     for (std::size_t i = 0; i < n_; ++i)
@@ -116,9 +150,10 @@ class NeighbourLists {
         if (near(static_cast<int>(i), j, code)) list_insert(static_cast<int>(i), j, code);
       });
     // 8 slots of room above the longest list: a run's fluctuations pass the start's longest
-    // soon, and a capacity grown then would grow the store (and the peak memory) mid-run
+    // soon, and a capacity grown then would grow the store (and the peak memory) mid-run. A
+    // rebuild keeps the room it has (it grows, as a renewal does, only when a list fills it)
     const int longest = n_ > 0 ? *std::max_element(nbn_.begin(), nbn_.end()) : 0;
-    if (nbcap_ < longest + 8) grow_lists(longest + 8);
+    if (!rebuild && nbcap_ < longest + 8) grow_lists(longest + 8);
   }
 
   /// i's centre has moved: i goes to its new cell and its list is rebuilt from there, with
