@@ -13,11 +13,14 @@
 //
 // (shell: the neighbour-list shell in diameters, Config::shell; 0, the default, chooses it from phi;
 // observe: 1 observes the timed forward run's scalars, 2 also a 50-bin speed histogram and 10
-// slabs (revcol/engine/observe.hpp); run_back ends the observation, so the reverse is unobserved)
+// slabs (revcol/engine/observe.hpp); run_back ends the observation, so the reverse is unobserved;
+// shuffle=1 numbers the start's particles in a random order, as a gas long diffused from a
+// sorted start is; resort: Config::resort, the spatial re-sort of the particles' storage)
 //
 // Metrics: forward_per_s, reverse_per_s, events_per_collision, invalid_per_collision,
-// log_bytes, engine_bytes, peak_rss_bytes (the process's VmHWM: run one case per process
-// to read it per case), roundtrip_rel_error_v (max |v - v_start| / max |v_start| after
+// resorts_timed (storage re-sorts in the timed runs), log_bytes, engine_bytes,
+// peak_rss_bytes (the process's VmHWM: run one case per process to read it per case),
+// roundtrip_rel_error_v (max |v - v_start| / max |v_start| after
 // forward and back: beyond the horizon at large --collisions, a measure, not a check).
 #include <chrono>
 #include <cmath>
@@ -50,10 +53,12 @@ struct Case {
   bool groups = true;
   double shell = 0.0;  // Config::shell: 0 chooses it from phi
   int observe = 0;     // 0 off, 1 scalars, 2 scalars + speed histogram + slabs
+  bool shuffle = false;  // the start's ids in a random order (a gas long diffused from a sorted start)
+  int resort = -1;       // Config::resort: -1 chooses from N, 0 never, R every R renewals per particle
 };
 
 void apply_environment(Case& c) {
-  apply_settings("REVCOL_ENGINE", "d, n, phi, boundary, law, mode, seed, warm, groups, shell, observe",
+  apply_settings("REVCOL_ENGINE", "d, n, phi, boundary, law, mode, seed, warm, groups, shell, observe, shuffle, resort",
                  [&](const std::string& key, const std::string& value) {
                    if (key == "d") c.d = std::stoi(value);
                    else if (key == "n") c.n = std::stoull(value);
@@ -66,6 +71,8 @@ void apply_environment(Case& c) {
                    else if (key == "groups") c.groups = value != "0";
                    else if (key == "shell") c.shell = std::stod(value);
                    else if (key == "observe") c.observe = std::stoi(value);
+                   else if (key == "shuffle") c.shuffle = value != "0";
+                   else if (key == "resort") c.resort = std::stoi(value);
                    else return false;
                    return true;
                  });
@@ -79,6 +86,22 @@ double peak_rss_bytes() {
   return 0.0;
 }
 
+// Renumbers the particles of st in a random order (Fisher-Yates from a fixed generator): the
+// same gas, its ids no longer following the lattice the start was built on.
+void shuffle_ids(en::InitialState& st, std::uint64_t seed) {
+  const int d = st.config.dim;
+  const std::size_t n = st.x.size() / static_cast<std::size_t>(d);
+  std::uint64_t s = seed * 0x9E3779B97F4A7C15ull + 1;
+  for (std::size_t i = n; i > 1; --i) {
+    s = s * 6364136223846793005ull + 1442695040888963407ull;
+    const std::size_t j = static_cast<std::size_t>((s >> 33) % i);
+    for (int k = 0; k < d; ++k) {
+      std::swap(st.x[(i - 1) * d + k], st.x[j * d + k]);
+      std::swap(st.v[(i - 1) * d + k], st.v[j * d + k]);
+    }
+  }
+}
+
 std::vector<Metric> run_case(Case c, std::uint64_t nc) {
   apply_environment(c);
   en::Config cfg;
@@ -89,7 +112,9 @@ std::vector<Metric> run_case(Case c, std::uint64_t nc) {
   cfg.seed = static_cast<std::uint32_t>(c.seed);
   cfg.groups = c.groups;
   cfg.shell = c.shell;
-  const en::InitialState st = en::random_state(cfg, c.n, c.phi, c.seed);
+  cfg.resort = c.resort;
+  en::InitialState st = en::random_state(cfg, c.n, c.phi, c.seed);
+  if (c.shuffle) shuffle_ids(st, c.seed);
   auto sim = en::make_simulation(st.config, st.x, st.v);
   const auto warm = static_cast<std::uint64_t>(c.warm * static_cast<double>(c.n) / 2.0);
   if (warm > 0) sim->run(warm, std::numeric_limits<double>::infinity());
@@ -128,6 +153,7 @@ std::vector<Metric> run_case(Case c, std::uint64_t nc) {
           {"engine_bytes", static_cast<double>(sim->memory_bytes())},
           {"peak_rss_bytes", peak_rss_bytes()},
           {"roundtrip_rel_error_v", err / vmax},
+          {"resorts_timed", static_cast<double>(sim->diagnostics().storage_resorts - d0.storage_resorts)},
           {"n", static_cast<double>(c.n)},
           {"phi", c.phi},
           {"dim", static_cast<double>(c.d)}};
