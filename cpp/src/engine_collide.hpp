@@ -488,7 +488,7 @@ void EngineImpl<Dim, Op>::check_conservation() {
   std::array<double, Dim> p{};
   for (std::size_t i = 0; i < n_; ++i)  // in id order: the sums' bits do not depend on storage
     for (int k = 0; k < Dim; ++k) {
-      const double vk = p_[slot_[i]].v[k];
+      const double vk = p_[slot(i)].v[k];
       e += 0.5 * vk * vk;
       p[k] += vk;
     }

@@ -243,22 +243,22 @@ class EngineImpl final : public Simulation {
     return r;
   }
 
-  // (every per-particle output is in id order: slot_[id] is where particle id is stored)
+  // (every per-particle output is in id order: slot(id) is where particle id is stored)
   std::vector<double> positions() const override {
     std::vector<double> out(n_ * Dim);
     for (std::size_t i = 0; i < n_; ++i)
-      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = Kin::pos_at(p_[slot_[i]], k, clock_);
+      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = Kin::pos_at(p_[slot(i)], k, clock_);
     return out;
   }
   std::vector<double> velocities() const override {
     std::vector<double> out(n_ * Dim);
     for (std::size_t i = 0; i < n_; ++i)
-      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = p_[slot_[i]].v[k];
+      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = p_[slot(i)].v[k];
     return out;
   }
   std::vector<std::uint64_t> collision_counts() const override {
     std::vector<std::uint64_t> out(n_);
-    for (std::size_t i = 0; i < n_; ++i) out[i] = bk_[slot_[i]].ncoll;
+    for (std::size_t i = 0; i < n_; ++i) out[i] = bk_[slot(i)].ncoll;
     return out;
   }
   double time() const override { return clock_; }
@@ -276,7 +276,7 @@ class EngineImpl final : public Simulation {
   [[gnu::noinline, gnu::cold]] void note_pair(int a, int b);
 
   std::size_t memory_bytes() const override {
-    return n_ * (sizeof(Particle<Dim>) + sizeof(Book) + sizeof(std::int32_t)) +
+    return n_ * (sizeof(Particle<Dim>) + sizeof(Book)) + slot_.capacity() * sizeof(std::int32_t) +
            nl_.memory_bytes() + queue_.memory_bytes() + log_.bytes() + pre_.bytes() + wlog_.bytes() + trace_.bytes() +
            clcg_.size() * sizeof(rng::CLCG4);
   }
@@ -437,10 +437,10 @@ class EngineImpl final : public Simulation {
       width = 8.0 * 2.0 * *mid / static_cast<double>(ahead.size());
     }
     if (!(width > 0.0) || !std::isfinite(width)) width = 1.0;
-    queue_.reset(n_, clock_, width);
+    queue_.reset(n_, clock_, width, /*ties=*/!slot_.empty());
     for (std::size_t i = 0; i < n_; ++i) update(static_cast<int>(i));
   }
-  void update(int i) { queue_.set(i, bk_[i].ev.t, bk_[i].ev.kind, bk_[i].id); }
+  void update(int i) { queue_.set(i, bk_[i].ev.t, bk_[i].ev.kind, bk_[i].id); }  // the id: slot i's tie
   void rebuild_events() {
     for (std::size_t i = 0; i < n_; ++i) predict(static_cast<int>(i));
     build_queue();
@@ -451,7 +451,7 @@ class EngineImpl final : public Simulation {
   }
 
   // ---- storage order --------------------------------------------------------------------
-  // Particle id is stored in slot slot_[id] (its Particle, Book and list centre); the Book
+  // Particle id is stored in slot slot(id) (its Particle, Book and list centre); the Book
   // names its id back. Every array of the engine's state is per slot, and everything that
   // decides the trajectory reads ids: the queue's key (t, kind, id), a prediction's choice
   // between equal times, the pair's order and its stream, a group's order, the logs' keys,
@@ -460,14 +460,18 @@ class EngineImpl final : public Simulation {
   // of a run, and the storage can follow the particles through space: a gas that diffused
   // from a sorted start scans lists whose entries lie all over memory.
 
-  // Slots in id order (construction, restore).
+  // Slots in id order (construction, restore). slot_ is held only by an engine that
+  // re-sorts (empty otherwise: slot i holds id i, and nothing is held for it).
   void number_slots() {
-    slot_.resize(n_);
+    if (resort_every_ > 0) slot_.resize(n_);
+    else std::vector<std::int32_t>().swap(slot_);
     for (std::size_t i = 0; i < n_; ++i) {
-      slot_[i] = static_cast<std::int32_t>(i);
+      if (resort_every_ > 0) slot_[i] = static_cast<std::int32_t>(i);
       bk_[i].id = static_cast<std::int32_t>(i);
     }
   }
+  // The slot of particle id.
+  std::size_t slot(std::size_t id) const { return slot_.empty() ? id : static_cast<std::size_t>(slot_[id]); }
 
   // Stores the particles in the order of their list centres' cells (the grid's row-major
   // order; ids within a cell): a list scan then reads a few runs of nearby slots. Moves
@@ -576,10 +580,10 @@ class EngineImpl final : public Simulation {
 
   // Draws taken from stream k (its particle's Book, or the single stream's count).
   std::uint64_t& drawn(int stream) {
-    return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[slot_[stream]].drawn;
+    return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[slot(static_cast<std::size_t>(stream))].drawn;
   }
   std::uint64_t drawn(int stream) const {
-    return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[slot_[stream]].drawn;
+    return cfg_.streams == rng::StreamPolicy::single ? drawn1_ : bk_[slot(static_cast<std::size_t>(stream))].drawn;
   }
   // CLCG4 only: each stream's state, from the family and the draws taken (drawn).
   void make_generators();
@@ -699,7 +703,7 @@ class EngineImpl final : public Simulation {
                 "the engine's limit on N must fit the lists' packed ids");
   EventQueue<double> queue_;               // one event per slot, key (t, kind, the slot's particle id)
   std::vector<Book> bk_;                   // per slot: its event, group gate, counts, draws and id
-  std::vector<std::int32_t> slot_;         // per id: the slot its Particle and Book are stored in
+  std::vector<std::int32_t> slot_;         // per id: its slot (held when re-sorting: slot())
   int resort_every_ = 0;                   // list renewals per particle between re-sorts (0: never)
   std::uint64_t resort_at_ = 0;            // the renewal count of the next re-sort
   std::uint64_t resorts_ = 0;              // re-sorts done by run / run_back

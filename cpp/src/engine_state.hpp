@@ -15,7 +15,7 @@ Diagnostics EngineImpl<Dim, Op>::diagnostics() const {
   double e = 0.0;
   for (std::size_t i = 0; i < n_; ++i)  // in id order: the sums' bits do not depend on storage
     for (int k = 0; k < Dim; ++k) {
-      const double vk = p_[slot_[i]].v[k];
+      const double vk = p_[slot(i)].v[k];
       e += 0.5 * vk * vk;
       d.momentum[k] += vk;
     }
@@ -68,7 +68,7 @@ Snapshot EngineImpl<Dim, Op>::snapshot() const {
   s.touching.resize(n_);
   s.cell.resize(nl_.cells().size());
   for (std::size_t i = 0; i < n_; ++i) {  // per id: particle i is in slot j
-    const auto j = static_cast<std::size_t>(slot_[i]);
+    const std::size_t j = slot(i);
     for (int k = 0; k < Dim; ++k) {
       s.x[i * Dim + k] = p_[j].x[k];
       s.v[i * Dim + k] = p_[j].v[k];

@@ -51,7 +51,7 @@ int run_pattern(std::size_t n, Time now, Time width, int steps, std::uint32_t se
   EventQueue<Time> q;
   Brute<Time> b(n);
   if (permuted_ties) std::shuffle(b.tie.begin(), b.tie.end(), rng);
-  q.reset(n, now, width);
+  q.reset(n, now, width, permuted_ties);
   int bad = 0;
   auto set = [&](int id, Time t, std::int32_t kind) {
     if (permuted_ties) q.set(id, t, kind, b.tie[static_cast<std::size_t>(id)]);

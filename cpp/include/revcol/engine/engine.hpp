@@ -357,7 +357,7 @@ struct Diagnostics {
   std::uint64_t trace_stride = 0;         ///< the trace's grid stride now (collisions)
   std::size_t trace_points = 0;           ///< grid points kept
   double clock_deviation = 0.0;           ///< largest |t - t_forward| at the trace's points in the last reversed pass
-  std::uint64_t storage_resorts = 0;      ///< spatial re-sorts of the particles' storage since construction or restore (Config::resort)
+  std::uint64_t storage_resorts = 0;      ///< periodic re-sorts of the particles' storage by run / run_back since construction or restore (Config::resort)
   Counters counters;
 };
 

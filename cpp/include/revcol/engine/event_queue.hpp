@@ -43,10 +43,14 @@ class EventQueue {
   }
 
   /// Ids [0, n), all unscheduled; the first window starts at `now` with buckets of
-  /// `bucket_width` (> 0; anything else, or a non-finite width, is taken as 1).
-  void reset(std::size_t n, Time now, Time bucket_width) {
+  /// `bucket_width` (> 0; anything else, or a non-finite width, is taken as 1). `ties`: set()
+  /// will be given tie breakers other than the ids (an array of n more; without it the id
+  /// breaks ties and a given tie must equal it).
+  void reset(std::size_t n, Time now, Time bucket_width, bool ties = false) {
     time_.assign(n, never());
-    key_.assign(n, 0);
+    kind_.assign(n, 0);
+    if (ties) tie_.assign(n, 0);
+    else std::vector<std::int32_t>().swap(tie_);
     hpos_.assign(n, 0);
     next_.assign(n, -1);
     prev_.assign(n, -1);
@@ -73,16 +77,16 @@ class EventQueue {
   /// (Re)schedules id's one event at time t with a kind (smaller kinds first at equal t), the
   /// id breaking ties.
   void set(int id, Time t, std::int32_t kind) { set(id, t, kind, id); }
-  /// The same with another tie breaker (>= 0 and distinct over the ids; the smaller first
-  /// at equal t and kind).
+  /// The same with another tie breaker (distinct over the ids; the smaller first at equal t
+  /// and kind), for a queue reset with `ties`.
   void set(int id, Time t, std::int32_t kind, std::int32_t tie) {
-    const std::int64_t key = pack(kind, tie);
     if (loc_[id] == kInHeap) {
       const int p = hpos_[id];
       const Node old = heap_[p];
-      const Node e{t, key, id};
+      const Node e{t, kind, tie, id};
       time_[id] = t;
-      key_[id] = key;
+      kind_[id] = kind;
+      if (!tie_.empty()) tie_[id] = tie;
       const int b = bucket_of(t);
       if (!only_never_ && b != kOverflow && b <= cur_) {  // stays in the current bucket
         heap_[p] = e;
@@ -95,7 +99,8 @@ class EventQueue {
       list_pop(loc_[id] == kOverflow ? ohead_ : bhead_[loc_[id]], id);
     }
     time_[id] = t;
-    key_[id] = key;
+    kind_[id] = kind;
+    if (!tie_.empty()) tie_[id] = tie;
     insert(id);
   }
 
@@ -107,7 +112,7 @@ class EventQueue {
     } else if (loc_[id] != kUnscheduled) list_pop(loc_[id] == kOverflow ? ohead_ : bhead_[loc_[id]], id);
     loc_[id] = kUnscheduled;
     time_[id] = never();
-    key_[id] = 0;
+    kind_[id] = 0;
   }
 
   /// The id with the smallest (time, kind, tie), or -1 when nothing is scheduled; not removed.
@@ -131,7 +136,7 @@ class EventQueue {
   /// id's scheduled time (never() when unscheduled).
   Time time(int id) const { return time_[id]; }
   /// id's scheduled kind (0 when unscheduled).
-  std::int32_t kind(int id) const { return static_cast<std::int32_t>(key_[id] >> 32); }
+  std::int32_t kind(int id) const { return kind_[id]; }
   /// Whether id has an event in the queue.
   bool scheduled(int id) const { return loc_[id] != kUnscheduled; }
   /// Number of ids.
@@ -144,7 +149,7 @@ class EventQueue {
       if (++cur_ < nbuckets_) {
         for (int i = bhead_[cur_]; i >= 0;) {
           const int nx = next_[i];
-          heap_.push_back(Node{time_[i], key_[i], i});
+          heap_.push_back(node(i));
           hpos_[i] = static_cast<int>(heap_.size()) - 1;
           loc_[i] = kInHeap;
           i = nx;
@@ -161,7 +166,7 @@ class EventQueue {
  public:
   /// Bytes held by the queue's arrays.
   std::size_t memory_bytes() const {
-    return time_.capacity() * sizeof(Time) + key_.capacity() * sizeof(std::int64_t) +
+    return time_.capacity() * sizeof(Time) + (kind_.capacity() + tie_.capacity()) * sizeof(std::int32_t) +
            (hpos_.capacity() + next_.capacity() + prev_.capacity() + loc_.capacity() + bhead_.capacity()) *
                sizeof(int) +
            heap_.capacity() * sizeof(Node);
@@ -176,7 +181,7 @@ class EventQueue {
     for (int p = 0; p < static_cast<int>(heap_.size()); ++p) {
       const Node& e = heap_[p];
       if (e.id < 0 || e.id >= n || loc_[e.id] != kInHeap || hpos_[e.id] != p) return false;
-      if (e.t != time_[e.id] || e.key != key_[e.id]) return false;
+      if (e.t != time_[e.id] || e.kind != kind_[e.id] || e.tie != tie_of(e.id)) return false;
       if (p > 0 && less(e, heap_[(p - 1) / 2])) return false;
       ++seen[e.id];
     }
@@ -200,19 +205,19 @@ class EventQueue {
   }
 
  private:
-  // (kind, tie) in one word that orders as the pair does (tie >= 0): kind in the high half
-  static std::int64_t pack(std::int32_t kind, std::int32_t tie) {
-    return static_cast<std::int64_t>(kind) * (std::int64_t{1} << 32) + static_cast<std::uint32_t>(tie);
-  }
   struct Node {
     Time t;
-    std::int64_t key;  // pack(kind, tie)
+    std::int32_t kind;
+    std::int32_t tie;
     std::int32_t id;
   };
   static bool less(const Node& a, const Node& b) {
     if (a.t != b.t) return a.t < b.t;
-    return a.key < b.key;
+    if (a.kind != b.kind) return a.kind < b.kind;
+    return a.tie < b.tie;
   }
+  std::int32_t tie_of(int i) const { return tie_.empty() ? i : tie_[i]; }
+  Node node(int i) const { return Node{time_[i], kind_[i], tie_of(i), i}; }
   static constexpr int kInHeap = -1, kOverflow = -2, kUnscheduled = -3;
   static constexpr double kPerBucket = 8.0;  // measured: 2 to 16 within the noise
 
@@ -281,7 +286,7 @@ class EventQueue {
     if (next_[i] >= 0) prev_[next_[i]] = prev_[i];
   }
   void heap_push(int i) {
-    heap_.push_back(Node{time_[i], key_[i], i});
+    heap_.push_back(node(i));
     loc_[i] = kInHeap;
     sift_up(static_cast<int>(heap_.size()) - 1);
   }
@@ -382,8 +387,9 @@ class EventQueue {
     else return a > (std::numeric_limits<Time>::max() - 1) / b ? std::numeric_limits<Time>::max() - 1 : a * b;
   }
 
-  std::vector<Time> time_;             // each id's key: time, and (kind, tie) in key_
-  std::vector<std::int64_t> key_;       // pack(kind, tie)
+  std::vector<Time> time_;             // each id's key: time, kind and tie
+  std::vector<std::int32_t> kind_;
+  std::vector<std::int32_t> tie_;      // empty unless reset with `ties` (then the id breaks ties)
   std::vector<int> hpos_, next_, prev_, loc_, bhead_;  // heap positions; bucket and overflow lists; where
   std::vector<Node> heap_;             // the current bucket's heap
   int ohead_ = -1, nbuckets_ = 64, cur_ = 0;  // overflow list, buckets in the window, current bucket
