@@ -389,7 +389,7 @@ class EventQueue {
 
   std::vector<Time> time_;             // each id's key: time, kind and tie
   std::vector<std::int32_t> kind_;
-  std::vector<std::int32_t> tie_;      // empty unless reset with `ties` (then the id breaks ties)
+  std::vector<std::int32_t> tie_;      // each id's tie when reset with `ties`; empty otherwise (the id is the tie)
   std::vector<int> hpos_, next_, prev_, loc_, bhead_;  // heap positions; bucket and overflow lists; where
   std::vector<Node> heap_;             // the current bucket's heap
   int ohead_ = -1, nbuckets_ = 64, cur_ = 0;  // overflow list, buckets in the window, current bucket
