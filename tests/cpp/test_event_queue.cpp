@@ -224,6 +224,44 @@ TEST_CASE("for_next names at most k scheduled events other than the top, and the
   CHECK(next_named > steps / 4);  // a heap of the bucket's events holds the next top often
 }
 
+TEST_CASE("second is the second event in key order, the next top when the top moves past it") {
+  // coarse times and permuted ties: the order among equal (time, kind) is the ties'
+  for (std::uint32_t seed = 1; seed <= 3; ++seed) {
+    std::mt19937_64 rng(seed);
+    const int n = 300;
+    EventQueue<double> q;
+    Brute<double> b(n);
+    std::shuffle(b.tie.begin(), b.tie.end(), rng);
+    q.reset(n, 0.0, 0.25, /*ties=*/true);
+    const auto set = [&](int id, double t, std::int32_t kind) {
+      q.set(id, t, kind, b.tie[static_cast<std::size_t>(id)]);
+      b.t[id] = t;
+      b.k[id] = kind;
+      b.on[id] = true;
+    };
+    for (int i = 0; i < n; ++i) set(i, static_cast<double>(rng() % 40) * 0.25, static_cast<std::int32_t>(rng() % 3));
+    int named = 0, next_named = 0;
+    for (int s = 0; s < 20000; ++s) {
+      const int top = q.top();
+      CHECK(top == b.top());
+      const int g = q.second();
+      if (g >= 0) {
+        ++named;
+        b.on[top] = false;  // the reference's second: its top with the top left out
+        CHECK(g == b.top());
+        b.on[top] = true;
+      }
+      const double now = b.t[top];
+      set(top, now + static_cast<double>(1 + rng() % 40) * 0.25, static_cast<std::int32_t>(rng() % 3));
+      if (g >= 0 && rng() % 2 == 0) set(static_cast<int>(rng() % n), now + static_cast<double>(rng() % 8) * 0.25, 0);
+      if (g >= 0) next_named += q.top() == g ? 1 : 0;
+    }
+    std::printf("  second: named %d of 20000 tops, the next top %d times\n", named, next_named);
+    CHECK(named > 10000);
+    CHECK(next_named > named / 2);
+  }
+}
+
 CHECK_MAIN()
 
 TEST_CASE("a tie breaker other than the id: equal (time, kind) leave in the order of the ties") {

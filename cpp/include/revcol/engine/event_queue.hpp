@@ -133,6 +133,16 @@ class EventQueue {
     for (int p = 1; p < m; ++p) f(heap_[p].id);
   }
 
+  /// The id of the current bucket's second event in key order (the smaller of the top's two
+  /// children in the heap), or -1: the next top once the top is rescheduled, unless an event
+  /// set meanwhile comes before it or the bucket runs out.
+  int second() const {
+    const int m = static_cast<int>(heap_.size());
+    if (m < 2) return -1;
+    if (m == 2 || less(heap_[1], heap_[2])) return heap_[1].id;
+    return heap_[2].id;
+  }
+
   /// id's scheduled time (never() when unscheduled).
   Time time(int id) const { return time_[id]; }
   /// id's scheduled kind (0 when unscheduled).
