@@ -110,8 +110,9 @@ def patch_source(text: str, warmup: int, collisions: int) -> str:
                 .replace("TIMED_COLLISIONS", str(int(collisions))))
 
 
-def build_peer(src: str, build: str, warmup: int, collisions: int) -> str:
-    """Copies Single/ to ``build``, patches it, compiles it with the peer's flags; the binary."""
+def build_peer(src: str, build: str, warmup: int, collisions: int, extra_flags: Optional[list] = None) -> str:
+    """Copies Single/ to ``build``, patches it, compiles it with the peer's flags (and
+    ``extra_flags``, e.g. ``-g`` for a profile); the binary."""
     single = os.path.join(src, "Single")
     if not os.path.isfile(os.path.join(single, "mdSingle.c")):
         raise PeerMissing(where_to_put(src))
@@ -124,8 +125,8 @@ def build_peer(src: str, build: str, warmup: int, collisions: int) -> str:
     with open(path, "w") as fh:
         fh.write(patch_source(text, warmup, collisions))
     exe = os.path.join(build, f"md_{warmup}_{collisions}")
-    subprocess.run(["gcc", "-Wall", "-Ofast", "-funroll-loops", "-march=native", "mdSingle.c", "-o",
-                    os.path.basename(exe), "-lm"], cwd=build, check=True, capture_output=True)
+    subprocess.run(["gcc", "-Wall", "-Ofast", "-funroll-loops", "-march=native"] + list(extra_flags or []) +
+                   ["mdSingle.c", "-o", os.path.basename(exe), "-lm"], cwd=build, check=True, capture_output=True)
     return exe
 
 

@@ -158,3 +158,73 @@ def test_lattice_child_reports_a_bad_state_by_name(tmp_path):
     np.savez(npz, x=x, v=v, box=np.full(3, 10.0))
     with pytest.raises(RuntimeError, match=r"lattice child failed[\s\S]*particles 0 and 1 overlap"):
         fs.run_lattice(str(npz), 10, 10, -1)
+
+
+PSPEC = importlib.util.spec_from_file_location("peer_profile", os.path.join(HERE, "..", "..", "bench", "peers", "profile.py"))
+prof = importlib.util.module_from_spec(PSPEC)
+PSPEC.loader.exec_module(prof)
+
+ENGINE = "revcol::engine::detail::EngineImpl<3, revcol::ops::Exact3D>::"
+
+
+@pytest.mark.parametrize("chain, part", [
+    # an inlined pair test, then the prediction it sits in
+    (["revcol::engine::FloatKinematics<3>::pair_test2(int)", ENGINE + "predict(int)"], "prediction"),
+    ([ENGINE + "predict(int)"], "prediction"),
+    (["revcol::engine::EventQueue<double>::sift_down(int)"], "queue"),
+    (["revcol::Pair3DExact::forward(...) const"], "operator + RNG"),
+    (["revcol::rng::philox4x32_10(...)", ENGINE + "draw(int, unsigned long&, bool)"], "operator + RNG"),
+    # a helper no part claims goes by its caller: near() in a renewal, and in collide's pair image
+    (["revcol::engine::NeighbourLists<3>::near(int, int, unsigned int&) const",
+      "revcol::engine::NeighbourLists<3>::rebuild_list(int)"], "renewal"),
+    (["revcol::engine::NeighbourLists<3>::near(int, int, unsigned int&) const",
+      "revcol::engine::NeighbourLists<3>::pair_shift(int, int) const", ENGINE + "collide(int, int, double, bool)"],
+     "bookkeeping"),
+    (["revcol::engine::NeighbourLists<3>::renew(int)"], "renewal"),
+    (["std::vector<int>::operator[](unsigned long)", ENGINE + "loop(...)"], "bookkeeping"),
+    (["memcpy"], "other"),
+    ([], "other"),
+])
+def test_profile_puts_a_revcol_sample_in_the_part_of_its_innermost_claimed_function(chain, part):
+    assert prof.part_of(chain, "revcol") == part
+
+
+@pytest.mark.parametrize("chain, part", [
+    (["findcollision", "findcollisions", "collision"], "prediction"),  # inlined into the collision
+    (["update", "collision"], "bookkeeping"),
+    (["collision"], "operator + RNG"),
+    (["removeevent", "step"], "queue"),
+    (["makeneighborlist"], "renewal"),
+    (["collisions_of_something_else"], "other"),  # exact names only
+])
+def test_profile_puts_a_peer_sample_in_the_part_of_its_innermost_claimed_function(chain, part):
+    assert prof.part_of(chain, "fs") == part
+
+
+def test_profile_reads_the_samples_of_one_binary_from_perf_script(tmp_path):
+    core = tmp_path / "_core.so"
+    core.write_text("")
+    out = "\n".join([
+        f"    7f00aa001234 _ZN6revcol7predictEi+0x1b3 ({core})",
+        f"    7f00aa001235 _ZN6revcol7predictEi+0x1b3 ({core})",
+        f"    7f00aa001300 _ZN6revcol4loopEv+0x10 ({core})",
+        "    55550000abcd _PyEval_EvalFrameDefault+0x99 (/usr/bin/python3.11)",
+        f"    7f00aa009999 [unknown] ({core})",
+        "garbage line",
+    ])
+    hits, total = prof.parse_samples(out, str(core))
+    assert total == 5
+    assert hits == {("_ZN6revcol7predictEi", 0x1b3): 2, ("_ZN6revcol4loopEv", 0x10): 1, ("[unknown]", -1): 1}
+
+
+def test_profile_turns_shares_into_ns_per_collision():
+    ns = prof.ns_per_part({"prediction": 30, "queue": 10, "other": 0}, 800.0)
+    assert ns == {"prediction": 600.0, "queue": 200.0, "other": 0.0}
+    assert prof.ns_per_part({"prediction": 0}, 800.0) == {"prediction": 0.0}
+
+
+def test_profile_without_the_peer_says_where_it_goes_and_measures_nothing(tmp_path, capsys):
+    out = tmp_path / "profile.json"
+    assert prof.main(["--src", str(tmp_path / "nowhere"), "--json", str(out)]) == 0
+    assert "git clone https://github.com/FSmallenburg/EDMD" in capsys.readouterr().out
+    assert not out.exists()

@@ -1,0 +1,311 @@
+"""Where a collision's time goes: revcol's float engine beside FSmallenburg/EDMD, part by part
+(issue 21's profile table). Writes bench/results/peer_profile.json.
+
+    python bench/peers/profile.py [--n 10976] [--phi 0.30 0.45] [--collisions 1e6] [--cpu 1]
+        [--src bench/peers/src/EDMD] [--json bench/results/peer_profile.json]
+
+Both codes run on the same equilibrated fluid as in ``fs_edmd.py`` (its state, its patched peer,
+its revcol child: 2e5 untimed collisions, then 1e6 timed; revcol also runs them back), each a
+fresh process pinned to ``--cpu`` under ``perf record -e cpu-clock``, ``--runs`` times each,
+interleaved; the samples are summed over the runs and the time per collision is the runs'
+median. Every sample in the
+code's own binary (the peer's executable; revcol's ``_core`` module, not the Python around it)
+is put in a part by the function it lies in, inlined functions included: addr2line names the
+chain of inlined calls at the sample's address, and the innermost function that a part claims
+decides (``part_of``). A part's time per collision is its share of those samples times the
+time per collision the run measured itself (forward and reverse weighed by their run times;
+the untimed warm-up runs the same code, so its samples only add to the count).
+
+The parts (the issue's table):
+
+- **prediction**: a particle's next event over its list (revcol ``predict`` and the pair tests
+  inlined into it; FS ``findcollisions``, ``findcollision``, ``findneighborlistupdate``);
+- **renewal**: the list renewal (revcol ``renew``, ``rebuild_list``, ``scan_cells``; FS
+  ``makeneighborlist`` and its cell lists);
+- **queue**: the event queue (revcol ``EventQueue``; FS ``addevent``, ``removeevent``,
+  ``addnexteventlist``, ``step``);
+- **operator + RNG**: the collision's new velocities (revcol's exact operator, its draws and
+  ``apply_pair``; FS's specular ``collision`` body, which draws nothing);
+- **bookkeeping**: the rest of the event loop and the collision's frame (revcol ``loop``,
+  ``collide``; FS ``update``);
+- **other**: any sample no part claims.
+
+Needs ``perf`` (Debian: linux-perf) and binutils. Line-level attribution needs debug
+information, which changes no machine code: the peer is compiled here with its own flags plus
+``-g``; for revcol pass ``--revcol-pkg`` a package staged from a build configured with
+``-DCMAKE_CXX_FLAGS=-g`` (``scripts/dev_build.sh build-prof -DCMAKE_CXX_FLAGS=-g``). Without
+it, a sample goes by its outermost function alone (the symbol perf names), and inlined
+helpers count with their caller. Without the peer's source the script says where it goes and
+measures nothing, as ``fs_edmd.py`` does.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+from typing import Optional
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import fs_edmd  # noqa: E402
+
+PARTS = ("prediction", "renewal", "queue", "operator + RNG", "bookkeeping", "other")
+
+#: revcol: (part, regular expression on a demangled function name), tried in this order
+REVCOL_RULES = [
+    ("queue", r"EventQueue<"),
+    ("operator + RNG", r"Pair[23]DExact|ExactCollision|Philox|philox|::draw\b|apply_pair|FixedPoint|revcol::trig::"),
+    ("renewal", r"rebuild_list|scan_cells|near_coded|list_insert|list_erase|list_recode|grow_lists|"
+                r"NeighbourLists<\d>::renew\b|renew_event|move_centre|::unlink\b|::link\b|::place\b"),
+    ("prediction", r"::predict\b|pair_time|pair_test2|renewal_time|plane_time|for_neighbour_pairs|prune_limit|"
+                   r"Pair2::"),
+    ("bookkeeping", r"::collide\b|::loop\b|finish_collision|trace_collision|trace_point|prefetch_collision|"
+                    r"validate_collision|pair_shift|wall_event|touch_walls|EngineImpl<.*>::advance\b|repredict"),
+]
+#: FS (C functions): (part, exact names)
+FS_RULES = [
+    ("queue", {"addevent", "addeventtotree", "removeevent", "addnexteventlist", "createevent", "step"}),
+    ("renewal", {"makeneighborlist", "removefromcelllist", "addtocelllist", "celloffset"}),
+    ("prediction", {"findcollisions", "findcollision", "findneighborlistupdate", "findallcollisions"}),
+    ("operator + RNG", {"collision"}),
+    ("bookkeeping", {"update", "backinbox", "main"}),
+]
+
+
+def part_of(chain: list, code: str) -> str:
+    """The part a sample goes to: ``chain`` the functions at its address, innermost first (an
+    inlined call, then its caller ...); the first one a rule of ``code`` ('revcol' or 'fs')
+    claims decides, and 'other' when none does."""
+    for name in chain:
+        if code == "fs":
+            base = name.split("(")[0].strip()
+            for part, names in FS_RULES:
+                if base in names:
+                    return part
+        else:
+            for part, rx in REVCOL_RULES:
+                if re.search(rx, name):
+                    return part
+    return "other"
+
+
+_SAMPLE = re.compile(r"^\s*[0-9a-f]+\s+(\S+)\s+\((.*)\)\s*$")
+
+
+def samples(data: str, binary: str) -> tuple[dict, int]:
+    """The samples of perf.data that lie in ``binary``: {(symbol, offset): count}, and the
+    count of all samples."""
+    out = subprocess.run(["perf", "script", "-i", data, "-F", "ip,sym,symoff,dso", "--no-demangle"],
+                         capture_output=True, text=True, check=True).stdout
+    return parse_samples(out, binary)
+
+
+def parse_samples(out: str, binary: str) -> tuple[dict, int]:
+    """``perf script -F ip,sym,symoff,dso --no-demangle`` output (one sample a line: address,
+    symbol+0xoffset, (dso)) -> ({(symbol, offset): count} of the samples in ``binary``, the
+    count of all samples). A sample without a symbol keeps perf's name for it, offset -1."""
+    real = os.path.realpath(binary)
+    hits: dict = {}
+    total = 0
+    for line in out.splitlines():
+        m = _SAMPLE.match(line)
+        if not m:
+            continue
+        total += 1
+        if os.path.realpath(m.group(2)) != real:
+            continue
+        sym, _, off = m.group(1).rpartition("+0x")
+        key = (sym, int(off, 16)) if sym else (m.group(1), -1)
+        hits[key] = hits.get(key, 0) + 1
+    return hits, total
+
+
+def symbol_addresses(binary: str) -> dict:
+    """{mangled symbol: address} of the binary's defined functions (nm)."""
+    out = subprocess.run(["nm", "--defined-only", binary], capture_output=True, text=True, check=True).stdout
+    addr = {}
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[1] in "tTwW":
+            addr.setdefault(parts[2], int(parts[0], 16))
+    return addr
+
+
+def demangle(names: list) -> list:
+    if not names:
+        return []
+    out = subprocess.run(["c++filt"], input="\n".join(names), capture_output=True, text=True, check=True).stdout
+    return out.splitlines()
+
+
+def inline_chains(binary: str, addresses: list) -> dict:
+    """{address: [function, its caller, ...]} by addr2line (innermost first; empty when the
+    binary has no debug information there)."""
+    chains: dict = {}
+    for k in range(0, len(addresses), 2000):
+        batch = addresses[k:k + 2000]
+        out = subprocess.run(["addr2line", "-e", binary, "-f", "-i", "-C", "-a"] + [hex(a) for a in batch],
+                             capture_output=True, text=True, check=True).stdout.splitlines()
+        cur = None
+        u = 0
+        while u < len(out):
+            line = out[u]
+            if line.startswith("0x"):
+                cur = int(line, 16)
+                chains[cur] = []
+                u += 1
+                continue
+            if cur is not None and line != "??":
+                chains[cur].append(line)
+            u += 2  # a function name, then its file:line
+    return chains
+
+
+def attribute(data: str, binary: str, code: str) -> dict:
+    """Samples in ``binary`` per part, and how many samples the run took in all."""
+    hits, total = samples(data, binary)
+    addr = symbol_addresses(binary)
+    syms = sorted({s for s, _ in hits})
+    plain = dict(zip(syms, demangle(syms)))
+    where = {}
+    for (sym, off) in hits:
+        if sym in addr and off >= 0:
+            where[(sym, off)] = addr[sym] + off
+    chains = inline_chains(binary, sorted(set(where.values())))
+    parts = {p: 0 for p in PARTS}
+    for key, c in hits.items():
+        chain = list(chains.get(where.get(key, -1), []))
+        chain.append(plain.get(key[0], key[0]))  # the symbol perf names: the outermost function
+        parts[part_of(chain, code)] += c
+    return {"parts": parts, "in_binary": sum(hits.values()), "all_samples": total}
+
+
+def perf_record(cmd: list, data: str, cpu: int, cwd: Optional[str] = None, env: Optional[dict] = None) -> str:
+    p = subprocess.run(fs_edmd._pin(["perf", "record", "-e", "cpu-clock", "-F", "4000", "-o", data, "--"] + cmd, cpu),
+                       capture_output=True, text=True, cwd=cwd, env=env)
+    if p.returncode != 0:
+        raise RuntimeError(f"perf record failed ({p.returncode}):\n{p.stderr[-2000:]}")
+    return p.stdout
+
+
+def ns_per_part(parts: dict, ns_per_collision: float) -> dict:
+    """Each part's ns per collision: its share of the binary's samples times the measured time."""
+    n = sum(parts.values())
+    return {p: (ns_per_collision * c / n if n else 0.0) for p, c in parts.items()}
+
+
+_REVCOL_PROFILE_CHILD = fs_edmd._REVCOL_CHILD + """
+import revcol._core
+print("REVCOL_CORE " + revcol._core.__file__)
+"""
+
+
+def _merge(acc: Optional[dict], a: dict) -> dict:
+    """Sums the sample counts of two attributions."""
+    if acc is None:
+        return {"parts": dict(a["parts"]), "in_binary": a["in_binary"], "all_samples": a["all_samples"]}
+    for p, c in a["parts"].items():
+        acc["parts"][p] += c
+    acc["in_binary"] += a["in_binary"]
+    acc["all_samples"] += a["all_samples"]
+    return acc
+
+
+def profile_workload(n: int, phi: float, args, src: str, tmp: str) -> dict:
+    """``--runs`` interleaved runs of each code (peer, revcol; then revcol, peer; ...) on one
+    state: samples summed over the runs, the time per collision the median of the runs'."""
+    import numpy as np
+    st = fs_edmd.equilibrated_state(n, phi, args.warmup, max_per_particle=args.max_warmup)
+    npz = os.path.join(tmp, f"state_{n}_{phi}.npz")
+    np.savez(npz, x=st["x"], v=st["v"], box=st["box"])
+    run_dir = os.path.join(tmp, "peer_run")
+    os.makedirs(run_dir, exist_ok=True)
+    fs_edmd.write_sph(os.path.join(run_dir, "init.sph"), st["x"], st["box"])
+    warm, coll = int(float(args.warmup_peer)), int(float(args.collisions))
+    exe = fs_edmd.build_peer(src, os.path.join(tmp, "peer"), warm, coll, extra_flags=["-g"])
+    env = dict(os.environ)
+    if args.revcol_pkg:
+        env["PYTHONPATH"] = os.path.abspath(args.revcol_pkg)
+    peer, mine, core = None, None, ""
+    peer_ns, my_ns, my_fwd, my_rev, loads = [], [], [], [], []
+
+    def run_peer() -> None:
+        nonlocal peer
+        data = os.path.join(tmp, "peer.data")
+        out = perf_record([exe], data, args.cpu, cwd=run_dir)
+        line = next(l for l in out.splitlines() if l.startswith("REVCOL_PEER "))
+        peer_ns.append(1e9 * float(line.split()[2]) / int(line.split()[1]))
+        peer = _merge(peer, attribute(data, exe, "fs"))
+
+    def run_revcol() -> None:
+        nonlocal mine, core
+        data = os.path.join(tmp, "revcol.data")
+        out = perf_record([sys.executable, "-c", _REVCOL_PROFILE_CHILD, npz, str(warm), str(coll)], data, args.cpu,
+                          env=env)
+        me = json.loads(next(l for l in out.splitlines() if l.startswith("REVCOL_SELF "))[len("REVCOL_SELF "):])
+        core = next(l for l in out.splitlines() if l.startswith("REVCOL_CORE "))[len("REVCOL_CORE "):]
+        my_fwd.append(me["forward"])
+        my_rev.append(me["reverse"])
+        # forward and reverse weighed by their run times: the mean time of a collision over both
+        my_ns.append(1e9 * (1.0 / me["forward"] + 1.0 / me["reverse"]) / 2.0)
+        mine = _merge(mine, attribute(data, core, "revcol"))
+
+    for r in range(args.runs):
+        loads.append(os.getloadavg()[0])
+        for f in ((run_peer, run_revcol) if r % 2 == 0 else (run_revcol, run_peer)):
+            f()
+    pn, mn = statistics.median(peer_ns), statistics.median(my_ns)
+    return {"n": n, "phi": phi, "s_bragg_after": st["s_bragg_after"], "fluid": st["fluid"], "load_before_runs": loads,
+            "peer": {"ns_per_collision": pn, "ns_per_collision_runs": peer_ns, **peer, "ns": ns_per_part(peer["parts"], pn)},
+            "revcol": {"ns_per_collision": mn, "ns_per_collision_runs": my_ns, "forward_per_s_runs": my_fwd,
+                       "reverse_per_s_runs": my_rev, "core": core, **mine, "ns": ns_per_part(mine["parts"], mn)}}
+
+
+def main(argv: Optional[list] = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--src", default=fs_edmd.DEFAULT_SRC, help="the peer's checkout (FSmallenburg/EDMD)")
+    ap.add_argument("--n", type=int, nargs="+", default=[10976])
+    ap.add_argument("--phi", type=float, nargs="+", default=[0.30, 0.45])
+    ap.add_argument("--collisions", default="1e6", help="timed collisions per run")
+    ap.add_argument("--warmup-peer", default="2e5", help="untimed collisions before the timing, in each run")
+    ap.add_argument("--warmup", type=float, default=50.0, help="collisions per particle that equilibrate the state")
+    ap.add_argument("--max-warmup", type=float, default=2000.0)
+    ap.add_argument("--cpu", type=int, default=1, help="core each run is pinned to (-1: none)")
+    ap.add_argument("--runs", type=int, default=3, help="interleaved runs of each code per workload")
+    ap.add_argument("--revcol-pkg", default="", help="a staged revcol package built with -g (default: the one imported)")
+    ap.add_argument("--json", default=os.path.join(fs_edmd.RESULTS, "peer_profile.json"))
+    args = ap.parse_args(argv)
+    src = os.path.abspath(args.src)
+    if not os.path.isfile(os.path.join(src, "Single", "mdSingle.c")):
+        print(fs_edmd.where_to_put(src))
+        return 0
+    for tool in ("perf", "addr2line", "nm", "c++filt"):
+        if shutil.which(tool) is None:
+            print(f"profile.py needs `{tool}` (Debian: linux-perf for perf, binutils for the rest); measured nothing")
+            return 0
+    res = {"command": " ".join(sys.argv), "peer_commit": fs_edmd.peer_commit(src), "load_before": os.getloadavg()[0],
+           "workloads": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in args.n:
+            for phi in args.phi:
+                w = profile_workload(n, phi, args, src, tmp)
+                res["workloads"].append(w)
+                pr, rv = w["peer"]["ns"], w["revcol"]["ns"]
+                print(f"N = {n}, phi = {phi}: ns per collision, revcol / peer "
+                      f"(total {w['revcol']['ns_per_collision']:.0f} / {w['peer']['ns_per_collision']:.0f})")
+                for p in PARTS:
+                    print(f"  {p:16s} {rv[p]:7.0f} {pr[p]:7.0f}")
+    res["load_after"] = os.getloadavg()[0]
+    fs_edmd._write_json(args.json, res)
+    print(f"wrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
