@@ -9,7 +9,8 @@
 //
 //   revcol-bench --bench lattice/ --collisions 200000
 //
-// REVCOL_LATTICE=tick_bits=T,cell_bits=B overrides the units' defaults (automatic T, 2^16 cells).
+// REVCOL_LATTICE=tick_bits=T,cell_bits=B overrides the units' defaults (automatic T, 2^16 cells);
+// observe=1 (scalars) or 2 (+ speed histogram and slabs) observes the timed forward run.
 //
 // Metrics: forward_per_s, reverse_per_s, forward_cpu_per_s, reverse_cpu_per_s, bit_exact (1 when positions, velocities, streams, X and
 // clock are restored bit for bit), events_per_collision, log_entries, redraws_per_collision,
@@ -71,11 +72,15 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
   la::LatticeConfigN<D> cfg = config_of<D>(c);
   // REVCOL_LATTICE=tick_bits=20,cell_bits=20 runs the engine as before the automatic tick;
   // shell=S sets the neighbour search (set_list_shell: 0 the cell grid, S > 0 lists, < 0 automatic)
+  // observe=1 observes the timed forward run's scalars, 2 also a 50-bin speed histogram and 10
+  // slabs (revcol/engine/observe.hpp; run_back ends it: the reverse is unobserved)
   double shell = -1.0;
-  apply_settings("REVCOL_LATTICE", "tick_bits, cell_bits, shell", [&](const std::string& k, const std::string& v) {
+  int observe = 0;
+  apply_settings("REVCOL_LATTICE", "tick_bits, cell_bits, shell, observe", [&](const std::string& k, const std::string& v) {
     if (k == "tick_bits") cfg.tick_bits = std::stoi(v);
     else if (k == "cell_bits") cfg.cell_bits = std::stoi(v);
     else if (k == "shell") shell = std::stod(v);
+    else if (k == "observe") observe = std::stoi(v);
     else return false;
     return true;
   });
@@ -86,6 +91,14 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
   e.run(c.n, la::tick_limit - 1);
   const la::SnapshotN<D> s0 = e.snapshot();
   const la::Counters k0 = e.counters();
+  if (observe > 0) {
+    en::ObserveConfig oc;
+    if (observe > 1) {
+      oc.speed_bins = 50;
+      oc.slabs = 10;
+    }
+    e.observe(oc);
+  }
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const double c0 = cpu_seconds();

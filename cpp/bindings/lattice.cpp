@@ -20,6 +20,7 @@
 
 #include "args.hpp"
 #include "bindings.hpp"
+#include "observe.hpp"
 #include "revcol/error.hpp"
 #include "revcol/lattice/engine.hpp"
 
@@ -380,6 +381,24 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
       .def_property_readonly("units", [](const P& p) { return units_dict(p.engine().units()); })
       .def_property_readonly("n", [](const P& p) { return p.engine().size(); })
       .def_property_readonly("law", [](const P& p) { return std::string(to_string(p.law)); })
+      // ---- observation (the float engine's observer, revcol/engine/observe.hpp) ----
+      .def(
+          "observe",
+          [](P& p, PyReal block_time, PyInt min_blocks, PyInt slab_axis, PyInt slabs, PyInt speed_bins,
+             PyReal speed_max, PyInt pair_bins, PyReal pair_rmax) {
+            p.engine().observe(
+                observe_config(block_time, min_blocks, slab_axis, slabs, speed_bins, speed_max, pair_bins, pair_rmax));
+          },
+          py::arg("block_time") = 0.0, py::arg("min_blocks") = 16, py::arg("slab_axis") = 0, py::arg("slabs") = 0,
+          py::arg("speed_bins") = 0, py::arg("speed_max") = 0.0, py::arg("pair_bins") = 0, py::arg("pair_rmax") = 0.0)
+      .def("observation",
+           [](const P& p) -> py::object {
+             const engine::Observer* o = p.engine().observer();
+             if (o == nullptr) return py::none();
+             return observation_dict(o->results());
+           })
+      .def("stop_observing", [](P& p) { p.engine().stop_observing(); })
+      .def_property_readonly("observing", [](const P& p) { return p.engine().observing(); })
       .def("diagnostics", [](const P& p) {
         const la::DiagnosticsN<D> g = la::diagnostics(p.engine());
         py::dict d = counters_dict(p.engine().counters());

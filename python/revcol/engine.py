@@ -45,6 +45,7 @@ from ._args import integer, names
 from ._args import packing_fraction as _packing_fraction
 from ._attach import Attachable
 from ._io import read_checkpoint, stamped, write_npz_atomic
+from .observe import Observing
 from .roundtrip import divergence_text
 
 __all__ = ["Simulation"]
@@ -64,7 +65,7 @@ def _real_array(a, name: str) -> np.ndarray:
         raise TypeError(f"{name} must be an array of real numbers ({e})") from None
 
 
-class Simulation(Attachable):
+class Simulation(Observing, Attachable):
     """N hard spheres in d = 1, 2, 3, run forward and backwards (revcol/engine/engine.hpp).
 
     Build from arrays (``Simulation(positions, velocities, box=...)``) or at random
@@ -202,39 +203,6 @@ class Simulation(Attachable):
             warnings.warn("run_back diverged " + divergence_text(d) + " (beyond the round-off horizon, "
                           "docs/engine.md)", RuntimeWarning, stacklevel=2)
         return r
-
-    # --- observation (revcol.observe, revcol/engine/observe.hpp) -------------------------
-
-    def observe(self, *, block_time: float = 0.0, min_blocks: int = 16, slabs: int = 0, slab_axis: int = 0,
-                speed_bins: int = 0, speed_max: float = 0.0, pair_bins: int = 0, pair_rmax: float = 0.0) -> None:
-        """Starts observing the forward run from now (replacing any earlier observation):
-        pressure (collision virial and walls), temperature, collision rate, mean free time and
-        path, mean squared displacement, all time-averaged with block errors; optionally
-        ``slabs`` along ``slab_axis`` (density and temperature), a time-weighted speed histogram
-        (``speed_bins`` over [0, ``speed_max``], default 5 v_rms) and, for 2-64 particles in a
-        closed box, pair distances (``pair_bins`` over [0, ``pair_rmax``]). ``block_time``: the
-        first blocks' length (0: D / v_rms; blocks merge as the run grows); errors use blocks
-        merged down to [``min_blocks``, 2 ``min_blocks``). Observation is forward only:
-        ``run_back`` ends it. A bad argument raises TypeError / ValueError naming it and
-        changes nothing. Off (the default) it costs nothing."""
-        self._e.observe(block_time, min_blocks, slab_axis, slabs, speed_bins, speed_max, pair_bins, pair_rmax)
-
-    def observation(self):
-        """The running or last observation's results (:class:`revcol.observe.Observation`), or
-        None if ``observe`` was never called. Up to the end of the last run call."""
-        from .observe import Observation
-
-        raw = self._e.observation()
-        return None if raw is None else Observation(raw)
-
-    @property
-    def observing(self) -> bool:
-        """Whether an observation is running (``run_back`` and ``stop_observing`` end it)."""
-        return bool(self._e.observing)
-
-    def stop_observing(self) -> None:
-        """Ends the observation at the clock; ``observation()`` still reads it."""
-        self._e.stop_observing()
 
     # --- state ---------------------------------------------------------------------------
 

@@ -35,6 +35,7 @@ from ._args import integer, name, names, real
 from ._args import packing_fraction as _packing_fraction
 from ._attach import Attachable
 from ._io import read_checkpoint, stamped, write_npz_atomic
+from .observe import Observing
 from .engine import _real_array
 
 __all__ = ["LatticeSimulation", "LatticeSimulation3D"]
@@ -71,7 +72,7 @@ _RANDOM_START = {2: "lattice_random_start", 3: "lattice3d_random_start"}
 _QUANTIZE = {2: "lattice_quantize", 3: "lattice3d_quantize"}
 
 
-class LatticeSimulation(Attachable):
+class LatticeSimulation(Observing, Attachable):
     """N hard disks on the integer lattice, run forward and back bit for bit (2D; spheres in 3D:
     :class:`LatticeSimulation3D`, the same API).
 
@@ -238,6 +239,17 @@ class LatticeSimulation(Attachable):
     def dim(self) -> int:
         """Dimension: 2 (3 for LatticeSimulation3D)."""
         return self._DIM
+
+    @property
+    def box(self) -> np.ndarray:
+        """Box lengths in float units, shape (dim,) (``Simulation.box``)."""
+        u = self._e.units
+        return np.asarray(u["L"], dtype=float) * float(u["length_unit"])
+
+    @property
+    def periodic(self) -> tuple:
+        """Per axis: periodic (True) or walls (``Simulation.periodic``)."""
+        return tuple(not w for w in self._e.units["wall"])
 
     @property
     def units(self) -> dict:

@@ -171,6 +171,18 @@ class Observer {
   void group(double t, int n, const int* ids, const double* x, const double* v);
   /// A wall reflection of particle i at t (also at a collision's instant): its velocity after.
   void wall(double t, int i, const double* v);
+  /// Engines whose events move centres (the lattice engine: a collision's post phases, a
+  /// group's stall, a reflection's mirror point) give each particle's position after the
+  /// event (in the box, float units). The observer moves its own unwrapped position there by
+  /// the nearest image of the difference (the MSD stays unwrapped and exact), and the virial
+  /// takes these positions: r . Delta v_a with r = x_a - x_b (nearest image) for a pair.
+  void pair_at(double t, int a, int b, const double* xa, const double* xb, const double* va, const double* vb);
+  /// A group collision at t with the members' positions after (image-consistent, n x dim).
+  void group_at(double t, int n, const int* ids, const double* x, const double* v);
+  /// A wall reflection of i at t with its position and velocity after; bit k of `axes`: it
+  /// met a wall of axis k (the lower one if it now moves up, else the upper one), whose
+  /// contact plane (D/2 or L - D/2) is the wall virial's position.
+  void wall_at(double t, int i, const double* x, const double* v, unsigned axes);
   /// Every segment closed at t (the end of a run call); closes any block ended by then.
   void sync(double t);
   /// The results up to the last hook or sync.
@@ -211,6 +223,7 @@ class Observer {
   [[gnu::noinline]] void pairs_to(int i, double t);
   void pair_interval(int i, int j, double t0, double t1);
   void set_cell(Segment& s, double cell) const;
+  void place(int i, const double* x);  // moves i's closed segment to x (nearest image), *_at hooks
   void slab_cross(Segment& s, double t, double end);
   void end_block();
   Block empty_block(double t0) const;

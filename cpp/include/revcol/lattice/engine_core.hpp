@@ -57,6 +57,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -65,6 +66,7 @@
 #include <vector>
 
 #include "revcol/engine/event_queue.hpp"
+#include "revcol/engine/observe.hpp"
 #include "revcol/error.hpp"
 #include "revcol/lattice/cell_grid.hpp"
 #include "revcol/lattice/geometry.hpp"
@@ -185,6 +187,19 @@ inline std::uint64_t draw48(std::uint32_t p, std::uint32_t seed, std::uint64_t k
   const auto w = rng::philox4x32_10({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k >> 32), 0U, 0U}, {p, seed});
   return (std::uint64_t{w[0]} << 16) | (w[1] >> 16);
 }
+/// One forward velocity change as the engine applied it (tests and studies: BasicEngine::events;
+/// the observer's direct-sum check). Positions at the event's tick (in the box), velocities
+/// before and after, per member.
+template <std::size_t D>
+struct EventRecordN {
+  enum Kind : int { pair = 0, wall = 1, group = 2 };
+  std::int64_t tick = 0;           ///< the tick the change takes effect (the transition into it)
+  int kind = pair;                 ///< pair, wall or group
+  unsigned axes = 0;               ///< a wall: bit k, it met a wall of axis k
+  std::vector<int> ids;            ///< the particles
+  std::vector<VecN<D>> x, v_before, v_after;  ///< per particle
+};
+
 /// The 256 initial bits of X for a seed: four words from stream key {2^32 - 1, seed}.
 std::vector<std::uint64_t> initial_bits(std::uint32_t seed);
 
@@ -257,6 +272,8 @@ class BasicEngine {
             "lattice snapshot: origin <= clock within +-2^60 required");
     check_operator(s.units);
     load(s);
+    observer_.reset();  // another state: an observation of the old one ends
+    obs_ = nullptr;
   }
 
   /// Runs forward until `collisions` more collisions (clock = the last one's tick) or up to tick
@@ -269,9 +286,14 @@ class BasicEngine {
     // run changes (O(changes), so that run(collisions=1) stays O(1) at any N)
     begin_undo();
     try {
-      return loop(collisions, until, false, 0, poll);
+      const std::uint64_t done = loop(collisions, until, false, 0, poll);
+      if (obs_) obs_->sync(time_of(clock_));
+      return done;
     } catch (...) {
       undo();
+      // the observer has seen events the undo took back: the observation ends, discarded
+      observer_.reset();
+      obs_ = nullptr;
       throw;
     }
   }
@@ -280,6 +302,7 @@ class BasicEngine {
   void run_back(std::uint64_t to_collisions, std::int64_t to_tick, const std::function<bool()>& poll = {}) {
     require(to_collisions <= ncoll_, "lattice run_back: the target collision count is ahead of the state");
     require(to_tick >= origin_ && to_tick <= clock_, "lattice run_back: the target tick must be in [origin, clock]");
+    stop_observing();  // observation is forward only (revcol/engine/observe.hpp)
     const Snapshot before = snapshot();  // an engine error mid-run leaves the state as it was
     flip();
     try {
@@ -310,6 +333,47 @@ class BasicEngine {
     s.counters = cnt_;
     return s;
   }
+  /// Starts observing the forward run from the clock (replacing any earlier observation):
+  /// the float engine's observer (revcol/engine/observe.hpp) fed at every velocity change
+  /// with the exact state converted once to float units (x length_unit, ticks x tick), the
+  /// positions the engine gives (its *_at hooks: a lattice event moves centres by up to a
+  /// tick's travel). Observation is forward only: run_back ends it; restore discards it.
+  void observe(const engine::ObserveConfig& c) {
+    const std::size_t n = ln_.size();
+    std::vector<double> x(n * D), v(n * D);
+    for (std::size_t p = 0; p < n; ++p) {
+      const Vec xp = pos(static_cast<int>(p), clock_);
+      for (std::size_t k = 0; k < D; ++k) {
+        x[p * D + k] = to_length(xp[k]);
+        v[p * D + k] = to_speed(ln_[p].v[k]);
+      }
+    }
+    std::array<double, 3> box{};
+    std::array<bool, 3> walls{};
+    for (std::size_t k = 0; k < D; ++k) {
+      box[k] = to_length(u_.L[k]);
+      walls[k] = u_.wall[k];
+    }
+    observer_ = std::make_unique<engine::Observer>(c, static_cast<int>(D), x, v, time_of(clock_), box, walls,
+                                                   to_length(u_.sigma));
+    obs_ = observer_.get();
+  }
+  /// The running or last observation (null before observe()).
+  const engine::Observer* observer() const noexcept { return observer_.get(); }
+  /// Whether an observation is running.
+  bool observing() const noexcept { return obs_ != nullptr; }
+  /// Ends the observation at the clock; observer() still reads it.
+  void stop_observing() {
+    if (obs_) obs_->sync(time_of(clock_));
+    obs_ = nullptr;
+  }
+  /// A tick as float time (the observer's clock).
+  double time_of(std::int64_t tick) const noexcept { return static_cast<double>(tick) * u_.tick; }
+  /// Lattice units as a float length.
+  double to_length(std::int64_t x) const noexcept { return static_cast<double>(x) * u_.length_unit; }
+  /// Lattice units per tick as a float speed.
+  double to_speed(std::int64_t v) const noexcept { return static_cast<double>(v) * (u_.length_unit / u_.tick); }
+
   /// Positions at the clock, wrapped.
   std::vector<Vec> positions() const {
     std::vector<Vec> out(ln_.size());
@@ -344,6 +408,8 @@ class BasicEngine {
   std::uint64_t throw_at_collision = 0;
   /// When set, every forward collision appends (tick, i, j), i < j (tests, studies).
   std::vector<std::array<std::int64_t, 3>>* trace = nullptr;
+  /// When set, every forward velocity change (pair, wall, group) is appended (tests, studies).
+  std::vector<EventRecordN<D>>* events = nullptr;
   /// Tests only: every candidate pair of a prediction goes to the exact search (no double
   /// filter); the events, hence the state and the bits, must be the same.
   bool exhaustive_search = false;
@@ -778,8 +844,10 @@ class BasicEngine {
     journal(p);
     Vec x = pos(p, a - 1), v = ln_[p].v;
     Vec old_line_at_a = pos(p, a);
+    unsigned axes = 0;  // the walls it meets
     for (std::size_t k = 0; k < D; ++k) {
-      if (!(u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k))))) x[k] += v[k];
+      if (u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k)))) axes |= 1u << k;
+      else x[k] += v[k];
       if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
     }
     const Vec ghost = wrapped(sub(x, v));
@@ -794,6 +862,7 @@ class BasicEngine {
       }
       if (overlap(old_line_at_a, pos(q, a))) ++cnt_.wall_body;
     });
+    if (!reversed_ && (obs_ || events)) [[unlikely]] note_wall(a, p, x, v, axes);
     pre_wall_[p] = Line{pos(p, a - 1), ln_[p].v, a - 1};  // a group collision at a may take it back
     ln_[p].x = x;
     ln_[p].v = v;
@@ -931,6 +1000,7 @@ class BasicEngine {
     X_ = std::move(out);
     ++ncoll_;
     if (trace != nullptr) trace->push_back({a, i, j});
+    if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
     apply(i, j, xi2, xj2, vi2, vj2, a);
   }
   void collide_back(int i, int j, std::int64_t a) {
@@ -1155,6 +1225,7 @@ class BasicEngine {
         ++cnt_.wall_groups;
       }
     if (trace != nullptr) trace->push_back({a, i, j});
+    if (obs_ || events) [[unlikely]] note_group(a, g, post, vel);
     for (std::size_t m = 0; m < g.size(); ++m) {
       ln_[g[m]] = Line{post[m], vel[m], a};
       sync(g[m]);
@@ -1190,6 +1261,42 @@ class BasicEngine {
     ++cnt_.collisions;
     for (int q : g) predict(q, a);
   }
+
+  // ---- the observer's hooks (forward only; cold: one test per velocity change when off) ----
+  // the event's record (events) and its float form to the observer
+  [[gnu::noinline, gnu::cold]] void note(int kind, std::int64_t a, const std::vector<int>& ids, const std::vector<Vec>& x,
+                                         const std::vector<Vec>& v, unsigned axes) {
+    if (events != nullptr) {
+      EventRecordN<D> r{a, kind, axes, ids, x, {}, v};
+      for (int q : ids) r.v_before.push_back(ln_[q].v);
+      events->push_back(std::move(r));
+    }
+    if (!obs_) return;
+    const std::size_t n = ids.size();
+    std::vector<double> xf(n * D), vf(n * D);
+    for (std::size_t m = 0; m < n; ++m)
+      for (std::size_t k = 0; k < D; ++k) {
+        // a group's positions image-consistent about its first member's
+        const std::int64_t xk = kind == EventRecordN<D>::group && m > 0 ? x[0][k] + diff(x[m], x[0])[k] : x[m][k];
+        xf[m * D + k] = to_length(xk);
+        vf[m * D + k] = to_speed(v[m][k]);
+      }
+    const double t = time_of(a);
+    if (kind == EventRecordN<D>::pair) obs_->pair_at(t, ids[0], ids[1], &xf[0], &xf[D], &vf[0], &vf[D]);
+    else if (kind == EventRecordN<D>::wall) obs_->wall_at(t, ids[0], xf.data(), vf.data(), axes);
+    else obs_->group_at(t, static_cast<int>(n), ids.data(), xf.data(), vf.data());
+  }
+  void note_pair(std::int64_t a, int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj) {
+    note(EventRecordN<D>::pair, a, {i, j}, {xi, xj}, {vi, vj}, 0);
+  }
+  void note_wall(std::int64_t a, int p, const Vec& x, const Vec& v, unsigned axes) {
+    note(EventRecordN<D>::wall, a, {p}, {x}, {v}, axes);
+  }
+  void note_group(std::int64_t a, const std::vector<int>& g, const std::vector<Vec>& x, const std::vector<Vec>& v) {
+    note(EventRecordN<D>::group, a, g, x, v, 0);
+  }
+  std::unique_ptr<engine::Observer> observer_;  // the running or last observation (observe.hpp)
+  engine::Observer* obs_ = nullptr;             // observer_ while it runs, else null
 
   // The operator must work in the units' lattice: the same sigma and (an operator with
   // direction cells) the same cell resolution.
