@@ -1,4 +1,4 @@
-"""Two builds of the event-chain sampler (revcol.ecmc) interleaved, A B A B ..., pinned to one core.
+"""Two builds of the event-chain sampler (revcol.studies.ecmc) interleaved, A B A B ..., pinned to one core.
 
 Each measurement is a child process: the package directory of one build first on sys.path, a
 random start (``ecmc.start``, seed 5), 2000 chains to warm up, then ``chains`` chains timed
@@ -25,7 +25,10 @@ CASES = [(2, 0.6, 1000, 60000), (3, 0.45, 1000, 30000)]
 CHILD = """
 import sys, time, json
 sys.path.insert(0, sys.argv[1])
-from revcol import ecmc
+try:
+    from revcol.studies import ecmc
+except ImportError:  # a build from before revcol.studies
+    from revcol import ecmc
 d, phi, n, chains = int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5])
 s = ecmc.start(d, phi, n, seed=5)
 ell = ecmc.default_chain_length(d, phi)

@@ -1,6 +1,6 @@
 """Independent replicas of one equation-of-state point: are the block errors honest?
 
-The dense study (`python -m revcol.physics dense`) quotes Z with a block-average error from one
+The dense study (`python -m revcol.studies.equilibrium dense`) quotes Z with a block-average error from one
 long run. Slow modes that outlive the blocks make such an error too small. Here the same point
 runs from `--seeds` independent starts (each its own random state and warm-up, as the study
 makes them), and the spread of the runs' Z is set against the errors their blocks claimed:
@@ -16,7 +16,7 @@ study's reference) and, for two laws, with each other.
         --laws specular flux --per-particle 20000 --seeds 12 --first-seed 201 \
         --cores 0 1 --json bench/results/eos_replicas_2d_phi0.6_n4000.json
 
-Each run is a child process (`revcol.physics dense`, pinned with taskset to one of `--cores`
+Each run is a child process (`revcol.studies.equilibrium dense`, pinned with taskset to one of `--cores`
 when given; runs on different cores go side by side). The JSON is written atomically, and
 rewritten after every run (a stopped study keeps what it finished).
 
@@ -69,7 +69,7 @@ def _module_path() -> str:
 
 def _run(args, law: str, seed: int, core, workdir: str) -> dict:
     out = os.path.join(workdir, f"{law}_{seed}.json")
-    cmd = [sys.executable, "-m", "revcol.physics", "dense", "--dim", str(args.dim), "--phi", str(args.phi),
+    cmd = [sys.executable, "-m", "revcol.studies.equilibrium", "dense", "--dim", str(args.dim), "--phi", str(args.phi),
            "--n", str(args.n), "--laws", law, "--per-particle", str(args.per_particle), "--seed", str(seed),
            "--json", out]
     if core is not None and shutil.which("taskset"):

@@ -105,7 +105,7 @@ def check(collisions: int = 200_000, every: int = 10_000, particles: int = 1000,
     about ``every`` collisions apart) and the checks; returns the report."""
     from revcol.observe import compressibility_from_contact
     from revcol.scene import scene_from_dict
-    from revcol.simulate import simulate
+    from revcol.cli.simulate import simulate
     from revcol.trajectory import read_gsd
 
     try:

@@ -22,7 +22,7 @@ import time
 import numpy as np
 from scipy import stats
 
-from revcol.randomness import stream
+from revcol.studies.words import stream
 
 
 def main() -> None:

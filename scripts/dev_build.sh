@@ -10,8 +10,9 @@ cmake -S . -B "$dir" -G Ninja -DREVCOL_BUILD_TESTS=ON \
   -DPython_EXECUTABLE="$(command -v "$py")" \
   -Dpybind11_DIR="$("$py" -m pybind11 --cmakedir)" "$@" >/dev/null
 cmake --build "$dir" -j"$(nproc)"
-mkdir -p "$dir/pkg/revcol"
-cp python/revcol/*.py python/revcol/*.pyi "$dir/pkg/revcol/" 2>/dev/null || true
+# the whole package tree (revcol.studies, revcol.cli, revcol.sweep ...), nothing left of an older layout
+rm -rf "$dir/pkg/revcol" && mkdir -p "$dir/pkg"
+cp -r python/revcol "$dir/pkg/"
 [ -f "$dir/_core"*.so ] 2>/dev/null || true
 cp "$dir"/_core*.so "$dir/pkg/revcol/" 2>/dev/null || true
 echo "staged: $dir/pkg"

@@ -13,6 +13,7 @@ Protopopescu, ACM TOMACS 2013, and beyond).
     >>> np.allclose(op.reverse(post, [-1.0, 0.0], rng=g), v)
     True
 """
+from ._version import __version__
 from .collide import Collision, Pair1D, Pair2D, Wall, named_cases
 from .rng import CLCG4, Philox, philox4x32
 from .verify import VERIFY_CASES, verify, verify_cases
@@ -20,8 +21,7 @@ from .paper import Pair3DPaper, Triple1DPaper, Triple2DPaper
 from . import paper
 from . import statesave
 from .engine import Simulation
-from . import observe, physics
+from . import observe
 from .sweep import sweep
 
-__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper", "Simulation", "observe", "physics", "sweep"]
-__version__ = "0.1.0"
+__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper", "Simulation", "observe", "sweep"]

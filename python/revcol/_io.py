@@ -1,15 +1,25 @@
 """Atomic output: a file is written beside its target and moved into place, so a reader (or a
-crash, or Ctrl-C) never sees half a checkpoint."""
+crash, or Ctrl-C) never sees half a checkpoint; and reports as JSON (numpy values and
+non-finite floats become plain JSON)."""
 from __future__ import annotations
 
 import contextlib
+import json
+import math
 import os
 import tempfile
-from typing import IO, Iterator, Mapping, Union
+import warnings
+import zipfile
+from pathlib import Path
+from typing import IO, Any, Iterator, Mapping, Union
 
 import numpy as np
 
-__all__ = ["write_npz_atomic", "atomic_open", "save_figure", "read_checkpoint", "STAMP_KEYS"]
+from . import _core
+from ._version import __version__
+
+__all__ = ["write_npz_atomic", "atomic_open", "save_figure", "read_checkpoint", "STAMP_KEYS", "jsonable",
+           "write_json"]
 
 #: keys a checkpoint file carries besides the snapshot: what wrote it
 STAMP_KEYS = ("revcol_version", "revcol_build", "revcol_engine")
@@ -78,7 +88,6 @@ def write_npz_atomic(path: Union[str, os.PathLike], arrays: Mapping[str, np.ndar
 
 def stamped(arrays: Mapping[str, np.ndarray], engine: str) -> dict:
     """``arrays`` with the stamp of this revcol (version, build: compiler and flags) and ``engine``."""
-    from . import __version__, _core
     out = dict(arrays)
     out.update(revcol_version=np.asarray(__version__), revcol_build=np.asarray(_core.build),
                revcol_engine=np.asarray(engine))
@@ -90,10 +99,6 @@ def read_checkpoint(path: Union[str, os.PathLike], engine: str) -> dict:
     not an ``.npz``, or whose stamp names another engine, raises ValueError naming the problem; one
     written by another revcol version or build loads with a RuntimeWarning (it resumes, but bit-for-bit
     agreement with the other build's run is not promised). Files from before stamps load silently."""
-    import warnings
-    import zipfile
-
-    from . import __version__, _core
     try:
         z = np.load(path, allow_pickle=False)
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as e:
@@ -116,3 +121,30 @@ def read_checkpoint(path: Union[str, os.PathLike], engine: str) -> dict:
                       f"({_core.build}): the run resumes, but bit-for-bit agreement across builds is not promised",
                       RuntimeWarning, stacklevel=3)
     return out
+
+
+def jsonable(o: Any) -> Any:
+    """``o`` with numpy values as Python's, non-finite floats as strings ("inf", "nan") and paths
+    as strings: what :func:`json.dumps` takes."""
+    if isinstance(o, dict):
+        return {str(k): jsonable(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [jsonable(v) for v in o]
+    if isinstance(o, np.ndarray):
+        return jsonable(o.tolist())
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, (np.floating, float)):
+        return float(o) if math.isfinite(o) else str(o)
+    if isinstance(o, Path):
+        return str(o)
+    return o
+
+
+def write_json(report: dict, path: str | os.PathLike) -> str:
+    """Writes the report as indented JSON (:func:`jsonable`; creating the directory, atomically);
+    returns the path."""
+    p = Path(path)
+    with atomic_open(p) as f:
+        f.write(json.dumps(jsonable(report), indent=1) + "\n")
+    return str(p)

@@ -19,20 +19,23 @@ import datetime as dt
 import math
 import os
 import sys
+import tempfile
 import time as _time
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
-from . import _core
+from . import _core, plots
 from .engine import Simulation
+from .lattice_gas import _LatticeRun, build_lattice
 from .progress import Bar, Interrupt, peak_rss
-from .report import version
+from ._version import __version__
 from .roundtrip import BAR, ERROR_DEFINITIONS, geometry, round_trip_errors
 from .scene import Scene, SceneError, engine_options, read_initial
 
-__all__ = ["build_simulation", "run_gas", "round_trip", "list_renewals"]
+__all__ = ["build_simulation", "run_gas", "round_trip", "list_renewals", "BYTES_PER_PARTICLE", "check_memory",
+           "check_output"]
 
 
 def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
@@ -43,8 +46,6 @@ def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
     if scene.kind != "gas":
         raise SceneError(f"{scene.source}: [scene] kind: {scene.kind!r} scenes build no particles")
     if scene.engine == "lattice":
-        from .lattice_gas import build_lattice
-
         return build_lattice(scene, seed)
     opts = engine_options(scene)
     if seed is not None:
@@ -113,7 +114,7 @@ class _GasRun:
         self.writer = None
         self.frames_t: list[float] = []
         if trajectory is not None:
-            from .trajectory import open_trajectory
+            from .trajectory import open_trajectory  # the writers only when a run writes frames
 
             self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter)
             self.writer.write(self.x0, self.v0, self.t0, 0, "forward")
@@ -250,7 +251,7 @@ class _GasRun:
         fs, rs = self.forward_s, self.reverse_s
         paused = self.ckpt_every or self.traj_every or self.plot is not None
         return {
-            "kind": "gas", "revcol_version": version(), "scene": scene.to_dict(), "summary": scene.summary(),
+            "kind": "gas", "revcol_version": __version__, "scene": scene.to_dict(), "summary": scene.summary(),
             "particles": n, "dimension": self.d, "box": self.box.tolist(), "periodic": self.periodic.tolist(),
             "collisions_forward": done, "collisions_back": self.back, "per_particle": 2.0 * done / n,
             "time_start": self.t0, "time_turn": self.t_turn, "time_end": sim.time,
@@ -286,8 +287,8 @@ class _GasRun:
 def run_gas(scene: Scene, *, plot: str | os.PathLike | None = None,
             trajectory: str | os.PathLike | None = None, progress: bool | None = None,
             checkpoints: bool = True, plot_format: str = "png") -> dict:
-    """Runs a gas scene forward and back; returns the report (a dict, see :mod:`revcol.run`;
-    a lattice scene's: :mod:`revcol.lattice_gas`).
+    """Runs a gas scene forward and back; returns the report (a dict, see
+    :mod:`revcol.studies.scenes`; a lattice scene's: :mod:`revcol.lattice_gas`).
 
     ``plot``: a directory for the PNG figures (round-trip error and energy drift against
     collisions, snapshots at the start, the turn and the end); ``trajectory``: a ``.xyz`` or
@@ -298,24 +299,20 @@ def run_gas(scene: Scene, *, plot: str | os.PathLike | None = None,
     if scene.kind != "gas":
         raise SceneError(f"{scene.source}: [scene] kind: run_gas needs a 'gas' scene, got {scene.kind!r}")
     if trajectory is not None:
-        from .trajectory import check_format
+        from .trajectory import check_format  # the writers only when a run writes frames
 
         try:
             check_format(trajectory)
         except ValueError as e:
             raise SceneError(str(e)) from None
     if plot is not None:
-        from .plots import check_format, require_matplotlib
-
-        require_matplotlib()
-        check_format(plot_format)
+        plots.require_matplotlib()
+        plots.check_format(plot_format)
     if progress is None:
         progress = sys.stdout.isatty()
-    if scene.engine == "lattice":
-        from .lattice_gas import run_lattice_gas
-
-        return run_lattice_gas(scene, plot=plot, trajectory=trajectory, progress=progress, checkpoints=checkpoints,
-                               plot_format=plot_format)
+    if scene.engine == "lattice":  # the lattice engine's run (revcol.lattice_gas), its own figures
+        return round_trip(_LatticeRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_lattice_gas",
+                          plot_format)
     return round_trip(_GasRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_gas", plot_format)
 
 
@@ -329,9 +326,55 @@ def round_trip(run, plot, figures: str, plot_format: str = "png") -> dict:
         run.reverse(stop, stop.presses)
     report = run.report()
     if plot is not None:
-        from . import plots
-
         sim = run.sim
         report["written"] += getattr(plots, figures)(report, Path(plot), (run.x0, run.v0), run.shot_turn,
                                                      (sim.positions, sim.velocities), fmt=plot_format)
     return report
+
+
+
+#: bytes a gas scene needs per particle, measured with margin: the float engine holds 254 (2D) to
+#: 282 (3D) bytes per particle (N = 1e5, Simulation.diagnostics()["memory_bytes"]); the start
+#: arrays, the report's copies and Python's arrays come on top
+BYTES_PER_PARTICLE = 1024
+
+
+def _available_bytes() -> int | None:
+    """MemAvailable from /proc/meminfo (None where there is none)."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def check_memory(scene: Scene) -> None:
+    need, have = scene.particles * BYTES_PER_PARTICLE, _available_bytes()
+    if have is not None and need > have:
+        raise SceneError(f"{scene.source}: [system] particles: {scene.particles} particles need about "
+                         f"{need / 2**30:.1f} GiB ({BYTES_PER_PARTICLE} bytes each), this machine has "
+                         f"{have / 2**30:.1f} GiB available")
+
+
+def check_output(source: str, what: str, path, folder: bool) -> None:
+    """Raises SceneError naming ``what`` unless ``path`` can be written: not the scene file, not a
+    folder where a file goes (or the reverse), its folder creatable and writable (tried)."""
+    if path is None:
+        return
+    p = Path(path).resolve()
+    if source and Path(source).is_file() and p == Path(source).resolve():
+        raise SceneError(f"{source}: {what}: {p} is the scene file itself")
+    if folder and p.exists() and not p.is_dir():
+        raise SceneError(f"{source}: {what}: {p} exists and is not a folder")
+    if not folder and p.is_dir():
+        raise SceneError(f"{source}: {what}: {p} is a folder, not a file")
+    parent = p if folder else p.parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=parent):
+            pass
+    except OSError as e:
+        raise SceneError(f"{source}: {what}: cannot write into {parent} ({e.strerror or e})") from None

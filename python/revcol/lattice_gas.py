@@ -34,11 +34,11 @@ import numpy as np
 from . import _core
 from .lattice import LatticeSimulation, LatticeSimulation3D
 from .progress import Bar, Interrupt, peak_rss
-from .report import version
+from ._version import __version__
 from .roundtrip import BAR, round_trip_errors
 from .scene import Scene, SceneError, lattice_options, read_initial
 
-__all__ = ["build_lattice", "run_lattice_gas", "lattice_horizon", "restored", "RESTORED_PARTS",
+__all__ = ["build_lattice", "lattice_horizon", "restored", "RESTORED_PARTS",
            "LATTICE_HORIZON_GRID"]
 
 #: the parts of the state compared exactly after the round trip: report name -> snapshot() keys
@@ -130,7 +130,7 @@ class _LatticeRun:
         self.trajectory, self.writer = trajectory, None
         self.frames: list[int] = []
         if trajectory is not None:
-            from .trajectory import open_trajectory
+            from .trajectory import open_trajectory  # the writers only when a run writes frames
 
             self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter)
             self.frame(0, "forward")
@@ -272,7 +272,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
     per = (lambda c: c / done) if done else (lambda c: 0.0)
     units = sim.units
     return {
-        "kind": "gas", "engine": "lattice", "revcol_version": version(), "scene": scene.to_dict(),
+        "kind": "gas", "engine": "lattice", "revcol_version": __version__, "scene": scene.to_dict(),
         "summary": scene.summary(), "particles": n, "dimension": sim.dim, "box": run.box.tolist(),
         "periodic": run.periodic.tolist(),
         "units": {"S": units["S"], "sigma": units["sigma"], "tick": units["tick"],
@@ -312,18 +312,6 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "energy_series": [list(p) for p in run.energy_series], "bits_series": [list(p) for p in run.bits_series],
         "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), "written": [],
     }
-
-
-def run_lattice_gas(scene: Scene, *, plot=None, trajectory=None, progress: bool | None = None,
-                    checkpoints: bool = True, plot_format: str = "png") -> dict:
-    """Runs a lattice gas scene forward and back; returns the report (outputs as
-    :func:`revcol.gas.run_gas`; the figures are the energy drift, X's size and snapshots)."""
-    from .gas import round_trip
-
-    if progress is None:
-        progress = sys.stdout.isatty()
-    return round_trip(_LatticeRun(scene, plot, trajectory, progress, checkpoints), plot, "plot_lattice_gas",
-                      plot_format)
 
 
 def lattice_horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000,

@@ -9,9 +9,11 @@
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["BAR", "ERROR_DEFINITIONS", "round_trip_errors", "geometry", "divergence_text"]
+__all__ = ["BAR", "ERROR_DEFINITIONS", "round_trip_errors", "geometry", "divergence_text", "combine_seeds"]
 
 #: the round-trip bar (the paper's): both errors must be at most this
 BAR = 1e-9
@@ -50,3 +52,27 @@ def divergence_text(d: dict) -> str:
     if d.get("verified_at") is not None:
         where += f"; last verified at {d['verified_at']:,}"
     return where + "): the state run_back restores is not the forward run's"
+
+
+
+def combine_seeds(grid: list[int], n: int, per_seed: list[list[tuple[float, float]]]) -> tuple[list[dict], int]:
+    """The horizon's table from each seed's (position, velocity) errors at the grid's N_c (a seed
+    stops early once O(1)): per N_c the worst of the seeds (a stopped seed counts as infinite),
+    the median of each seed's larger error and how many fail the bar; and the horizon, the
+    largest N_c before the first that fails. ``revcol sweep`` combines its seeds with this too."""
+    rows = []
+    for k, nc in enumerate(grid):
+        if all(k >= len(e) for e in per_seed):
+            break
+        ex = [e[k][0] if k < len(e) else math.inf for e in per_seed]
+        ev = [e[k][1] if k < len(e) else math.inf for e in per_seed]
+        worst = [max(a, b) for a, b in zip(ex, ev)]
+        rows.append({"collisions": nc, "per_particle": 2.0 * nc / n, "error_x": max(ex), "error_v": max(ev),
+                     "median": float(np.median(worst)), "fails": int(sum(w > BAR for w in worst)),
+                     "seeds": len(per_seed)})
+    h = 0
+    for r in rows:
+        if max(r["error_x"], r["error_v"]) > BAR:
+            break
+        h = r["collisions"]
+    return rows, h

@@ -1,42 +1,104 @@
-"""The paper's performance study (§6): state saving against reverse computation, and beyond.
+"""One run of the paper's state-saving study in this process (:func:`run`), the bytes a
+variant would save (:func:`projected_bytes`), and the argument checks every run shares.
 
-N particles in 2D (positions uniform in the unit box, velocity components uniform in
-[-1, 1)). Each step draws exactly 3 numbers from the reversible generator (pair, exponential
-inter-collision time, the operator's G), moves every particle x += v dt, and collides the
-pair with the normal +-(x_i - x_j) oriented so that it approaches. After N_c steps the run
-rolls back to the start:
+The model, the variants and the maths are in the study, :mod:`revcol.studies.statesave`, and
+the C++ header ``revcol/statesave.hpp``; the study (many runs, each in a fresh process, the
+table and the figure) builds on this module, which the library (scene checks) uses too.
 
-- ``ss1``: saves all positions and velocities before every step (32 N bytes); restores them;
-- ``ss2``: saves all positions and the pair's indices and pre-collision velocities (16 N + 40);
-- ``ssp`` (lazy only): the pair's indices, x0 and velocities (72 bytes: the best lazy state saving);
-- ``rc``:  saves nothing; reverse operator, then reverse transport, the generator stepping back.
-
-Every step's record also holds the clock and the generator state (24 bytes more). *Lazy
-transport* stores x0 = x - v t per particle, so a step costs O(1): a collision at time t
-updates x0 += (v_old - v_new) t, and reverse undoes it. The C++ header
-``revcol/statesave.hpp`` has the maths (orientation, grazing rule, exact mode's pre log).
-
-:func:`run` does one run in this process. :func:`study` runs a grid of (mode, N, variant),
-each in a fresh ``revcol-bench`` process so that its peak resident set (VmHWM) is its own,
-and reports times (the repeat with the median total), bytes saved (counted), peak RSS and
-the round-trip error; runs whose saved state exceeds the budget are skipped with their
-projection. :func:`write_json`, :func:`write_csv` and :func:`plot` write the results.
-
-    >>> import revcol
-    >>> r = revcol.statesave.run(1000, 200, variant="rc")
+    >>> r = run(1000, 200, variant="rc")
     >>> r["restored"], r["max_rel_error"] < 1e-9, r["draws"] == 3 * 200
     (True, True, True)
-
-This module gathers the study's parts: :mod:`revcol.statesave_run` (one run, the checks),
-:mod:`revcol.statesave_study` (the study driver), :mod:`revcol.statesave_output` (JSON, CSV,
-table, figure) and :mod:`revcol.statesave_cli` (``revcol bench statesave``).
 """
 from __future__ import annotations
 
-from .statesave_cli import add_arguments, cli_main
-from .statesave_output import format_table, plot, write_csv, write_json
-from .statesave_run import MODES, projected_bytes, run, variants
-from .statesave_study import _find_binary, _run_inline, study  # noqa: F401 - kept importable from here
+import math
+from typing import Any
 
-__all__ = ["run", "projected_bytes", "variants", "study", "write_json", "write_csv", "plot",
-           "format_table", "add_arguments", "cli_main", "MODES"]
+from . import _core
+
+__all__ = ["run", "projected_bytes", "variants", "MODES"]
+
+#: operator modes of the study
+MODES = ("exact", "paper")
+_GIB = 1 << 30
+_MAX_PARTICLES = 1 << 26
+_MAX_COLLISIONS = 1 << 32
+_LABEL = {"ss1": "SS1", "ss2": "SS2", "ssp": "SS-pair", "rc": "RC"}
+
+
+def _gib(b: float) -> str:
+    return f"{b / _GIB:.1f} GiB"
+
+
+# --- validation --------------------------------------------------------------------------
+
+def _int(value: Any, name: str, lo: int, hi: int | None = None) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value):
+        raise ValueError(f"{name} must be an integer, got {value!r}")
+    v = int(value)
+    if v < lo or (hi is not None and v > hi):
+        bound = f"[{lo}, {hi}]" if hi is not None else f">= {lo}"
+        raise ValueError(f"{name} must be {bound}, got {v}")
+    return v
+
+
+def _budget_bytes(budget_gib: Any) -> int:
+    if isinstance(budget_gib, bool) or not isinstance(budget_gib, (int, float)) \
+            or not math.isfinite(budget_gib) or budget_gib <= 0:
+        raise ValueError(f"budget_gib must be a positive number of GiB, got {budget_gib!r}")
+    return int(budget_gib * _GIB)
+
+
+def _supported(lazy: bool) -> tuple[str, ...]:
+    return tuple(_core.statesave_variants("lazy" if lazy else "eager"))
+
+
+def variants(lazy: bool = False) -> tuple[str, ...]:
+    """The variants a transport supports, in report order (eager: ss1 ss2 rc; lazy adds ssp)."""
+    return _supported(lazy)
+
+
+def _kwargs(particles, collisions, variant, lazy, mode, law, rng, seed, mean_dt, grazing_tol,
+            budget_gib, prefault, bits=40) -> dict:
+    if mode not in MODES:
+        raise ValueError(f"mode must be 'exact' or 'paper', got {mode!r}")
+    if variant not in _supported(lazy):
+        need = " (ssp needs lazy=True)" if variant == "ssp" else ""
+        raise ValueError(f"variant must be one of {', '.join(_supported(lazy))}, got {variant!r}{need}")
+    return dict(particles=_int(particles, "particles", 2, _MAX_PARTICLES),
+                collisions=_int(collisions, "collisions", 1, _MAX_COLLISIONS), variant=variant,
+                transport="lazy" if lazy else "eager", mode=mode, law=law, bits=_int(bits, "bits", 8, 52),
+                rng=rng, seed=_int(seed, "seed", 0, 2**32 - 1), mean_dt=float(mean_dt),
+                grazing_tol=float(grazing_tol), budget_bytes=_budget_bytes(budget_gib),
+                prefault=bool(prefault))
+
+
+# --- one run -------------------------------------------------------------------------------
+
+def run(particles: int, collisions: int = 1000, *, variant: str = "rc", lazy: bool = False,
+        mode: str = "exact", law: str = "flux", rng: str = "clcg4", seed: int = 0,
+        mean_dt: float = 1e-5, grazing_tol: float = 1e-11, budget_gib: float = 8.0,
+        prefault: bool = True, capture: bool = False) -> dict:
+    """One run in this process: N_c steps forward, roll back, compare with the start.
+
+    Returns a dict: ``forward_s``, ``rollback_s``, ``bytes_saved`` (counted: the records, or
+    for ``rc`` its logs), ``projected_bytes``, ``peak_rss_bytes`` (this *process's* VmHWM),
+    ``max_rel_error`` (max of |x - x_0| / box and |v - v_0| / max|v_0|), ``restored`` (state
+    saving: bit for bit; rc: within 1e-9; both: generator and clock back, logs empty),
+    ``draws`` / ``draws_undone`` (3 per step), ``skipped`` (over the budget: not run), and
+    with ``capture`` the (N, 4) arrays ``start``, ``turn`` and ``end`` (x, y, vx, vy;
+    positions at the snapshot's time). Bad arguments raise ValueError naming the problem.
+    """
+    kw = _kwargs(particles, collisions, variant, lazy, mode, law, rng, seed, mean_dt,
+                 grazing_tol, budget_gib, prefault)
+    return _core.statesave_run(capture=bool(capture), **kw)
+
+
+def projected_bytes(particles: int, collisions: int = 1000, *, variant: str = "ss1",
+                    lazy: bool = False, **kw: Any) -> int:
+    """Bytes the variant saves over a run (rc: 0; its logs are counted when it runs)."""
+    args = dict(mode="exact", law="flux", rng="clcg4", seed=0, mean_dt=1e-5, grazing_tol=1e-11,
+                budget_gib=8.0, prefault=True)
+    args.update(kw)
+    return int(_core.statesave_projected_bytes(
+        **_kwargs(particles, collisions, variant, lazy, **args))["projected_bytes"])

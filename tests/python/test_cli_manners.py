@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import revcol
-from revcol.cli import main
+from revcol.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
 SMALL = "[system]\ndimension = 2\nparticles = 40\npacking_fraction = 0.2\n[run]\ncollisions = 40\n"

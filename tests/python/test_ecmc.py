@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from revcol import ecmc
-from revcol import physics as P
+from revcol.studies import ecmc
+from revcol.studies import equilibrium as P
 
 LIMIT = 3.5  # standard errors; seeded, so the same bits every time
 

@@ -269,7 +269,7 @@ SCENE = '[system]\ndimension = 2\npacking_fraction = 0.3\nparticles = 100\n[run]
 
 
 def _revcol_run(tmp_path, text, capsys, name="s.toml"):
-    from revcol.cli import main
+    from revcol.cli.main import main
     path = tmp_path / name
     path.write_text(text)
     cwd = os.getcwd()
@@ -305,7 +305,7 @@ def test_a_report_over_the_scene_file_is_refused_before_the_run(tmp_path, capsys
 
 
 def test_a_scene_too_large_for_memory_is_refused_before_allocating(tmp_path, capsys, monkeypatch):
-    import revcol.run as run_mod
+    import revcol.gas as run_mod
     monkeypatch.setattr(run_mod, "_available_bytes", lambda: 50 * 1024)  # 50 KiB: 100 particles need 100 KiB
     rc, err, _ = _revcol_run(tmp_path, SCENE, capsys)
     assert rc == 2 and "[system] particles: 100 particles need about" in err[0], err
@@ -376,8 +376,8 @@ def test_a_report_figure_and_csv_keep_the_previous_file_when_the_write_fails(tmp
     import matplotlib.pyplot as plt
 
     from revcol._io import save_figure
-    from revcol.report import write_json
-    from revcol.statesave_output import write_csv, write_json as ss_json
+    from revcol._io import write_json
+    from revcol.studies.statesave.output import write_csv, write_json as ss_json
     fig = plt.figure()
     writers = {"a.json": lambda p: write_json({"a": 1}, p), "b.json": lambda p: ss_json({"b": 2}, p),
                "c.csv": lambda p: write_csv({"ratios": [], "runs": []}, p), "d.png": lambda p: save_figure(fig, p)}
@@ -407,7 +407,7 @@ def test_a_trajectory_appears_only_when_closed(tmp_path):
 
 
 def test_statesave_json_dash_is_standard_output(capsys):
-    from revcol.cli import main as cli_main
+    from revcol.cli.main import main as cli_main
     code = cli_main(["bench", "statesave", "--n", "100", "--collisions", "1e2", "--inline", "--variants", "rc",
                      "--json", "-", "--no-progress"])
     out = capsys.readouterr()

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import revcol
-from revcol.cli import main as cli_main
+from revcol.cli.main import main as cli_main
 from revcol.observe import Estimate, Observation, radial_distribution
-from revcol.run import run_scene
+from revcol.studies.scenes import run_scene
 from revcol.scene import SceneError, scene_from_dict
 
 

@@ -126,7 +126,7 @@ def test_scenes_are_found_by_name(tmp_path, monkeypatch):
 
 
 def test_revcol_run_by_name(tmp_path, monkeypatch, capsys):
-    from revcol.cli import main
+    from revcol.cli.main import main
 
     monkeypatch.chdir(tmp_path)
     assert main(["run", "rods-1d", "--collisions", "200", "--no-progress"]) == 0

@@ -222,7 +222,7 @@ def test_bad_batch_entry_named_and_options_checked():
 
 
 def test_module_cli_prints_json():
-    out = subprocess.run([sys.executable, "-m", "revcol.paper_study", "failure-rate", "triple1d",
+    out = subprocess.run([sys.executable, "-m", "revcol.studies.paper_study", "failure-rate", "triple1d",
                           "--collisions", "2000", "--arc", "table"], capture_output=True, text=True, check=True)
     r = json.loads(out.stdout)
     assert r["failure_rate"] == 0.0 and r["collisions"] == 2000

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from revcol import physics as P
+from revcol.studies import equilibrium as P
 
 COLLISIONS = 200_000
 LIMIT = 3.5  # standard errors; the runs are seeded, so the result is the same bits every time
@@ -130,7 +130,7 @@ def test_dense_gas_flux_matches_specular_and_enskog_uniform_does_not():
 
 
 def test_study_command_line(tmp_path, capsys):
-    from revcol.cli import main as cli_main
+    from revcol.cli.main import main as cli_main
 
     out = tmp_path / "small.json"
     assert cli_main(["study", "equilibrium", "small", "--collisions", "20000", "--mc-samples", "1000000",
@@ -155,7 +155,7 @@ def test_closed_box_walls_share_the_pressure_uniform_lowers_it():
 def test_extrapolate_in_one_over_n():
     """Z(N) = Z_inf + a / N: two sizes give the line through both (error propagated by hand),
     three on a line give it back exactly, and one size is refused."""
-    from revcol.physics import extrapolate
+    from revcol.studies.eos import extrapolate
 
     zi, ei, a = extrapolate([1000, 4000], [6.4609, 6.4568], [0.0022, 0.0012])
     assert zi == pytest.approx((4 * 6.4568 - 6.4609) / 3, abs=1e-12)

@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from revcol import plots  # noqa: E402
-from revcol.cli import main as cli_main  # noqa: E402
+from revcol.cli.main import main as cli_main  # noqa: E402
 from revcol.gas import run_gas  # noqa: E402
 from revcol.scene import SceneError, scene_from_dict  # noqa: E402
 

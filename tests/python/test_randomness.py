@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-import revcol.randomness as R
+import revcol.studies.randomness as R
 
 
 def ks_p(words):
@@ -148,7 +148,7 @@ def test_reduced_battery_gas_passes(tmp_path):
 
 
 def test_revcol_study_randomness_forwards(tmp_path):
-    from revcol import cli
+    import revcol.cli.main as cli
 
     path = tmp_path / "w.bin"
     assert cli.main(["study", "randomness", "words", str(path), "--words", "100", "--case", "pair3d"]) == 0

@@ -14,8 +14,11 @@ import numpy as np
 import pytest
 
 import revcol
-from revcol.cli import main as cli_main
-from revcol.run import BAR, build_simulation, horizon, run_gas, run_scene, round_trip_errors
+from revcol.cli.main import main as cli_main
+from revcol.gas import build_simulation, run_gas
+from revcol.roundtrip import BAR, round_trip_errors
+from revcol.studies.horizon import horizon
+from revcol.studies.scenes import run_scene
 from revcol.scene import SceneError, load_scene, scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -312,10 +315,10 @@ def sigint_once_running(monkeypatch, interrupt_class) -> list:
 
 
 def test_ctrl_c_stops_forward_and_still_reverses_and_writes(tmp_path, capsys, monkeypatch):
-    import revcol.run as run
+    import revcol.gas as run
 
     # a 1D gas reverses exactly however long it runs: 1e8 collisions would take a minute.
-    timers = sigint_once_running(monkeypatch, run._Interrupt)
+    timers = sigint_once_running(monkeypatch, run.Interrupt)
     before = signal.getsignal(signal.SIGINT)
     p = tmp_path / "long.toml"
     p.write_text("[system]\ndimension = 1\nparticles = 1000\npacking_fraction = 0.3\n[run]\ncollisions = 100000000\n")
@@ -365,7 +368,7 @@ def test_reversal_builds_no_particles(monkeypatch):
 
 
 def test_imports_only_what_a_run_uses():
-    code = ("import sys, revcol.run as r; rep = r.run_scene(None, collisions=20000, progress=False); "
+    code = ("import sys, revcol.studies.scenes as r; rep = r.run_scene(None, collisions=20000, progress=False); "
             "print(rep['passed'], *[m in sys.modules for m in ('matplotlib', 'revcol.trajectory', 'tqdm', 'gsd')])")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
@@ -396,7 +399,7 @@ def _has(module: str) -> bool:
 def test_ctrl_c_ends_a_statesave_study_after_the_run_under_way(tmp_path, capsys, monkeypatch):
     # the SIGINT arrives during the first run (each run is one C++ call): the study ends
     # after it, reports that run, writes the JSON, and exits 130
-    import revcol.statesave_study as ss
+    import revcol.studies.statesave.driver as ss
 
     real = ss._run_inline
     calls = []
@@ -421,7 +424,7 @@ def test_ctrl_c_ends_a_statesave_study_after_the_run_under_way(tmp_path, capsys,
 
 
 def test_ctrl_c_during_a_reversal_scene_still_reports(tmp_path, capsys, monkeypatch):
-    ver = importlib.import_module("revcol.verify")  # the module (revcol.verify is also the function)
+    ver = importlib.import_module("revcol.studies.paper_scenes")  # where the reversal scene calls verify
     real = ver.verify
 
     def verify(*a, **k):

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import revcol.lattice_gas as lg
-from revcol.cli import main as cli_main
+from revcol.cli.main import main as cli_main
 from revcol.lattice import LatticeSimulation
-from revcol.run import run_scene
+from revcol.studies.scenes import run_scene
 from revcol.scene import DEFAULT_SCENE, SceneError, load_scene, scene_from_dict, with_engine
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -251,7 +251,7 @@ def test_limits_are_the_engines(monkeypatch):
 
 
 def test_paper_mode_gases_in_1d_and_2d_as_the_engine(tmp_path):
-    from revcol.run import run_scene
+    from revcol.studies.scenes import run_scene
 
     for d in (1, 2):
         s = scene_from_dict({"system": {"dimension": d, "particles": 40, "packing_fraction": 0.2},

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from revcol import Simulation
-from revcol.cli import main as cli_main
+from revcol.cli.main import main as cli_main
 from revcol.lattice import LatticeSimulation
-from revcol.simulate import simulate
+from revcol.cli.simulate import simulate
 from revcol.scene import SceneError
 
 FLOAT = "[system]\ndimension = 2\nparticles = 100\npacking_fraction = 0.3\n[collisions]\nengine = \"float\"\n" \
@@ -164,7 +164,7 @@ def test_the_python_api_names_bad_values_too(tmp_path, kw, message):
 
 
 def test_ctrl_c_stops_cleanly_with_the_outputs_closed(tmp_path, capsys, monkeypatch):
-    import revcol.simulate as sm
+    import revcol.cli.simulate as sm
 
     enter, timers = sm.Interrupt.__enter__, []
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from revcol import stability as S
+from revcol.studies import stability as S
 
 COUNT, LAW = S.REDUCED["count"], S.REDUCED["law_samples"]
 ROUND_TRIP = 2e-15          # exact mode: back to the quantized pre state, to a few ulps

@@ -1,4 +1,4 @@
-"""revcol.statesave: the paper's state saving vs reverse computation study, at small N and N_c
+"""revcol.studies.statesave: the paper's state saving vs reverse computation study, at small N and N_c
 (seconds in all; the big runs are benchmarks whose results are committed)."""
 import json
 import math
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import revcol
-from revcol import statesave as ss
-from revcol.cli import main as cli_main
+from revcol.studies import statesave as ss
+from revcol.cli.main import main as cli_main
 
 N, NC = 200, 400  # about 4 collisions per particle
 
@@ -140,7 +140,7 @@ def test_study_writes_json_csv_and_plot(tmp_path):
 
 
 def test_study_interleaves_variants_round_by_round(monkeypatch):
-    import revcol.statesave_study as sst
+    import revcol.studies.statesave.driver as sst
     order = []
     real = sst._run_inline
 
@@ -233,13 +233,15 @@ def test_cli(tmp_path, capsys):
 
 
 def test_exported():
-    assert revcol.statesave is ss and "statesave" in revcol.__all__
+    # revcol.statesave is the library's side (one run in this process); the study re-exports it
+    assert revcol.statesave is sys.modules["revcol.statesave"] and "statesave" in revcol.__all__
+    assert ss.run is revcol.statesave.run and ss.variants is revcol.statesave.variants
 
 
 def test_markdown_tables_of_a_saved_report(tmp_path, capsys):
     rep = ss.study([100, 200], 50, modes=["exact", "paper"], variants=["ss2", "rc"], repeats=3, inline=True,
                    progress=False)
-    from revcol.statesave_output import markdown
+    from revcol.studies.statesave.output import markdown
     text = markdown(rep, "s.json")
     lines = text.splitlines()
     # a table of 4 runs per mode, and one ratio row per (mode, N) with the paired median [range]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from revcol.run import run_scene
+from revcol.studies.scenes import run_scene
 from revcol.scene import load_scene
 from revcol.sweep import SweepError, load_sweep, sweep, sweep_from_dict
 
@@ -257,7 +257,7 @@ def test_run_and_statesave_studies(tmp_path):
 def test_randomness_and_equilibrium_studies(tmp_path):
     """The studies without a scene: one dieharder battery, one dense gas per point; the same
     parameters give the same report as the study's own function."""
-    from revcol import physics, randomness
+    from revcol.studies import equilibrium as physics, randomness
 
     doc = {"sweep": {"name": "rnd", "study": "randomness"}, "vary": {"rng": ["philox", "clcg4"]},
            "options": {"case": "raw", "words": 30000, "tests": [15]}}
@@ -333,7 +333,7 @@ def test_bad_sweep_files_are_named_errors(doc, message):
 
 
 def test_bad_arguments_and_files_exit_2(tmp_path, capsys):
-    from revcol.cli import main
+    from revcol.cli.main import main
 
     bad = tmp_path / "bad.toml"
     bad.write_text('[sweep]\nstudy = "nope"\n')

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import revcol
-from revcol import tradeoff
-from revcol.cli import main as cli_main
+from revcol.studies import tradeoff
+from revcol.cli.main import main as cli_main
 
 
 def _bench_binary():

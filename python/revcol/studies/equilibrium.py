@@ -13,7 +13,7 @@ value g(sigma) = (Z - 1) / (2^(d-1) phi) it implies, the collision rate against 
 with that g(sigma), the speeds against the Maxwell-Boltzmann law (chi^2 of the time-weighted
 histogram), and the temperature across slabs.
 
-(c) The same N without dynamics: event-chain Monte Carlo (``revcol.ecmc``) samples the
+(c) The same N without dynamics: event-chain Monte Carlo (:mod:`revcol.studies.ecmc`) samples the
 equilibrium of the engine's own N and box and gives its pressure exactly at that N, so the
 engine's Z is tested with no equation of state and no extrapolation (``mc``, ``mc-compare``).
 
@@ -21,12 +21,12 @@ Every law runs from the same start: ``flux`` (the default), ``specular`` (determ
 reflection: the textbook hard-sphere gas), ``uniform`` and ``paper`` (2D). docs/physics.md has
 the derivations, the tables and the figures.
 
-    python -m revcol.physics small --collisions 4000000 --json bench/results/equilibrium_small.json
-    python -m revcol.physics dense --dim 2 --phi 0.3 0.5 0.6 0.7 --json bench/results/equilibrium_dense2d.json
-    python -m revcol.physics walls --dim 2 --phi 0.5 --json bench/results/equilibrium_walls2d.json
-    python -m revcol.physics mc --dim 2 --phi 0.6 --n 1000 --seeds 8 --per-particle 20000 --json bench/results/ecmc_2d_phi0.6_n1000.json
-    python -m revcol.physics mc-compare --mc bench/results/ecmc_[23]d_*.json --md bench/results/eos_replicas_2d_phi0.6_n1000.json
-    python -m revcol.physics figures --out docs/figures/physics bench/results/equilibrium_*.json
+    python -m revcol.studies.equilibrium small --collisions 4000000 --json bench/results/equilibrium_small.json
+    python -m revcol.studies.equilibrium dense --dim 2 --phi 0.3 0.5 0.6 0.7 --json bench/results/equilibrium_dense2d.json
+    python -m revcol.studies.equilibrium walls --dim 2 --phi 0.5 --json bench/results/equilibrium_walls2d.json
+    python -m revcol.studies.equilibrium mc --dim 2 --phi 0.6 --n 1000 --seeds 8 --per-particle 20000 --json bench/results/ecmc_2d_phi0.6_n1000.json
+    python -m revcol.studies.equilibrium mc-compare --mc bench/results/ecmc_[23]d_*.json --md bench/results/eos_replicas_2d_phi0.6_n1000.json
+    python -m revcol.studies.equilibrium figures --out docs/figures/physics bench/results/equilibrium_*.json
     revcol study equilibrium ...   (the same)
 """
 from __future__ import annotations
@@ -34,7 +34,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import subprocess
 import sys
 import time
@@ -42,8 +41,13 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from ._io import atomic_open, save_figure
-from .engine import Simulation
+from .._io import atomic_open
+from ..engine import Simulation
+from ..observe import radial_distribution
+from . import ecmc
+from .eos import (carnahan_starling, classic_z, contact_value, enskog_rate, extrapolate, henderson,  # noqa: F401 (__all__)
+                  liu_disks, liu_spheres, maxwell_speed_density, microcanonical_speed_density, reference_z)
+from .equilibrium_figures import figures
 
 __all__ = ["LAWS", "exact_pair", "monte_carlo", "two_body", "small_study", "henderson", "carnahan_starling",
            "liu_disks", "liu_spheres", "reference_z", "classic_z",
@@ -196,84 +200,6 @@ def small_study(collisions: int = 4_000_000, box: float = 2.5, seed: int = 1, mc
 
 # ---- (b) dense gases -------------------------------------------------------------------
 
-def henderson(phi: float) -> float:
-    """Henderson's equation of state of hard disks (Mol. Phys. 30, 971 (1975)):
-    Z = (1 + phi^2 / 8) / (1 - phi)^2."""
-    return (1.0 + phi * phi / 8.0) / (1.0 - phi) ** 2
-
-
-def carnahan_starling(phi: float) -> float:
-    """Carnahan and Starling's equation of state of hard spheres (J. Chem. Phys. 51, 635
-    (1969)): Z = (1 + phi + phi^2 - phi^3) / (1 - phi)^3."""
-    return (1.0 + phi + phi**2 - phi**3) / (1.0 - phi) ** 3
-
-
-def liu_disks(phi: float) -> float:
-    """Liu's equation of state of the stable hard-disk fluid (H. Liu, "Global equation of state
-    and phase transitions of the hard disc systems", arXiv:2010.10624 (2020), Eq. 1):
-    Z = (1 + phi^2/8 + phi^3/18 - 4 phi^4/21) / (1 - phi)^2 (a Henderson-type form refitted
-    to modern simulation data; fluid only, phi up to about 0.7)."""
-    return (1.0 + phi**2 / 8.0 + phi**3 / 18.0 - 4.0 * phi**4 / 21.0) / (1.0 - phi) ** 2
-
-
-def liu_spheres(phi: float) -> float:
-    """Liu's correction to Carnahan-Starling for the hard-sphere fluid (H. Liu, Mol. Phys. 119,
-    e1886364 (2021)): Z = (1 + phi + phi^2 - 8 phi^3/13 - phi^4 + phi^5/2) / (1 - phi)^3."""
-    return (1.0 + phi + phi**2 - 8.0 * phi**3 / 13.0 - phi**4 + phi**5 / 2.0) / (1.0 - phi) ** 3
-
-
-def reference_z(d: int, phi: float) -> float:
-    """The reference equation of state of the fluid: Liu's for disks (2D) and spheres (3D),
-    both within about 0.05% of modern simulation data where Henderson's (2D) drifts to +1% at
-    0.6 and Carnahan-Starling's (3D) is 0.2-0.3% low at 0.3-0.45. In 1D, Tonks' exact
-    1 / (1 - phi)."""
-    if d == 1:
-        return 1.0 / (1.0 - phi)
-    return liu_disks(phi) if d == 2 else liu_spheres(phi)
-
-
-def classic_z(d: int, phi: float) -> float:
-    """Henderson (2D) or Carnahan-Starling (3D), the textbook forms, for comparison."""
-    return henderson(phi) if d == 2 else carnahan_starling(phi)
-
-
-def contact_value(d: int, phi: float, z: float) -> float:
-    """g(sigma) from Z: Z - 1 = 2^(d-1) phi g(sigma) (the virial theorem for hard spheres)."""
-    return (z - 1.0) / (2 ** (d - 1) * phi)
-
-
-def enskog_rate(d: int, phi: float, temperature: float, g_contact: float, diameter: float = 1.0) -> float:
-    """Collisions per particle per unit time, Enskog: n sigma^(d-1) S g(sigma) sqrt(T / pi)
-    with S = 2 pi (2D) or ... : 2 n sigma g sqrt(pi T) in 2D, 4 n sigma^2 g sqrt(pi T) in 3D
-    (unit mass)."""
-    vol = math.pi / 4 * diameter**2 if d == 2 else math.pi / 6 * diameter**3
-    n = phi / vol
-    pref = 2.0 * n * diameter if d == 2 else 4.0 * n * diameter**2
-    return pref * g_contact * math.sqrt(math.pi * temperature)
-
-
-def maxwell_speed_density(d: int, s: np.ndarray, temperature: float) -> np.ndarray:
-    """The Maxwell-Boltzmann density of the speed in d dimensions (unit mass)."""
-    s = np.asarray(s, dtype=float)
-    if d == 2:
-        return s / temperature * np.exp(-s * s / (2 * temperature))
-    return np.sqrt(2 / math.pi) * s * s / temperature**1.5 * np.exp(-s * s / (2 * temperature))
-
-
-def microcanonical_speed_density(d: int, n: int, s: np.ndarray, temperature: float) -> np.ndarray:
-    """The exact speed density of one of n particles with total momentum 0 and kinetic energy
-    E = n d T / 2 (a periodic box): velocities uniform on the sphere of the d (n - 1)
-    dimensional subspace, whose one-particle marginal is proportional to
-    s^(d-1) (1 - n s^2 / (2 (n - 1) E))^((d (n - 1) - d - 2) / 2). Tends to Maxwell-Boltzmann as n grows."""
-    s = np.asarray(s, dtype=float)
-    energy = n * d * temperature / 2.0
-    a = n / (2.0 * (n - 1) * energy)
-    p = (d * (n - 1) - d - 2) / 2.0
-    grid = np.linspace(0.0, 1.0 / math.sqrt(a), 20001)
-    f = lambda x: np.where(a * x * x < 1.0, x ** (d - 1) * np.clip(1.0 - a * x * x, 0.0, None) ** p, 0.0)
-    norm = np.trapezoid(f(grid), grid)
-    return f(s) / norm
-
 
 #: a speed bin enters the resolved chi^2 when each block draws at least this many new speeds
 #: in it (2 per collision, by the reference law): its block error is then an estimate, not
@@ -317,8 +243,6 @@ def dense(d: int, phi: float, law: str, n: int = 1000, per_particle: float = 200
     ``law``, 200 collisions per particle to equilibrate, then ``per_particle`` observed; Z,
     collision rate, speeds and slab temperatures with block errors, g(r) from ``frames``
     frames (numpy or freud) and its contact value by a quadratic fit of the first bins."""
-    from .observe import radial_distribution
-
     sim = Simulation.random(n=n, dim=d, phi=phi, seed=seed, boundary="periodic", **LAWS[law])
     sim.run(collisions=int(100 * n))
     T = float(sim.diagnostics()["energy"]) * 2.0 / (d * n)
@@ -457,20 +381,6 @@ def dense_table(runs: Sequence[dict]) -> str:
     return "\n".join(rows)
 
 
-def extrapolate(ns: Sequence[float], zs: Sequence[float], errors: Sequence[float]) -> tuple[float, float, float]:
-    """Z(N) = Z_inf + a / N through runs at two or more sizes, weighted least squares (weights
-    1 / error^2): (Z_inf, its standard error, a). With two sizes the line goes through both."""
-    x = 1.0 / np.asarray(ns, dtype=float)
-    z, e = np.asarray(zs, dtype=float), np.asarray(errors, dtype=float)
-    if len(x) < 2 or len(set(x.tolist())) < 2:
-        raise ValueError("extrapolate needs runs at two different sizes at least")
-    w = 1.0 / e ** 2
-    a_mat = np.array([[w.sum(), (w * x).sum()], [(w * x).sum(), (w * x * x).sum()]])
-    cov = np.linalg.inv(a_mat)
-    zi, slope = cov @ np.array([(w * z).sum(), (w * x * z).sum()])
-    return float(zi), float(math.sqrt(cov[0, 0])), float(slope)
-
-
 def finite_size(runs: Sequence[dict]) -> list[dict[str, Any]]:
     """Z(N -> infinity) per (d, phi, law) from dense runs at several N (``extrapolate``),
     against Liu's equation of state: value, error, number of standard errors."""
@@ -518,155 +428,14 @@ def _run_info(argv: Sequence[str], t0: float) -> dict[str, Any]:
             return subprocess.run(cmd, capture_output=True, text=True, timeout=10).stdout.strip()
         except (OSError, subprocess.SubprocessError):
             return ""
-    return {"command": "python -m revcol.physics " + " ".join(argv), "commit": sh(["git", "rev-parse", "--short", "HEAD"]),
+    return {"command": "python -m revcol.studies.equilibrium " + " ".join(argv), "commit": sh(["git", "rev-parse", "--short", "HEAD"]),
             "uptime": sh(["uptime"]), "wall_s": time.time() - t0,
             "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
 
 
-def figures(paths: Sequence[str], out: str) -> list[str]:
-    """Z against phi with the equation of state, g(r), speed histograms with the Maxwellian,
-    and the two-disk distance distribution, from the study's JSON files; PNGs into ``out``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    docs = [json.load(open(p)) for p in paths]
-    dense_runs = [r for d in docs for r in d.get("dense", [])]
-    small = [d["small"] for d in docs if "small" in d]
-    from .ecmc import summarize
-    mc_rows = summarize([r for d in docs for r in d.get("mc", [])])
-    os.makedirs(out, exist_ok=True)
-    written = []
-    colours = {"flux": "C0", "specular": "k", "uniform": "C3", "paper": "C1"}
-    if dense_runs:
-        fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharex="col")
-        for col, d in enumerate((2, 3)):
-            rs = [r for r in dense_runs if r["dim"] == d]
-            if not rs:
-                continue
-            ax, dev = axes[0][col], axes[1][col]
-            ph = np.linspace(0.0, max(r["phi"] for r in rs) + 0.02, 100)
-            eos = "Liu"
-            classic = "Henderson" if d == 2 else "Carnahan-Starling"
-            ax.plot(ph, [reference_z(d, p) for p in ph], "-", color="0.6", label=f"{eos} (EOS)")
-            ax.plot(ph, [classic_z(d, p) for p in ph], ":", color="0.6", label=classic)
-            dev.plot(ph, [100 * (classic_z(d, p) / reference_z(d, p) - 1) for p in ph], ":", color="0.6",
-                     label=f"{classic} / {eos} - 1")
-            dev.axhline(0.0, color="0.6")
-            for k, law in enumerate(LAWS):
-                sel = [r for r in rs if r["law"] == law]
-                if not sel:
-                    continue
-                x = [r["phi"] + 0.004 * (k - 1.5) for r in sel]
-                ax.errorbar(x, [r["z"][0] for r in sel], yerr=[r["z"][1] for r in sel], fmt="o", ms=3,
-                            color=colours[law], label=law)
-                zr = [reference_z(d, r["phi"]) for r in sel]
-                dev.errorbar(x, [100 * (r["z"][0] / z - 1) for r, z in zip(sel, zr)],
-                             yerr=[100 * r["z"][1] / z for r, z in zip(sel, zr)], fmt="o", ms=3, color=colours[law])
-            same_n = [m for m in mc_rows if m["dim"] == d and m["n"] == rs[0]["n"]]
-            if same_n:  # the equilibrium of the same N and box (event chains), in the engine's convention
-                x = [m["phi"] + 0.008 for m in same_n]
-                ax.errorbar(x, [m["z_md"][0] for m in same_n], yerr=[m["z_md"][1] for m in same_n], fmt="s", ms=4,
-                            mfc="none", color="C2", label="event chains, same N")
-                dev.errorbar(x, [100 * (m["z_md"][0] / reference_z(d, m["phi"]) - 1) for m in same_n],
-                             yerr=[100 * m["z_md"][1] / reference_z(d, m["phi"]) for m in same_n], fmt="s", ms=4,
-                             mfc="none", color="C2", label="event chains, same N")
-            ax.set_ylabel("Z = PV / NkT"), ax.set_title(f"{d}D, N = {rs[0]['n']}, periodic")
-            dev.set_xlabel("packing fraction"), dev.set_ylabel(f"Z / {eos} - 1 (%)")
-            ax.legend(fontsize=7)
-            dev.legend(fontsize=7)
-        fig.tight_layout()
-        written.append(_save(fig, out, "z_vs_phi.png"))
-        def g_panel(ax, d, phi, rs):
-            for r in rs:
-                ax.plot(r["g_r"][0], r["g_r"][1], color=colours[r["law"]], lw=1, label=r["law"])
-            ax.set_xlabel("r / sigma"), ax.set_ylabel("g(r) (40 frames)"), ax.set_title(f"{d}D, phi = {phi}")
-
-        written.append(_per_dim(plt, dense_runs, {2: 0.5, 3: 0.45}, g_panel, out, "g_of_r.png"))
-
-        def speed_panel(ax, d, phi, rs):
-            for r in rs:
-                c = np.asarray(r["speed_centres"])
-                ref = microcanonical_speed_density(d, r["n"], c, r["temperature"][0])
-                ax.errorbar(c, np.asarray(r["speed"]) / ref - 1.0, yerr=np.asarray(r["speed_error"]) / ref, fmt=".-",
-                            lw=0.6, ms=3, color=colours[r["law"]], label=r["law"])
-            ax.axhline(0.0, color="0.6")
-            ax.set_ylim(-0.05, 0.05), ax.set_xlim(0, 3.5 * math.sqrt(rs[0]["temperature"][0]))
-            ax.set_xlabel("speed"), ax.set_title(f"{d}D, phi = {phi}")
-            ax.set_ylabel("time-weighted density / exact - 1")
-
-        written.append(_per_dim(plt, dense_runs, {2: 0.3, 3: 0.1}, speed_panel, out, "speeds.png"))
-    walls = [r for d in docs for r in d.get("walls", [])]
-    if walls:
-        dims = sorted({r["dim"] for r in walls})
-        fig, axes = plt.subplots(len(dims), 2, figsize=(9, 3.2 * len(dims)), squeeze=False)
-        for row, d in zip(axes, dims):
-            rs = [r for r in walls if r["dim"] == d]
-            for r in rs:
-                e = np.asarray(r["slab_edges"])
-                c = 0.5 * (e[1:] + e[:-1]) / e[-1]
-                T = r["temperature"][0]
-                row[0].errorbar(c, 100 * (np.asarray(r["slab_temperature"]) / T - 1),
-                                yerr=100 * np.asarray(r["slab_temperature_error"]) / T, fmt="o-", ms=3, lw=0.7,
-                                color=colours[r["law"]], label=r["law"])
-                row[1].plot(c, r["slab_density"], "o-", ms=3, lw=0.7, color=colours[r["law"]], label=r["law"])
-            row[0].axhline(0.0, color="0.6")
-            row[0].set_ylabel("slab temperature / T - 1 (%)"), row[1].set_ylabel("number density")
-            for ax in row:
-                ax.set_xlabel("x / L"), ax.legend(fontsize=7)
-                ax.set_title(f"{d}D, phi = {rs[0]['phi']}, walls, N = {rs[0]['n']}")
-        fig.tight_layout()
-        written.append(_save(fig, out, "walls_slabs.png"))
-    for st in small:
-        fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
-        for ax, d in zip(axes, (2, 3)):
-            mc = st.get(f"mc_{d}d")
-            if mc is None:
-                continue
-            e = np.asarray(mc["distance_edges"])
-            c = 0.5 * (e[1:] + e[:-1])
-            ax.plot(c, mc["distance"], "-", color="0.6", lw=2, label="Monte Carlo (exact)")
-            for r in st["runs"]:
-                if r["dim"] == d:
-                    n = min(len(c), len(r["distance"]))
-                    ax.plot(c[:n], r["distance"][:n], "-", lw=0.8, color=colours[r["law"]], label=r["law"])
-            ax.set_xlim(0.95, 1.6)
-            ax.set_xlabel("|r| / sigma"), ax.set_ylabel("density of the distance")
-            ax.set_title("two disks, box 2.5" if d == 2 else "two spheres, box 2.5")
-            ax.legend(fontsize=7)
-        fig.tight_layout()
-        written.append(_save(fig, out, "two_body_distance.png"))
-    return written
-
-
-def _per_dim(plt, runs: Sequence[dict], phis: dict[int, float], panel, out: str, name: str) -> str:
-    """One panel per dimension, of the runs at phis[d] (or the densest), saved as out/name."""
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
-    for ax, d in zip(axes, (2, 3)):
-        rs = [r for r in runs if r["dim"] == d]
-        if not rs:
-            continue
-        have = {r["phi"] for r in rs}
-        phi = phis[d] if phis[d] in have else max(have)
-        panel(ax, d, phi, [r for r in rs if r["phi"] == phi])
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    return _save(fig, out, name)
-
-
-def _save(fig, out: str, name: str) -> str:
-    import matplotlib.pyplot as plt
-
-    path = os.path.join(out, name)
-    save_figure(fig, path, dpi=90)
-    plt.close(fig)
-    return path
-
-
 def main(argv: Optional[Sequence[str]] = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    ap = argparse.ArgumentParser(prog="python -m revcol.physics", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m revcol.studies.equilibrium", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="what", required=True)
     a = sub.add_parser("small", help="(a) two particles in a closed box against the exact equilibrium")
     a.add_argument("--collisions", type=int, default=4_000_000)
@@ -747,8 +516,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
 
 def _mc_main(args: argparse.Namespace, argv: Sequence[str], t0: float) -> int:
-    """The `mc` and `mc-compare` subcommands (revcol.ecmc)."""
-    from . import ecmc
+    """The `mc` and `mc-compare` subcommands (:mod:`revcol.studies.ecmc`)."""
     if args.what == "mc":
         if args.seeds < 1 or any(n < 2 for n in args.n):
             raise SystemExit("mc: --seeds must be >= 1 and every --n >= 2")
@@ -769,7 +537,7 @@ def _mc_main(args: argparse.Namespace, argv: Sequence[str], t0: float) -> int:
         for p in args.mc:
             doc_mc = json.load(open(p))
             if "mc" not in doc_mc:
-                raise SystemExit(f"mc-compare: {p} holds no `mc` runs (a JSON of `python -m revcol.physics mc` has an 'mc' list)")
+                raise SystemExit(f"mc-compare: {p} holds no `mc` runs (a JSON of `python -m revcol.studies.equilibrium mc` has an 'mc' list)")
             runs += doc_mc["mc"]
         rows = ecmc.summarize(runs)
         md = [e for p in args.md for e in ecmc.md_estimates(json.load(open(p)))]

@@ -1,27 +1,16 @@
-"""Reports of ``revcol run`` as text and as JSON: a gas round trip, a reversal scene, a
-state-saving study and the horizon table (:func:`format_report`, :func:`format_horizon`,
-:func:`write_json`; numpy values and non-finite floats become plain JSON).
+"""Reports of ``revcol run`` as text: a gas round trip, a reversal scene, a state-saving study
+and the horizon table (:func:`format_report`, :func:`format_horizon`); the JSON report is
+:func:`revcol._io.write_json`'s.
 """
 from __future__ import annotations
 
-import json
 import math
-import os
 from pathlib import Path
-from typing import Any
 
-import numpy as np
+from ..roundtrip import BAR, ERROR_DEFINITIONS, divergence_text
+from ..studies.statesave.output import format_table
 
-from .roundtrip import BAR, ERROR_DEFINITIONS, divergence_text
-
-__all__ = ["format_report", "format_horizon", "verify_lines", "write_json", "version"]
-
-
-def version() -> str:
-    """The package version (for reports)."""
-    from . import __version__
-
-    return __version__
+__all__ = ["format_report", "format_horizon", "verify_lines"]
 
 
 def _si(x: float | None, unit: str = "") -> str:
@@ -47,8 +36,6 @@ def format_report(r: dict) -> str:
         if r["interrupted"]:
             lines.append("  interrupted         (Ctrl-C) after the reversal, which is one call: it ran to the end")
     elif r["kind"] == "statesave":
-        from .statesave import format_table
-
         lines = [head, f"  scene   {r['summary']}", f"  runner  {r['runner']}: {r['rss_note']}", format_table(r)]
         if r["interrupted"]:
             lines.append(f"  interrupted (Ctrl-C): the table covers the runs done; {r.get('not_run', 0)} not run")
@@ -220,30 +207,3 @@ def _lattice_horizon(r: dict) -> str:
     if r.get("written"):
         lines.append("  written  " + " ".join(r["written"]))
     return "\n".join(lines)
-
-
-def _jsonable(o: Any) -> Any:
-    if isinstance(o, dict):
-        return {str(k): _jsonable(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [_jsonable(v) for v in o]
-    if isinstance(o, np.ndarray):
-        return _jsonable(o.tolist())
-    if isinstance(o, (np.integer,)):
-        return int(o)
-    if isinstance(o, (np.floating, float)):
-        return float(o) if math.isfinite(o) else str(o)
-    if isinstance(o, Path):
-        return str(o)
-    return o
-
-
-def write_json(report: dict, path: str | os.PathLike) -> str:
-    """Writes the report as indented JSON (creating the directory); returns the path."""
-    from ._io import atomic_open
-
-    p = Path(path)
-    with atomic_open(p) as f:
-        f.write(json.dumps(_jsonable(report), indent=1) + "\n")
-    return str(p)
-

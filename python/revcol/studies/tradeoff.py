@@ -54,9 +54,9 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from . import _core
-from ._io import atomic_open
-from .statesave_study import find_binary
+from .. import _core
+from .._io import atomic_open
+from .statesave.driver import find_binary
 
 __all__ = ["all_points", "reduced_points", "run", "law_distance", "rejection_posts", "pareto_front", "format_table",
            "write_json", "write_csv", "plot", "main", "add_arguments", "cli_main", "ERRORS"]
@@ -256,7 +256,7 @@ def law_distance(settings: dict, samples: int) -> dict:
     (``law_D``); ``law_D_noise`` = 1.54 sqrt(2 / samples), the 95% level of the largest of
     three independent distances when the laws are equal. None for the 1D pair (no draw). ``invalid_post``: the fraction of post states that
     do not separate (paper mode; they are compared as they are)."""
-    from . import paper as _paper
+    from .. import paper as _paper
 
     case, mode = settings["case"], settings["mode"]
     law = "uniform" if mode == "paper" else settings["law"]  # the paper's stated target

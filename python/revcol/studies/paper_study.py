@@ -18,7 +18,7 @@ import json
 import sys
 from typing import Sequence
 
-from .paper import PAPER_CASES, bias, failure_rate, uniformity
+from ..paper import PAPER_CASES, bias, failure_rate, uniformity
 
 __all__ = ["main"]
 

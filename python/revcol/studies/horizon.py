@@ -8,44 +8,19 @@ particle; :func:`horizon` measures it.
 from __future__ import annotations
 
 import datetime as dt
-import math
 import sys
 
-import numpy as np
-
-from .engine import Simulation
-from .gas import build_simulation
-from .progress import Bar, Interrupt, peak_rss
-from .roundtrip import BAR, ERROR_DEFINITIONS, geometry, round_trip_errors
-from .scene import Scene, SceneError
+from ..engine import Simulation
+from ..gas import build_simulation
+from ..lattice_gas import lattice_horizon
+from ..progress import Bar, Interrupt, peak_rss
+from ..roundtrip import BAR, ERROR_DEFINITIONS, combine_seeds, geometry, round_trip_errors
+from ..scene import Scene, SceneError
 
 __all__ = ["HORIZON_GRID", "horizon"]
 
 #: collisions per particle tried by :func:`horizon` (1, 1.5, 2, 3, 5, 7 per decade)
 HORIZON_GRID = tuple(m * 10.0**e for e in range(-1, 5) for m in (1, 1.5, 2, 3, 5, 7))
-
-
-def combine_seeds(grid: list[int], n: int, per_seed: list[list[tuple[float, float]]]) -> tuple[list[dict], int]:
-    """The horizon's table from each seed's (position, velocity) errors at the grid's N_c (a seed
-    stops early once O(1)): per N_c the worst of the seeds (a stopped seed counts as infinite),
-    the median of each seed's larger error and how many fail the bar; and the horizon, the
-    largest N_c before the first that fails. ``revcol sweep`` combines its seeds with this too."""
-    rows = []
-    for k, nc in enumerate(grid):
-        if all(k >= len(e) for e in per_seed):
-            break
-        ex = [e[k][0] if k < len(e) else math.inf for e in per_seed]
-        ev = [e[k][1] if k < len(e) else math.inf for e in per_seed]
-        worst = [max(a, b) for a, b in zip(ex, ev)]
-        rows.append({"collisions": nc, "per_particle": 2.0 * nc / n, "error_x": max(ex), "error_v": max(ev),
-                     "median": float(np.median(worst)), "fails": int(sum(w > BAR for w in worst)),
-                     "seeds": len(per_seed)})
-    h = 0
-    for r in rows:
-        if max(r["error_x"], r["error_v"]) > BAR:
-            break
-        h = r["collisions"]
-    return rows, h
 
 
 def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1: float = 0.1,
@@ -66,8 +41,6 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
         raise SceneError(f"{scene.source}: [rng] seed: seeds {scene.seed} .. {scene.seed + seeds - 1} "
                          "pass 2^32 - 1")
     if scene.engine == "lattice":  # no horizon: checked bit for bit at a few N_c instead
-        from .lattice_gas import lattice_horizon
-
         return lattice_horizon(scene, seeds=seeds, max_collisions=max_collisions, progress=progress)
     if progress is None:
         progress = sys.stdout.isatty()

@@ -1,15 +1,19 @@
 """The studies a sweep runs without a scene: the randomness battery (one point: one stream
-configuration through dieharder, :func:`revcol.randomness.battery`) and the equilibrium study's
-dense gas (one point: one dimension x packing fraction x law x N, :func:`revcol.physics.dense`).
+configuration through dieharder, :func:`revcol.studies.randomness.battery`) and the equilibrium study's
+dense gas (one point: one dimension x packing fraction x law x N, :func:`revcol.studies.equilibrium.dense`).
 
 Each parameter has a default and a check; a point's parameters are checked before anything runs
 (ValueError naming the parameter and what is allowed), and the point's report is the study
-function's dict with ``kind`` added.
+function's dict with ``kind`` added. The study modules are imported where a check or a point
+needs them, not with this module: ``import revcol`` imports ``revcol.sweep``, and the studies
+load only when a sweep names them.
 """
 from __future__ import annotations
 
 import math
 from typing import Any, Callable
+
+from ..scene import LIMITS
 
 __all__ = ["SCENELESS", "defaults", "check", "run", "memory"]
 
@@ -35,7 +39,7 @@ def _one_of(*names: str) -> Callable[[Any], str | None]:
 
 
 def _tests(v: Any) -> str | None:
-    from .randomness import PAPER_TESTS
+    from ..studies.randomness import PAPER_TESTS
 
     if not isinstance(v, list) or not v or any(isinstance(t, bool) or t not in PAPER_TESTS for t in v):
         return f"a non-empty list of dieharder test numbers among {sorted(PAPER_TESTS)}"
@@ -43,7 +47,7 @@ def _tests(v: Any) -> str | None:
 
 
 def _case(v: Any) -> str | None:
-    from .randomness import stream_cases
+    from ..studies.words import stream_cases
 
     cases = sorted(set(stream_cases("exact")) | set(stream_cases("paper")))
     return None if v in cases else "a word-stream case: " + ", ".join(cases)
@@ -78,8 +82,6 @@ def check(study: str, params: dict[str, Any]) -> None:
         if bad is not None:
             raise ValueError(f"parameter {k!r}: must be {bad}, got {v!r}")
     if study == "equilibrium":
-        from .scene import LIMITS
-
         d, phi = params.get("dimension", 2), params.get("packing_fraction", 0.3)
         if phi > LIMITS["max_fraction"][d]:
             raise ValueError(f"parameter 'packing_fraction': at most {LIMITS['max_fraction'][d]} in {d}D "
@@ -95,7 +97,7 @@ def memory(study: str, params: dict[str, Any]) -> int:
 def run(study: str, params: dict[str, Any]) -> dict:
     """Runs one point; its report (the study function's dict, ``kind`` added)."""
     if study == "randomness":
-        from .randomness import battery, has_dieharder
+        from ..studies.randomness import battery, has_dieharder
 
         if not has_dieharder():
             raise RuntimeError("the randomness battery needs the dieharder program on every worker "
@@ -103,7 +105,7 @@ def run(study: str, params: dict[str, Any]) -> dict:
         config = {k: params[k] for k in ("case", "mode", "law", "rng", "seed")}
         r = battery(config, params["words"], tuple(params["tests"]))
         return {"kind": "randomness", **r}
-    from .physics import dense
+    from ..studies.equilibrium import dense
 
     r = dense(params["dimension"], float(params["packing_fraction"]), params["law"], n=params["particles"],
               per_particle=float(params["per_particle"]), seed=params["seed"])

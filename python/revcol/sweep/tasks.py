@@ -25,40 +25,30 @@ import uuid
 from pathlib import Path
 from typing import Callable
 
-from ._io import atomic_open
-from .scene import Scene, SceneError, scene_from_dict, with_engine
+from .._io import atomic_open, jsonable
+from ..progress import Bar
+from ..scene import SceneError, scene_from_dict
+from .output import gather, point_path, read_point
+from . import studies as sceneless
+from .spec import SweepError
 
-__all__ = ["run_point", "check_options", "execute"]
+__all__ = ["run_point", "execute"]
 
 #: Dask worker resource a task claims (bytes of memory); LocalCluster workers offer their memory limit
 MEMORY = "MEMORY"
 
 
-def check_options(scene: Scene, options: dict) -> None:
-    """Raises ValueError naming the option when a study option is out of range."""
-    for k in ("max_collisions", "seeds"):
-        if k in options:
-            v = options[k]
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise ValueError(f"{k} must be a positive integer, got {v!r}")
-    if "engine" in options:
-        with_engine(scene, options["engine"])  # SceneError naming the engine
-    if scene.seed + options.get("seeds", 1) > 2**32:
-        raise ValueError(f"seeds {scene.seed} .. {scene.seed + options['seeds'] - 1} pass 2^32 - 1")
-
-
 def run_point(task: dict) -> dict:
     """Runs one point (on a worker, or here) and returns ``{"report", "seconds", "host", "pid"}``;
     the report is the dict ``revcol run --json`` writes (JSON values only)."""
-    from .report import _jsonable
-    from .run import run_scene
+    # deferred, not a cycle: `import revcol` imports revcol.sweep, and the studies load only
+    # when a point runs (on the worker)
+    from ..studies.scenes import run_scene
 
     t0 = time.perf_counter()
     opts = task["options"]
     if task["study"] in ("randomness", "equilibrium"):
-        from . import _sweep_studies
-
-        r = _sweep_studies.run(task["study"], opts)
+        r = sceneless.run(task["study"], opts)
     elif task["study"] == "horizon":
         scene = scene_from_dict(task["doc"], task["label"], Path(task["base"]))
         r = run_scene(scene, horizon_seeds=opts.get("seeds", 1), max_collisions=opts.get("max_collisions", 1_000_000),
@@ -66,22 +56,8 @@ def run_point(task: dict) -> dict:
     else:
         scene = scene_from_dict(task["doc"], task["label"], Path(task["base"]))
         r = run_scene(scene, engine=opts.get("engine"), progress=False)
-    return {"report": _jsonable(r), "seconds": time.perf_counter() - t0, "host": socket.gethostname(),
+    return {"report": jsonable(r), "seconds": time.perf_counter() - t0, "host": socket.gethostname(),
             "pid": os.getpid()}
-
-
-def point_path(out: Path, h: str) -> Path:
-    """Where the point with hash ``h`` is written."""
-    return out / "points" / f"{h}.json"
-
-
-def read_point(out: Path, h: str) -> dict | None:
-    """The finished point with hash ``h``, or None (absent, or not a whole point file)."""
-    try:
-        d = json.loads(point_path(out, h).read_text())
-    except (OSError, ValueError):
-        return None
-    return d if isinstance(d, dict) and d.get("hash") == h and isinstance(d.get("report"), dict) else None
 
 
 def _write_point(out: Path, spec, p, result: dict) -> None:
@@ -106,9 +82,6 @@ class _State:
 def execute(spec, out: Path, *, workers, scheduler, scheduler_file, client, progress, stop_after,
             log: Callable[[str], None], on_result: Callable[[dict], None] | None = None) -> dict:
     """Runs the points of ``spec`` not yet in ``out``, then gathers the table and the summary."""
-    from ._sweep_output import gather
-    from .progress import Bar
-
     todo = [p for p in spec.points if read_point(out, p.hash) is None]
     reused = len(spec.points) - len(todo)
     load0, t0 = os.getloadavg(), time.perf_counter()
@@ -162,8 +135,6 @@ def _connect(workers, scheduler, scheduler_file, log):
     from distributed import Client, LocalCluster
 
     if scheduler is not None or scheduler_file is not None:
-        from .sweep import SweepError
-
         where = scheduler or f"the scheduler in {scheduler_file}"
         if scheduler_file is not None and not os.path.isfile(scheduler_file):  # Client would wait for it forever
             raise SweepError(f"{scheduler_file}: no such scheduler file (dask scheduler --scheduler-file writes it)")
@@ -214,8 +185,6 @@ def _total_memory() -> int | None:
 def _resources(spec, client, todo, log) -> bool:
     """Whether tasks claim MEMORY: yes when every worker offers it (a point needing more than the
     largest offer is an error: it would never run); no, with a note, when no worker does."""
-    from .sweep import SweepError
-
     offers = [w.get("resources", {}).get(MEMORY) for w in client.scheduler_info()["workers"].values()]
     if not offers or any(o is None for o in offers):
         log("revcol sweep: the workers declare no MEMORY resource (dask worker --resources MEMORY=BYTES): "

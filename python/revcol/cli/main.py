@@ -8,9 +8,9 @@
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
     revcol bench tradeoff [--reduced] [--repeats 3] --json bench/results/tradeoff.json --plot docs/figures/tradeoff
-    revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.randomness ...)
-    revcol study equilibrium small|dense|walls|mc|mc-compare|figures|table ...   (= python -m revcol.physics ...)
-    revcol study stability [--full] [--json FILE] [--markdown]   (= python -m revcol.stability ...)
+    revcol study randomness battery|controls|matrix|words|coverage ...   (= python -m revcol.studies.randomness ...)
+    revcol study equilibrium small|dense|walls|mc|mc-compare|figures|table ...   (= python -m revcol.studies.equilibrium ...)
+    revcol study stability [--full] [--json FILE] [--markdown]   (= python -m revcol.studies.stability ...)
     revcol sweep SWEEP.toml|NAME [--out DIR] [--workers K | --scheduler tcp://HOST:PORT | --scheduler-file F]
     revcol --version
 
@@ -30,9 +30,15 @@ import os
 import sys
 import warnings
 
-from ._io import atomic_open
-from . import statesave
-from .verify import VERIFY_CASES, verify
+from .._io import atomic_open, jsonable
+from .._version import __version__
+from ..scene import SceneError, load_scene
+from ..studies import equilibrium, randomness, stability, statesave, tradeoff
+from ..sweep import SweepError, sweep
+from ..verify import VERIFY_CASES, verify
+from .report import verify_lines
+from .run import run_command
+from .simulate import format_simulate, simulate
 
 
 def _positive_int(text: str) -> int:
@@ -101,8 +107,6 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> argparse.ArgumentParser:
-    from . import __version__
-
     p = _Parser(prog="revcol", description="Reversible elastic collisions.")
     p.add_argument("--version", action="version", version=f"revcol {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
@@ -152,85 +156,28 @@ def _parser() -> argparse.ArgumentParser:
     bsub = b.add_subparsers(dest="study", required=True)
     statesave.add_arguments(bsub.add_parser(
         "statesave", help="the paper's state saving vs reverse computation study (and lazy transport)"))
-    from . import tradeoff  # revcol bench tradeoff (issue 18): run time against error
+    # revcol bench tradeoff (issue 18): run time against error
     tradeoff.add_arguments(bsub.add_parser(
         "tradeoff", help="run time against error for every operator and accuracy knob, with Pareto plots"))
     st = sub.add_parser("study", help="studies (their arguments go to the study's module)")
     stsub = st.add_subparsers(dest="study", required=True)
     rnd = stsub.add_parser("randomness", add_help=False,
-                           help="the paper's randomness (dieharder) and coverage experiments: python -m revcol.randomness")
+                           help="the paper's randomness (dieharder) and coverage experiments: python -m revcol.studies.randomness")
     rnd.add_argument("rest", nargs=argparse.REMAINDER)
     eq = stsub.add_parser("equilibrium", add_help=False,
                           help="does a collision law keep equilibrium (two particles exactly, dense gases against "
                           "the equations of state and against event-chain Monte Carlo of the same N): "
-                          "python -m revcol.physics")
+                          "python -m revcol.studies.equilibrium")
     eq.add_argument("rest", nargs=argparse.REMAINDER)
     stab = stsub.add_parser("stability", add_help=False,
-                            help="the numerical stress suite, every class for every operator: python -m revcol.stability")
+                            help="the numerical stress suite, every class for every operator: python -m revcol.studies.stability")
     stab.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 
 
 def _summary(r: dict) -> str:
-    from .report import verify_lines as _verify_lines
-
     mode = r["mode"] + (f"/{r['law']}" if r["mode"] == "exact" and r["case"] != "pair1d" else "")
-    return "\n".join([f"revcol verify {r['case']}  mode={mode}  rng={r['rng']}  seed={r['seed']}"] + _verify_lines(r))
-
-
-def _warn_line(message, category, *rest) -> None:
-    print(f"revcol run: warning: {message}", file=sys.stderr)
-
-
-def _run(args: argparse.Namespace) -> int:
-    """``revcol run``: exit 0 passed, 1 failed, 2 bad scene/option, 130 interrupted."""
-    from .run import format_report, run_scene
-    from .scene import SceneError
-
-    if args.seeds is not None and not args.horizon:
-        print("revcol run: error: --seeds applies to --horizon only", file=sys.stderr)
-        return 2
-    to_stdout = args.json == "-"
-    try:
-        with warnings.catch_warnings():  # a scene's deprecated spellings: one line each on stderr
-            warnings.simplefilter("always", DeprecationWarning)
-            warnings.showwarning = _warn_line
-            scene = args.scene
-            if to_stdout:  # the scene's own [output] json is replaced by standard output
-                from .scene import load_scene
-
-                scene = dataclasses.replace(load_scene(scene), json=None)
-            report = run_scene(scene, json_path=None if to_stdout else args.json, plot=args.plot,
-                               trajectory=args.trajectory,
-                               horizon_seeds=(args.seeds or 1) if args.horizon else None,
-                               max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
-                               engine=args.engine, progress=False if args.no_progress else None,
-                               plot_format=args.plot_format)
-    except SceneError as e:
-        print(f"revcol run: error: {e}", file=sys.stderr)
-        return 2
-    except OSError as e:  # an output that cannot be written (permissions, a file where a directory goes)
-        print(f"revcol run: error: {e}", file=sys.stderr)
-        return 2
-    except MemoryError:
-        print("revcol run: error: not enough memory for this scene (fewer particles, or a larger machine)",
-              file=sys.stderr)
-        return 2
-    text = sys.stderr if to_stdout else sys.stdout
-    print(format_report(report), file=text)
-    if report.get("observe"):
-        from .observe import report_lines
-
-        print("\n".join(report_lines(report["observe"])), file=text)
-    if to_stdout:
-        from .report import _jsonable
-
-        print(json.dumps(_jsonable(report), indent=1))
-    if report.get("interrupted"):
-        return 130
-    if report["kind"] == "horizon":  # a measurement; on the lattice, a check that fails exits 1
-        return 0 if report.get("passed", True) else 1
-    return 0 if report["passed"] else 1
+    return "\n".join([f"revcol verify {r['case']}  mode={mode}  rng={r['rng']}  seed={r['seed']}"] + verify_lines(r))
 
 
 def _simulate_parser(sub) -> None:
@@ -267,9 +214,6 @@ def _simulate_parser(sub) -> None:
 
 def _simulate(args: argparse.Namespace) -> int:
     """``revcol simulate``: exit 0 ran, 1 engine error, 2 bad scene/option, 130 interrupted."""
-    from .scene import SceneError, load_scene
-    from .simulate import format_simulate, simulate
-
     to_stdout = args.json == "-"
     try:
         with warnings.catch_warnings():
@@ -292,9 +236,7 @@ def _simulate(args: argparse.Namespace) -> int:
         return 2
     print(format_simulate(report), file=sys.stderr if to_stdout else sys.stdout)
     if to_stdout:
-        from .report import _jsonable
-
-        print(json.dumps(_jsonable(report), indent=1))
+        print(json.dumps(jsonable(report), indent=1))
     if report["interrupted"]:
         return 130
     return 1 if report["engine_error"] else 0
@@ -322,8 +264,6 @@ def _sweep_parser(sub) -> None:
 
 def _sweep(args: argparse.Namespace) -> int:
     """``revcol sweep``: exit 0 all done, 1 some points failed, 2 bad sweep file/option, 130 interrupted."""
-    from .sweep import SweepError, sweep
-
     if args.workers is not None and args.workers < 0:
         print(f"revcol sweep: error: --workers must be >= 0, got {args.workers}", file=sys.stderr)
         return 2
@@ -362,20 +302,14 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str] | None) -> int:
     words = sys.argv[1:] if argv is None else list(argv)
     if words[:2] == ["study", "randomness"]:  # everything after it (-h included) is the study's
-        from . import randomness
-
         return randomness.main(words[2:])
     if words[:2] == ["study", "equilibrium"]:
-        from . import physics
-
-        return physics.main(words[2:])
+        return equilibrium.main(words[2:])
     if words[:2] == ["study", "stability"]:
-        from . import stability
-
         return stability.main(words[2:])
     args = _parser().parse_args(argv)
     if args.command == "run":
-        return _run(args)
+        return run_command(args)
     if args.command == "simulate":
         return _simulate(args)
     if args.command == "sweep":
@@ -397,8 +331,6 @@ def _main(argv: list[str] | None) -> int:
                     json.dump(report, f, indent=1)
         return 0 if report["passed"] else 1
     if args.command == "bench" and args.study == "tradeoff":
-        from . import tradeoff
-
         return tradeoff.cli_main(args, argv)
     if args.command == "bench":
         return statesave.cli_main(args, argv)

@@ -33,8 +33,9 @@ from typing import Any, Optional
 
 import numpy as np
 
-from . import _core
-from ._core import EventChain
+from .. import _core
+from .._core import EventChain
+from .eos import extrapolate, reference_z
 
 __all__ = ["EventChain", "md_equivalent", "mc_equivalent", "start", "default_chain_length", "sample"]
 
@@ -65,7 +66,6 @@ def default_chain_length(dim: int, phi: float, diameter: float = 1.0) -> float:
     """A chain length that gives about 100 lifts per chain: 100 times the mean free
     displacement of an active sphere, 1 / lift rate, with the lift rate from Liu's Z. Any length
     samples the same equilibrium; this one was the cheapest per unit error in 2D at 0.6."""
-    from .physics import reference_z
     z = reference_z(dim, phi)
     # Z - 1 = lift rate x <dx>; <dx> ~ D pi/4 (2D), 2D/3 (3D), D (1D)
     mean_dx = {1: 1.0, 2: math.pi / 4, 3: 2.0 / 3.0}[dim] * diameter
@@ -114,7 +114,6 @@ def summarize(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     happens to be small nor blocks that slow modes outlive make it too small), the scatter
     ratio (spread over rms block error, about 1 when the blocks are honest), Z_md
     (md_equivalent) and Liu's Z for the infinite fluid."""
-    from .physics import reference_z
     groups: dict[tuple, list[dict]] = {}
     for r in runs:
         groups.setdefault((r["dim"], r["phi"], r["n"]), []).append(r)
@@ -199,7 +198,6 @@ def compare_table(rows: list[dict[str, Any]]) -> str:
 def infinite_size(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Z_mc(N) = Z(inf) + a / N through the chain summaries at two or more sizes per (dim,
     phi), against Liu's form: the equation of state of the infinite fluid from the chains."""
-    from .physics import extrapolate, reference_z
     groups: dict[tuple, list[dict]] = {}
     for r in rows:
         groups.setdefault((r["dim"], r["phi"]), []).append(r)

@@ -34,7 +34,7 @@ The names a point sets: scene fields ``seed``, ``particles`` (a statesave scene:
 ``time``, ``variants``, ``lazy``, ``repeats``, ``budget_gib``, ``runner`` (or any
 ``"table.field"`` of a scene), and the study's options: ``engine`` (run, horizon),
 ``max_collisions`` and ``seeds`` (horizon, default 1 seed per point). The studies without a scene
-take their own parameters (:data:`revcol._sweep_studies.SCENELESS`): ``randomness`` (``case``,
+take their own parameters (:data:`revcol.sceneless.SCENELESS`): ``randomness`` (``case``,
 ``mode``, ``law``, ``rng``, ``seed``, ``words``, ``tests``: one dieharder battery) and
 ``equilibrium`` (``dimension``, ``packing_fraction``, ``law``, ``particles``, ``per_particle``,
 ``seed``: one dense gas against the equation of state). Every point is validated
@@ -65,6 +65,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import difflib
 import hashlib
 import itertools
 import json
@@ -74,10 +75,16 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from ._toml import read_toml, shipped_dirs
-from .scene import DEFAULT_SCENE, Scene, SceneError, find_scene, scene_from_dict
+from .. import _core
+from .._toml import read_toml, shipped_dirs
+from .._version import __version__
+from ..gas import BYTES_PER_PARTICLE
+from ..scene import DEFAULT_SCENE, Scene, SceneError, find_scene, scene_from_dict, with_engine
+from ..statesave import _kwargs
+from . import studies as sceneless
 
-__all__ = ["SweepError", "Sweep", "Point", "load_sweep", "sweep_from_dict", "sweep", "STUDIES", "SCENE_PARAMS"]
+__all__ = ["SweepError", "Sweep", "Point", "load_sweep", "sweep_from_dict", "sweep_names", "check_options", "STUDIES",
+           "SCENE_PARAMS"]
 
 #: the studies a sweep runs, and the options each takes besides the scene's fields
 STUDIES: dict[str, tuple[str, ...]] = {"run": ("engine",), "horizon": ("engine", "max_collisions", "seeds"),
@@ -214,8 +221,6 @@ def _apply(doc: dict, key: str, value: Any, kind: str, options: dict, study: str
 def _memory(scene: Scene, study: str, options: dict) -> int:
     """Bytes a point needs (an estimate with margin): the engine's state (twice for a horizon: a
     clone runs back), or for a statesave scene the largest state saving it will attempt."""
-    from .run import BYTES_PER_PARTICLE
-
     if scene.kind == "gas":
         copies = 2 if study == "horizon" else 1
         return BASE_BYTES + copies * BYTES_PER_PARTICLE * scene.particles
@@ -227,9 +232,6 @@ def _memory(scene: Scene, study: str, options: dict) -> int:
 
 def _statesave_projection(scene: Scene) -> int:
     """The most bytes any run of a statesave scene saves (the engine's projection)."""
-    from . import _core
-    from .statesave_study import _kwargs
-
     most = 0
     for n in scene.statesave_particles:
         for v in scene.variants or ("ss1", "ss2", "rc"):
@@ -243,8 +245,6 @@ def _statesave_projection(scene: Scene) -> int:
 
 def _hash(doc: dict, options: dict, study: str) -> str:
     """The point's name: a hash of what decides its result (scene, study, options, revcol build)."""
-    from . import __version__, _core
-
     text = json.dumps({"study": study, "scene": doc, "options": options, "revcol": __version__,
                        "build": _core.build}, sort_keys=True, separators=(",", ":"), default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -340,30 +340,39 @@ def sweep_from_dict(doc: dict, source: str = "<dict>", base: str | os.PathLike |
 
 def _sceneless_points(source: str, study: str, fixed: dict, combos: list[dict], mem) -> list[Point]:
     """The points of a study without a scene: its defaults, then [options], then [vary]."""
-    from . import _sweep_studies
-
     points, seen = [], {}
     for k, params in enumerate(combos):
         given = dict(list(fixed.items()) + list(params.items()))
         try:
-            _sweep_studies.check(study, given)
+            sceneless.check(study, given)
         except ValueError as e:
             raise _fail(source, f"point {k} ({', '.join(f'{a}={b!r}' for a, b in params.items()) or 'no parameters'})",
                         str(e)) from None
-        full = dict(_sweep_studies.defaults(study), **given)
+        full = dict(sceneless.defaults(study), **given)
         h = _hash({}, full, study)
         if h in seen:
             raise _fail(source, "[vary]", f"points {seen[h]} and {k} are the same run (a value listed twice?)")
         seen[h] = k
-        need = int(mem * 2**30) if mem is not None else BASE_BYTES + _sweep_studies.memory(study, full)
+        need = int(mem * 2**30) if mem is not None else BASE_BYTES + sceneless.memory(study, full)
         points.append(Point(k, given, {}, full, None, h, need))
     return points
 
 
+def check_options(scene: Scene, options: dict) -> None:
+    """Raises ValueError naming the option when a study option is out of range."""
+    for k in ("max_collisions", "seeds"):
+        if k in options:
+            v = options[k]
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise ValueError(f"{k} must be a positive integer, got {v!r}")
+    if "engine" in options:
+        with_engine(scene, options["engine"])  # SceneError naming the engine
+    if scene.seed + options.get("seeds", 1) > 2**32:
+        raise ValueError(f"seeds {scene.seed} .. {scene.seed + options['seeds'] - 1} pass 2^32 - 1")
+
+
 def _point_scene(doc: dict, options: dict, where: str, base: str) -> Scene:
     """The point's scene, validated (a SweepError naming the point otherwise), its options checked."""
-    from ._sweep_tasks import check_options
-
     try:
         scene = scene_from_dict(doc, where, Path(base))
         check_options(scene, options)
@@ -395,42 +404,8 @@ def load_sweep(path: str | os.PathLike) -> Sweep:
         if found:
             p = found[0]
         else:
-            import difflib
-
             close = difflib.get_close_matches(stem, sweep_names(), n=1)
             raise SweepError(f"{p}: no such sweep file, nor a sweep name (shipped: "
                              f"{', '.join(sweep_names()) or 'none found'})"
                              + (f"; did you mean {close[0]!r}?" if close else ""))
     return sweep_from_dict(read_toml(p, SweepError, "sweep"), str(p), p.parent)
-
-
-def sweep(spec: Sweep | str | os.PathLike, *, out: str | os.PathLike | None = None, workers: int | None = None,
-          scheduler: str | None = None, scheduler_file: str | os.PathLike | None = None, client=None,
-          progress: bool | None = None, stop_after: int | None = None, log=None, on_result=None) -> dict:
-    """Runs a sweep (a :class:`Sweep` or a sweep file) and returns its summary (also written to
-    ``out/NAME.json``, with the table ``out/NAME.csv``).
-
-    ``workers``: the LocalCluster's worker processes (default: the machine's cores; 0: no Dask, the
-    points run here one after another). ``scheduler`` / ``scheduler_file``: use that running Dask
-    cluster instead; ``client``: an existing ``distributed.Client``. ``stop_after``: stop once that
-    many points have finished in this call (the rest stay to do: run again to resume). ``log``: a
-    callable taking a line of text (default: nothing printed); ``on_result``: called here with
-    ``{"index", "hash", "point"}`` as each point's file is written."""
-    from ._sweep_tasks import execute
-
-    if not isinstance(spec, Sweep):
-        spec = load_sweep(spec)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
-        raise SweepError(f"workers must be an integer >= 0, got {workers!r}")
-    if stop_after is not None and (isinstance(stop_after, bool) or not isinstance(stop_after, int) or stop_after < 1):
-        raise SweepError(f"stop_after must be a positive integer, got {stop_after!r}")
-    if sum(x is not None for x in (scheduler, scheduler_file, client)) > 1:
-        raise SweepError("give at most one of scheduler, scheduler_file and client")
-    if workers is not None and (scheduler is not None or scheduler_file is not None or client is not None):
-        raise SweepError("workers sets the size of a local cluster; an existing cluster has its own")
-    out = Path(out) if out is not None else Path.cwd() / "out" / "sweeps" / spec.name
-    if out.exists() and not out.is_dir():
-        raise SweepError(f"{out}: exists and is not a folder")
-    return execute(spec, out, workers=workers, scheduler=scheduler,
-                   scheduler_file=None if scheduler_file is None else str(scheduler_file), client=client,
-                   progress=progress, stop_after=stop_after, log=log or (lambda line: None), on_result=on_result)

@@ -39,10 +39,18 @@ import time as _time
 from pathlib import Path
 from typing import Any
 
-from ._args import integer
-from .progress import Bar, Interrupt, peak_rss
-from .report import version
-from .scene import Scene, SceneError, load_scene, with_engine
+from .._args import integer
+from .._io import write_json
+from .._version import __version__
+from ..engine import Simulation
+from ..gas import build_simulation, check_memory, check_output
+from ..lattice import LatticeSimulation
+from ..lattice_gas import geometry as lattice_geometry
+from ..observe import report_lines
+from ..progress import Bar, Interrupt, peak_rss
+from ..roundtrip import geometry
+from ..scene import Scene, SceneError, load_scene, with_engine
+from ..trajectory import _species, check_format, open_trajectory  # revcol simulate writes frames
 
 __all__ = ["simulate", "format_simulate"]
 
@@ -99,8 +107,6 @@ def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, che
     if checkpoints is not None and not checkpoint_every:
         raise SceneError(f"{src}: --checkpoint needs --checkpoint-every K (or the scene's [run] checkpoint_interval)")
     if trajectory is not None:
-        from .trajectory import check_format
-
         try:
             check_format(trajectory)
         except ValueError as e:
@@ -113,13 +119,8 @@ def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, che
 def _build(scene: Scene, resume):
     """The engine: from a checkpoint (``resume``, the scene's engine) or from the scene."""
     if resume is None:
-        from .gas import build_simulation
-
         return build_simulation(scene)
-    if scene.engine == "lattice":
-        from .lattice import LatticeSimulation as cls
-    else:
-        from .engine import Simulation as cls
+    cls = LatticeSimulation if scene.engine == "lattice" else Simulation
     try:
         return cls.load(resume)
     except (ValueError, KeyError, TypeError) as e:
@@ -147,14 +148,7 @@ class _Production:
         self.written_ckpt: list[str] = []
         self.trajectory, self.writer, self.last_frame = trajectory, None, None
         if trajectory is not None:
-            from .trajectory import open_trajectory
-
-            if self.lattice:
-                from .lattice_gas import geometry
-            else:
-                from .roundtrip import geometry
-
-            box, periodic = geometry(sim)
+            box, periodic = lattice_geometry(sim) if self.lattice else geometry(sim)
             self.writer = open_trajectory(trajectory, box, periodic, scene.diameter, species=species,
                                           precise=precise)
         if scene.observe is not None and not self.lattice:
@@ -260,7 +254,7 @@ class _Production:
         obs = sim.observation() if scene.observe is not None and not self.lattice else None
         ran = self.done - self.start
         return {
-            "kind": "simulate", "revcol_version": version(), "scene": scene.to_dict(), "summary": scene.summary(),
+            "kind": "simulate", "revcol_version": __version__, "scene": scene.to_dict(), "summary": scene.summary(),
             "engine": scene.engine, "particles": sim.n, "dimension": sim.dim,
             "resumed_from": None if resume is None else os.fspath(resume),
             "collisions": ran, "net_collisions": self.done, "collisions_per_particle": 2.0 * ran / sim.n,
@@ -299,26 +293,20 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
     json_path = json_path if json_path is not None else scene.json
     collisions, time, trajectory, every, checkpoints, checkpoint_every = _options(
         scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume, every_time)
-    from .run import _check_memory, _check_output
-
     for what, path, folder in (("--json", json_path, False), ("--trajectory", trajectory, False),
                                ("--checkpoint", checkpoints, True)):
-        _check_output(scene.source, what, path, folder)
+        check_output(scene.source, what, path, folder)
     try:
-        from .trajectory import _species
-
         _species(species)
     except ValueError as e:
         raise SceneError(f"{scene.source}: --species: {e}") from None
-    _check_memory(scene)
+    check_memory(scene)
     sim = _build(scene, resume)
     run = _Production(scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
                       species, precise, every_time)
     run.go(sys.stdout.isatty() if progress is None else progress)
     r = run.report(resume)
     if json_path is not None:
-        from .report import write_json
-
         r["written"].append(os.fspath(json_path))
         write_json(r, json_path)
     return r
@@ -346,8 +334,6 @@ def format_simulate(r: dict) -> str:
     if r["stalled"]:
         lines.append("  stalled          the engine had no more collisions to do before the end")
     if r["observe"]:
-        from .observe import report_lines
-
         lines += report_lines(r["observe"])
     if r["written"]:
         lines.append("  written          " + " ".join(r["written"]))

@@ -1,4 +1,5 @@
-"""``revcol run``: run a scene forward, back to its start, and report the round trip.
+"""Run any scene (``revcol run``, and each point of a ``revcol sweep``): forward, back to its
+start, and the report of the round trip.
 
 A *gas* scene (``revcol.scene``) builds N hard spheres, runs N_c collisions forward (or to an
 end time), then ``run_back`` to the start time, and compares with the start. On the lattice
@@ -16,21 +17,25 @@ The report also has forward and reverse collisions/s (engine calls only), energy
 exchange momentum, so there is none to conserve along a walled axis), the rare-log bytes,
 and the process's peak RSS. A real gas is chaotic: on the float engine round-off grows by
 about an order of magnitude per collision per particle, so a round trip passes only within a
-*horizon* of a few collisions per particle; :func:`horizon` measures it (``revcol run
---horizon``; on a lattice scene it checks a few N_c bit for bit instead: there is none).
+*horizon* of a few collisions per particle; :func:`revcol.studies.horizon.horizon` measures it
+(``revcol run --horizon``; on a lattice scene it checks a few N_c bit for bit instead: there is
+none).
 
 A float-engine gas scene with an ``[observe]`` table also reports its forward run's
 observables (``report["observe"]``: pressure, temperature, collision rate, ... with block
 errors; :mod:`revcol.observe`), measured on its forward run itself.
 
 *Reversal* scenes run the paper's illustration (:func:`revcol.verify`; velocities only, no
-positions are built), *statesave* scenes the paper's §6 study (:func:`revcol.statesave.study`).
+positions are built), *statesave* scenes the paper's §6 study
+(:func:`revcol.studies.statesave.study`).
 
-This module is the entry point, :func:`run_scene`; the parts live in small modules, each
-re-exported here: :mod:`revcol.gas` (the gas run), :mod:`revcol.lattice_gas` (on the lattice
-engine), :mod:`revcol.horizon`, :mod:`revcol.paper_scenes` (reversal and statesave scenes), :mod:`revcol.report` (text and
-JSON), :mod:`revcol.plots`, :mod:`revcol.roundtrip` (the bar and the errors) and
-:mod:`revcol.progress` (Ctrl-C, progress bar, peak RSS).
+This module is the entry point, :func:`run_scene`; the parts: :mod:`revcol.gas` (the gas run),
+:mod:`revcol.lattice_gas` (on the lattice engine), :mod:`revcol.studies.horizon`,
+:mod:`revcol.studies.paper_scenes` (reversal and statesave scenes), :mod:`revcol.plots`,
+:mod:`revcol.roundtrip` (the bar and the errors) and :mod:`revcol.progress` (Ctrl-C, progress
+bar, peak RSS); the text report is the command line's (:mod:`revcol.cli.report`). It sits
+with the studies because two scene kinds and the horizon are studies; the library's part is
+the gas run.
 
 Only what a run asks for is built or imported: matplotlib with ``plot`` only, the trajectory
 writers with ``trajectory`` only, the intermediate round trips (state clones run back to the
@@ -48,67 +53,16 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import tempfile
 from pathlib import Path
 
-from .engine import Simulation  # noqa: F401 - kept importable from here
-from .gas import build_simulation, run_gas
-from .horizon import HORIZON_GRID, horizon  # noqa: F401
+from .._io import write_json
+from ..gas import check_memory, check_output, run_gas
+from ..plots import check_format, plot_horizon, require_matplotlib
+from ..scene import Scene, SceneError, load_scene, with_engine
+from .horizon import horizon
 from .paper_scenes import run_reversal, run_statesave
-from .progress import Bar as _Bar, Interrupt as _Interrupt, peak_rss as _peak_rss  # noqa: F401
-from .report import format_horizon, format_report, write_json
-from .roundtrip import BAR, ERROR_DEFINITIONS, round_trip_errors  # noqa: F401
-from .scene import Scene, SceneError, load_scene, with_engine
 
-__all__ = ["BAR", "build_simulation", "run_gas", "run_reversal", "run_statesave", "horizon", "run_scene",
-           "format_report", "format_horizon", "write_json", "round_trip_errors"]
-
-
-#: bytes a gas scene needs per particle, measured with margin: the float engine holds 254 (2D) to
-#: 282 (3D) bytes per particle (N = 1e5, Simulation.diagnostics()["memory_bytes"]); the start
-#: arrays, the report's copies and Python's arrays come on top
-BYTES_PER_PARTICLE = 1024
-
-
-def _available_bytes() -> int | None:
-    """MemAvailable from /proc/meminfo (None where there is none)."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
-
-
-def _check_memory(scene: Scene) -> None:
-    need, have = scene.particles * BYTES_PER_PARTICLE, _available_bytes()
-    if have is not None and need > have:
-        raise SceneError(f"{scene.source}: [system] particles: {scene.particles} particles need about "
-                         f"{need / 2**30:.1f} GiB ({BYTES_PER_PARTICLE} bytes each), this machine has "
-                         f"{have / 2**30:.1f} GiB available")
-
-
-def _check_output(source: str, what: str, path, folder: bool) -> None:
-    """Raises SceneError naming ``what`` unless ``path`` can be written: not the scene file, not a
-    folder where a file goes (or the reverse), its folder creatable and writable (tried)."""
-    if path is None:
-        return
-    p = Path(path).resolve()
-    if source and Path(source).is_file() and p == Path(source).resolve():
-        raise SceneError(f"{source}: {what}: {p} is the scene file itself")
-    if folder and p.exists() and not p.is_dir():
-        raise SceneError(f"{source}: {what}: {p} exists and is not a folder")
-    if not folder and p.is_dir():
-        raise SceneError(f"{source}: {what}: {p} is a folder, not a file")
-    parent = p if folder else p.parent
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=parent):
-            pass
-    except OSError as e:
-        raise SceneError(f"{source}: {what}: cannot write into {parent} ({e.strerror or e})") from None
+__all__ = ["run_scene"]
 
 
 def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str | os.PathLike | None = None,
@@ -149,8 +103,6 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
         raise SceneError(f"{scene.source}: --horizon --plot: a lattice scene has no horizon to plot "
                          "(every round trip is bit for bit); add --engine float for the float engine's")
     if plot is not None:
-        from .plots import check_format, require_matplotlib
-
         require_matplotlib()
         check_format(plot_format)
     # every output and the memory are checked before anything runs: a run must not be lost to
@@ -158,14 +110,12 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
     for what, path, folder in (("[output] json / --json", json_path, False), ("[output] plot / --plot", plot, True),
                                ("[output] trajectory / --trajectory", trajectory, False),
                                ("[output] checkpoints", getattr(scene, "checkpoints", None), True)):
-        _check_output(scene.source, what, path, folder)
+        check_output(scene.source, what, path, folder)
     if scene.kind == "gas":
-        _check_memory(scene)
+        check_memory(scene)
     if horizon_seeds is not None:
         r = horizon(scene, seeds=horizon_seeds, max_collisions=max_collisions, progress=progress)
         if plot is not None:
-            from .plots import plot_horizon
-
             r["written"] += plot_horizon(r, Path(plot), fmt=plot_format)
     elif scene.kind == "reversal":
         r = run_reversal(scene)

@@ -8,8 +8,8 @@ import json
 import os
 from pathlib import Path
 
-from ._io import atomic_open, save_figure
-from .statesave_run import _GIB, _LABEL, _gib
+from ..._io import atomic_open, save_figure
+from ...statesave import _GIB, _LABEL, _gib
 
 __all__ = ["write_json", "write_csv", "format_table", "plot"]
 

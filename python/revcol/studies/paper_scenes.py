@@ -1,6 +1,6 @@
 """The paper's scene kinds, run from a scene: the reversal illustration (``kind =
 "reversal"``, :func:`revcol.verify`; velocities only, no positions are built) and the
-state-saving study (``kind = "statesave"``, :func:`revcol.statesave.study`).
+state-saving study (``kind = "statesave"``, :func:`revcol.studies.statesave.study`).
 
 Each is one C++ call or one process per run, so Ctrl-C is counted and acted on between
 calls: the report, marked interrupted, is still written.
@@ -10,16 +10,18 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .progress import Interrupt, peak_rss
-from .scene import Scene, SceneError
+from ..plots import require_matplotlib
+from ..progress import Interrupt, peak_rss
+from ..scene import Scene, SceneError
+from ..verify import verify
+from . import statesave
+from .statesave.driver import find_binary
 
 __all__ = ["run_reversal", "run_statesave"]
 
 
 def run_reversal(scene: Scene) -> dict:
     """The paper's reversal illustration for the scene's case (:func:`revcol.verify`)."""
-    from .verify import verify
-
     # one C++ call (10^6 collisions both ways in about a second): a Ctrl-C waits for it to end,
     # and the report, marked interrupted, is still written
     with Interrupt() as stop:
@@ -33,15 +35,10 @@ def run_reversal(scene: Scene) -> dict:
 
 def run_statesave(scene: Scene, plot: str | os.PathLike | None = None, progress: bool | None = None,
                   plot_format: str = "png") -> dict:
-    """The paper's state-saving study for the scene's settings (:func:`revcol.statesave.study`).
+    """The paper's state-saving study for the scene's settings (:func:`revcol.studies.statesave.study`).
     ``runner = "auto"`` runs each point in a fresh ``revcol-bench`` process when one is
     found (so peak RSS is the run's own), in this process otherwise."""
-    from . import statesave
-    from .statesave_study import find_binary
-
     if plot is not None:
-        from .plots import require_matplotlib
-
         require_matplotlib()
     inline = scene.runner == "inline"
     if not inline:

@@ -17,9 +17,10 @@ import json
 import os
 from pathlib import Path
 
-from ._io import atomic_open
-from .horizon import combine_seeds
-from .roundtrip import BAR
+from .._io import atomic_open, save_figure
+from .._version import __version__
+from ..plots import _pyplot
+from ..roundtrip import BAR, combine_seeds
 
 __all__ = ["gather", "combine_horizon", "table_rows"]
 
@@ -121,9 +122,6 @@ def _groups(spec, points: list[dict]) -> list[dict]:
 
 def gather(spec, out: Path, state, *, reused: int, seconds: float, load, log) -> dict:
     """Writes ``NAME.csv`` (+ ``.parquet``), the figures and ``NAME.json``; returns the summary."""
-    from . import __version__
-    from ._sweep_tasks import read_point
-
     points, missing = [], []
     for p in spec.points:
         d = read_point(out, p.hash)
@@ -154,13 +152,9 @@ def _figures(spec, out: Path, combined: list[dict]) -> list[str]:
     if not groups:
         return []
     try:
-        from .plots import _pyplot
-
         plt = _pyplot()
     except ImportError:  # no matplotlib: the table and the summary say it all
         return []
-    from ._io import save_figure
-
     written = []
     fig, ax = plt.subplots(figsize=(6, 4))
     for g in groups:
@@ -194,3 +188,18 @@ def _figures(spec, out: Path, combined: list[dict]) -> list[str]:
         plt.close(fig)
         written.append(str(path))
     return written
+
+
+
+def point_path(out: Path, h: str) -> Path:
+    """Where the point with hash ``h`` is written."""
+    return out / "points" / f"{h}.json"
+
+
+def read_point(out: Path, h: str) -> dict | None:
+    """The finished point with hash ``h``, or None (absent, or not a whole point file)."""
+    try:
+        d = json.loads(point_path(out, h).read_text())
+    except (OSError, ValueError):
+        return None
+    return d if isinstance(d, dict) and d.get("hash") == h and isinstance(d.get("report"), dict) else None

@@ -22,8 +22,8 @@ import tempfile
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
-from . import _core
-from .statesave_run import MODES, _LABEL, _MAX_PARTICLES, _gib, _int, _kwargs, _supported
+from ... import _core
+from ...statesave import MODES, _LABEL, _MAX_PARTICLES, _gib, _int, _kwargs, _supported
 
 __all__ = ["study", "find_binary"]
 

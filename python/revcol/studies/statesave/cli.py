@@ -10,9 +10,9 @@ import sys
 from pathlib import Path
 from typing import Sequence
 
-from .statesave_output import format_table, markdown, plot, write_csv, write_json
-from .statesave_run import MODES
-from .statesave_study import study
+from .output import format_table, markdown, plot, write_csv, write_json
+from ...statesave import MODES
+from .driver import study
 
 __all__ = ["add_arguments", "cli_main"]
 

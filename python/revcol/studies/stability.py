@@ -56,9 +56,9 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _core
-from .collide import Collision, Pair1D, Pair2D, named_cases
-from .paper import Pair3DPaper, Triple1DPaper, Triple2DPaper, paper_cases
+from .. import _core
+from ..collide import Collision, Pair1D, Pair2D, named_cases
+from ..paper import Pair3DPaper, Triple1DPaper, Triple2DPaper, paper_cases
 
 __all__ = ["OPERATORS", "CLASSES", "MISMATCH", "operators", "stress", "chains", "run", "main"]
 
@@ -159,7 +159,7 @@ def _pair1d() -> Operator:
 def _paper(case: str, cos_tol: float = 1e-8) -> Operator:
     """The paper's operator of a case; the 1D triple with the table arc length (the forward
     and the reverse use the same psi, so the method changes no round trip; it is the fast one)."""
-    from .paper import _contacts
+    from ..paper import _contacts
 
     c = paper_cases()[case]
     geo = c["geometry"]
@@ -582,7 +582,7 @@ def ripple(angle: str = "parametric", *, samples: int = 100_000_000, bins: Seque
     so to +-bins/samples). ``closed_form``: the same from the arc-length density alone, summed
     over the six shifts of pi/3 (Finding 2.3: the forward step is a rotation mod pi/3), at
     600,000 points of one period."""
-    from .paper import S1_START
+    from ..paper import S1_START
 
     c = paper_cases()["triple1d"]
     x, v = c["geometry"], c["velocities"][:, 0]
@@ -744,7 +744,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     res["seconds"] = time.perf_counter() - t
     res["command"] = "python -m revcol.stability " + " ".join(sys.argv[1:] if argv is None else argv)
     if a.json:
-        from ._io import atomic_open
+        from .._io import atomic_open
 
         with atomic_open(a.json, "w") as f:
             json.dump(res, f, indent=1, allow_nan=True)

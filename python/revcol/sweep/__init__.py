@@ -1,0 +1,47 @@
+"""``revcol sweep``: many runs of one study, spread over Dask distributed, gathered in one table.
+
+The sweep file and its points: :mod:`.spec` (the format is described there); the tasks and the
+client that submits them: :mod:`.tasks`; the table, the summary and the figures:
+:mod:`.output`; the studies a sweep runs without a scene: :mod:`.studies`. This module is the
+entry point, :func:`sweep` (also ``revcol.sweep``).
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .spec import SCENE_PARAMS, STUDIES, Point, Sweep, SweepError, load_sweep, sweep_from_dict, sweep_names
+from .tasks import execute
+
+__all__ = ["SweepError", "Sweep", "Point", "load_sweep", "sweep_from_dict", "sweep_names", "sweep", "STUDIES",
+           "SCENE_PARAMS"]
+
+
+def sweep(spec: Sweep | str | os.PathLike, *, out: str | os.PathLike | None = None, workers: int | None = None,
+          scheduler: str | None = None, scheduler_file: str | os.PathLike | None = None, client=None,
+          progress: bool | None = None, stop_after: int | None = None, log=None, on_result=None) -> dict:
+    """Runs a sweep (a :class:`Sweep` or a sweep file) and returns its summary (also written to
+    ``out/NAME.json``, with the table ``out/NAME.csv``).
+
+    ``workers``: the LocalCluster's worker processes (default: the machine's cores; 0: no Dask, the
+    points run here one after another). ``scheduler`` / ``scheduler_file``: use that running Dask
+    cluster instead; ``client``: an existing ``distributed.Client``. ``stop_after``: stop once that
+    many points have finished in this call (the rest stay to do: run again to resume). ``log``: a
+    callable taking a line of text (default: nothing printed); ``on_result``: called here with
+    ``{"index", "hash", "point"}`` as each point's file is written."""
+    if not isinstance(spec, Sweep):
+        spec = load_sweep(spec)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
+        raise SweepError(f"workers must be an integer >= 0, got {workers!r}")
+    if stop_after is not None and (isinstance(stop_after, bool) or not isinstance(stop_after, int) or stop_after < 1):
+        raise SweepError(f"stop_after must be a positive integer, got {stop_after!r}")
+    if sum(x is not None for x in (scheduler, scheduler_file, client)) > 1:
+        raise SweepError("give at most one of scheduler, scheduler_file and client")
+    if workers is not None and (scheduler is not None or scheduler_file is not None or client is not None):
+        raise SweepError("workers sets the size of a local cluster; an existing cluster has its own")
+    out = Path(out) if out is not None else Path.cwd() / "out" / "sweeps" / spec.name
+    if out.exists() and not out.is_dir():
+        raise SweepError(f"{out}: exists and is not a folder")
+    return execute(spec, out, workers=workers, scheduler=scheduler,
+                   scheduler_file=None if scheduler_file is None else str(scheduler_file), client=client,
+                   progress=progress, stop_after=stop_after, log=log or (lambda line: None), on_result=on_result)
