@@ -6,6 +6,8 @@ studies of bench/engine_study.py run against each build's staged package.
         [--case engine/d3/n10000/phi0.45 ...] [--custom "d=3,n=10976,phi=0.45,warm=30" ...]
         [--json bench/results/ab_throughput.json]
     python3 bench/ab_compare.py studies    OLD_BUILD NEW_BUILD
+    python3 bench/ab_compare.py callgrind  OLD_BUILD NEW_BUILD [--case engine/d2/n10000/phi0.5 ...]
+        [--setting lattice/periodic/n10000/phi0.3:REVCOL_LATTICE=observe=1 ...]
 
 A build directory is one made by scripts/dev_build.sh (it holds revcol-bench and pkg/).
 Throughput: each round runs every case once per build, alternating which build goes first,
@@ -17,6 +19,11 @@ quartiles, which resolve a few per cent where the medians of either build swing 
 `--case` chooses named cases (default: all five below; `floor/pair2d` and `floor/pair3d`
 report the operator's ns per collision and its ratio to the floor instead of throughput);
 `--custom SPEC` adds an `engine/custom` case with REVCOL_ENGINE=SPEC (any number of each).
+Callgrind: instructions per collision, which a loaded host does not change: for each case and
+build, valgrind's Ir of the whole benchmark at two collision counts C1 < C2, and their
+difference over C2 - C1 (forward and back, the start and setup cancelling); `--setting
+CASE:VAR=VALUE` adds a case run with that environment on the new build (e.g. an observed
+lattice run) against the plain case on the old build: the setting's cost. Default cases: the float engine 2D and 3D and the lattice engine 2D and 3D.
 Studies: engine_study.py horizon and memory, once per build, with each build's package on
 PYTHONPATH; their JSON goes to a temporary folder and the report keeps both. Writes
 bench/results/ab_<what>.json (or --json).
@@ -59,6 +66,46 @@ def _bench(build: str, case: str, collisions: int, cpu: int | None) -> dict:
         with open(js) as f:
             data = json.load(f)
     return {r["metric"]: r["median"] for r in data["results"] if r["bench"] == name}
+
+
+CALLGRIND_CASES = ["engine/d2/n10000/phi0.5", "engine/d3/n10000/phi0.3", "lattice/periodic/n10000/phi0.3",
+                   "lattice3d/periodic/n10000/phi0.3"]
+
+
+def _instructions(build: str, case: str, collisions: int) -> int:
+    """valgrind --tool=callgrind's total Ir of one benchmark run; `case` is NAME or NAME:VAR=VALUE."""
+    name, _, setting = case.partition(":")
+    env = dict(os.environ)
+    if setting:
+        var, _, value = setting.partition("=")
+        env[var] = value
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "cg.out")
+        cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", os.path.join(build, "revcol-bench"),
+               "--bench", name, "--collisions", str(collisions), "--repeats", "1", "--json", os.path.join(tmp, "b.json")]
+        subprocess.run(cmd, check=True, capture_output=True, env=env)
+        with open(out) as f:
+            for line in f:
+                if line.startswith("summary:") or line.startswith("totals:"):
+                    return int(line.split()[1])
+    raise RuntimeError(f"no instruction total from callgrind for {case}")
+
+
+def callgrind(args) -> dict:
+    cases = (args.case or CALLGRIND_CASES) + (args.setting or [])
+    c1, c2 = args.c1, args.c2
+    rows = []
+    for case in cases:
+        row = {"case": case}
+        for label, build in (("old", args.old), ("new", args.new)):
+            # a setting runs on the new build only; the old one runs the case without it
+            run = case if label == "new" else case.partition(":")[0]
+            a, b = _instructions(build, run, c1), _instructions(build, run, c2)
+            row[label] = (b - a) / (c2 - c1)
+        row["new_over_old"] = row["new"] / row["old"]
+        rows.append(row)
+        print(f"{case:60s} old {row['old']:9.1f}  new {row['new']:9.1f}  Ir per collision  new/old {row['new_over_old']:.4f}")
+    return {"c1": c1, "c2": c2, "rows": rows}
 
 
 def _metrics(case: str) -> tuple[str, ...]:
@@ -166,7 +213,7 @@ def studies(args) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=["throughput", "studies"])
+    ap.add_argument("what", choices=["throughput", "studies", "callgrind"])
     ap.add_argument("old")
     ap.add_argument("new")
     ap.add_argument("--rounds", type=int, default=5)
@@ -174,11 +221,14 @@ def main() -> None:
     ap.add_argument("--cpu", type=int, default=1, help="core to pin each run to (taskset); -1: no pinning")
     ap.add_argument("--case", action="append", help="a named engine bench, or floor/pair2d, floor/pair3d (repeatable; default: the five engine cases)")
     ap.add_argument("--custom", action="append", help="an engine/custom case: its REVCOL_ENGINE (repeatable)")
+    ap.add_argument("--setting", action="append", help="callgrind: CASE:VAR=VALUE, a case run with that environment")
+    ap.add_argument("--c1", type=int, default=2000, help="callgrind: the smaller collision count")
+    ap.add_argument("--c2", type=int, default=22000, help="callgrind: the larger collision count")
     ap.add_argument("--json", help="where the report goes (default bench/results/ab_<what>.json)")
     args = ap.parse_args()
     if args.cpu is not None and args.cpu < 0:
         args.cpu = None
-    report = throughput(args) if args.what == "throughput" else studies(args)
+    report = {"throughput": throughput, "studies": studies, "callgrind": callgrind}[args.what](args)
     report.update(command=" ".join(sys.argv), date=time.strftime("%Y-%m-%d %H:%M:%S %Z"), machine=os.uname().nodename,
                   old=os.path.abspath(args.old), new=os.path.abspath(args.new))
     os.makedirs(RESULTS, exist_ok=True)
