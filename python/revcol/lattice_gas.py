@@ -251,7 +251,7 @@ class _LatticeRun:
 
 
 def lattice_report(run: _LatticeRun) -> dict[str, Any]:
-    """The report of a lattice round trip (see :mod:`revcol.report` for its text)."""
+    """The report of a lattice round trip (see :mod:`revcol.cli.report` for its text)."""
     sim, scene, done, n = run.sim, run.scene, run.done, run.n
     end, d_turn, d_end = sim.snapshot(), run.diag_turn, sim.diagnostics()
     same = restored(run.s0, end)

@@ -13,11 +13,11 @@ measurements that show where they are not invertible or not uniform.
   :func:`uniform_posts`, per velocity component and per paper angle, for fixed pre states.
 - :func:`uniformity`: the 1D triple's post angle against its exact uniform law, on 10^8 samples.
 
-Command line (``python -m revcol.paper_study``; each finding in docs/paper-findings.md quotes one)::
+Command line (``python -m revcol.studies.paper_study``; each finding in docs/paper-findings.md quotes one)::
 
-    python -m revcol.paper_study failure-rate triple2d-c1 --collisions 1000000 --pre uniform
-    python -m revcol.paper_study bias pair3d --samples 1000000
-    python -m revcol.paper_study uniformity --samples 100000000
+    python -m revcol.studies.paper_study failure-rate triple2d-c1 --collisions 1000000 --pre uniform
+    python -m revcol.studies.paper_study bias pair3d --samples 1000000
+    python -m revcol.studies.paper_study uniformity --samples 100000000
 
     >>> import numpy as np, revcol
     >>> op, g = revcol.Triple1DPaper(arc="table"), revcol.CLCG4()
@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._core import Pair3DPaper, Triple1DPaper, Triple2DPaper
+from ._core import Collision, Pair3DPaper, Triple1DPaper, Triple2DPaper
 from .rng import CLCG4
 
 __all__ = ["Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "PAPER_CASES", "paper_cases",
@@ -138,8 +138,6 @@ def exact_uniform_posts(case: str, velocities: np.ndarray, samples: int, *, seed
                         geometry: np.ndarray | None = None) -> np.ndarray:
     """As :func:`uniform_posts`, from exact mode's ``uniform`` law (``revcol.Collision``, the
     general exact operator) instead of rejection sampling: a cross-check of both."""
-    from ._core import Collision
-
     c = paper_cases()[case]
     geometry = c["geometry"] if geometry is None else np.asarray(geometry, float)
     contacts = _contacts(case, geometry)
@@ -210,7 +208,7 @@ def bias(case: str, *, samples: int = 1_000_000, states: int = 3, seed: int = 0,
     Also the fraction of paper-mode post states that do not separate. reference="exact" uses
     exact mode's uniform law (revcol.Collision) instead of rejection sampling;
     "exact-vs-rejection" compares those two references with each other (no paper mode)."""
-    from scipy import stats
+    from scipy import stats  # optional (the test extra) and slow to import: only when used
 
     c = paper_cases()[case]
     geometry = c["geometry"]
@@ -254,7 +252,7 @@ def uniformity(*, samples: int = 100_000_000, states: int = 3, seed: int = 0, ar
     p-value is the asymptotic Kolmogorov one), and ``law_D``: the distance of the operator's
     own law of u (from 10^7 evenly spaced G) from uniform. Large samples find deviations that
     the two-sample test of :func:`bias` at 10^6 cannot."""
-    from scipy import stats
+    from scipy import stats  # optional (the test extra) and slow to import: only when used
 
     c = paper_cases()["triple1d"]
     x = c["geometry"]

@@ -50,11 +50,11 @@ def check_format(fmt: str) -> str:
 
 
 def _pyplot():
-    import matplotlib
+    import matplotlib  # optional (the plot extra): imported only when a figure is drawn
 
     if "matplotlib.pyplot" not in sys.modules:
         matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # optional (the plot extra): imported only when a figure is drawn
 
     return plt
 
@@ -214,7 +214,7 @@ def _edges(ax, box, periodic) -> None:
 
 
 def _disks(ax, x, v, box, periodic, sigma, vmax, d):
-    from matplotlib.collections import EllipseCollection
+    from matplotlib.collections import EllipseCollection  # optional (the plot extra)
 
     speed = np.linalg.norm(v, axis=1)
     diam = np.full(len(x), float(sigma))

@@ -25,7 +25,7 @@ def peak_rss() -> int | None:
     except OSError:
         pass
     try:
-        import resource
+        import resource  # Unix only
 
         r = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         return int(r) if sys.platform == "darwin" else int(r) * 1024
@@ -63,7 +63,7 @@ class Bar:
         self.bar, self.n = None, 0.0
         if enabled:
             try:
-                from tqdm import tqdm
+                from tqdm import tqdm  # only when a progress bar is drawn
             except ImportError:
                 return
             self.bar = tqdm(total=total, desc=desc, unit=unit, leave=False, file=sys.stdout,

@@ -102,18 +102,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import difflib
+
+import numpy as np
+
 from . import _core
 from ._toml import read_toml, shipped_dirs
+from .engine import Simulation
+from .lattice import LatticeSimulation
+from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINES, KINDS,  # noqa: F401 (__all__)
+                           LATTICE_DEFAULT_COLLISIONS, LIMITS, SCHEMA, USES)
+from .statesave import variants as statesave_variants
+from .verify import verify_cases
 
 __all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "engine_options", "lattice_options", "with_engine",
            "DEFAULT_SCENE", "KINDS", "ENGINES"]
-
-#: the kinds of scene
-KINDS = ("gas", "reversal", "statesave")
-
-#: the engines a gas scene can run on (``[collisions] engine``)
-ENGINES = ("float", "lattice")
-
 
 class SceneError(ValueError):
     """A scene file that cannot be run; the message is one line naming the problem."""
@@ -194,105 +197,6 @@ class Scene:
         return out
 
 
-#: the engine's limits and names (revcol/engine/limits.hpp), the one source of truth
-LIMITS: dict[str, Any] = _core.engine_limits()
-
-# old spellings still read: (table, field) -> {old: new}, with a DeprecationWarning
-_DEPRECATED: dict[tuple[str, str], dict[str, str]] = {
-    ("system", "boundaries"): {"walls": "wall"},
-    ("rng", "streams"): {"per-particle": "per_particle"},
-}
-
-# the schema: table -> field -> (type check name, allowed values or range)
-_SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
-    "scene": {"name": ("str", None), "description": ("str", None), "kind": ("str", KINDS),
-              "case": ("str", None)},
-    "system": {
-        "dimension": ("int", tuple(LIMITS["dimensions"])),
-        "particles": ("int", (1, (1 << 31) - 1)),
-        "diameter": ("float", (0.0, None)),
-        "packing_fraction": ("float", (0.0, None)),
-        "box": ("floats", (0.0, None)),
-        "boundaries": ("strs", tuple(LIMITS["boundaries"])),
-        "start": ("str", ("auto", "random", "lattice")),
-        "kinetic_energy": ("float", (0.0, None)),
-        "initial_state": ("str", None),
-    },
-    "collisions": {
-        "engine": ("str", ENGINES),
-        "mode": ("str", ("exact", "paper")),
-        "law": ("str", ("flux", "uniform")),
-        "bits": ("int", tuple(LIMITS["bits"])),
-    },
-    "rng": {
-        "generator": ("str", tuple(sorted(LIMITS["generators"]))),
-        "streams": ("str", tuple(LIMITS["streams"])),
-        "seed": ("int", (0, int(LIMITS["max_seed"]))),   # the engine's and the generators' keys are 32-bit
-    },
-    "run": {
-        "collisions": ("int", (1, None)),
-        "time": ("float", (0.0, None)),
-        "checkpoint_interval": ("int", (0, None)),
-    },
-    "statesave": {
-        "particles": ("ints", (2, 1 << 26)),
-        "variants": ("strs", ("ss1", "ss2", "ssp", "rc")),
-        "lazy": ("bool", None),
-        "repeats": ("int", (1, 1000)),
-        "budget_gib": ("float", (0.0, None)),
-        "runner": ("str", ("auto", "process", "inline")),
-    },
-    "output": {
-        "json": ("str", None),
-        "plot": ("str", None),
-        "trajectory": ("str", None),
-        "trajectory_every": ("int", (1, None)),
-        "checkpoints": ("str", None),
-    },
-    "observe": {
-        "block_time": ("float", (0.0, None)),
-        "min_blocks": ("int", (2, 64)),
-        "slab_axis": ("int", (0, 2)),
-        "slabs": ("int", (0, 1 << 20)),
-        "speed_bins": ("int", (0, 1 << 20)),
-        "speed_max": ("float", (0.0, None)),
-        "pair_bins": ("int", (0, 1 << 20)),
-        "pair_rmax": ("float", (0.0, None)),
-    },
-}
-
-# what each kind uses; any other field is an error naming it ("*" = the whole table)
-_USES: dict[str, dict[str, Any]] = {
-    "gas": {"scene": {"name", "description", "kind"}, "system": "*", "collisions": "*", "rng": "*",
-            "run": "*", "output": "*", "observe": "*"},
-    "reversal": {"scene": {"name", "description", "kind", "case"}, "collisions": {"mode", "law", "bits"},
-                 "rng": {"generator", "seed"}, "run": {"collisions"}, "output": {"json"}},
-    "statesave": {"scene": {"name", "description", "kind"}, "statesave": "*", "collisions": {"mode", "law"},
-                  "rng": {"generator", "seed"}, "run": {"collisions"}, "output": {"json", "plot"}},
-}
-
-# N_c when a float-engine gas scene gives neither collisions nor time: 2 collisions per
-# particle. A gas is chaotic and round-off grows by about an order of magnitude per collision
-# per particle, so a round trip restores the start to 1e-9 only within a horizon of 4-10
-# collisions per particle in 2D/3D (docs/engine.md); 2 per particle sits well inside it
-# (docs/run.md). The lattice engine has no horizon: its default is a real length, 10^6.
-_DEFAULT_PER_PARTICLE = 2
-_LATTICE_DEFAULT_COLLISIONS = 1_000_000
-
-DEFAULT_SCENE: dict[str, Any] = {
-    "scene": {"name": "default",
-              "description": "2D hard-disk gas on the lattice engine, N = 1000, area fraction 0.3, walls"},
-    "system": {"dimension": 2, "particles": 1000, "diameter": 1.0, "packing_fraction": 0.3,
-               "boundaries": "wall"},
-    "collisions": {"engine": "lattice", "mode": "exact", "law": "flux"},
-    "rng": {"generator": "philox", "streams": "per_particle", "seed": 0},
-    # 10^6 collisions (2000 per particle, 2 N_c / N) forward and back, restored bit for bit;
-    # about 3 s of CPU each way (docs/run.md). The float engine's horizon for this gas is
-    # 3 collisions per particle (revcol run --horizon --engine float).
-    "run": {"collisions": 1_000_000},
-}
-
-
 def _fail(source: str, where: str, msg: str) -> SceneError:
     return SceneError(f"{source}: {where}: {msg}")
 
@@ -346,27 +250,27 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         raise SceneError(f"{source}: a scene is a TOML document of tables")
     values: dict[tuple[str, str], Any] = {}
     for table, fields in doc.items():
-        if table not in _SCHEMA:
-            raise _fail(source, f"[{table}]", f"unknown table; allowed: {', '.join(_SCHEMA)}")
+        if table not in SCHEMA:
+            raise _fail(source, f"[{table}]", f"unknown table; allowed: {', '.join(SCHEMA)}")
         if not isinstance(fields, dict):
             raise _fail(source, f"[{table}]", "must be a table")
         for key, value in fields.items():
-            if key not in _SCHEMA[table]:
+            if key not in SCHEMA[table]:
                 raise _fail(source, f"[{table}] {key}",
-                            f"unknown field; allowed in [{table}]: {', '.join(_SCHEMA[table])}")
-            kind, allowed = _SCHEMA[table][key]
+                            f"unknown field; allowed in [{table}]: {', '.join(SCHEMA[table])}")
+            kind, allowed = SCHEMA[table][key]
             value = _modernize(source, table, key, value)
             values[(table, key)] = _check(source, table, key, value, kind, allowed)
 
     # fields the kind does not use are errors, not silently ignored
     kind = values.get(("scene", "kind"), "gas")
-    uses = _USES[kind]
+    uses = USES[kind]
     if "observe" in doc and "observe" not in uses:
         raise _fail(source, "[observe]", f"does not apply to kind = {kind!r} (used by: 'gas')")
     for table, key in values:
         used = uses.get(table)
         if used is None or (used != "*" and key not in used):
-            whose = [k for k in KINDS if _USES[k].get(table) == "*" or key in _USES[k].get(table, ())]
+            whose = [k for k in KINDS if USES[k].get(table) == "*" or key in USES[k].get(table, ())]
             raise _fail(source, f"[{table}] {key}",
                         f"does not apply to kind = {kind!r} (used by: {', '.join(map(repr, whose))})")
 
@@ -471,7 +375,7 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
     if nc is not None and t_end is not None:
         raise _fail(source, "[run] time", "give either collisions or time, not both")
     if nc is None and t_end is None:
-        nc = _LATTICE_DEFAULT_COLLISIONS if engine == "lattice" else max(1, _DEFAULT_PER_PARTICLE * n // 2)
+        nc = LATTICE_DEFAULT_COLLISIONS if engine == "lattice" else max(1, DEFAULT_PER_PARTICLE * n // 2)
     if nc is not None and n == 1:
         raise _fail(source, "[run] collisions", "a single particle never collides; give [run] time instead")
     checkpoint_interval = get("run", "checkpoint_interval", 0)
@@ -559,8 +463,6 @@ def with_engine(scene: Scene, engine: str) -> Scene:
 
 
 def _reversal(source, get, common, mode, law, out) -> Scene:
-    from .verify import verify_cases
-
     case = get("scene", "case")
     if case is None:
         raise _fail(source, "[scene] case", f"is required for kind = 'reversal'; one of {', '.join(verify_cases(mode))}")
@@ -572,10 +474,8 @@ def _reversal(source, get, common, mode, law, out) -> Scene:
 
 
 def _statesave(source, get, common, mode, law, out) -> Scene:
-    from .statesave import variants as supported
-
     lazy = get("statesave", "lazy", False)
-    have = supported(lazy)
+    have = statesave_variants(lazy)
     vs = get("statesave", "variants", have)
     for v in vs:
         if v not in have:
@@ -591,8 +491,6 @@ def _statesave(source, get, common, mode, law, out) -> Scene:
 def read_initial(source: str, path: Path, d: int):
     """The (positions, velocities) arrays of an initial-state file, each (N, d); SceneError
     naming ``[system] initial_state`` when the file is missing, unreadable or misshapen."""
-    import numpy as np
-
     where = "[system] initial_state"
     if not path.is_file():
         raise _fail(source, where, f"file not found: {path}")
@@ -613,9 +511,6 @@ def _check_initial(source: str, scene: Scene, x, v) -> None:
     """Builds the engine once from the explicit state: its validation (finite values, inside
     the box, no overlap, non-zero kinetic energy; on the lattice also the quantization: a box or
     speed range it cannot hold, an overlap after rounding) is the one the run will meet."""
-    from .engine import Simulation
-    from .lattice import LatticeSimulation
-
     try:
         if scene.engine == "lattice":
             LatticeSimulation(x, v, scene.box, **lattice_options(scene))
@@ -630,7 +525,7 @@ _read_initial = read_initial  # its name before it was public
 
 def _modernize(source: str, table: str, key: str, value: Any) -> Any:
     """``value`` with deprecated spellings replaced, warning once per field (DeprecationWarning)."""
-    old_new = _DEPRECATED.get((table, key))
+    old_new = DEPRECATED.get((table, key))
     if old_new is None:
         return value
     items = value if isinstance(value, list) else [value]
@@ -687,8 +582,6 @@ def load_scene(path: str | Path | None = None) -> Scene:
     if not p.is_file():
         found = None if p.exists() else find_scene(str(path))
         if found is None:
-            import difflib
-
             close = difflib.get_close_matches(p.stem, scene_names(), n=1)
             hint = f"; did you mean {close[0]!r}?" if close else ""
             raise SceneError(f"{p}: no such scene file, nor a scene name (shipped: "

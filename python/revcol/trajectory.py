@@ -52,6 +52,7 @@ GSD frames follow HOOMD's conventions: the box is centred on the origin (positio
 from __future__ import annotations
 
 import os
+import tempfile
 import warnings
 from pathlib import Path
 from typing import Sequence
@@ -263,7 +264,7 @@ def read_gsd(path: str | os.PathLike) -> dict:
     d: the float64 positions when the file was written ``precise``, else float32's),
     ``image`` (F, n, d), ``unwrapped`` = positions + image L on periodic axes (what an MSD
     across periodic boundaries uses), ``box`` (d,), ``periodic`` (d,). Needs ``gsd``."""
-    import gsd.hoomd
+    import gsd.hoomd  # optional (the gsd extra): only for a .gsd trajectory
 
     with gsd.hoomd.open(os.fspath(path), mode="r") as f:
         frames = list(f)
@@ -289,8 +290,6 @@ def read_gsd(path: str | os.PathLike) -> dict:
 def _part(path: Path) -> str:
     """A temporary file beside ``path`` that the frames go to until close() (atomic output:
     a reader never sees a file at ``path`` that is still being written)."""
-    import tempfile
-
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".revcol-", suffix=path.suffix + ".part", dir=path.parent)
     os.close(fd)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import revcol
-from revcol.studies import tradeoff
+from revcol.studies import law_distance as ld, tradeoff
 from revcol.cli.main import main as cli_main
 
 
@@ -125,8 +125,8 @@ def test_law_distance_sees_a_wrong_law():
     same = tradeoff.rejection_posts(v, contacts, "flux", n, np.random.default_rng(1))
     other = tradeoff.rejection_posts(v, contacts, "uniform", n, np.random.default_rng(2))
     u = np.random.default_rng(3).normal(size=6)
-    d_same = tradeoff._ks2(post.reshape(n, -1) @ u, same.reshape(n, -1) @ u)
-    d_other = tradeoff._ks2(post.reshape(n, -1) @ u, other.reshape(n, -1) @ u)
+    d_same = ld._ks2(post.reshape(n, -1) @ u, same.reshape(n, -1) @ u)
+    d_other = ld._ks2(post.reshape(n, -1) @ u, other.reshape(n, -1) @ u)
     crit = 1.95 * math.sqrt(2 / n)  # the two-sample KS distance's 0.1% level, one projection
     assert d_same < crit and d_other > 3 * crit, (d_same, d_other, crit)
     # the rejection samples keep momentum and energy and separate

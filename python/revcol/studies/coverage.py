@@ -64,7 +64,7 @@ def _relative(case: str, post: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _save(fig: Any, path: str, dpi: int) -> str:
     """Saves a figure as a 256-colour PNG (a third of the size of matplotlib's RGBA PNG)."""
     import matplotlib.pyplot as plt  # optional: only when a figure is drawn
-    from PIL import Image
+    from PIL import Image  # comes with matplotlib: only when a figure is drawn
 
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)

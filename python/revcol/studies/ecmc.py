@@ -21,7 +21,7 @@ d N degrees of freedom; at zero total momentum the contacts that give Z_mc - 1 g
 exactly, so an engine run and a chain run of the same N and box can be compared with no
 extrapolation and no equation of state. Example::
 
-    >>> from revcol.ecmc import sample
+    >>> from revcol.studies.ecmc import sample
     >>> r = sample(2, 0.3, n=100, seed=1, per_particle=50, blocks=8)   # doctest: +SKIP
     >>> r["z_md"]                                                       # [value, error]
 """
@@ -148,7 +148,7 @@ def summary_table(rows: list[dict[str, Any]]) -> str:
 
 
 def md_estimates(doc: dict[str, Any]) -> list[dict[str, Any]]:
-    """The engine's Z per (dim, phi, n, law) from a JSON file of ``python -m revcol.physics
+    """The engine's Z per (dim, phi, n, law) from a JSON file of ``python -m revcol.studies.equilibrium
     dense`` (one run each, block error) or of ``bench/eos_replicas.py`` (the mean of the
     replicas with the error from their spread)."""
     out = []

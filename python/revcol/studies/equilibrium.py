@@ -462,7 +462,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     fs = sub.add_parser("finite-size", help="Z(N -> infinity) from dense runs at several N against Liu")
     fs.add_argument("runs", nargs="+", help="JSON files of `dense` runs (any sizes, laws, densities)")
     fs.add_argument("--json")
-    mc = sub.add_parser("mc", help="the equilibrium Z at the engine's own N by event-chain Monte Carlo (revcol.ecmc)")
+    mc = sub.add_parser("mc", help="the equilibrium Z at the engine's own N by event-chain Monte Carlo (revcol.studies.ecmc)")
     mc.add_argument("--dim", type=int, choices=(1, 2, 3), required=True)
     mc.add_argument("--phi", type=float, nargs="+", required=True)
     mc.add_argument("--n", type=int, nargs="+", default=[1000])

@@ -26,7 +26,7 @@ def figures(paths: Sequence[str], out: str) -> list[str]:
     import matplotlib  # optional and slow to import: only when figures are drawn
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # optional (the plot extra): imported only when a figure is drawn
 
     docs = [json.load(open(p)) for p in paths]
     dense_runs = [r for d in docs for r in d.get("dense", [])]

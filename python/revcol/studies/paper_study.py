@@ -1,10 +1,10 @@
 """The measurements of docs/paper-findings.md from the command line (JSON on stdout).
 
-    python -m revcol.paper_study failure-rate CASE [--collisions 1e6] [--pre chain|uniform]
+    python -m revcol.studies.paper_study failure-rate CASE [--collisions 1e6] [--pre chain|uniform]
                                  [--printed-reverse] [--cos-tol 1e-8] [--arc simpson|elliptic|table]
                                  [--angle parametric|polar] [--seed 0]
-    python -m revcol.paper_study bias CASE [--samples 1e6] [--states 3] [--reference rejection|exact|exact-vs-rejection]
-    python -m revcol.paper_study uniformity [--samples 1e8] [--angle parametric|polar]
+    python -m revcol.studies.paper_study bias CASE [--samples 1e6] [--states 3] [--reference rejection|exact|exact-vs-rejection]
+    python -m revcol.studies.paper_study uniformity [--samples 1e8] [--angle parametric|polar]
 
 CASE is one of pair3d, triple1d, triple2d-c1 .. triple2d-c4. The functions are
 :func:`revcol.paper.failure_rate`, :func:`revcol.paper.bias` and :func:`revcol.paper.uniformity`.
@@ -24,8 +24,8 @@ __all__ = ["main"]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m revcol.paper_study failure-rate|bias CASE [options] | uniformity``: prints JSON."""
-    p = argparse.ArgumentParser(prog="python -m revcol.paper_study", description=__doc__.split("\n")[0])
+    """``python -m revcol.studies.paper_study failure-rate|bias CASE [options] | uniformity``: prints JSON."""
+    p = argparse.ArgumentParser(prog="python -m revcol.studies.paper_study", description=__doc__.split("\n")[0])
     sub = p.add_subparsers(dest="command", required=True)
     f = sub.add_parser("failure-rate", help="forward + reverse per collision; count the failures")
     f.add_argument("case", choices=PAPER_CASES)
@@ -64,7 +64,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             r = bias(args.case, samples=int(args.samples), states=args.states, seed=args.seed,
                      reference=args.reference, **opts)
     except ValueError as e:
-        print(f"python -m revcol.paper_study: error: {e}", file=sys.stderr)
+        print(f"python -m revcol.studies.paper_study: error: {e}", file=sys.stderr)
         return 2
     print(json.dumps(r))
     return 0

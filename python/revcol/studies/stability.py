@@ -34,11 +34,11 @@ The classes (docs/stability.md says what each one means for each operator):
 
 Command line::
 
-    python -m revcol.stability --json out.json            # the reduced run (the CI's counts)
-    python -m revcol.stability --full --json bench/results/stability.json
+    python -m revcol.studies.stability --json out.json            # the reduced run (the CI's counts)
+    python -m revcol.studies.stability --full --json bench/results/stability.json
     revcol study stability --full --json bench/results/stability.json
 
-    >>> from revcol import stability
+    >>> from revcol.studies import stability
     >>> r = stability.stress("pair2d/exact/flux", "grazing", count=8, law_samples=500)
     >>> r["failures"], r["roundtrip"] < 1e-9
     (0, True)
@@ -50,17 +50,18 @@ import json
 import math
 import sys
 import time
-from dataclasses import dataclass, field
-from functools import partial
-from typing import Any, Callable, Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
 from .. import _core
-from ..collide import Collision, Pair1D, Pair2D, named_cases
-from ..paper import Pair3DPaper, Triple1DPaper, Triple2DPaper, paper_cases
+from .._io import atomic_open
+from ..paper import S1_START, Triple1DPaper, paper_cases
+from .stability_operators import EXACT_CASES, OPERATORS, PAPER_CASES, Operator, operators  # noqa: F401 (__all__)
+from .stability_report import markdown, progress_line
 
-__all__ = ["OPERATORS", "CLASSES", "MISMATCH", "operators", "stress", "chains", "run", "main"]
+__all__ = ["OPERATORS", "CLASSES", "MISMATCH", "EXACT_CASES", "PAPER_CASES", "operators", "stress", "chains", "ripple",
+           "run", "markdown", "main"]
 
 #: a round trip above this (relative to the speed scale) is a reversal mismatch: the paper's bar
 MISMATCH = 1e-9
@@ -73,139 +74,6 @@ DELTAS = tuple(10.0 ** -k for k in range(6, 17))
 RATIOS = tuple(10.0 ** k for k in range(0, 13))
 SCALES = (5e-324, 1e-310, 2.2250738585072014e-308, 1e-300, 1e-200, 1e-150, 1e-140, 1e-100, 1e-50, 1.0,
           1e50, 1e100, 1e135, 1e136, 1e150, 1e200, 1e300)
-
-EXACT_CASES = ("pair3d", "triple1d", "triple2d-c1", "triple2d-c2", "triple2d-c3", "triple2d-c4",
-               "chain4-1d", "chain4-2d", "chain4-3d", "triple3d-2", "triple3d-3", "cradle1d", "cradle2d")
-PAPER_CASES = ("pair3d", "triple1d", "triple2d-c1", "triple2d-c2", "triple2d-c3", "triple2d-c4")
-
-
-@dataclass
-class Operator:
-    """One operator under stress: its geometry, and forward / reverse / chart on (B, n, d)."""
-
-    name: str
-    case: str
-    mode: str
-    law: str
-    n: int
-    d: int
-    contacts: list            # [(i, j)]; the normal of contact k points from j to i
-    normals: np.ndarray       # (m, d)
-    draws: int
-    forward: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    reverse: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    chart: Optional[Callable[[np.ndarray], np.ndarray]]   # post -> coordinates uniform under the law
-    pushed: Callable[[], int]
-    logged: Callable[[], int]
-    options: dict = field(default_factory=dict)
-    quantize: Optional[Callable[[np.ndarray], np.ndarray]] = None   # exact mode: the pre state's cell centre
-    clear: Callable[[], None] = lambda: None   # empty the rare log (between parameter values)
-
-
-def _normals(positions: np.ndarray, contacts) -> np.ndarray:
-    x = np.asarray(positions, float)
-    x = x.reshape(len(x), -1)
-    out = [(x[i] - x[j]) / np.linalg.norm(x[i] - x[j]) for (i, j) in contacts]
-    return np.array(out)
-
-
-def _named(case: str) -> dict:
-    return next(c for c in named_cases() if c["name"] == case)
-
-
-def _log(op) -> tuple[Callable[[], int], Callable[[], int]]:
-    return (lambda: int(op.log_pushed)), (lambda: int(op.log_size))
-
-
-def _with_clear(o: Operator, op) -> Operator:
-    o.clear = op.clear_log
-    return o
-
-
-def _exact(case: str, law: str) -> Operator:
-    c = _named(case)
-    op = Collision.named(case, law=law)
-    pushed, logged = _log(op)
-    return _with_clear(Operator(f"{case}/exact/{law}", case, "exact", law, c["n"], c["d"], list(c["contacts"]),
-                    _normals(c["positions"], c["contacts"]), op.draws,
-                    lambda v, g: op.forward(v, g=g), lambda v, g: op.reverse(v, g=g), op.chart,
-                    pushed, logged, quantize=op.quantize), op)
-
-
-def _pair2d(mode: str, law: str) -> Operator:
-    c = _named("pair2d")
-    normal = _normals(c["positions"], c["contacts"])
-    op = Pair2D(mode=mode, law=law)
-    ref = op if mode == "exact" else Pair2D(law="uniform")
-    pushed, logged = _log(op)
-    name = f"pair2d/{mode}/{law}" if mode == "exact" else "pair2d/paper"
-    return _with_clear(Operator(name, "pair2d", mode, law if mode == "exact" else "uniform", 2, 2, [(0, 1)], normal, 1,
-                    lambda v, g: op.forward(v, normal[0], g=g[:, 0]),
-                    lambda v, g: op.reverse(v, normal[0], g=g[:, 0]),
-                    lambda v: ref.chart(v, normal[0]).reshape(len(v), -1), pushed, logged,
-                    quantize=(lambda v: op.quantize(v, normal[0])) if mode == "exact" else None), op)
-
-
-def _pair1d() -> Operator:
-    c = _named("pair1d")
-    normal = _normals(c["positions"], c["contacts"])
-    op = Pair1D()
-    return Operator("pair1d", "pair1d", "exact", "-", 2, 1, [(0, 1)], normal, 0,
-                    lambda v, g: op.forward(v[:, :, 0], normal[0]).reshape(v.shape),
-                    lambda v, g: op.reverse(v[:, :, 0], normal[0]).reshape(v.shape),
-                    None, lambda: 0, lambda: 0)
-
-
-def _paper(case: str, cos_tol: float = 1e-8) -> Operator:
-    """The paper's operator of a case; the 1D triple with the table arc length (the forward
-    and the reverse use the same psi, so the method changes no round trip; it is the fast one)."""
-    from ..paper import _contacts
-
-    c = paper_cases()[case]
-    geo = c["geometry"]
-    con = _contacts(case, geo)
-    contacts = [(i, j) for (i, j, _) in con]
-    normals = np.array([r for (_, _, r) in con])
-    ref = Collision(c["n"], c["d"], contacts, normals=normals, law="uniform")
-    opts: dict = {}
-    op: Any
-    if case == "pair3d":
-        op = Pair3DPaper()
-        fwd = lambda v, g: op.forward(v, geo, g=g)  # noqa: E731
-        rev = lambda v, g: op.reverse(v, geo, g=g)  # noqa: E731
-    elif case == "triple1d":
-        op = Triple1DPaper(arc="table", cos_tol=cos_tol)
-        opts = {"arc": "table", "cos_tol": cos_tol}
-        fwd = lambda v, g: op.forward(v[:, :, 0], geo, g=g[:, 0])[:, :, None]  # noqa: E731
-        rev = lambda v, g: op.reverse(v[:, :, 0], geo, g=g[:, 0])[:, :, None]  # noqa: E731
-    else:
-        op = Triple2DPaper()
-        fwd = lambda v, g: op.forward(v, geo, g=g)  # noqa: E731
-        rev = lambda v, g: op.reverse(v, geo, g=g)  # noqa: E731
-    chart = None if case.startswith("triple2d") else ref.chart
-    name = f"{case}/paper" + ("" if cos_tol == 1e-8 else f"/cos_tol={cos_tol:g}")
-    pushed, logged = _log(op)
-    return _with_clear(Operator(name, case, "paper", "uniform", c["n"], c["d"], contacts, normals,
-                                type(op).draws, fwd, rev, chart, pushed, logged, opts), op)
-
-
-def operators() -> dict[str, Callable[[], Operator]]:
-    """Every operator of the suite by name, as a constructor."""
-    out: dict[str, Callable[[], Operator]] = {"pair1d": _pair1d}
-    for law in ("flux", "uniform"):
-        out[f"pair2d/exact/{law}"] = partial(_pair2d, "exact", law)
-    out["pair2d/paper"] = partial(_pair2d, "paper", "uniform")
-    for case in EXACT_CASES:
-        for law in ("flux", "uniform"):
-            out[f"{case}/exact/{law}"] = partial(_exact, case, law)
-    for case in PAPER_CASES:
-        out[f"{case}/paper"] = partial(_paper, case)
-    out["triple1d/paper/cos_tol=0"] = partial(_paper, "triple1d", 0.0)
-    return out
-
-
-#: the operator names, in report order
-OPERATORS = tuple(operators())
 
 
 # ---- the geometry of the pre states -----------------------------------------------------------
@@ -364,7 +232,7 @@ def _law(op: Operator, v0: Optional[np.ndarray], samples: int, rng: np.random.Ge
     """Largest KS distance from uniform of the post chart coordinates from one pre state."""
     if op.chart is None or samples <= 0 or v0 is None:
         return None
-    from scipy import stats
+    from scipy import stats  # optional (the test extra) and slow to import
 
     g = rng.random(size=(samples, max(op.draws, 1)))[:, :op.draws] if op.draws else np.zeros((samples, 0))
     g = np.clip(g, 2.0**-53, 1 - 2.0**-53)
@@ -582,8 +450,6 @@ def ripple(angle: str = "parametric", *, samples: int = 100_000_000, bins: Seque
     so to +-bins/samples). ``closed_form``: the same from the arc-length density alone, summed
     over the six shifts of pi/3 (Finding 2.3: the forward step is a rotation mod pi/3), at
     600,000 points of one period."""
-    from ..paper import S1_START
-
     c = paper_cases()["triple1d"]
     x, v = c["geometry"], c["velocities"][:, 0]
     op = Triple1DPaper(arc="table", angle=angle)
@@ -635,88 +501,12 @@ def run(names: Sequence[str] = OPERATORS, classes: Sequence[str] = CLASSES, *, f
             r["seconds"] = time.perf_counter() - t
             out["results"].append(r)
             if progress:
-                progress(_line(r))
+                progress(progress_line(r))
     return out
 
 
-def _fmt(x) -> str:
-    return "-" if x is None else (f"{x:.2e}" if isinstance(x, float) else str(x))
-
-
-def _line(r: dict) -> str:
-    if not r.get("applies", True):
-        return f"{r['operator']:28s} {r['class']:10s} n/a: {r['why']}"
-    extra = (f"growth {_fmt(r.get('growth_exponent'))} bit_exact {r['bit_exact_all']}" if r["class"] == "chains"
-             else f"law_D {_fmt(r.get('law_D'))} refused {r['refused']} nonfinite {r['nonfinite']} "
-                  f"mismatch {r['mismatch']}")
-    return (f"{r['operator']:28s} {r['class']:10s} roundtrip {_fmt(r['roundtrip'])} failures {r['failures']} "
-            f"log {_fmt(r['log_rate'])} {extra} ({r['seconds']:.1f} s)")
-
-
-def _span(values) -> str:
-    v = [r["value"] for r in values]
-    return f"{v[0]:.0e} .. {v[-1]:.0e}" if len(v) > 1 else f"{v[0]:g}"
-
-
-def _failed_at(values) -> str:
-    bad = [r for r in values if r["failures"]]
-    if not bad:
-        return ""
-    kinds = sorted({k for r in bad for k in ("refused", "nonfinite", "mismatch") if r[k]})
-    return f" at {_span(bad)} ({', '.join(kinds)})"
-
-
-def _magnitude_row(r: dict, q, law: str) -> str:
-    """Magnitudes: the scales handled, and those refused (below and above) with their message."""
-    done = [v for v in r["values"] if v["refused"] < r["count"]]
-    lo = min((v["value"] for v in done), default=math.inf)
-    parts = []
-    for side in ([v for v in r["values"] if v["value"] < lo], [v for v in r["values"] if v["value"] > lo and v not in done]):
-        if side:
-            msgs = sorted({v["first_refusal"].split(":")[0] for v in side})
-            parts.append(f"refused {_span(side)} (" + "; ".join(f'"{m}"' for m in msgs) + ")")
-    other = sum(v["nonfinite"] + v["mismatch"] + v["refused"] for v in done)
-    said = ", ".join(parts) if parts else "none refused"
-    return (f"| magnitude | handled {_span(done)}, {said} | {_fmt(r['roundtrip'])} | {_fmt(q)} "
-            f"| {law} | {other} / {r['count'] * len(done)} handled{_failed_at(done)} | {_fmt(r['log_rate'])} |")
-
-
-def markdown(res: dict) -> str:
-    """One table per operator, a row per class, from a :func:`run` result."""
-    out = []
-    by: dict = {}
-    for r in res["results"]:
-        by.setdefault(r["operator"], []).append(r)
-    for name, rows in by.items():
-        out += [f"### {name}", "",
-                "| class | values | worst round trip | quantization | law KS D (bound) | failures / round trips "
-                "| rare log per collision |", "|---|---|---|---|---|---|---|"]
-        for r in rows:
-            if not r.get("applies", True):
-                out.append(f"| {r['class']} | n/a: {r['why']} | | | | | |")
-            elif r["class"] == "chains":
-                last = r["values"][-1]
-                drift = ("bit for bit at every length" if r["bit_exact_all"] else
-                         f"growth exponent {_fmt(r['growth_exponent'])}")
-                out.append(f"| chains | 1e2 .. {last['collisions']:.0e} collisions | {_fmt(r['roundtrip'])} "
-                           f"({drift}) | | | {r['failures']} of {len(r['values'])} lengths fail verify "
-                           f"| {_fmt(r['log_rate'])} |")
-            else:
-                q = max((v["quantization"] for v in r["values"] if v.get("quantization") is not None), default=None)
-                law = "-" if r["law_D"] is None else f"{r['law_D']:.2g} ({r['law_D_bound']:.2g})"
-                n = r["count"] * len(r["values"])
-                extra = f"; {r['not_pre']} not pre states" if r.get("not_pre") else ""
-                if r["class"] == "magnitude":
-                    out.append(_magnitude_row(r, q, law))
-                    continue
-                out.append(f"| {r['class']} | {_span(r['values'])} | {_fmt(r['roundtrip'])} | {_fmt(q)} | {law} "
-                           f"| {r['failures']} / {n}{_failed_at(r['values'])}{extra} | {_fmt(r['log_rate'])} |")
-        out.append("")
-    return "\n".join(out)
-
-
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m revcol.stability", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m revcol.studies.stability", description=__doc__.split("\n\n")[0])
     ap.add_argument("--full", action="store_true", help="the bench counts (else the CI's reduced counts)")
     ap.add_argument("--operators", nargs="*", default=list(OPERATORS), choices=OPERATORS, metavar="OP",
                     help="operators to run (default: all): " + ", ".join(OPERATORS))
@@ -742,10 +532,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         res = run(a.operators, a.classes, full=a.full, seed=a.seed, count=a.count, law_samples=a.law_samples,
                   progress=lambda s: print(s, flush=True))
     res["seconds"] = time.perf_counter() - t
-    res["command"] = "python -m revcol.stability " + " ".join(sys.argv[1:] if argv is None else argv)
+    res["command"] = "python -m revcol.studies.stability " + " ".join(sys.argv[1:] if argv is None else argv)
     if a.json:
-        from .._io import atomic_open
-
         with atomic_open(a.json, "w") as f:
             json.dump(res, f, indent=1, allow_nan=True)
     return 0

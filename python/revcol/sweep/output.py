@@ -3,7 +3,7 @@ installed), the JSON summary, the horizon combined over seeds, and the figures.
 
 The table is built from the point files of the sweep's own points, in the sweep's order, so it has
 one row per finished point whatever ran when (a resumed sweep, a rerun task): never two.
-Combining the horizon over seeds follows :func:`revcol.horizon.horizon` exactly (per grid point
+Combining the horizon over seeds follows :func:`revcol.studies.horizon.horizon` exactly (per grid point
 the worst error over the seeds, a seed that stopped counting as O(1); the median of the per-seed
 worst; the horizon the largest N_c before the first grid point over the bar), so a sweep over
 seeds 0 .. K-1 of one scene reports what ``revcol run --horizon --seeds K`` does.
@@ -56,8 +56,8 @@ def _write_table(path: Path, rows: list[dict]) -> list[str]:
         f.write(buf.getvalue())
     written = [str(path)]
     try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
+        import pyarrow as pa  # optional: the parquet table only when pyarrow is installed
+        import pyarrow.parquet as pq  # optional: the parquet table only when pyarrow is installed
     except ImportError:
         return written
     columns = {}

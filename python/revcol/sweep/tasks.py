@@ -132,7 +132,7 @@ def _serial(spec, todo, state: _State, finished) -> None:
 
 def _connect(workers, scheduler, scheduler_file, log):
     """(client, things to close): a client of the named cluster, or of a new LocalCluster."""
-    from distributed import Client, LocalCluster
+    from distributed import Client, LocalCluster  # optional (the sweep extra): Dask only when a sweep runs on it
 
     if scheduler is not None or scheduler_file is not None:
         where = scheduler or f"the scheduler in {scheduler_file}"
@@ -199,7 +199,7 @@ def _resources(spec, client, todo, log) -> bool:
 
 
 def _distributed(spec, todo, state: _State, finished, *, workers, scheduler, scheduler_file, client, log) -> None:
-    from distributed import as_completed
+    from distributed import as_completed  # optional (the sweep extra): Dask only when a sweep runs on it
 
     owned = []
     try:

@@ -59,7 +59,7 @@ class _Progress:
         self.total, self.done, self.bar = total, 0, None
         if self.enabled:
             try:
-                from tqdm import tqdm
+                from tqdm import tqdm  # only when a progress bar is drawn
                 self.bar = tqdm(total=total, unit="run", leave=False, file=sys.stdout)
             except ImportError:
                 self.bar = None

@@ -144,9 +144,9 @@ def plot(report: dict, path: str | os.PathLike) -> None:
     the repeats, and the memory bars below (log scale; a variant that saved 0 bytes gets no
     bar and a "0 B" label, never a bar at 1 byte). The ratios are in the table, not here.
     The format follows the file's suffix (.png, .pdf, .svg)."""
-    import matplotlib
+    import matplotlib  # optional (the plot extra): imported only when a figure is drawn
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # optional (the plot extra): imported only when a figure is drawn
 
     ns, modes, vs = report["particles"], report["modes"], report["variants"]
     runs = {(r["mode"], r["particles"], r["variant"]): r for r in report["runs"]}
@@ -204,8 +204,8 @@ def plot(report: dict, path: str | os.PathLike) -> None:
         if c == 0:
             ax.set_ylabel("time per run (ms)")
             mx.set_ylabel("bytes")
-    from matplotlib.patches import Patch
-    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch  # optional (the plot extra): imported only when a figure is drawn
+    from matplotlib.lines import Line2D  # optional (the plot extra): imported only when a figure is drawn
     handles = [Patch(color="C0", label="forward time"), Patch(color="C1", label="rollback time"),
                Line2D([], [], color="k", lw=0.8, label=f"range of {report['repeats']} interleaved repeats"),
                Patch(color="C2", label="bytes saved (hatched: projected, skipped)"),
