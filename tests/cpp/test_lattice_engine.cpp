@@ -11,6 +11,7 @@
 
 #include "check.hpp"
 #include "revcol/lattice/engine.hpp"
+#include "lattice/engine_impl.hpp"  // BasicEngine over the test operator
 
 using namespace revcol::lattice;
 

@@ -245,128 +245,29 @@ class BasicEngine {
   BasicEngine(const Snapshot& s, Op op) : op_(std::move(op)) { restore(s); }
 
   /// Replaces the state by a snapshot (validated first: on bad input nothing changes).
-  void restore(const Snapshot& s) {
-    validate_state(s.units, s.x, s.v);
-    require(s.streams.size() == s.x.size(), "lattice snapshot: streams must hold one counter per particle");
-    {
-      // energy is kept by every collision to the lattice's rounding (~1e-11 relative over 10^4
-      // collisions per particle): a checkpoint whose energy0 is not its velocities' (1e-6
-      // relative) was not written by a run. (Momentum is not checked: a group bounce reverses
-      // its members' velocities.)
-      const double E = static_cast<double>(kinetic2(s.v));
-      const double E0 = static_cast<double>((static_cast<u128>(s.energy0[1]) << 64) | s.energy0[0]);
-      require(std::fabs(E - E0) <= 1e-6 * E0, "lattice snapshot: energy0 is not the sum |v|^2 of v (1e-6 relative)");
-    }
-    for (const auto& e : s.groups) {
-      require(e.index >= 1 && e.index <= s.collisions && e.members.size() >= 2 && e.drawer >= 0 &&
-                  static_cast<std::size_t>(e.drawer) < s.x.size(),
-              "lattice snapshot: a group entry out of range");
-      require(e.pre_v.empty() || e.pre_v.size() == e.members.size(),
-              "lattice snapshot: a group entry needs one pre velocity per member (or none: a bounce)");
-      for (int m : e.members) require(m >= 0 && static_cast<std::size_t>(m) < s.x.size(), "lattice snapshot: a group member out of range");
-      for (const Vec& w : e.pre_v)
-        for (std::size_t k = 0; k < D; ++k)
-          require(w[k] >= -s.units.vmax && w[k] <= s.units.vmax, "lattice snapshot: a group entry's pre velocity is faster than vmax");
-    }
-    require(s.origin <= s.clock && tick_limit / 2 > s.clock && s.origin > -tick_limit / 2,
-            "lattice snapshot: origin <= clock within +-2^60 required");
-    check_operator(s.units);
-    load(s);
-    observer_.reset();  // another state: an observation of the old one ends
-    obs_ = nullptr;
-  }
+  void restore(const Snapshot& s);
 
   /// Runs forward until `collisions` more collisions (clock = the last one's tick) or up to tick
   /// `until` (clock = until), whichever comes first. Returns the collisions done.
-  std::uint64_t run(std::uint64_t collisions, std::int64_t until, const std::function<bool()>& poll = {}) {
-    require(until >= clock_, "lattice run: the end tick is before the clock");
-    require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
-    if (collisions == 0) return 0;
-    // an engine error mid-run leaves the state as it was: an undo journal of the particles the
-    // run changes (O(changes), so that run(collisions=1) stays O(1) at any N)
-    begin_undo();
-    try {
-      const std::uint64_t done = loop(collisions, until, false, 0, poll);
-      if (obs_) obs_->sync(time_of(clock_));
-      return done;
-    } catch (...) {
-      undo();
-      // the observer has seen events the undo took back: the observation ends, discarded
-      observer_.reset();
-      obs_ = nullptr;
-      throw;
-    }
-  }
+  std::uint64_t run(std::uint64_t collisions, std::int64_t until, const std::function<bool()>& poll = {});
   /// Runs back to collision count `to_collisions` (the state the forward run had right after it,
   /// clock = its tick) or to tick `to_tick` (clock = to_tick), whichever comes first in reverse.
-  void run_back(std::uint64_t to_collisions, std::int64_t to_tick, const std::function<bool()>& poll = {}) {
-    require(to_collisions <= ncoll_, "lattice run_back: the target collision count is ahead of the state");
-    require(to_tick >= origin_ && to_tick <= clock_, "lattice run_back: the target tick must be in [origin, clock]");
-    stop_observing();  // observation is forward only (revcol/engine/observe.hpp)
-    const Snapshot before = snapshot();  // an engine error mid-run leaves the state as it was
-    flip();
-    try {
-      loop(0, -to_tick, true, to_collisions, poll);
-    } catch (...) {
-      restore(before);
-      throw;
-    }
-    flip();
-  }
+  void run_back(std::uint64_t to_collisions, std::int64_t to_tick, const std::function<bool()>& poll = {});
 
   /// The state (forward frame, positions at the clock).
-  Snapshot snapshot() const {
-    Snapshot s;
-    s.units = u_;
-    s.seed = seed_;
-    s.clock = clock_;
-    s.origin = origin_;
-    s.collisions = ncoll_;
-    s.x = positions();
-    s.v = velocities();
-    s.streams = ctr_;
-    s.bits = X_.words();
-    s.log.assign(log_.begin(), log_.end());
-    for (const auto& [k, g] : groups_) s.groups.push_back(GroupEntry{k, g.drawer, g.members, g.pre_v});
-    s.energy0 = energy0_;
-    s.momentum0 = momentum0_;
-    s.counters = cnt_;
-    return s;
-  }
+  Snapshot snapshot() const;
   /// Starts observing the forward run from the clock (replacing any earlier observation):
   /// the float engine's observer (revcol/engine/observe.hpp) fed at every velocity change
   /// with the exact state converted once to float units (x length_unit, ticks x tick), the
   /// positions the engine gives (its *_at hooks: a lattice event moves centres by up to a
   /// tick's travel). Observation is forward only: run_back ends it; restore discards it.
-  void observe(const engine::ObserveConfig& c) {
-    const std::size_t n = ln_.size();
-    std::vector<double> x(n * D), v(n * D);
-    for (std::size_t p = 0; p < n; ++p) {
-      const Vec xp = pos(static_cast<int>(p), clock_);
-      for (std::size_t k = 0; k < D; ++k) {
-        x[p * D + k] = to_length(xp[k]);
-        v[p * D + k] = to_speed(ln_[p].v[k]);
-      }
-    }
-    std::array<double, 3> box{};
-    std::array<bool, 3> walls{};
-    for (std::size_t k = 0; k < D; ++k) {
-      box[k] = to_length(u_.L[k]);
-      walls[k] = u_.wall[k];
-    }
-    observer_ = std::make_unique<engine::Observer>(c, static_cast<int>(D), x, v, time_of(clock_), box, walls,
-                                                   to_length(u_.sigma));
-    obs_ = observer_.get();
-  }
+  void observe(const engine::ObserveConfig& c);
   /// The running or last observation (null before observe()).
   const engine::Observer* observer() const noexcept { return observer_.get(); }
   /// Whether an observation is running.
   bool observing() const noexcept { return obs_ != nullptr; }
   /// Ends the observation at the clock; observer() still reads it.
-  void stop_observing() {
-    if (obs_) obs_->sync(time_of(clock_));
-    obs_ = nullptr;
-  }
+  void stop_observing();
   /// A tick as float time (the observer's clock).
   double time_of(std::int64_t tick) const noexcept { return static_cast<double>(tick) * u_.tick; }
   /// Lattice units as a float length.
@@ -418,43 +319,18 @@ class BasicEngine {
   /// centres, neighbour_lists.hpp), 0.02 <= s <= 2; s < 0 (the default) chooses: lists in 3D with
   /// auto_list_shell(), cells in 2D. Either search finds the same collisions: the state, the
   /// trace and the bits are the same; only the speed and the neutral-event counts differ.
-  void set_list_shell(double s) {
-    require(std::isfinite(s) && (s <= 0.0 || (s >= 0.02 && s <= 2.0)), "lattice: the list shell must be 0 (cells), negative (automatic) or in [0.02, 2] diameters");
-    list_shell_ = s;
-    rebuild();
-  }
+  void set_list_shell(double s);
   /// The search in use: 0 the cell grid, 1 lists (the relative vector imaged per pair: a
   /// periodic axis shorter than about 2 (R + 2 h)), 2 lists with the centre offsets.
   int neighbour_search() const noexcept { return lists_ ? (direct_ ? 2 : 1) : 0; }
   /// The shell in use, in diameters (0: the cell grid).
   double list_shell() const noexcept { return lists_ ? 2.0 * static_cast<double>(nl_.radius()) / static_cast<double>(u_.sigma) : 0.0; }
   /// The automatic shell for this gas, in diameters (0: cells; see set_list_shell).
-  double auto_list_shell() const noexcept {
-    if constexpr (D == 2) {
-      return 0.0;
-    } else {
-      double vol = 1.0;
-      for (std::size_t k = 0; k < D; ++k) vol *= static_cast<double>(u_.L[k]) / static_cast<double>(u_.sigma);
-      const double phi = static_cast<double>(ln_.size()) * (std::numbers::pi / 6.0) / vol;
-      // Enskog mean free path in diameters; the shell grows with it (docs/lattice.md, measured)
-      const double g = (1.0 - 0.5 * phi) / ((1.0 - phi) * (1.0 - phi) * (1.0 - phi));
-      const double lam = phi > 0.0 ? 1.0 / (6.0 * std::numbers::sqrt2 * phi * g) : 1e9;
-      return std::clamp(kShellBase + kShellSlope * lam, kShellMin, kShellMax);
-    }
-  }
+  double auto_list_shell() const noexcept;
   /// Bytes held by the engine's arrays, queue, grid and log.
-  std::size_t memory_bytes() const noexcept {
-    const std::size_t n = ln_.size();
-    return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() + nl_.memory_bytes() +
-           log_.size() * 48 + group_bytes() + X_.words().size() * 8 + undo_.capacity() * sizeof(Saved) +
-           undo_epoch_.capacity() * sizeof(std::uint32_t);
-  }
+  std::size_t memory_bytes() const noexcept;
   /// Bytes held by the group entries of the rare log (map node, members, pre velocities).
-  std::size_t group_bytes() const noexcept {
-    std::size_t b = 0;
-    for (const auto& [k, g] : groups_) b += 80 + g.members.size() * sizeof(int) + g.pre_v.size() * sizeof(Vec);
-    return b;
-  }
+  std::size_t group_bytes() const noexcept;
   /// Momentum sum v per axis, 128 bits.
   static std::array<i128, D> momentum_of(const std::vector<Vec>& v) noexcept {
     std::array<i128, D> p{};
@@ -472,46 +348,19 @@ class BasicEngine {
 
  private:
   enum Type : std::uint8_t { none = 0, cross = 1, wall = 2, coll = 3 };
-
-  void load(const Snapshot& s) {
-    u_ = s.units;
-    seed_ = s.seed;
-    const std::size_t n = s.x.size();
-    ln_.resize(n);
-    for (std::size_t p = 0; p < n; ++p) ln_[p] = Line{s.x[p], s.v[p], s.clock};
-    slot_.assign(n, Slot{});
-    ctr_ = s.streams;
-    X_ = Bits(s.bits);
-    log_.clear();
-    for (const auto& e : s.log) log_[e.first] = e.second;
-    groups_.clear();
-    for (const auto& e : s.groups) groups_[e.index] = Group{e.drawer, e.members, e.pre_v};
-    clock_ = s.clock;
-    origin_ = s.origin;
-    ncoll_ = s.collisions;
-    energy0_ = s.energy0;
-    momentum0_ = s.momentum0;
-    cnt_ = s.counters;
-    wall_tick_.assign(n, std::numeric_limits<std::int64_t>::min());
-    pre_wall_.assign(n, Line{});
-    reversed_ = false;
-    sigma2_ = static_cast<u128>(u_.sigma) * static_cast<u128>(u_.sigma);
-    sigma2d_ = static_cast<double>(sigma2_);
-    const double far = static_cast<double>(u_.sigma) + 4.0 * static_cast<double>(u_.vmax);
-    far2_ = far * far * (1.0 + 1e-9);
-    for (std::size_t k = 0; k < D; ++k) {
-      Ld_[k] = static_cast<double>(u_.L[k]);
-      invL_[k] = 1.0 / Ld_[k];
-      edge_[k] = 0.5 * Ld_[k] * (1.0 - 1e-9) - 4096.0;
+  // a prediction's best event so far, in the slot order (tick, kind, other particle)
+  struct Best {
+    std::int64_t t = std::numeric_limits<std::int64_t>::max();
+    std::int32_t k = 0;
+    Type type = none;
+    int q = -1;
+    void offer(std::int64_t t2, std::int32_t k2, Type ty, int q2) noexcept {
+      if (t2 >= tick_limit) return;
+      if (std::tie(t2, k2, q2) < std::tie(t, k, q) || type == none) t = t2, k = k2, type = ty, q = q2;
     }
-    for (unsigned code = 0; code < shift_.size(); ++code)
-      for (std::size_t k = 0; k < D; ++k) {
-        const unsigned ck = (code >> (2 * k)) & 3u;
-        shift_[code][k] = ck == 1 ? Ld_[k] : ck == 2 ? -Ld_[k] : 0.0;
-      }
-    hlo_ = u_.sigma / 2;
-    rebuild();
-  }
+  };
+
+  void load(const Snapshot& s);
 
   // ---- geometry of the lines ----
   [[gnu::always_inline]] Vec pos(int p, std::int64_t t) const noexcept {
@@ -562,215 +411,12 @@ class BasicEngine {
   }
   std::int32_t wall_kind() const noexcept { return reversed_ ? n32() + 1 : 1; }
 
-  // ---- prediction ----
-  void reanchor(int p, std::int64_t t) {
-    ln_[p].x = pos(p, t);
-    ln_[p].ta = t;
-    if (lists_) {  // a post point outside the ball (a collision moves it by ~vmax): renew now
-      if (!nl_.inside(p, ln_[p].x)) nl_.renew(p, ln_[p].x);
-      sync(p);
-      return;
-    }
-    const int id = grid_.cell_id(ln_[p].x);
-    if (grid_.cell_of_particle(p) != id) {
-      grid_.remove(p);
-      grid_.insert(p, id);
-    }
-  }
-  void schedule(int p, Type type, std::int64_t t, std::int32_t kind, int partner) {
-    Slot& b = slot_[static_cast<std::size_t>(p)];
-    b.type = type;
-    b.partner = partner;
-    b.vself = b.ver;
-    b.vpart = partner >= 0 ? slot_[static_cast<std::size_t>(partner)].ver : 0;
-    if (type == none) queue_.erase(p); else queue_.set(p, t, kind);
-  }
-  void predict(int p, std::int64_t lo) {
-    reanchor(p, lo);
-    constexpr std::int64_t inf = std::numeric_limits<std::int64_t>::max();
-    std::int64_t bt = inf;
-    std::int32_t bk = 0;
-    Type btype = none;
-    int bq = -1;
-    auto offer = [&](std::int64_t t, std::int32_t k, Type ty, int q) {
-      if (t >= tick_limit) return;
-      if (std::tie(t, k, q) < std::tie(bt, bk, bq) || btype == none) {
-        bt = t, bk = k, btype = ty, bq = q;
-      }
-    };
-    std::array<int, D> c{};
-    if (lists_) {  // the renewal: when the line leaves the ball about p's list centre
-      const std::int64_t dt = nl_.exit_ticks(p, ln_[p].x, ln_[p].v);
-      if (dt > 0) offer(lo + dt, 0, cross, -1);
-    } else {
-      c = grid_.coords(grid_.cell_of_particle(p));
-    }
-    for (std::size_t k = 0; k < D; ++k) {
-      if (!lists_) {
-        const std::int64_t dt = grid_.exit_ticks(static_cast<int>(k), c[k], ln_[p].x[k], ln_[p].v[k]);
-        if (dt > 0) offer(lo + dt, 0, cross, -1);
-      }
-      if (u_.wall[k]) {
-        const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(static_cast<int>(k)));
-        if (dw >= 0) offer(lo + dw, wall_kind(), wall, -1);
-      }
-    }
-    // The candidates. A double-precision filter drops the pairs that cannot collide, or not
-    // before the best event so far; the others get the exact search (measure before changing).
-    // Rounding: a position is within 2^10 lattice units of its double (|x| < 2^63; an unwrapped
-    // anchor, two such roundings) and sigma >= 2^40 (units.hpp), so r is within ~2^-27 sigma of
-    // the exact relative vector and |r|^2, the closest approach and |r + w t|^2 within ~2^-26
-    // (|r|^2 + sigma^2): the margins below are 1e-6 of that (~2^-20), so a filtered pair is one
-    // whose every integer tick is provably outside.
-    // The image is the exact search's unless |r_k| is within rounding of L_k / 2 (edge: no filter).
-    const Line& lp = ln_[p];
-    constexpr double never = std::numeric_limits<double>::infinity();
-    double tb = btype != none ? static_cast<double>(bt - lo) : never;  // the best so far, ticks from lo
-    auto exact = [&](int q, double guess) {
-      const Vec r = diff(lp.x, pos(q, lo));
-      std::int64_t tau;
-      if constexpr (D == 3) {
-        tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_, guess);
-      } else {
-        (void)guess;
-        tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_);
-      }
-      if (tau >= 0) {
-        offer(lo + tau, coll_kind(p, q), coll, q);
-        tb = static_cast<double>(bt - lo);
-      }
-    };
-    // the filter's tests on r, w (doubles): true when the pair surely has no overlap tick <= t
-    auto beyond = [&](double rr, double bb, double aa, double t) {
-      // never inside: the smallest |r + w t|^2 over t >= 0 (rr - bb^2 / aa when approaching, here
-      // times aa: no division on the loop's path; its rounding, ~4u rr aa by Cauchy-Schwarz, is far
-      // inside the margin) is beyond sigma^2
-      const double lim = sigma2d_ + 1e-6 * (rr + sigma2d_);
-      if (bb >= 0.0 ? rr > lim : rr * aa - bb * bb > lim * aa) return true;
-      // not up to t: f(t) = |r + w t|^2 is still falling at t and outside there
-      return t != never && -bb >= aa * t && rr + t * (2.0 * bb + aa * t) > sigma2d_ + 1e-6 * (rr + aa * t * t + sigma2d_);
-    };
-    if (direct_ && !exhaustive_search) {
-      // lists on a box wide enough: r = (a_p - a_q - s) - v_q (lo - t_q), with a the anchors
-      // unwrapped about their list centres and s the entry's image shift: no image to find
-      // (a and s are exact integers rounded once, as the positions of the other path)
-      const LineD& dp = lnd_[static_cast<std::size_t>(p)];
-      const int* ids = nl_.ids(p);
-      const std::uint8_t* codes = nl_.codes(p);
-      // every partner's line requested first: the filter's branches are unpredictable, and a
-      // mispredicted one would otherwise serialize the cache misses (as the float engine does)
-      for (int e = 0, ne = nl_.size(p); e < ne; ++e) __builtin_prefetch(&lnd_[static_cast<std::size_t>(ids[e])]);
-      for (int e = 0, ne = nl_.size(p); e < ne; ++e) {
-        const int q = ids[e];
-        const LineD& dq = lnd_[static_cast<std::size_t>(q)];
-        const double dtq = static_cast<double>(lo - dq.ta);
-        const double* sh = shift_[codes[e]].data();
-        double rr = 0.0, bb = 0.0, aa = 0.0;
-        for (std::size_t k = 0; k < D; ++k) {
-          const double r = ((dp.a[k] - dq.a[k]) - sh[k]) - dq.v[k] * dtq;
-          const double w = dp.v[k] - dq.v[k];
-          rr += r * r;
-          bb += r * w;
-          aa += w * w;
-        }
-        if (beyond(rr, bb, aa, tb)) continue;
-        // the entry root of aa t^2 + 2 bb t + rr - sigma^2 from these doubles: first_overlap's
-        // first guess (its exact predicates decide; any guess gives the same answer)
-        const double c0 = rr - sigma2d_;
-        exact(q, c0 / (std::sqrt(std::max(0.0, bb * bb - aa * c0)) - bb));
-      }
-    } else {
-      std::array<double, D> xp{};
-      for (std::size_t k = 0; k < D; ++k) xp[k] = static_cast<double>(lp.x[k]);
-      near(p, [&](int q) {
-        if (q == p) return;
-        const Line& lq = ln_[q];
-        if (!exhaustive_search) {
-          const double dtq = static_cast<double>(lo - lq.ta);
-          double rr = 0.0, bb = 0.0, aa = 0.0;
-          bool edge = false;
-          for (std::size_t k = 0; k < D; ++k) {
-            double r = (xp[k] - static_cast<double>(lq.x[k])) - static_cast<double>(lq.v[k]) * dtq;
-            if (!u_.wall[k]) {  // the nearest image (an inline rounding: libm's is a call)
-              const double m = r * invL_[k];
-              r -= Ld_[k] * static_cast<double>(static_cast<std::int64_t>(m + (m >= 0.0 ? 0.5 : -0.5)));
-              edge = edge || std::fabs(r) > edge_[k];
-            }
-            const double w = static_cast<double>(lp.v[k] - lq.v[k]);
-            rr += r * r;
-            bb += r * w;
-            aa += w * w;
-          }
-          if (!edge && beyond(rr, bb, aa, tb)) return;
-        }
-        exact(q, std::numeric_limits<double>::quiet_NaN());
-      });
-    }
-    schedule(p, btype, bt, bk, bq);
-    if (btype == coll) {  // write it into the partner's slot when before the event there
-      // in offer's order (tick, kind, other particle): with (tick, kind) alone, a tie (two pairs of
-      // one particle at one tick and one kind, i.e. the same lower index) went to whichever
-      // prediction wrote the slot first, so the search's neutral events (crossings or renewals,
-      // which re-predict) could choose the partner; measured once in 6.6 x 10^6 collisions
-      const Slot& sq = slot_[static_cast<std::size_t>(bq)];
-      if (!queue_.scheduled(bq) ||
-          std::tie(bt, bk, p) < std::tuple<std::int64_t, std::int32_t, int>(queue_.time(bq), queue_.kind(bq), sq.partner)) {
-        schedule(bq, coll, bt, bk, p);
-      }
-    }
-  }
-  void rebuild() {
-    const std::size_t n = ln_.size();
-    slot_.resize(n);
-    for (Slot& b : slot_) {
-      b.type = none;
-      b.partner = -1;
-      b.vself = b.vpart = 0;
-    }
-    for (std::size_t p = 0; p < n; ++p) {
-      ln_[p].x = pos(static_cast<int>(p), clock_);
-      ln_[p].ta = clock_;
-    }
-    const double shell = list_shell_ < 0.0 ? auto_list_shell() : list_shell_;
-    lists_ = shell > 0.0;
-    grid_ = CellGridN<D>{};
-    nl_ = NeighbourListsN<D>{};
-    direct_ = false;
-    if (lists_) {
-      const double h = std::max(1.0, std::round(0.5 * shell * static_cast<double>(u_.sigma)));
-      std::vector<Vec> centres(n);
-      for (std::size_t p = 0; p < n; ++p) centres[p] = ln_[p].x;
-      nl_.build(u_, static_cast<std::int64_t>(std::min(h, static_cast<double>(u_.sigma))), centres);
-      // the prediction takes r from the centre offsets when no periodic axis is short enough
-      // for a relative vector (< R + 2 h + 4 vmax) to reach half the box
-      direct_ = true;
-      for (std::size_t k = 0; k < D; ++k)
-        if (!u_.wall[k] && u_.L[k] / 2 - 4096 <= nl_.reach() + 2 * nl_.radius() + 4 * u_.vmax) direct_ = false;
-    } else {
-      grid_.build(u_, n);
-      for (std::size_t p = 0; p < n; ++p) grid_.insert(static_cast<int>(p), grid_.cell_id(ln_[p].x));
-    }
-    lnd_.resize(n);
-    for (std::size_t p = 0; p < n; ++p) sync(static_cast<int>(p));
-    // first bucket width: ~2^tick_bits ticks per mean free time per particle, over N particles
-    // (the queue adapts it; a speed setting only)
-    queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << u_.tick_bits) / static_cast<std::int64_t>(n)));
-    // forward: events at the clock may still be pending (a run stopped after a collision);
-    // reverse: the clock's tick is done (see run_back), the search starts one tick later
-    const std::int64_t lo = reversed_ ? clock_ + 1 : clock_;
-    for (std::size_t p = 0; p < n; ++p) predict(static_cast<int>(p), lo);
-    last_key_ = {std::numeric_limits<std::int64_t>::min(), 0};
-  }
-  void flip() {
-    for (Line& l : ln_) {
-      l.v = neg(l.v);
-      l.ta = -l.ta;
-    }
-    clock_ = -clock_;
-    for (auto& t : wall_tick_) t = std::numeric_limits<std::int64_t>::min();
-    reversed_ = !reversed_;
-    rebuild();
-  }
+  void reanchor(int p, std::int64_t t);
+  void schedule(int p, Type type, std::int64_t t, std::int32_t kind, int partner);
+  void predict(int p, std::int64_t lo);
+  [[gnu::always_inline]] void scan(int p, std::int64_t lo, Best& b);
+  void rebuild();
+  void flip();
 
   // ---- the loop ----
   bool valid(int p) const noexcept {
@@ -778,101 +424,10 @@ class BasicEngine {
     if (b.ver != b.vself) return false;
     return b.type != coll || slot_[static_cast<std::size_t>(b.partner)].ver == b.vpart;
   }
-  void check_order(std::int64_t t, std::int32_t k) {
-    if (std::make_pair(t, k) < last_key_)
-      throw std::logic_error("lattice engine: events out of order (a bug): (tick " + std::to_string(t) + ", kind " +
-                             std::to_string(k) + ") after (tick " + std::to_string(last_key_.first) + ", kind " +
-                             std::to_string(last_key_.second) + "), collision " + std::to_string(ncoll_));
-    last_key_ = {t, k};
-  }
-  std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target,
-                     const std::function<bool()>& poll) {
-    std::uint64_t done = 0;
-    std::uint32_t since_poll = 0;
-    for (;;) {
-      const int p = queue_.top();
-      if (poll && ++since_poll == kPollEvents && p >= 0) {
-        // Ctrl-C: end at the tick before the next event, as run(until = that tick) would
-        since_poll = 0;
-        if (!poll()) until = std::max(clock_, std::min(until, queue_.time(p) - 1));
-      }
-      if (p < 0 || queue_.time(p) > until) {
-        clock_ = until;
-        return done;
-      }
-      const std::int64_t t = queue_.time(p);
-      ++cnt_.events;
-      if (!valid(p)) {
-        ++cnt_.stale;
-        predict(p, t);
-        continue;
-      }
-      const Slot& sp = slot_[static_cast<std::size_t>(p)];
-      if (sp.type == cross) {
-        ++cnt_.crossings;
-        if (lists_) nl_.renew(p, pos(p, t));
-        predict(p, t);
-        continue;
-      }
-      check_order(t, queue_.kind(p));
-      if (sp.type == wall) {
-        reflect(p, t);
-        continue;
-      }
-      const int i = std::min(p, sp.partner), j = std::max(p, sp.partner);
-      if (throw_at_collision != 0 && (back ? ncoll_ : ncoll_ + 1) == throw_at_collision)
-        throw std::runtime_error("lattice engine: test hook at collision " + std::to_string(throw_at_collision));
-      if (back) {
-        if (ncoll_ == target) {
-          clock_ = t - 1;
-          return done;
-        }
-        collide_back(i, j, t);
-      } else {
-        collide_forward(i, j, t);
-      }
-      ++done;
-      if (!back && done == want) {
-        clock_ = t;
-        return done;
-      }
-    }
-  }
+  void check_order(std::int64_t t, std::int32_t k);
+  std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target, const std::function<bool()>& poll);
 
-  // ---- walls ----
-  void reflect(int p, std::int64_t a) {
-    journal(p);
-    Vec x = pos(p, a - 1), v = ln_[p].v;
-    Vec old_line_at_a = pos(p, a);
-    unsigned axes = 0;  // the walls it meets
-    for (std::size_t k = 0; k < D; ++k) {
-      if (u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k)))) axes |= 1u << k;
-      else x[k] += v[k];
-      if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
-    }
-    const Vec ghost = wrapped(sub(x, v));
-    near(p, [&](int q) {
-      if (q == p) return;
-      // the forward's guard (its reverse would meet q first); the reverse replays the forward, and
-      // its ghost is the forward's pre-wall line at a, beyond the wall (right after a collision
-      // undone on this tick, a body may well overlap it there)
-      if (!reversed_ && overlap(ghost, pos(q, a - 1))) {
-        throw std::runtime_error("lattice engine: a wall and a body within one tick that the rule cannot resolve (particle " +
-                                 std::to_string(p) + ", tick " + std::to_string(a) + "); not supported yet");
-      }
-      if (overlap(old_line_at_a, pos(q, a))) ++cnt_.wall_body;
-    });
-    if (!reversed_ && (obs_ || events)) [[unlikely]] note_wall(a, p, x, v, axes);
-    pre_wall_[p] = Line{pos(p, a - 1), ln_[p].v, a - 1};  // a group collision at a may take it back
-    ln_[p].x = x;
-    ln_[p].v = v;
-    ln_[p].ta = a;
-    sync(p);
-    ++slot_[static_cast<std::size_t>(p)].ver;
-    wall_tick_[p] = a;
-    ++cnt_.walls;
-    predict(p, a);
-  }
+  void reflect(int p, std::int64_t a);
 
   // ---- collisions ----
   // origin + d, wrapped on periodic axes (128-bit sum: no overflow whatever the box)
@@ -890,425 +445,22 @@ class BasicEngine {
       if (!u_.wall[k]) o[k] = wrap(x[k], u_.L[k]);
     return o;
   }
-  // why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none.
-  // The same scan flags `multi` when a pre line (pre_a: i's and j's pre lines at tick a) overlaps
-  // a third body at a: complete whenever 0 is returned (every neighbour was looked at).
-  int post_reason(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a,
-                  const Vec (&pre_a)[2], bool& multi) const {
-    for (std::size_t k = 0; k < D; ++k) {
-      for (const Vec* vv : {&vi, &vj})
-        if ((*vv)[k] > u_.vmax || (*vv)[k] < -u_.vmax) return redraw_outside;
-      if (!u_.wall[k]) continue;
-      for (const Vec* xx : {&xi, &xj})
-        if ((*xx)[k] < hlo_ || (*xx)[k] > hhi(static_cast<int>(k))) return redraw_outside;
-    }
-    int why = 0;
-    multi = false;
-    for (int s = 0; s < 2 && why == 0; ++s) {
-      const Vec& x = s == 0 ? xi : xj;
-      const Vec& v = s == 0 ? vi : vj;
-      const Vec ghost = wrapped(sub(x, v));
-      auto third = [&](int q) {
-        if (why != 0 || q == i || q == j) return;
-        const Vec qa = pos(q, a);
-        // exit (measure before changing): farther than sigma + 4 vmax, none of the three can hold
-        // (the ghost and the pre point are within 2 vmax of x, q moves at most vmax per tick)
-        const Vec d = diff(x, qa);
-        double dd = static_cast<double>(d[0]) * d[0];
-        for (std::size_t k = 1; k < D; ++k) dd += static_cast<double>(d[k]) * d[k];
-        if (dd > far2_) return;
-        if (overlap(x, qa)) why = redraw_overlap_after;
-        else if (overlap(ghost, wrapped(sub(qa, ln_[q].v)))) why = redraw_ghost_tie;
-        if (overlap(pre_a[s], qa)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
-      };
-      if (direct_) {  // the owner's list (x is within 2 vmax of its line), far ones dropped in double
-        const int o = s == 0 ? i : j;
-        const std::array<double, D> ax = unwrapped_about(o, x);
-        const int* ids = nl_.ids(o);
-        const std::uint8_t* codes = nl_.codes(o);
-        for (int e = 0, ne = nl_.size(o); e < ne; ++e) __builtin_prefetch(&lnd_[static_cast<std::size_t>(ids[e])]);
-        for (int e = 0, ne = nl_.size(o); e < ne && why == 0; ++e) {
-          const LineD& dq = lnd_[static_cast<std::size_t>(ids[e])];
-          const double dt = static_cast<double>(a - dq.ta);
-          const double* sh = shift_[codes[e]].data();
-          double dd = 0.0;
-          for (std::size_t k = 0; k < D; ++k) {
-            const double r = ((ax[k] - dq.a[k]) - sh[k]) - dq.v[k] * dt;
-            dd += r * r;
-          }
-          if (dd <= far2_ * (1.0 + 1e-6)) third(ids[e]);
-        }
-      } else if (lists_) {
-        nl_.for_each(s == 0 ? i : j, third);
-      } else {
-        grid_.for_neighbours(grid_.cell_id(x), third);
-      }
-    }
-    return why;
-  }
-  void apply(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a) {
-    ln_[i].x = xi;
-    ln_[j].x = xj;
-    ln_[i].v = vi;
-    ln_[j].v = vj;
-    ln_[i].ta = ln_[j].ta = a;
-    sync(i);
-    sync(j);
-    ++slot_[static_cast<std::size_t>(i)].ver;
-    ++slot_[static_cast<std::size_t>(j)].ver;
-    ++cnt_.collisions;
-    predict(i, a);
-    predict(j, a);
-  }
-  void collide_forward(int i, int j, std::int64_t a) {
-    journal(i);
-    journal(j);
-    if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
-    const Vec pre_a[2] = {pos(i, a), pos(j, a)};
-    bool multi = false;
-    const std::uint64_t ctr0 = ctr_[i];
-    std::array<std::uint64_t, 8> reasons{};
-    // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
-    // values stay within a few sigma of 0 whatever the box
-    const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
-    Vec xi2, xj2, vi2, vj2;
-    Bits out;
-    std::uint32_t redraws = 0;
-    for (;;) {
-      if (static_cast<std::int64_t>(redraws) > max_redraws) {
-        group_collide(i, j, a, ctr0, reasons);
-        return;
-      }
-      const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
-      const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_, xi2, xj2, vi2, vj2, out);
-      int why = static_cast<int>(rf);
-      if (why == 0) {
-        xi2 = shifted(xj, xi2);
-        xj2 = shifted(xj, xj2);
-        why = post_reason(i, j, xi2, xj2, vi2, vj2, a, pre_a, multi);
-      }
-      if (why == 0) break;
-      ++cnt_.redraws[std::min(why, 7)];
-      ++reasons[std::min(why, 7)];
-      ++redraws;
-    }
-    if (multi) ++cnt_.multi_body;
-    if (redraws > 0) {
-      log_[ncoll_ + 1] = redraws;
-      ++cnt_.log_entries;
-    }
-    X_ = std::move(out);
-    ++ncoll_;
-    if (trace != nullptr) trace->push_back({a, i, j});
-    if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
-    apply(i, j, xi2, xj2, vi2, vj2, a);
-  }
-  void collide_back(int i, int j, std::int64_t a) {
-    if (const auto g = groups_.find(ncoll_); g != groups_.end()) {
-      group_back(i, j, a, g);
-      return;
-    }
-    const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
-    std::uint32_t redraws = 0;
-    const auto it = log_.find(ncoll_);
-    if (it != log_.end()) redraws = it->second;
-    if (ctr_[i] < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
-    const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i] - 1);
-    Vec xi0, xj0, vi0, vj0;
-    op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, X_, xi0, xj0, vi0, vj0);
-    xi0 = shifted(xj, xi0);
-    xj0 = shifted(xj, xj0);
-    ctr_[i] -= 1 + redraws;
-    if (it != log_.end()) log_.erase(it);
-    --ncoll_;
-    apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
-  }
+  int post_reason(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const;
+  void apply(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a);
+  void collide_forward(int i, int j, std::int64_t a);
+  void collide_back(int i, int j, std::int64_t a);
 
-  // ---- a third body within one tick: group collisions (LATTICE.md §4, docs/lattice.md) ----
-  // When no draw is acceptable (a third body k is met within the tick, so every post state of the
-  // pair overlaps it or ties with it), the group G = {i, j}, closed under "a member's pre line
-  // overlaps a body at tick a", collides as one. Every member stays at its tick a-1 position at
-  // tick a (a stall of one tick), so the members' positions at a never overlap each other.
-  //   Resolve (first choice): the members' velocities go through sequential specular collisions
-  //   of the touching pairs (normal along the centres at a-1) until no touching pair approaches,
-  //   rounded to integers with the momentum kept exactly; the exact pre velocities go to the log.
-  //   For one pair this is the specular collision, and its reversed lines overlap at a-1 exactly
-  //   where the pre lines did at a, so the reverse meets the group at the same tick.
-  //   Bounce (fallback): every member's velocity negated (an involution: nothing but the members
-  //   is logged); the group's momentum is reversed.
-  // Either way a body that the post state would overlap at a, or whose point at a-1 the new lines
-  // would overlap, joins G (up to 16 members); a resolve whose reversed lines meet no member pair
-  // at a-1 (the reverse would not see it) or that breaks vmax falls back to the bounce. The post
-  // state must meet the invariants against bodies outside G and the walls, otherwise the collision
-  // is an error, nothing changed. The draws tried are logged with the entry.
-  // The group closed under "a member's pre line at a overlaps a body at a", ascending.
-  std::vector<int> group_of(int i, int j, std::int64_t a) const {
-    std::vector<int> g{i, j};
-    auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
-    for (std::size_t m = 0; m < g.size(); ++m) {
-      const Vec xa = pos(g[m], a);
-      near(g[m], [&](int q) {
-        if (!member(q) && overlap(xa, pos(q, a))) g.push_back(q);
-      });
-    }
-    return g;
-  }
-  // Post velocities of a resolve for the members g (positions at a-1: x): sequential specular
-  // collisions of the pairs whose pre lines overlap at a, then integer rounding with the sum kept.
-  std::vector<Vec> resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const {
-    using VecD = std::array<double, D>;
-    // a . b, summed from the first axis on (the 2D engine's order)
-    auto ddot = [](const VecD& p, const VecD& q) {
-      double s = p[0] * q[0];
-      for (std::size_t k = 1; k < D; ++k) s += p[k] * q[k];
-      return s;
-    };
-    const std::size_t n = g.size();
-    std::vector<VecD> v(n);
-    for (std::size_t m = 0; m < n; ++m)
-      for (std::size_t k = 0; k < D; ++k) v[m][k] = static_cast<double>(ln_[g[m]].v[k]);
-    struct Touch {
-      std::size_t p, q;
-      VecD n;
-    };
-    std::vector<Touch> touch;
-    for (std::size_t p = 0; p < n; ++p)
-      for (std::size_t q = p + 1; q < n; ++q) {
-        const Vec r = diff(x[p], x[q]);
-        VecD rd, w;
-        for (std::size_t k = 0; k < D; ++k) {
-          rd[k] = static_cast<double>(r[k]);
-          w[k] = v[p][k] - v[q][k];
-        }
-        const double len = std::sqrt(ddot(rd, rd));
-        // touching: the pre lines overlap at a, or the pair is within one tick's relative travel at a-1
-        const bool near = len < static_cast<double>(u_.sigma) + std::sqrt(ddot(w, w));
-        if (len > 0.0 && (near || overlap(pos(g[p], a), pos(g[q], a)))) {
-          for (std::size_t k = 0; k < D; ++k) rd[k] /= len;
-          touch.push_back({p, q, rd});
-        }
-      }
-    // a wall is met within the tick by a member whose line is beyond it at a: -1 lower, +1 upper
-    std::vector<std::array<int, D>> wall(n, std::array<int, D>{});
-    for (std::size_t m = 0; m < n; ++m) {
-      const Vec xa = pos(g[m], a);
-      for (std::size_t k = 0; k < D; ++k)
-        if (u_.wall[k]) wall[m][k] = xa[k] < hlo_ ? -1 : xa[k] > hhi(static_cast<int>(k)) ? 1 : 0;
-    }
-    const double eps = 1e-12 * static_cast<double>(u_.vmax);
-    for (int sweep = 0; sweep < 64; ++sweep) {
-      bool any = false;
-      for (std::size_t m = 0; m < n; ++m)
-        for (std::size_t k = 0; k < D; ++k)
-          if (wall[m][k] * v[m][k] > 0.0) {  // approaching a wall it meets: specular, exact
-            v[m][k] = -v[m][k];
-            any = true;
-          }
-      for (const Touch& t : touch) {
-        VecD w;
-        for (std::size_t k = 0; k < D; ++k) w[k] = v[t.p][k] - v[t.q][k];
-        const double wn = ddot(w, t.n);
-        if (wn >= -eps) continue;  // not approaching along the normal
-        for (std::size_t k = 0; k < D; ++k) {
-          v[t.p][k] = v[t.p][k] - wn * t.n[k];
-          v[t.q][k] = v[t.q][k] + wn * t.n[k];
-        }
-        any = true;
-      }
-      if (!any) break;
-    }
-    std::vector<Vec> out(n);
-    for (std::size_t k = 0; k < D; ++k) {
-      i128 before = 0, after = 0;
-      std::size_t big = 0;
-      for (std::size_t m = 0; m < n; ++m) {
-        const double c = std::clamp(v[m][k], -static_cast<double>(tick_limit), static_cast<double>(tick_limit));
-        out[m][k] = static_cast<std::int64_t>(std::llround(c));
-        before += ln_[g[m]].v[k];
-        after += out[m][k];
-        if (std::abs(out[m][k]) > std::abs(out[big][k])) big = m;
-      }
-      out[big][k] += static_cast<std::int64_t>(before - after);  // momentum kept exactly
-    }
-    return out;
-  }
-  // The post state of a group collision: positions at a (the a-1 points) and velocities, the
-  // group grown by every body the post state would meet. False when it breaks the walls, vmax,
-  // the 16-member cap or (a resolve) the reverse's view of it.
-  bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec>& post, std::vector<Vec>& vel) const {
-    auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
-    for (;;) {
-      if (g.size() > 16) return false;
-      std::sort(g.begin(), g.end());
-      post.assign(g.size(), Vec{});
-      for (std::size_t m = 0; m < g.size(); ++m) post[m] = pos(g[m], a - 1);
-      if (resolve) {
-        vel = resolve_velocities(g, post, a);
-      } else {
-        vel.assign(g.size(), Vec{});
-        for (std::size_t m = 0; m < g.size(); ++m) vel[m] = neg(ln_[g[m]].v);
-      }
-      bool grew = false;
-      for (std::size_t m = 0; m < g.size() && !grew; ++m) {
-        for (std::size_t k = 0; k < D; ++k) {
-          if (vel[m][k] > u_.vmax || vel[m][k] < -u_.vmax) return false;
-          if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(static_cast<int>(k)))) return false;
-        }
-        const Vec ghost = wrapped(sub(post[m], vel[m]));  // the new line at a-1
-        near(g[m], [&](int q) {
-          if (grew || member(q)) return;
-          if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) {
-            g.push_back(q);
-            grew = true;
-          }
-        });
-      }
-      if (grew) continue;
-      // the reverse must meet the group at this tick: some member pair's new lines overlap at a-1
-      // (a bounce's new lines at a-1 are its pre lines at a, so it holds unless a member's line
-      // was taken back from a reflection at a)
-      for (std::size_t p = 0; p < g.size(); ++p)
-        for (std::size_t q = p + 1; q < g.size(); ++q) {
-          const Vec gp = wrapped(sub(post[p], vel[p]));
-          const Vec gq = wrapped(sub(post[q], vel[q]));
-          if (overlap(gp, gq)) return true;  // the reverse meets this pair at a-1
-        }
-      return false;
-    }
-  }
-  void group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
-    // a member reflected at this very tick takes its line from before the reflection, and the
-    // wall joins the group as a contact (resolve_velocities): the stall point is then a real point
-    // inside the box, and the log's pre velocity is the one before the reflection
-    const Line keep[2] = {ln_[i], ln_[j]};
-    bool unreflected[2] = {false, false};
-    for (int s = 0; s < 2; ++s) {
-      const int m = s == 0 ? i : j;
-      if (wall_tick_[m] == a) {
-        ln_[m] = pre_wall_[m];
-        unreflected[s] = true;
-      }
-    }
-    const std::vector<int> g0 = group_of(i, j, a);
-    std::vector<int> g = g0;
-    std::vector<Vec> post, vel;
-    bool resolve = group_resolve, ok = resolve && group_post(g, a, true, post, vel);
-    if (!ok) {
-      resolve = false;
-      g = g0;
-      ok = group_post(g, a, false, post, vel);
-    }
-    if (!ok) {
-      ctr_[i] = ctr0;  // nothing changed
-      ln_[i] = keep[0];
-      ln_[j] = keep[1];
-      std::string why = "lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
-                        std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
-                        " found no acceptable post state in " + std::to_string(max_redraws) +
-                        " redraws, and its group of " + std::to_string(g.size()) + " can neither resolve nor bounce back (";
-      for (int k = 1; k < 8; ++k) why += std::string(redraw_names[k]) + " " + std::to_string(reasons[k]) + (k < 7 ? ", " : ")");
-      throw std::runtime_error(why);
-    }
-    std::vector<Vec> pre_v;
-    for (int q : g) journal(q);
-    if (resolve)
-      for (int q : g) pre_v.push_back(ln_[q].v);
-    ++ncoll_;
-    log_[ncoll_] = static_cast<std::uint32_t>(ctr_[i] - ctr0);
-    ++cnt_.log_entries;
-    groups_[ncoll_] = Group{i, g, std::move(pre_v)};
-    ++cnt_.multi_body;
-    ++(resolve ? cnt_.group_resolves : cnt_.group_bounces);
-    for (int s = 0; s < 2; ++s)
-      if (unreflected[s]) {
-        wall_tick_[s == 0 ? i : j] = std::numeric_limits<std::int64_t>::min();  // the group took the reflection in
-        ++cnt_.wall_groups;
-      }
-    if (trace != nullptr) trace->push_back({a, i, j});
-    if (obs_ || events) [[unlikely]] note_group(a, g, post, vel);
-    for (std::size_t m = 0; m < g.size(); ++m) {
-      ln_[g[m]] = Line{post[m], vel[m], a};
-      sync(g[m]);
-      ++slot_[static_cast<std::size_t>(g[m])].ver;
-    }
-    ++cnt_.collisions;
-    for (int q : g) predict(q, a);
-  }
+  std::vector<int> group_of(int i, int j, std::int64_t a) const;
+  std::vector<Vec> resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const;
+  bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec>& post, std::vector<Vec>& vel) const;
+  void group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons);
   template <class It>
-  void group_back(int i, int j, std::int64_t a, It entry) {
-    const std::vector<int> g = entry->second.members;
-    if (std::find(g.begin(), g.end(), i) == g.end() || std::find(g.begin(), g.end(), j) == g.end()) {
-      throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
-    }
-    const auto it = log_.find(ncoll_);
-    const std::uint32_t draws = it == log_.end() ? 0 : it->second;
-    const int drawer = entry->second.drawer;
-    if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
-    const std::vector<Vec>& pre_v = entry->second.pre_v;  // forward frame; empty: a bounce
-    std::vector<Vec> pre(g.size());
-    for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
-    for (std::size_t m = 0; m < g.size(); ++m) {
-      Line& l = ln_[g[m]];
-      const Vec v = pre_v.empty() ? neg(l.v) : neg(pre_v[m]);
-      l = Line{pre[m], v, a};
-      sync(g[m]);
-      ++slot_[static_cast<std::size_t>(g[m])].ver;
-    }
-    ctr_[drawer] -= draws;
-    if (it != log_.end()) log_.erase(it);
-    groups_.erase(entry);
-    --ncoll_;
-    ++cnt_.collisions;
-    for (int q : g) predict(q, a);
-  }
+  void group_back(int i, int j, std::int64_t a, It entry);
 
-  // ---- the observer's hooks (forward only; cold: one test per velocity change when off) ----
-  // A pair and a wall go to the observer from arrays on the stack (measure before changing:
-  // building vectors per event cost ~1 000 instructions); the event records (tests) are built
-  // only when asked for.
-  void record(int kind, std::int64_t a, const std::vector<int>& ids, const std::vector<Vec>& x,
-              const std::vector<Vec>& v, unsigned axes) {
-    EventRecordN<D> r{a, kind, axes, ids, x, {}, v};
-    for (int q : ids) r.v_before.push_back(ln_[q].v);
-    events->push_back(std::move(r));
-  }
-  [[gnu::noinline, gnu::cold]] void note_pair(std::int64_t a, int i, int j, const Vec& xi, const Vec& xj, const Vec& vi,
-                                              const Vec& vj) {
-    if (events != nullptr) record(EventRecordN<D>::pair, a, {i, j}, {xi, xj}, {vi, vj}, 0);
-    if (!obs_) return;
-    double x[2 * D], v[2 * D];
-    for (std::size_t k = 0; k < D; ++k) {
-      x[k] = to_length(xi[k]);
-      x[D + k] = to_length(xj[k]);
-      v[k] = to_speed(vi[k]);
-      v[D + k] = to_speed(vj[k]);
-    }
-    obs_->pair_at(time_of(a), i, j, x, x + D, v, v + D);
-  }
-  [[gnu::noinline, gnu::cold]] void note_wall(std::int64_t a, int p, const Vec& xp, const Vec& vp, unsigned axes) {
-    if (events != nullptr) record(EventRecordN<D>::wall, a, {p}, {xp}, {vp}, axes);
-    if (!obs_) return;
-    double x[D], v[D];
-    for (std::size_t k = 0; k < D; ++k) {
-      x[k] = to_length(xp[k]);
-      v[k] = to_speed(vp[k]);
-    }
-    obs_->wall_at(time_of(a), p, x, v, axes);
-  }
-  [[gnu::noinline, gnu::cold]] void note_group(std::int64_t a, const std::vector<int>& g, const std::vector<Vec>& xg,
-                                               const std::vector<Vec>& vg) {
-    if (events != nullptr) record(EventRecordN<D>::group, a, g, xg, vg, 0);
-    if (!obs_) return;
-    const std::size_t n = g.size();
-    std::vector<double> x(n * D), v(n * D);
-    for (std::size_t m = 0; m < n; ++m)
-      for (std::size_t k = 0; k < D; ++k) {
-        // positions image-consistent about the first member's
-        x[m * D + k] = to_length(m > 0 ? xg[0][k] + diff(xg[m], xg[0])[k] : xg[m][k]);
-        v[m * D + k] = to_speed(vg[m][k]);
-      }
-    obs_->group_at(time_of(a), static_cast<int>(n), g.data(), x.data(), v.data());
-  }
+  void record(int kind, std::int64_t a, const std::vector<int>& ids, const std::vector<Vec>& x, const std::vector<Vec>& v, unsigned axes);
+  [[gnu::noinline, gnu::cold]] void note_pair(std::int64_t a, int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj);
+  [[gnu::noinline, gnu::cold]] void note_wall(std::int64_t a, int p, const Vec& xp, const Vec& vp, unsigned axes);
+  [[gnu::noinline, gnu::cold]] void note_group(std::int64_t a, const std::vector<int>& g, const std::vector<Vec>& xg, const std::vector<Vec>& vg);
   std::unique_ptr<engine::Observer> observer_;  // the running or last observation (observe.hpp)
   engine::Observer* obs_ = nullptr;             // observer_ while it runs, else null
 
@@ -1376,40 +528,14 @@ class BasicEngine {
   Counters undo_cnt_;
   std::int64_t undo_clock_ = 0;
   std::uint64_t undo_ncoll_ = 0;
-  void begin_undo() {
-    if (undo_epoch_.size() != ln_.size() || ++epoch_ == 0) {  // new size, or the epoch wrapped
-      undo_epoch_.assign(ln_.size(), 0);
-      epoch_ = 1;
-    }
-    undo_.clear();
-    undo_X_ = X_;
-    undo_cnt_ = cnt_;
-    undo_clock_ = clock_;
-    undo_ncoll_ = ncoll_;
-  }
+  void begin_undo();
   // keeps p's state as it was when this run() began (first change only)
   void journal(int p) {
     if (undo_epoch_.empty() || undo_epoch_[p] == epoch_) return;
     undo_epoch_[p] = epoch_;
     undo_.push_back(Saved{p, ln_[p], pre_wall_[p], ctr_[p], wall_tick_[p]});
   }
-  void undo() {
-    for (const Saved& sv : undo_) {
-      ln_[sv.p] = sv.line;
-      pre_wall_[sv.p] = sv.pre_wall;
-      ctr_[sv.p] = sv.ctr;
-      wall_tick_[sv.p] = sv.wall_tick;
-      ++slot_[static_cast<std::size_t>(sv.p)].ver;
-    }
-    undo_.clear();
-    X_ = undo_X_;
-    cnt_ = undo_cnt_;
-    clock_ = undo_clock_;
-    log_.erase(log_.upper_bound(undo_ncoll_), log_.end());  // the forward run only adds keys
-    groups_.erase(groups_.upper_bound(undo_ncoll_), groups_.end());
-    ncoll_ = undo_ncoll_;
-    rebuild();
-  }
+  void undo();
   std::vector<std::uint64_t> ctr_;
   // one particle's event bookkeeping, together in memory (the loop reads it per event, and the
   // partner's version): its version (bumped at every change of its line), its scheduled event's

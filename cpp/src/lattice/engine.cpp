@@ -1,7 +1,9 @@
 // The lattice engine (lattice/engine.hpp): the explicit instantiation of the 2D engine over the
-// exact pair operator (the 3D engine's is lattice_engine3d.cpp), starts from float states in 2D and
+// exact pair operator (the 3D engine's is engine3d.cpp), starts from float states in 2D and
 // 3D, and diagnostics.
 #include "revcol/lattice/engine.hpp"
+
+#include "engine_impl.hpp"
 
 #include <cmath>
 

@@ -1,0 +1,154 @@
+// The lattice engine's pair collisions: the forward acceptance test (redraws: operator refusals,
+// outside the walls or vmax, overlap of a third body at tick a, a false tie at a-1), the rare
+// log, and the reverse, which reads the log and steps the stream back.
+// Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
+// design); included by engine_impl.hpp, which the instantiating sources include.
+#pragma once
+#include <algorithm>
+#include <stdexcept>
+
+#include "revcol/lattice/engine_core.hpp"
+
+namespace revcol::lattice {
+
+// why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none.
+// The same scan flags `multi` when a pre line (pre_a: i's and j's pre lines at tick a) overlaps
+// a third body at a: complete whenever 0 is returned (every neighbour was looked at).
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const -> int {
+  for (std::size_t k = 0; k < D; ++k) {
+    for (const Vec* vv : {&vi, &vj})
+      if ((*vv)[k] > u_.vmax || (*vv)[k] < -u_.vmax) return redraw_outside;
+    if (!u_.wall[k]) continue;
+    for (const Vec* xx : {&xi, &xj})
+      if ((*xx)[k] < hlo_ || (*xx)[k] > hhi(static_cast<int>(k))) return redraw_outside;
+  }
+  int why = 0;
+  multi = false;
+  for (int s = 0; s < 2 && why == 0; ++s) {
+    const Vec& x = s == 0 ? xi : xj;
+    const Vec& v = s == 0 ? vi : vj;
+    const Vec ghost = wrapped(sub(x, v));
+    auto third = [&](int q) {
+      if (why != 0 || q == i || q == j) return;
+      const Vec qa = pos(q, a);
+      // exit (measure before changing): farther than sigma + 4 vmax, none of the three can hold
+      // (the ghost and the pre point are within 2 vmax of x, q moves at most vmax per tick)
+      const Vec d = diff(x, qa);
+      double dd = static_cast<double>(d[0]) * d[0];
+      for (std::size_t k = 1; k < D; ++k) dd += static_cast<double>(d[k]) * d[k];
+      if (dd > far2_) return;
+      if (overlap(x, qa)) why = redraw_overlap_after;
+      else if (overlap(ghost, wrapped(sub(qa, ln_[q].v)))) why = redraw_ghost_tie;
+      if (overlap(pre_a[s], qa)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
+    };
+    if (direct_) {  // the owner's list (x is within 2 vmax of its line), far ones dropped in double
+      const int o = s == 0 ? i : j;
+      const std::array<double, D> ax = unwrapped_about(o, x);
+      const int* ids = nl_.ids(o);
+      const std::uint8_t* codes = nl_.codes(o);
+      for (int e = 0, ne = nl_.size(o); e < ne; ++e) __builtin_prefetch(&lnd_[static_cast<std::size_t>(ids[e])]);
+      for (int e = 0, ne = nl_.size(o); e < ne && why == 0; ++e) {
+        const LineD& dq = lnd_[static_cast<std::size_t>(ids[e])];
+        const double dt = static_cast<double>(a - dq.ta);
+        const double* sh = shift_[codes[e]].data();
+        double dd = 0.0;
+        for (std::size_t k = 0; k < D; ++k) {
+          const double r = ((ax[k] - dq.a[k]) - sh[k]) - dq.v[k] * dt;
+          dd += r * r;
+        }
+        if (dd <= far2_ * (1.0 + 1e-6)) third(ids[e]);
+      }
+    } else if (lists_) {
+      nl_.for_each(s == 0 ? i : j, third);
+    } else {
+      grid_.for_neighbours(grid_.cell_id(x), third);
+    }
+  }
+  return why;
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::apply(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a) {
+  ln_[i].x = xi;
+  ln_[j].x = xj;
+  ln_[i].v = vi;
+  ln_[j].v = vj;
+  ln_[i].ta = ln_[j].ta = a;
+  sync(i);
+  sync(j);
+  ++slot_[static_cast<std::size_t>(i)].ver;
+  ++slot_[static_cast<std::size_t>(j)].ver;
+  ++cnt_.collisions;
+  predict(i, a);
+  predict(j, a);
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::collide_forward(int i, int j, std::int64_t a) {
+  journal(i);
+  journal(j);
+  if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
+  const Vec pre_a[2] = {pos(i, a), pos(j, a)};
+  bool multi = false;
+  const std::uint64_t ctr0 = ctr_[i];
+  std::array<std::uint64_t, 8> reasons{};
+  // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
+  // values stay within a few sigma of 0 whatever the box
+  const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+  Vec xi2, xj2, vi2, vj2;
+  Bits out;
+  std::uint32_t redraws = 0;
+  for (;;) {
+    if (static_cast<std::int64_t>(redraws) > max_redraws) {
+      group_collide(i, j, a, ctr0, reasons);
+      return;
+    }
+    const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
+    const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_, xi2, xj2, vi2, vj2, out);
+    int why = static_cast<int>(rf);
+    if (why == 0) {
+      xi2 = shifted(xj, xi2);
+      xj2 = shifted(xj, xj2);
+      why = post_reason(i, j, xi2, xj2, vi2, vj2, a, pre_a, multi);
+    }
+    if (why == 0) break;
+    ++cnt_.redraws[std::min(why, 7)];
+    ++reasons[std::min(why, 7)];
+    ++redraws;
+  }
+  if (multi) ++cnt_.multi_body;
+  if (redraws > 0) {
+    log_[ncoll_ + 1] = redraws;
+    ++cnt_.log_entries;
+  }
+  X_ = std::move(out);
+  ++ncoll_;
+  if (trace != nullptr) trace->push_back({a, i, j});
+  if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
+  apply(i, j, xi2, xj2, vi2, vj2, a);
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
+  if (const auto g = groups_.find(ncoll_); g != groups_.end()) {
+    group_back(i, j, a, g);
+    return;
+  }
+  const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+  std::uint32_t redraws = 0;
+  const auto it = log_.find(ncoll_);
+  if (it != log_.end()) redraws = it->second;
+  if (ctr_[i] < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+  const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i] - 1);
+  Vec xi0, xj0, vi0, vj0;
+  op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, X_, xi0, xj0, vi0, vj0);
+  xi0 = shifted(xj, xi0);
+  xj0 = shifted(xj, xj0);
+  ctr_[i] -= 1 + redraws;
+  if (it != log_.end()) log_.erase(it);
+  --ncoll_;
+  apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
+}
+
+}  // namespace revcol::lattice

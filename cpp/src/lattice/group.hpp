@@ -1,0 +1,262 @@
+// The lattice engine's group collisions: a third body within one tick (LATTICE.md §4). The group,
+// its specular resolution or bounce back, the post state's checks, the log entry, the reverse.
+// Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
+// design); included by engine_impl.hpp, which the instantiating sources include.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "revcol/lattice/engine_core.hpp"
+
+namespace revcol::lattice {
+
+// ---- a third body within one tick: group collisions (LATTICE.md §4, docs/lattice.md) ----
+// When no draw is acceptable (a third body k is met within the tick, so every post state of the
+// pair overlaps it or ties with it), the group G = {i, j}, closed under "a member's pre line
+// overlaps a body at tick a", collides as one. Every member stays at its tick a-1 position at
+// tick a (a stall of one tick), so the members' positions at a never overlap each other.
+//   Resolve (first choice): the members' velocities go through sequential specular collisions
+//   of the touching pairs (normal along the centres at a-1) until no touching pair approaches,
+//   rounded to integers with the momentum kept exactly; the exact pre velocities go to the log.
+//   For one pair this is the specular collision, and its reversed lines overlap at a-1 exactly
+//   where the pre lines did at a, so the reverse meets the group at the same tick.
+//   Bounce (fallback): every member's velocity negated (an involution: nothing but the members
+//   is logged); the group's momentum is reversed.
+// Either way a body that the post state would overlap at a, or whose point at a-1 the new lines
+// would overlap, joins G (up to 16 members); a resolve whose reversed lines meet no member pair
+// at a-1 (the reverse would not see it) or that breaks vmax falls back to the bounce. The post
+// state must meet the invariants against bodies outside G and the walls, otherwise the collision
+// is an error, nothing changed. The draws tried are logged with the entry.
+// The group closed under "a member's pre line at a overlaps a body at a", ascending.
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::group_of(int i, int j, std::int64_t a) const -> std::vector<int> {
+  std::vector<int> g{i, j};
+  auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
+  for (std::size_t m = 0; m < g.size(); ++m) {
+    const Vec xa = pos(g[m], a);
+    near(g[m], [&](int q) {
+      if (!member(q) && overlap(xa, pos(q, a))) g.push_back(q);
+    });
+  }
+  return g;
+}
+
+// Post velocities of a resolve for the members g (positions at a-1: x): sequential specular
+// collisions of the pairs whose pre lines overlap at a, then integer rounding with the sum kept.
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const -> std::vector<Vec> {
+  using VecD = std::array<double, D>;
+  // a . b, summed from the first axis on (the 2D engine's order)
+  auto ddot = [](const VecD& p, const VecD& q) {
+    double s = p[0] * q[0];
+    for (std::size_t k = 1; k < D; ++k) s += p[k] * q[k];
+    return s;
+  };
+  const std::size_t n = g.size();
+  std::vector<VecD> v(n);
+  for (std::size_t m = 0; m < n; ++m)
+    for (std::size_t k = 0; k < D; ++k) v[m][k] = static_cast<double>(ln_[g[m]].v[k]);
+  struct Touch {
+    std::size_t p, q;
+    VecD n;
+  };
+  std::vector<Touch> touch;
+  for (std::size_t p = 0; p < n; ++p)
+    for (std::size_t q = p + 1; q < n; ++q) {
+      const Vec r = diff(x[p], x[q]);
+      VecD rd, w;
+      for (std::size_t k = 0; k < D; ++k) {
+        rd[k] = static_cast<double>(r[k]);
+        w[k] = v[p][k] - v[q][k];
+      }
+      const double len = std::sqrt(ddot(rd, rd));
+      // touching: the pre lines overlap at a, or the pair is within one tick's relative travel at a-1
+      const bool near = len < static_cast<double>(u_.sigma) + std::sqrt(ddot(w, w));
+      if (len > 0.0 && (near || overlap(pos(g[p], a), pos(g[q], a)))) {
+        for (std::size_t k = 0; k < D; ++k) rd[k] /= len;
+        touch.push_back({p, q, rd});
+      }
+    }
+  // a wall is met within the tick by a member whose line is beyond it at a: -1 lower, +1 upper
+  std::vector<std::array<int, D>> wall(n, std::array<int, D>{});
+  for (std::size_t m = 0; m < n; ++m) {
+    const Vec xa = pos(g[m], a);
+    for (std::size_t k = 0; k < D; ++k)
+      if (u_.wall[k]) wall[m][k] = xa[k] < hlo_ ? -1 : xa[k] > hhi(static_cast<int>(k)) ? 1 : 0;
+  }
+  const double eps = 1e-12 * static_cast<double>(u_.vmax);
+  for (int sweep = 0; sweep < 64; ++sweep) {
+    bool any = false;
+    for (std::size_t m = 0; m < n; ++m)
+      for (std::size_t k = 0; k < D; ++k)
+        if (wall[m][k] * v[m][k] > 0.0) {  // approaching a wall it meets: specular, exact
+          v[m][k] = -v[m][k];
+          any = true;
+        }
+    for (const Touch& t : touch) {
+      VecD w;
+      for (std::size_t k = 0; k < D; ++k) w[k] = v[t.p][k] - v[t.q][k];
+      const double wn = ddot(w, t.n);
+      if (wn >= -eps) continue;  // not approaching along the normal
+      for (std::size_t k = 0; k < D; ++k) {
+        v[t.p][k] = v[t.p][k] - wn * t.n[k];
+        v[t.q][k] = v[t.q][k] + wn * t.n[k];
+      }
+      any = true;
+    }
+    if (!any) break;
+  }
+  std::vector<Vec> out(n);
+  for (std::size_t k = 0; k < D; ++k) {
+    i128 before = 0, after = 0;
+    std::size_t big = 0;
+    for (std::size_t m = 0; m < n; ++m) {
+      const double c = std::clamp(v[m][k], -static_cast<double>(tick_limit), static_cast<double>(tick_limit));
+      out[m][k] = static_cast<std::int64_t>(std::llround(c));
+      before += ln_[g[m]].v[k];
+      after += out[m][k];
+      if (std::abs(out[m][k]) > std::abs(out[big][k])) big = m;
+    }
+    out[big][k] += static_cast<std::int64_t>(before - after);  // momentum kept exactly
+  }
+  return out;
+}
+
+// The post state of a group collision: positions at a (the a-1 points) and velocities, the
+// group grown by every body the post state would meet. False when it breaks the walls, vmax,
+// the 16-member cap or (a resolve) the reverse's view of it.
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec>& post, std::vector<Vec>& vel) const -> bool {
+  auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
+  for (;;) {
+    if (g.size() > 16) return false;
+    std::sort(g.begin(), g.end());
+    post.assign(g.size(), Vec{});
+    for (std::size_t m = 0; m < g.size(); ++m) post[m] = pos(g[m], a - 1);
+    if (resolve) {
+      vel = resolve_velocities(g, post, a);
+    } else {
+      vel.assign(g.size(), Vec{});
+      for (std::size_t m = 0; m < g.size(); ++m) vel[m] = neg(ln_[g[m]].v);
+    }
+    bool grew = false;
+    for (std::size_t m = 0; m < g.size() && !grew; ++m) {
+      for (std::size_t k = 0; k < D; ++k) {
+        if (vel[m][k] > u_.vmax || vel[m][k] < -u_.vmax) return false;
+        if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(static_cast<int>(k)))) return false;
+      }
+      const Vec ghost = wrapped(sub(post[m], vel[m]));  // the new line at a-1
+      near(g[m], [&](int q) {
+        if (grew || member(q)) return;
+        if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) {
+          g.push_back(q);
+          grew = true;
+        }
+      });
+    }
+    if (grew) continue;
+    // the reverse must meet the group at this tick: some member pair's new lines overlap at a-1
+    // (a bounce's new lines at a-1 are its pre lines at a, so it holds unless a member's line
+    // was taken back from a reflection at a)
+    for (std::size_t p = 0; p < g.size(); ++p)
+      for (std::size_t q = p + 1; q < g.size(); ++q) {
+        const Vec gp = wrapped(sub(post[p], vel[p]));
+        const Vec gq = wrapped(sub(post[q], vel[q]));
+        if (overlap(gp, gq)) return true;  // the reverse meets this pair at a-1
+      }
+    return false;
+  }
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
+  // a member reflected at this very tick takes its line from before the reflection, and the
+  // wall joins the group as a contact (resolve_velocities): the stall point is then a real point
+  // inside the box, and the log's pre velocity is the one before the reflection
+  const Line keep[2] = {ln_[i], ln_[j]};
+  bool unreflected[2] = {false, false};
+  for (int s = 0; s < 2; ++s) {
+    const int m = s == 0 ? i : j;
+    if (wall_tick_[m] == a) {
+      ln_[m] = pre_wall_[m];
+      unreflected[s] = true;
+    }
+  }
+  const std::vector<int> g0 = group_of(i, j, a);
+  std::vector<int> g = g0;
+  std::vector<Vec> post, vel;
+  bool resolve = group_resolve, ok = resolve && group_post(g, a, true, post, vel);
+  if (!ok) {
+    resolve = false;
+    g = g0;
+    ok = group_post(g, a, false, post, vel);
+  }
+  if (!ok) {
+    ctr_[i] = ctr0;  // nothing changed
+    ln_[i] = keep[0];
+    ln_[j] = keep[1];
+    std::string why = "lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
+                      std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
+                      " found no acceptable post state in " + std::to_string(max_redraws) +
+                      " redraws, and its group of " + std::to_string(g.size()) + " can neither resolve nor bounce back (";
+    for (int k = 1; k < 8; ++k) why += std::string(redraw_names[k]) + " " + std::to_string(reasons[k]) + (k < 7 ? ", " : ")");
+    throw std::runtime_error(why);
+  }
+  std::vector<Vec> pre_v;
+  for (int q : g) journal(q);
+  if (resolve)
+    for (int q : g) pre_v.push_back(ln_[q].v);
+  ++ncoll_;
+  log_[ncoll_] = static_cast<std::uint32_t>(ctr_[i] - ctr0);
+  ++cnt_.log_entries;
+  groups_[ncoll_] = Group{i, g, std::move(pre_v)};
+  ++cnt_.multi_body;
+  ++(resolve ? cnt_.group_resolves : cnt_.group_bounces);
+  for (int s = 0; s < 2; ++s)
+    if (unreflected[s]) {
+      wall_tick_[s == 0 ? i : j] = std::numeric_limits<std::int64_t>::min();  // the group took the reflection in
+      ++cnt_.wall_groups;
+    }
+  if (trace != nullptr) trace->push_back({a, i, j});
+  if (obs_ || events) [[unlikely]] note_group(a, g, post, vel);
+  for (std::size_t m = 0; m < g.size(); ++m) {
+    ln_[g[m]] = Line{post[m], vel[m], a};
+    sync(g[m]);
+    ++slot_[static_cast<std::size_t>(g[m])].ver;
+  }
+  ++cnt_.collisions;
+  for (int q : g) predict(q, a);
+}
+
+template <class Op, class Bits, class Queue>
+template <class It>
+void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, It entry) {
+  const std::vector<int> g = entry->second.members;
+  if (std::find(g.begin(), g.end(), i) == g.end() || std::find(g.begin(), g.end(), j) == g.end()) {
+    throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
+  }
+  const auto it = log_.find(ncoll_);
+  const std::uint32_t draws = it == log_.end() ? 0 : it->second;
+  const int drawer = entry->second.drawer;
+  if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+  const std::vector<Vec>& pre_v = entry->second.pre_v;  // forward frame; empty: a bounce
+  std::vector<Vec> pre(g.size());
+  for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
+  for (std::size_t m = 0; m < g.size(); ++m) {
+    Line& l = ln_[g[m]];
+    const Vec v = pre_v.empty() ? neg(l.v) : neg(pre_v[m]);
+    l = Line{pre[m], v, a};
+    sync(g[m]);
+    ++slot_[static_cast<std::size_t>(g[m])].ver;
+  }
+  ctr_[drawer] -= draws;
+  if (it != log_.end()) log_.erase(it);
+  groups_.erase(entry);
+  --ncoll_;
+  ++cnt_.collisions;
+  for (int q : g) predict(q, a);
+}
+
+}  // namespace revcol::lattice

@@ -1,0 +1,150 @@
+// The lattice engine's event loop: run and run_back, the loop over the queue, and the wall
+// reflection (a mirror on the transition into the first tick beyond the wall).
+// Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
+// design); included by engine_impl.hpp, which the instantiating sources include.
+#pragma once
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "revcol/lattice/engine_core.hpp"
+
+namespace revcol::lattice {
+
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::run(std::uint64_t collisions, std::int64_t until, const std::function<bool()>& poll) -> std::uint64_t {
+  require(until >= clock_, "lattice run: the end tick is before the clock");
+  require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
+  if (collisions == 0) return 0;
+  // an engine error mid-run leaves the state as it was: an undo journal of the particles the
+  // run changes (O(changes), so that run(collisions=1) stays O(1) at any N)
+  begin_undo();
+  try {
+    const std::uint64_t done = loop(collisions, until, false, 0, poll);
+    if (obs_) obs_->sync(time_of(clock_));
+    return done;
+  } catch (...) {
+    undo();
+    // the observer has seen events the undo took back: the observation ends, discarded
+    observer_.reset();
+    obs_ = nullptr;
+    throw;
+  }
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::run_back(std::uint64_t to_collisions, std::int64_t to_tick, const std::function<bool()>& poll) {
+  require(to_collisions <= ncoll_, "lattice run_back: the target collision count is ahead of the state");
+  require(to_tick >= origin_ && to_tick <= clock_, "lattice run_back: the target tick must be in [origin, clock]");
+  stop_observing();  // observation is forward only (revcol/engine/observe.hpp)
+  const Snapshot before = snapshot();  // an engine error mid-run leaves the state as it was
+  flip();
+  try {
+    loop(0, -to_tick, true, to_collisions, poll);
+  } catch (...) {
+    restore(before);
+    throw;
+  }
+  flip();
+}
+
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target, const std::function<bool()>& poll) -> std::uint64_t {
+  std::uint64_t done = 0;
+  std::uint32_t since_poll = 0;
+  for (;;) {
+    const int p = queue_.top();
+    if (poll && ++since_poll == kPollEvents && p >= 0) {
+      // Ctrl-C: end at the tick before the next event, as run(until = that tick) would
+      since_poll = 0;
+      if (!poll()) until = std::max(clock_, std::min(until, queue_.time(p) - 1));
+    }
+    if (p < 0 || queue_.time(p) > until) {
+      clock_ = until;
+      return done;
+    }
+    const std::int64_t t = queue_.time(p);
+    ++cnt_.events;
+    if (!valid(p)) {
+      ++cnt_.stale;
+      predict(p, t);
+      continue;
+    }
+    const Slot& sp = slot_[static_cast<std::size_t>(p)];
+    if (sp.type == cross) {
+      ++cnt_.crossings;
+      if (lists_) nl_.renew(p, pos(p, t));
+      predict(p, t);
+      continue;
+    }
+    check_order(t, queue_.kind(p));
+    if (sp.type == wall) {
+      reflect(p, t);
+      continue;
+    }
+    const int i = std::min(p, sp.partner), j = std::max(p, sp.partner);
+    if (throw_at_collision != 0 && (back ? ncoll_ : ncoll_ + 1) == throw_at_collision)
+      throw std::runtime_error("lattice engine: test hook at collision " + std::to_string(throw_at_collision));
+    if (back) {
+      if (ncoll_ == target) {
+        clock_ = t - 1;
+        return done;
+      }
+      collide_back(i, j, t);
+    } else {
+      collide_forward(i, j, t);
+    }
+    ++done;
+    if (!back && done == want) {
+      clock_ = t;
+      return done;
+    }
+  }
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::check_order(std::int64_t t, std::int32_t k) {
+  if (std::make_pair(t, k) < last_key_)
+    throw std::logic_error("lattice engine: events out of order (a bug): (tick " + std::to_string(t) + ", kind " +
+                           std::to_string(k) + ") after (tick " + std::to_string(last_key_.first) + ", kind " +
+                           std::to_string(last_key_.second) + "), collision " + std::to_string(ncoll_));
+  last_key_ = {t, k};
+}
+
+// ---- walls ----
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
+  journal(p);
+  Vec x = pos(p, a - 1), v = ln_[p].v;
+  Vec old_line_at_a = pos(p, a);
+  unsigned axes = 0;  // the walls it meets
+  for (std::size_t k = 0; k < D; ++k) {
+    if (u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k)))) axes |= 1u << k;
+    else x[k] += v[k];
+    if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
+  }
+  const Vec ghost = wrapped(sub(x, v));
+  near(p, [&](int q) {
+    if (q == p) return;
+    // the forward's guard (its reverse would meet q first); the reverse replays the forward, and
+    // its ghost is the forward's pre-wall line at a, beyond the wall (right after a collision
+    // undone on this tick, a body may well overlap it there)
+    if (!reversed_ && overlap(ghost, pos(q, a - 1))) {
+      throw std::runtime_error("lattice engine: a wall and a body within one tick that the rule cannot resolve (particle " +
+                               std::to_string(p) + ", tick " + std::to_string(a) + "); not supported yet");
+    }
+    if (overlap(old_line_at_a, pos(q, a))) ++cnt_.wall_body;
+  });
+  if (!reversed_ && (obs_ || events)) [[unlikely]] note_wall(a, p, x, v, axes);
+  pre_wall_[p] = Line{pos(p, a - 1), ln_[p].v, a - 1};  // a group collision at a may take it back
+  ln_[p].x = x;
+  ln_[p].v = v;
+  ln_[p].ta = a;
+  sync(p);
+  ++slot_[static_cast<std::size_t>(p)].ver;
+  wall_tick_[p] = a;
+  ++cnt_.walls;
+  predict(p, a);
+}
+
+}  // namespace revcol::lattice

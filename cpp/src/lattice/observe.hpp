@@ -1,0 +1,92 @@
+// The lattice engine's observation hooks: the float engine's observer (revcol/engine/observe.hpp)
+// fed at every forward velocity change, and the event records of tests and studies.
+// Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
+// design); included by engine_impl.hpp, which the instantiating sources include.
+#pragma once
+#include <memory>
+
+#include "revcol/lattice/engine_core.hpp"
+
+namespace revcol::lattice {
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
+  const std::size_t n = ln_.size();
+  std::vector<double> x(n * D), v(n * D);
+  for (std::size_t p = 0; p < n; ++p) {
+    const Vec xp = pos(static_cast<int>(p), clock_);
+    for (std::size_t k = 0; k < D; ++k) {
+      x[p * D + k] = to_length(xp[k]);
+      v[p * D + k] = to_speed(ln_[p].v[k]);
+    }
+  }
+  std::array<double, 3> box{};
+  std::array<bool, 3> walls{};
+  for (std::size_t k = 0; k < D; ++k) {
+    box[k] = to_length(u_.L[k]);
+    walls[k] = u_.wall[k];
+  }
+  observer_ = std::make_unique<engine::Observer>(c, static_cast<int>(D), x, v, time_of(clock_), box, walls,
+                                                 to_length(u_.sigma));
+  obs_ = observer_.get();
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::stop_observing() {
+  if (obs_) obs_->sync(time_of(clock_));
+  obs_ = nullptr;
+}
+
+// ---- the observer's hooks (forward only; cold: one test per velocity change when off) ----
+// A pair and a wall go to the observer from arrays on the stack (measure before changing:
+// building vectors per event cost ~1 000 instructions); the event records (tests) are built
+// only when asked for.
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::record(int kind, std::int64_t a, const std::vector<int>& ids, const std::vector<Vec>& x, const std::vector<Vec>& v, unsigned axes) {
+  EventRecordN<D> r{a, kind, axes, ids, x, {}, v};
+  for (int q : ids) r.v_before.push_back(ln_[q].v);
+  events->push_back(std::move(r));
+}
+
+template <class Op, class Bits, class Queue>
+[[gnu::noinline, gnu::cold]] void BasicEngine<Op, Bits, Queue>::note_pair(std::int64_t a, int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj) {
+  if (events != nullptr) record(EventRecordN<D>::pair, a, {i, j}, {xi, xj}, {vi, vj}, 0);
+  if (!obs_) return;
+  double x[2 * D], v[2 * D];
+  for (std::size_t k = 0; k < D; ++k) {
+    x[k] = to_length(xi[k]);
+    x[D + k] = to_length(xj[k]);
+    v[k] = to_speed(vi[k]);
+    v[D + k] = to_speed(vj[k]);
+  }
+  obs_->pair_at(time_of(a), i, j, x, x + D, v, v + D);
+}
+
+template <class Op, class Bits, class Queue>
+[[gnu::noinline, gnu::cold]] void BasicEngine<Op, Bits, Queue>::note_wall(std::int64_t a, int p, const Vec& xp, const Vec& vp, unsigned axes) {
+  if (events != nullptr) record(EventRecordN<D>::wall, a, {p}, {xp}, {vp}, axes);
+  if (!obs_) return;
+  double x[D], v[D];
+  for (std::size_t k = 0; k < D; ++k) {
+    x[k] = to_length(xp[k]);
+    v[k] = to_speed(vp[k]);
+  }
+  obs_->wall_at(time_of(a), p, x, v, axes);
+}
+
+template <class Op, class Bits, class Queue>
+[[gnu::noinline, gnu::cold]] void BasicEngine<Op, Bits, Queue>::note_group(std::int64_t a, const std::vector<int>& g, const std::vector<Vec>& xg, const std::vector<Vec>& vg) {
+  if (events != nullptr) record(EventRecordN<D>::group, a, g, xg, vg, 0);
+  if (!obs_) return;
+  const std::size_t n = g.size();
+  std::vector<double> x(n * D), v(n * D);
+  for (std::size_t m = 0; m < n; ++m)
+    for (std::size_t k = 0; k < D; ++k) {
+      // positions image-consistent about the first member's
+      x[m * D + k] = to_length(m > 0 ? xg[0][k] + diff(xg[m], xg[0])[k] : xg[m][k]);
+      v[m * D + k] = to_speed(vg[m][k]);
+    }
+  obs_->group_at(time_of(a), static_cast<int>(n), g.data(), x.data(), v.data());
+}
+
+}  // namespace revcol::lattice

@@ -1,0 +1,174 @@
+// The lattice engine's prediction: a particle's earliest event (neutral crossing or list
+// renewal, wall, collision with a neighbour), the double-precision filter in front of the exact
+// first-overlap search, and the slot order that makes the search never decide a collision.
+// Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
+// design); included by engine_impl.hpp, which the instantiating sources include.
+#pragma once
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+#include "revcol/lattice/engine_core.hpp"
+
+namespace revcol::lattice {
+
+// ---- prediction ----
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::reanchor(int p, std::int64_t t) {
+  ln_[p].x = pos(p, t);
+  ln_[p].ta = t;
+  if (lists_) {  // a post point outside the ball (a collision moves it by ~vmax): renew now
+    if (!nl_.inside(p, ln_[p].x)) nl_.renew(p, ln_[p].x);
+    sync(p);
+    return;
+  }
+  const int id = grid_.cell_id(ln_[p].x);
+  if (grid_.cell_of_particle(p) != id) {
+    grid_.remove(p);
+    grid_.insert(p, id);
+  }
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::schedule(int p, Type type, std::int64_t t, std::int32_t kind, int partner) {
+  Slot& b = slot_[static_cast<std::size_t>(p)];
+  b.type = type;
+  b.partner = partner;
+  b.vself = b.ver;
+  b.vpart = partner >= 0 ? slot_[static_cast<std::size_t>(partner)].ver : 0;
+  if (type == none) queue_.erase(p); else queue_.set(p, t, kind);
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
+  reanchor(p, lo);
+  Best b;
+  std::array<int, D> c{};
+  if (lists_) {  // the renewal: when the line leaves the ball about p's list centre
+    const std::int64_t dt = nl_.exit_ticks(p, ln_[p].x, ln_[p].v);
+    if (dt > 0) b.offer(lo + dt, 0, cross, -1);
+  } else {
+    c = grid_.coords(grid_.cell_of_particle(p));
+  }
+  for (std::size_t k = 0; k < D; ++k) {
+    if (!lists_) {
+      const std::int64_t dt = grid_.exit_ticks(static_cast<int>(k), c[k], ln_[p].x[k], ln_[p].v[k]);
+      if (dt > 0) b.offer(lo + dt, 0, cross, -1);
+    }
+    if (u_.wall[k]) {
+      const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(static_cast<int>(k)));
+      if (dw >= 0) b.offer(lo + dw, wall_kind(), wall, -1);
+    }
+  }
+  scan(p, lo, b);
+  schedule(p, b.type, b.t, b.k, b.q);
+  if (b.type == coll) {  // write it into the partner's slot when before the event there
+    // in offer's order (tick, kind, other particle): with (tick, kind) alone, a tie (two pairs of
+    // one particle at one tick and one kind, i.e. the same lower index) went to whichever
+    // prediction wrote the slot first, so the search's neutral events (crossings or renewals,
+    // which re-predict) could choose the partner; measured once in 6.6 x 10^6 collisions
+    const Slot& sq = slot_[static_cast<std::size_t>(b.q)];
+    if (!queue_.scheduled(b.q) ||
+        std::tie(b.t, b.k, p) < std::tuple<std::int64_t, std::int32_t, int>(queue_.time(b.q), queue_.kind(b.q), sq.partner)) {
+      schedule(b.q, coll, b.t, b.k, p);
+    }
+  }
+}
+
+// p's candidate partners (its list, or its 3^D cells) into b.
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) {
+  // The candidates. A double-precision filter drops the pairs that cannot collide, or not
+  // before the best event so far; the others get the exact search (measure before changing).
+  // Rounding: a position is within 2^10 lattice units of its double (|x| < 2^63; an unwrapped
+  // anchor, two such roundings) and sigma >= 2^40 (units.hpp), so r is within ~2^-27 sigma of
+  // the exact relative vector and |r|^2, the closest approach and |r + w t|^2 within ~2^-26
+  // (|r|^2 + sigma^2): the margins below are 1e-6 of that (~2^-20), so a filtered pair is one
+  // whose every integer tick is provably outside.
+  // The image is the exact search's unless |r_k| is within rounding of L_k / 2 (edge: no filter).
+  const Line& lp = ln_[p];
+  constexpr double never = std::numeric_limits<double>::infinity();
+  double tb = b.type != none ? static_cast<double>(b.t - lo) : never;  // the best so far, ticks from lo
+  auto exact = [&](int q, double guess) {
+    const Vec r = diff(lp.x, pos(q, lo));
+    std::int64_t tau;
+    if constexpr (D == 3) {
+      tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_, guess);
+    } else {
+      (void)guess;
+      tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_);
+    }
+    if (tau >= 0) {
+      b.offer(lo + tau, coll_kind(p, q), coll, q);
+      tb = static_cast<double>(b.t - lo);
+    }
+  };
+  // the filter's tests on r, w (doubles): true when the pair surely has no overlap tick <= t
+  auto beyond = [&](double rr, double bb, double aa, double t) {
+    // never inside: the smallest |r + w t|^2 over t >= 0 (rr - bb^2 / aa when approaching, here
+    // times aa: no division on the loop's path; its rounding, ~4u rr aa by Cauchy-Schwarz, is far
+    // inside the margin) is beyond sigma^2
+    const double lim = sigma2d_ + 1e-6 * (rr + sigma2d_);
+    if (bb >= 0.0 ? rr > lim : rr * aa - bb * bb > lim * aa) return true;
+    // not up to t: f(t) = |r + w t|^2 is still falling at t and outside there
+    return t != never && -bb >= aa * t && rr + t * (2.0 * bb + aa * t) > sigma2d_ + 1e-6 * (rr + aa * t * t + sigma2d_);
+  };
+  if (direct_ && !exhaustive_search) {
+    // lists on a box wide enough: r = (a_p - a_q - s) - v_q (lo - t_q), with a the anchors
+    // unwrapped about their list centres and s the entry's image shift: no image to find
+    // (a and s are exact integers rounded once, as the positions of the other path)
+    const LineD& dp = lnd_[static_cast<std::size_t>(p)];
+    const int* ids = nl_.ids(p);
+    const std::uint8_t* codes = nl_.codes(p);
+    // every partner's line requested first: the filter's branches are unpredictable, and a
+    // mispredicted one would otherwise serialize the cache misses (as the float engine does)
+    for (int e = 0, ne = nl_.size(p); e < ne; ++e) __builtin_prefetch(&lnd_[static_cast<std::size_t>(ids[e])]);
+    for (int e = 0, ne = nl_.size(p); e < ne; ++e) {
+      const int q = ids[e];
+      const LineD& dq = lnd_[static_cast<std::size_t>(q)];
+      const double dtq = static_cast<double>(lo - dq.ta);
+      const double* sh = shift_[codes[e]].data();
+      double rr = 0.0, bb = 0.0, aa = 0.0;
+      for (std::size_t k = 0; k < D; ++k) {
+        const double r = ((dp.a[k] - dq.a[k]) - sh[k]) - dq.v[k] * dtq;
+        const double w = dp.v[k] - dq.v[k];
+        rr += r * r;
+        bb += r * w;
+        aa += w * w;
+      }
+      if (beyond(rr, bb, aa, tb)) continue;
+      // the entry root of aa t^2 + 2 bb t + rr - sigma^2 from these doubles: first_overlap's
+      // first guess (its exact predicates decide; any guess gives the same answer)
+      const double c0 = rr - sigma2d_;
+      exact(q, c0 / (std::sqrt(std::max(0.0, bb * bb - aa * c0)) - bb));
+    }
+  } else {
+    std::array<double, D> xp{};
+    for (std::size_t k = 0; k < D; ++k) xp[k] = static_cast<double>(lp.x[k]);
+    near(p, [&](int q) {
+      if (q == p) return;
+      const Line& lq = ln_[q];
+      if (!exhaustive_search) {
+        const double dtq = static_cast<double>(lo - lq.ta);
+        double rr = 0.0, bb = 0.0, aa = 0.0;
+        bool edge = false;
+        for (std::size_t k = 0; k < D; ++k) {
+          double r = (xp[k] - static_cast<double>(lq.x[k])) - static_cast<double>(lq.v[k]) * dtq;
+          if (!u_.wall[k]) {  // the nearest image (an inline rounding: libm's is a call)
+            const double m = r * invL_[k];
+            r -= Ld_[k] * static_cast<double>(static_cast<std::int64_t>(m + (m >= 0.0 ? 0.5 : -0.5)));
+            edge = edge || std::fabs(r) > edge_[k];
+          }
+          const double w = static_cast<double>(lp.v[k] - lq.v[k]);
+          rr += r * r;
+          bb += r * w;
+          aa += w * w;
+        }
+        if (!edge && beyond(rr, bb, aa, tb)) return;
+      }
+      exact(q, std::numeric_limits<double>::quiet_NaN());
+    });
+  }
+}
+
+}  // namespace revcol::lattice
