@@ -83,6 +83,9 @@ py::dict units_dict(const la::UnitsN<D>& u) {
   d["S"] = u.S;
   d["sigma"] = u.sigma;
   d["L"] = tuple_of(u.L);
+  py::tuple kinds(D);  // each axis's kind by name (engine/boundary_kind.hpp)
+  for (std::size_t k = 0; k < D; ++k) kinds[k] = engine::to_string(la::boundary_of(u, k));
+  d["boundary"] = kinds;
   d["wall"] = tuple_of(u.wall);
   d["vmax"] = u.vmax;
   d["length_unit"] = u.length_unit;
@@ -103,6 +106,15 @@ la::UnitsN<D> units_from(const py::dict& d) {
   for (std::size_t k = 0; k < D; ++k) {
     u.L[k] = L[k];
     u.wall[k] = w[k];
+  }
+  // each axis's kind by name; units written before bounce-back walls hold the wall flags only
+  if (d.contains("boundary")) {
+    const auto b = get<std::vector<std::string>>(d, "boundary");
+    require(b.size() == D, D == 2 ? "lattice units: boundary needs two names" : "lattice units: boundary needs three names (3D)");
+    for (std::size_t k = 0; k < D; ++k) {
+      la::set_boundary(u, k, engine::parse_boundary(b[k]));
+      require(u.wall[k] == w[k], "lattice units: boundary and wall disagree");
+    }
   }
   u.vmax = get<std::int64_t>(d, "vmax");
   u.length_unit = get<double>(d, "length_unit");
@@ -280,17 +292,28 @@ struct PyLattice {
   }
 };
 
+// one boundary name, or one per axis (engine::parse_boundary, the one parser), into a config
+template <std::size_t D>
+void set_boundaries(la::LatticeConfigN<D>& c, const std::vector<std::string>& boundary) {
+  require(boundary.size() == 1 || boundary.size() == D,
+          D == 2 ? "boundary must be one name or 2, one per axis (2D)" : "boundary must be one name or 3, one per axis (3D)");
+  for (std::size_t k = 0; k < D; ++k) {
+    const engine::Boundary b = engine::parse_boundary(boundary.size() == 1 ? boundary[0] : boundary[k]);
+    c.wall[k] = engine::has_walls(b);
+    c.bounce[k] = b == engine::Boundary::bounce;
+  }
+}
+
 // lattice_random_start (2D) and lattice3d_random_start
 template <std::size_t D>
-py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<bool> wall, PyReal diameter_arg, PyInt seed_arg,
+py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<std::string> boundary, PyReal diameter_arg, PyInt seed_arg,
                         const std::string& init, PyInt tick_bits_arg, PyInt cell_bits_arg) {
   const auto n = to_int<std::size_t>(n_arg, "n");
   const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
   const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
   const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
-  require(wall.size() == D, D == 2 ? "lattice: walls need one flag per axis (2D)" : "lattice: walls need one flag per axis (3D)");
   la::LatticeConfigN<D> c;
-  for (std::size_t k = 0; k < D; ++k) c.wall[k] = wall[k];
+  set_boundaries(c, boundary);
   c.diameter = diameter;
   c.seed = static_cast<std::uint32_t>(seed);
   c.tick_bits = tick_bits;
@@ -300,20 +323,17 @@ py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<bool> wall, PyR
 
 // lattice_quantize (2D) and lattice3d_quantize
 template <std::size_t D>
-py::dict quantize_d(const FArray& x, const FArray& v, std::vector<double> box, std::vector<bool> wall, PyReal diameter_arg,
+py::dict quantize_d(const FArray& x, const FArray& v, std::vector<double> box, std::vector<std::string> boundary, PyReal diameter_arg,
                     PyInt tick_bits_arg, PyInt cell_bits_arg) {
   const double diameter = to_real(diameter_arg, "diameter");
   const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
-  require(box.size() == D && wall.size() == D,
-          D == 2 ? "lattice: box and walls need two entries (2D)" : "lattice: box and walls need three entries (3D)");
+  require(box.size() == D, D == 2 ? "lattice: box needs two lengths (2D)" : "lattice: box needs three lengths (3D)");
   const auto nd = static_cast<py::ssize_t>(D);
   require(x.ndim() == 2 && x.shape(1) == nd && v.ndim() == 2 && v.shape(1) == nd,
           D == 2 ? "lattice: positions and velocities must be (n, 2)" : "lattice: positions and velocities must be (n, 3)");
   la::LatticeConfigN<D> c;
-  for (std::size_t k = 0; k < D; ++k) {
-    c.box[k] = box[k];
-    c.wall[k] = wall[k];
-  }
+  for (std::size_t k = 0; k < D; ++k) c.box[k] = box[k];
+  set_boundaries(c, boundary);
   c.diameter = diameter;
   c.tick_bits = tick_bits;
   c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
@@ -419,16 +439,16 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
 }  // namespace
 
 void register_lattice(py::module_& m) {
-  m.def("lattice_random_start", &random_start_d<2>, py::arg("n"), py::arg("phi"), py::arg("wall"), py::arg("diameter"),
+  m.def("lattice_random_start", &random_start_d<2>, py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"),
         py::arg("seed"), py::arg("init"), py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
         "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
-  m.def("lattice3d_random_start", &random_start_d<3>, py::arg("n"), py::arg("phi"), py::arg("wall"), py::arg("diameter"),
+  m.def("lattice3d_random_start", &random_start_d<3>, py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"),
         py::arg("seed"), py::arg("init"), py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
         "A random 3D start (spheres) as engine_random_state, quantized once: {units, x, v, errors}.");
-  m.def("lattice_quantize", &quantize_d<2>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("wall"), py::arg("diameter"),
+  m.def("lattice_quantize", &quantize_d<2>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
         py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
         "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
-  m.def("lattice3d_quantize", &quantize_d<3>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("wall"), py::arg("diameter"),
+  m.def("lattice3d_quantize", &quantize_d<3>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
         py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
         "3D units from the box and rms speed, and one quantization of (n, 3) arrays: {units, x, v, errors}.");
   register_engine<la::LatticeEngine>(m, "LatticeEngine", "The 2D lattice engine (revcol/lattice/engine.hpp).");

@@ -348,13 +348,13 @@ class LatticeEngine3D(_LatticeEngineMethods):
     @staticmethod
     def from_snapshot(snapshot: dict[str, Any]) -> LatticeEngine3D: ...
 
-def lattice_quantize(x: npt.ArrayLike, v: npt.ArrayLike, box: Sequence[_Float], wall: Sequence[bool],
+def lattice_quantize(x: npt.ArrayLike, v: npt.ArrayLike, box: Sequence[_Float], boundary: Sequence[str],
                      diameter: _Float, tick_bits: _Int = ..., cell_bits: _Int = ...) -> dict[str, Any]: ...
-def lattice_random_start(n: _Int, phi: _Float, wall: Sequence[bool], diameter: _Float, seed: _Int,
+def lattice_random_start(n: _Int, phi: _Float, boundary: Sequence[str], diameter: _Float, seed: _Int,
                          init: str, tick_bits: _Int = ..., cell_bits: _Int = ...) -> dict[str, Any]: ...
-def lattice3d_quantize(x: npt.ArrayLike, v: npt.ArrayLike, box: Sequence[_Float], wall: Sequence[bool],
+def lattice3d_quantize(x: npt.ArrayLike, v: npt.ArrayLike, box: Sequence[_Float], boundary: Sequence[str],
                        diameter: _Float, tick_bits: _Int = ..., cell_bits: _Int = ...) -> dict[str, Any]: ...
-def lattice3d_random_start(n: _Int, phi: _Float, wall: Sequence[bool], diameter: _Float, seed: _Int,
+def lattice3d_random_start(n: _Int, phi: _Float, boundary: Sequence[str], diameter: _Float, seed: _Int,
                            init: str, tick_bits: _Int = ..., cell_bits: _Int = ...) -> dict[str, Any]: ...
 
 # ---- cpp/bindings/randomness.cpp: the randomness study's word stream (revcol.randomness drives it).

@@ -43,22 +43,10 @@ __all__ = ["LatticeSimulation", "LatticeSimulation3D"]
 _Boundary = Union[str, Sequence[str]]
 
 
-def _walls(boundary: _Boundary, dim: int = 2) -> list:
-    given = names(boundary, "boundary")
-    given = given * dim if isinstance(boundary, str) else given
-    if len(given) != dim:
-        if dim == 2:
-            raise ValueError("the lattice engine is 2D: boundary must be one name or two")
-        raise ValueError(f"a {dim}D lattice: boundary must be one name or {dim}")
-    out = []
-    for b in given:
-        if b in ("wall", "walls"):
-            out.append(True)
-        elif b == "periodic":
-            out.append(False)
-        else:
-            raise ValueError(f"boundary must be 'wall' or 'periodic', got {b!r}")
-    return out
+def _boundary(boundary: _Boundary) -> list:
+    """One boundary name or one per axis, as the binding takes them (the C++ parser,
+    revcol/engine/boundary_kind.hpp, names a wrong one or a wrong count)."""
+    return names(boundary, "boundary")
 
 
 def _tick(tick_bits: Optional[int]) -> int:
@@ -78,7 +66,8 @@ class LatticeSimulation(Observing, Attachable):
 
     Build from float arrays (``LatticeSimulation(positions, velocities, box)``, quantized once)
     or at random (``LatticeSimulation.random(n, phi=...)``, the float engine's initialiser then
-    quantized). ``boundary``: ``"periodic"`` or ``"wall"`` (one or per axis). ``law``: ``"flux"``
+    quantized). ``boundary``: ``"periodic"``, ``"wall"`` (specular) or ``"bounce"`` (bounce-back, v -> -v,
+    as the float engine's), one name or one per axis. ``law``: ``"flux"``
     (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and X's
     first 256 bits. ``tick_bits`` T (16..26; default ``None``: automatic): a particle of rms speed
     moves 2^-T diameters per tick; a finer tick (larger T) makes redraws and group collisions (a
@@ -109,7 +98,7 @@ class LatticeSimulation(Observing, Attachable):
         if dim == 3 and (box.ndim > 1 or box.size not in (1, 3)):
             raise ValueError(f"box must be one length or three (3D), got shape {box.shape}")
         start = getattr(_core, _QUANTIZE[dim])(x, v, [float(b) for b in np.broadcast_to(box, (dim,))],
-                                               _walls(boundary, dim), diameter, _tick(tick_bits), cell_bits)
+                                               _boundary(boundary), diameter, _tick(tick_bits), cell_bits)
         self._init_from_start(start, law, seed, dim)
 
     def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2) -> None:
@@ -134,7 +123,7 @@ class LatticeSimulation(Observing, Attachable):
             if cls._DIM == 2:
                 raise ValueError(f"the lattice engine is 2D, got dim={dim} (spheres: LatticeSimulation3D)")
             raise ValueError(f"LatticeSimulation3D is 3D, got dim={dim}")
-        start = getattr(_core, _RANDOM_START[dim])(n, phi, _walls(boundary, dim), diameter, seed, name(init, "init"),
+        start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, name(init, "init"),
                                                    _tick(tick_bits), cell_bits)
         sim = cls.__new__(cls)
         sim._init_from_start(start, law, seed, dim)
@@ -252,8 +241,13 @@ class LatticeSimulation(Observing, Attachable):
         return tuple(not w for w in self._e.units["wall"])
 
     @property
+    def boundary(self) -> tuple:
+        """Per axis its kind: ``"periodic"``, ``"wall"`` or ``"bounce"``."""
+        return tuple(self._e.units["boundary"])
+
+    @property
     def units(self) -> dict:
-        """S, sigma, L, wall, vmax, length_unit, tick."""
+        """S, sigma, L, boundary (per axis its kind), wall (per axis: walls), vmax, length_unit, tick."""
         return dict(self._e.units)
 
     @property

@@ -3,6 +3,7 @@ reversal, checkpoints through save/load, diagnostics, float starts and bad input
 import numpy as np
 import pytest
 
+import revcol
 from revcol.lattice import LatticeSimulation
 
 
@@ -182,3 +183,27 @@ def test_a_reflection_and_a_pair_within_one_tick_resolve_as_a_group():
     sim.run(collisions=20000)
     sim.run_back(to_collision=4018557)
     assert _same(sim.snapshot(), s0)
+
+
+@pytest.mark.parametrize("dim,boundary", [(2, ["periodic", "bounce"]), (3, ["bounce", "wall", "periodic"])])
+def test_bounce_back_walls_reverse_bit_for_bit_and_survive_a_checkpoint(dim, boundary, tmp_path):
+    # the float engine's boundary kinds on the lattice (one parser, revcol/engine/boundary_kind.hpp)
+    sim = revcol.Simulation.random(n=300, dim=dim, phi=0.3, seed=7, engine="lattice", boundary=boundary)
+    assert sim.boundary == tuple(boundary)
+    assert sim.periodic == tuple(b == "periodic" for b in boundary)
+    x0, v0 = sim.lattice_positions, sim.lattice_velocities
+    sim.run(collisions=100_000)
+    assert sim.diagnostics()["walls"] > 0
+    sim.save(tmp_path / "c.npz")
+    back = type(sim).load(tmp_path / "c.npz")
+    assert back.boundary == tuple(boundary)
+    for s in (sim, back):
+        s.run_back()
+        assert np.array_equal(s.lattice_positions, x0) and np.array_equal(s.lattice_velocities, v0)
+
+
+def test_a_bad_boundary_name_is_named_by_the_one_parser():
+    with pytest.raises(ValueError, match="boundary must be one of 'wall', 'periodic', 'bounce', got 'walls'"):
+        revcol.Simulation.random(n=50, dim=2, phi=0.3, engine="lattice", boundary="walls")
+    with pytest.raises(ValueError, match="one name or 2"):
+        revcol.Simulation.random(n=50, dim=2, phi=0.3, engine="lattice", boundary=["wall"] * 3)

@@ -35,6 +35,8 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
   const double v_rms = std::sqrt(s2 / static_cast<double>(x.size() / D));
   LatticeStartN<D> s;
   s.units = choose_units_d<D>(c.box, c.diameter, v_rms, c.wall, c.tick_bits, c.cell_bits, x.size() / D);
+  s.units.bounce = c.bounce;
+  validate(s.units);
   QuantizedN<D> q = quantize(s.units, x, v);
   s.x = std::move(q.x);
   s.v = std::move(q.v);
@@ -49,7 +51,8 @@ LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double 
   engine::Config fc;
   fc.dim = static_cast<int>(D);
   fc.diameter = c.diameter;
-  for (std::size_t k = 0; k < D; ++k) fc.boundary[k] = c.wall[k] ? engine::Boundary::wall : engine::Boundary::periodic;
+  for (std::size_t k = 0; k < D; ++k)
+    fc.boundary[k] = !c.wall[k] ? engine::Boundary::periodic : c.bounce[k] ? engine::Boundary::bounce : engine::Boundary::wall;
   const engine::InitialState st = engine::random_state(fc, n, phi, seed, 0.0, init);
   LatticeConfigN<D> lc = c;
   for (std::size_t k = 0; k < D; ++k) lc.box[k] = st.config.box[k];

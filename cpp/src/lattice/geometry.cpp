@@ -147,6 +147,7 @@ void validate(const UnitsN<Dim>& u) {
     require(u.L[k] > 0 && u.L[k] < max_box_of<Dim>,
             Dim == 2 ? "lattice units: a box length must be in (0, 2^63 - 2^56) lattice units"
                      : "lattice units: a box length must be in (0, 2^62) lattice units in 3D");
+    require(u.wall[k] || !u.bounce[k], "lattice units: a bounce-back axis must have walls");
     if (u.wall[k]) {
       require(u.L[k] > u.sigma + 2, "lattice units: a walled axis must be longer than one diameter");
     } else {

@@ -92,7 +92,11 @@ auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g,
     for (std::size_t m = 0; m < n; ++m)
       for (std::size_t k = 0; k < D; ++k)
         if (wall[m][k] * v[m][k] > 0.0) {  // approaching a wall it meets: specular, exact
-          v[m][k] = -v[m][k];
+          if (u_.bounce[k]) {
+            for (std::size_t j = 0; j < D; ++j) v[m][j] = -v[m][j];  // a bounce-back wall: v -> -v
+          } else {
+            v[m][k] = -v[m][k];
+          }
           any = true;
         }
     for (const Touch& t : touch) {

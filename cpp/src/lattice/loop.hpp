@@ -112,17 +112,32 @@ void BasicEngine<Op, Bits, Queue>::check_order(std::int64_t t, std::int32_t k) {
 }
 
 // ---- walls ----
+// The reflection on the transition a-1 -> a of a line whose point at a is beyond the walls of
+// the axes C. Specular (every axis of C specular): on each axis of C the integer mirror of the
+// pre phase (wall_mirror, its own inverse) and v_k -> -v_k; the other axes fly on. Bounce back
+// (an axis of C bounces, engine::Boundary::bounce): the mirror on each axis of C, every other
+// axis stalls at its a-1 point, v -> -v. Reversed (velocity v again from the post point), the
+// line is beyond exactly the walls of C at the next tick (mirror(x) + v is beyond iff x was
+// inside; a stalled axis is back at its forward a point, inside), so the reverse applies the
+// same rule and mirror(mirror(x)) = x, the stall and -(-v) restore the pre state exactly.
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   journal(p);
   Vec x = pos(p, a - 1), v = ln_[p].v;
   Vec old_line_at_a = pos(p, a);
   unsigned axes = 0;  // the walls it meets
+  bool whole = false;  // one of them bounces back
+  for (std::size_t k = 0; k < D; ++k)
+    if (u_.wall[k] && (x[k] + v[k] < hlo_ || x[k] + v[k] > hhi(static_cast<int>(k)))) {
+      axes |= 1u << k;
+      whole = whole || u_.bounce[k];
+    }
   for (std::size_t k = 0; k < D; ++k) {
-    if (u_.wall[k] && wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k)))) axes |= 1u << k;
-    else x[k] += v[k];
+    if (axes >> k & 1u) wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k)));
+    else if (!whole) x[k] += v[k];  // a bounce back: the other axes stall at their a-1 point
     if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
   }
+  if (whole) v = neg(ln_[p].v);
   const Vec ghost = wrapped(sub(x, v));
   near(p, [&](int q) {
     if (q == p) return;

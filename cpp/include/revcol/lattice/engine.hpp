@@ -46,6 +46,7 @@ template <std::size_t D>
 struct LatticeConfigN {
   std::array<double, D> box = filled<D>(1.0);  ///< box lengths (float units)
   std::array<bool, D> wall{};                  ///< per axis: walls (else periodic)
+  std::array<bool, D> bounce{};                ///< per walled axis: bounce-back walls (v -> -v), else specular
   double diameter = 1.0;                   ///< D
   Law law = Law::flux;                     ///< the operator's post-direction law
   std::uint32_t seed = 1;                  ///< stream seed (Philox key {particle, seed}) and X's first bits

@@ -149,7 +149,7 @@ using Snapshot3 = SnapshotN<3>;
 template <std::size_t D>
 bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
   const UnitsN<D> &u = a.units, &w = b.units;
-  return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.vmax == w.vmax &&
+  return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.bounce == w.bounce && u.vmax == w.vmax &&
          u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
          a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&

@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "revcol/engine/boundary_kind.hpp"
 #include "revcol/lattice/geometry.hpp"
 
 namespace revcol::lattice {
@@ -58,12 +59,24 @@ struct UnitsN {
   std::int64_t sigma = std::int64_t{1} << 60;  ///< lattice units per diameter
   std::array<std::int64_t, Dim> L{};         ///< box lengths in lattice units, per axis
   std::array<bool, Dim> wall{};              ///< per axis: flat walls at 0 and L (else periodic)
+  std::array<bool, Dim> bounce{};            ///< per walled axis: bounce-back walls (v -> -v), else specular
   std::int64_t vmax = std::int64_t{1} << 52;  ///< largest |v| per axis, units per tick
   double length_unit = 0.0;                  ///< float length of one lattice unit (D / sigma)
   double tick = 0.0;                         ///< float time of one tick
   int tick_bits = 20;                        ///< T: a particle of rms speed moves 2^-T sigma per tick
   int cell_bits = 20;                        ///< the pair operator's 2^cell_bits direction cells per turn
 };
+/// The boundary kind of axis k (engine/boundary_kind.hpp): periodic, wall or bounce.
+template <std::size_t Dim>
+engine::Boundary boundary_of(const UnitsN<Dim>& u, std::size_t k) noexcept {
+  return !u.wall[k] ? engine::Boundary::periodic : u.bounce[k] ? engine::Boundary::bounce : engine::Boundary::wall;
+}
+/// Sets axis k of the units to a boundary kind (its walls and bounce flags).
+template <std::size_t Dim>
+void set_boundary(UnitsN<Dim>& u, std::size_t k, engine::Boundary b) noexcept {
+  u.wall[k] = engine::has_walls(b);
+  u.bounce[k] = b == engine::Boundary::bounce;
+}
 /// The 2D units.
 using Units = UnitsN<2>;
 /// The 3D units.
