@@ -52,6 +52,105 @@ def test_observing_changes_no_bit_and_run_back_ends_it():
     assert b.observation().to_dict() == before
 
 
+def _direct_sums(sim, collisions, D=1.0):
+    """The virial sums of the next ``collisions`` collisions straight from the engine's states,
+    one collision per ``run`` call (a call ends half way between its collision and the next
+    event, so nothing changes a velocity after the collision's instant within a step). Each
+    pair's contact vector is taken at contact: its post-collision relative line traced back
+    to |r| = D (taking r at the step's end instead adds s w_post . dv > 0 per collision and
+    puts such a sum about 1 / N above the observer's Z). Reflections are found from the
+    velocity changes (specular walls flip one component; the wall is the one it points away
+    from). Returns the collision virial W, the wall virial, the wall impulses per axis and
+    K2 = the integral of sum |v|^2 dt over the steps."""
+    box, per = np.asarray(sim.box), np.asarray(sim.periodic)
+    lo, hi, tol = 0.5 * D, box - 0.5 * D, 1e-9 * D
+
+    def nearest(r):
+        return np.where(per, r - box * np.round(r / box), r)
+
+    out = {"w": 0.0, "w_wall": 0.0, "k2": 0.0, "dp": np.zeros(sim.dim)}
+
+    def walls(q, dv):  # a reflection's impulse dv (walled axes only) on q
+        for k in np.nonzero(dv != 0.0)[0]:
+            assert not per[k]
+            out["w_wall"] += (lo if dv[k] > 0 else hi[k]) * dv[k]
+            out["dp"][k] += abs(dv[k])
+
+    x0, v0, t0, c0 = sim.positions, sim.velocities, sim.time, sim.collision_counts
+    for _ in range(collisions):
+        assert sim.run(collisions=1)["collisions"] == 1
+        x1, v1, t1, c1 = sim.positions, sim.velocities, sim.time, sim.collision_counts
+        i, j = np.nonzero(c1 != c0)[0]  # a pair (these gases make no group)
+        r1, w1 = nearest(x1[i] - x1[j]), v1[i] - v1[j]
+        a, b, c = w1 @ w1, r1 @ w1, r1 @ r1 - D * D
+        back = c / (b + np.sqrt(b * b - a * c))  # t1 - t_contact (the cancellation-free root)
+        rc, tc = r1 - w1 * back, t1 - back
+        touched = []  # i or j reflected in the step: on a wall at contact, or crossed one before
+        for q in (i, j):
+            at, pre = x1[q] - v1[q] * back, x0[q] + v0[q] * (tc - t0)
+            if np.any(~per & ((np.minimum(at, pre) < lo + tol) | (np.maximum(at, pre) > hi - tol))):
+                touched.append(q)
+        assert len(touched) < 2
+        dv_i, dv_j = v1[i] - v0[i], v1[j] - v0[j]
+        if touched == [i]:  # the pair's impulse on i is then -(j's change); the rest is walls
+            walls(i, dv_i + dv_j)
+            dv_i = -dv_j
+        elif touched == [j]:
+            walls(j, dv_i + dv_j)
+        out["w"] += rc @ dv_i
+        for q in np.nonzero(np.any(v1 != v0, axis=1))[0]:
+            if q != i and q != j:
+                walls(q, v1[q] - v0[q])
+        out["k2"] += np.sum(v0 * v0) * (tc - t0) + np.sum(v1 * v1) * (t1 - tc)  # walls keep |v|
+        x0, v0, t0, c0 = x1, v1, t1, c1
+    return out
+
+
+def _observed_sums(o, box):
+    """K2, W, the wall virial and the wall impulses from an observation's results."""
+    d, tau, vol = o.dim, o.t_end - o.t_start, float(np.prod(box))
+    k2 = o.temperature.value * d * o.n * tau
+    w = (o.compressibility.value - 1.0) * k2
+    dp = [o.pressure_wall[k].value * 2.0 * tau * vol / box[k] for k in range(d)]
+    return {"k2": k2, "w": w, "w_wall": o.virial_balance.value * k2 - k2 - w, "dp": np.array(dp),
+            "p": o.pressure_virial.value * d * vol * tau}
+
+
+@pytest.mark.parametrize("phi, boundary, mode", [
+    (0.5, "periodic", "exact"), (0.3, "wall", "exact"), (0.5, "periodic", "specular"), (0.3, "wall", "specular")])
+def test_observed_virial_equals_the_direct_sum_over_collisions(phi, boundary, mode):
+    """On one trajectory the observer's K2, collision virial W (hence Z and the virial
+    pressure), wall virial and wall impulses equal the direct sums over the engine's
+    collisions and reflections (_direct_sums) to 1e-9 relative: observed one collision per
+    call, and in one call from the same state (the first segment from the observe instant,
+    the last to half way to the next event, block ends and block merges in between)."""
+    sim = revcol.Simulation.random(n=400, dim=2, phi=phi, boundary=boundary, mode=mode, seed=3)
+    sim.run(collisions=4000)
+    start = sim.snapshot()
+    config = {"block_time": 0.003, "slabs": 5, "speed_bins": 20}  # > 256 blocks: they merge
+    sim.observe(**config)
+    direct = _direct_sums(sim, 3000)
+    whole = revcol.Simulation.from_snapshot(start)
+    whole.observe(**config)
+    whole.run(collisions=3000)
+    assert whole.time == sim.time and np.array_equal(whole.velocities, sim.velocities)
+    box = np.asarray(sim.box)
+    for o in (sim.observation(), whole.observation()):
+        assert o.pair_collisions == 3000 and o.group_collisions == 0
+        seen = _observed_sums(o, box)
+        assert seen["k2"] == pytest.approx(direct["k2"], rel=1e-9)
+        assert seen["w"] == pytest.approx(direct["w"], rel=1e-9)
+        assert seen["p"] == pytest.approx(direct["k2"] + direct["w"], rel=1e-9)
+        assert o.compressibility.value == pytest.approx(1.0 + direct["w"] / direct["k2"], rel=1e-9)
+        if boundary == "wall":
+            assert o.wall_reflections > 0
+            assert seen["w_wall"] == pytest.approx(direct["w_wall"], rel=1e-9)
+            assert seen["dp"] == pytest.approx(direct["dp"], rel=1e-9)
+        else:
+            assert direct["w_wall"] == 0.0 and seen["w_wall"] == pytest.approx(0.0, abs=1e-12 * direct["k2"])
+    assert whole.observation().blocks >= 16
+
+
 @pytest.mark.parametrize("kwargs, error, word", [
     ({"speed_bins": -1}, ValueError, "speed_bins"),
     ({"speed_bins": 2.5}, TypeError, "speed_bins"),
