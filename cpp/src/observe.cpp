@@ -1,6 +1,9 @@
-// The observer of a float-engine run: segments, blocks and results (the physics and the
-// definitions are in revcol/engine/observe.hpp).
+// The observer: its start, segments, slabs, pair distances, blocks and the float engine's pair
+// hook (the physics and the definitions are in revcol/engine/observe.hpp; the other hooks in
+// observe_hooks.cpp, snapshots in observe_save.cpp, results in observe_results.cpp).
 #include "revcol/engine/observe.hpp"
+
+#include "observe_inline.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,19 +12,10 @@
 
 #include "revcol/error.hpp"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace revcol::engine {
 
 namespace {
-
-constexpr std::size_t kMaxBlocks = 256;  // merged pairwise when full
-constexpr std::size_t kHeader = 18, kBlockReals = 9, kBlockCounts = 4;  // snapshots (save)
-constexpr int kMaxBins = 1 << 20;
-constexpr std::size_t kMaxPairParticles = 64;
-constexpr double kRound = 6755399441055744.0;  // 1.5 2^52
 
 // Time tau in [0, span] with a tau^2 + 2 b tau + c < q (a >= 0): the measure of the
 // interval between the roots of the quadratic, clipped to [0, span].
@@ -33,17 +27,6 @@ double time_below(double a, double b, double c, double q, double span) {
   const double lo = std::max(0.0, (-b - sq) / a), hi = std::min(span, (-b + sq) / a);
   return hi > lo ? hi - lo : 0.0;
 }
-
-// sqrt of x >= 0, correctly rounded like std::sqrt, without its errno branch (x is a sum of
-// squares: never negative).
-inline double root(double x) {
-#if defined(__SSE2__)
-  return _mm_cvtsd_f64(_mm_sqrt_sd(_mm_setzero_pd(), _mm_set_sd(x)));
-#else
-  return std::sqrt(x);
-#endif
-}
-
 
 }  // namespace
 
@@ -66,10 +49,8 @@ void Observer::Block::add(const Block& b) {
   sum(pair, b.pair);
 }
 
-namespace {
-
 // The config's checks (the constructor's and a snapshot's): n particles in dim dimensions.
-void check_config(const ObserveConfig& c, int dim, std::size_t n, const std::array<bool, 3>& walls) {
+void observe_detail::check_config(const ObserveConfig& c, int dim, std::size_t n, const std::array<bool, 3>& walls) {
   require(std::isfinite(c.block_time) && c.block_time >= 0.0,
           [&] { return "observe: block_time must be finite and >= 0, got " + num(c.block_time); });
   require(c.min_blocks >= 2 && c.min_blocks <= 64,
@@ -92,7 +73,6 @@ void check_config(const ObserveConfig& c, int dim, std::size_t n, const std::arr
   }
 }
 
-}  // namespace
 
 Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x, const std::vector<double>& v,
                    double t, const std::array<double, 3>& box, const std::array<bool, 3>& walls, double diameter)
@@ -155,199 +135,12 @@ Observer::Block Observer::empty_block(double t0) const {
   return b;
 }
 
-// K: the dimension known at compile time (the pair hook's fast path), 0: dim_ at run time.
-// The same sums in the same order either way (same bits).
-template <int K>
-[[gnu::always_inline]] inline void Observer::set_velocity(int i, const double* v) {
-  Segment& s = seg_[i];
-  double v2 = v[0] * v[0];  // (what 0 + v[0]^2 gives, a square being never -0)
-  s.v[0] = v[0];
-  for (int k = 1; k < (K > 0 ? K : dim_); ++k) {
-    s.v[k] = v[k];
-    v2 += v[k] * v[k];
-  }
-  const double speed = root(v2);
-  v2_sum_ += v2 - s.v2;  // sum_i v_i^2 and sum_i |v_i| (their time integrals: accumulate)
-  speed_sum_ += speed - s.speed;
-  s.v2 = v2;
-  s.speed = speed;
-  // the speed's bin; speeds from speed_max up, and every speed without a histogram
-  // (bin_scale_ 0), go to the last bin, never reported: close adds without a test
-  s.bin = static_cast<int>(std::min(speed * bin_scale_, bin_cap_));
-}
 
-// ---- snapshots (the layout of save's reals and counts: observe.hpp) ----------------------
 
-void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const {
-  const ObserveConfig& c = cfg_;
-  reals = {static_cast<double>(dim_), static_cast<double>(n_), c.block_time, static_cast<double>(c.min_blocks),
-           static_cast<double>(c.slab_axis), static_cast<double>(c.slabs), static_cast<double>(c.speed_bins),
-           c.speed_max, static_cast<double>(c.pair_bins), c.pair_rmax, block_time_, t_start_, t_now_, speed_max_,
-           static_cast<double>(blocks_.size()), static_cast<double>(msd_.size()), v2_sum_, speed_sum_};
-  for (const Segment& s : seg_) {
-    reals.insert(reals.end(), s.x, s.x + dim_);
-    reals.insert(reals.end(), s.v, s.v + dim_);
-    reals.push_back(s.t0);
-    if (cfg_.slabs > 0) reals.push_back(std::round(s.lo / slab_w_));  // its cell
-  }
-  reals.insert(reals.end(), start_.begin(), start_.end());
-  reals.insert(reals.end(), pair_t_.begin(), pair_t_.end());
-  counts.clear();
-  auto block = [&](const Block& b) {
-    for (double q : {b.t0, b.t1, b.k2, b.w, b.w_wall, b.dist, b.wall_dp[0], b.wall_dp[1], b.wall_dp[2]})
-      reals.push_back(q);
-    for (int half = 0; half < 2; ++half)  // the times, then the v^2 times
-      for (std::size_t u = 0; u < b.slab.size(); u += 2) reals.push_back(b.slab[u + half]);
-    reals.insert(reals.end(), b.speed.begin(), b.speed.end() - 1);  // not the overflow bin
-    reals.insert(reals.end(), b.pair.begin(), b.pair.end());
-    for (std::uint64_t q : {b.pairs, b.groups, b.parts, b.walls}) counts.push_back(q);
-  };
-  for (const Block& b : blocks_) block(b);
-  block(cur_);
-  reals.insert(reals.end(), msd_t_.begin(), msd_t_.end());
-  reals.insert(reals.end(), msd_.begin(), msd_.end());
-}
 
-Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint64_t>& counts, int dim,
-                   const std::vector<double>& v, double t, const std::array<double, 3>& box,
-                   const std::array<bool, 3>& walls, double diameter)
-    : dim_(dim), n_(0), box_(box), walls_(walls), diameter_(diameter) {
-  require(dim >= 1 && dim <= 3 && !v.empty() && v.size() % static_cast<std::size_t>(dim) == 0,
-          "snapshot: observer: the particles' velocities must be n x dim");
-  n_ = v.size() / static_cast<std::size_t>(dim);
-  require(reals.size() >= kHeader, "snapshot: observer holds fewer values than its header");
-  for (double q : reals) require(std::isfinite(q), "snapshot: observer values must be finite");
-  auto whole = [&](std::size_t k, double lo, double hi, const char* name) {
-    const double q = reals[k];
-    require(q >= lo && q <= hi && q == std::floor(q),
-            [&] { return std::string("snapshot: observer ") + name + " must be a whole number in range, got " +
-                         num(q); });
-    return static_cast<std::int64_t>(q);
-  };
-  require(whole(0, 1, 3, "dim") == dim && whole(1, 1, 1e15, "n") == static_cast<std::int64_t>(n_),
-          "snapshot: observer was taken of another number of particles or dimensions");
-  cfg_.block_time = reals[2];
-  cfg_.min_blocks = static_cast<int>(whole(3, 2, 64, "min_blocks"));
-  cfg_.slab_axis = static_cast<int>(whole(4, 0, 2, "slab_axis"));
-  cfg_.slabs = static_cast<int>(whole(5, 0, kMaxBins, "slabs"));
-  cfg_.speed_bins = static_cast<int>(whole(6, 0, kMaxBins, "speed_bins"));
-  cfg_.speed_max = reals[7];
-  cfg_.pair_bins = static_cast<int>(whole(8, 0, kMaxBins, "pair_bins"));
-  cfg_.pair_rmax = reals[9];
-  check_config(cfg_, dim, n_, walls);
-  block_time_ = reals[10];
-  t_start_ = reals[11];
-  t_now_ = reals[12];
-  speed_max_ = reals[13];
-  require(block_time_ > 0.0 && speed_max_ > 0.0, "snapshot: observer block time and speed_max must be > 0");
-  require(t_start_ <= t_now_ && t_now_ <= t, "snapshot: observer times must be ordered: start <= last update <= clock");
-  const auto nb = static_cast<std::size_t>(whole(14, 0, kMaxBlocks - 1, "block count"));
-  const auto nm = static_cast<std::size_t>(whole(15, 0, 1e12, "MSD count"));
-  const std::size_t d = static_cast<std::size_t>(dim), np = cfg_.pair_bins > 0 ? n_ * n_ : 0;
-  const std::size_t per_block = kBlockReals + 2 * cfg_.slabs + cfg_.speed_bins + cfg_.pair_bins;
-  const std::size_t per_particle = 3 * d + 1 + (cfg_.slabs > 0 ? 1 : 0);
-  require(reals.size() == kHeader + n_ * per_particle + np + (nb + 1) * per_block + 2 * nm,
-          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points)");
-  require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
-  bin_scale_ = cfg_.speed_bins / speed_max_;
-  bin_cap_ = cfg_.speed_bins;
-  set_geometry(box);
-  slab_w_ = cfg_.slabs > 0 ? box_[cfg_.slab_axis] / cfg_.slabs : 0.0;
-  std::size_t u = kHeader;
-  seg_.resize(n_);
-  for (std::size_t i = 0; i < n_; ++i) {
-    Segment& s = seg_[i];
-    for (int k = 0; k < 3; ++k) s.x[k] = s.v[k] = 0.0;
-    s.v2 = s.speed = 0.0;
-    for (std::size_t k = 0; k < d; ++k) s.x[k] = reals[u++];
-    for (std::size_t k = 0; k < d; ++k)
-      require(reals[u++] == v[i * d + k], "snapshot: observer: a segment's velocity is not its particle's");
-    s.t0 = reals[u++];
-    require(s.t0 >= t_start_ && s.t0 <= t, "snapshot: observer: a segment starts outside the observed time");
-    if (cfg_.slabs > 0) {
-      const double cell = reals[u++];
-      require(cell == std::floor(cell) && std::fabs(cell) < 1e15 &&
-                  (!walls_[cfg_.slab_axis] || (cell >= 0.0 && cell < cfg_.slabs)),
-              "snapshot: observer: a segment's slab cell must be a whole number (in [0, slabs) between walls)");
-      set_cell(s, cell);
-    }
-    set_velocity<0>(static_cast<int>(i), &v[i * d]);
-  }
-  auto take = [&](std::vector<double>& out, std::size_t m) {
-    out.assign(reals.begin() + static_cast<std::ptrdiff_t>(u), reals.begin() + static_cast<std::ptrdiff_t>(u + m));
-    u += m;
-  };
-  take(start_, n_ * d);
-  take(pair_t_, np);
-  auto block = [&](std::size_t b) {
-    Block k = empty_block(reals[u]);
-    k.t1 = reals[u + 1];
-    k.k2 = reals[u + 2];
-    k.w = reals[u + 3];
-    k.w_wall = reals[u + 4];
-    k.dist = reals[u + 5];
-    for (int a = 0; a < 3; ++a) k.wall_dp[a] = reals[u + 6 + a];
-    require(k.t0 >= t_start_ && k.t1 >= k.t0 && k.t1 <= t, "snapshot: observer: a block outside the observed time");
-    u += kBlockReals;
-    for (int half = 0; half < 2; ++half)
-      for (std::size_t w = 0; w < k.slab.size(); w += 2) k.slab[w + half] = reals[u++];
-    take(k.speed, k.speed.size() - 1);
-    k.speed.push_back(0.0);  // the overflow bin (never reported, not saved)
-    take(k.pair, k.pair.size());
-    k.pairs = counts[b * kBlockCounts];
-    k.groups = counts[b * kBlockCounts + 1];
-    k.parts = counts[b * kBlockCounts + 2];
-    k.walls = counts[b * kBlockCounts + 3];
-    return k;
-  };
-  for (std::size_t b = 0; b < nb; ++b) blocks_.push_back(block(b));
-  cur_ = block(nb);
-  take(msd_t_, nm);
-  take(msd_, nm);
-  v2_sum_ = reals[16];  // the running sums as they were (set_velocity above rebuilt them afresh)
-  speed_sum_ = reals[17];
-  set_fast_until();
-}
 
-// Closes i's segment at t: its duration weights its speed bin and its slabs (credited to
-// the open block); its position moves to t. K: the position components advanced, the
-// dimension on the pair hook's path, elsewhere 3 with no test of dim (the components beyond
-// d are 0 whatever dt).
-template <int K>
-[[gnu::always_inline]] inline void Observer::close(int i, double t) {
-  Segment& s = seg_[i];
-  const double dt = t - s.t0;
-  cur_.speed[s.bin] += dt;
-  if (cfg_.slabs > 0) {
-    const double end = s.x[cfg_.slab_axis] + s.v[cfg_.slab_axis] * dt;
-    if (in_cell(s, end)) {
-      add_slab(s, dt);
-    } else {
-      slab_cross(s, t, end);
-    }
-  }
-  fly<K>(s, t, dt);
-}
 
-// Slabs: whether s's position on the slab axis at its end is still in its cell (then the
-// segment never left it: the motion is linear).
-[[gnu::always_inline]] inline bool Observer::in_cell(const Segment& s, double end) {
-  return end >= s.lo && end < s.hi;
-}
 
-// A segment that ends in its cell: its duration (and v^2 times it) to its slab.
-[[gnu::always_inline]] inline void Observer::add_slab(const Segment& s, double dt) {
-  double* q = &cur_.slab[2 * static_cast<std::size_t>(s.slab)];
-  q[0] += dt;
-  q[1] += s.v2 * dt;
-}
-
-// The segment's position moves on by dt to t (K components).
-template <int K>
-[[gnu::always_inline]] inline void Observer::fly(Segment& s, double t, double dt) {
-  for (int k = 0; k < K; ++k) s.x[k] += s.v[k] * dt;
-  s.t0 = t;
-}
 
 // Slabs. A segment keeps its cell along the slab axis, cell = floor(x_a / w) in unwrapped
 // coordinates (any whole number on a periodic axis; [0, slabs) between walls), as the
@@ -419,9 +212,6 @@ void Observer::pair_interval(int i, int j, double t0, double t1) {
   }
 }
 
-[[gnu::always_inline]] inline void Observer::close_pairs(int i, double t) {
-  if (cfg_.pair_bins > 0) pairs_to(i, t);  // out of line: the hooks' hot path keeps fewer registers
-}
 
 void Observer::pairs_to(int i, double t) {
   for (std::size_t j = 0; j < n_; ++j) {
@@ -433,14 +223,6 @@ void Observer::pairs_to(int i, double t) {
   }
 }
 
-// The integrals of sum v^2 and sum |v| (constant between velocity changes) from the last
-// update to t, which becomes the last update.
-[[gnu::always_inline]] inline void Observer::accumulate(double t) {
-  const double dt = t - t_now_;
-  cur_.k2 += v2_sum_ * dt;
-  cur_.dist += speed_sum_ * dt;
-  t_now_ = t;
-}
 
 // The open block ends at te: the sums are integrated to te and the MSD is taken from every
 // particle's position then, without closing the segments (a segment's profile time goes
@@ -476,10 +258,6 @@ void Observer::end_block() {
   set_fast_until();
 }
 
-[[gnu::always_inline]] inline void Observer::reach(double t) {
-  while (t >= cur_.t0 + block_time_) end_block();
-  accumulate(t);
-}
 
 // The pair hook with the dimension at compile time: the loops unrolled, positions advanced
 // in d components only. Its common case runs in a path that calls nothing (fewer registers
@@ -548,123 +326,12 @@ template void Observer::pair_d<1>(double, int, int, const double*, const double*
 template void Observer::pair_d<2>(double, int, int, const double*, const double*);
 template void Observer::pair_d<3>(double, int, int, const double*, const double*);
 
-void Observer::group(double t, int n, const int* ids, const double* x, const double* v) {
-  reach(t);
-  for (int u = 0; u < n; ++u) {
-    const int i = ids[u];
-    for (int k = 0; k < dim_; ++k) cur_.w += x[u * dim_ + k] * (v[u * dim_ + k] - seg_[i].v[k]);
-    close<3>(i, t);
-    close_pairs(i, t);
-  }
-  for (int u = 0; u < n; ++u) set_velocity<0>(ids[u], v + u * dim_);
-  ++cur_.groups;
-  cur_.parts += static_cast<std::uint64_t>(n);
-}
 
-void Observer::wall(double t, int i, const double* v) {
-  reach(t);
-  close<3>(i, t);
-  close_pairs(i, t);
-  const double r = 0.5 * diameter_, tol = 1e-6 * diameter_;
-  for (int k = 0; k < dim_; ++k) {
-    const double dv = v[k] - seg_[i].v[k], xk = seg_[i].x[k];
-    if (!walls_[k] || dv == 0.0) continue;
-    if (std::fabs(xk - r) > tol && std::fabs(xk - (box_[k] - r)) > tol) continue;  // a tangential flip (v -> -v)
-    cur_.wall_dp[k] += std::fabs(dv);
-    cur_.w_wall += xk * dv;
-  }
-  set_velocity<0>(i, v);
-  ++cur_.walls;
-}
 
-// The *_at hooks (engines whose events move centres, the lattice engine): i's segment,
-// closed at the event, moves to the position x the engine gives, by the nearest image of
-// the difference on periodic axes (its position stays unwrapped), and takes the slab cell
-// of its new position.
-void Observer::place(int i, const double* x) {
-  Segment& s = seg_[i];
-  for (int k = 0; k < dim_; ++k) {
-    double d = x[k] - s.x[k];
-    if (!walls_[k]) d -= box_[k] * std::nearbyint(d * inv_box_[k]);
-    s.x[k] += d;
-  }
-  if (cfg_.slabs > 0) set_cell(s, std::floor(s.x[cfg_.slab_axis] / slab_w_));
-}
 
-void Observer::pair_at(double t, int a, int b, const double* xa, const double* xb, const double* va,
-                       const double* vb) {
-  reach(t);
-  close<3>(a, t);
-  close<3>(b, t);
-  close_pairs(a, t);
-  close_pairs(b, t);
-  double w = 0.0;
-  for (int k = 0; k < dim_; ++k) {
-    double r = xa[k] - xb[k];
-    if (!walls_[k]) r -= box_[k] * std::nearbyint(r * inv_box_[k]);  // the nearest image
-    w += r * (va[k] - seg_[a].v[k]);
-  }
-  cur_.w += w;
-  place(a, xa);
-  place(b, xb);
-  if (cfg_.collision_record) [[unlikely]] record_pair(a, b, va, vb);
-  set_velocity<0>(a, va);
-  set_velocity<0>(b, vb);
-  ++cur_.pairs;
-  cur_.parts += 2;
-}
 
-void Observer::group_at(double t, int n, const int* ids, const double* x, const double* v) {
-  reach(t);
-  for (int u = 0; u < n; ++u) {
-    const int i = ids[u];
-    close<3>(i, t);
-    close_pairs(i, t);
-    for (int k = 0; k < dim_; ++k) cur_.w += x[u * dim_ + k] * (v[u * dim_ + k] - seg_[i].v[k]);
-  }
-  for (int u = 0; u < n; ++u) {
-    place(ids[u], x + u * dim_);
-    set_velocity<0>(ids[u], v + u * dim_);
-  }
-  ++cur_.groups;
-  cur_.parts += static_cast<std::uint64_t>(n);
-}
 
-void Observer::wall_at(double t, int i, const double* x, const double* v, unsigned axes) {
-  reach(t);
-  close<3>(i, t);
-  close_pairs(i, t);
-  const double r = 0.5 * diameter_;
-  for (int k = 0; k < dim_; ++k) {
-    if (!(axes >> k & 1u) || !walls_[k]) continue;
-    const double dv = v[k] - seg_[i].v[k];
-    cur_.wall_dp[k] += std::fabs(dv);
-    cur_.w_wall += (v[k] > 0.0 ? r : box_[k] - r) * dv;  // the contact plane it left from
-  }
-  place(i, x);
-  set_velocity<0>(i, v);
-  ++cur_.walls;
-}
 
-void Observer::sync(double t) {
-  reach(t);
-  for (std::size_t i = 0; i < n_; ++i) {
-    close<3>(static_cast<int>(i), t);
-    close_pairs(static_cast<int>(i), t);
-  }
-}
 
-// The collision record's entry of a pair at the positions just closed (header comment).
-void Observer::record_pair(int a, int b, const double* va, const double* vb) {
-  double r[3] = {0.0, 0.0, 0.0}, rr = 0.0;
-  for (int k = 0; k < dim_; ++k) {
-    r[k] = seg_[a].x[k] - seg_[b].x[k];
-    if (!walls_[k]) r[k] -= box_[k] * std::nearbyint(r[k] * inv_box_[k]);  // the nearest image
-    rr += r[k] * r[k];
-  }
-  const double inv = 1.0 / std::sqrt(rr);
-  for (int k = 0; k < dim_; ++k) record_.push_back(r[k] * inv);
-  for (int k = 0; k < dim_; ++k) record_.push_back(va[k] - vb[k]);
-}
 
 }  // namespace revcol::engine

@@ -1,0 +1,132 @@
+// The observer's hooks other than the float engine's pair hook (observe.cpp): group
+// collisions, wall reflections, the *_at hooks of engines whose events move centres (the
+// lattice engine), the sync at a run's end and the collision record.
+#include "revcol/engine/observe.hpp"
+
+#include <cmath>
+
+#include "observe_inline.hpp"
+#include "revcol/error.hpp"
+
+namespace revcol::engine {
+
+void Observer::group(double t, int n, const int* ids, const double* x, const double* v) {
+  reach(t);
+  for (int u = 0; u < n; ++u) {
+    const int i = ids[u];
+    for (int k = 0; k < dim_; ++k) cur_.w += x[u * dim_ + k] * (v[u * dim_ + k] - seg_[i].v[k]);
+    close<3>(i, t);
+    close_pairs(i, t);
+  }
+  for (int u = 0; u < n; ++u) set_velocity<0>(ids[u], v + u * dim_);
+  ++cur_.groups;
+  cur_.parts += static_cast<std::uint64_t>(n);
+}
+
+void Observer::wall(double t, int i, const double* v) {
+  reach(t);
+  close<3>(i, t);
+  close_pairs(i, t);
+  const double r = 0.5 * diameter_, tol = 1e-6 * diameter_;
+  for (int k = 0; k < dim_; ++k) {
+    const double dv = v[k] - seg_[i].v[k], xk = seg_[i].x[k];
+    if (!walls_[k] || dv == 0.0) continue;
+    if (std::fabs(xk - r) > tol && std::fabs(xk - (box_[k] - r)) > tol) continue;  // a tangential flip (v -> -v)
+    cur_.wall_dp[k] += std::fabs(dv);
+    cur_.w_wall += xk * dv;
+  }
+  set_velocity<0>(i, v);
+  ++cur_.walls;
+}
+
+// The *_at hooks (engines whose events move centres, the lattice engine): i's segment,
+// closed at the event, moves to the position x the engine gives, by the nearest image of
+// the difference on periodic axes (its position stays unwrapped), and takes the slab cell
+// of its new position.
+void Observer::place(int i, const double* x) {
+  Segment& s = seg_[i];
+  for (int k = 0; k < dim_; ++k) {
+    double d = x[k] - s.x[k];
+    if (!walls_[k]) d -= box_[k] * std::nearbyint(d * inv_box_[k]);
+    s.x[k] += d;
+  }
+  if (cfg_.slabs > 0) set_cell(s, std::floor(s.x[cfg_.slab_axis] / slab_w_));
+}
+
+void Observer::pair_at(double t, int a, int b, const double* xa, const double* xb, const double* va,
+                       const double* vb) {
+  reach(t);
+  close<3>(a, t);
+  close<3>(b, t);
+  close_pairs(a, t);
+  close_pairs(b, t);
+  double w = 0.0;
+  for (int k = 0; k < dim_; ++k) {
+    double r = xa[k] - xb[k];
+    if (!walls_[k]) r -= box_[k] * std::nearbyint(r * inv_box_[k]);  // the nearest image
+    w += r * (va[k] - seg_[a].v[k]);
+  }
+  cur_.w += w;
+  place(a, xa);
+  place(b, xb);
+  if (cfg_.collision_record) [[unlikely]] record_pair(a, b, va, vb);
+  set_velocity<0>(a, va);
+  set_velocity<0>(b, vb);
+  ++cur_.pairs;
+  cur_.parts += 2;
+}
+
+void Observer::group_at(double t, int n, const int* ids, const double* x, const double* v) {
+  reach(t);
+  for (int u = 0; u < n; ++u) {
+    const int i = ids[u];
+    close<3>(i, t);
+    close_pairs(i, t);
+    for (int k = 0; k < dim_; ++k) cur_.w += x[u * dim_ + k] * (v[u * dim_ + k] - seg_[i].v[k]);
+  }
+  for (int u = 0; u < n; ++u) {
+    place(ids[u], x + u * dim_);
+    set_velocity<0>(ids[u], v + u * dim_);
+  }
+  ++cur_.groups;
+  cur_.parts += static_cast<std::uint64_t>(n);
+}
+
+void Observer::wall_at(double t, int i, const double* x, const double* v, unsigned axes) {
+  reach(t);
+  close<3>(i, t);
+  close_pairs(i, t);
+  const double r = 0.5 * diameter_;
+  for (int k = 0; k < dim_; ++k) {
+    if (!(axes >> k & 1u) || !walls_[k]) continue;
+    const double dv = v[k] - seg_[i].v[k];
+    cur_.wall_dp[k] += std::fabs(dv);
+    cur_.w_wall += (v[k] > 0.0 ? r : box_[k] - r) * dv;  // the contact plane it left from
+  }
+  place(i, x);
+  set_velocity<0>(i, v);
+  ++cur_.walls;
+}
+
+void Observer::sync(double t) {
+  reach(t);
+  for (std::size_t i = 0; i < n_; ++i) {
+    close<3>(static_cast<int>(i), t);
+    close_pairs(static_cast<int>(i), t);
+  }
+}
+
+// The collision record's entry of a pair at the positions just closed (header comment).
+void Observer::record_pair(int a, int b, const double* va, const double* vb) {
+  double r[3] = {0.0, 0.0, 0.0}, rr = 0.0;
+  for (int k = 0; k < dim_; ++k) {
+    r[k] = seg_[a].x[k] - seg_[b].x[k];
+    if (!walls_[k]) r[k] -= box_[k] * std::nearbyint(r[k] * inv_box_[k]);  // the nearest image
+    rr += r[k] * r[k];
+  }
+  const double inv = 1.0 / std::sqrt(rr);
+  for (int k = 0; k < dim_; ++k) record_.push_back(r[k] * inv);
+  for (int k = 0; k < dim_; ++k) record_.push_back(va[k] - vb[k]);
+}
+
+}  // namespace revcol::engine

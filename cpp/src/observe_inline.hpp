@@ -1,0 +1,122 @@
+// The observer's private parts shared by its sources (observe.cpp, observe_hooks.cpp,
+// observe_save.cpp): limits, the snapshot layout's sizes, the config check, and the inline
+// steps of every hook (a segment's close, the running sums, block ends). Measure before
+// changing: the pair hook's fast path is built from these.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+
+#include "revcol/engine/observe.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace revcol::engine {
+namespace observe_detail {
+
+inline constexpr std::size_t kMaxBlocks = 256;  // merged pairwise when full
+inline constexpr std::size_t kHeader = 18, kBlockReals = 9, kBlockCounts = 4;  // snapshots (save)
+inline constexpr int kMaxBins = 1 << 20;
+inline constexpr std::size_t kMaxPairParticles = 64;
+inline constexpr double kRound = 6755399441055744.0;  // 1.5 2^52
+
+// sqrt of x >= 0, correctly rounded like std::sqrt, without its errno branch (x is a sum of
+// squares: never negative).
+inline double root(double x) {
+#if defined(__SSE2__)
+  return _mm_cvtsd_f64(_mm_sqrt_sd(_mm_setzero_pd(), _mm_set_sd(x)));
+#else
+  return std::sqrt(x);
+#endif
+}
+
+/// The config's checks (the constructor's and a snapshot's): n particles in dim dimensions.
+void check_config(const ObserveConfig& c, int dim, std::size_t n, const std::array<bool, 3>& walls);
+
+}  // namespace observe_detail
+
+using namespace observe_detail;  // NOLINT: the observer's own sources only
+
+// K: the dimension known at compile time (the pair hook's fast path), 0: dim_ at run time.
+// The same sums in the same order either way (same bits).
+template <int K>
+[[gnu::always_inline]] inline void Observer::set_velocity(int i, const double* v) {
+  Segment& s = seg_[i];
+  double v2 = v[0] * v[0];  // (what 0 + v[0]^2 gives, a square being never -0)
+  s.v[0] = v[0];
+  for (int k = 1; k < (K > 0 ? K : dim_); ++k) {
+    s.v[k] = v[k];
+    v2 += v[k] * v[k];
+  }
+  const double speed = root(v2);
+  v2_sum_ += v2 - s.v2;  // sum_i v_i^2 and sum_i |v_i| (their time integrals: accumulate)
+  speed_sum_ += speed - s.speed;
+  s.v2 = v2;
+  s.speed = speed;
+  // the speed's bin; speeds from speed_max up, and every speed without a histogram
+  // (bin_scale_ 0), go to the last bin, never reported: close adds without a test
+  s.bin = static_cast<int>(std::min(speed * bin_scale_, bin_cap_));
+}
+
+// Closes i's segment at t: its duration weights its speed bin and its slabs (credited to
+// the open block); its position moves to t. K: the position components advanced, the
+// dimension on the pair hook's path, elsewhere 3 with no test of dim (the components beyond
+// d are 0 whatever dt).
+template <int K>
+[[gnu::always_inline]] inline void Observer::close(int i, double t) {
+  Segment& s = seg_[i];
+  const double dt = t - s.t0;
+  cur_.speed[s.bin] += dt;
+  if (cfg_.slabs > 0) {
+    const double end = s.x[cfg_.slab_axis] + s.v[cfg_.slab_axis] * dt;
+    if (in_cell(s, end)) {
+      add_slab(s, dt);
+    } else {
+      slab_cross(s, t, end);
+    }
+  }
+  fly<K>(s, t, dt);
+}
+
+// Slabs: whether s's position on the slab axis at its end is still in its cell (then the
+// segment never left it: the motion is linear).
+[[gnu::always_inline]] inline bool Observer::in_cell(const Segment& s, double end) {
+  return end >= s.lo && end < s.hi;
+}
+
+// A segment that ends in its cell: its duration (and v^2 times it) to its slab.
+[[gnu::always_inline]] inline void Observer::add_slab(const Segment& s, double dt) {
+  double* q = &cur_.slab[2 * static_cast<std::size_t>(s.slab)];
+  q[0] += dt;
+  q[1] += s.v2 * dt;
+}
+
+// The segment's position moves on by dt to t (K components).
+template <int K>
+[[gnu::always_inline]] inline void Observer::fly(Segment& s, double t, double dt) {
+  for (int k = 0; k < K; ++k) s.x[k] += s.v[k] * dt;
+  s.t0 = t;
+}
+
+[[gnu::always_inline]] inline void Observer::close_pairs(int i, double t) {
+  if (cfg_.pair_bins > 0) pairs_to(i, t);  // out of line: the hooks' hot path keeps fewer registers
+}
+
+// The integrals of sum v^2 and sum |v| (constant between velocity changes) from the last
+// update to t, which becomes the last update.
+[[gnu::always_inline]] inline void Observer::accumulate(double t) {
+  const double dt = t - t_now_;
+  cur_.k2 += v2_sum_ * dt;
+  cur_.dist += speed_sum_ * dt;
+  t_now_ = t;
+}
+
+[[gnu::always_inline]] inline void Observer::reach(double t) {
+  while (t >= cur_.t0 + block_time_) end_block();
+  accumulate(t);
+}
+
+}  // namespace revcol::engine
