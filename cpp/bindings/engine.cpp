@@ -225,10 +225,10 @@ class PyEngine {
     d["dim"] = c.dim;
     d["box"] = vec_array(std::vector<double>(c.box.begin(), c.box.begin() + c.dim));
     std::vector<std::int64_t> bnd;
-    // the Boundary value per axis (0 wall, 1 periodic: the same as a periodic flag; other
-    // kinds by their values, engine.hpp)
+    // each axis's kind by its value (0 wall, 1 periodic, 2 bounce: engine/boundary_kind.hpp);
+    // checkpoints written before this name held the same values as "periodic"
     for (int k = 0; k < c.dim; ++k) bnd.push_back(static_cast<std::int64_t>(c.boundary[k]));
-    d["periodic"] = vec_array(bnd);
+    d["boundary"] = vec_array(bnd);
     d["diameter"] = c.diameter;
     d["mode"] = std::string(to_string(c.mode));
     d["law"] = std::string(to_string(c.law));
@@ -266,9 +266,10 @@ class PyEngine {
     c.dim = checkpoint_field<int>(get("dim"), "dim");
     require(c.dim >= 1 && c.dim <= 3, "checkpoint: dim must be 1, 2 or 3");
     const auto box = array_vec<double>(d, "box");
-    const auto per = array_vec<std::int64_t>(d, "periodic");
+    require(d.contains("boundary") || d.contains("periodic"), "checkpoint is missing 'boundary'");
+    const auto per = array_vec<std::int64_t>(d, d.contains("boundary") ? "boundary" : "periodic");
     require(static_cast<int>(box.size()) == c.dim && static_cast<int>(per.size()) == c.dim,
-            "checkpoint: box and periodic need one entry per axis");
+            "checkpoint: box and boundary need one entry per axis");
     for (int k = 0; k < c.dim; ++k) {
       c.box[k] = box[k];
       c.boundary[k] = en::boundary_from_value(per[k]);  // every kind of en::kBoundaries, by value
@@ -371,6 +372,13 @@ void register_engine(py::module_& m) {
                              [](const PyEngine& e) {
                                const auto& c = e.sim().config();
                                return std::vector<double>(c.box.begin(), c.box.begin() + c.dim);
+                             })
+      .def_property_readonly("boundary",
+                             [](const PyEngine& e) {
+                               const auto& c = e.sim().config();
+                               std::vector<std::string> b;
+                               for (int k = 0; k < c.dim; ++k) b.emplace_back(en::to_string(c.boundary[k]));
+                               return b;
                              })
       .def_property_readonly("periodic",
                              [](const PyEngine& e) {

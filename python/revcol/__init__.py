@@ -20,8 +20,10 @@ from .verify import VERIFY_CASES, verify, verify_cases
 from .paper import Pair3DPaper, Triple1DPaper, Triple2DPaper
 from . import paper
 from . import statesave
+from .simulation import SimulationBase
 from .engine import Simulation
+from . import lattice  # registers engine="lattice" (revcol.simulation)
 from . import observe
 from .sweep import sweep
 
-__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper", "Simulation", "observe", "sweep"]
+__all__ = ["CLCG4", "Philox", "philox4x32", "Collision", "named_cases", "Pair1D", "Pair2D", "Wall", "verify", "verify_cases", "VERIFY_CASES", "statesave", "Pair3DPaper", "Triple1DPaper", "Triple2DPaper", "paper", "Simulation", "SimulationBase", "lattice", "observe", "sweep"]

@@ -10,6 +10,8 @@ import math
 import operator
 from typing import Optional
 
+import numpy as np
+
 
 def integer(x, name: str, lo: Optional[int] = None, hi: Optional[int] = None) -> int:
     """``x`` as an int (anything with ``__index__`` but bool); TypeError / ValueError naming ``name``."""
@@ -61,3 +63,11 @@ def packing_fraction(phi, packing_fraction, default: float = 0.3):
         raise TypeError("give the packing fraction once: phi= or packing_fraction=, not both")
     v = phi if phi is not None else packing_fraction
     return default if v is None else v
+
+
+def real_array(a, name: str) -> np.ndarray:
+    """``a`` as a float64 array; a TypeError naming ``name`` when it is not one."""
+    try:
+        return np.asarray(a, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name} must be an array of real numbers ({e})") from None

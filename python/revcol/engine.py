@@ -41,12 +41,11 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._args import integer, names
+from ._args import integer, names, real_array
 from ._args import packing_fraction as _packing_fraction
-from ._attach import Attachable
 from ._io import read_checkpoint, stamped, write_npz_atomic
-from .observe import Observing
 from .roundtrip import divergence_text
+from .simulation import SimulationBase, engine_class, register_engine
 
 __all__ = ["Simulation"]
 
@@ -57,15 +56,7 @@ def _boundary_list(boundary: _Boundary) -> list:
     return names(boundary, "boundary")
 
 
-def _real_array(a, name: str) -> np.ndarray:
-    """``a`` as a float64 array; a TypeError naming ``name`` when it is not one (issue 17)."""
-    try:
-        return np.asarray(a, dtype=float)
-    except (TypeError, ValueError) as e:
-        raise TypeError(f"{name} must be an array of real numbers ({e})") from None
-
-
-class Simulation(Observing, Attachable):
+class Simulation(SimulationBase):
     """N hard spheres in d = 1, 2, 3, run forward and backwards (revcol/engine/engine.hpp).
 
     Build from arrays (``Simulation(positions, velocities, box=...)``) or at random
@@ -75,18 +66,21 @@ class Simulation(Observing, Attachable):
 
     ``generator``: ``"philox"`` (default) or ``"clcg4"``; ``streams``: ``"per-particle"``
     (default; the smallest id of a collision draws) or ``"single"``.
+
+    ``engine="lattice"`` builds the lattice engine's simulation instead
+    (:class:`revcol.lattice.LatticeSimulation`, or ``LatticeSimulation3D`` for (n, 3)
+    positions): both are a :class:`revcol.SimulationBase`.
     """
+
+    engine = "float"
 
     def __new__(cls, *args, engine: str = "float", **kwargs):
         # engine="lattice" hands the whole call to the lattice engine (revcol.lattice: disks, or
         # spheres for (n, 3) positions), which takes the same positions, velocities, box,
         # boundary, diameter, law and seed
-        if engine == "lattice":
-            from .lattice import LatticeSimulation, LatticeSimulation3D
-            x = np.asarray(args[0] if args else kwargs.get("positions", ()))
-            return (LatticeSimulation3D if x.ndim == 2 and x.shape[1] == 3 else LatticeSimulation)(*args, **kwargs)
         if engine != "float":
-            raise ValueError(f"engine must be 'float' or 'lattice', got {engine!r}")
+            x = np.asarray(args[0] if args else kwargs.get("positions", ()))
+            return engine_class(engine, 3 if x.ndim == 2 and x.shape[1] == 3 else 2)(*args, **kwargs)
         return super().__new__(cls)
 
     def __init__(self, positions, velocities, box, *, engine: str = "float", boundary: _Boundary = "periodic",
@@ -97,13 +91,13 @@ class Simulation(Observing, Attachable):
         if _engine is not None:
             self._e = _engine
             return
-        x = _real_array(positions, "positions")
-        v = _real_array(velocities, "velocities")
+        x = real_array(positions, "positions")
+        v = real_array(velocities, "velocities")
         if x.ndim == 1:
             x = x[:, None]
         if v.ndim == 1:
             v = v[:, None]
-        box = np.atleast_1d(_real_array(box, "box")).tolist()
+        box = np.atleast_1d(real_array(box, "box")).tolist()
         # scalars go through as given: the engine names a wrong type or range (issue 17)
         self._e = _core.Engine(x, v, box, _boundary_list(boundary), diameter, mode, law,
                                seed, bits, bool(groups), group_tol, time,
@@ -123,15 +117,12 @@ class Simulation(Observing, Attachable):
         ``LatticeSimulation.random`` (dim 2) or ``LatticeSimulation3D.random`` (dim 3), reversed
         bit for bit (``law`` and ``seed`` apply)."""
         phi = _packing_fraction(phi, packing_fraction)
-        if engine == "lattice":
-            from .lattice import LatticeSimulation, LatticeSimulation3D
+        if engine != "float":
+            lat = engine_class(engine, dim)
             if energy is not None or equal_speeds:
                 raise ValueError("engine='lattice' starts at kT = 1 with Gaussian velocities: energy and "
                                  "equal_speeds are not available")
-            lat = LatticeSimulation3D if dim == 3 else LatticeSimulation
             return lat.random(n, dim, phi, boundary=boundary, diameter=diameter, seed=seed, init=init, **kwargs)
-        if engine != "float":
-            raise ValueError(f"engine must be 'float' or 'lattice', got {engine!r}")
         x, v, box = _core.engine_random_state(dim, n, phi, _boundary_list(boundary), diameter, seed,
                                               energy if energy is not None else 0.0, init,
                                               bool(equal_speeds))
@@ -251,6 +242,16 @@ class Simulation(Observing, Attachable):
         """Per axis, whether it is periodic (else walls at 0 and L_k: ``"wall"`` or ``"bounce"``)."""
         return tuple(bool(p) for p in self._e.periodic)
 
+    @property
+    def boundary(self) -> tuple:
+        """Per axis its kind: ``"periodic"``, ``"wall"`` or ``"bounce"``."""
+        return tuple(self._e.boundary)
+
+    @property
+    def collisions(self) -> int:
+        """Net collisions since the start (forward less undone)."""
+        return int(self._e.diagnostics()["net_collisions"])
+
     def diagnostics(self) -> dict:
         """Energy and momentum (and their drift from the start), rare-log bytes, collisions
         per particle, events by type."""
@@ -269,18 +270,6 @@ class Simulation(Observing, Attachable):
         """Rebuilds from ``snapshot()``; the run resumes bit for bit."""
         return cls(None, None, None, _engine=_core.Engine.from_snapshot(dict(snapshot)))
 
-    def state(self) -> dict:
-        """Deprecated name of ``snapshot()``."""
-        warnings.warn("Simulation.state() is now Simulation.snapshot()", DeprecationWarning, stacklevel=2)
-        return self.snapshot()
-
-    @classmethod
-    def from_state(cls, state: dict) -> "Simulation":
-        """Deprecated name of ``from_snapshot()``."""
-        warnings.warn("Simulation.from_state() is now Simulation.from_snapshot()", DeprecationWarning,
-                      stacklevel=2)
-        return cls.from_snapshot(state)
-
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the full state to ``path`` (numpy ``.npz``)."""
         st = self.snapshot()
@@ -292,10 +281,8 @@ class Simulation(Observing, Attachable):
         st = {k: (a.item() if a.ndim == 0 else a) for k, a in read_checkpoint(path, "float").items()}
         return cls.from_snapshot(st)
 
-    def __reduce__(self):
-        """Pickling (threads, process pools, ensembles): the state is ``snapshot()``, rebuilt by
-        ``from_snapshot``, so an unpickled copy resumes bit for bit; ``copy.deepcopy`` too."""
-        return (type(self).from_snapshot, (self.snapshot(),))
-
     def __repr__(self) -> str:
         return f"Simulation(n={self.n}, dim={self.dim}, time={self.time:.6g})"
+
+
+register_engine("float", lambda dim: Simulation)

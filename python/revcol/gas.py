@@ -92,8 +92,7 @@ class _GasRun:
         self.n, self.d = sim.n, sim.dim
         self.box, self.periodic = geometry(sim)
         # momentum is conserved along periodic axes unless a bounce-back wall (v -> -v) takes it
-        snap = sim.snapshot()
-        bounce = np.asarray(snap["periodic"])[: self.d] == 2 if "periodic" in snap else np.zeros(self.d, bool)
+        bounce = np.array([b == "bounce" for b in sim.boundary])
         self.conserved = self.periodic & ~bounce.any()
         self.x0, self.v0 = sim.positions, sim.velocities
         diag0 = sim.diagnostics()

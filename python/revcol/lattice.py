@@ -25,18 +25,15 @@ round trip is exact from the quantized state on. Times in floats are ``clock * t
 from __future__ import annotations
 
 import os
-import warnings
 from typing import Optional, Sequence, Union
 
 import numpy as np
 
 from . import _core
-from ._args import integer, name, names, real
+from ._args import integer, name, names, real, real_array
 from ._args import packing_fraction as _packing_fraction
-from ._attach import Attachable
 from ._io import read_checkpoint, stamped, write_npz_atomic
-from .observe import Observing
-from .engine import _real_array
+from .simulation import SimulationBase, register_engine
 
 __all__ = ["LatticeSimulation", "LatticeSimulation3D"]
 
@@ -60,7 +57,7 @@ _RANDOM_START = {2: "lattice_random_start", 3: "lattice3d_random_start"}
 _QUANTIZE = {2: "lattice_quantize", 3: "lattice3d_quantize"}
 
 
-class LatticeSimulation(Observing, Attachable):
+class LatticeSimulation(SimulationBase):
     """N hard disks on the integer lattice, run forward and back bit for bit (2D; spheres in 3D:
     :class:`LatticeSimulation3D`, the same API).
 
@@ -80,6 +77,7 @@ class LatticeSimulation(Observing, Attachable):
     """
 
     _DIM = 2  # LatticeSimulation3D: 3
+    engine = "lattice"
 
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
                  diameter: float = 1.0, law: str = "flux", seed: int = 1, tick_bits: Optional[int] = None,
@@ -89,9 +87,9 @@ class LatticeSimulation(Observing, Attachable):
             self._e = _engine
             self._q = dict(_quantization or {})
             return
-        x = _real_array(positions, "positions")
-        v = _real_array(velocities, "velocities")
-        box = _real_array(box, "box")
+        x = real_array(positions, "positions")
+        v = real_array(velocities, "velocities")
+        box = real_array(box, "box")
         dim = self._DIM
         if dim == 2 and (box.ndim > 1 or box.size not in (1, 2)):
             raise ValueError(f"box must be one length or two (2D), got shape {box.shape}")
@@ -236,11 +234,6 @@ class LatticeSimulation(Observing, Attachable):
         return np.asarray(u["L"], dtype=float) * float(u["length_unit"])
 
     @property
-    def periodic(self) -> tuple:
-        """Per axis: periodic (True) or walls (``Simulation.periodic``)."""
-        return tuple(not w for w in self._e.units["wall"])
-
-    @property
     def boundary(self) -> tuple:
         """Per axis its kind: ``"periodic"``, ``"wall"`` or ``"bounce"``."""
         return tuple(self._e.units["boundary"])
@@ -303,17 +296,6 @@ class LatticeSimulation(Observing, Attachable):
         out = LatticeSimulation3D if dim == 3 else LatticeSimulation
         return out(None, None, None, _engine=engine_class.from_snapshot(st), _quantization=q)
 
-    def state(self) -> dict:
-        """Deprecated name of ``snapshot()``."""
-        warnings.warn("LatticeSimulation.state() is now snapshot()", DeprecationWarning, stacklevel=2)
-        return self.snapshot()
-
-    @classmethod
-    def from_state(cls, state: dict) -> "LatticeSimulation":
-        """Deprecated name of ``from_snapshot()``."""
-        warnings.warn("LatticeSimulation.from_state() is now from_snapshot()", DeprecationWarning, stacklevel=2)
-        return cls.from_snapshot(state)
-
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the full state to ``path`` atomically (numpy ``.npz``; nested dicts as ``a.b`` keys)."""
         flat = {}
@@ -339,11 +321,6 @@ class LatticeSimulation(Observing, Attachable):
             else:
                 st[k] = val
         return cls.from_snapshot(st)
-
-    def __reduce__(self):
-        """Pickling (threads, process pools, ensembles): the state is ``snapshot()``, rebuilt by
-        ``from_snapshot``, so an unpickled copy resumes bit for bit; ``copy.deepcopy`` too."""
-        return (type(self).from_snapshot, (self.snapshot(),))
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n={self.n}, collisions={self.collisions}, clock={self.clock})"
@@ -372,3 +349,6 @@ class LatticeSimulation3D(LatticeSimulation):
     """
 
     _DIM = 3
+
+
+register_engine("lattice", lambda dim: LatticeSimulation3D if dim == 3 else LatticeSimulation)

@@ -207,13 +207,14 @@ def test_box_periodic_and_snapshot_names():
     snap = sim.snapshot()
     assert np.array_equal(sim.box, snap["box"]) and sim.box.shape == (2,)
     assert sim.periodic == (False, True)
-    assert list(snap["periodic"]) == [0, 1]
-    # the old names still work, with a deprecation warning
-    with pytest.warns(DeprecationWarning):
-        st = sim.state()
-    with pytest.warns(DeprecationWarning):
-        b = Simulation.from_state(st)
-    assert np.array_equal(b.positions, sim.positions)
+    assert sim.boundary == ("wall", "periodic")
+    assert list(snap["boundary"]) == [0, 1]  # each axis's kind by value: 0 wall, 1 periodic, 2 bounce
+    b = Simulation.from_snapshot(snap)
+    assert np.array_equal(b.positions, sim.positions) and b.boundary == sim.boundary
+    # a snapshot written before the key was named "boundary" holds the same values as "periodic"
+    old = dict(snap)
+    old["periodic"] = old.pop("boundary")
+    assert Simulation.from_snapshot(old).boundary == sim.boundary
 
 
 @pytest.mark.parametrize("dim", [1, 2, 3])
@@ -245,7 +246,7 @@ def test_bounce_boundary_end_to_end():
     c = Simulation([[2.0, 2.0], [6.0, 3.0]], [[1.0, -1.5], [-0.5, 1.0]], [9.0, 6.0],
                    boundary=["periodic", "bounce"])
     snap = c.snapshot()
-    assert list(snap["periodic"]) == [1, 2]
+    assert list(snap["boundary"]) == [1, 2]
     c.run(time=20.0)
     d = Simulation.from_snapshot(c.snapshot())
     c.run(time=30.0)
