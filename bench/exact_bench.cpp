@@ -3,7 +3,7 @@
 // Reports collisions/s each way, the round trip's error, and the rare log's size.
 #include "bench.hpp"
 #include "revcol/collide/cases.hpp"
-#include "revcol/verify.hpp"
+#include "revcol/studies/verify.hpp"
 
 namespace revcol::bench {
 

@@ -13,8 +13,8 @@
 #include "bench.hpp"
 #include "revcol/collide/calotte.hpp"
 #include "revcol/collide/ellipse_arc.hpp"
-#include "revcol/collide/paper_study.hpp"
 #include "revcol/rng/clcg4.hpp"
+#include "revcol/studies/paper_study.hpp"
 
 namespace revcol::bench {
 namespace {

@@ -19,7 +19,7 @@
 #include "bench.hpp"
 #include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
-#include "revcol/verify.hpp"
+#include "revcol/studies/verify.hpp"
 
 namespace revcol::bench {
 namespace {

@@ -1,4 +1,4 @@
-// The state-saving study in revcol-bench (workload and maths: revcol/statesave.hpp).
+// The state-saving study in revcol-bench (workload and maths: revcol/studies/statesave.hpp).
 //
 //   statesave/<mode>/<transport>/<variant>     mode exact|paper, transport eager|lazy,
 //                                               variant ss1|ss2|rc (eager), ss1|ss2|ssp|rc (lazy)
@@ -18,7 +18,7 @@
 
 #include "bench.hpp"
 #include "revcol/error.hpp"
-#include "revcol/statesave.hpp"
+#include "revcol/studies/statesave.hpp"
 
 namespace revcol::bench {
 namespace {

@@ -52,17 +52,17 @@
 #include <variant>
 #include <vector>
 
-#include "../cpp/src/paper_adapt.hpp"  // the paper operators behind one interface (private glue)
 #include "bench.hpp"
 #include "revcol/collide/calotte.hpp"
 #include "revcol/collide/cases.hpp"
 #include "revcol/collide/ellipse_arc.hpp"
-#include "revcol/rng/clcg4.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
 #include "revcol/collide/pair2d_paper.hpp"
 #include "revcol/engine/engine.hpp"
 #include "revcol/engine/init.hpp"
-#include "revcol/verify.hpp"
+#include "revcol/rng/clcg4.hpp"
+#include "revcol/studies/paper_adapt.hpp"
+#include "revcol/studies/verify.hpp"
 
 namespace revcol::bench {
 namespace {

@@ -1,4 +1,4 @@
-// Binding of revcol/ecmc.hpp, the event-chain sampler: numpy in and out, the sums as a dict.
+// Binding of revcol/studies/ecmc.hpp, the event-chain sampler: numpy in and out, the sums as a dict.
 // No physics here (python/revcol/ecmc.py drives it).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -10,8 +10,8 @@
 
 #include "args.hpp"
 #include "bindings.hpp"
-#include "revcol/ecmc.hpp"
 #include "revcol/error.hpp"
+#include "revcol/studies/ecmc.hpp"
 
 namespace py = pybind11;
 
@@ -36,7 +36,7 @@ py::dict sums_dict(const ChainSums& s) {
 
 void register_ecmc(py::module_& m) {
   py::class_<EventChain>(m, "EventChain",
-                         "Event-chain Monte Carlo of hard spheres in a periodic box (revcol/ecmc.hpp): "
+                         "Event-chain Monte Carlo of hard spheres in a periodic box (revcol/studies/ecmc.hpp): "
                          "an independent sampler of the equilibrium configurations and their pressure.")
       .def(py::init([](const std::vector<double>& box, const py::array_t<double, py::array::c_style | py::array::forcecast>& x,
                        PyReal diameter, PyInt seed) {

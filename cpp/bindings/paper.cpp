@@ -16,9 +16,9 @@
 #include "bindings.hpp"
 #include "revcol/collide/batch.hpp"
 #include "revcol/collide/pair3d_paper.hpp"
-#include "revcol/collide/paper_study.hpp"
 #include "revcol/collide/triple1d_paper.hpp"
 #include "revcol/collide/triple2d_paper.hpp"
+#include "revcol/studies/paper_study.hpp"
 
 namespace py = pybind11;
 

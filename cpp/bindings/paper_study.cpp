@@ -12,7 +12,7 @@
 #include "bindings.hpp"
 #include "revcol/collide/calotte.hpp"
 #include "revcol/collide/ellipse_arc.hpp"
-#include "revcol/collide/paper_study.hpp"
+#include "revcol/studies/paper_study.hpp"
 
 namespace py = pybind11;
 

@@ -1,4 +1,4 @@
-// Binding of revcol/randomness.hpp: the word stream of the randomness study (type
+// Binding of revcol/studies/randomness.hpp: the word stream of the randomness study (type
 // conversion and registration only; python/revcol/randomness.py drives it).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -10,7 +10,7 @@
 #include "args.hpp"
 #include "bindings.hpp"
 #include "revcol/error.hpp"
-#include "revcol/randomness.hpp"
+#include "revcol/studies/randomness.hpp"
 
 namespace py = pybind11;
 

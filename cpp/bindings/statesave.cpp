@@ -1,4 +1,4 @@
-// Binding of the state-saving study (revcol/statesave.hpp): keyword arguments in, a dict
+// Binding of the state-saving study (revcol/studies/statesave.hpp): keyword arguments in, a dict
 // out, snapshots as (N, 4) float64 arrays (x, y, vx, vy). Type conversion only.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -10,7 +10,7 @@
 #include "args.hpp"
 #include "bindings.hpp"
 #include "revcol/error.hpp"
-#include "revcol/statesave.hpp"
+#include "revcol/studies/statesave.hpp"
 
 namespace py = pybind11;
 

@@ -4,7 +4,7 @@
 
 #include "args.hpp"
 #include "bindings.hpp"
-#include "revcol/verify.hpp"
+#include "revcol/studies/verify.hpp"
 
 namespace py = pybind11;
 

@@ -1,7 +1,7 @@
-// Event-chain Monte Carlo (revcol/ecmc.hpp): its pressure against the exact finite-N answers
+// Event-chain Monte Carlo (revcol/studies/ecmc.hpp): its pressure against the exact finite-N answers
 // (rods on a ring, two disks, two spheres), no overlaps in dense gases, determinism, errors
 // that change nothing, and an interrupt between chains.
-#include "revcol/ecmc.hpp"
+#include "revcol/studies/ecmc.hpp"
 
 #include <cmath>
 #include <cstdint>

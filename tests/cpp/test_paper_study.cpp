@@ -1,13 +1,13 @@
 // The paper-mode verify cases (verify_paper.cpp) and the failure-rate measurement
 // (paper_study.hpp), on reduced counts: the 10^6-collision runs are quoted in
 // docs/paper-findings.md, not run here.
-#include "revcol/collide/paper_study.hpp"
+#include "revcol/studies/paper_study.hpp"
 
 #include <algorithm>
 #include <string>
 
 #include "check.hpp"
-#include "revcol/verify.hpp"
+#include "revcol/studies/verify.hpp"
 
 using namespace revcol;
 

@@ -6,7 +6,7 @@
 // stream is deterministic and resumable; bad configurations throw. The engine's collisions
 // in a gas (gas2d, gas3d) pass KS through their law's CDF and fail through the other's;
 // a Newton's cradle starts from rest, so its words are not triple1d's.
-#include "revcol/randomness.hpp"
+#include "revcol/studies/randomness.hpp"
 
 #include <algorithm>
 #include <cmath>

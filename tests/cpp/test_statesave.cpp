@@ -1,7 +1,7 @@
-// The state-saving study's workload (revcol/statesave.hpp), at small N and N_c: every
+// The state-saving study's workload (revcol/studies/statesave.hpp), at small N and N_c: every
 // variant comes back to the start (state saving bit for bit, RC within 1e-9), the draw count
 // is fixed, lazy transport agrees with eager, over-budget runs are skipped, bad input throws.
-#include "revcol/statesave.hpp"
+#include "revcol/studies/statesave.hpp"
 
 #include <cmath>
 #include <limits>

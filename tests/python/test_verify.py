@@ -67,7 +67,7 @@ def test_cli_reports_failure_and_bad_arguments():
 
 # Known answers: every case, both modes, both laws (exact mode), both generators, the
 # printed reverse (paper mode), 2000 collisions at seed 3, as verify reported them before
-# its three reversal loops became one (cpp/include/revcol/verify.hpp, reversal_chain). The
+# its three reversal loops became one (cpp/include/revcol/studies/verify.hpp, reversal_chain). The
 # timings are left out; every other field must be the same, bit for bit. The last four lines,
 # case pair3d-fast (Pair3DExact, issue 21), were recorded when that case was added.
 _KNOWN = [json.loads(line) for line in

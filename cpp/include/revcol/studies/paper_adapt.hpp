@@ -1,6 +1,7 @@
-// Private glue for verify_paper.cpp and paper_study.cpp: the three paper-mode operators seen
-// through one interface (state from a flat vector, flatten, negate, held invariants, the
-// approach/separation predicates), and a small deterministic normal generator.
+// The paper-mode operators behind one interface, for the studies that drive all three (the
+// paper study, the paper verify cases, the randomness study and the tradeoff bench): state from
+// a flat vector, flatten, negate, held invariants, the approach/separation predicates, and a
+// small deterministic normal generator.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -9,13 +10,13 @@
 #include <vector>
 
 #include "revcol/collide/pair3d_paper.hpp"
-#include "revcol/collide/paper_study.hpp"
+#include "revcol/studies/paper_study.hpp"
 #include "revcol/collide/triple1d_paper.hpp"
 #include "revcol/collide/triple2d_paper.hpp"
 
 namespace revcol::paper::adapt {
 
-// splitmix64 and Box-Muller: deterministic normals on every platform (no <random>).
+/// splitmix64 and Box-Muller: deterministic normals on every platform (no <random>).
 struct Normal {
   std::uint64_t s;
   std::uint64_t bits() {
@@ -28,8 +29,10 @@ struct Normal {
   double operator()() { return std::sqrt(-2.0 * std::log(uniform())) * std::cos(kTwoPi * uniform()); }
 };
 
+/// One paper-mode operator seen through the studies' interface (specialised per operator).
 template <class Op> struct Adapter;
 
+/// The 3D pair: a 6-component state, the contact normal as geometry.
 template <>
 struct Adapter<Pair3DPaper> {
   using Op = Pair3DPaper;
@@ -67,6 +70,7 @@ struct Adapter<Pair3DPaper> {
   static Op make(const StudyConfig& c) { return Op(c.printed_reverse); }
 };
 
+/// What the two triples share: a 3 x Dim state, flattened particle by particle.
 template <int Dim>
 struct TripleCommon {
   using State = Triple<Dim>;
@@ -100,6 +104,7 @@ struct TripleCommon {
   }
 };
 
+/// The 1D triple: three positions as geometry.
 template <>
 struct Adapter<Triple1DPaper> : TripleCommon<1> {
   using Op = Triple1DPaper;
@@ -122,6 +127,7 @@ struct Adapter<Triple1DPaper> : TripleCommon<1> {
   static Op make(const StudyConfig& c) { return Op(c.arc, c.cos_tol, c.printed_reverse, c.angle); }
 };
 
+/// The 2D triple: three 2D positions as geometry (predicates in its canonical frame).
 template <>
 struct Adapter<Triple2DPaper> : TripleCommon<2> {
   using Op = Triple2DPaper;

@@ -1,4 +1,4 @@
-#include "revcol/verify.hpp"
+#include "revcol/studies/verify.hpp"
 
 #include <cmath>
 #include <cstdio>

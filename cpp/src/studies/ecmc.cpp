@@ -1,5 +1,5 @@
-// Event-chain Monte Carlo of hard spheres: see revcol/ecmc.hpp.
-#include "revcol/ecmc.hpp"
+// Event-chain Monte Carlo of hard spheres: see revcol/studies/ecmc.hpp.
+#include "revcol/studies/ecmc.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,13 +1,12 @@
 // The word stream of randomness.hpp: generators (good and bad), the forward chain over
 // every operator signature, and the chart that maps a post state to words.
-#include "revcol/randomness.hpp"
+#include "revcol/studies/randomness.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <functional>
 #include <limits>
 
-#include "paper_adapt.hpp"
 #include "revcol/collide/cases.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
 #include "revcol/collide/pair2d_paper.hpp"
@@ -19,6 +18,7 @@
 #include "revcol/rng/clcg4.hpp"
 #include "revcol/rng/philox.hpp"
 #include "revcol/rng/streams.hpp"
+#include "revcol/studies/paper_adapt.hpp"
 
 namespace revcol::randomness {
 namespace {

@@ -22,8 +22,8 @@
 // valid next collision. Failure rates over 10^6 collisions: paper_study.hpp.
 #include <variant>
 
-#include "paper_adapt.hpp"
-#include "revcol/verify.hpp"
+#include "revcol/studies/paper_adapt.hpp"
+#include "revcol/studies/verify.hpp"
 
 namespace revcol::detail {
 namespace {

@@ -8,7 +8,7 @@
 #include <variant>
 
 #include "revcol/collide/cases.hpp"
-#include "revcol/verify.hpp"
+#include "revcol/studies/verify.hpp"
 
 namespace revcol::detail {
 namespace {

@@ -1,5 +1,5 @@
 // Paper-mode cases and the reversal-failure measurement (see paper_study.hpp).
-#include "revcol/collide/paper_study.hpp"
+#include "revcol/studies/paper_study.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <sstream>
 
-#include "paper_adapt.hpp"
 #include "revcol/rng/clcg4.hpp"
+#include "revcol/studies/paper_adapt.hpp"
 
 namespace revcol::paper {
 

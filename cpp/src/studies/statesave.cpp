@@ -1,5 +1,5 @@
 // The state-saving study (see statesave.hpp for the workload and its maths).
-#include "revcol/statesave.hpp"
+#include "revcol/studies/statesave.hpp"
 
 #include <sys/resource.h>
 
