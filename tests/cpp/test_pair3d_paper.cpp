@@ -4,7 +4,7 @@
 #include <random>
 
 #include "check.hpp"
-#include "revcol/collide/paper_batch.hpp"
+#include "revcol/collide/batch.hpp"
 #include "revcol/rng/clcg4.hpp"
 
 using namespace revcol;
@@ -144,10 +144,10 @@ TEST_CASE("exactly two draws per collision, drawn after the whole batch is valid
   std::vector<N3> n = {N3{1.0, 1.0, 1.0}, N3{-1.0, 0.0, 0.0}};
   rng::CLCG4 gen(5), ref(5);
   const std::vector<V> start = v;
-  paper::forward_batch(op, v.data(), n.data(), v.size(), gen, log);
+  forward_batch(op, v.data(), n.data(), v.size(), gen, log);
   for (int k = 0; k < 4; ++k) ref.next();
   CHECK(gen == ref);
-  paper::reverse_batch(op, v.data(), n.data(), v.size(), gen, log);
+  reverse_batch(op, v.data(), n.data(), v.size(), gen, log);
   CHECK(gen == rng::CLCG4(5));
   // a bad entry: nothing drawn, nothing changed, its index named
   std::vector<V> bad = start;
@@ -156,7 +156,7 @@ TEST_CASE("exactly two draws per collision, drawn after the whole batch is valid
   rng::CLCG4 g2(5);
   bool named = false;
   try {
-    paper::forward_batch(op, bad.data(), n.data(), bad.size(), g2, log);
+    forward_batch(op, bad.data(), n.data(), bad.size(), g2, log);
   } catch (const InvalidArgument& e) {
     named = std::string(e.what()).find("entry 1") != std::string::npos;
   }

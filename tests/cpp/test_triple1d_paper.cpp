@@ -4,7 +4,7 @@
 #include <random>
 
 #include "check.hpp"
-#include "revcol/collide/paper_batch.hpp"
+#include "revcol/collide/batch.hpp"
 #include "revcol/rng/clcg4.hpp"
 
 using namespace revcol;
@@ -161,10 +161,10 @@ TEST_CASE("exactly one draw per collision; validation changes nothing") {
   std::vector<T> v = {T{{{0.75}, {0.25}, {-0.5}}}, T{{{2.0}, {0.0}, {-1.0}}}, T{{{1.0}, {0.5}, {0.0}}}};
   std::vector<X> x(3, kRow);
   rng::CLCG4 gen(4), ref(4);
-  paper::forward_batch(op, v.data(), x.data(), v.size(), gen, log);
+  forward_batch(op, v.data(), x.data(), v.size(), gen, log);
   for (int k = 0; k < 3; ++k) ref.next();
   CHECK(gen == ref);
-  paper::reverse_batch(op, v.data(), x.data(), v.size(), gen, log);
+  reverse_batch(op, v.data(), x.data(), v.size(), gen, log);
   CHECK(gen == rng::CLCG4(4));
   CHECK(std::fabs(v[1][0][0] - 2.0) < 1e-14);
   const Triple1DPaper::Draws g{0.5};

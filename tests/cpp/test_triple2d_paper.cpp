@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "check.hpp"
-#include "revcol/collide/paper_batch.hpp"
+#include "revcol/collide/batch.hpp"
 #include "revcol/rng/clcg4.hpp"
 
 using namespace revcol;
@@ -275,7 +275,7 @@ TEST_CASE("exactly three draws per collision; validation changes nothing") {
   std::vector<P> x = {kC1, kC2};
   rng::CLCG4 gen(2), ref(2);
   const auto before = v;
-  paper::forward_batch(op, v.data(), x.data(), v.size(), gen, log);
+  forward_batch(op, v.data(), x.data(), v.size(), gen, log);
   for (int k = 0; k < 6; ++k) ref.next();
   CHECK(gen == ref);
   // C1 and C2 are mirror images: the same draws give mirrored post states
@@ -290,7 +290,7 @@ TEST_CASE("exactly three draws per collision; validation changes nothing") {
   bad[1] = T{{{-0.5, 0.3}, {0.5, 0.25}, {0.05, -0.6}}};  // P1 and P2 separate
   const auto copy = bad;
   rng::CLCG4 g3(2);
-  CHECK_THROWS_AS(paper::forward_batch(op, bad.data(), x.data(), bad.size(), g3, log), InvalidArgument);
+  CHECK_THROWS_AS(forward_batch(op, bad.data(), x.data(), bad.size(), g3, log), InvalidArgument);
   CHECK(g3 == rng::CLCG4(2));
   CHECK(bad == copy);
   const Triple2DPaper::Draws mid{0.5, 0.5, 0.5};

@@ -192,10 +192,4 @@ void reverse_batch(const Op& op, typename batch::OpTypes<Op>::State* v,
   batch::run(a, src, log, batch::Dir::reverse);
 }
 
-/// The paper-mode operators' batches are the same template.
-namespace paper {
-using revcol::forward_batch;
-using revcol::reverse_batch;
-}  // namespace paper
-
 }  // namespace revcol
