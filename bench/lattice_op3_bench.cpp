@@ -2,8 +2,8 @@
 // ns per forward / reverse on a pool of gas-like pre states (sigma = 2^60 lattice units, relative
 // speed |w| in [2^31, 2^32) units per tick as the engine's automatic tick gives, incidence from
 // the flux law, X of 256 bits, random 48-bit G), beside the 2D operator on the same speeds; and
-// the candidates of docs/lattice.md "3D: the direction chart": refusals by kind, energy change,
-// X's balance, for AzimuthMode::rows (the engine's) and AzimuthMode::carry (the rejected one).
+// the engine's candidate of docs/lattice.md "3D: the direction chart" (bits-back over the exact
+// rows of the azimuth cell): refusals by kind, energy change, X's balance.
 //
 //   revcol-bench --bench lattice/pair3d
 #include <algorithm>
@@ -22,7 +22,6 @@ namespace revcol::bench {
 
 namespace {
 
-using lattice::AzimuthMode;
 using lattice::BitsBack;
 using lattice::LatticePair2D;
 using lattice::LatticePair3D;
@@ -91,8 +90,8 @@ std::vector<OpState> make_states(const LatticePair3D& op, const BitsBack& X) {
   return pool;
 }
 
-std::vector<Metric> run_forward(AzimuthMode mode, std::uint64_t n) {
-  const LatticePair3D op(1LL << 60, revcol::Law::flux, 16, mode);
+std::vector<Metric> run_forward(std::uint64_t n) {
+  const LatticePair3D op(1LL << 60, revcol::Law::flux, 16);
   const BitsBack X = x256();
   const std::vector<OpState> pool = make_states(op, X);
   Vec3 q2, w2;
@@ -161,21 +160,19 @@ std::vector<Metric> run_forward2d(std::uint64_t n) {
   return {{"ns_per_call", 1e9 * secs(t0) / static_cast<double>(n)}};
 }
 
-// The design study: n gas collisions per candidate (a new gas pre state each, X chained, a
+// The design study: n gas collisions per speed (a new gas pre state each, X chained, a
 // G-dependent refusal redrawn): refusals per collision by kind, the energy change per
 // collision (|w2|^2 - |w|^2) / |w|^2 (mean, rms, max |.|), X's balance (bits per collision and
-// its range), at |w| ~ 2^31; rows mode also at |w| ~ 2^23 and 2^27 (refusals scale ~1 / |w|).
+// its range), at |w| ~ 2^31, 2^27 and 2^23 (refusals scale ~1 / |w|).
 std::vector<Metric> run_study(std::uint64_t n) {
   std::vector<Metric> out;
   struct Run {
-    AzimuthMode mode;
     int e;
     const char* tag;
   };
-  const Run runs[] = {{AzimuthMode::rows, 31, "rows"}, {AzimuthMode::carry, 31, "carry"}, {AzimuthMode::rows, 27, "rows_w2^27"},
-                      {AzimuthMode::rows, 23, "rows_w2^23"}};
+  const Run runs[] = {{31, "rows"}, {27, "rows_w2^27"}, {23, "rows_w2^23"}};
   for (const Run& r : runs) {
-    const LatticePair3D op(1LL << 60, revcol::Law::flux, 16, r.mode);
+    const LatticePair3D op(1LL << 60, revcol::Law::flux, 16);
     std::mt19937_64 rng(7);
     BitsBack X = x256(), X2;
     const double start = static_cast<double>(X.bit_length());
@@ -189,7 +186,7 @@ std::vector<Metric> run_study(std::uint64_t n) {
       int tries = 0;
       while ((why = op.forward(q, w, rng() >> 16, X, q2, w2, X2)) != Refusal::none && ++tries < 1000) ++kinds[static_cast<int>(why)];
       draws += static_cast<std::uint64_t>(tries) + 1;
-      if (why != Refusal::none) continue;  // (carry: a state no draw accepts)
+      if (why != Refusal::none) continue;  // a state no draw accepts
       ++accepted;
       std::swap(X, X2);
       const double b = static_cast<double>(X.bit_length());
@@ -247,11 +244,10 @@ std::vector<Metric> run_readback(std::uint64_t n) {
 }  // namespace
 
 void add_lattice_op3_benches(std::vector<Bench>& out) {
-  out.push_back({"lattice/pair3d/forward", "calls", [](std::uint64_t n) { return run_forward(AzimuthMode::rows, n); }});
+  out.push_back({"lattice/pair3d/forward", "calls", [](std::uint64_t n) { return run_forward(n); }});
   out.push_back({"lattice/pair3d/reverse", "calls", [](std::uint64_t n) { return run_reverse(n); }});
-  out.push_back({"lattice/pair3d/carry/forward", "calls", [](std::uint64_t n) { return run_forward(AzimuthMode::carry, n); }});
   out.push_back({"lattice/pair3d/pair2d_forward_same_speed", "calls", [](std::uint64_t n) { return run_forward2d(n); }});
-  out.push_back({"lattice/pair3d/study", "collisions per candidate", [](std::uint64_t n) { return run_study(n); }});
+  out.push_back({"lattice/pair3d/study", "collisions per speed", [](std::uint64_t n) { return run_study(n); }});
   out.push_back({"lattice/pair3d/readback", "draws per speed and cells", [](std::uint64_t n) { return run_readback(n); }});
 }
 

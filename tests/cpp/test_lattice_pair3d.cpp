@@ -109,9 +109,9 @@ struct LawRun {
 
 // n collisions of one fixed pre state: KS of the post polar angle's CDF value (flux: sin^2;
 // uniform: 1 - cos) and of the azimuth about the normal / 2 pi; X's size; spot reverses.
-LawRun run_law(Law law, AzimuthMode mode, double nt, double np, double inc_deg, long n, std::uint64_t seed) {
+LawRun run_law(Law law, double nt, double np, double inc_deg, long n, std::uint64_t seed) {
   const i64 sigma = 1LL << 60;
-  const LatticePair3D op(sigma, law, 16, mode);
+  const LatticePair3D op(sigma, law, 16);
   Vec3 q, w;
   LawRun out;
   if (!make_pre(sigma, nt, np, inc_deg * kPi / 180.0, 0.7, std::ldexp(1.0, 31), 0.37, q, w)) {
@@ -280,7 +280,7 @@ TEST_CASE("polar table: cum(0) = 0, cum(Q) = 2^30, every f >= 1, decode exact at
     }
 }
 
-TEST_CASE("round trip: 1.5e5 random pre states, sigma 2^20..2^60, speeds 2^20..2^45, both modes and laws") {
+TEST_CASE("round trip: 1.5e5 random pre states, sigma 2^20..2^60, speeds 2^20..2^45, both laws") {
   Rng rng(3);
   int bad = 0, done = 0;
   long refused[5] = {0, 0, 0, 0, 0};
@@ -288,8 +288,7 @@ TEST_CASE("round trip: 1.5e5 random pre states, sigma 2^20..2^60, speeds 2^20..2
     const int S = static_cast<int>(rng.range(20, 60));
     const i64 sigma = (1LL << S) - (t % 2 ? rng.range(0, 1000) : 0);
     const Law law = t % 3 == 0 ? Law::uniform : Law::flux;
-    const AzimuthMode mode = t % 5 == 0 ? AzimuthMode::carry : AzimuthMode::rows;
-    const LatticePair3D op(sigma, law, static_cast<int>(rng.range(12, 20)), mode);
+    const LatticePair3D op(sigma, law, static_cast<int>(rng.range(12, 20)));
     const double speed = std::ldexp(1.0 + rng.uni(), static_cast<int>(rng.range(std::min(20, S - 8), std::min(45, S - 4))));
     Vec3 q, w;
     if (!make_pre(sigma, std::acos(2 * rng.uni() - 1), 2 * kPi * rng.uni(), std::asin(std::sqrt(rng.uni())) * 1.02,
@@ -472,7 +471,7 @@ TEST_CASE("post law: KS of sin^2(theta) and of the azimuth at 4 fixed pre states
   const double states[4][3] = {{0.0, 0.0, 0.0}, {0.9, 0.2, 30.0}, {0.9553, kPi / 4, 60.0}, {2.2, -2.0, 88.0}};
   const long n = g_long > 0 ? g_long : 20000;
   for (int i = 0; i < 4; ++i) {
-    const LawRun r = run_law(Law::flux, AzimuthMode::rows, states[i][0], states[i][1], states[i][2], n, 100 + static_cast<std::uint64_t>(i));
+    const LawRun r = run_law(Law::flux, states[i][0], states[i][1], states[i][2], n, 100 + static_cast<std::uint64_t>(i));
     std::printf("  flux, normal (%.2f, %.2f), incidence %4.1f deg, n %ld: KS p(sin^2 theta) = %.4f, p(phi) = %.4f, mean cos %.5f "
                 "(2/3), refused %ld, X bits %g -> %g (min %g, max %g)\n",
                 states[i][0], states[i][1], states[i][2], n, r.p_theta, r.p_phi, r.mean_cos, r.refusals, r.bits_start, r.bits_end,
@@ -499,27 +498,14 @@ TEST_CASE("post law: KS of sin^2(theta) and of the azimuth at 4 fixed pre states
       CHECK(r.bits_start - r.bits_min < 200 + 0.01 * static_cast<double>(n));
     }
   }
-  const LawRun u = run_law(Law::uniform, AzimuthMode::rows, 0.5, 1.0, 20.0, n, 9);
+  const LawRun u = run_law(Law::uniform, 0.5, 1.0, 20.0, n, 9);
   std::printf("  uniform, n %ld: KS p(1 - cos theta) = %.4f, p(phi) = %.4f, mean cos %.5f (1/2)\n", n, u.p_theta, u.p_phi, u.mean_cos);
   CHECK(u.bad == 0);
   CHECK(u.p_theta > 0.001);
   CHECK(u.p_phi > 0.001);
   // the test can fail: the flux run's sin^2 read as the uniform law's 1 - cos is far from uniform
-  const LawRun f = run_law(Law::flux, AzimuthMode::rows, 0.5, 1.0, 20.0, std::min(n, 20000L), 9);
+  const LawRun f = run_law(Law::flux, 0.5, 1.0, 20.0, std::min(n, 20000L), 9);
   CHECK(std::fabs(f.mean_cos - 0.5) > 0.1);
-}
-
-TEST_CASE("the rejected candidate (azimuth offset carried, a changed cell refused): exact, but refuses and biases") {
-  // docs/lattice.md "3D: the direction chart": carrying the offset y across a polar rotation
-  // moves the azimuth by y / x_a, so the post leaves its azimuth cell unless the polar angle grows;
-  // the refusals are redraws (rare-log entries) and select posts, which biases the law.
-  const long n = g_long > 0 ? std::min(g_long, 200000L) : 20000;
-  const LawRun r = run_law(Law::flux, AzimuthMode::carry, 0.9, 0.2, 30.0, n, 11);
-  const double refused = static_cast<double>(r.refusals) / static_cast<double>(r.refusals + n);
-  std::printf("  carry, incidence 30 deg, n %ld: refused %.4f of draws, KS p(sin^2 theta) = %.3g, p(phi) = %.3g, mean cos %.5f, "
-              "X bits %g -> %g\n", n, refused, r.p_theta, r.p_phi, r.mean_cos, r.bits_start, r.bits_end);
-  CHECK(r.bad == 0);
-  CHECK(refused > 0.1);  // the measured reason it is rejected: far above the 1e-5 log bar
 }
 
 TEST_CASE("X's size over a gas of pre states: bounded under flux, +0.7213 bit/collision under uniform") {

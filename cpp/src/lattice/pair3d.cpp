@@ -225,8 +225,8 @@ std::optional<std::array<i64, 2>> row_of(const AzCell& az, i64 xa) {
 
 }  // namespace
 
-LatticePair3D::LatticePair3D(std::int64_t sigma, Law law, int cell_bits, AzimuthMode mode)
-    : sigma_(sigma), sigma2_(static_cast<i128>(sigma) * sigma), law_(law), shift_(kCellBits - cell_bits), mode_(mode) {
+LatticePair3D::LatticePair3D(std::int64_t sigma, Law law, int cell_bits)
+    : sigma_(sigma), sigma2_(static_cast<i128>(sigma) * sigma), law_(law), shift_(kCellBits - cell_bits) {
   require(sigma >= 2 && sigma <= (1LL << 60), "LatticePair3D: sigma must be in [2, 2^60] lattice units");
   require(cell_bits >= min_cell_bits && cell_bits <= max_cell_bits,
           "LatticePair3D: cell_bits must be in [12, 20] (2^cell_bits polar cells per turn)");
@@ -277,10 +277,8 @@ Refusal LatticePair3D::check_pre(const Vec3& q, const Vec3& w) const {
   Chart ch;
   const Refusal r = chart_of(neg(to_normal(W, col)), shift_, ch);
   if (r != Refusal::none) return r;
-  if (mode_ == AzimuthMode::rows) {
-    const auto rw = row_of(ch.az, ch.xa);
-    if (!rw || ch.y < (*rw)[0] || ch.y > (*rw)[1]) return Refusal::out_of_domain;
-  }
+  const auto rw = row_of(ch.az, ch.xa);
+  if (!rw || ch.y < (*rw)[0] || ch.y > (*rw)[1]) return Refusal::out_of_domain;
   return Refusal::none;
 }
 
@@ -312,17 +310,13 @@ Refusal LatticePair3D::forward(const Vec3& q, const Vec3& w, std::uint64_t g, co
   if (r0 != Refusal::none) return refuse(r0);
   tr.phi = ch.phi;
   tr.a = ch.cell;
-  std::array<i64, 2> rw{ch.y, ch.y};
-  if (mode_ == AzimuthMode::rows) {
-    const auto r = row_of(ch.az, ch.xa);
-    if (!r || ch.y < (*r)[0] || ch.y > (*r)[1]) return refuse(Refusal::out_of_domain);
-    rw = *r;
-  }
+  const auto r = row_of(ch.az, ch.xa);
+  if (!r || ch.y < (*r)[0] || ch.y > (*r)[1]) return refuse(Refusal::out_of_domain);
+  const std::array<i64, 2> rw = *r;
   tr.row = rw[1] - rw[0] + 1;
   X_out = X;
   X_out.push_uniform(static_cast<std::uint64_t>(col.pz - *lo), static_cast<std::uint64_t>(tr.m));
-  if (mode_ == AzimuthMode::rows)
-    X_out.push_uniform(static_cast<std::uint64_t>(ch.y - rw[0]), static_cast<std::uint64_t>(tr.row));
+  X_out.push_uniform(static_cast<std::uint64_t>(ch.y - rw[0]), static_cast<std::uint64_t>(tr.row));
   // 5-6. the joint symbol (Phi, a), the torus shift
   const std::uint64_t ca = cum(ch.cell);
   X_out.push_rans((static_cast<std::uint64_t>(ch.phi) << kTotBits) + ca, cum(ch.cell + 1) - ca);
@@ -336,13 +330,10 @@ Refusal LatticePair3D::forward(const Vec3& q, const Vec3& w, std::uint64_t g, co
   const IVec t2 = rotate({ch.uz, ch.xa}, rot_coef((tr.b - ch.cell) << shift_));
   if (!in_polar_cell(t2, tr.b, shift_)) return refuse(Refusal::cell_readback);
   const AzCell az2 = az_cell(tr.phi2);
-  i64 y2 = ch.y;
-  if (mode_ == AzimuthMode::rows) {
-    const auto r2 = row_of(az2, t2.y);
-    if (!r2) return refuse(Refusal::empty_post);
-    tr.row2 = (*r2)[1] - (*r2)[0] + 1;
-    y2 = (*r2)[0] + static_cast<i64>(X_out.pop_uniform(static_cast<std::uint64_t>(tr.row2)));
-  }
+  const auto r2 = row_of(az2, t2.y);
+  if (!r2) return refuse(Refusal::empty_post);
+  tr.row2 = (*r2)[1] - (*r2)[0] + 1;
+  const i64 y2 = (*r2)[0] + static_cast<i64>(X_out.pop_uniform(static_cast<std::uint64_t>(tr.row2)));
   const IVec uxy = rotate({t2.y, y2}, az2.c);
   const bool pole = uxy.x == 0 && uxy.y == 0;  // read back as azimuth cell 0
   if (pole ? tr.phi2 != 0 : !az2.holds(uxy)) return refuse(Refusal::cell_readback);
@@ -378,17 +369,14 @@ void LatticePair3D::reverse(const Vec3& q2, const Vec3& w2, std::uint64_t g, Bit
   Chart ch;
   require(chart_of(to_normal(W2, col), shift_, ch) == Refusal::none,
           "LatticePair3D::reverse: w2 is not outgoing about the normal (not a forward's output)");
-  std::array<i64, 2> rw2{ch.y, ch.y};
-  if (mode_ == AzimuthMode::rows) {
-    const auto r = row_of(ch.az, ch.xa);
-    require(r && ch.y >= (*r)[0] && ch.y <= (*r)[1], "LatticePair3D::reverse: post azimuth off its row");
-    rw2 = *r;
-  }
+  const auto r2 = row_of(ch.az, ch.xa);
+  require(r2 && ch.y >= (*r2)[0] && ch.y <= (*r2)[1], "LatticePair3D::reverse: post azimuth off its row");
+  const std::array<i64, 2> rw2 = *r2;
   const std::uint64_t row2 = static_cast<std::uint64_t>(rw2[1] - rw2[0] + 1);
   const std::uint64_t cb = cum(ch.cell), fb = cum(ch.cell + 1) - cb;
   const std::uint64_t csym = (static_cast<std::uint64_t>(ch.phi) << kTotBits) + cb;
   X.push_uniform(static_cast<std::uint64_t>(idx2), static_cast<std::uint64_t>(m2));
-  if (mode_ == AzimuthMode::rows) X.push_uniform(static_cast<std::uint64_t>(ch.y - rw2[0]), row2);
+  X.push_uniform(static_cast<std::uint64_t>(ch.y - rw2[0]), row2);
   X.push_rans(csym, fb);
   X.sub_low48(g);
   const std::uint64_t s = X.low48();
@@ -402,22 +390,18 @@ void LatticePair3D::reverse(const Vec3& q2, const Vec3& w2, std::uint64_t g, Bit
     X.push_rans(casym, fa);  // undo: X is left as it came in
     X.add_low48(g);
     X.pop_rans(csym, fb);
-    if (mode_ == AzimuthMode::rows) X.pop_uniform(row2);
+    X.pop_uniform(row2);
     X.pop_uniform(static_cast<std::uint64_t>(m2));
     require(false, why);
   };
   const IVec t = rotate_inv({ch.uz, ch.xa}, rot_coef((ch.cell - a) << shift_));
   if (t.x <= 0 || t.y < 0) fail(0, 0, "LatticePair3D::reverse: no pre state maps to this post state (not a forward's output)");
   const AzCell az = az_cell(phi);
-  i64 y = ch.y;
-  std::uint64_t row_len = 0, row_idx = 0;
-  if (mode_ == AzimuthMode::rows) {
-    const auto r = row_of(az, t.y);
-    if (!r) fail(0, 0, "LatticePair3D::reverse: the pre azimuth row is empty (not a forward's output)");
-    row_len = static_cast<std::uint64_t>((*r)[1] - (*r)[0] + 1);
-    row_idx = X.pop_uniform(row_len);
-    y = (*r)[0] + static_cast<i64>(row_idx);
-  }
+  const auto r = row_of(az, t.y);
+  if (!r) fail(0, 0, "LatticePair3D::reverse: the pre azimuth row is empty (not a forward's output)");
+  const std::uint64_t row_len = static_cast<std::uint64_t>((*r)[1] - (*r)[0] + 1);
+  const std::uint64_t row_idx = X.pop_uniform(row_len);
+  const i64 y = (*r)[0] + static_cast<i64>(row_idx);
   const IVec uxy = rotate({t.y, y}, az.c);
   const Vec3 W = from_normal(neg(Vec3{uxy.x, uxy.y, t.x}), col);
   const auto lo = small(W, kMaxComp) ? lo_pre3(sigma2_, col, W) : std::nullopt;

@@ -13,7 +13,7 @@
 //     proportional to sin(theta)). A post direction therefore lies in its azimuth cell by
 //     construction: no read-back refusal and no law distortion from the azimuth.
 // The measured design study (docs/lattice.md "3D: the direction chart") compares this with the
-// issue's other candidates; AzimuthMode::carry keeps the rejected one for that study.
+// issue's other candidates.
 //
 // Units: positions in lattice units (sphere diameter sigma, 2 <= sigma <= 2^60), velocities in
 // lattice units per tick, time in ticks. A pair collides on the transition from tick a-1 to tick
@@ -93,12 +93,6 @@ namespace revcol::lattice {
 
 using Vec3 = std::array<std::int64_t, 3>;  ///< an integer 3D vector (x, y, z)
 
-/// How the 3D operator moves the azimuth offset (the design study's two candidates).
-enum class AzimuthMode : std::uint8_t {
-  rows,   ///< bits-back over the exact rows of the azimuth cell (the engine's operator)
-  carry,  ///< the offset carried unchanged, a changed cell refused (the rejected candidate)
-};
-
 /// What one 3D forward did (for tests, statistics and the engine's counters).
 struct Trace3 {
   int face = 0;             ///< 2 * axis + (sign < 0), axis 0..2 = x, y, z
@@ -116,8 +110,7 @@ struct Trace3 {
 class LatticePair3D {
  public:
   /// Throws InvalidArgument unless 2 <= sigma <= 2^60 and 12 <= cell_bits <= 20.
-  explicit LatticePair3D(std::int64_t sigma, Law law = Law::flux, int cell_bits = 16,
-                         AzimuthMode mode = AzimuthMode::rows);
+  explicit LatticePair3D(std::int64_t sigma, Law law = Law::flux, int cell_bits = 16);
   static constexpr int draw_bits = 48;                      ///< G is a 48-bit integer
   static constexpr int phi_bits = 18;                       ///< 2^18 azimuth cells per turn
   static constexpr int theta_total_bits = draw_bits - phi_bits;  ///< the polar table's total 2^30
@@ -127,7 +120,6 @@ class LatticePair3D {
   Law law() const { return law_; }               ///< flux or uniform
   int cell_bits() const { return kCellBits - shift_; }  ///< 2^cell_bits polar cells per turn
   std::int64_t polar_cells() const { return quarter_ + 1; }  ///< polar cells in [0, pi/2): 2^cell_bits / 4 + 1
-  AzimuthMode mode() const { return mode_; }     ///< rows (the engine's) or carry (study)
 
   /// The G-independent refusal of a pre state (none, not_approaching or out_of_domain).
   Refusal check_pre(const Vec3& q, const Vec3& w) const;
@@ -168,7 +160,6 @@ class LatticePair3D {
   Law law_;
   int shift_;            // polar cells are 2^shift_ of cells.hpp's 2^20 per turn
   std::int64_t quarter_; // polar cells in [0, pi/2)
-  AzimuthMode mode_;
 };
 
 }  // namespace revcol::lattice
