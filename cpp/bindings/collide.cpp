@@ -91,9 +91,7 @@ Example:
     >>> back = op.reverse(post, normal=[-1.0, 0.0], rng=g)   # g steps back
 )";
 
-}  // namespace
-
-void register_collide(py::module_& m) {
+void register_pair2d(py::module_& m) {
   py::class_<Pair2D>(m, "Pair2D", kPair2DDoc)
       .def(py::init([](PyStr mode, PyStr law, PyInt bits, bool printed) {
              return Pair2D(parse_mode(to_str(mode, "mode")), parse_law(to_str(law, "law")),
@@ -167,57 +165,65 @@ void register_collide(py::module_& m) {
         return std::string("revcol.Pair2D(mode='") + to_string(op.mode()) + "', law='" +
                to_string(op.law()) + "', bits=" + std::to_string(op.bits()) + ")";
       });
+}
 
-  auto pair1d = [](const Array& v, const Array& n, int dir) {
-    const bool batched = v.ndim() == 2;
-    require((v.ndim() == 1 && v.shape(0) == 2) || (v.ndim() == 2 && v.shape(1) == 2),
-            [&] { return "velocities must have shape (2,) or (B, 2), got " + shape_of(v); });
-    const std::size_t B = batched ? v.shape(0) : 1;
-    require((n.ndim() == 0) || (n.ndim() == 1 && static_cast<std::size_t>(n.shape(0)) == B),
-            [&] { return "normal must be a number or have shape (B,), got " + shape_of(n); });
-    const Pair1D op;
-    std::vector<PairV<1>> out(B);
-    for (std::size_t b = 0; b < B; ++b) {  // validate all before returning anything
-      const PairV<1> x{{v.data()[2 * b]}, {v.data()[2 * b + 1]}};
-      const double nb = n.data()[n.ndim() == 0 ? 0 : b];
-      try {
-        out[b] = dir > 0 ? op.forward(x, nb) : op.reverse(x, nb);
-      } catch (const InvalidArgument& e) {
-        throw InvalidArgument((batched ? "entry " + std::to_string(b) + ": " : std::string()) + e.what());
-      }
+// Pair1D forward (dir > 0) or reverse on (2,) or (B, 2) velocities, every entry validated first.
+Array run_pair1d(const Array& v, const Array& n, int dir) {
+  const bool batched = v.ndim() == 2;
+  require((v.ndim() == 1 && v.shape(0) == 2) || (v.ndim() == 2 && v.shape(1) == 2),
+          [&] { return "velocities must have shape (2,) or (B, 2), got " + shape_of(v); });
+  const std::size_t B = batched ? v.shape(0) : 1;
+  require((n.ndim() == 0) || (n.ndim() == 1 && static_cast<std::size_t>(n.shape(0)) == B),
+          [&] { return "normal must be a number or have shape (B,), got " + shape_of(n); });
+  const Pair1D op;
+  std::vector<PairV<1>> out(B);
+  for (std::size_t b = 0; b < B; ++b) {  // validate all before returning anything
+    const PairV<1> x{{v.data()[2 * b]}, {v.data()[2 * b + 1]}};
+    const double nb = n.data()[n.ndim() == 0 ? 0 : b];
+    try {
+      out[b] = dir > 0 ? op.forward(x, nb) : op.reverse(x, nb);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument((batched ? "entry " + std::to_string(b) + ": " : std::string()) + e.what());
     }
-    Array res(std::vector<py::ssize_t>(v.shape(), v.shape() + v.ndim()));
-    for (std::size_t b = 0; b < B; ++b) {
-      res.mutable_data()[2 * b] = out[b].i[0];
-      res.mutable_data()[2 * b + 1] = out[b].j[0];
-    }
-    return res;
-  };
+  }
+  Array res(std::vector<py::ssize_t>(v.shape(), v.shape() + v.ndim()));
+  for (std::size_t b = 0; b < B; ++b) {
+    res.mutable_data()[2 * b] = out[b].i[0];
+    res.mutable_data()[2 * b + 1] = out[b].j[0];
+  }
+  return res;
+}
+
+void register_pair1d(py::module_& m) {
   py::class_<Pair1D>(m, "Pair1D",
                      "Pair collisions in 1 dimension: the velocities are exchanged (no random number).\n"
                      "velocities (2,) or (B, 2) = (v_i, v_j); normal = sign of x_i - x_j.")
       .def(py::init<>())
-      .def("forward", [pair1d](const Pair1D&, const ArrayArg& v_arg, const ArrayArg& n_arg) {
+      .def("forward", [](const Pair1D&, const ArrayArg& v_arg, const ArrayArg& n_arg) {
         const auto v = to_array(v_arg, "velocities");
-        const auto n = to_array(n_arg, "normal"); return pair1d(v, n, +1); },
+        const auto n = to_array(n_arg, "normal"); return run_pair1d(v, n, +1); },
            py::arg("velocities"), py::arg("normal"), "Pre -> post (the pair must approach).")
-      .def("reverse", [pair1d](const Pair1D&, const ArrayArg& v_arg, const ArrayArg& n_arg) {
+      .def("reverse", [](const Pair1D&, const ArrayArg& v_arg, const ArrayArg& n_arg) {
         const auto v = to_array(v_arg, "velocities");
-        const auto n = to_array(n_arg, "normal"); return pair1d(v, n, -1); },
+        const auto n = to_array(n_arg, "normal"); return run_pair1d(v, n, -1); },
            py::arg("velocities"), py::arg("normal"), "Post -> pre (the pair must separate).")
       .def_property_readonly_static("draws", [](py::object) { return Pair1D::draws; });
+}
 
-  auto wall = [](const Wall& w, const Array& x, const Array& v, double radius, double tol, int dir) {
-    const Box& box = w.box();
-    require(x.ndim() == 1 && v.ndim() == 1 && x.shape(0) == box.dim && v.shape(0) == box.dim,
-            [&] { return "position and velocity must have shape (" + std::to_string(box.dim) + ",)"; });
-    std::array<double, 3> xa{}, va{};
-    for (int k = 0; k < box.dim; ++k) { xa[k] = x.data()[k]; va[k] = v.data()[k]; }
-    const auto out = dir > 0 ? w.forward(xa, va, radius, tol) : w.reverse(xa, va, radius, tol);
-    Array res(box.dim);
-    for (int k = 0; k < box.dim; ++k) res.mutable_data()[k] = out[k];
-    return res;
-  };
+// Wall forward (dir > 0) or reverse of one particle: position and velocity of shape (d,).
+Array run_wall(const Wall& w, const Array& x, const Array& v, double radius, double tol, int dir) {
+  const Box& box = w.box();
+  require(x.ndim() == 1 && v.ndim() == 1 && x.shape(0) == box.dim && v.shape(0) == box.dim,
+          [&] { return "position and velocity must have shape (" + std::to_string(box.dim) + ",)"; });
+  std::array<double, 3> xa{}, va{};
+  for (int k = 0; k < box.dim; ++k) { xa[k] = x.data()[k]; va[k] = v.data()[k]; }
+  const auto out = dir > 0 ? w.forward(xa, va, radius, tol) : w.reverse(xa, va, radius, tol);
+  Array res(box.dim);
+  for (int k = 0; k < box.dim; ++k) res.mutable_data()[k] = out[k];
+  return res;
+}
+
+void register_wall(py::module_& m) {
   py::class_<Wall>(m, "Wall",
                   "Reflection on the walls of the box [lo, hi] (d = 1..3): every wall the particle\n"
                   "touches (within tol) and approaches flips its normal velocity component. A particle\n"
@@ -239,15 +245,23 @@ void register_collide(py::module_& m) {
              return Wall(b);
            }),
            py::arg("lo"), py::arg("hi"))
-      .def("forward", [wall](const Wall& w, const ArrayArg& x_arg, const ArrayArg& v_arg, double r, double tol) {
+      .def("forward", [](const Wall& w, const ArrayArg& x_arg, const ArrayArg& v_arg, double r, double tol) {
         const auto x = to_array(x_arg, "positions");
-        const auto v = to_array(v_arg, "velocities"); return wall(w, x, v, r, tol, +1); },
+        const auto v = to_array(v_arg, "velocities"); return run_wall(w, x, v, r, tol, +1); },
            py::arg("position"), py::arg("velocity"), py::arg("radius"), py::arg("tol") = 1e-9)
-      .def("reverse", [wall](const Wall& w, const ArrayArg& x_arg, const ArrayArg& v_arg, double r, double tol) {
+      .def("reverse", [](const Wall& w, const ArrayArg& x_arg, const ArrayArg& v_arg, double r, double tol) {
         const auto x = to_array(x_arg, "positions");
-        const auto v = to_array(v_arg, "velocities"); return wall(w, x, v, r, tol, -1); },
+        const auto v = to_array(v_arg, "velocities"); return run_wall(w, x, v, r, tol, -1); },
            py::arg("position"), py::arg("velocity"), py::arg("radius"), py::arg("tol") = 1e-9)
       .def_property_readonly_static("draws", [](py::object) { return Wall::draws; });
+}
+
+}  // namespace
+
+void register_collide(py::module_& m) {
+  register_pair2d(m);
+  register_pair1d(m);
+  register_wall(m);
 }
 
 }  // namespace revcol::bind

@@ -85,34 +85,35 @@ recovers the pre state exactly (after its first quantization) with the same numb
     True
 )";
 
-}  // namespace
+// Collision(n, d, contacts, normals= or positions=, ...): the constructor's checks and conversions.
+Collision make_collision(PyInt n_arg, PyInt d_arg, const std::vector<std::pair<int, int>>& contacts,
+                         std::optional<ArrayArg> normals_arg, std::optional<ArrayArg> positions_arg,
+                         PyReal diameter_arg, PyStr law_arg, PyInt bits_arg, PyReal tol_arg) {
+  const std::string law = to_str(law_arg, "law");
+  const auto normals = to_array(normals_arg, "normals");
+  const auto positions = to_array(positions_arg, "positions");
+  const int n = to_int<int>(n_arg, "n"), d = to_int<int>(d_arg, "d");
+  const int bits = to_int<int>(bits_arg, "bits", FixedPoint::min_bits, FixedPoint::max_bits);
+  const double diameter = to_real(diameter_arg, "diameter"), tol = to_real(tol_arg, "tol");
+  require(normals.has_value() != positions.has_value(),
+          "give exactly one of normals= (m x d) or positions= (n x d)");
+  if (positions) {
+    require(positions->ndim() == 2 && positions->shape(0) == n && positions->shape(1) == d,
+            [&] { return "positions must have shape (" + std::to_string(n) + ", " + std::to_string(d) + "), got " + shape_of(*positions); });
+    std::vector<double> p(positions->data(), positions->data() + n * d);
+    return Collision(ExactCollision::from_positions(n, d, contacts_from(contacts), p,
+                                                    diameter, parse_law(law), bits, tol));
+  }
+  require(normals->ndim() == 2 && normals->shape(1) == d &&
+              normals->shape(0) == static_cast<py::ssize_t>(contacts.size()),
+          [&] { return "normals must have shape (" + std::to_string(contacts.size()) + ", " + std::to_string(d) + "), got " + shape_of(*normals); });
+  std::vector<double> nv(normals->data(), normals->data() + normals->size());
+  return Collision(ExactCollision(n, d, contacts_from(contacts), nv, parse_law(law), bits));
+}
 
-void register_exact(py::module_& m) {
+void register_collision(py::module_& m) {
   py::class_<Collision>(m, "Collision", kDoc)
-      .def(py::init([](PyInt n_arg, PyInt d_arg, const std::vector<std::pair<int, int>>& contacts,
-                       std::optional<ArrayArg> normals_arg, std::optional<ArrayArg> positions_arg,
-                       PyReal diameter_arg, PyStr law_arg, PyInt bits_arg, PyReal tol_arg) {
-             const std::string law = to_str(law_arg, "law");
-        const auto normals = to_array(normals_arg, "normals");
-        const auto positions = to_array(positions_arg, "positions");
-             const int n = to_int<int>(n_arg, "n"), d = to_int<int>(d_arg, "d");
-             const int bits = to_int<int>(bits_arg, "bits", FixedPoint::min_bits, FixedPoint::max_bits);
-             const double diameter = to_real(diameter_arg, "diameter"), tol = to_real(tol_arg, "tol");
-             require(normals.has_value() != positions.has_value(),
-                     "give exactly one of normals= (m x d) or positions= (n x d)");
-             if (positions) {
-               require(positions->ndim() == 2 && positions->shape(0) == n && positions->shape(1) == d,
-                       [&] { return "positions must have shape (" + std::to_string(n) + ", " + std::to_string(d) + "), got " + shape_of(*positions); });
-               std::vector<double> p(positions->data(), positions->data() + n * d);
-               return Collision(ExactCollision::from_positions(n, d, contacts_from(contacts), p,
-                                                               diameter, parse_law(law), bits, tol));
-             }
-             require(normals->ndim() == 2 && normals->shape(1) == d &&
-                         normals->shape(0) == static_cast<py::ssize_t>(contacts.size()),
-                     [&] { return "normals must have shape (" + std::to_string(contacts.size()) + ", " + std::to_string(d) + "), got " + shape_of(*normals); });
-             std::vector<double> nv(normals->data(), normals->data() + normals->size());
-             return Collision(ExactCollision(n, d, contacts_from(contacts), nv, parse_law(law), bits));
-           }),
+      .def(py::init(&make_collision),
            py::arg("n"), py::arg("d"), py::arg("contacts"), py::kw_only(),
            py::arg("normals") = py::none(), py::arg("positions") = py::none(),
            py::arg("diameter") = 1.0, py::arg("law") = "flux", py::arg("bits") = 40,
@@ -194,7 +195,9 @@ void register_exact(py::module_& m) {
                std::to_string(c.op().dim()) + ", contacts=" + std::to_string(c.op().contacts()) +
                ", law='" + to_string(c.op().law()) + "')";
       });
+}
 
+void register_named_cases(py::module_& m) {
   m.def("named_cases", [] {
     py::list out;
     for (const NamedCase& c : named_cases()) {
@@ -213,6 +216,13 @@ void register_exact(py::module_& m) {
     }
     return out;
   }, "The named collision geometries (the paper's configurations and beyond).");
+}
+
+}  // namespace
+
+void register_exact(py::module_& m) {
+  register_collision(m);
+  register_named_cases(m);
 }
 
 }  // namespace revcol::bind

@@ -256,104 +256,117 @@ std::unique_ptr<Simulation> make_simulation(const Config& c, const std::vector<d
   return detail::make_engine<3>(c, x, v, t0);
 }
 
-// Every snapshot field checked before anything is built, each message naming its field
-// (issue 17's crafted-checkpoint suite, tests/python/test_checkpoints.py).
-void validate_snapshot(const Snapshot& s) {
-  validate_config(s.config);
+namespace {
+
+// A snapshot array of the wrong length: its name, the length wanted and what that length is.
+void require_size(const char* name, std::size_t got, std::size_t want, const char* what) {
+  require(got == want, [&] {
+    return std::string("snapshot: ") + name + " must have " + std::to_string(want) + " entries (" + what +
+           "), got " + std::to_string(got);
+  });
+}
+
+void require_finite(const char* name, const std::vector<double>& a) {
+  for (double q : a) require(std::isfinite(q), [&] { return std::string("snapshot: ") + name + " must be finite"; });
+}
+
+// The per-particle arrays: n x dim or n entries each (and the centre's values finite).
+void check_snapshot_shapes(const Snapshot& s) {
   const std::size_t n = s.n, d = static_cast<std::size_t>(s.config.dim);
   require(n > 0, "snapshot: n must be > 0 (no particles)");
-  const auto size = [](const char* name, std::size_t got, std::size_t want, const char* what) {
-    require(got == want, [&] {
-      return std::string("snapshot: ") + name + " must have " + std::to_string(want) + " entries (" + what +
-             "), got " + std::to_string(got);
-    });
-  };
-  const auto finite = [](const char* name, const std::vector<double>& a) {
-    for (double q : a) require(std::isfinite(q), [&] { return std::string("snapshot: ") + name + " must be finite"; });
-  };
-  size("x", s.x.size(), n * d, "n x dim");
-  size("v", s.v.size(), n * d, "n x dim");
-  size("cell", s.cell.size(), n * d, "n x dim");
-  if (!s.centre.empty()) size("centre", s.centre.size(), n * d, "n x dim, or none");
-  finite("centre", s.centre);
-  size("t_local", s.t_local.size(), n, "n");
-  size("stamp", s.stamp.size(), n, "n");
-  size("ncoll", s.ncoll.size(), n, "n");
-  size("ev_t", s.ev_t.size(), n, "n");
-  size("ev_kind", s.ev_kind.size(), n, "n");
-  size("ev_partner", s.ev_partner.size(), n, "n");
-  size("ev_stamp", s.ev_stamp.size(), n, "n");
-  size("second", s.second.size(), n, "n");
-  size("touching", s.touching.size(), n, "n");
-  size("netc", s.netc.size(), n, "n");
-  size("rng", s.rng.size(), s.config.streams == rng::StreamPolicy::single ? 1 : n, "one per stream: n, or 1");
+  require_size("x", s.x.size(), n * d, "n x dim");
+  require_size("v", s.v.size(), n * d, "n x dim");
+  require_size("cell", s.cell.size(), n * d, "n x dim");
+  if (!s.centre.empty()) require_size("centre", s.centre.size(), n * d, "n x dim, or none");
+  require_finite("centre", s.centre);
+  require_size("t_local", s.t_local.size(), n, "n");
+  require_size("stamp", s.stamp.size(), n, "n");
+  require_size("ncoll", s.ncoll.size(), n, "n");
+  require_size("ev_t", s.ev_t.size(), n, "n");
+  require_size("ev_kind", s.ev_kind.size(), n, "n");
+  require_size("ev_partner", s.ev_partner.size(), n, "n");
+  require_size("ev_stamp", s.ev_stamp.size(), n, "n");
+  require_size("second", s.second.size(), n, "n");
+  require_size("touching", s.touching.size(), n, "n");
+  require_size("netc", s.netc.size(), n, "n");
+  require_size("rng", s.rng.size(), s.config.streams == rng::StreamPolicy::single ? 1 : n, "one per stream: n, or 1");
+}
+
+// The clock and the velocities: finite, resolvable, and still carrying the conserved energy and
+// momentum.
+void check_snapshot_motion(const Snapshot& s) {
+  const std::size_t n = s.n, d = static_cast<std::size_t>(s.config.dim);
   for (auto q : s.touching) require(q == 0 || q == 1, "snapshot: touching must be 0 or 1");
   require(std::isfinite(s.time), "snapshot: time must be finite");
   require(std::isfinite(s.start_time), "snapshot: start_time must be finite");
-  finite("t_local", s.t_local);
-  finite("x", s.x);
-  finite("v", s.v);
-  {
-    double vmax = 0.0;
-    for (double q : s.v) vmax = std::max(vmax, std::fabs(q));
-    require(limits::clock_fits(s.time, s.config.diameter, vmax) && limits::clock_fits(s.start_time, s.config.diameter, vmax),
-            "snapshot: time or start_time too large for the clock to resolve flights of one diameter (|t| v_max / D > 4.5e9)");
-    require(vmax >= limits::kMinGasSpeed && vmax <= limits::max_gas_speed(static_cast<double>(n), static_cast<int>(d)),
-            "snapshot: v outside the speeds the operators resolve ([2^-420, 2^450 / sqrt(N d)] for v_max)");
-  }
+  require_finite("t_local", s.t_local);
+  require_finite("x", s.x);
+  require_finite("v", s.v);
+  double vmax = 0.0;
+  for (double q : s.v) vmax = std::max(vmax, std::fabs(q));
+  require(limits::clock_fits(s.time, s.config.diameter, vmax) && limits::clock_fits(s.start_time, s.config.diameter, vmax),
+          "snapshot: time or start_time too large for the clock to resolve flights of one diameter (|t| v_max / D > 4.5e9)");
+  require(vmax >= limits::kMinGasSpeed && vmax <= limits::max_gas_speed(static_cast<double>(n), static_cast<int>(d)),
+          "snapshot: v outside the speeds the operators resolve ([2^-420, 2^450 / sqrt(N d)] for v_max)");
   require(std::isfinite(s.energy0) && s.energy0 > 0.0, "snapshot: energy0 must be finite and > 0");
   for (double q : s.momentum0) require(std::isfinite(q), "snapshot: momentum0 must be finite");
-  {
-    // both are conserved: the velocities must still carry them (round-off keeps them within
-    // ~1e-12 over 10^9 collisions; 1e-6 is the bar). Momentum only on periodic axes without
-    // bounce walls (specular walls flip their own component, bounce walls every component).
-    double e = 0.0;
-    std::array<double, 3> p{};
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t k = 0; k < d; ++k) {
-        e += 0.5 * s.v[i * d + k] * s.v[i * d + k];
-        p[k] += s.v[i * d + k];
-      }
-    require(std::fabs(e - s.energy0) <= 1e-6 * s.energy0,
-            "snapshot: energy0 is not the kinetic energy of v (energy is conserved; 1e-6 relative)");
-    bool bounce = false;
-    for (std::size_t k = 0; k < d; ++k) bounce = bounce || s.config.boundary[k] == Boundary::bounce;
-    const double scale = std::sqrt(2.0 * s.energy0 * static_cast<double>(n));
-    for (std::size_t k = 0; k < d && !bounce; ++k)
-      require(s.config.boundary[k] != Boundary::periodic || std::fabs(p[k] - s.momentum0[k]) <= 1e-6 * scale,
-              "snapshot: momentum0 is not the momentum of v on a periodic axis (it is conserved; 1e-6 of sqrt(2 E0 N))");
-  }
+  // both are conserved: the velocities must still carry them (round-off keeps them within
+  // ~1e-12 over 10^9 collisions; 1e-6 is the bar). Momentum only on periodic axes without
+  // bounce walls (specular walls flip their own component, bounce walls every component).
+  double e = 0.0;
+  std::array<double, 3> p{};
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < d; ++k) {
+      e += 0.5 * s.v[i * d + k] * s.v[i * d + k];
+      p[k] += s.v[i * d + k];
+    }
+  require(std::fabs(e - s.energy0) <= 1e-6 * s.energy0,
+          "snapshot: energy0 is not the kinetic energy of v (energy is conserved; 1e-6 relative)");
+  bool bounce = false;
+  for (std::size_t k = 0; k < d; ++k) bounce = bounce || s.config.boundary[k] == Boundary::bounce;
+  const double scale = std::sqrt(2.0 * s.energy0 * static_cast<double>(n));
+  for (std::size_t k = 0; k < d && !bounce; ++k)
+    require(s.config.boundary[k] != Boundary::periodic || std::fabs(p[k] - s.momentum0[k]) <= 1e-6 * scale,
+            "snapshot: momentum0 is not the momentum of v on a periodic axis (it is conserved; 1e-6 of sqrt(2 E0 N))");
+}
+
+// The list centres inside the box, and the positions at the clock inside the box (walls: to
+// 1e-9 D) and without overlaps (a damaged diameter or position made the list build spin
+// forever: the fuzz suite, issue 17).
+void check_snapshot_positions(const Snapshot& s) {
+  const std::size_t n = s.n, d = static_cast<std::size_t>(s.config.dim);
   for (std::size_t i = 0; i < s.centre.size(); ++i)
     require(s.centre[i] >= 0.0 && s.centre[i] <= s.config.box[i % d], "snapshot: centre (a list centre) outside the box");
-  {
-    // the positions at the clock inside the box (walls: to 1e-9 D) and without overlaps (a
-    // damaged diameter or position made the list build spin forever: the fuzz suite, issue 17)
-    const Config& c = s.config;
-    const double r = 0.5 * c.diameter, slack = 1e-9 * c.diameter;
-    std::vector<double> now(n * d);
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t k = 0; k < d; ++k) {
-        double q = s.x[i * d + k] + s.v[i * d + k] * (s.time - s.t_local[i]);
-        require(std::isfinite(q), "snapshot: x + v (time - t_local), a position at the clock, is not finite");
-        if (has_walls(c.boundary[k])) {
-          require(q >= r - slack && q <= c.box[k] - r + slack, [&] {
-            return "snapshot: particle " + std::to_string(i) + " (x, v, t_local) is outside the box on axis " +
-                   std::to_string(k) + " at the clock (x = " + num(q) + ")";
-          });
-        } else {
-          q -= c.box[k] * std::floor(q / c.box[k]);
-          if (!(q < c.box[k])) q = 0.0;  // q / L rounded up to 1
-        }
-        now[i * d + k] = q;
+  const Config& c = s.config;
+  const double r = 0.5 * c.diameter, slack = 1e-9 * c.diameter;
+  std::vector<double> now(n * d);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < d; ++k) {
+      double q = s.x[i * d + k] + s.v[i * d + k] * (s.time - s.t_local[i]);
+      require(std::isfinite(q), "snapshot: x + v (time - t_local), a position at the clock, is not finite");
+      if (has_walls(c.boundary[k])) {
+        require(q >= r - slack && q <= c.box[k] - r + slack, [&] {
+          return "snapshot: particle " + std::to_string(i) + " (x, v, t_local) is outside the box on axis " +
+                 std::to_string(k) + " at the clock (x = " + num(q) + ")";
+        });
+      } else {
+        q -= c.box[k] * std::floor(q / c.box[k]);
+        if (!(q < c.box[k])) q = 0.0;  // q / L rounded up to 1
       }
-    try {
-      check_overlaps(c, now, n);
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument(std::string("snapshot: x (positions at the clock), diameter: ") + e.what());
+      now[i * d + k] = q;
     }
+  try {
+    check_overlaps(c, now, n);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("snapshot: x (positions at the clock), diameter: ") + e.what());
   }
+}
+
+// The logs: the rare log's count, the exact-pre log ((stream, counter) keys, values that are
+// velocities) and the wall-mask log ((smallest id, its net count) keys, members, masks).
+void check_snapshot_logs(const Snapshot& s) {
+  const std::size_t n = s.n, d = static_cast<std::size_t>(s.config.dim);
   require(s.log_pushed >= s.log_cells.size(), "snapshot: log_pushed is smaller than log_cells");
-  // the exact-pre log: (stream, counter) keys, values that are velocities
   require(s.pre_keys.size() == 2 * s.pre_sizes.size(), "snapshot: pre_keys must hold 2 per pre_sizes entry");
   for (std::size_t e = 0; e < s.pre_sizes.size(); ++e)
     require(s.pre_keys[2 * e] < s.rng.size(), "snapshot: pre_keys names a stream outside the rng streams");
@@ -366,7 +379,7 @@ void validate_snapshot(const Snapshot& s) {
   for (double q : s.pre_vals)
     require(std::isfinite(q) && std::fabs(q) <= kMaxSpeed, "snapshot: pre_vals must be finite velocities (|v| <= 2^450)");
   require(s.pre_pushed >= s.pre_sizes.size(), "snapshot: pre_pushed is smaller than the exact-pre log");
-  // the wall-mask log: (smallest id, its net count) keys, members, masks W1 | W2 << 8
+  // the wall-mask log: masks W1 | W2 << 8
   require(s.wall_keys.size() == 2 * s.wall_sizes.size(), "snapshot: wall_keys must hold 2 per wall_sizes entry");
   for (std::size_t e = 0; e < s.wall_sizes.size(); ++e)
     require(s.wall_keys[2 * e] < n, "snapshot: wall_keys names a particle outside [0, n)");
@@ -377,13 +390,26 @@ void validate_snapshot(const Snapshot& s) {
   }
   require(wm == s.wall_masks.size() && wm == s.wall_ids.size() && wm == s.wall_netc.size(),
           "snapshot: wall_sizes do not add up to wall_masks, wall_ids and wall_netc");
-  size("wall_times", s.wall_times.size(), s.wall_sizes.size(), "one per wall_sizes entry");
-  finite("wall_times", s.wall_times);
+  require_size("wall_times", s.wall_times.size(), s.wall_sizes.size(), "one per wall_sizes entry");
+  require_finite("wall_times", s.wall_times);
   for (auto q : s.wall_ids) require(q < n, "snapshot: wall_ids names a particle outside [0, n)");
   // a Reflection (boundary.hpp): bit k flips component k (k < dim), or kReversed; W1 | W2 << 8
   const std::uint64_t one = ((std::uint64_t{1} << d) - 1) | kReversed;
   for (auto q : s.wall_masks)
     require((q & ~(one | one << 8)) == 0, "snapshot: wall_masks holds a reflection on an axis that does not exist");
+}
+
+}  // namespace
+
+// Every snapshot field checked before anything is built, each message naming its field
+// (issue 17's crafted-checkpoint suite, tests/python/test_checkpoints.py). The checks run in
+// this order (shapes before values), so a snapshot damaged in two places names the same field.
+void validate_snapshot(const Snapshot& s) {
+  validate_config(s.config);
+  check_snapshot_shapes(s);
+  check_snapshot_motion(s);
+  check_snapshot_positions(s);
+  check_snapshot_logs(s);
 }
 
 std::unique_ptr<Simulation> restore_simulation(const Snapshot& s) {
