@@ -13,7 +13,7 @@ namespace {
 
 constexpr i128 kOne = static_cast<i128>(1) << kFixBits;   // 1.0 in 62-bit fixed point
 constexpr i128 kHalf = static_cast<i128>(1) << (kFixBits - 1);
-// round(2*pi * 2^100) (tests/reference/lattice_vectors.py recomputes it with Machin's formula).
+// round(2*pi * 2^100) (tests/reference/lattice_cells.py recomputes it with Machin's formula).
 constexpr i128 kTwoPiFx100 = (static_cast<i128>(0x6487ed5110ULL) << 64) | static_cast<i128>(0xb4611a62633145c0ULL);
 constexpr std::int64_t kOctant = 1LL << 18;    // pi/4 at half-cell resolution (2^21 per turn)
 constexpr std::int64_t kQuadrant = 1LL << 19;  // pi/2 at half-cell resolution

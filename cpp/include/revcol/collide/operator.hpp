@@ -23,7 +23,8 @@
 //
 // To add an operator: write it (its own header under collide/, this form, or an adapter
 // here), give it a Mode value (collide/common.hpp), and choose it in the engine's
-// make_simulation (cpp/src/engine_make.cpp); ARCHITECTURE.md "To add an operator".
+// with_operator (cpp/src/engine_operators.hpp, the one place that names the operators);
+// ARCHITECTURE.md "To add an operator".
 #pragma once
 #include <array>
 #include <concepts>
