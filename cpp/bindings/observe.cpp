@@ -80,6 +80,7 @@ py::dict observation_dict(const engine::Observation& o) {
   d["pair_distance"] = profile(o.pair_distance);
   d["msd_time"] = array(o.msd_time);
   d["msd"] = array(o.msd);
+  d["vacf"] = array(o.vacf);
   return d;
 }
 

@@ -104,6 +104,7 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
     set_velocity<0>(static_cast<int>(i), &v[i * dim]);
   }
   start_ = x;
+  start_v_ = v;
   if (c.pair_bins > 0) pair_t_.assign(n_ * n_, t);
   cur_ = empty_block(t);
   set_fast_until();
@@ -243,6 +244,12 @@ void Observer::end_block() {
     }
   msd_t_.push_back(te - t_start_);
   msd_.push_back(msd / static_cast<double>(n_));
+  if (!start_v_.empty()) {  // velocities are constant on segments: the segment's is the one at te
+    double c = 0.0;
+    for (std::size_t i = 0; i < n_; ++i)
+      for (int k = 0; k < dim_; ++k) c += seg_[i].v[k] * start_v_[i * dim_ + k];
+    vacf_.push_back(c / static_cast<double>(n_));
+  }
   cur_.t1 = te;
   blocks_.push_back(cur_);
   cur_ = empty_block(te);

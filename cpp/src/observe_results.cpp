@@ -101,6 +101,7 @@ Observation Observer::results() const {
   }
   o.msd_time = msd_t_;
   o.msd = msd_;
+  o.vacf = vacf_;
   return o;
 }
 

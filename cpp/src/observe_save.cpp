@@ -38,6 +38,10 @@ void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& coun
   block(cur_);
   reals.insert(reals.end(), msd_t_.begin(), msd_t_.end());
   reals.insert(reals.end(), msd_.begin(), msd_.end());
+  if (!start_v_.empty()) {  // the velocity autocorrelation (absent in older snapshots)
+    reals.insert(reals.end(), start_v_.begin(), start_v_.end());
+    reals.insert(reals.end(), vacf_.begin(), vacf_.end());
+  }
 }
 
 Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint64_t>& counts, int dim,
@@ -78,7 +82,8 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   const std::size_t d = static_cast<std::size_t>(dim), np = cfg_.pair_bins > 0 ? n_ * n_ : 0;
   const std::size_t per_block = kBlockReals + 2 * cfg_.slabs + cfg_.speed_bins + cfg_.pair_bins;
   const std::size_t per_particle = 3 * d + 1 + (cfg_.slabs > 0 ? 1 : 0);
-  require(reals.size() == kHeader + n_ * per_particle + np + (nb + 1) * per_block + 2 * nm,
+  const std::size_t size = kHeader + n_ * per_particle + np + (nb + 1) * per_block + 2 * nm;
+  require(reals.size() == size || reals.size() == size + n_ * d + nm,  // with the VACF, or without (older)
           "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points)");
   require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
   bin_scale_ = cfg_.speed_bins / speed_max_;
@@ -136,6 +141,10 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   cur_ = block(nb);
   take(msd_t_, nm);
   take(msd_, nm);
+  if (u < reals.size()) {  // the velocity autocorrelation (a snapshot without it resumes none)
+    take(start_v_, n_ * d);
+    take(vacf_, nm);
+  }
   v2_sum_ = reals[16];  // the running sums as they were (set_velocity above rebuilt them afresh)
   speed_sum_ = reals[17];
   set_fast_until();

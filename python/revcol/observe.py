@@ -104,6 +104,9 @@ class Profile:
 _SCALARS = ("temperature", "pressure_virial", "compressibility", "collision_rate", "mean_free_time",
             "mean_free_path", "virial_balance")
 _PROFILES = ("slab_density", "slab_temperature", "speed", "pair_distance")
+_COUNTS = ("dim", "n", "t_start", "t_end", "blocks", "block_time", "pair_collisions", "group_collisions",
+           "particle_collisions", "wall_reflections")
+_KNOWN = set(_SCALARS) | set(_PROFILES) | set(_COUNTS) | {"pressure_wall"}
 
 
 class Observation:
@@ -116,7 +119,10 @@ class Observation:
     ``virial_balance`` ((K2 + W + W_wall) / K2, near 0 in a closed box). Profiles
     (:class:`Profile` or None): ``slab_density``, ``slab_temperature``, ``speed`` (probability
     density of the speed), ``pair_distance`` (of a pair's distance). ``msd_time``, ``msd``: the
-    mean squared displacement (unwrapped) at each block end. Counts: ``pair_collisions``,
+    mean squared displacement (unwrapped) at each block end; ``vacf``: the velocity
+    autocorrelation (1/N) sum_i v_i(t_start) . v_i(t) at the same times (empty for an
+    observation resumed from a snapshot written before it existed). Any other entry the C++
+    observer reports appears as an attribute of its own name. Counts: ``pair_collisions``,
     ``group_collisions``, ``particle_collisions``, ``wall_reflections``; ``t_start``, ``t_end``,
     ``blocks``, ``block_time``.
     """
@@ -145,8 +151,7 @@ class Observation:
 
     def __init__(self, raw: dict[str, Any]):
         self.raw = raw
-        for key in ("dim", "n", "t_start", "t_end", "blocks", "block_time", "pair_collisions", "group_collisions",
-                    "particle_collisions", "wall_reflections"):
+        for key in _COUNTS:
             setattr(self, key, raw[key])
         for key in _SCALARS:
             setattr(self, key, Estimate(float(raw[key]["value"]), float(raw[key]["error"])))
@@ -155,8 +160,19 @@ class Observation:
             p = raw[key]
             setattr(self, key, None if p is None else Profile(np.asarray(p["edges"]), np.asarray(p["value"]),
                                                               np.asarray(p["error"])))
-        self.msd_time = np.asarray(raw["msd_time"])
-        self.msd = np.asarray(raw["msd"])
+        # every other entry as it comes (an observable added in C++ needs no change here):
+        # {"value", "error"} an Estimate, sequences numpy arrays (msd_time, msd, vacf, ...)
+        self._arrays = []
+        for key, val in raw.items():
+            if key in _KNOWN:
+                continue
+            if isinstance(val, dict) and set(val) == {"value", "error"}:
+                setattr(self, key, Estimate(float(val["value"]), float(val["error"])))
+            elif isinstance(val, (list, tuple, np.ndarray)):
+                setattr(self, key, np.asarray(val))
+                self._arrays.append(key)
+            else:
+                setattr(self, key, val)
 
     @property
     def duration(self) -> float:
@@ -165,9 +181,7 @@ class Observation:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-able values: scalars as [value, error], profiles as lists."""
-        out: dict[str, Any] = {k: getattr(self, k) for k in ("dim", "n", "t_start", "t_end", "blocks", "block_time",
-                                                            "pair_collisions", "group_collisions",
-                                                            "particle_collisions", "wall_reflections")}
+        out: dict[str, Any] = {k: getattr(self, k) for k in _COUNTS}
         for key in _SCALARS:
             e = getattr(self, key)
             out[key] = [e.value, e.error]
@@ -176,7 +190,8 @@ class Observation:
             p = getattr(self, key)
             out[key] = None if p is None else {"edges": p.edges.tolist(), "value": p.value.tolist(),
                                                "error": p.error.tolist()}
-        out["msd_time"], out["msd"] = self.msd_time.tolist(), self.msd.tolist()
+        for key in self._arrays:
+            out[key] = getattr(self, key).tolist()
         return out
 
     def lines(self) -> list[str]:

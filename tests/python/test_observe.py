@@ -221,6 +221,42 @@ def test_snapshot_resumes_the_observation_bit_for_bit(tmp_path):
         revcol.Simulation.from_snapshot(bad)
 
 
+def test_velocity_autocorrelation_at_block_ends():
+    """vacf[k] = (1/N) sum_i v_i(t_start) . v_i(t_k) at each block end t_k (msd_time): a run
+    that stops on a block end gives the same number from the velocities it stops with; it
+    starts near d T and decays; a snapshot keeps it, and one written without it (older)
+    resumes the other observables with no VACF."""
+    sim = revcol.Simulation.random(n=200, dim=2, phi=0.3, seed=8, mode="specular")
+    sim.run(collisions=2000)
+    v0, t0, bt = sim.velocities, sim.time, 0.05
+    sim.observe(block_time=bt)
+    te = t0
+    for _ in range(7):  # the 7th block end as the observer sums it
+        te += bt
+    sim.run(time=te)
+    o = sim.observation()
+    assert len(o.vacf) == len(o.msd) == len(o.msd_time) == 7
+    direct = float(np.sum(v0 * sim.velocities)) / sim.n
+    assert o.vacf[-1] == pytest.approx(direct, rel=1e-12, abs=1e-12)
+    assert 0 < o.vacf[0] <= 2 * o.temperature.value * 1.0001
+    sim.run(time=t0 + 300 * bt)  # many collision times: the correlation is gone
+    o = sim.observation()
+    assert abs(o.vacf[-1]) < 0.2 * o.vacf[0]
+    # lattice engine: the same observable
+    lat = revcol.Simulation.random(n=200, dim=2, phi=0.3, seed=8, engine="lattice")
+    lat.observe(block_time=bt)
+    lat.run(collisions=5000)
+    assert len(lat.observation().vacf) == len(lat.observation().msd) > 0
+    # snapshots: kept; an older observer entry (without start velocities and VACF) resumes without it
+    snap = sim.snapshot()
+    assert np.array_equal(revcol.Simulation.from_snapshot(snap).observation().vacf, o.vacf)
+    old = dict(snap)
+    old["observer"] = np.asarray(snap["observer"])[: -(sim.n * sim.dim + len(o.vacf))]
+    resumed = revcol.Simulation.from_snapshot(old)
+    assert resumed.observing and len(resumed.observation().vacf) == 0
+    assert np.array_equal(resumed.observation().msd, o.msd)
+
+
 def _batched_rdf(points, box, batches, **kw):
     """g(r) of each batch of frames: the mean and its standard error over the batches."""
     gs = []

@@ -137,6 +137,8 @@ struct Observation {
   Profile speed;                     ///< probability density of the speed (time-weighted)
   Profile pair_distance;             ///< probability density of a pair's distance (time-weighted, all pairs)
   std::vector<double> msd_time, msd; ///< mean squared displacement (unwrapped) at each block end
+  std::vector<double> vacf;          ///< velocity autocorrelation (1/N) sum_i v_i(t_start) . v_i(t) at each block end (msd_time);
+                                     ///< empty for an observation resumed from a snapshot that did not keep it
 };
 
 /// The accumulator behind Simulation::observe (any d; the engine calls the hooks).
@@ -157,7 +159,9 @@ class Observer {
   /// sums of v^2 and |v|); per particle its segment (x, v: dim each; t0; with slabs its
   /// cell); start_ (n x dim); pair_t_ (n x n, with pair bins); each complete block, then the
   /// open one (t0, t1, k2, w, w_wall, dist, wall_dp[3], slab_t, slab_k2, speed, pair);
-  /// msd_t_, msd_. counts: per block (the same order) pairs, groups, parts, walls.
+  /// msd_t_, msd_; then start_v_ (n x dim) and vacf_ (one per MSD point), absent in
+  /// snapshots written before the velocity autocorrelation existed (a resumed observation
+  /// then reports none). counts: per block (the same order) pairs, groups, parts, walls.
   /// Integers among the reals are exact (all far below 2^53).
   void save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const;
 
@@ -247,6 +251,7 @@ class Observer {
   std::vector<Block> blocks_;   // complete blocks
   Block cur_;                   // the open block
   std::vector<double> msd_t_, msd_;
+  std::vector<double> start_v_, vacf_;  // velocities at the start (n x dim; empty: not kept), VACF per block end
 
   // --- the collision record (see the header comment) ---
  public:
