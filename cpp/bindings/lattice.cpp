@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <type_traits>
 
 #include "args.hpp"
 #include "bindings.hpp"
@@ -141,51 +142,39 @@ py::dict start_dict(const la::LatticeStartN<D>& s) {
   return d;
 }
 
-py::dict counters_dict(const la::Counters& c) {
-  py::dict d;
-  d["events"] = c.events;
-  d["collisions_applied"] = c.collisions;
-  d["walls"] = c.walls;
-  d["crossings"] = c.crossings;
-  d["stale"] = c.stale;
-  py::dict r;
-  for (int k = 1; k < 8; ++k) r[la::redraw_names[k]] = c.redraws[k];
-  d["redraws"] = r;
-  d["log_entries_written"] = c.log_entries;
-  d["multi_body"] = c.multi_body;
-  d["wall_body"] = c.wall_body;
-  d["group_resolves"] = c.group_resolves;
-  d["group_bounces"] = c.group_bounces;
-  d["wall_groups"] = c.wall_groups;
-  return d;
-}
+// ---- checkpoints: the engine's state written and read by a loop over its fields ----------
+// (la::SnapshotN::visit, la::Counters::visit): one overload per field type below; a new field
+// needs its line in visit_fields and, for a new type, an overload here.
 
 template <std::size_t D>
-py::dict snapshot_dict(const la::SnapshotN<D>& s, revcol::Law law) {
-  py::dict d;
-  d["engine"] = "lattice";
-  if constexpr (D == 3) d["dim"] = 3;  // (a 2D checkpoint has no dim key, as before)
-  d["units"] = units_dict(s.units);
-  d["law"] = to_string(law);
-  d["seed"] = s.seed;
-  d["clock"] = s.clock;
-  d["origin"] = s.origin;
-  d["collisions"] = s.collisions;
-  d["x"] = vec_array(s.x);
-  d["v"] = vec_array(s.v);
-  d["streams"] = flat_array(s.streams.data(), s.streams.size());
-  d["bits"] = flat_array(s.bits.data(), s.bits.size());
+void put(py::dict& d, const char* key, const la::UnitsN<D>& u) { d[key] = units_dict(u); }
+void put(py::dict& d, const char* key, revcol::Law law) { d[key] = to_string(law); }
+template <class T>
+  requires std::is_integral_v<T>
+void put(py::dict& d, const char* key, T v) { d[key] = v; }
+template <std::size_t D>
+void put(py::dict& d, const char* key, const std::vector<la::VecN<D>>& v) { d[key] = vec_array(v); }
+template <class T, std::size_t K>
+void put(py::dict& d, const char* key, const std::array<T, K>& a) { d[key] = flat_array(a.data(), K); }
+void put(py::dict& d, const char* key, const std::vector<std::uint64_t>& v) { d[key] = flat_array(v.data(), v.size()); }
+// the rare log as two arrays: log_index (collision index) and log_redraws
+void put(py::dict& d, const char*, const std::vector<std::pair<std::uint64_t, std::uint32_t>>& log) {
   std::vector<std::uint64_t> li, lr;
-  for (const auto& e : s.log) {
+  for (const auto& e : log) {
     li.push_back(e.first);
     lr.push_back(e.second);
   }
   d["log_index"] = flat_array(li.data(), li.size());
   d["log_redraws"] = flat_array(lr.data(), lr.size());
+}
+// the group entries as six arrays: group_index, group_drawer, group_size, group_members,
+// group_kind (0 bounce, 1 resolve) and group_v (the pre velocities of the resolves)
+template <std::size_t D>
+void put(py::dict& d, const char*, const std::vector<la::GroupEntryN<D>>& groups) {
   std::vector<std::uint64_t> gi;
   std::vector<std::int64_t> gd, gs, gm, gk;
   std::vector<la::VecN<D>> gv;
-  for (const auto& g : s.groups) {
+  for (const auto& g : groups) {
     gi.push_back(g.index);
     gd.push_back(g.drawer);
     gs.push_back(static_cast<std::int64_t>(g.members.size()));
@@ -197,32 +186,39 @@ py::dict snapshot_dict(const la::SnapshotN<D>& s, revcol::Law law) {
   d["group_drawer"] = flat_array(gd.data(), gd.size());
   d["group_size"] = flat_array(gs.data(), gs.size());
   d["group_members"] = flat_array(gm.data(), gm.size());
-  d["group_kind"] = flat_array(gk.data(), gk.size());  // 0 bounce, 1 resolve (pre velocities in group_v)
+  d["group_kind"] = flat_array(gk.data(), gk.size());
   d["group_v"] = vec_array(gv);
-  d["energy0"] = flat_array(s.energy0.data(), 2);
-  d["momentum0"] = flat_array(s.momentum0.data(), 2 * D);
-  return d;
 }
 
 template <std::size_t D>
-la::SnapshotN<D> snapshot_from(const py::dict& d) {
-  la::SnapshotN<D> s;
-  if constexpr (D == 3) require(get<int>(d, "dim") == 3, "lattice checkpoint: dim must be 3 for the 3D engine");
-  s.units = units_from<D>(get<py::dict>(d, "units"));
-  s.seed = get<std::uint32_t>(d, "seed");
-  s.clock = get<std::int64_t>(d, "clock");
-  s.origin = get<std::int64_t>(d, "origin");
-  s.collisions = get<std::uint64_t>(d, "collisions");
-  for (const char* k : {"x", "v"})
-    require(d.contains(k), [&] { return std::string("lattice checkpoint is missing '") + k + "'"; });
-  s.x = checkpoint_entry("x", [&] { return vecs<D>(int_array(d["x"], "x"), "x"); });
-  s.v = checkpoint_entry("v", [&] { return vecs<D>(int_array(d["v"], "v"), "v"); });
-  s.streams = get_flat<std::uint64_t>(d, "streams");
-  s.bits = get_flat<std::uint64_t>(d, "bits");
+void take(const py::dict& d, const char* key, la::UnitsN<D>& u) { u = units_from<D>(get<py::dict>(d, key)); }
+void take(const py::dict& d, const char* key, revcol::Law& law) { law = parse_law(get<std::string>(d, key)); }
+template <class T>
+  requires std::is_integral_v<T>
+void take(const py::dict& d, const char* key, T& v) { v = get<T>(d, key); }
+template <std::size_t D>
+void take(const py::dict& d, const char* key, std::vector<la::VecN<D>>& v) {
+  require(d.contains(key), [&] { return std::string("lattice checkpoint is missing '") + key + "'"; });
+  v = checkpoint_entry(key, [&] { return vecs<D>(int_array(d[key], key), key); });
+}
+void take(const py::dict& d, const char* key, std::vector<std::uint64_t>& v) { v = get_flat<std::uint64_t>(d, key); }
+template <class T, std::size_t K>
+void take(const py::dict& d, const char* key, std::array<T, K>& a) {
+  const auto v = get_flat<T>(d, key);
+  require(v.size() == K, [&] {
+    return std::string("lattice checkpoint: ") + key + " " + std::to_string(K) + " words expected, got " +
+           std::to_string(v.size());
+  });
+  for (std::size_t k = 0; k < K; ++k) a[k] = v[k];
+}
+void take(const py::dict& d, const char*, std::vector<std::pair<std::uint64_t, std::uint32_t>>& log) {
   const auto li = get_flat<std::uint64_t>(d, "log_index");
   const auto lr = get_flat<std::uint64_t>(d, "log_redraws");
   require(li.size() == lr.size(), "lattice checkpoint: log_index and log_redraws differ in length");
-  for (std::size_t k = 0; k < li.size(); ++k) s.log.emplace_back(li[k], static_cast<std::uint32_t>(lr[k]));
+  for (std::size_t k = 0; k < li.size(); ++k) log.emplace_back(li[k], static_cast<std::uint32_t>(lr[k]));
+}
+template <std::size_t D>
+void take(const py::dict& d, const char*, std::vector<la::GroupEntryN<D>>& groups) {
   const auto gi = get_flat<std::uint64_t>(d, "group_index");
   const auto gd = get_flat<std::int64_t>(d, "group_drawer");
   const auto gs = get_flat<std::int64_t>(d, "group_size");
@@ -247,22 +243,45 @@ la::SnapshotN<D> snapshot_from(const py::dict& d) {
       atv += static_cast<std::size_t>(gs[k]);
     }
     at += static_cast<std::size_t>(gs[k]);
-    s.groups.push_back(std::move(e));
+    groups.push_back(std::move(e));
   }
   require(at == gm.size() && atv == gv.size(), "lattice checkpoint: group_members or group_v longer than the groups");
-  const auto e0 = get_flat<std::uint64_t>(d, "energy0");
-  const auto p0 = get_flat<std::int64_t>(d, "momentum0");
-  require(e0.size() == 2 && p0.size() == 2 * D, D == 2 ? "lattice checkpoint: energy0 needs 2 words and momentum0 4"
-                                                        : "lattice checkpoint: energy0 needs 2 words and momentum0 6 (3D)");
-  s.energy0 = {e0[0], e0[1]};
-  for (std::size_t k = 0; k < 2 * D; ++k) s.momentum0[k] = p0[k];
+}
+
+py::dict counters_dict(const la::Counters& c) {
+  py::dict d;
+  c.visit([&](const char* key, const auto& v) {
+    if constexpr (std::is_integral_v<std::decay_t<decltype(v)>>) {
+      d[key] = v;
+    } else {  // redraws, by reason
+      py::dict r;
+      for (int k = 1; k < 8; ++k) r[la::redraw_names[k]] = v[k];
+      d[key] = r;
+    }
+  });
+  return d;
+}
+
+template <std::size_t D>
+py::dict snapshot_dict(const la::SnapshotN<D>& s) {
+  py::dict d;
+  d["engine"] = "lattice";
+  if constexpr (D == 3) d["dim"] = 3;  // (a 2D checkpoint has no dim key, as before)
+  s.visit([&](const char* key, const auto& v) { put(d, key, v); });
+  return d;
+}
+
+template <std::size_t D>
+la::SnapshotN<D> snapshot_from(const py::dict& d) {
+  la::SnapshotN<D> s;
+  if constexpr (D == 3) require(get<int>(d, "dim") == 3, "lattice checkpoint: dim must be 3 for the 3D engine");
+  s.visit([&](const char* key, auto& v) { take(d, key, v); });
   return s;
 }
 
-/// The engine with the law it was made with (the operator's law is not in the snapshot struct).
+/// The engine, guarded against calls from other threads while a run is under way.
 template <class Engine>
 struct PyLattice {
-  revcol::Law law;
   Engine e;
   std::optional<std::thread::id> runner{};  ///< the thread whose run/run_back is under way (GIL held to touch)
 
@@ -353,15 +372,14 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
              const auto clock = to_int<std::int64_t>(clock_arg, "clock");
              const la::UnitsN<D> u = units_from<D>(units);
              const revcol::Law lw = parse_law(law);
-             return P{lw, Engine(u, vecs<D>(x, "x"), vecs<D>(v, "v"), static_cast<std::uint32_t>(seed), la::operator_for(u, lw), clock)};
+             return P{Engine(u, vecs<D>(x, "x"), vecs<D>(v, "v"), static_cast<std::uint32_t>(seed), la::operator_for(u, lw), clock)};
            }),
            py::arg("units"), py::arg("x"), py::arg("v"), py::arg("seed"), py::arg("law"), py::arg("clock") = 0)
       .def_static(
           "from_snapshot",
           [](const py::dict& d) {
             const la::SnapshotN<D> s = snapshot_from<D>(d);
-            const revcol::Law lw = parse_law(get<std::string>(d, "law"));
-            return P{lw, Engine(s, la::operator_for(s.units, lw))};
+            return P{Engine(s, la::operator_for(s.units, s.law))};
           },
           py::arg("snapshot"), "Rebuilds an engine from snapshot(); it resumes bit for bit.")
       .def(
@@ -392,7 +410,7 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
           },
           py::arg("to_collisions") = py::none(), py::arg("to_tick") = py::none(),
           "Back to collision count `to_collisions` or tick `to_tick` (default: the start).")
-      .def("snapshot", [](const P& p) { return snapshot_dict(p.engine().snapshot(), p.law); })
+      .def("snapshot", [](const P& p) { return snapshot_dict(p.engine().snapshot()); })
       .def_property_readonly("positions", [](const P& p) { return vec_array(p.engine().positions()); })
       .def_property_readonly("velocities", [](const P& p) { return vec_array(p.engine().velocities()); })
       .def_property_readonly("clock", [](const P& p) { return p.engine().clock(); })
@@ -400,7 +418,17 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
       .def_property_readonly("collisions", [](const P& p) { return p.engine().collisions(); })
       .def_property_readonly("units", [](const P& p) { return units_dict(p.engine().units()); })
       .def_property_readonly("n", [](const P& p) { return p.engine().size(); })
-      .def_property_readonly("law", [](const P& p) { return std::string(to_string(p.law)); })
+      .def_property_readonly("law", [](const P& p) { return std::string(to_string(p.engine().law())); })
+      // ---- the neighbour search (BasicEngine::set_list_shell): never changes which collisions happen ----
+      .def(
+          "set_search", [](P& p, PyReal shell) { p.engine().set_list_shell(to_real(shell, "shell")); }, py::arg("shell"),
+          "The neighbour search: shell 0 the cell grid, in [0.02, 2] neighbour lists with that shell in diameters, "
+          "< 0 automatic (lists in 3D, cells in 2D). The state, trace and bits are the same whichever.")
+      .def_property_readonly("list_shell", [](const P& p) { return p.engine().list_shell(); },
+                             "The shell in use, in diameters (0: the cell grid).")
+      .def_property_readonly("neighbour_search", [](const P& p) { return p.engine().neighbour_search(); },
+                             "The search in use: 0 the cell grid, 1 lists (each pair's relative vector imaged), "
+                             "2 lists with the centre offsets.")
       // ---- observation (the float engine's observer, revcol/engine/observe.hpp) ----
       .def(
           "observe",

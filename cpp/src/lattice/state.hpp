@@ -38,6 +38,7 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
   }
   require(s.origin <= s.clock && tick_limit / 2 > s.clock && s.origin > -tick_limit / 2,
           "lattice snapshot: origin <= clock within +-2^60 required");
+  require(s.law == law(), "lattice snapshot: its law is not the operator's");
   check_operator(s.units);
   load(s);
   observer_.reset();  // another state: an observation of the old one ends
@@ -48,6 +49,7 @@ template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   Snapshot s;
   s.units = u_;
+  s.law = law();
   s.seed = seed_;
   s.clock = clock_;
   s.origin = origin_;

@@ -105,6 +105,7 @@
 #include "revcol/engine/boundary_kind.hpp"
 #include "revcol/engine/trace.hpp"
 #include "revcol/error.hpp"
+#include "revcol/visitable.hpp"
 #include "revcol/rng/streams.hpp"
 
 namespace revcol::engine {
@@ -147,21 +148,7 @@ struct Config {
                     ///< does not depend on it, to the bit (not saved in snapshots)
 };
 
-/// visit(f): calls f(name, field) for each field of a struct that lists them in a static
-/// visit_fields(self, f) (Counters, Snapshot); const and non-const alike.
-template <class Derived>
-struct Visitable {
-  /// Every field, writable.
-  template <class F>
-  void visit(F&& f) {
-    Derived::visit_fields(static_cast<Derived&>(*this), f);
-  }
-  /// Every field, read-only.
-  template <class F>
-  void visit(F&& f) const {
-    Derived::visit_fields(static_cast<const Derived&>(*this), f);
-  }
-};
+using revcol::Visitable;  // revcol/visitable.hpp, shared with the lattice engine
 
 /// Event counts (cumulative over both directions).
 struct Counters : Visitable<Counters> {

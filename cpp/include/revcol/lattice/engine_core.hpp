@@ -67,7 +67,9 @@
 
 #include "revcol/engine/event_queue.hpp"
 #include "revcol/engine/observe.hpp"
+#include "revcol/collide/common.hpp"
 #include "revcol/error.hpp"
+#include "revcol/visitable.hpp"
 #include "revcol/lattice/cell_grid.hpp"
 #include "revcol/lattice/geometry.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
@@ -91,7 +93,7 @@ inline constexpr const char* redraw_names[8] = {"",           "cell_readback", "
                                                  "out_of_domain", "overlap_after", "ghost_tie",   "outside"};
 
 /// Event and rare-case counts, cumulative over both directions (not part of the physical state).
-struct Counters {
+struct Counters : Visitable<Counters> {
   std::uint64_t events = 0;              ///< queue pops
   std::uint64_t collisions = 0;          ///< collisions applied (forward and reverse)
   std::uint64_t walls = 0;               ///< wall reflections applied (both directions)
@@ -104,6 +106,24 @@ struct Counters {
   std::uint64_t group_resolves = 0;      ///< groups resolved specularly, pre velocities logged (a log entry)
   std::uint64_t group_bounces = 0;       ///< groups that bounced back (the fallback; a log entry)
   std::uint64_t wall_groups = 0;         ///< group members whose reflection at the same tick the group took in
+
+  /// Calls f(name, count) for every counter, with the names of the diagnostics (redraws: the
+  /// array by RedrawReason, index 0 unused).
+  template <class S, class F>
+  static void visit_fields(S& c, F& f) {
+    f("events", c.events);
+    f("collisions_applied", c.collisions);
+    f("walls", c.walls);
+    f("crossings", c.crossings);
+    f("stale", c.stale);
+    f("redraws", c.redraws);
+    f("log_entries_written", c.log_entries);
+    f("multi_body", c.multi_body);
+    f("wall_body", c.wall_body);
+    f("group_resolves", c.group_resolves);
+    f("group_bounces", c.group_bounces);
+    f("wall_groups", c.wall_groups);
+  }
 };
 
 /// A group collision in the rare log: a pair that no draw could resolve because a third body (or
@@ -124,8 +144,9 @@ using GroupEntry = GroupEntryN<2>;
 
 /// Everything that defines a lattice state in D dimensions, in the forward frame, positions at the clock.
 template <std::size_t D>
-struct SnapshotN {
+struct SnapshotN : Visitable<SnapshotN<D>> {
   UnitsN<D> units;                             ///< units and box
+  Law law = Law::flux;                         ///< the pair operator's post-direction law
   std::uint32_t seed = 1;                      ///< Philox key {particle, seed}
   std::int64_t clock = 0;                      ///< the current tick
   std::int64_t origin = 0;                     ///< the tick of the initial state (no run back past it)
@@ -139,6 +160,26 @@ struct SnapshotN {
   std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
   std::array<std::int64_t, 2 * D> momentum0{};  ///< initial momentum per axis (128 bits: low, high)
   Counters counters;                           ///< statistics (not compared by same_state)
+
+  /// Calls f(name, field) for every field but `counters`, in the checkpoint format's order and
+  /// with its names (log and groups are each written as several arrays by the binding).
+  template <class S, class F>
+  static void visit_fields(S& s, F& f) {
+    f("units", s.units);
+    f("law", s.law);
+    f("seed", s.seed);
+    f("clock", s.clock);
+    f("origin", s.origin);
+    f("collisions", s.collisions);
+    f("x", s.x);
+    f("v", s.v);
+    f("streams", s.streams);
+    f("bits", s.bits);
+    f("log", s.log);
+    f("groups", s.groups);
+    f("energy0", s.energy0);
+    f("momentum0", s.momentum0);
+  }
 };
 /// A 2D snapshot.
 using Snapshot = SnapshotN<2>;
@@ -151,7 +192,7 @@ bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
   const UnitsN<D> &u = a.units, &w = b.units;
   return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.bounce == w.bounce && u.vmax == w.vmax &&
          u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
-         a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
+         a.law == b.law && a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&
          a.groups == b.groups &&
          a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
@@ -226,6 +267,7 @@ class BasicEngine {
     require(clock > -tick_limit / 2 && clock < tick_limit / 2, "lattice: the start tick must be within +-2^60");
     Snapshot s;
     s.units = u;
+    s.law = law();
     s.seed = seed;
     s.clock = s.origin = clock;
     s.x = std::move(x);
@@ -299,6 +341,11 @@ class BasicEngine {
   std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
   const std::vector<std::uint64_t>& streams() const noexcept { return ctr_; }  ///< stream counters
   const Op& op() const noexcept { return op_; }                         ///< the pair operator
+  /// The operator's post-direction law (an operator without one, a test's, counts as flux).
+  Law law() const noexcept {
+    if constexpr (requires { op_.law(); }) return op_.law();
+    else return Law::flux;
+  }
   /// Redraws tried before a collision is resolved as a group bounce (group_bounce); -1 (tests
   /// only) resolves every collision so.
   int max_redraws = 256;
