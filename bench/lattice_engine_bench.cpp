@@ -52,7 +52,7 @@ struct LatticeCase {
 };
 
 // the initial placement: 2D as before; 3D: random_state's choice (rsa to 0.2, else FCC)
-const char* init_of(const LatticeCase& c) { return c.dim == 3 ? "auto" : c.phi > 0.35 ? "lattice" : "auto"; }
+const char* init_of(const LatticeCase& c) { return c.dim == 3 ? "auto" : c.phi > 0.35 ? "crystal" : "auto"; }
 
 template <std::size_t D>
 using EngineOf = std::conditional_t<D == 2, la::LatticeEngine, la::LatticeEngine3D>;

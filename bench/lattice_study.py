@@ -119,7 +119,7 @@ def roundtrip(args) -> dict:
     rows = []
     for boundary in (("periodic", "wall") if args.boundary == "both" else (args.boundary,)):
         sim = LatticeSimulation.random(n=args.n, phi=args.phi, boundary=boundary, seed=args.seed,
-                                       init="lattice" if args.phi > 0.35 else "auto", law=args.law)
+                                       init="crystal" if args.phi > 0.35 else "auto", law=args.law)
         s0 = sim.snapshot()
         nc = args.n * 10
         while nc <= float(args.max):

@@ -135,8 +135,8 @@ def _write_atomic(path: str, obj) -> None:
 
 def _init_for(phi: float) -> str:
     # random sequential addition jams near 0.55 in 2D and 0.38 in 3D: dense gases start from a
-    # jittered lattice (square in 2D, FCC in 3D)
-    return "lattice" if phi > (0.35 if DIM == 2 else 0.2) else "auto"
+    # jittered crystal (square in 2D, FCC in 3D)
+    return "crystal" if phi > (0.35 if DIM == 2 else 0.2) else "auto"
 
 
 def _checkpoints(c: int) -> list:

@@ -180,7 +180,7 @@ def equilibrated_state(n: int, phi: float, warmup_per_particle: float, seed: int
     max_per_particle is reached; positions, velocities, box, S(k) before and after, the
     collisions per particle it took."""
     from revcol import Simulation
-    sim = Simulation.random(n, 3, phi, seed=seed, init="lattice")
+    sim = Simulation.random(n, 3, phi, seed=seed, init="crystal")
     k = fcc_bragg_vectors(n, sim.box)
     s_before = float(structure_factor(sim.positions, k).max())
     t0 = time.time()

@@ -1,5 +1,5 @@
 // Random initial states for the engine (engine/init.hpp): random sequential addition or a
-// jittered lattice in any box, Gaussian (or equal-speed) velocities. Draws come from Philox
+// jittered crystal in any box, Gaussian (or equal-speed) velocities. Draws come from Philox
 // keys {stream, seed} with streams 0xFFFFFF00+ (never a particle id the engine uses for
 // collisions).
 #include <algorithm>
@@ -114,7 +114,7 @@ bool place_rsa(const Geometry& g, std::size_t n, Draws& pos, std::vector<double>
   return true;
 }
 
-// The nearest-site distance of a lattice of spacings a[0..d): square (1D/2D) or
+// The nearest-site distance of a crystal of spacings a[0..d): square (1D/2D) or
 // face-centred cubic (3D: min(a1, |(a1, a2)| / 2) over the two smallest spacings, written
 // so that a cube gives a / sqrt(2) to the bit).
 double nearest_site(int d, const double* a) {
@@ -131,8 +131,8 @@ double nearest_site(int d, const double* a) {
   return std::min(s0, s0 / std::sqrt(2.0) * std::sqrt(0.5 * (1.0 + r * r)));
 }
 
-// A jittered lattice into x (n x d); false when the sites are closer than D.
-bool place_lattice(const Geometry& g, std::size_t n, Draws& pos, std::vector<double>& x) {
+// A jittered crystal into x (n x d); false when the sites are closer than D.
+bool place_crystal(const Geometry& g, std::size_t n, Draws& pos, std::vector<double>& x) {
   const int d = g.d;
   const int basis = d == 3 ? 4 : 1;
   int m[3] = {1, 1, 1};
@@ -240,13 +240,13 @@ InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, do
   s.v.assign(n * c.dim, 0.0);
   auto place = [&](bool use_rsa) {
     Draws pos(0xFFFFFF00u, seed);
-    return use_rsa ? place_rsa(g, n, pos, s.x) : place_lattice(g, n, pos, s.x);
+    return use_rsa ? place_rsa(g, n, pos, s.x) : place_crystal(g, n, pos, s.x);
   };
   if (!place(rsa) && !(fallback && place(!rsa))) {
     if (rsa && !fallback)
-      throw InvalidArgument("random sequential addition did not place every particle; use init='lattice'");
+      throw InvalidArgument("random sequential addition did not place every particle; use init='crystal'");
     throw InvalidArgument(std::to_string(n) + " particles of diameter " + num(c.diameter) +
-                          " do not fit on a lattice in this box (nearest sites closer than D)" +
+                          " do not fit on a crystal in this box (nearest sites closer than D)" +
                           (fallback ? ", nor by random sequential addition" : "") +
                           ": make the box larger or the packing fraction lower");
   }
@@ -275,8 +275,9 @@ void check_common(const Config& c, std::size_t n, std::uint64_t seed) {
 Placement parse_placement(const std::string& s) {
   if (s == "auto") return Placement::automatic;
   if (s == "rsa") return Placement::rsa;
-  if (s == "lattice") return Placement::lattice;
-  throw InvalidArgument("init must be 'auto', 'rsa' or 'lattice', got '" + s + "'");
+  // "lattice" is the crystal's old name, still read ("lattice" names the integer engine now)
+  if (s == "crystal" || s == "lattice") return Placement::crystal;
+  throw InvalidArgument("init must be 'auto', 'rsa' or 'crystal', got '" + s + "'");
 }
 
 double particle_volume(int d, double D) { return limits::particle_volume(d, D); }

@@ -83,7 +83,7 @@ std::string error_of(F&& f) {
 
 }  // namespace
 
-TEST_CASE("random_start: rsa and lattice in non-cubic boxes, walls and periodic per axis") {
+TEST_CASE("random_start: rsa and crystal in non-cubic boxes, walls and periodic per axis") {
   const Boundary W = Boundary::wall, P = Boundary::periodic;
   struct Case {
     std::vector<double> box;
@@ -93,10 +93,10 @@ TEST_CASE("random_start: rsa and lattice in non-cubic boxes, walls and periodic 
     double D;
   };
   const Case cases[] = {
-      {{40.0}, {W}, 30, "rsa", 1.0},          {{40.0}, {P}, 35, "lattice", 1.0},
-      {{12.0, 5.0}, {W, P}, 30, "lattice", 1.0}, {{12.0, 5.0}, {P, W}, 20, "rsa", 1.0},
-      {{30.0, 4.0}, {W}, 45, "lattice", 1.0}, {{5.0, 6.0, 9.0}, {W, P, W}, 60, "lattice", 1.0},
-      {{5.0, 6.0, 9.0}, {P}, 60, "rsa", 1.0}, {{8.0, 8.0, 3.5}, {P}, 90, "lattice", 1.0},
+      {{40.0}, {W}, 30, "rsa", 1.0},          {{40.0}, {P}, 35, "crystal", 1.0},
+      {{12.0, 5.0}, {W, P}, 30, "crystal", 1.0}, {{12.0, 5.0}, {P, W}, 20, "rsa", 1.0},
+      {{30.0, 4.0}, {W}, 45, "crystal", 1.0}, {{5.0, 6.0, 9.0}, {W, P, W}, 60, "crystal", 1.0},
+      {{5.0, 6.0, 9.0}, {P}, 60, "rsa", 1.0}, {{8.0, 8.0, 3.5}, {P}, 90, "crystal", 1.0},
       {{7.5, 12.0}, {W}, 15, "auto", 1.5},   {{9.0, 12.0}, {W}, 30, "auto", 1.5},
   };
   for (const Case& k : cases) {
@@ -142,7 +142,7 @@ TEST_CASE("random_start refuses more particles than a list entry's id holds, bef
 
 TEST_CASE("random_start: same seed same bits; another seed another start") {
   const Config c = box_config({9.0, 7.0, 11.0}, {Boundary::periodic, Boundary::wall, Boundary::periodic});
-  for (const char* init : {"rsa", "lattice"}) {
+  for (const char* init : {"rsa", "crystal"}) {
     const InitialState a = random_start(c, 80, 5, 0.0, init), b = random_start(c, 80, 5, 0.0, init);
     const InitialState o = random_start(c, 80, 6, 0.0, init);
     CHECK(a.x == b.x && a.v == b.v);
@@ -150,9 +150,20 @@ TEST_CASE("random_start: same seed same bits; another seed another start") {
   }
 }
 
+TEST_CASE("parse_placement: \"crystal\", and \"lattice\" its old name for the same start") {
+  CHECK(parse_placement("crystal") == Placement::crystal);
+  CHECK(parse_placement("lattice") == Placement::crystal);
+  const Config c = box_config({9.0, 7.0, 11.0}, {Boundary::periodic, Boundary::wall, Boundary::periodic});
+  const InitialState a = random_start(c, 80, 5, 0.0, "crystal"), b = random_start(c, 80, 5, 0.0, "lattice");
+  CHECK(a.x == b.x);
+  CHECK(a.v == b.v);
+  const std::string e = error_of([&] { parse_placement("grid"); });
+  CHECK(e.find("'auto', 'rsa' or 'crystal'") != std::string::npos);
+}
+
 TEST_CASE("random_state is random_start in the cube of its packing fraction") {
   for (int d = 1; d <= 3; ++d)
-    for (const char* init : {"rsa", "lattice"}) {
+    for (const char* init : {"rsa", "crystal"}) {
       Config c;
       c.dim = d;
       c.boundary = {Boundary::wall, Boundary::periodic, Boundary::wall};
@@ -163,13 +174,13 @@ TEST_CASE("random_state is random_start in the cube of its packing fraction") {
     }
 }
 
-TEST_CASE("random_state: a walled cube whose equal lattice counts crowd the sites takes unequal ones") {
+TEST_CASE("random_state: a walled cube whose equal crystal counts crowd the sites takes unequal ones") {
   // 1000 spheres at volume fraction 0.45 between walls: 7 x 7 x 7 FCC cells of the usable box
   // put the nearest sites 0.96 D apart (this threw before); 6 x 6 x 7 cells fit
   Config c;
   c.dim = 3;
   c.boundary = {Boundary::wall, Boundary::wall, Boundary::wall};
-  const InitialState s = random_state(c, 1000, 0.45, 3, 0.0, "lattice");
+  const InitialState s = random_state(c, 1000, 0.45, 3, 0.0, "crystal");
   const Shape sh = shape(s.config, s);
   CHECK(sh.inside);
   CHECK(sh.min_gap >= 1.0);
@@ -177,7 +188,7 @@ TEST_CASE("random_state: a walled cube whose equal lattice counts crowd the site
   // a cube whose equal counts fit keeps them, bit for bit: test_engine_hash's known starts
   Config p = c;
   p.boundary = {Boundary::periodic, Boundary::periodic, Boundary::periodic};
-  const InitialState q = random_state(p, 1000, 0.45, 3, 0.0, "lattice");
+  const InitialState q = random_state(p, 1000, 0.45, 3, 0.0, "crystal");
   CHECK(shape(q.config, q).min_gap >= 1.0);
 }
 
@@ -185,9 +196,9 @@ TEST_CASE("random_start: N that does not fit, and bad input, are clear errors") 
   const Config c = box_config({5.0, 6.0, 9.0}, {Boundary::wall, Boundary::periodic, Boundary::wall});
   CHECK(error_of([&] { random_start(c, 500, 1); }).find("500 particles of diameter 1") != std::string::npos);
   CHECK(error_of([&] { random_start(c, 500, 1); }).find("do not fit") != std::string::npos);
-  // under the packing-fraction limit, but no lattice of spacing > D holds 9 disks in 3.5 x 3.5 walls
+  // under the packing-fraction limit, but no crystal of spacing > D holds 9 disks in 3.5 x 3.5 walls
   const Config small = box_config({3.5, 3.5}, {Boundary::wall});
-  CHECK(error_of([&] { random_start(small, 9, 1, 0.0, "lattice"); }).find("do not fit on a lattice") !=
+  CHECK(error_of([&] { random_start(small, 9, 1, 0.0, "crystal"); }).find("do not fit on a crystal") !=
         std::string::npos);
   CHECK(error_of([&] { random_start(c, 0, 1); }).find("N = 0") != std::string::npos);
   CHECK(error_of([&] { random_start(c, 10, 1ull << 32); }).find("seed") != std::string::npos);

@@ -67,7 +67,7 @@ LatticeStart start(std::size_t n, double phi, bool walls, std::uint64_t seed) {
   LatticeConfig c;
   c.wall = {walls, walls};
   c.seed = static_cast<std::uint32_t>(seed);
-  return random_start(c, n, phi, seed, phi > 0.5 ? "lattice" : "auto");
+  return random_start(c, n, phi, seed, phi > 0.5 ? "crystal" : "auto");
 }
 
 LatticeEngine make(std::size_t n, double phi, bool walls, std::uint64_t seed) {
