@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import operator
+import warnings
 from typing import Optional
 
 import numpy as np
@@ -71,3 +72,16 @@ def real_array(a, name: str) -> np.ndarray:
         return np.asarray(a, dtype=float)
     except (TypeError, ValueError) as e:
         raise TypeError(f"{name} must be an array of real numbers ({e})") from None
+
+
+def placement(init, stacklevel: int = 3) -> str:
+    """A random start's placement, ``init``: ``"auto"``, ``"rsa"`` (random sequential addition)
+    or ``"crystal"`` (a jittered crystal: square in 1D/2D, face-centred cubic in 3D). The old
+    name ``"lattice"`` (the word names the integer engine now) gives ``"crystal"`` with a
+    DeprecationWarning; any other name is passed on for the engine to refuse by name."""
+    init = name(init, "init")
+    if init == "lattice":
+        warnings.warn("init='lattice' is deprecated, write init='crystal' (the jittered crystal start; "
+                      "'lattice' names the integer engine)", DeprecationWarning, stacklevel=stacklevel)
+        return "crystal"
+    return init

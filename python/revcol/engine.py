@@ -41,7 +41,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._args import integer, names, real_array
+from ._args import integer, names, placement, real_array
 from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .roundtrip import divergence_text
@@ -109,14 +109,16 @@ class Simulation(SimulationBase):
                init: str = "auto", equal_speeds: bool = False, engine: str = "float",
                packing_fraction: Optional[float] = None, **kwargs) -> "Simulation":
         """n particles at packing fraction ``phi`` (or ``packing_fraction=``, the scenes' name;
-        default 0.3) in a cubic box: random sequential addition
-        or a jittered lattice (square; face-centred cubic in 3D), Gaussian velocities with
-        zero momentum scaled to kinetic ``energy`` (default n d / 2, kT = 1), or all of one
-        speed (``equal_speeds``). Other keywords go to the constructor (mode, law, ...);
+        default 0.3) in a cubic box: ``init`` ``"rsa"``, random sequential addition, or
+        ``"crystal"``, a jittered crystal (square in 1D/2D, face-centred cubic in 3D); ``"auto"``
+        picks (the old name ``"lattice"`` still works, with a DeprecationWarning); Gaussian
+        velocities with zero momentum scaled to kinetic ``energy`` (default n d / 2, kT = 1), or
+        all of one speed (``equal_speeds``). Other keywords go to the constructor (mode, law, ...);
         the same ``seed`` keys the collision streams. ``engine="lattice"``: the lattice engine's
         ``LatticeSimulation.random`` (dim 2) or ``LatticeSimulation3D.random`` (dim 3), reversed
         bit for bit (``law`` and ``seed`` apply)."""
         phi = _packing_fraction(phi, packing_fraction)
+        init = placement(init)
         if engine != "float":
             lat = engine_class(engine, dim)
             if energy is not None or equal_speeds:

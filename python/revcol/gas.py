@@ -2,7 +2,7 @@
 the start, and report the round trip (errors in :mod:`revcol.roundtrip`).
 
 The start comes from the engine (C++ ``engine/init.hpp``: random sequential addition or a
-jittered lattice, in the cube of the scene's packing fraction or in its explicit box) or
+jittered crystal, in the cube of the scene's packing fraction or in its explicit box) or
 from the scene's initial-state file. Forward, the run pauses for checkpoints, trajectory frames and,
 with a plot, 9 intermediate round trips (state clones run back to the start). Ctrl-C stops
 the forward run between events; the run then goes back from where it stopped. Ctrl-C during
@@ -40,7 +40,7 @@ __all__ = ["build_simulation", "run_gas", "round_trip", "list_renewals", "BYTES_
 
 def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
     """The engine for a gas scene: from its initial state, or from the engine's random start
-    in its box (``[system] start``: auto, random or lattice). ``seed`` overrides the
+    in its box (``[system] start``: auto, random or crystal). ``seed`` overrides the
     scene's. A state the engine refuses raises :class:`SceneError` naming the field. A
     lattice scene gets a :class:`revcol.lattice.LatticeSimulation` (:mod:`revcol.lattice_gas`)."""
     if scene.kind != "gas":
@@ -53,7 +53,7 @@ def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
     if scene.initial_state is not None:
         x, v = read_initial(scene.source, scene.initial_state, scene.dimension)
         return _engine(scene, "[system] initial_state", lambda: Simulation(x, v, scene.box, **opts))
-    init = {"auto": "auto", "random": "rsa", "lattice": "lattice"}[scene.start]
+    init = {"auto": "auto", "random": "rsa", "crystal": "crystal"}[scene.start]
     if scene.packing_fraction is not None:  # the engine's cube for that fraction (random_state)
         return _engine(scene, "[system] packing_fraction", lambda: Simulation.random(
             scene.particles, scene.dimension, scene.packing_fraction, init=init,

@@ -30,7 +30,7 @@ from typing import Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._args import integer, name, names, real, real_array
+from ._args import integer, name, names, placement, real, real_array
 from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .simulation import SimulationBase, register_engine
@@ -49,6 +49,23 @@ def _boundary(boundary: _Boundary) -> list:
 def _tick(tick_bits: Optional[int]) -> int:
     """The binding's tick_bits: 0 asks for the automatic tick."""
     return 0 if tick_bits is None else integer(tick_bits, "tick_bits", 16, 26)
+
+
+#: the neighbour searches by name, as the engine's list shell (BasicEngine::set_list_shell)
+SEARCHES = {"auto": -1.0, "cells": 0.0}
+
+
+def _shell(search: Union[str, float]) -> float:
+    """The engine's list shell for ``search``: ``"auto"`` -1, ``"cells"`` 0, or a shell in
+    diameters in [0.02, 2]; a ValueError naming ``search`` otherwise."""
+    if isinstance(search, str):
+        if search in SEARCHES:
+            return SEARCHES[search]
+        raise ValueError(f"search must be 'auto', 'cells' or a shell in diameters in [0.02, 2], got {search!r}")
+    s = real(search, "search")
+    if not 0.02 <= s <= 2.0:
+        raise ValueError(f"search = {s!r} is outside [0.02, 2] (a shell in diameters; or 'auto', 'cells')")
+    return s
 
 
 # the binding's engine class and start functions per dimension
@@ -72,8 +89,12 @@ class LatticeSimulation(SimulationBase):
     units for the rms speed, S set by the box). The automatic tick keeps 30 bits:
     T = clamp(S - 30, 16, 24) (docs/lattice.md). ``cell_bits`` (12..20, default 16): the pair operator
     cuts directions into 2^cell_bits equal-angle cells per turn; fewer cells make the lifting
-    rotation's read-back redraws rarer (docs/lattice.md). Bad input raises ``ValueError`` naming
-    the problem.
+    rotation's read-back redraws rarer (docs/lattice.md). ``search``: the neighbour search,
+    ``"auto"`` (default: neighbour lists in 3D, the cell grid in 2D), ``"cells"`` (the cell
+    grid) or neighbour lists with a shell of that many diameters (a float in [0.02, 2]); it
+    changes the speed only, never which collisions happen (the state is the same bit for bit),
+    and it is kept in snapshots and checkpoints. Bad input raises ``ValueError`` naming the
+    problem.
     """
 
     _DIM = 2  # LatticeSimulation3D: 3
@@ -81,12 +102,14 @@ class LatticeSimulation(SimulationBase):
 
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
                  diameter: float = 1.0, law: str = "flux", seed: int = 1, tick_bits: Optional[int] = None,
-                 cell_bits: int = 16, _engine=None,
+                 cell_bits: int = 16, search: Union[str, float] = "auto", _engine=None,
                  _quantization: Optional[dict] = None):
         if _engine is not None:
             self._e = _engine
             self._q = dict(_quantization or {})
+            self._search = -1.0
             return
+        shell = _shell(search)
         x = real_array(positions, "positions")
         v = real_array(velocities, "velocities")
         box = real_array(box, "box")
@@ -97,34 +120,46 @@ class LatticeSimulation(SimulationBase):
             raise ValueError(f"box must be one length or three (3D), got shape {box.shape}")
         start = getattr(_core, _QUANTIZE[dim])(x, v, [float(b) for b in np.broadcast_to(box, (dim,))],
                                                _boundary(boundary), diameter, _tick(tick_bits), cell_bits)
-        self._init_from_start(start, law, seed, dim)
+        self._init_from_start(start, law, seed, dim, shell)
 
-    def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2) -> None:
+    def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2, shell: float = -1.0) -> None:
         engine = getattr(_core, _ENGINE[dim])
         self._e = engine(start["units"], start["x"], start["v"], seed, name(law, "law"))
         self._q = {"max_position_error": start["max_position_error"],
                    "max_velocity_error": start["max_velocity_error"]}
+        self._search = -1.0
+        self._set_shell(shell)
+
+    def _set_shell(self, shell: float) -> None:
+        """The engine's neighbour search (its list shell; -1 automatic, the engine's default)."""
+        if shell != self._search:
+            self._e.set_search(shell)
+        self._search = shell
 
     @classmethod
     def random(cls, n: int, dim: Optional[int] = None, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
                diameter: float = 1.0, seed: int = 1, init: str = "auto", law: str = "flux",
-               tick_bits: Optional[int] = None, cell_bits: int = 16,
+               tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
                packing_fraction: Optional[float] = None) -> "LatticeSimulation":
         """n disks (spheres for LatticeSimulation3D) at area (volume) fraction ``phi`` (or
         ``packing_fraction=``; default 0.3) in a square (cubic) box (the float engine's
-        ``random_state``: random sequential addition or a jittered lattice (FCC in 3D), Gaussian
-        velocities with zero momentum, kT = 1), quantized once. The same ``seed`` keys the
-        streams. ``dim`` (default: the class's, 2 or 3) must be the class's."""
+        ``random_state``: ``init`` ``"rsa"``, random sequential addition, or ``"crystal"``, a
+        jittered crystal, square in 2D and face-centred cubic in 3D; ``"auto"`` picks; the old
+        name ``"lattice"`` still works, with a DeprecationWarning; Gaussian velocities with zero
+        momentum, kT = 1), quantized once. The same ``seed`` keys the streams. ``dim`` (default:
+        the class's, 2 or 3) must be the class's; the other keywords as the constructor's."""
         phi = _packing_fraction(phi, packing_fraction)
+        init = placement(init)
+        shell = _shell(search)
         dim = cls._DIM if dim is None else dim
         if dim != cls._DIM:
             if cls._DIM == 2:
                 raise ValueError(f"the lattice engine is 2D, got dim={dim} (spheres: LatticeSimulation3D)")
             raise ValueError(f"LatticeSimulation3D is 3D, got dim={dim}")
-        start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, name(init, "init"),
+        start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, init,
                                                    _tick(tick_bits), cell_bits)
         sim = cls.__new__(cls)
-        sim._init_from_start(start, law, seed, dim)
+        sim._init_from_start(start, law, seed, dim, shell)
         return sim
 
     # --- running ---------------------------------------------------------------------------
@@ -244,6 +279,19 @@ class LatticeSimulation(SimulationBase):
         return dict(self._e.units)
 
     @property
+    def search(self) -> Union[str, float]:
+        """The neighbour search in use: ``"cells"`` (the cell grid) or the neighbour lists' shell
+        in diameters (a float, the asked one on the lattice's integer radius); ``"auto"`` has
+        resolved to one of them (lists in 3D, cells in 2D). Setting it (``"auto"``, ``"cells"``
+        or a shell in [0.02, 2]) changes the speed only: the run is the same bit for bit."""
+        shell = float(self._e.list_shell)
+        return "cells" if shell == 0.0 else shell
+
+    @search.setter
+    def search(self, search: Union[str, float]) -> None:
+        self._set_shell(_shell(search))
+
+    @property
     def quantization(self) -> dict:
         """Max position error (in diameters) and velocity error (relative to the rms speed) of
         the one quantization of the float start."""
@@ -262,9 +310,11 @@ class LatticeSimulation(SimulationBase):
 
     def snapshot(self) -> dict:
         """The full state (units, positions at the clock, velocities, stream counters, X's
-        words, rare log, clock, collision count) as numpy arrays and numbers."""
+        words, rare log, clock, collision count) as numpy arrays and numbers, and the neighbour
+        search asked (``"search"``: the list shell in diameters, -1 automatic, 0 the cell grid)."""
         s = dict(self._e.snapshot())
         s["quantization"] = dict(self._q)
+        s["search"] = self._search
         return s
 
     @classmethod
@@ -273,6 +323,7 @@ class LatticeSimulation(SimulationBase):
         gives a LatticeSimulation3D whichever class is asked."""
         st = dict(snapshot)
         q = st.pop("quantization", None)
+        shell = _snapshot_shell(st.pop("search", -1.0))  # written before it existed: automatic
         engine = st.get("engine", "lattice")
         if str(np.asarray(engine)) != "lattice":
             raise ValueError(f"snapshot: engine must be 'lattice', got {str(np.asarray(engine))[:40]!r}")
@@ -294,7 +345,9 @@ class LatticeSimulation(SimulationBase):
             raise ValueError(f"snapshot: dim must be 2 or 3, got {dim}")
         engine_class = getattr(_core, _ENGINE[dim])
         out = LatticeSimulation3D if dim == 3 else LatticeSimulation
-        return out(None, None, None, _engine=engine_class.from_snapshot(st), _quantization=q)
+        sim = out(None, None, None, _engine=engine_class.from_snapshot(st), _quantization=q)
+        sim._set_shell(shell)
+        return sim
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the full state to ``path`` atomically (numpy ``.npz``; nested dicts as ``a.b`` keys)."""
@@ -326,6 +379,20 @@ class LatticeSimulation(SimulationBase):
         return f"{type(self).__name__}(n={self.n}, collisions={self.collisions}, clock={self.clock})"
 
 
+def _snapshot_shell(value) -> float:
+    """A snapshot's ``search`` entry, checked: -1 (automatic; any negative), 0 (the cell grid)
+    or a shell in [0.02, 2] diameters."""
+    try:
+        shell = float(np.asarray(value))
+    except (TypeError, ValueError):
+        raise ValueError(f"snapshot: search must be a number (the list shell), got {value!r:.40}") from None
+    if shell < 0.0:
+        return -1.0
+    if not (shell == 0.0 or 0.02 <= shell <= 2.0):
+        raise ValueError(f"snapshot: search = {shell!r} must be -1 (automatic), 0 (cells) or in [0.02, 2]")
+    return shell
+
+
 class LatticeSimulation3D(LatticeSimulation):
     """N hard spheres on the integer lattice, run forward and back bit for bit: the 3D lattice
     engine (``LatticeEngine3D``), with :class:`LatticeSimulation`'s API.
@@ -333,7 +400,8 @@ class LatticeSimulation3D(LatticeSimulation):
     Build from (n, 3) float arrays and one or three box lengths
     (``LatticeSimulation3D(positions, velocities, box)``) or at random
     (``LatticeSimulation3D.random(n, phi=...)``: the float engine's 3D ``random_state``, random
-    sequential addition up to a volume fraction 0.2, else a jittered FCC lattice). ``boundary``:
+    sequential addition up to a volume fraction 0.2, else a jittered face-centred cubic
+    crystal). ``boundary``:
     one name or three. The pair operator is ``LatticePair3D`` (the polar angle by whole-cell
     lifting rotations, the azimuth by bits-back over the exact rows of its cell;
     docs/lattice.md); ``cell_bits`` sets its 2^cell_bits polar cells per turn. Snapshots carry

@@ -69,7 +69,7 @@ def build_lattice(scene: Scene, seed: int | None = None) -> LatticeSimulation:
     opts = lattice_options(scene)
     if seed is not None:
         opts["seed"] = int(seed)
-    init = {"auto": "auto", "random": "rsa", "lattice": "lattice"}[scene.start]
+    init = {"auto": "auto", "random": "rsa", "crystal": "crystal"}[scene.start]
     cls = LatticeSimulation3D if scene.dimension == 3 else LatticeSimulation
     if scene.initial_state is not None:
         x, v = read_initial(scene.source, scene.initial_state, scene.dimension)
@@ -278,6 +278,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "units": {"S": units["S"], "sigma": units["sigma"], "tick": units["tick"],
                   "tick_bits": units["tick_bits"], "cell_bits": units["cell_bits"],
                   "length_unit": units["length_unit"], "L": list(units["L"])},
+        "search": sim.search,  # the neighbour search in use: "cells" or the lists' shell in diameters
         "quantization": sim.quantization,
         "collisions_forward": done, "collisions_back": run.back, "per_particle": 2.0 * done / n,
         "time_start": 0.0, "time_turn": run.t_turn, "time_end": sim.time, "clock_turn": run.clock_turn,

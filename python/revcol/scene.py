@@ -24,8 +24,9 @@ The limits a scene is checked against (the largest packing fraction, the particl
 periodic axes of at least 3 diameters, the dimensions paper mode runs in, the bits and the
 seed range) are the engine's own, read from C++ (``revcol._core.engine_limits``, header
 ``revcol/engine/limits.hpp``), and so are the names: the engine's vocabulary ``"wall"`` and
-``"per_particle"``. The older spellings ``"walls"`` and ``"per-particle"`` are still read,
-with a :class:`DeprecationWarning` naming the file and the replacement.
+``"per_particle"``. The older spellings ``"walls"``, ``"per-particle"`` and ``start =
+"lattice"`` (now ``"crystal"``) are still read, with a :class:`DeprecationWarning` naming the
+file and the replacement.
 
 .. code-block:: toml
 
@@ -41,8 +42,9 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     diameter = 1.0                # sigma > 0
     packing_fraction = 0.3        # sets a cubic box; or give box = [Lx, Ly]
     boundaries = "wall"           # "wall" | "periodic" | "bounce" (float engine), or one per axis ("walls": deprecated)
-    start = "auto"                # "auto" | "random" (sequential addition) | "lattice";
-                                  # auto: random up to the engine's rsa_fraction, else lattice
+    start = "auto"                # "auto" | "random" (sequential addition) | "crystal" (jittered:
+                                  # square in 2D, face-centred cubic in 3D; "lattice": deprecated);
+                                  # auto: random up to the engine's rsa_fraction, else crystal
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
 
@@ -52,6 +54,11 @@ with a :class:`DeprecationWarning` naming the file and the replacement.
     mode = "exact"                # "exact" | "paper" (gas: 1D and 2D, the engine's limit)
     law = "flux"                  # exact mode: "flux" | "uniform"
     bits = 40                     # K, bits per chart coordinate, 8..52 (not statesave, not lattice)
+    tick_bits = 20                # engine = "lattice" only: 16..26 (default automatic), a particle of
+                                  # rms speed moves 2^-tick_bits diameters per tick
+    cell_bits = 16                # engine = "lattice" only: 12..20, 2^cell_bits direction cells per turn
+    search = "auto"               # engine = "lattice" only: "auto" | "cells" | a neighbour-list shell in
+                                  # diameters, 0.02..2 (the speed only: the run is the same bit for bit)
 
     [rng]
     generator = "clcg4"           # "clcg4" | "philox"
@@ -95,9 +102,7 @@ directory and nothing is written into the installed package.
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -111,16 +116,13 @@ from ._toml import read_toml, shipped_dirs
 from .engine import Simulation
 from .lattice import LatticeSimulation
 from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINES, KINDS,  # noqa: F401 (__all__)
-                           LATTICE_DEFAULT_COLLISIONS, LIMITS, SCHEMA, USES)
+                           LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES, SceneError, _check,
+                           _fail, _modernize)
 from .statesave import variants as statesave_variants
 from .verify import verify_cases
 
 __all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "engine_options", "lattice_options", "with_engine",
-           "DEFAULT_SCENE", "KINDS", "ENGINES"]
-
-class SceneError(ValueError):
-    """A scene file that cannot be run; the message is one line naming the problem."""
-
+           "with_lattice_options", "DEFAULT_SCENE", "KINDS", "ENGINES"]
 
 @dataclass(frozen=True)
 class Scene:
@@ -145,6 +147,9 @@ class Scene:
     mode: str = "exact"
     law: str = "flux"
     bits: int = 40
+    tick_bits: int | None = None  # the lattice engine's options (None: automatic)
+    cell_bits: int = 16
+    search: str | float = "auto"
     generator: str = "clcg4"
     streams: str = "per_particle"
     seed: int = 0
@@ -195,48 +200,6 @@ class Scene:
             v = getattr(self, f.name)
             out[f.name] = str(v) if isinstance(v, Path) else (list(v) if isinstance(v, tuple) else v)
         return out
-
-
-def _fail(source: str, where: str, msg: str) -> SceneError:
-    return SceneError(f"{source}: {where}: {msg}")
-
-
-def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: Any) -> Any:
-    where = f"[{table}] {key}"
-    if kind == "int":
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise _fail(source, where, f"must be an integer, got {value!r}")
-        lo, hi = allowed
-        if value < lo or (hi is not None and value > hi):
-            span = f"{lo}..{hi}" if hi is not None else f">= {lo}"
-            raise _fail(source, where, f"must be {span}, got {value}")
-        return value
-    if kind == "float":
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise _fail(source, where, f"must be a finite number, got {value!r}")
-        if not value > allowed[0]:
-            raise _fail(source, where, f"must be > {allowed[0]:g}, got {value}")
-        return float(value)
-    if kind == "bool":
-        if not isinstance(value, bool):
-            raise _fail(source, where, f"must be true or false, got {value!r}")
-        return value
-    if kind == "str":
-        if not isinstance(value, str):
-            raise _fail(source, where, f"must be a string, got {value!r}")
-        if allowed is not None and value not in allowed:
-            raise _fail(source, where, f"must be one of {', '.join(map(repr, allowed))}, got {value!r}")
-        return value
-    if kind in ("floats", "ints"):
-        if not isinstance(value, list) or not value:
-            raise _fail(source, where, f"must be a non-empty list of numbers, got {value!r}")
-        return tuple(_check(source, table, key, v, kind[:-1], allowed) for v in value)
-    if kind == "strs":
-        items = [value] if isinstance(value, str) else value
-        if not isinstance(items, list) or not items:
-            raise _fail(source, where, f"must be a string or a list of strings, got {value!r}")
-        return tuple(_check(source, table, key, v, "str", allowed) for v in items)
-    raise AssertionError(kind)
 
 
 def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | None = None,
@@ -365,6 +328,10 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         _check_lattice(source, d, mode, get("rng", "generator", "philox"), get("rng", "streams", "per_particle"),
                        ("collisions", "bits") in values)
         common = {**common, "generator": get("rng", "generator", "philox")}
+    for key in LATTICE_FIELDS:  # the lattice's own options: an error on the float engine, not ignored
+        if engine != "lattice" and ("collisions", key) in values:
+            raise _fail(source, f"[collisions] {key}", "applies to engine = 'lattice' only (the float engine has no "
+                        "ticks, direction cells or list shells)")
 
     paper_dims = tuple(LIMITS["paper_mode_dimensions"])
     if mode == "paper" and d not in paper_dims:
@@ -394,7 +361,8 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         dimension=d, particles=n, diameter=sigma, box=tuple(box), packing_fraction=phi,
         boundaries=tuple(bounds), start=start, engine=engine,
         kinetic_energy=get("system", "kinetic_energy"), initial_state=initial_path,
-        mode=mode, law=law, bits=get("collisions", "bits", 40),
+        mode=mode, law=law, bits=get("collisions", "bits", 40), tick_bits=get("collisions", "tick_bits"),
+        cell_bits=get("collisions", "cell_bits", 16), search=get("collisions", "search", "auto"),
         streams=get("rng", "streams", "per_particle"), collisions=nc, time=t_end,
         checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
         json=out("json"), plot=out("plot"), trajectory=trajectory,
@@ -440,13 +408,16 @@ def with_engine(scene: Scene, engine: str) -> Scene:
     """``scene`` on another engine (``revcol run --engine``), checked as a scene file saying
     ``[collisions] engine = ...`` would be: a scene that names no generator gets the engine's
     default one (Philox on the lattice); a lattice scene moved to the float engine keeps its
-    Philox streams and gets the float engine's default chart bits, 40."""
+    Philox streams, gets the float engine's default chart bits, 40, and drops the lattice's own
+    options (tick_bits, cell_bits, search)."""
     if engine not in ENGINES:
         raise SceneError(f"{scene.source}: --engine must be one of {', '.join(map(repr, ENGINES))}, got {engine!r}")
     if scene.kind != "gas":
         raise SceneError(f"{scene.source}: --engine applies to 'gas' scenes, not {scene.kind!r}")
     fields = scene.extra.get("fields", ())
     out = dataclasses.replace(scene, engine=engine)
+    if engine == "float":
+        out = dataclasses.replace(out, tick_bits=None, cell_bits=16, search="auto")
     if engine == "lattice":
         if "rng.generator" not in fields:  # the lattice's default generator, as in a scene file
             out = dataclasses.replace(out, generator="philox")
@@ -523,21 +494,6 @@ def _check_initial(source: str, scene: Scene, x, v) -> None:
 _read_initial = read_initial  # its name before it was public
 
 
-def _modernize(source: str, table: str, key: str, value: Any) -> Any:
-    """``value`` with deprecated spellings replaced, warning once per field (DeprecationWarning)."""
-    old_new = DEPRECATED.get((table, key))
-    if old_new is None:
-        return value
-    items = value if isinstance(value, list) else [value]
-    old = sorted({v for v in items if isinstance(v, str) and v in old_new})
-    if not old:
-        return value
-    said = ", ".join(f"{o!r} is deprecated, write {old_new[o]!r}" for o in old)
-    warnings.warn(f"{source}: [{table}] {key}: {said}", DeprecationWarning, stacklevel=4)
-    new = [old_new.get(v, v) if isinstance(v, str) else v for v in items]
-    return new if isinstance(value, list) else new[0]
-
-
 def engine_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.Simulation` that a gas scene sets."""
     return dict(boundary=list(scene.boundaries),
@@ -547,7 +503,26 @@ def engine_options(scene: Scene) -> dict[str, Any]:
 
 def lattice_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.lattice.LatticeSimulation` that a gas scene sets."""
-    return dict(boundary=list(scene.boundaries), diameter=scene.diameter, law=scene.law, seed=scene.seed)
+    return dict(boundary=list(scene.boundaries), diameter=scene.diameter, law=scene.law, seed=scene.seed,
+                tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search)
+
+
+def with_lattice_options(scene: Scene, *, tick_bits: int | None = None, cell_bits: int | None = None,
+                         search: str | float | None = None) -> Scene:
+    """``scene`` with the lattice engine's options that are not None replaced (``revcol run`` and
+    ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``), each checked as its
+    ``[collisions]`` field; a scene that does not run the lattice engine refuses them."""
+    given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search)) if v is not None}
+    flags = {k: "--" + k.replace("_", "-") for k in given}
+    if given and (scene.kind != "gas" or scene.engine != "lattice"):
+        runs = "the float engine (add --engine lattice)" if scene.kind == "gas" else f"no gas (kind = {scene.kind!r})"
+        raise SceneError(f"{scene.source}: {', '.join(flags.values())}: the lattice engine's options; this scene runs {runs}")
+    for k, v in given.items():
+        try:
+            given[k] = _check(scene.source, "collisions", k, v, *SCHEMA["collisions"][k])
+        except SceneError as e:
+            raise SceneError(str(e).replace(f"[collisions] {k}", flags[k])) from None
+    return dataclasses.replace(scene, **given)
 
 
 def scene_dirs() -> list[Path]:

@@ -1,14 +1,18 @@
 """The scene file's schema: its tables and fields, each with its type and allowed values; the
-fields each kind of scene uses; the old spellings still read; the built-in default scene.
-:mod:`revcol.scene` reads a scene against them (and re-exports the public names).
+fields each kind of scene uses; the old spellings still read; the built-in default scene; and
+the check of one field against them (:class:`SceneError` naming it). :mod:`revcol.scene`
+reads a scene with them (and re-exports the public names).
 """
 from __future__ import annotations
 
+import math
+import warnings
 from typing import Any
 
 from . import _core
 
-__all__ = ["KINDS", "ENGINES", "LIMITS", "DEFAULT_SCENE", "SCHEMA", "USES", "DEPRECATED"]
+__all__ = ["KINDS", "ENGINES", "LIMITS", "DEFAULT_SCENE", "SCHEMA", "USES", "DEPRECATED", "LATTICE_FIELDS",
+           "SceneError"]
 
 #: the kinds of scene
 KINDS = ("gas", "reversal", "statesave")
@@ -24,7 +28,11 @@ LIMITS: dict[str, Any] = _core.engine_limits()
 DEPRECATED: dict[tuple[str, str], dict[str, str]] = {
     ("system", "boundaries"): {"walls": "wall"},
     ("rng", "streams"): {"per-particle": "per_particle"},
+    ("system", "start"): {"lattice": "crystal"},  # "lattice" names the engine only
 }
+
+#: the [collisions] fields of the lattice engine alone (LatticeSimulation's options)
+LATTICE_FIELDS = ("tick_bits", "cell_bits", "search")
 
 # the schema: table -> field -> (type check name, allowed values or range)
 SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
@@ -37,7 +45,7 @@ SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "packing_fraction": ("float", (0.0, None)),
         "box": ("floats", (0.0, None)),
         "boundaries": ("strs", tuple(LIMITS["boundaries"])),
-        "start": ("str", ("auto", "random", "lattice")),
+        "start": ("str", ("auto", "random", "crystal")),
         "kinetic_energy": ("float", (0.0, None)),
         "initial_state": ("str", None),
     },
@@ -46,6 +54,10 @@ SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "mode": ("str", ("exact", "paper")),
         "law": ("str", ("flux", "uniform")),
         "bits": ("int", tuple(LIMITS["bits"])),
+        # the lattice engine's (revcol/lattice/units.hpp, engine_core.hpp set_list_shell)
+        "tick_bits": ("int", (16, 26)),
+        "cell_bits": ("int", (12, 20)),
+        "search": ("search", (0.02, 2.0)),
     },
     "rng": {
         "generator": ("str", tuple(sorted(LIMITS["generators"]))),
@@ -114,3 +126,71 @@ DEFAULT_SCENE: dict[str, Any] = {
     # 3 collisions per particle (revcol run --horizon --engine float).
     "run": {"collisions": 1_000_000},
 }
+
+
+class SceneError(ValueError):
+    """A scene file that cannot be run; the message is one line naming the problem."""
+
+
+
+def _fail(source: str, where: str, msg: str) -> SceneError:
+    return SceneError(f"{source}: {where}: {msg}")
+
+
+def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: Any) -> Any:
+    where = f"[{table}] {key}"
+    if kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise _fail(source, where, f"must be an integer, got {value!r}")
+        lo, hi = allowed
+        if value < lo or (hi is not None and value > hi):
+            span = f"{lo}..{hi}" if hi is not None else f">= {lo}"
+            raise _fail(source, where, f"must be {span}, got {value}")
+        return value
+    if kind == "float":
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise _fail(source, where, f"must be a finite number, got {value!r}")
+        if not value > allowed[0]:
+            raise _fail(source, where, f"must be > {allowed[0]:g}, got {value}")
+        return float(value)
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise _fail(source, where, f"must be true or false, got {value!r}")
+        return value
+    if kind == "str":
+        if not isinstance(value, str):
+            raise _fail(source, where, f"must be a string, got {value!r}")
+        if allowed is not None and value not in allowed:
+            raise _fail(source, where, f"must be one of {', '.join(map(repr, allowed))}, got {value!r}")
+        return value
+    if kind == "search":  # "auto", "cells" or a neighbour-list shell in diameters
+        if value in ("auto", "cells") or (not isinstance(value, (bool, str)) and isinstance(value, (int, float))
+                                         and allowed[0] <= value <= allowed[1]):
+            return value if isinstance(value, str) else float(value)
+        raise _fail(source, where, f"must be 'auto', 'cells' or a shell in diameters, {allowed[0]:g}..{allowed[1]:g}, "
+                    f"got {value!r}")
+    if kind in ("floats", "ints"):
+        if not isinstance(value, list) or not value:
+            raise _fail(source, where, f"must be a non-empty list of numbers, got {value!r}")
+        return tuple(_check(source, table, key, v, kind[:-1], allowed) for v in value)
+    if kind == "strs":
+        items = [value] if isinstance(value, str) else value
+        if not isinstance(items, list) or not items:
+            raise _fail(source, where, f"must be a string or a list of strings, got {value!r}")
+        return tuple(_check(source, table, key, v, "str", allowed) for v in items)
+    raise AssertionError(kind)
+
+
+def _modernize(source: str, table: str, key: str, value: Any) -> Any:
+    """``value`` with deprecated spellings replaced, warning once per field (DeprecationWarning)."""
+    old_new = DEPRECATED.get((table, key))
+    if old_new is None:
+        return value
+    items = value if isinstance(value, list) else [value]
+    old = sorted({v for v in items if isinstance(v, str) and v in old_new})
+    if not old:
+        return value
+    said = ", ".join(f"{o!r} is deprecated, write {old_new[o]!r}" for o in old)
+    warnings.warn(f"{source}: [{table}] {key}: {said}", DeprecationWarning, stacklevel=4)
+    new = [old_new.get(v, v) if isinstance(v, str) else v for v in items]
+    return new if isinstance(value, list) else new[0]

@@ -229,7 +229,7 @@ def test_bad_scene_files_one_line_exit_2(tmp_path, capsys, text, needle):
     assert not (tmp_path / "r.json").exists()
 
 
-@pytest.mark.parametrize("start", ["auto", "random", "lattice"])
+@pytest.mark.parametrize("start", ["auto", "random", "crystal"])
 def test_explicit_box_starts_from_the_engine(start):
     doc = {"system": {"dimension": 3, "particles": 60, "box": [5.0, 6.0, 9.0], "start": start,
                       "boundaries": ["wall", "periodic", "wall"], "kinetic_energy": 30.0},
@@ -239,7 +239,7 @@ def test_explicit_box_starts_from_the_engine(start):
     assert sim.n == 60 and sim.diagnostics()["energy"] == pytest.approx(30.0)
     assert np.abs(sim.velocities.sum(axis=0)).max() < 1e-12
     # the start is the engine's (C++ engine/init.hpp), bit for bit
-    init = {"auto": "auto", "random": "rsa", "lattice": "lattice"}[start]
+    init = {"auto": "auto", "random": "rsa", "crystal": "crystal"}[start]
     x, v = revcol._core.engine_random_start(60, [5.0, 6.0, 9.0], ["wall", "periodic", "wall"], 1.0, 0, 30.0, init)
     assert np.array_equal(sim.positions, x) and np.array_equal(sim.velocities, v)
     assert run_gas(scene, progress=False)["passed"]
@@ -247,9 +247,9 @@ def test_explicit_box_starts_from_the_engine(start):
         build_simulation(scene_from_dict({**doc, "system": {**doc["system"], "particles": 500}}, "box.toml"))
 
 
-def test_a_lattice_that_does_not_fit_is_a_scene_error():
-    doc = {"system": {"dimension": 2, "particles": 9, "box": [3.5, 3.5], "start": "lattice"}}
-    with pytest.raises(SceneError, match=r"\[system\] box: 9 particles of diameter 1.* do not fit on a lattice"):
+def test_a_crystal_that_does_not_fit_is_a_scene_error():
+    doc = {"system": {"dimension": 2, "particles": 9, "box": [3.5, 3.5], "start": "crystal"}}
+    with pytest.raises(SceneError, match=r"\[system\] box: 9 particles of diameter 1.* do not fit on a crystal"):
         build_simulation(scene_from_dict(doc, "tight.toml"))
 
 

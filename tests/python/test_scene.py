@@ -33,7 +33,7 @@ particles = 64
 diameter = 0.5
 box = [4.0, 4.0, 5.0]
 boundaries = ["periodic", "periodic", "wall"]
-start = "lattice"
+start = "crystal"
 kinetic_energy = 96.0
 [collisions]
 mode = "exact"
@@ -211,16 +211,19 @@ def test_initial_state_checked_by_the_engine(tmp_path):
 
 def test_deprecated_spellings_warn_and_mean_the_same(tmp_path):
     new = load_scene(write(tmp_path, "[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\n"
-                                     "boundaries = ['wall', 'periodic']\n[rng]\nstreams = 'per_particle'\n"))
+                                     "boundaries = ['wall', 'periodic']\nstart = 'crystal'\n"
+                                     "[rng]\nstreams = 'per_particle'\n"))
     p = tmp_path / "old.toml"
     p.write_text("[system]\ndimension = 2\nparticles = 5\npacking_fraction = 0.1\n"
-                 "boundaries = ['walls', 'periodic']\n[rng]\nstreams = 'per-particle'\n")
+                 "boundaries = ['walls', 'periodic']\nstart = 'lattice'\n[rng]\nstreams = 'per-particle'\n")
     with pytest.warns(DeprecationWarning) as got:
         old = load_scene(p)
     said = [str(w.message) for w in got]
     assert f"{p}: [system] boundaries: 'walls' is deprecated, write 'wall'" in said
     assert f"{p}: [rng] streams: 'per-particle' is deprecated, write 'per_particle'" in said
+    assert f"{p}: [system] start: 'lattice' is deprecated, write 'crystal'" in said
     assert old.boundaries == new.boundaries == ("wall", "periodic") and old.streams == new.streams == "per_particle"
+    assert old.start == new.start == "crystal"
     assert old.summary().replace("old", "s") == new.summary()
 
 

@@ -1,10 +1,11 @@
 """The ``revcol`` command line.
 
     revcol run [SCENE.toml] [--json FILE] [--plot DIR] [--trajectory FILE.xyz|.gsd] [--collisions N] [--seed S]
-               [--engine float|lattice]
+               [--engine float|lattice] [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]
     revcol run [SCENE.toml] --horizon [--seeds K] [--max-collisions N] [--engine float] [--json FILE] [--plot DIR]
     revcol simulate [SCENE] [--collisions N | --time T] [--trajectory FILE --every K|--every-time T] [--checkpoint DIR
                --checkpoint-every K] [--resume CHECKPOINT] [--species Ar] [--json FILE]   (forward only)
+               [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]   (lattice engine)
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
     revcol bench tradeoff [--reduced] [--repeats 3] --json bench/results/tradeoff.json --plot docs/figures/tradeoff
@@ -69,6 +70,26 @@ def _positive_real(text: str) -> float:
     if not (value > 0 and value != float("inf")):
         raise argparse.ArgumentTypeError(f"expected a positive finite number, got {text!r}")
     return value
+
+
+def _search(text: str):
+    """``--search``: "auto", "cells" or a shell in diameters (its range is checked with the scene's)."""
+    if text in ("auto", "cells"):
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected 'auto', 'cells' or a shell in diameters (0.02..2), got {text!r}") from None
+
+
+def _lattice_flags(p: argparse.ArgumentParser) -> None:
+    """The lattice engine's options, overriding the scene's [collisions] tick_bits, cell_bits, search."""
+    g = p.add_argument_group("lattice engine", "override the scene's [collisions] fields; refused on the float engine")
+    g.add_argument("--tick-bits", type=int, metavar="T", help="a particle of rms speed moves 2^-T diameters per "
+                   "tick, 16..26 (default: automatic)")
+    g.add_argument("--cell-bits", type=int, metavar="C", help="2^C direction cells per turn, 12..20 (default 16)")
+    g.add_argument("--search", type=_search, metavar="S", help="neighbour search: 'auto' (lists in 3D, cells in 2D), "
+                   "'cells', or lists with a shell of S diameters, 0.02..2; the run is the same bit for bit")
 
 
 def _did_you_mean(word: str, candidates) -> str:
@@ -138,6 +159,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="run a gas scene on this engine instead of its [collisions] engine (with --horizon: "
                    "--engine float measures the float engine's horizon for a lattice scene's gas)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
+    _lattice_flags(r)
     _simulate_parser(sub)
     _sweep_parser(sub)
     v = sub.add_parser("verify", help="run the paper's reversal illustration and check the round trip")
@@ -210,6 +232,7 @@ def _simulate_parser(sub) -> None:
     s.add_argument("--json", metavar="FILE", help="write the report as JSON ('-': to standard output, and the "
                    "text report to standard error)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
+    _lattice_flags(s)
 
 
 def _simulate(args: argparse.Namespace) -> int:
@@ -226,6 +249,7 @@ def _simulate(args: argparse.Namespace) -> int:
             report = simulate(scene, collisions=args.collisions, time=args.time, trajectory=args.trajectory,
                               every=args.every, checkpoints=args.checkpoint, checkpoint_every=args.checkpoint_every,
                               resume=args.resume, seed=args.seed, engine=args.engine, species=args.species,
+                              tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search,
                               json_path=None if to_stdout else args.json,
                               progress=False if args.no_progress else None, every_time=args.every_time)
     except (SceneError, OSError) as e:

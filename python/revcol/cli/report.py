@@ -86,6 +86,13 @@ _PARTS = {"positions": "positions", "velocities": "velocities", "rng_counters": 
           "rare_log": "rare log"}
 
 
+def _search(search) -> str:
+    """The lattice's neighbour search as the report says it."""
+    if search is None or search == "cells":
+        return "cells (the cell grid)" if search else "n/a"
+    return f"neighbour lists, shell {search:.3g} diameters"
+
+
 def _lattice_lines(r: dict) -> list[str]:
     """A lattice-engine round trip: what came back bit for bit, X's size, the rare log,
     redraws, multi-body ticks, drifts, rates and memory."""
@@ -101,6 +108,7 @@ def _lattice_lines(r: dict) -> list[str]:
     lines = [
         f"  engine           lattice: sigma = 2^{u['S']} lattice units per diameter, a tick = {u['tick']:.3g} time "
         f"units (a typical particle moves 2^-{u['tick_bits']} sigma per tick), 2^{u['cell_bits']} direction cells",
+        f"  settings         tick_bits {u['tick_bits']}, cell_bits {u['cell_bits']}, search {_search(r.get('search'))}",
         f"  start            quantized once: positions within {_err(q['max_position_error'], 'diameters')}, "
         f"velocities within {_err(q['max_velocity_error'], 'v_rms')}; exact from there on",
         f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:,.4g} per particle) to "

@@ -10,7 +10,7 @@ import warnings
 
 from .._io import jsonable
 from ..observe import report_lines
-from ..scene import SceneError, load_scene
+from ..scene import Scene, SceneError, load_scene, with_engine, with_lattice_options
 from ..studies.scenes import run_scene
 from .report import format_report
 
@@ -31,14 +31,19 @@ def run_command(args: argparse.Namespace) -> int:
         with warnings.catch_warnings():  # a scene's deprecated spellings: one line each on stderr
             warnings.simplefilter("always", DeprecationWarning)
             warnings.showwarning = _warn_line
-            scene = args.scene
+            scene, engine = args.scene, args.engine
+            lattice = dict(tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search)
+            if any(v is not None for v in lattice.values()):  # on the engine the scene runs on (--engine too)
+                scene = load_scene(scene)
+                scene, engine = (with_engine(scene, engine) if engine else scene), None
+                scene = with_lattice_options(scene, **lattice)
             if to_stdout:  # the scene's own [output] json is replaced by standard output
-                scene = dataclasses.replace(load_scene(scene), json=None)
+                scene = dataclasses.replace(scene if isinstance(scene, Scene) else load_scene(scene), json=None)
             report = run_scene(scene, json_path=None if to_stdout else args.json, plot=args.plot,
                                trajectory=args.trajectory,
                                horizon_seeds=(args.seeds or 1) if args.horizon else None,
                                max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
-                               engine=args.engine, progress=False if args.no_progress else None,
+                               engine=engine, progress=False if args.no_progress else None,
                                plot_format=args.plot_format)
     except SceneError as e:
         print(f"revcol run: error: {e}", file=sys.stderr)

@@ -49,7 +49,7 @@ from ..lattice_gas import geometry as lattice_geometry
 from ..observe import report_lines
 from ..progress import Bar, Interrupt, peak_rss
 from ..roundtrip import geometry
-from ..scene import Scene, SceneError, load_scene, with_engine
+from ..scene import Scene, SceneError, load_scene, with_engine, with_lattice_options
 from ..trajectory import _species, check_format, open_trajectory  # revcol simulate writes frames
 
 __all__ = ["simulate", "format_simulate"]
@@ -256,6 +256,8 @@ class _Production:
         return {
             "kind": "simulate", "revcol_version": __version__, "scene": scene.to_dict(), "summary": scene.summary(),
             "engine": scene.engine, "particles": sim.n, "dimension": sim.dim,
+            "lattice": {"tick_bits": sim.units["tick_bits"], "cell_bits": sim.units["cell_bits"],
+                        "search": sim.search} if self.lattice else None,
             "resumed_from": None if resume is None else os.fspath(resume),
             "collisions": ran, "net_collisions": self.done, "collisions_per_particle": 2.0 * ran / sim.n,
             "time_start": self.t_start, "time_end": sim.time,
@@ -278,16 +280,22 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
              checkpoints: str | os.PathLike | None = None, checkpoint_every: int | None = None,
              resume: str | os.PathLike | None = None, seed: int | None = None, engine: str | None = None,
              species: str = "Ar", precise: bool = False, json_path: str | os.PathLike | None = None,
-             progress: bool | None = None, every_time: float | None = None) -> dict:
+             progress: bool | None = None, every_time: float | None = None, tick_bits: int | None = None,
+             cell_bits: int | None = None, search: str | float | None = None) -> dict:
     """Runs a gas scene forward only (see the module's docstring) and returns the report; with
     ``json_path`` also writes it (atomically). ``species`` names the trajectory's element,
     ``precise`` adds float64 positions to a GSD trajectory; ``every_time`` writes frames at the
-    multiples of that time instead of every ``every`` collisions. A bad option raises
+    multiples of that time instead of every ``every`` collisions. ``tick_bits``, ``cell_bits``,
+    ``search``: the lattice engine's options instead of the scene's (a resumed run keeps its
+    checkpoint's units, tick and cells, and takes a new search). A bad option raises
     SceneError before anything runs."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     if engine is not None:
         scene = with_engine(scene, engine)
+    scene = with_lattice_options(scene, tick_bits=tick_bits, cell_bits=cell_bits, search=search)
+    if resume is not None and (tick_bits, cell_bits) != (None, None):
+        raise SceneError(f"{scene.source}: --tick-bits, --cell-bits: a resumed run keeps its checkpoint's units")
     if seed is not None:
         scene = dataclasses.replace(scene, seed=int(seed))
     json_path = json_path if json_path is not None else scene.json
@@ -302,6 +310,8 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
         raise SceneError(f"{scene.source}: --species: {e}") from None
     check_memory(scene)
     sim = _build(scene, resume)
+    if resume is not None and search is not None:  # the checkpoint holds its own; a new one is the same run
+        sim.search = scene.search
     run = _Production(scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
                       species, precise, every_time)
     run.go(sys.stdout.isatty() if progress is None else progress)
@@ -317,7 +327,9 @@ def format_simulate(r: dict) -> str:
     s = r["scene"]
     rate = r["collisions_per_s"]
     lines = [f"revcol simulate {s['name']}  ({s['source']})", f"  scene            {r['summary']}",
-             f"  engine           {r['engine']}" + (f"  (resumed from {r['resumed_from']})" if r["resumed_from"] else ""),
+             f"  engine           {r['engine']}" + (f"  (resumed from {r['resumed_from']})" if r["resumed_from"] else "")
+             + (f"  (tick_bits {r['lattice']['tick_bits']}, cell_bits {r['lattice']['cell_bits']}, search "
+                f"{r['lattice']['search']})" if r.get("lattice") else ""),
              f"  collisions       {r['collisions']:,} ({r['collisions_per_particle']:.3g} per particle; "
              f"net count now {r['net_collisions']:,})",
              f"  time             {r['time_start']:.6g} -> {r['time_end']:.6g}",
