@@ -119,7 +119,7 @@ void BasicEngine<Op, Bits, Queue>::collide_forward(int i, int j, std::int64_t a)
   }
   if (multi) ++cnt_.multi_body;
   if (redraws > 0) {
-    log_[ncoll_ + 1] = redraws;
+    log_.push(ncoll_ + 1, redraws);
     ++cnt_.log_entries;
   }
   X_ = std::move(out);
@@ -131,14 +131,13 @@ void BasicEngine<Op, Bits, Queue>::collide_forward(int i, int j, std::int64_t a)
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
-  if (const auto g = groups_.find(ncoll_); g != groups_.end()) {
-    group_back(i, j, a, g);
+  if (Group* g = groups_.top(ncoll_)) {
+    group_back(i, j, a, *g);
     return;
   }
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
-  std::uint32_t redraws = 0;
-  const auto it = log_.find(ncoll_);
-  if (it != log_.end()) redraws = it->second;
+  const std::uint32_t* logged = log_.top(ncoll_);
+  const std::uint32_t redraws = logged ? *logged : 0;
   if (ctr_[i] < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
   const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i] - 1);
   Vec xi0, xj0, vi0, vj0;
@@ -146,7 +145,7 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
   ctr_[i] -= 1 + redraws;
-  if (it != log_.end()) log_.erase(it);
+  if (logged) log_.pop();
   --ncoll_;
   apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
 }

@@ -213,9 +213,9 @@ void BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
   if (resolve)
     for (int q : g) pre_v.push_back(ln_[q].v);
   ++ncoll_;
-  log_[ncoll_] = static_cast<std::uint32_t>(ctr_[i] - ctr0);
+  log_.push(ncoll_, static_cast<std::uint32_t>(ctr_[i] - ctr0));
   ++cnt_.log_entries;
-  groups_[ncoll_] = Group{i, g, std::move(pre_v)};
+  groups_.push(ncoll_, Group{i, g, std::move(pre_v)});
   ++cnt_.multi_body;
   ++(resolve ? cnt_.group_resolves : cnt_.group_bounces);
   for (int s = 0; s < 2; ++s)
@@ -235,17 +235,16 @@ void BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
 }
 
 template <class Op, class Bits, class Queue>
-template <class It>
-void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, It entry) {
-  const std::vector<int> g = entry->second.members;
+void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Group& entry) {
+  const std::vector<int> g = entry.members;
   if (std::find(g.begin(), g.end(), i) == g.end() || std::find(g.begin(), g.end(), j) == g.end()) {
     throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
   }
-  const auto it = log_.find(ncoll_);
-  const std::uint32_t draws = it == log_.end() ? 0 : it->second;
-  const int drawer = entry->second.drawer;
+  const std::uint32_t* logged = log_.top(ncoll_);
+  const std::uint32_t draws = logged ? *logged : 0;
+  const int drawer = entry.drawer;
   if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
-  const std::vector<Vec>& pre_v = entry->second.pre_v;  // forward frame; empty: a bounce
+  const std::vector<Vec> pre_v = entry.pre_v;  // forward frame; empty: a bounce (a copy: popped below)
   std::vector<Vec> pre(g.size());
   for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
   for (std::size_t m = 0; m < g.size(); ++m) {
@@ -256,8 +255,8 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, It e
     ++slot_[static_cast<std::size_t>(g[m])].ver;
   }
   ctr_[drawer] -= draws;
-  if (it != log_.end()) log_.erase(it);
-  groups_.erase(entry);
+  if (logged) log_.pop();
+  groups_.pop();  // entry, the top
   --ncoll_;
   ++cnt_.collisions;
   for (int q : g) predict(q, a);

@@ -25,6 +25,13 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
     const double E0 = static_cast<double>((static_cast<u128>(s.energy0[1]) << 64) | s.energy0[0]);
     require(std::fabs(E - E0) <= 1e-6 * E0, "lattice snapshot: energy0 is not the sum |v|^2 of v (1e-6 relative)");
   }
+  // the logs are stacks keyed by collision index (engine/logs.hpp): strictly increasing keys
+  // within [1, collisions], so that the reverse meets each entry on top at its collision
+  for (std::size_t k = 0; k < s.log.size(); ++k)
+    require(s.log[k].first >= 1 && s.log[k].first <= s.collisions && (k == 0 || s.log[k - 1].first < s.log[k].first),
+            "lattice snapshot: rare-log indices must increase within [1, collisions]");
+  for (std::size_t k = 1; k < s.groups.size(); ++k)
+    require(s.groups[k - 1].index < s.groups[k].index, "lattice snapshot: group entries' indices must increase");
   for (const auto& e : s.groups) {
     require(e.index >= 1 && e.index <= s.collisions && e.members.size() >= 2 && e.drawer >= 0 &&
                 static_cast<std::size_t>(e.drawer) < s.x.size(),
@@ -58,8 +65,8 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   s.v = velocities();
   s.streams = ctr_;
   s.bits = X_.words();
-  s.log.assign(log_.begin(), log_.end());
-  for (const auto& [k, g] : groups_) s.groups.push_back(GroupEntry{k, g.drawer, g.members, g.pre_v});
+  s.log.assign(log_.items().begin(), log_.items().end());
+  for (const auto& [k, g] : groups_.items()) s.groups.push_back(GroupEntry{k, g.drawer, g.members, g.pre_v});
   s.energy0 = energy0_;
   s.momentum0 = momentum0_;
   s.counters = cnt_;
@@ -77,9 +84,9 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s) {
   ctr_ = s.streams;
   X_ = Bits(s.bits);
   log_.clear();
-  for (const auto& e : s.log) log_[e.first] = e.second;
+  for (const auto& e : s.log) log_.push(e.first, e.second);
   groups_.clear();
-  for (const auto& e : s.groups) groups_[e.index] = Group{e.drawer, e.members, e.pre_v};
+  for (const auto& e : s.groups) groups_.push(e.index, Group{e.drawer, e.members, e.pre_v});
   clock_ = s.clock;
   origin_ = s.origin;
   ncoll_ = s.collisions;
@@ -189,8 +196,8 @@ void BasicEngine<Op, Bits, Queue>::undo() {
   X_ = undo_X_;
   cnt_ = undo_cnt_;
   clock_ = undo_clock_;
-  log_.erase(log_.upper_bound(undo_ncoll_), log_.end());  // the forward run only adds keys
-  groups_.erase(groups_.upper_bound(undo_ncoll_), groups_.end());
+  log_.truncate_after(undo_ncoll_);  // the forward run only adds keys
+  groups_.truncate_after(undo_ncoll_);
   ncoll_ = undo_ncoll_;
   rebuild();
 }
@@ -221,14 +228,14 @@ template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::memory_bytes() const noexcept -> std::size_t {
   const std::size_t n = ln_.size();
   return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() + nl_.memory_bytes() +
-         log_.size() * 48 + group_bytes() + X_.words().size() * 8 + undo_.capacity() * sizeof(Saved) +
+         log_.size() * sizeof(std::pair<std::uint64_t, std::uint32_t>) + group_bytes() + X_.words().size() * 8 + undo_.capacity() * sizeof(Saved) +
          undo_epoch_.capacity() * sizeof(std::uint32_t);
 }
 
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::group_bytes() const noexcept -> std::size_t {
   std::size_t b = 0;
-  for (const auto& [k, g] : groups_) b += 80 + g.members.size() * sizeof(int) + g.pre_v.size() * sizeof(Vec);
+  for (const auto& [k, g] : groups_.items()) b += 48 + g.members.size() * sizeof(int) + g.pre_v.size() * sizeof(Vec);
   return b;
 }
 

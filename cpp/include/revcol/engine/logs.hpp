@@ -14,6 +14,12 @@
 // wall unless the entry of its next reversed collision says W2 applied that wall's
 // reflection at this instant (`entry`).
 //
+// KeyedStack. The common shape of such a log: entries pushed forward under a key both
+// directions recover exactly, whose keys increase as they are pushed, and popped in reverse
+// when the key on top is the current one (LIFO); an undone forward run drops the entries
+// pushed after a key. The lattice engine keeps its redraw log and its group log so, keyed by
+// the collision index (lattice/engine_core.hpp).
+//
 // ExactPreLog. At singular points of a chart (a 3D pair almost head-on, groups with resting
 // contacts) a pre state's K-bit cell spans up to ~2^(-K/2); when its centre is off by more
 // than 1e-10 (relative), the forward run keeps the pre velocities, keyed by (stream,
@@ -24,9 +30,42 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace revcol::engine {
+
+/// A log of entries pushed forward under increasing keys and popped in reverse (see above).
+template <class Key, class Entry>
+class KeyedStack {
+ public:
+  using Item = std::pair<Key, Entry>;  ///< a key and its entry
+  /// Forward: keeps e under key (greater than every key held: see increasing()).
+  void push(Key key, Entry e) { items_.emplace_back(key, std::move(e)); }
+  /// Reverse: the top entry if its key is `key`, else null (nothing of this key is held).
+  Entry* top(Key key) noexcept { return !items_.empty() && items_.back().first == key ? &items_.back().second : nullptr; }
+  /// Removes the top entry.
+  void pop() { items_.pop_back(); }
+  /// Drops the entries pushed after `key` (an undone forward run).
+  void truncate_after(Key key) {
+    while (!items_.empty() && key < items_.back().first) items_.pop_back();
+  }
+  /// The entries, bottom (oldest) first.
+  const std::vector<Item>& items() const noexcept { return items_; }
+  /// Entries now held.
+  std::size_t size() const noexcept { return items_.size(); }
+  /// Removes every entry.
+  void clear() noexcept { items_.clear(); }
+  /// Whether the keys increase strictly from bottom to top (a snapshot's log must).
+  bool increasing() const {
+    for (std::size_t k = 1; k < items_.size(); ++k)
+      if (!(items_[k - 1].first < items_[k].first)) return false;
+    return true;
+  }
+
+ private:
+  std::vector<Item> items_;
+};
 
 /// The wall-mask log (see above). Masks: W1 | W2 << 8 per member, each a Reflection of
 /// revcol/engine/boundary.hpp (bit k: component k flipped; 1 << 7: v -> -v).

@@ -56,7 +56,6 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
-#include <map>
 #include <memory>
 #include <numbers>
 #include <stdexcept>
@@ -66,6 +65,7 @@
 #include <vector>
 
 #include "revcol/engine/event_queue.hpp"
+#include "revcol/engine/logs.hpp"
 #include "revcol/engine/observe.hpp"
 #include "revcol/collide/common.hpp"
 #include "revcol/error.hpp"
@@ -395,6 +395,7 @@ class BasicEngine {
 
  private:
   enum Type : std::uint8_t { none = 0, cross = 1, wall = 2, coll = 3 };
+  struct Group;  // a group collision in the rare log (below)
   // a prediction's best event so far, in the slot order (tick, kind, other particle)
   struct Best {
     std::int64_t t = std::numeric_limits<std::int64_t>::max();
@@ -501,8 +502,7 @@ class BasicEngine {
   std::vector<Vec> resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const;
   bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec>& post, std::vector<Vec>& vel) const;
   void group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons);
-  template <class It>
-  void group_back(int i, int j, std::int64_t a, It entry);
+  void group_back(int i, int j, std::int64_t a, Group& entry);
 
   void record(int kind, std::int64_t a, const std::vector<int>& ids, const std::vector<Vec>& x, const std::vector<Vec>& v, unsigned axes);
   [[gnu::noinline, gnu::cold]] void note_pair(std::int64_t a, int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj);
@@ -594,13 +594,13 @@ class BasicEngine {
   };
   std::vector<Slot> slot_;
   Bits X_;
-  std::map<std::uint64_t, std::uint32_t> log_;
+  engine::KeyedStack<std::uint64_t, std::uint32_t> log_;  // collision index -> redraws (the rare log)
   struct Group {
     int drawer;                 // whose stream the tried draws came from
     std::vector<int> members;   // ascending
     std::vector<Vec> pre_v;     // exact pre velocities (a resolve) or empty (a bounce)
   };
-  std::map<std::uint64_t, Group> groups_;  // collision index -> group collision
+  engine::KeyedStack<std::uint64_t, Group> groups_;  // collision index -> group collision
   std::int64_t clock_ = 0, origin_ = 0;
   std::uint64_t ncoll_ = 0;
   std::array<std::uint64_t, 2> energy0_{};
