@@ -117,6 +117,10 @@ class _LatticeRun:
     def __init__(self, scene: Scene, plot, trajectory, progress: bool, checkpoints: bool):
         self.scene, self.plot, self.progress = scene, plot, progress
         self.sim = sim = build_lattice(scene)
+        # [observe]: the forward run itself is observed (run_back ends the observation)
+        self.observation = None
+        if scene.observe is not None:
+            sim.observe(**scene.observe)
         self.n = sim.n
         self.box, self.periodic = geometry(sim)
         self.s0 = sim.snapshot()
@@ -203,6 +207,8 @@ class _LatticeRun:
     def turn(self) -> None:
         sim = self.sim
         self.diag_turn = sim.diagnostics()
+        if self.scene.observe is not None:
+            self.observation = sim.observation()
         self.state_turn = sim.snapshot()
         self.t_turn, self.clock_turn = sim.time, sim.clock
         self.shot_turn = (sim.positions, sim.velocities)
@@ -292,6 +298,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "error_x": ex, "error_v": ev, "bar": BAR,
         "round_trip_complete": complete, "passed": bool(complete and all(same.values())),
         "interrupted": run.interrupted, "engine_error": run.engine_error,
+        "observe": run.observation.to_dict() if run.observation is not None else None,
         "bits_back": {"start": run.bits0, "turn": int(d_turn["bits_length"]), "end": int(d_end["bits_length"]),
                       "max": run.bits_max, "sampled_every": run.every},
         "log_entries_turn": entries_turn, "log_bytes_turn": bytes_turn,

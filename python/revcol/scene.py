@@ -85,7 +85,7 @@ file and the replacement.
     trajectory_every = 100        # gas: collisions between frames
     checkpoints = "checkpoints"   # gas: where checkpoint_interval writes (default ./NAME-checkpoints)
 
-    [observe]                     # gas, float engine: observables of the forward run (revcol.observe);
+    [observe]                     # gas, either engine: observables of the forward run (revcol.observe);
                                   # the table alone observes the scalars; its values go in the report
     speed_bins = 50               # time-weighted speed histogram over [0, speed_max] (default 5 v_rms)
     slabs = 10                    # density and temperature in slabs along slab_axis (default 0)
@@ -375,8 +375,6 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
 def _observe(source: str, values: dict, d: int, n: int, bounds, engine: str) -> dict[str, Any]:
     """The [observe] table as Simulation.observe's arguments, checked against the system."""
     obs = {key: v for (table, key), v in values.items() if table == "observe"}
-    if engine == "lattice":
-        raise _fail(source, "[observe]", "observes the float engine's run only; use [collisions] engine = 'float'")
     if obs.get("slab_axis", 0) >= d:
         raise _fail(source, "[observe] slab_axis", f"must be an axis of the {d}D box (0..{d - 1}), got {obs['slab_axis']}")
     if obs.get("pair_bins", 0) > 0:
@@ -426,8 +424,6 @@ def with_engine(scene: Scene, engine: str) -> Scene:
                            "collisions.bits" in fields)
         except SceneError as e:
             raise SceneError(f"{e} (--engine lattice)") from None
-        if scene.observe is not None:
-            raise SceneError(f"{scene.source}: [observe]: observes the float engine's run only (--engine lattice)")
     if scene.initial_state is not None:
         _check_initial(scene.source, out, *read_initial(scene.source, scene.initial_state, scene.dimension))
     return out

@@ -348,13 +348,22 @@ def test_scene_observe_in_report_and_json(tmp_path, capsys):
     ({"speed_bins": -1}, "float", "speed_bins"),
     ({"speed_bins": 1.5}, "float", "speed_bins"),
     ({"colour": 1}, "float", "colour"),
-    ({}, "lattice", "observe"),
 ])
 def test_scene_observe_errors(tmp_path, observe, engine, word):
     doc = observed_scene(tmp_path, **observe)
     doc["collisions"]["engine"] = engine
     with pytest.raises(SceneError, match=word):
         scene_from_dict(doc, "obs.toml", tmp_path)
+
+
+@pytest.mark.parametrize("engine", ["float", "lattice"])
+def test_scene_observe_runs_on_either_engine(tmp_path, engine):
+    doc = observed_scene(tmp_path, speed_bins=10)
+    doc["collisions"]["engine"] = engine
+    scene = scene_from_dict(doc, "obs.toml", tmp_path)
+    report = run_scene(scene, progress=False)
+    assert report["passed"] and report["observe"]["pair_collisions"] + report["observe"]["group_collisions"] == 400
+    assert report["observe"]["compressibility"][0] > 1.0
 
 
 def test_observe_table_only_for_gas(tmp_path):

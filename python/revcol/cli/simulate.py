@@ -16,7 +16,7 @@ keeps the numbering of the run it resumes):
   ``checkpoint_every`` and at the end; ``resume`` continues from one bit for bit (the run that
   resumes from checkpoint k and goes on to n collisions ends in the state of one that never
   stopped);
-- a float-engine scene's ``[observe]`` table: the forward run is observed and its values go in
+- a scene's ``[observe]`` table (either engine): the forward run is observed and its values go in
   the report (``report["observe"]``, :mod:`revcol.observe`).
 
 Ctrl-C (SIGINT) stops the run between events (float engine) or between chunks of at most
@@ -151,7 +151,7 @@ class _Production:
             box, periodic = lattice_geometry(sim) if self.lattice else geometry(sim)
             self.writer = open_trajectory(trajectory, box, periodic, scene.diameter, species=species,
                                           precise=precise)
-        if scene.observe is not None and not self.lattice:
+        if scene.observe is not None:
             sim.observe(**scene.observe)
         self.interrupted, self.engine_error, self.stalled, self.wall_s = False, None, False, 0.0
 
@@ -251,7 +251,7 @@ class _Production:
     def report(self, resume) -> dict[str, Any]:
         sim, scene = self.sim, self.scene
         d = sim.diagnostics()
-        obs = sim.observation() if scene.observe is not None and not self.lattice else None
+        obs = sim.observation() if scene.observe is not None else None
         ran = self.done - self.start
         return {
             "kind": "simulate", "revcol_version": __version__, "scene": scene.to_dict(), "summary": scene.summary(),
