@@ -1,8 +1,8 @@
-"""Studies of the event-driven engine (docs/engine.md): the round-trip horizon, relaxation to
-Maxwell-Boltzmann speeds, and memory over long runs. Writes bench/results/engine_*.
+"""Benchmarks of the event-driven engine (docs/engine.md): the round-trip horizon (error against
+run length), memory over long runs and throughput. Writes bench/results/engine_*. (Relaxation to
+Maxwell-Boltzmann speeds is the study `python -m revcol.studies.maxwell`.)
 
     PYTHONPATH=build-dev/pkg python3 bench/engine_study.py horizon   [--n 1000] [--max 1e6]
-    PYTHONPATH=build-dev/pkg python3 bench/engine_study.py maxwell   [--n 1000]
     PYTHONPATH=build-dev/pkg python3 bench/engine_study.py memory    [--n 10000] [--max 1e7]
     PYTHONPATH=build-dev/pkg python3 bench/engine_study.py throughput [--bin build-dev/revcol-bench] [--rounds 5] [--cpu 1]
     PYTHONPATH=build-dev/pkg python3 bench/engine_study.py all
@@ -12,11 +12,6 @@ law) runs N_c collisions forward and then back to its start time; the error is
 max |x - x0| / L (periodic images folded) and max |v - v0| / max |v0|. The horizon is the
 largest N_c on the grid with both below 1e-9, in collisions per particle (2 N_c / N).
 A 1D gas is run to 1e6 collisions the same way.
-
-maxwell: from all speeds equal (random directions), N particles relax for `relax` collisions
-per particle; then `samples` snapshots, `gap` collisions per particle apart, are pooled and
-the speeds compared with the Maxwell-Boltzmann law of the measured kT by Kolmogorov-Smirnov
-(p > 0.001 is the criterion; pooled snapshots are correlated, so p is optimistic).
 
 throughput: revcol-bench --bench engine/<case> --collisions 1e6 (2e6 for N = 1e5), one fresh
 process per run (peak RSS per case), every case once per round and the rounds interleaved
@@ -125,41 +120,6 @@ def horizon(args):
     fig.tight_layout()
     fig.savefig(os.path.join(RESULTS, "engine_horizon.png"), dpi=120)
     print("wrote bench/results/engine_horizon.{json,csv,png}")
-
-
-def _mb_cdf(s, dim, kT):
-    from scipy import special
-    return special.gammainc(dim / 2.0, s * s / (2.0 * kT))
-
-
-def maxwell(args):
-    from scipy import stats
-    revcol = _revcol()
-    out = []
-    cases = [(2, "exact", "flux"), (3, "exact", "flux"), (2, "exact", "uniform"), (3, "exact", "uniform"),
-             (2, "paper", "flux")]
-    for dim, mode, law in cases:
-        sim = revcol.Simulation.random(n=args.n, dim=dim, phi=0.3, seed=3, equal_speeds=True, mode=mode, law=law)
-        sim.run(collisions=int(args.relax * args.n / 2))
-        pooled = []
-        for _ in range(args.samples):
-            sim.run(collisions=int(args.gap * args.n / 2))
-            pooled.append(np.linalg.norm(sim.velocities, axis=1))
-        s = np.concatenate(pooled)
-        kT = float((s ** 2).mean() / dim)
-        ks = stats.kstest(s, lambda q: _mb_cdf(q, dim, kT))
-        one = stats.kstest(pooled[-1], lambda q: _mb_cdf(q, dim, kT))
-        r = dict(dim=dim, mode=mode, law=law, n=args.n, samples=len(s), kT=kT, ks_stat=float(ks.statistic),
-                 p_value=float(ks.pvalue), p_value_last_snapshot=float(one.pvalue),
-                 passes=bool(ks.pvalue > 1e-3))
-        out.append(r)
-        print(f"d={dim} {mode:5s} {law:7s}: KS D={r['ks_stat']:.4f} p={r['p_value']:.3g} "
-              f"(last snapshot alone p={r['p_value_last_snapshot']:.3g}) {'PASS' if r['passes'] else 'FAIL'}")
-    os.makedirs(RESULTS, exist_ok=True)
-    with open(os.path.join(RESULTS, "engine_maxwell.json"), "w") as f:
-        json.dump(dict(command=" ".join(sys.argv), relax_per_particle=args.relax, gap_per_particle=args.gap,
-                       rows=out), f, indent=1)
-    print("wrote bench/results/engine_maxwell.json")
 
 
 _MEMORY_CHILD = r"""
@@ -275,26 +235,20 @@ def throughput(args):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("study", choices=["horizon", "maxwell", "memory", "throughput", "all"])
+    ap.add_argument("study", choices=["horizon", "memory", "throughput", "all"])
     ap.add_argument("--bin", default=os.path.join(HERE, "..", "build-dev", "revcol-bench"))
     ap.add_argument("--rounds", type=int, default=5, help="throughput: interleaved rounds (every case once each)")
     ap.add_argument("--cpu", type=int, default=None, help="throughput: pin each run to this core (taskset)")
     ap.add_argument("--n", type=int, default=None)
     ap.add_argument("--max", type=float, default=None)
-    ap.add_argument("--relax", type=float, default=40.0, help="maxwell: collisions per particle to relax")
-    ap.add_argument("--gap", type=float, default=4.0, help="maxwell: collisions per particle between samples")
-    ap.add_argument("--samples", type=int, default=25, help="maxwell: snapshots pooled")
     args = ap.parse_args()
-    todo = ["horizon", "maxwell", "memory", "throughput"] if args.study == "all" else [args.study]
+    todo = ["horizon", "memory", "throughput"] if args.study == "all" else [args.study]
     for s in todo:
         a = argparse.Namespace(**vars(args))
         if s == "horizon":
             a.n = a.n or 1000
             a.max = a.max or 1e6
             horizon(a)
-        elif s == "maxwell":
-            a.n = a.n or 1000
-            maxwell(a)
         elif s == "throughput":
             throughput(a)
         else:

@@ -1,7 +1,6 @@
-"""bench/eos_replicas.py, reduced: its summary by hand, and one small end-to-end study (two
+"""revcol.studies.eos_replicas, reduced: its summary by hand, and one small end-to-end study (two
 seeds, two laws, a few hundred disks) through the same child processes as the full runs whose
 JSON docs/physics.md quotes."""
-import importlib.util
 import json
 import math
 import os
@@ -9,10 +8,7 @@ import sys
 
 import pytest
 
-_PATH = os.path.join(os.path.dirname(__file__), "..", "..", "bench", "eos_replicas.py")
-_spec = importlib.util.spec_from_file_location("eos_replicas", _PATH)
-er = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(er)
+from revcol.studies import eos_replicas as er
 
 
 def test_summary_by_hand():

@@ -1,12 +1,10 @@
-"""bench/eos_zinf_compare.py on the committed results: every engine Z(inf) has its chains'
+"""revcol.studies.eos_zinf_compare on the committed results: every engine Z(inf) has its chains'
 Z(inf), and the table is what docs/physics.md quotes (within 3 combined errors everywhere)."""
-import importlib.util
 from pathlib import Path
 
+from revcol.studies import eos_zinf_compare as mod
+
 ROOT = Path(__file__).resolve().parents[2]
-spec = importlib.util.spec_from_file_location("eos_zinf_compare", ROOT / "bench" / "eos_zinf_compare.py")
-mod = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(mod)
 
 
 def test_committed_results(capsys):

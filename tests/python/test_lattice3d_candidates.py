@@ -1,17 +1,13 @@
-"""CI-reduced version of bench/lattice3d_candidates.py (issue 14's design study): the cube-sphere
+"""CI-reduced version of revcol.studies.lattice3d_candidates (issue 14's design study): the cube-sphere
 chart's cells are not congruent, so a rotation between cells maps part of a cell off its target.
 The full run (N = 16, 64, 256 per face edge) is bench/results/lattice3d_candidates.json."""
-import importlib.util
 import json
 import math
 import os
 
 import numpy as np
 
-_PATH = os.path.join(os.path.dirname(__file__), "..", "..", "bench", "lattice3d_candidates.py")
-_spec = importlib.util.spec_from_file_location("lattice3d_candidates", _PATH)
-lc = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(lc)
+from revcol.studies import lattice3d_candidates as lc
 
 
 def test_cells_and_rotations_are_what_the_study_says():

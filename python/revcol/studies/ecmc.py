@@ -149,7 +149,7 @@ def summary_table(rows: list[dict[str, Any]]) -> str:
 
 def md_estimates(doc: dict[str, Any]) -> list[dict[str, Any]]:
     """The engine's Z per (dim, phi, n, law) from a JSON file of ``python -m revcol.studies.equilibrium
-    dense`` (one run each, block error) or of ``bench/eos_replicas.py`` (the mean of the
+    dense`` (one run each, block error) or of ``python -m revcol.studies.eos_replicas`` (the mean of the
     replicas with the error from their spread)."""
     out = []
     if "dense" in doc:

@@ -475,7 +475,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     mc.add_argument("--json")
     cmp_ = sub.add_parser("mc-compare", help="engine runs against event chains of the same N, and Z(inf) from the chains")
     cmp_.add_argument("--mc", nargs="+", required=True, help="JSON files of `mc` runs")
-    cmp_.add_argument("--md", nargs="*", default=[], help="JSON files of `dense` runs or bench/eos_replicas.py studies")
+    cmp_.add_argument("--md", nargs="*", default=[], help="JSON files of `dense` runs or revcol.studies.eos_replicas studies")
     cmp_.add_argument("--json")
     args = ap.parse_args(argv)
     t0 = time.time()

@@ -16,7 +16,7 @@ to the top face):
 Points are uniform on the sphere inside the pre cell; the result is the fraction mapped outside
 the post cell (the redraw probability per draw), with its binomial standard error.
 
-    python bench/lattice3d_candidates.py --json bench/results/lattice3d_candidates.json
+    python -m revcol.studies.lattice3d_candidates --json bench/results/lattice3d_candidates.json
 """
 from __future__ import annotations
 
@@ -26,6 +26,8 @@ import math
 import time
 
 import numpy as np
+
+from .._io import atomic_open
 
 
 def cell_of(v: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -133,14 +135,13 @@ def main() -> None:
     for r in rows:
         print(f"N = {r['n_per_face_edge']:4d}: redraw per draw, minimal rotation {r['minimal_redraw_fraction']:.4f} "
               f"+- {r['minimal_redraw_se']:.4f}; per-face axis rotations {r['axes_redraw_fraction']:.4f} +- {r['axes_redraw_se']:.4f}")
-    doc = {"command": "python bench/lattice3d_candidates.py " + " ".join(
+    doc = {"command": "python -m revcol.studies.lattice3d_candidates " + " ".join(
         ["--n"] + [str(n) for n in a.n] + ["--pairs", str(a.pairs), "--points", str(a.points), "--seed", str(a.seed)]),
         "seconds": time.time() - t0, "rows": rows}
     if a.json:
-        from revcol._io import atomic_open  # the package's atomic writer (PYTHONPATH: the staged package)
-
         with atomic_open(a.json) as f:
             json.dump(doc, f, indent=1)
+
 
 if __name__ == "__main__":
     main()

@@ -12,7 +12,7 @@ for k runs). The mean of the runs with the error from their spread, sd / sqrt(k)
 estimate of Z that does not lean on the blocks, compared with Liu's equation of state (the
 study's reference) and, for two laws, with each other.
 
-    PYTHONPATH=<package> python3 bench/eos_replicas.py --dim 2 --phi 0.6 --n 4000 \
+    PYTHONPATH=<package> python -m revcol.studies.eos_replicas --dim 2 --phi 0.6 --n 4000 \
         --laws specular flux --per-particle 20000 --seeds 12 --first-seed 201 \
         --cores 0 1 --json bench/results/eos_replicas_2d_phi0.6_n4000.json
 
@@ -20,7 +20,7 @@ Each run is a child process (`revcol.studies.equilibrium dense`, pinned with tas
 when given; runs on different cores go side by side). The JSON is written atomically, and
 rewritten after every run (a stopped study keeps what it finished).
 
-    python3 bench/eos_replicas.py --fit STUDY_N1.json STUDY_N2.json ... --json FIT.json
+    python -m revcol.studies.eos_replicas --fit STUDY_N1.json STUDY_N2.json ... --json FIT.json
 
 fits Z(N) = Z(inf) + a / N through the studies' replica means (one point at several N), per law
 and pooled, and sets Z(inf) against Liu's form in its own error.
@@ -39,19 +39,21 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 
+from .. import _core
+from .._io import atomic_open
+
 
 def _write_atomic(path: str, obj) -> None:
-    from revcol._io import atomic_open  # the package's atomic writer (the package under test)
     with atomic_open(path) as f:
         json.dump(obj, f, indent=1)
         f.write("\n")
 
 
 def _git_commit() -> str:
-    here = os.path.dirname(os.path.abspath(__file__))
+    """The commit of the checkout the study is run from (the current directory)."""
     try:
-        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=here, capture_output=True, text=True, check=True)
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=here,
+        head = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, check=True)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
                                capture_output=True, text=True, check=True)
         return head.stdout.strip() + ("-dirty" if dirty.stdout.strip() else "")
     except (OSError, subprocess.CalledProcessError):
@@ -60,11 +62,7 @@ def _git_commit() -> str:
 
 def _module_path() -> str:
     """The compiled module the runs import (the children inherit this environment)."""
-    try:
-        from revcol import _core
-        return _core.__file__
-    except ImportError:
-        return "not importable"
+    return _core.__file__
 
 
 def _run(args, law: str, seed: int, core, workdir: str) -> dict:
@@ -184,7 +182,7 @@ def main(argv=None) -> int:
     if args.n < 2 or args.per_particle < 1 or not (0.0 < args.phi < 1.0):
         ap.error("--n >= 2, --per-particle >= 1 and 0 < --phi < 1")
     cores = args.cores or [None]
-    res = {"what": "independent replicas of one equation-of-state point (bench/eos_replicas.py)",
+    res = {"what": "independent replicas of one equation-of-state point (python -m revcol.studies.eos_replicas)",
            "command": " ".join([os.path.basename(sys.executable)] + sys.argv),
            "commit": _git_commit(), "module": _module_path(),
            "dim": args.dim, "phi": args.phi, "n": args.n, "per_particle": args.per_particle,

@@ -1,8 +1,9 @@
 """What a randomized collision law does to transport: self-diffusion of a hard-sphere gas under
 the flux and uniform laws against the specular (textbook) gas and Enskog's value
-(docs/physics.md, "Transport"). Writes bench/results/transport.json.
+(docs/physics.md, "Transport"). Writes its JSON to --out (default transport.json).
 
-    PYTHONPATH=build-dev/pkg python3 bench/transport_study.py [--seeds 3] [--collisions 1e6]
+    PYTHONPATH=build-dev/pkg python -m revcol.studies.transport [--seeds 3] [--collisions 1e6] \
+        [--out bench/results/transport.json]
 
 Each run: N = 1000, periodic box, 100 collisions per particle to equilibrate, then observed
 (revcol.Simulation.observe) for `collisions` collisions; D = slope / (2 d) of a least-squares
@@ -26,7 +27,8 @@ import time
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+from ..engine import Simulation
+
 CASES = [(2, 0.3), (2, 0.5), (3, 0.1), (3, 0.3)]
 LAWS = [("specular", {"mode": "specular"}), ("flux", {"law": "flux"}), ("uniform", {"law": "uniform"})]
 
@@ -43,9 +45,8 @@ def enskog(d: int, phi: float, temperature: float) -> float:
 
 def diffusion(d: int, phi: float, seed: int, collisions: int, **kw) -> tuple[float, float, float]:
     """(D, T, mean free time) of one run."""
-    import revcol
     n = 1000
-    s = revcol.Simulation.random(n, d, phi, seed=seed, **kw)
+    s = Simulation.random(n, d, phi, seed=seed, **kw)
     s.run(collisions=50 * n)
     s.observe()
     s.run(collisions=collisions)
@@ -60,7 +61,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--collisions", type=float, default=1e6)
-    ap.add_argument("--out", default=os.path.join(HERE, "results", "transport.json"))
+    ap.add_argument("--out", default="transport.json")
     a = ap.parse_args()
     t0 = time.time()
     rows = []
@@ -80,9 +81,9 @@ def main() -> None:
     for r in rows:  # against the specular gas of the same (d, phi)
         ref = next(q for q in rows if q["dim"] == r["dim"] and q["phi"] == r["phi"] and q["law"] == "specular")
         r["D_over_specular"] = r["D"] / ref["D"]
-    out = {"command": " ".join(["python3", "bench/transport_study.py"] + sys.argv[1:]),
-           "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                                    cwd=HERE).stdout.strip(),
+    out = {"command": " ".join(["python", "-m", "revcol.studies.transport"] + sys.argv[1:]),
+           "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                                    text=True).stdout.strip(),
            "loadavg": os.getloadavg(), "wall_s": time.time() - t0, "n": 1000, "rows": rows}
     tmp = a.out + ".tmp"
     with open(tmp, "w") as f:

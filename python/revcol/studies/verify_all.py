@@ -1,13 +1,13 @@
-#!/usr/bin/env python3
 """Runs `revcol.verify` on every named case (exact mode, both laws) and writes the reports to
-bench/results/verify_exact.json and a table to stdout.
+--out (default verify_exact.json) and a table to stdout.
 
-    python bench/verify_all.py --collisions 1000000
-    python bench/verify_all.py --bits-scan 32 36 40 44 48 --cases pair3d triple2d-c1 chain4-1d
+    python -m revcol.studies.verify_all --collisions 1000000 --out bench/results/verify_exact.json
+    python -m revcol.studies.verify_all --bits-scan 32 36 40 44 48 --cases pair3d triple2d-c1 chain4-1d \
+        --out bench/results/exact_bits.json
 
 The second form is the precision/memory trade-off of K (bits per chart coordinate): the
 quantization error falls like 2^-K while the rare log grows until every collision logs
-(bench/results/exact_bits.json).
+(bench/results/exact_bits.json; --out defaults to exact_bits.json with --bits-scan).
 """
 from __future__ import annotations
 
@@ -16,9 +16,8 @@ import json
 import sys
 from pathlib import Path
 
-import revcol
-
-HERE = Path(__file__).resolve().parent
+from ..collide import named_cases
+from ..verify import verify
 
 
 def main() -> int:
@@ -31,8 +30,8 @@ def main() -> int:
     p.add_argument("--cases", nargs="+", default=None, help="named cases (default: all)")
     args = p.parse_args()
     if args.out is None:
-        args.out = str(HERE / "results" / ("exact_bits.json" if args.bits_scan else "verify_exact.json"))
-    cases = args.cases or [c["name"] for c in revcol.named_cases()]
+        args.out = "exact_bits.json" if args.bits_scan else "verify_exact.json"
+    cases = args.cases or [c["name"] for c in named_cases()]
     if args.bits_scan:
         return _bits_scan(args, cases)
     rows = []
@@ -40,15 +39,19 @@ def main() -> int:
           f"{'fwd/s':>9s} {'rev/s':>9s} {'log B':>8s} {'log B/coll':>10s}")
     for case in cases:
         for law in ("flux", "uniform"):
-            r = revcol.verify(case, collisions=args.collisions, mode="exact", law=law,
+            r = verify(case, collisions=args.collisions, mode="exact", law=law,
                               rng=args.rng, bits=args.bits)
             rows.append({k: r[k] for k in r if k not in ("initial", "final", "reference")})
             print(f"{case:14s} {law:8s} {str(r['passed']):7s} {str(r['bit_exact']):9s} "
                   f"{r['max_rel_error']:11.2e} {r['forward_per_s']:9.3g} {r['reverse_per_s']:9.3g} "
                   f"{r['log_bytes']:8d} {r['log_bytes'] / r['collisions']:10.2e}", flush=True)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(json.dumps({"command": " ".join(sys.argv), "results": rows}, indent=1) + "\n")
+    Path(args.out).write_text(json.dumps({"command": _command(), "results": rows}, indent=1) + "\n")
     return 0 if all(r["passed"] for r in rows) else 1
+
+
+def _command() -> str:
+    return " ".join(["python", "-m", "revcol.studies.verify_all"] + sys.argv[1:])
 
 
 def _bits_scan(args, cases) -> int:
@@ -56,12 +59,12 @@ def _bits_scan(args, cases) -> int:
     print(f"{'case':14s} {'K':>3s} {'passed':7s} {'bit_exact':9s} {'max_rel_err':>11s} {'log B/coll':>10s} {'fwd/s':>9s}")
     for case in cases:
         for bits in args.bits_scan:
-            r = revcol.verify(case, collisions=args.collisions, mode="exact", law="flux", rng=args.rng, bits=bits)
+            r = verify(case, collisions=args.collisions, mode="exact", law="flux", rng=args.rng, bits=bits)
             rows.append({k: r[k] for k in r if k not in ("initial", "final", "reference")} | {"bits": bits})
             print(f"{case:14s} {bits:3d} {str(r['passed']):7s} {str(r['bit_exact']):9s} {r['max_rel_error']:11.2e} "
                   f"{r['log_bytes'] / r['collisions']:10.2e} {r['forward_per_s']:9.3g}", flush=True)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(json.dumps({"command": " ".join(sys.argv), "results": rows}, indent=1) + "\n")
+    Path(args.out).write_text(json.dumps({"command": _command(), "results": rows}, indent=1) + "\n")
     return 0 if all(r["passed"] for r in rows) else 1
 
 

@@ -1,7 +1,7 @@
 """KS of a word stream and of its increments against the uniform law (docs/randomness.md,
 "Paper mode's triple1d long file").
 
-    PYTHONPATH=<revcol package> python3 bench/randomness_increments.py --words 2e7 \
+    PYTHONPATH=<revcol package> python -m revcol.studies.randomness_increments --words 2e7 \
         --json bench/results/randomness_triple1d_paper_increments_2e7.json
 
 The words of a chain whose step is a shift on the torus (the post chart coordinate is the pre
@@ -22,7 +22,7 @@ import time
 import numpy as np
 from scipy import stats
 
-from revcol.studies.words import stream
+from .words import stream
 
 
 def main() -> None:

@@ -3,10 +3,10 @@
 Both extrapolate Z(N) = Z(inf) + a / N through runs at several N, each in its own convention
 (the engine's Z_md and the chains' Z_mc differ at finite N, not in the limit). The engine's
 come from `python -m revcol.studies.equilibrium finite-size` (one run per size) and from
-`bench/eos_replicas.py --fit` (replicas at 2D 0.6); the chains' from `python -m revcol.studies.equilibrium
+`python -m revcol.studies.eos_replicas --fit` (replicas at 2D 0.6); the chains' from `python -m revcol.studies.equilibrium
 mc-compare`. Prints a markdown table: value, error, and the difference in combined errors.
 
-    python3 bench/eos_zinf_compare.py bench/results/equilibrium_finite_size.json \\
+    python -m revcol.studies.eos_zinf_compare bench/results/equilibrium_finite_size.json \\
         bench/results/eos_replicas_2d_phi0.6_fit.json bench/results/ecmc_compare.json
 """
 from __future__ import annotations
@@ -49,7 +49,7 @@ def table(rs: list[dict]) -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("finite_size", help="JSON of python -m revcol.studies.equilibrium finite-size")
-    ap.add_argument("replicas_fit", help="JSON of bench/eos_replicas.py --fit")
+    ap.add_argument("replicas_fit", help="JSON of python -m revcol.studies.eos_replicas --fit")
     ap.add_argument("chains", help="JSON of python -m revcol.studies.equilibrium mc-compare")
     args = ap.parse_args(argv)
     load = lambda p: json.load(open(p))  # noqa: E731
