@@ -10,7 +10,8 @@ CI runs a few hundred cases per test. The long run (issue 17's 10^5 cases) is th
 
     REVCOL_FUZZ_EXAMPLES=17000 .venv/bin/python -m pytest -q -p no:cacheprovider tests/python/test_fuzz.py
 
-(six tests x 17 000 examples); bench/results/fuzz_long.json records one.
+(six tests x 17 000 examples); tests/long/fuzz_long.py runs it test by test, and
+bench/results/fuzz_long.json records one.
 """
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""CI-reduced version of bench/lattice_validation.py (issue 13, "Done when"): the same code paths
-on small gases. The full runs (N = 10^3, 10^4, 10^7 collisions) are the benchmark's JSON."""
+"""CI-reduced version of tests/long/lattice_validation.py (issue 13, "Done when"): the same code paths
+on small gases. The full runs (N = 10^3, 10^4, 10^7 collisions) are bench/results/lattice_validation_*.json."""
 import importlib.util
 import math
 import os
@@ -8,7 +8,7 @@ import numpy as np
 
 from revcol import lattice
 
-_PATH = os.path.join(os.path.dirname(__file__), "..", "..", "bench", "lattice_validation.py")
+_PATH = os.path.join(os.path.dirname(__file__), "..", "long", "lattice_validation.py")
 _spec = importlib.util.spec_from_file_location("lattice_validation", _PATH)
 lv = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(lv)

@@ -2,7 +2,7 @@
 gas (periodic, float engine, observed) with GSD frames on a time trigger; g(r) from the
 frames (freud when installed) gives a contact value whose pressure matches the collision
 virial's, and the image flags are exactly those of the same run followed densely. The CI form of
-`bench/production_check.py` (which runs 10^7 collisions)."""
+`tests/long/production_check.py` (which runs 10^7 collisions)."""
 from __future__ import annotations
 
 import importlib.util
@@ -14,7 +14,7 @@ import pytest
 
 pytest.importorskip("gsd")
 
-_PATH = Path(__file__).resolve().parents[2] / "bench" / "production_check.py"
+_PATH = Path(__file__).resolve().parents[1] / "long" / "production_check.py"
 _spec = importlib.util.spec_from_file_location("production_check", _PATH)
 production_check = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(production_check)

@@ -9,7 +9,7 @@ import pytest
 
 import revcol
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "bench"))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "long"))
 import trace_study  # noqa: E402
 
 
@@ -84,7 +84,7 @@ def test_checkpoint_keeps_the_trace_and_an_old_one_loads(tmp_path):
 
 
 def test_detection_matches_the_round_trip_error():
-    """bench/trace_study.py's claims on a reduced grid: no false alarm within the bar, every
+    """tests/long/trace_study.py's claims on a reduced grid: no false alarm within the bar, every
     O(1) failure reported."""
     rows = []
     for seed in (1, 2):

@@ -2,7 +2,7 @@
 REVCOL_FUZZ_EXAMPLES examples each, one pytest process per test, hypothesis's own statistics
 parsed for the number of cases it really ran; the result is written atomically as JSON.
 
-    .venv/bin/python bench/fuzz_long.py --examples 15000 --out bench/results/fuzz_long.json
+    .venv/bin/python tests/long/fuzz_long.py --examples 15000 --out bench/results/fuzz_long.json
 """
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 TESTS = ["test_fuzz_named_operators", "test_fuzz_pair2d", "test_fuzz_generators", "test_fuzz_simulation_construction",
          "test_fuzz_run_and_run_back", "test_fuzz_damaged_snapshots", "test_fuzz_scene_files"]
 
@@ -47,7 +47,7 @@ def main() -> int:
         print(json.dumps(row), flush=True)
     doc = {"what": "issue 17's fuzz suite, long run: every generated call succeeds or raises a named "
                    "ValueError/TypeError, state unchanged after errors, no crash, no hang (20 s per case)",
-           "command": f"{sys.executable} bench/fuzz_long.py --examples {args.examples}",
+           "command": f"{sys.executable} tests/long/fuzz_long.py --examples {args.examples}",
            "commit": subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
                                     text=True).stdout.strip(),
            "load_at_end": os.getloadavg(), "cases": total, "all_passed": all(r["returncode"] == 0 for r in rows),

@@ -15,7 +15,7 @@ another tool's reading of those frames agrees with what the engine measured duri
    two must agree to the observer's own interpolation error (its MSD is sampled on a grid; a
    single wrong image flag of one particle moves the MSD by about 2 |x| L / N, far above it).
 
-    python bench/production_check.py --collisions 1e7 --every 1e4 --json bench/results/production_check.json
+    python tests/long/production_check.py --collisions 1e7 --every 1e4 --json bench/results/production_check.json
 
 The CI version (`tests/python/test_production.py`) runs `check(collisions=2e5, every=1e4)`.
 """
@@ -193,7 +193,7 @@ def main(argv=None) -> int:
                                 cwd=Path(__file__).parent).stdout.strip()
     except OSError:
         commit = None
-    r.update({"command": "python bench/production_check.py " + " ".join(shlex.quote(x) for x in (argv or sys.argv[1:])),
+    r.update({"command": "python tests/long/production_check.py " + " ".join(shlex.quote(x) for x in (argv or sys.argv[1:])),
               "commit": commit, "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
               "load_1m_before": load0[0], "load_1m_after": os.getloadavg()[0]})
     summary = {k: r[k] for k in ("collisions", "frames", "g_contact", "g_contact_error", "z_contact", "z_virial",

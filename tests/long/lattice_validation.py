@@ -2,12 +2,12 @@
 LatticeSimulation3D, volume fractions instead of area fractions). Writes
 bench/results/lattice_validation_*.json.
 
-    PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py matrix [--collisions 1e7]
+    PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py matrix [--collisions 1e7]
         [--n 1000 10000] [--phi 0.1 0.3 0.5 0.7] [--boundary wall periodic] [--out matrix]
-    PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py equilibrium [--n 1000] [--phi 0.5]
-    PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py failures [--phi 0.5 0.7] [--seeds 4] [--collisions 2e6] --out failures
-    PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py gas --n 1000 --phi 0.3 --boundary wall --collisions 1e5
-    PYTHONPATH=build-dev/pkg python3 bench/lattice_validation.py probe --n 1000 --phi 0.7 --boundary wall --collisions 3e6 --ticks 20 22 24 --cells 20 16 --out probe
+    PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py equilibrium [--n 1000] [--phi 0.5]
+    PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py failures [--phi 0.5 0.7] [--seeds 4] [--collisions 2e6] --out failures
+    PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py gas --n 1000 --phi 0.3 --boundary wall --collisions 1e5
+    PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py probe --n 1000 --phi 0.7 --boundary wall --collisions 3e6 --ticks 20 22 24 --cells 20 16 --out probe
 
 matrix: every gas (N x area fraction x boundary, flux law) in its own subprocess (``gas``), one
 at a time. The child runs C collisions forward, taking a snapshot at C/2, then runs back to C/2
@@ -62,7 +62,7 @@ import time
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-RESULTS = os.path.join(HERE, "results")
+RESULTS = os.path.normpath(os.path.join(HERE, "..", "..", "bench", "results"))
 DIM = 2  # --dim: 2 (disks, LatticeSimulation) or 3 (spheres, LatticeSimulation3D)
 
 

@@ -1,7 +1,7 @@
 """Does the collision trace say "diverged" exactly when a float round trip fails?
 (cpp/include/revcol/engine/trace.hpp, docs/robustness.md). Writes bench/results/trace_detection.json.
 
-    PYTHONPATH=build-dev/pkg python3 bench/trace_study.py [--seeds 6] [--quick]
+    PYTHONPATH=build-dev/pkg python3 tests/long/trace_study.py [--seeds 6] [--quick]
 
 For each case (dimension, N, packing fraction, boundary) and seed, a fresh gas runs forward
 along a grid of collision counts; at each count a copy (from its snapshot) runs back to the
@@ -29,7 +29,7 @@ import time
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-RESULTS = os.path.join(HERE, "results")
+RESULTS = os.path.normpath(os.path.join(HERE, "..", "..", "bench", "results"))
 
 # (dimension, N, packing fraction, boundary)
 CASES = [(2, 500, 0.3, "periodic"), (2, 500, 0.6, "wall"), (3, 500, 0.3, "periodic"),
@@ -80,7 +80,7 @@ def main() -> None:
     seeds = 2 if a.quick else a.seeds
     t0 = time.time()
     load0 = os.getloadavg()
-    out = {"command": " ".join(["python3", "bench/trace_study.py"] + sys.argv[1:]),
+    out = {"command": " ".join(["python3", "tests/long/trace_study.py"] + sys.argv[1:]),
            "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
                                     cwd=HERE).stdout.strip(),
            "machine": platform.processor() or platform.machine(), "loadavg_start": load0,
