@@ -1,9 +1,7 @@
-"""Studies of the 2D lattice engine (revcol/lattice/engine.hpp, LATTICE.md). Writes
-bench/results/lattice_*.json.
+"""Throughput of the lattice engine against the float engine (docs/lattice.md), both timed by
+revcol-bench. Writes bench/results/lattice_throughput.json (2D) or lattice_throughput3d.json (3D).
 
     python3 bench/lattice_study.py throughput [--bin build-dev/revcol-bench] [--collisions 2e5] [--rounds 5] [--cpu 1] [--dim 3]
-    PYTHONPATH=build-dev/pkg python3 bench/lattice_study.py roundtrip [--n 1000] [--phi 0.3] [--max 1e6] [--law flux] [--boundary both]
-    python3 bench/lattice_study.py all
 
 throughput: the lattice engine and, timed the same way, the float engine on the same periodic
 gases (N = 1e4 and 1e5, area fractions 0.3 and 0.5; revcol-bench lattice/periodic/... and
@@ -15,12 +13,7 @@ the 3D lattice engine and the float engine on the same sphere gases (N = 1e3 and
 fractions 0.3 and 0.45; revcol-bench lattice3d/periodic/... and lattice3d/float/...), written to
 lattice_throughput3d.json.
 
-roundtrip: one gas (N, area fraction, periodic and walls) run forward in steps of 10x collisions up
-to --max and back to the start after each step, from Python: bit-for-bit restoration of positions,
-velocities, stream counters, X and clock; X's bit length, rare-log entries, redraws, multi-body and
-wall-body ticks, energy drift (relative) and momentum drift (lattice units) after the forward run.
-Under the uniform law X grows (the entropy the non-equilibrium law produces): its bit length after
-each forward run is the measurement. Writes lattice_roundtrip_<law>_n<N>_phi<phi>.json.
+The lattice engine's bit-for-bit round trips at scale are tests/long/lattice_validation.py.
 """
 from __future__ import annotations
 
@@ -108,70 +101,17 @@ def throughput(args) -> dict:
     return res
 
 
-def _same(a: dict, b: dict) -> bool:
-    keys = ["clock", "origin", "collisions", "x", "v", "streams", "bits", "log_index", "log_redraws",
-            "group_index", "group_drawer", "group_size", "group_members", "group_kind", "group_v"]
-    return all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in keys)
-
-
-def roundtrip(args) -> dict:
-    from revcol.lattice import LatticeSimulation
-    rows = []
-    for boundary in (("periodic", "wall") if args.boundary == "both" else (args.boundary,)):
-        sim = LatticeSimulation.random(n=args.n, phi=args.phi, boundary=boundary, seed=args.seed,
-                                       init="crystal" if args.phi > 0.35 else "auto", law=args.law)
-        s0 = sim.snapshot()
-        nc = args.n * 10
-        while nc <= float(args.max):
-            t0 = time.perf_counter()
-            sim.run(collisions=nc)
-            t1 = time.perf_counter()
-            d = sim.diagnostics()
-            sim.run_back()
-            t2 = time.perf_counter()
-            ok = _same(sim.snapshot(), s0)
-            row = {"boundary": boundary, "law": args.law, "n": args.n, "phi": args.phi, "collisions": nc,
-                   "per_particle": 2 * nc / args.n, "bit_for_bit": bool(ok),
-                   "forward_s": t1 - t0, "reverse_s": t2 - t1,
-                   "bits_length": d["bits_length"], "log_entries": d["log_entries"],
-                   "log_entries_written": d["log_entries_written"],
-                   "redraws": d["redraws"], "multi_body": d["multi_body"], "wall_body": d["wall_body"],
-                   "group_resolves": d["group_resolves"], "group_bounces": d["group_bounces"],
-                   "energy_drift": d["energy_drift"], "momentum_drift": list(d["momentum_drift"]),
-                   "quantization": sim.quantization}
-            print(json.dumps(row))
-            rows.append(row)
-            if not ok:
-                break
-            nc *= 10
-    tag = "" if args.boundary == "both" else f"_{args.boundary}"
-    path = os.path.join(RESULTS, f"lattice_roundtrip_{args.law}_n{args.n}_phi{args.phi}{tag}.json")
-    with open(path, "w") as f:
-        json.dump({"rows": rows}, f, indent=1)
-    print("wrote", path)
-    return {"rows": rows}
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=["throughput", "roundtrip", "all"])
+    ap.add_argument("what", choices=["throughput"])
     ap.add_argument("--bin", default=os.path.join(HERE, "..", "build-dev", "revcol-bench"))
     ap.add_argument("--collisions", default="2e5")
     ap.add_argument("--rounds", type=int, default=5, help="throughput: interleaved rounds")
     ap.add_argument("--cpu", type=int, default=1, help="throughput: core to pin each run to (-1: none)")
-    ap.add_argument("--n", type=int, default=1000)
-    ap.add_argument("--phi", type=float, default=0.3)
-    ap.add_argument("--max", default="1e5")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--law", default="flux", choices=["flux", "uniform"])
     ap.add_argument("--dim", type=int, default=2, choices=[2, 3], help="throughput: 2D disks or 3D spheres")
-    ap.add_argument("--boundary", default="both", choices=["both", "periodic", "wall"])
     a = ap.parse_args(argv)
     os.makedirs(RESULTS, exist_ok=True)
-    if a.what in ("throughput", "all"):
-        throughput(a)
-    if a.what in ("roundtrip", "all"):
-        roundtrip(a)
+    throughput(a)
     return 0
 
 
