@@ -11,7 +11,7 @@ keeps the numbering of the run it resumes):
   every multiple of ``every`` collisions (or, with ``every_time`` T instead, at every multiple
   of T in time), and at the end. A frame on a collision trigger is taken at a collision: one
   pair sits exactly at contact in it. Structure (g(r) at contact) wants frames at times
-  independent of the events: ``every_time`` (bench/production_check.py measures the bias);
+  independent of the events: ``every_time`` (tests/long/production_check.py measures the bias);
 - ``checkpoints`` (a folder): ``checkpoint-<net collisions>.npz`` at every multiple of
   ``checkpoint_every`` and at the end; ``resume`` continues from one bit for bit (the run that
   resumes from checkpoint k and goes on to n collisions ends in the state of one that never
