@@ -333,7 +333,8 @@ class PyEngine {
 }  // namespace
 
 void register_engine(py::module_& m) {
-  py::class_<PyEngine>(m, "Engine", "The event-driven engine (revcol/engine/engine.hpp); use revcol.Simulation.")
+  py::class_<PyEngine> engine_class(m, "Engine", "The event-driven engine (revcol/engine/engine.hpp); use revcol.Simulation.");
+  engine_class
       .def(py::init([](const Array& x, const Array& v, const std::vector<double>& box,
                        const std::vector<std::string>& boundary, PyReal diameter_arg, PyStr mode_arg,
                        PyStr law_arg, PyInt seed_arg, PyInt bits_arg, bool groups, PyReal group_tol_arg,
@@ -388,25 +389,9 @@ void register_engine(py::module_& m) {
                                return p;
                              })
       .def("diagnostics", &PyEngine::diagnostics)
-      .def("snapshot", &PyEngine::snapshot)
-      // ---- observation (observe.cpp, revcol/engine/observe.hpp) ----
-      .def(
-          "observe",
-          [](PyEngine& e, PyReal block_time, PyInt min_blocks, PyInt slab_axis, PyInt slabs, PyInt speed_bins,
-             PyReal speed_max, PyInt pair_bins, PyReal pair_rmax) {
-            e.sim().observe(
-                observe_config(block_time, min_blocks, slab_axis, slabs, speed_bins, speed_max, pair_bins, pair_rmax));
-          },
-          py::arg("block_time") = 0.0, py::arg("min_blocks") = 16, py::arg("slab_axis") = 0, py::arg("slabs") = 0,
-          py::arg("speed_bins") = 0, py::arg("speed_max") = 0.0, py::arg("pair_bins") = 0, py::arg("pair_rmax") = 0.0)
-      .def("observation",
-           [](const PyEngine& e) -> py::object {
-             const en::Observer* o = e.sim().observer();
-             if (o == nullptr) return py::none();
-             return observation_dict(o->results());
-           })
-      .def("stop_observing", [](PyEngine& e) { e.sim().stop_observing(); })
-      .def_property_readonly("observing", [](const PyEngine& e) { return e.sim().observing(); });
+      .def("snapshot", &PyEngine::snapshot);
+  // ---- observation (observe.cpp, revcol/engine/observe.hpp) ----
+  def_observe(engine_class, [](PyEngine& e) -> en::Simulation& { return e.sim(); });
 
   m.def(
       "engine_random_state",

@@ -365,7 +365,10 @@ template <class Engine>
 void register_engine(py::module_& m, const char* name, const char* doc) {
   constexpr std::size_t D = Engine::D;
   using P = PyLattice<Engine>;
-  py::class_<P>(m, name, doc)
+  py::class_<P> cls(m, name, doc);
+  // observation: the float engine's observer (revcol/engine/observe.hpp)
+  def_observe(cls, [](P& p) -> Engine& { return p.engine(); });
+  cls
       .def(py::init([](const py::dict& units, const IArray& x, const IArray& v, PyInt seed_arg, const std::string& law,
                        PyInt clock_arg) {
              const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
@@ -429,24 +432,6 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
       .def_property_readonly("neighbour_search", [](const P& p) { return p.engine().neighbour_search(); },
                              "The search in use: 0 the cell grid, 1 lists (each pair's relative vector imaged), "
                              "2 lists with the centre offsets.")
-      // ---- observation (the float engine's observer, revcol/engine/observe.hpp) ----
-      .def(
-          "observe",
-          [](P& p, PyReal block_time, PyInt min_blocks, PyInt slab_axis, PyInt slabs, PyInt speed_bins,
-             PyReal speed_max, PyInt pair_bins, PyReal pair_rmax) {
-            p.engine().observe(
-                observe_config(block_time, min_blocks, slab_axis, slabs, speed_bins, speed_max, pair_bins, pair_rmax));
-          },
-          py::arg("block_time") = 0.0, py::arg("min_blocks") = 16, py::arg("slab_axis") = 0, py::arg("slabs") = 0,
-          py::arg("speed_bins") = 0, py::arg("speed_max") = 0.0, py::arg("pair_bins") = 0, py::arg("pair_rmax") = 0.0)
-      .def("observation",
-           [](const P& p) -> py::object {
-             const engine::Observer* o = p.engine().observer();
-             if (o == nullptr) return py::none();
-             return observation_dict(o->results());
-           })
-      .def("stop_observing", [](P& p) { p.engine().stop_observing(); })
-      .def_property_readonly("observing", [](const P& p) { return p.engine().observing(); })
       .def("diagnostics", [](const P& p) {
         const la::DiagnosticsN<D> g = la::diagnostics(p.engine());
         py::dict d = counters_dict(p.engine().counters());

@@ -16,4 +16,28 @@ engine::ObserveConfig observe_config(const PyReal& block_time, const PyInt& min_
 /// The results as a dict: estimates as {"value", "error"}, profiles as {"edges", "value", "error"} arrays.
 pybind11::dict observation_dict(const engine::Observation& o);
 
+/// Registers observe / observation / stop_observing / observing on a class whose engine
+/// (get(self): the float engine's Simulation or a lattice engine) has the observer's API.
+template <class Self, class... Extra, class Get>
+void def_observe(pybind11::class_<Self, Extra...>& cls, Get get) {
+  namespace py = pybind11;
+  cls.def(
+         "observe",
+         [get](Self& s, PyReal block_time, PyInt min_blocks, PyInt slab_axis, PyInt slabs, PyInt speed_bins,
+               PyReal speed_max, PyInt pair_bins, PyReal pair_rmax) {
+           get(s).observe(
+               observe_config(block_time, min_blocks, slab_axis, slabs, speed_bins, speed_max, pair_bins, pair_rmax));
+         },
+         py::arg("block_time") = 0.0, py::arg("min_blocks") = 16, py::arg("slab_axis") = 0, py::arg("slabs") = 0,
+         py::arg("speed_bins") = 0, py::arg("speed_max") = 0.0, py::arg("pair_bins") = 0, py::arg("pair_rmax") = 0.0)
+      .def("observation",
+           [get](Self& s) -> py::object {
+             const engine::Observer* o = get(s).observer();
+             if (o == nullptr) return py::none();
+             return observation_dict(o->results());
+           })
+      .def("stop_observing", [get](Self& s) { get(s).stop_observing(); })
+      .def_property_readonly("observing", [get](Self& s) { return get(s).observing(); });
+}
+
 }  // namespace revcol::bind
