@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "revcol/error.hpp"
+#include "revcol/rng/normal.hpp"
 
 namespace revcol {
 namespace {
@@ -15,21 +16,7 @@ NamedCase make(std::string name, int n, int d, std::vector<Contact> contacts,
                    std::move(description)};
 }
 
-// splitmix64 and Box-Muller: a small deterministic normal generator (no <random>, whose
-// distributions differ between standard libraries)
-struct Normal {
-  std::uint64_t s;
-  std::uint64_t bits() {
-    std::uint64_t z = (s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
-  double uniform() { return (static_cast<double>(bits() >> 11) + 0.5) * 0x1.0p-53; }
-  double operator()() {
-    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * kPi * uniform());
-  }
-};
+using Normal = rng::SplitMixNormal;  // revcol/rng/normal.hpp
 
 }  // namespace
 

@@ -10,24 +10,14 @@
 #include <vector>
 
 #include "revcol/collide/pair3d_paper.hpp"
-#include "revcol/studies/paper_study.hpp"
 #include "revcol/collide/triple1d_paper.hpp"
 #include "revcol/collide/triple2d_paper.hpp"
+#include "revcol/rng/normal.hpp"
+#include "revcol/studies/paper_study.hpp"
 
 namespace revcol::paper::adapt {
 
-/// splitmix64 and Box-Muller: deterministic normals on every platform (no <random>).
-struct Normal {
-  std::uint64_t s;
-  std::uint64_t bits() {
-    std::uint64_t z = (s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
-  double uniform() { return (static_cast<double>(bits() >> 11) + 0.5) * 0x1.0p-53; }
-  double operator()() { return std::sqrt(-2.0 * std::log(uniform())) * std::cos(kTwoPi * uniform()); }
-};
+using Normal = rng::SplitMixNormal;  // revcol/rng/normal.hpp
 
 /// One paper-mode operator seen through the studies' interface (specialised per operator).
 template <class Op> struct Adapter;
