@@ -2,7 +2,7 @@
 variant would save (:func:`projected_bytes`), and the argument checks every run shares.
 
 The model, the variants and the maths are in the study, :mod:`revcol.studies.statesave`, and
-the C++ header ``revcol/statesave.hpp``; the study (many runs, each in a fresh process, the
+the C++ header ``revcol/studies/statesave.hpp``; the study (many runs, each in a fresh process, the
 table and the figure) builds on this module, which the library (scene checks) uses too.
 
     >>> r = run(1000, 200, variant="rc")

@@ -3,7 +3,7 @@
 The engine's collision laws are tested against equilibrium. Equations of state (Liu's fits,
 Henderson, Carnahan-Starling) describe the infinite fluid and are good to about 0.05-0.1%;
 a run of 10^8 collisions measures Z to 0.005%. This module measures the reference itself:
-``EventChain`` (C++, revcol/ecmc.hpp) samples the uniform measure over non-overlapping
+``EventChain`` (C++, revcol/studies/ecmc.hpp) samples the uniform measure over non-overlapping
 configurations of N spheres in the periodic box of the engine's random start, which is the
 configurational equilibrium of hard spheres, by event-chain Monte Carlo (Bernard, Krauth and
 Wilson 2009), a different algorithm from the event-driven engine. Its pressure estimator

@@ -11,7 +11,7 @@ Paper mode is read through the exact uniform law's chart: the paper's stated law
 on the permitted set, uniform in its angles on a round circle for pair2d and triple1d).
 The cases gas2d and gas3d are the float engine's pair collisions in a periodic gas (exact
 mode): the direction of each post relative velocity about its contact normal, read through
-the law's CDF (revcol/randomness.hpp).
+the law's CDF (revcol/studies/randomness.hpp).
 
 The battery runs the paper's tests by dieharder number (``PAPER_TESTS``), one process per
 test and each from the start of the file, without dieharder's ``rate`` output field (its

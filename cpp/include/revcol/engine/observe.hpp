@@ -76,7 +76,7 @@
 // the segments' velocities are the particles' (InvalidArgument naming the first problem).
 //
 // The collision record (optional, ObserveConfig::collision_record; the randomness study's
-// gas streams, revcol/randomness.hpp). Per pair collision, in order: the unit contact
+// gas streams, revcol/studies/randomness.hpp). Per pair collision, in order: the unit contact
 // normal n = r / |r| (r = x_a - x_b from the observer's positions, nearest image) and the
 // post relative velocity w = v_a - v_b. In exact mode the direction of w about n has the
 // operator's law whatever the pre state (a torus shift of a measure-preserving chart,

@@ -14,7 +14,7 @@ rolls back to the start:
 Every step's record also holds the clock and the generator state (24 bytes more). *Lazy
 transport* stores x0 = x - v t per particle, so a step costs O(1): a collision at time t
 updates x0 += (v_old - v_new) t, and reverse undoes it. The C++ header
-``revcol/statesave.hpp`` has the maths (orientation, grazing rule, exact mode's pre log).
+``revcol/studies/statesave.hpp`` has the maths (orientation, grazing rule, exact mode's pre log).
 
 :func:`run` does one run in this process. :func:`study` runs a grid of (mode, N, variant),
 each in a fresh ``revcol-bench`` process so that its peak resident set (VmHWM) is its own,
