@@ -72,146 +72,12 @@
 #include "revcol/visitable.hpp"
 #include "revcol/lattice/cell_grid.hpp"
 #include "revcol/lattice/geometry.hpp"
+#include "revcol/lattice/state.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
 #include "revcol/lattice/units.hpp"
 #include "revcol/rng/philox.hpp"
 
 namespace revcol::lattice {
-
-/// Redraw reasons counted by the engine (index into Counters::redraws).
-enum RedrawReason : int {
-  redraw_cell_readback = 1,    ///< operator: the lifting round-off changes the read-back cell
-  redraw_not_approaching = 2,  ///< operator: pre not approaching about the quantized normal
-  redraw_empty_post = 3,       ///< operator: empty post phase set
-  redraw_out_of_domain = 4,    ///< operator: phases not an interval
-  redraw_overlap_after = 5,    ///< post state overlaps a third body at tick a
-  redraw_ghost_tie = 6,        ///< new lines overlap a third body at tick a-1
-  redraw_outside = 7,          ///< post centre beyond a wall or speed beyond vmax
-};
-/// Names of the redraw reasons, index 0 unused.
-inline constexpr const char* redraw_names[8] = {"",           "cell_readback", "not_approaching", "empty_post",
-                                                 "out_of_domain", "overlap_after", "ghost_tie",   "outside"};
-
-/// Event and rare-case counts, cumulative over both directions (not part of the physical state).
-struct Counters : Visitable<Counters> {
-  std::uint64_t events = 0;              ///< queue pops
-  std::uint64_t collisions = 0;          ///< collisions applied (forward and reverse)
-  std::uint64_t walls = 0;               ///< wall reflections applied (both directions)
-  std::uint64_t crossings = 0;           ///< neutral events: cell crossings, or list renewals (set_list_shell)
-  std::uint64_t stale = 0;               ///< stale events recomputed
-  std::array<std::uint64_t, 8> redraws{};  ///< forward redraws by RedrawReason
-  std::uint64_t log_entries = 0;         ///< rare-log entries written (forward)
-  std::uint64_t multi_body = 0;          ///< three bodies within one tick (resolved by the rule)
-  std::uint64_t wall_body = 0;           ///< a wall and a body within one tick (resolved by the rule)
-  std::uint64_t group_resolves = 0;      ///< groups resolved specularly, pre velocities logged (a log entry)
-  std::uint64_t group_bounces = 0;       ///< groups that bounced back (the fallback; a log entry)
-  std::uint64_t wall_groups = 0;         ///< group members whose reflection at the same tick the group took in
-
-  /// Calls f(name, count) for every counter, with the names of the diagnostics (redraws: the
-  /// array by RedrawReason, index 0 unused).
-  template <class S, class F>
-  static void visit_fields(S& c, F& f) {
-    f("events", c.events);
-    f("collisions_applied", c.collisions);
-    f("walls", c.walls);
-    f("crossings", c.crossings);
-    f("stale", c.stale);
-    f("redraws", c.redraws);
-    f("log_entries_written", c.log_entries);
-    f("multi_body", c.multi_body);
-    f("wall_body", c.wall_body);
-    f("group_resolves", c.group_resolves);
-    f("group_bounces", c.group_bounces);
-    f("wall_groups", c.wall_groups);
-  }
-};
-
-/// A group collision in the rare log: a pair that no draw could resolve because a third body (or
-/// more) is met within the same tick. Its members stay at their tick a-1 positions ("stall") and
-/// either take the velocities of a specular resolution (pre_v holds their exact pre velocities,
-/// so the reverse restores them) or, when that post state would break the event rule, bounce
-/// back (every velocity negated, an involution: pre_v empty).
-template <std::size_t D>
-struct GroupEntryN {
-  std::uint64_t index = 0;       ///< collision index (1-based)
-  int drawer = 0;                ///< whose stream the tried draws came from
-  std::vector<int> members;      ///< ascending
-  std::vector<VecN<D>> pre_v;    ///< members' exact pre velocities (a resolve); empty: a bounce
-  bool operator==(const GroupEntryN&) const = default;
-};
-/// A 2D group entry.
-using GroupEntry = GroupEntryN<2>;
-
-/// Everything that defines a lattice state in D dimensions, in the forward frame, positions at the clock.
-template <std::size_t D>
-struct SnapshotN : Visitable<SnapshotN<D>> {
-  UnitsN<D> units;                             ///< units and box
-  Law law = Law::flux;                         ///< the pair operator's post-direction law
-  std::uint32_t seed = 1;                      ///< Philox key {particle, seed}
-  std::int64_t clock = 0;                      ///< the current tick
-  std::int64_t origin = 0;                     ///< the tick of the initial state (no run back past it)
-  std::uint64_t collisions = 0;                ///< collisions since the initial state
-  std::vector<VecN<D>> x;                      ///< positions at the clock
-  std::vector<VecN<D>> v;                      ///< velocities
-  std::vector<std::uint64_t> streams;          ///< per-particle Philox counters
-  std::vector<std::uint64_t> bits;             ///< the bits-back integer X, 64-bit words, low first
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> log;  ///< rare log: collision index -> redraws
-  std::vector<GroupEntryN<D>> groups;          ///< rare log: group collisions (resolves and bounces)
-  std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
-  std::array<std::int64_t, 2 * D> momentum0{};  ///< initial momentum per axis (128 bits: low, high)
-  Counters counters;                           ///< statistics (not compared by same_state)
-
-  /// Calls f(name, field) for every field but `counters`, in the checkpoint format's order and
-  /// with its names (log and groups are each written as several arrays by the binding).
-  template <class S, class F>
-  static void visit_fields(S& s, F& f) {
-    f("units", s.units);
-    f("law", s.law);
-    f("seed", s.seed);
-    f("clock", s.clock);
-    f("origin", s.origin);
-    f("collisions", s.collisions);
-    f("x", s.x);
-    f("v", s.v);
-    f("streams", s.streams);
-    f("bits", s.bits);
-    f("log", s.log);
-    f("groups", s.groups);
-    f("energy0", s.energy0);
-    f("momentum0", s.momentum0);
-  }
-};
-/// A 2D snapshot.
-using Snapshot = SnapshotN<2>;
-/// A 3D snapshot.
-using Snapshot3 = SnapshotN<3>;
-
-/// True when two snapshots hold the same physical state bit for bit (everything but counters).
-template <std::size_t D>
-bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
-  const UnitsN<D> &u = a.units, &w = b.units;
-  return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.bounce == w.bounce && u.vmax == w.vmax &&
-         u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
-         a.law == b.law && a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
-         a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&
-         a.groups == b.groups &&
-         a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
-}
-
-/// -a, per component.
-template <std::size_t D>
-inline VecN<D> neg(const VecN<D>& a) noexcept {
-  VecN<D> o;
-  for (std::size_t k = 0; k < D; ++k) o[k] = -a[k];
-  return o;
-}
-/// a - b, per component (no wrap).
-template <std::size_t D>
-inline VecN<D> sub(const VecN<D>& a, const VecN<D>& b) noexcept {
-  VecN<D> o;
-  for (std::size_t k = 0; k < D; ++k) o[k] = a[k] - b[k];
-  return o;
-}
 
 /// The dimension of a pair operator: that of the vectors its pair_forward takes.
 template <class R, class O, std::size_t D, class... A>
@@ -228,19 +94,6 @@ inline std::uint64_t draw48(std::uint32_t p, std::uint32_t seed, std::uint64_t k
   const auto w = rng::philox4x32_10({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k >> 32), 0U, 0U}, {p, seed});
   return (std::uint64_t{w[0]} << 16) | (w[1] >> 16);
 }
-/// One forward velocity change as the engine applied it (tests and studies: BasicEngine::events;
-/// the observer's direct-sum check). Positions at the event's tick (in the box), velocities
-/// before and after, per member.
-template <std::size_t D>
-struct EventRecordN {
-  enum Kind : int { pair = 0, wall = 1, group = 2 };
-  std::int64_t tick = 0;           ///< the tick the change takes effect (the transition into it)
-  int kind = pair;                 ///< pair, wall or group
-  unsigned axes = 0;               ///< a wall: bit k, it met a wall of axis k
-  std::vector<int> ids;            ///< the particles
-  std::vector<VecN<D>> x, v_before, v_after;  ///< per particle
-};
-
 /// The 256 initial bits of X for a seed: four words from stream key {2^32 - 1, seed}.
 std::vector<std::uint64_t> initial_bits(std::uint32_t seed);
 
