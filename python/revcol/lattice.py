@@ -154,7 +154,8 @@ class LatticeSimulation(SimulationBase):
         dim = cls._DIM if dim is None else dim
         if dim != cls._DIM:
             if cls._DIM == 2:
-                raise ValueError(f"the lattice engine is 2D, got dim={dim} (spheres: LatticeSimulation3D)")
+                raise ValueError(f"LatticeSimulation is the 2D class, got dim={dim} (spheres: LatticeSimulation3D, or "
+                                 "Simulation.random(dim=3, engine='lattice'))")
             raise ValueError(f"LatticeSimulation3D is 3D, got dim={dim}")
         start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, init,
                                                    _tick(tick_bits), cell_bits)
