@@ -15,10 +15,11 @@
 // reflection at this instant (`entry`).
 //
 // KeyedStack. The common shape of such a log: entries pushed forward under a key both
-// directions recover exactly, whose keys increase as they are pushed, and popped in reverse
-// when the key on top is the current one (LIFO); an undone forward run drops the entries
-// pushed after a key. The lattice engine keeps its redraw log and its group log so, keyed by
-// the collision index (lattice/engine_core.hpp).
+// directions recover exactly and popped in reverse when the key on top is the current one
+// (LIFO); where keys increase as they are pushed, an undone forward run drops the entries
+// pushed after a key. The float engine's exact-pre log is one (keyed by stream and counter);
+// the lattice engine keeps its redraw log and its group log so, keyed by the collision index
+// (lattice/engine_core.hpp).
 //
 // ExactPreLog. At singular points of a chart (a 3D pair almost head-on, groups with resting
 // contacts) a pre state's K-bit cell spans up to ~2^(-K/2); when its centre is off by more
@@ -30,17 +31,18 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace revcol::engine {
 
-/// A log of entries pushed forward under increasing keys and popped in reverse (see above).
+/// A log of entries pushed forward under a key and popped in reverse (see above).
 template <class Key, class Entry>
 class KeyedStack {
  public:
   using Item = std::pair<Key, Entry>;  ///< a key and its entry
-  /// Forward: keeps e under key (greater than every key held: see increasing()).
+  /// Forward: keeps e under key (for truncate_after, greater than every key held: increasing()).
   void push(Key key, Entry e) { items_.emplace_back(key, std::move(e)); }
   /// Reverse: the top entry if its key is `key`, else null (nothing of this key is held).
   Entry* top(Key key) noexcept { return !items_.empty() && items_.back().first == key ? &items_.back().second : nullptr; }
@@ -162,7 +164,7 @@ class WallLog {
   std::vector<double> times_;
 };
 
-/// The exact-pre log (see above).
+/// The exact-pre log (see above): a KeyedStack of pre velocities keyed (stream, counter).
 class ExactPreLog {
  public:
   /// Whether b differs from a by more than 1e-10 of a's largest component (n values).
@@ -177,57 +179,67 @@ class ExactPreLog {
   /// Forward: keeps the pre velocities a (n values; and b, n more, for a pair) under the
   /// key (stream, generator counter before the draws).
   void push(int stream, std::uint64_t key, const double* a, const double* b, int n) {
-    keys_.push_back(static_cast<std::uint64_t>(stream));
-    keys_.push_back(key);
-    sizes_.push_back(static_cast<std::uint64_t>(b ? 2 * n : n));
-    vals_.insert(vals_.end(), a, a + n);
-    if (b) vals_.insert(vals_.end(), b, b + n);
+    std::vector<double> v(a, a + n);
+    if (b) v.insert(v.end(), b, b + n);
+    log_.push({static_cast<std::uint64_t>(stream), key}, std::move(v));
     ++pushed_;
   }
   /// Reverse: a (and b, the second half of a pair) are the pre velocities the reverse
   /// computed; replaced by the kept ones, popped, when the top entry is this key's.
   void pop(int stream, std::uint64_t key, double* a, double* b) {
-    if (sizes_.empty()) return;
-    const std::size_t e = sizes_.size() - 1;
-    if (keys_[2 * e] != static_cast<std::uint64_t>(stream) || keys_[2 * e + 1] != key) return;
-    const std::size_t n = sizes_[e];
-    const double* src = vals_.data() + (vals_.size() - n);
+    const std::vector<double>* e = log_.top({static_cast<std::uint64_t>(stream), key});
+    if (e == nullptr) return;
+    const std::size_t n = e->size();
     if (b) {
-      std::copy(src, src + n / 2, a);
-      std::copy(src + n / 2, src + n, b);
+      std::copy(e->begin(), e->begin() + static_cast<std::ptrdiff_t>(n / 2), a);
+      std::copy(e->begin() + static_cast<std::ptrdiff_t>(n / 2), e->end(), b);
     } else {
-      std::copy(src, src + n, a);
+      std::copy(e->begin(), e->end(), a);
     }
-    vals_.resize(vals_.size() - n);
-    sizes_.pop_back();
-    keys_.resize(keys_.size() - 2);
+    log_.pop();
   }
   /// Entries now held.
-  std::size_t entries() const { return sizes_.size(); }
+  std::size_t entries() const { return log_.size(); }
   /// Entries ever pushed.
   std::uint64_t pushed() const { return pushed_; }
-  /// Bytes now held.
+  /// Bytes now held (the values, and three words per entry: its key and size).
   std::size_t bytes() const {
-    return vals_.size() * sizeof(double) + (keys_.size() + sizes_.size()) * sizeof(std::uint64_t);
+    std::size_t b = 0;
+    for (const auto& item : log_.items()) b += item.second.size() * sizeof(double) + 3 * sizeof(std::uint64_t);
+    return b;
   }
-  /// The log's arrays and counter, for snapshots.
+  /// The log as a snapshot's arrays and counter: keys (stream, counter) per entry, values per
+  /// entry, the values, entries ever pushed. Written from a const log, read into a log (the
+  /// snapshot's arrays validated before: sizes add up, 2 keys per entry).
   template <class Self, class F>
   static void fields(Self& s, F&& f) {
-    f("pre_keys", s.keys_);
-    f("pre_sizes", s.sizes_);
-    f("pre_vals", s.vals_);
+    std::vector<std::uint64_t> keys, sizes;
+    std::vector<double> vals;
+    if constexpr (std::is_const_v<Self>) {
+      for (const auto& [k, v] : s.log_.items()) {
+        keys.push_back(k.first);
+        keys.push_back(k.second);
+        sizes.push_back(v.size());
+        vals.insert(vals.end(), v.begin(), v.end());
+      }
+    }
+    f("pre_keys", keys);
+    f("pre_sizes", sizes);
+    f("pre_vals", vals);
     f("pre_pushed", s.pushed_);
-  }
-  /// Whether the arrays fit together (2 keys per entry, sizes add up to the values).
-  bool consistent() const {
-    std::uint64_t total = 0;
-    for (auto q : sizes_) total += q;
-    return keys_.size() == 2 * sizes_.size() && total == vals_.size();
+    if constexpr (!std::is_const_v<Self>) {
+      s.log_.clear();
+      std::size_t at = 0;
+      for (std::size_t e = 0; e < sizes.size() && 2 * e + 1 < keys.size() && at + sizes[e] <= vals.size(); ++e) {
+        const auto from = vals.begin() + static_cast<std::ptrdiff_t>(at);
+        s.log_.push({keys[2 * e], keys[2 * e + 1]}, std::vector<double>(from, from + static_cast<std::ptrdiff_t>(sizes[e])));
+        at += sizes[e];
+      }
+    }
   }
 
  private:
-  std::vector<std::uint64_t> keys_, sizes_;
-  std::vector<double> vals_;
+  KeyedStack<std::pair<std::uint64_t, std::uint64_t>, std::vector<double>> log_;
   std::uint64_t pushed_ = 0;
 };
 
