@@ -14,8 +14,8 @@ import sys, numpy as np, revcol
 engine, direction = sys.argv[1], sys.argv[2]
 s = revcol.Simulation.random(2000, 2, 0.3, seed=1, engine=engine, boundary="wall")
 x0, v0 = s.positions.copy(), s.velocities.copy()
-if direction == "back":
-    s.run(collisions=400000)
+if direction == "back":  # a run_back of seconds, so that the SIGINT 0.3 s in surely lands inside it
+    s.run(collisions=2000000)
 print("ready", flush=True)
 try:
     if direction == "fwd":
