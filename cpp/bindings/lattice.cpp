@@ -157,6 +157,7 @@ void put(py::dict& d, const char* key, const std::vector<la::VecN<D>>& v) { d[ke
 template <class T, std::size_t K>
 void put(py::dict& d, const char* key, const std::array<T, K>& a) { d[key] = flat_array(a.data(), K); }
 void put(py::dict& d, const char* key, const std::vector<std::uint64_t>& v) { d[key] = flat_array(v.data(), v.size()); }
+void put(py::dict& d, const char* key, const std::vector<double>& v) { d[key] = flat_array(v.data(), v.size()); }
 // the rare log as two arrays: log_index (collision index) and log_redraws
 void put(py::dict& d, const char*, const std::vector<std::pair<std::uint64_t, std::uint32_t>>& log) {
   std::vector<std::uint64_t> li, lr;
@@ -202,6 +203,10 @@ void take(const py::dict& d, const char* key, std::vector<la::VecN<D>>& v) {
   v = checkpoint_entry(key, [&] { return vecs<D>(int_array(d[key], key), key); });
 }
 void take(const py::dict& d, const char* key, std::vector<std::uint64_t>& v) { v = get_flat<std::uint64_t>(d, key); }
+void take(const py::dict& d, const char* key, std::vector<double>& v) { v = get_flat<double>(d, key); }
+
+// a running observation's entries: written only while one runs, absent in older checkpoints
+bool observer_entry(const char* key) { return std::strcmp(key, "observer") == 0 || std::strcmp(key, "observer_counts") == 0; }
 template <class T, std::size_t K>
 void take(const py::dict& d, const char* key, std::array<T, K>& a) {
   const auto v = get_flat<T>(d, key);
@@ -267,7 +272,10 @@ py::dict snapshot_dict(const la::SnapshotN<D>& s) {
   py::dict d;
   d["engine"] = "lattice";
   if constexpr (D == 3) d["dim"] = 3;  // (a 2D checkpoint has no dim key, as before)
-  s.visit([&](const char* key, const auto& v) { put(d, key, v); });
+  s.visit([&](const char* key, const auto& v) {
+    if (observer_entry(key) && s.observer.empty()) return;  // no observation running: no entries
+    put(d, key, v);
+  });
   return d;
 }
 
@@ -275,7 +283,10 @@ template <std::size_t D>
 la::SnapshotN<D> snapshot_from(const py::dict& d) {
   la::SnapshotN<D> s;
   if constexpr (D == 3) require(get<int>(d, "dim") == 3, "lattice checkpoint: dim must be 3 for the 3D engine");
-  s.visit([&](const char* key, auto& v) { take(d, key, v); });
+  s.visit([&](const char* key, auto& v) {
+    if (observer_entry(key) && !d.contains(key)) return;  // none running (or an older checkpoint)
+    take(d, key, v);
+  });
   return s;
 }
 

@@ -11,24 +11,35 @@ namespace revcol::lattice {
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
-  const std::size_t n = ln_.size();
-  std::vector<double> x(n * D), v(n * D);
-  for (std::size_t p = 0; p < n; ++p) {
-    const Vec xp = pos(static_cast<int>(p), clock_);
+  observer_ = make_observer(u_, positions(), velocities(), clock_, &c, nullptr);
+  obs_ = observer_.get();
+}
+
+// An observer of the state (units u, positions x at tick clock, velocities v) in float units:
+// a new one with config c, or the one a snapshot s saved (resumed; InvalidArgument if spoiled).
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::make_observer(const Units& u, const std::vector<Vec>& x, const std::vector<Vec>& v,
+                                                 std::int64_t clock, const engine::ObserveConfig* c,
+                                                 const Snapshot* s) const -> std::unique_ptr<engine::Observer> {
+  const double len = u.length_unit, speed = u.length_unit / u.tick;
+  const std::size_t n = x.size();
+  std::vector<double> xf(n * D), vf(n * D);
+  for (std::size_t p = 0; p < n; ++p)
     for (std::size_t k = 0; k < D; ++k) {
-      x[p * D + k] = to_length(xp[k]);
-      v[p * D + k] = to_speed(ln_[p].v[k]);
+      xf[p * D + k] = static_cast<double>(x[p][k]) * len;
+      vf[p * D + k] = static_cast<double>(v[p][k]) * speed;
     }
-  }
   std::array<double, 3> box{};
   std::array<bool, 3> walls{};
   for (std::size_t k = 0; k < D; ++k) {
-    box[k] = to_length(u_.L[k]);
-    walls[k] = u_.wall[k];
+    box[k] = static_cast<double>(u.L[k]) * len;
+    walls[k] = u.wall[k];
   }
-  observer_ = std::make_unique<engine::Observer>(c, static_cast<int>(D), x, v, time_of(clock_), box, walls,
-                                                 to_length(u_.sigma));
-  obs_ = observer_.get();
+  const double t = static_cast<double>(clock) * u.tick, diameter = static_cast<double>(u.sigma) * len;
+  if (s != nullptr)
+    return std::make_unique<engine::Observer>(s->observer, s->observer_counts, static_cast<int>(D), vf, t, box, walls,
+                                              diameter);
+  return std::make_unique<engine::Observer>(*c, static_cast<int>(D), xf, vf, t, box, walls, diameter);
 }
 
 template <class Op, class Bits, class Queue>

@@ -47,9 +47,13 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
           "lattice snapshot: origin <= clock within +-2^60 required");
   require(s.law == law(), "lattice snapshot: its law is not the operator's");
   check_operator(s.units);
+  // a running observation resumes (built before anything changes: a spoiled one is an error)
+  std::unique_ptr<engine::Observer> resumed;
+  require(!s.observer.empty() || s.observer_counts.empty(), "lattice snapshot: observer_counts without observer");
+  if (!s.observer.empty()) resumed = make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);
   load(s);
-  observer_.reset();  // another state: an observation of the old one ends
-  obs_ = nullptr;
+  observer_ = std::move(resumed);  // none: an observation of the old state ends
+  obs_ = observer_.get();
 }
 
 template <class Op, class Bits, class Queue>
@@ -70,6 +74,7 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   s.energy0 = energy0_;
   s.momentum0 = momentum0_;
   s.counters = cnt_;
+  if (obs_) obs_->save(s.observer, s.observer_counts);  // a running observation resumes (observe.hpp)
   return s;
 }
 

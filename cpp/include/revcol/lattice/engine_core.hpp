@@ -357,6 +357,9 @@ class BasicEngine {
   void group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons);
   void group_back(int i, int j, std::int64_t a, Group& entry);
 
+  std::unique_ptr<engine::Observer> make_observer(const Units& u, const std::vector<Vec>& x, const std::vector<Vec>& v,
+                                                 std::int64_t clock, const engine::ObserveConfig* c,
+                                                 const Snapshot* s) const;
   void record(int kind, std::int64_t a, const std::vector<int>& ids, const std::vector<Vec>& x, const std::vector<Vec>& v, unsigned axes);
   [[gnu::noinline, gnu::cold]] void note_pair(std::int64_t a, int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj);
   [[gnu::noinline, gnu::cold]] void note_wall(std::int64_t a, int p, const Vec& xp, const Vec& vp, unsigned axes);

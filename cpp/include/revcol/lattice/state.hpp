@@ -97,6 +97,8 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
   std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
   std::array<std::int64_t, 2 * D> momentum0{};  ///< initial momentum per axis (128 bits: low, high)
   Counters counters;                           ///< statistics (not compared by same_state)
+  std::vector<double> observer;                ///< a running observation (engine::Observer::save; empty: none)
+  std::vector<std::uint64_t> observer_counts;  ///< its counts per block (not compared by same_state)
 
   /// Calls f(name, field) for every field but `counters`, in the checkpoint format's order and
   /// with its names (log and groups are each written as several arrays by the binding).
@@ -116,6 +118,8 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
     f("groups", s.groups);
     f("energy0", s.energy0);
     f("momentum0", s.momentum0);
+    f("observer", s.observer);
+    f("observer_counts", s.observer_counts);
   }
 };
 /// A 2D snapshot.
