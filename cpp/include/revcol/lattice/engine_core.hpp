@@ -155,7 +155,8 @@ class BasicEngine {
   /// the float engine's observer (revcol/engine/observe.hpp) fed at every velocity change
   /// with the exact state converted once to float units (x length_unit, ticks x tick), the
   /// positions the engine gives (its *_at hooks: a lattice event moves centres by up to a
-  /// tick's travel). Observation is forward only: run_back ends it; restore discards it.
+  /// tick's travel). Observation is forward only: run_back ends it; a snapshot keeps a running
+  /// one and restore resumes it (or ends the observation of the old state).
   void observe(const engine::ObserveConfig& c);
   /// The running or last observation (null before observe()).
   const engine::Observer* observer() const noexcept { return observer_.get(); }
