@@ -162,15 +162,13 @@ class Observation:
                                                               np.asarray(p["error"])))
         # every other entry as it comes (an observable added in C++ needs no change here):
         # {"value", "error"} an Estimate, sequences numpy arrays (msd_time, msd, vacf, ...)
-        self._arrays = []
-        for key, val in raw.items():
-            if key in _KNOWN:
-                continue
+        self._extra = [key for key in raw if key not in _KNOWN]
+        for key in self._extra:
+            val = raw[key]
             if isinstance(val, dict) and set(val) == {"value", "error"}:
                 setattr(self, key, Estimate(float(val["value"]), float(val["error"])))
             elif isinstance(val, (list, tuple, np.ndarray)):
                 setattr(self, key, np.asarray(val))
-                self._arrays.append(key)
             else:
                 setattr(self, key, val)
 
@@ -190,8 +188,10 @@ class Observation:
             p = getattr(self, key)
             out[key] = None if p is None else {"edges": p.edges.tolist(), "value": p.value.tolist(),
                                                "error": p.error.tolist()}
-        for key in self._arrays:
-            out[key] = getattr(self, key).tolist()
+        for key in self._extra:  # as they came: estimates as [value, error], arrays as lists
+            val = getattr(self, key)
+            out[key] = ([val.value, val.error] if isinstance(val, Estimate)
+                        else val.tolist() if isinstance(val, np.ndarray) else val)
         return out
 
     def lines(self) -> list[str]:

@@ -370,3 +370,18 @@ def test_observe_table_only_for_gas(tmp_path):
     doc = {"scene": {"kind": "reversal", "case": "pair2d"}, "observe": {}}
     with pytest.raises(SceneError, match="observe"):
         scene_from_dict(doc, "rev.toml", tmp_path)
+
+
+def test_observation_takes_a_result_it_does_not_know():
+    """A result the C++ observer adds (the recipe in ARCHITECTURE.md) reaches Python with no
+    Python change: an estimate as an Estimate, an array as numpy, both in to_dict."""
+    sim = revcol.Simulation.random(n=100, dim=2, phi=0.3, seed=2)
+    sim.observe()
+    sim.run(collisions=2000)
+    raw = dict(sim._e.observation())
+    raw["new_estimate"] = {"value": 1.5, "error": 0.25}
+    raw["new_series"] = np.array([1.0, 2.0])
+    o = Observation(raw)
+    assert o.new_estimate == Estimate(1.5, 0.25) and np.array_equal(o.new_series, [1.0, 2.0])
+    d = o.to_dict()
+    assert d["new_estimate"] == [1.5, 0.25] and d["new_series"] == [1.0, 2.0] and d["vacf"] == o.vacf.tolist()
