@@ -162,11 +162,11 @@ def test_no_import_cycles():
     assert not cycles, "import cycles:\n" + "\n".join(_describe(graph, c) for c in cycles)
 
 
-@pytest.mark.parametrize("pair", sorted(sorted(p) for p in ALLOWED_CYCLES))
-def test_each_allowed_cycle_is_still_there(pair):
-    """An allowed pair that no longer imports both ways is to be removed from ALLOWED_CYCLES."""
-    a, b = pair
-    assert b in GRAPH[a] and a in GRAPH[b], f"{a} <-> {b} is no longer a cycle: remove it from ALLOWED_CYCLES"
+def test_each_allowed_cycle_is_still_there():
+    """An allowed pair that no longer imports both ways is to be removed from ALLOWED_CYCLES
+    (none is allowed today: this guards the list once one is)."""
+    for a, b in (sorted(p) for p in ALLOWED_CYCLES):
+        assert b in GRAPH[a] and a in GRAPH[b], f"{a} <-> {b} is no longer a cycle: remove it from ALLOWED_CYCLES"
 
 
 def _in(module: str, package: str) -> bool:
