@@ -149,6 +149,7 @@ py::dict start_dict(const la::LatticeStartN<D>& s) {
 template <std::size_t D>
 void put(py::dict& d, const char* key, const la::UnitsN<D>& u) { d[key] = units_dict(u); }
 void put(py::dict& d, const char* key, revcol::Law law) { d[key] = to_string(law); }
+void put(py::dict& d, const char* key, revcol::Mode mode) { d[key] = to_string(mode); }
 template <class T>
   requires std::is_integral_v<T>
 void put(py::dict& d, const char* key, T v) { d[key] = v; }
@@ -194,6 +195,15 @@ void put(py::dict& d, const char*, const std::vector<la::GroupEntryN<D>>& groups
 template <std::size_t D>
 void take(const py::dict& d, const char* key, la::UnitsN<D>& u) { u = units_from<D>(get<py::dict>(d, key)); }
 void take(const py::dict& d, const char* key, revcol::Law& law) { law = parse_law(get<std::string>(d, key)); }
+// the lattice's modes: exact (the randomized operator) or specular (a checkpoint without the key is exact)
+revcol::Mode parse_lattice_mode(const std::string& s) {
+  if (s == "exact") return revcol::Mode::exact;
+  if (s == "specular") return revcol::Mode::specular;
+  throw revcol::InvalidArgument("lattice mode must be 'exact' or 'specular', got '" + s + "'");
+}
+void take(const py::dict& d, const char* key, revcol::Mode& mode) {
+  mode = d.contains(key) ? parse_lattice_mode(get<std::string>(d, key)) : revcol::Mode::exact;
+}
 template <class T>
   requires std::is_integral_v<T>
 void take(const py::dict& d, const char* key, T& v) { v = get<T>(d, key); }
@@ -381,14 +391,16 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
   def_observe(cls, [](P& p) -> Engine& { return p.engine(); });
   cls
       .def(py::init([](const py::dict& units, const IArray& x, const IArray& v, PyInt seed_arg, const std::string& law,
-                       PyInt clock_arg) {
+                       PyInt clock_arg, const std::string& mode) {
              const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
              const auto clock = to_int<std::int64_t>(clock_arg, "clock");
              const la::UnitsN<D> u = units_from<D>(units);
              const revcol::Law lw = parse_law(law);
-             return P{Engine(u, vecs<D>(x, "x"), vecs<D>(v, "v"), static_cast<std::uint32_t>(seed), la::operator_for(u, lw), clock)};
+             const revcol::Mode md = parse_lattice_mode(mode);
+             return P{Engine(u, vecs<D>(x, "x"), vecs<D>(v, "v"), static_cast<std::uint32_t>(seed), la::operator_for(u, lw), clock, md)};
            }),
-           py::arg("units"), py::arg("x"), py::arg("v"), py::arg("seed"), py::arg("law"), py::arg("clock") = 0)
+           py::arg("units"), py::arg("x"), py::arg("v"), py::arg("seed"), py::arg("law"), py::arg("clock") = 0,
+           py::arg("mode") = "exact")
       .def_static(
           "from_snapshot",
           [](const py::dict& d) {
@@ -433,6 +445,7 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
       .def_property_readonly("units", [](const P& p) { return units_dict(p.engine().units()); })
       .def_property_readonly("n", [](const P& p) { return p.engine().size(); })
       .def_property_readonly("law", [](const P& p) { return std::string(to_string(p.engine().law())); })
+      .def_property_readonly("mode", [](const P& p) { return std::string(to_string(p.engine().mode())); })
       // ---- the neighbour search (BasicEngine::set_list_shell): never changes which collisions happen ----
       .def(
           "set_search", [](P& p, PyReal shell) { p.engine().set_list_shell(to_real(shell, "shell")); }, py::arg("shell"),

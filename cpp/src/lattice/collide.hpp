@@ -86,6 +86,10 @@ void BasicEngine<Op, Bits, Queue>::apply(int i, int j, const Vec& xi, const Vec&
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::collide_forward(int i, int j, std::int64_t a) {
+  if (mode_ == Mode::specular) {
+    collide_specular(i, j, a);
+    return;
+  }
   journal(i);
   journal(j);
   if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
@@ -135,6 +139,10 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
     group_back(i, j, a, *g);
     return;
   }
+  if (mode_ == Mode::specular) {
+    back_specular(i, j, a);
+    return;
+  }
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
   const std::uint32_t* logged = log_.top(ncoll_);
   const std::uint32_t redraws = logged ? *logged : 0;
@@ -146,6 +154,53 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   xj0 = shifted(xj, xj0);
   ctr_[i] -= 1 + redraws;
   if (logged) log_.pop();
+  --ncoll_;
+  apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
+}
+
+// Specular mode (specular.hpp): one deterministic post state. When the map refuses it or it
+// fails the acceptance test (a third body at a, a false tie at a-1, a wall, vmax) no redraw
+// exists: the collision goes to the group rule (a log entry, its reason counted in redraws).
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a) {
+  journal(i);
+  journal(j);
+  if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
+  const Vec pre_a[2] = {pos(i, a), pos(j, a)};
+  const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+  Vec xi2, xj2, vi2, vj2;
+  SpecularTrace tr;
+  bool multi = false;
+  int why = static_cast<int>(spec_.pair_map(xi, zero, ln_[i].v, ln_[j].v, xi2, xj2, vi2, vj2, &tr));
+  if (why == 0) {
+    xi2 = shifted(xj, xi2);
+    xj2 = shifted(xj, xj2);
+    why = post_reason(i, j, xi2, xj2, vi2, vj2, a, pre_a, multi);
+  }
+  if (why != 0) {
+    std::array<std::uint64_t, 8> reasons{};
+    ++reasons[std::min(why, 7)];
+    ++cnt_.redraws[std::min(why, 7)];
+    group_collide(i, j, a, ctr_[i], reasons);
+    return;
+  }
+  if (multi) ++cnt_.multi_body;
+  if (tr.backscatter) ++cnt_.backscatters;
+  ++ncoll_;
+  if (trace != nullptr) trace->push_back({a, i, j});
+  if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
+  apply(i, j, xi2, xj2, vi2, vj2, a);
+}
+
+// The reverse of a specular collision: the map's exact inverse on the negated lines.
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::back_specular(int i, int j, std::int64_t a) {
+  const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+  Vec xi0, xj0, vi0, vj0;
+  if (spec_.pair_unmap(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi0, xj0, vi0, vj0) != Refusal::none)
+    throw std::logic_error("lattice engine: the specular map refused a post state it wrote (a bug)");
+  xi0 = shifted(xj, xi0);
+  xj0 = shifted(xj, xj0);
   --ncoll_;
   apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
 }

@@ -203,8 +203,9 @@ void BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
     ln_[j] = keep[1];
     std::string why = "lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
                       std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
-                      " found no acceptable post state in " + std::to_string(max_redraws) +
-                      " redraws, and its group of " + std::to_string(g.size()) + " can neither resolve nor bounce back (";
+                      (mode_ == Mode::specular ? std::string(" had its specular post state refused")
+                                               : " found no acceptable post state in " + std::to_string(max_redraws) + " redraws") +
+                      ", and its group of " + std::to_string(g.size()) + " can neither resolve nor bounce back (";
     for (int k = 1; k < 8; ++k) why += std::string(redraw_names[k]) + " " + std::to_string(reasons[k]) + (k < 7 ? ", " : ")");
     throw std::runtime_error(why);
   }

@@ -63,9 +63,7 @@ Column make_column(const Vec3& p, i128 sigma2, std::int64_t sigma) {
   c.xc = pf[0];
   c.yc = pf[1];
   c.pz = pf[2];
-  const int axis = c.face >> 1;  // strict ties where the frame axis has priority (z > y > x)
-  const int sx = axis == 2 ? 0 : 1, sy = axis == 0 ? 1 : 0;
-  c.zmin = std::max({i64{1}, iabs(c.xc) + sx, iabs(c.yc) + sy});
+  c.zmin = LatticePair3D::zmin_of(c.face, c.xc, c.yc);
   const i128 r2 = sq(c.xc) + sq(c.yc);
   c.zin = static_cast<i64>(isqrt(static_cast<u128>(sigma2 - r2 - 1)));
   std::int64_t kphi = 0, ktheta = 0;
@@ -94,14 +92,7 @@ inline Vec3 neg(const Vec3& v) { return {-v[0], -v[1], -v[2]}; }
 
 // The lowest pre phase of the column for inward W (face frame), or nullopt if not an interval.
 std::optional<i64> lo_pre3(i128 sigma2, const Column& c, const Vec3& W) {
-  i128 lo = c.zmin;
-  const i128 d = sigma2 - sq(c.xc - W[0]) - sq(c.yc - W[1]);
-  if (d > 0) {
-    const i128 z = isqrt_ceil(static_cast<u128>(d));
-    if (W[2] - z >= c.zmin) return std::nullopt;  // points below the sphere too
-    lo = std::max(lo, W[2] + z);
-  }
-  return static_cast<i64>(std::min<i128>(lo, static_cast<i128>(c.zin) + 1));
+  return LatticePair3D::lo_pre(sigma2, c.xc, c.yc, c.zmin, c.zin, W);
 }
 
 // The lowest post phase for outgoing W2, or nullopt.
@@ -191,6 +182,23 @@ Vec3 LatticePair3D::from_face(const Vec3& v, int f) {
 }
 
 std::optional<std::array<i64, 2>> LatticePair3D::row(std::int64_t phi, i64 xa) { return row_of(az_cell(phi), xa); }
+
+i64 LatticePair3D::zmin_of(int face, i64 xc, i64 yc) {
+  const int axis = face >> 1;  // strict ties where the frame axis has priority (z > y > x)
+  const int sx = axis == 2 ? 0 : 1, sy = axis == 0 ? 1 : 0;
+  return std::max({i64{1}, iabs(xc) + sx, iabs(yc) + sy});
+}
+
+std::optional<i64> LatticePair3D::lo_pre(i128 sigma2, i64 xc, i64 yc, i64 zmin, i64 zin, const Vec3& W) {
+  i128 lo = zmin;
+  const i128 d = sigma2 - sq(xc - W[0]) - sq(yc - W[1]);
+  if (d > 0) {
+    const i128 z = isqrt_ceil(static_cast<u128>(d));
+    if (W[2] - z >= zmin) return std::nullopt;  // points below the sphere too
+    lo = std::max(lo, W[2] + z);
+  }
+  return static_cast<i64>(std::min<i128>(lo, static_cast<i128>(zin) + 1));
+}
 
 namespace {
 

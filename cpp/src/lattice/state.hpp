@@ -46,6 +46,7 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
   require(s.origin <= s.clock && tick_limit / 2 > s.clock && s.origin > -tick_limit / 2,
           "lattice snapshot: origin <= clock within +-2^60 required");
   require(s.law == law(), "lattice snapshot: its law is not the operator's");
+  require(s.mode == Mode::exact || s.mode == Mode::specular, "lattice snapshot: mode must be exact or specular");
   check_operator(s.units);
   // a running observation resumes (built before anything changes: a spoiled one is an error)
   std::unique_ptr<engine::Observer> resumed;
@@ -61,6 +62,7 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   Snapshot s;
   s.units = u_;
   s.law = law();
+  s.mode = mode_;
   s.seed = seed_;
   s.clock = clock_;
   s.origin = origin_;
@@ -82,6 +84,8 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s) {
   u_ = s.units;
   seed_ = s.seed;
+  mode_ = s.mode;
+  if (mode_ == Mode::specular) spec_ = Specular(u_.sigma);
   const std::size_t n = s.x.size();
   ln_.resize(n);
   for (std::size_t p = 0; p < n; ++p) ln_[p] = Line{s.x[p], s.v[p], s.clock};

@@ -61,6 +61,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -74,6 +75,7 @@
 #include "revcol/lattice/geometry.hpp"
 #include "revcol/lattice/state.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
+#include "revcol/lattice/specular.hpp"
 #include "revcol/lattice/units.hpp"
 #include "revcol/rng/philox.hpp"
 
@@ -111,16 +113,20 @@ class BasicEngine {
   using Snapshot = SnapshotN<D>;    ///< the state
   using GroupEntry = GroupEntryN<D>;  ///< a group collision in the rare log
 
-  /// An engine on a validated integer state at tick clock, X from initial_bits(seed).
+  /// An engine on a validated integer state at tick clock, X from initial_bits(seed); mode
+  /// exact (the operator Op, randomized) or specular (the deterministic map of specular.hpp: no
+  /// draws, X never changes).
   BasicEngine(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, Op op,
-              std::int64_t clock = 0)
+              std::int64_t clock = 0, Mode mode = Mode::exact)
       : op_(std::move(op)) {
     check_operator(u);
+    require(mode == Mode::exact || mode == Mode::specular, "lattice: mode must be 'exact' or 'specular'");
     validate_state(u, x, v);
     require(clock > -tick_limit / 2 && clock < tick_limit / 2, "lattice: the start tick must be within +-2^60");
     Snapshot s;
     s.units = u;
     s.law = law();
+    s.mode = mode;
     s.seed = seed;
     s.clock = s.origin = clock;
     s.x = std::move(x);
@@ -200,6 +206,8 @@ class BasicEngine {
     if constexpr (requires { op_.law(); }) return op_.law();
     else return Law::flux;
   }
+  /// exact (the randomized operator Op) or specular (the deterministic map, specular.hpp).
+  Mode mode() const noexcept { return mode_; }
   /// Redraws tried before a collision is resolved as a group bounce (group_bounce); -1 (tests
   /// only) resolves every collision so.
   int max_redraws = 256;
@@ -351,6 +359,8 @@ class BasicEngine {
   void apply(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a);
   void collide_forward(int i, int j, std::int64_t a);
   void collide_back(int i, int j, std::int64_t a);
+  void collide_specular(int i, int j, std::int64_t a);
+  void back_specular(int i, int j, std::int64_t a);
 
   std::vector<int> group_of(int i, int j, std::int64_t a) const;
   std::vector<Vec> resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const;
@@ -376,6 +386,10 @@ class BasicEngine {
       require(op_.cell_bits() == u.cell_bits, "lattice: the operator's cell_bits differ from the units'");
   }
   Op op_;
+  // specular mode: the deterministic map (built by load for the units' sigma)
+  using Specular = std::conditional_t<D == 2, LatticeSpecular2D, LatticeSpecular3D>;
+  Mode mode_ = Mode::exact;
+  Specular spec_{2};
   Units u_;
   std::uint32_t seed_ = 1;
   // one particle's line, together in memory (the prediction loop reads all three)

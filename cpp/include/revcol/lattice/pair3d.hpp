@@ -153,6 +153,13 @@ class LatticePair3D {
   static Vec3 to_face(const Vec3& v, int f);
   /// The inverse of to_face.
   static Vec3 from_face(const Vec3& v, int f);
+  /// The lowest z of face f's column (xc, yc): max(1, |xc| + sx, |yc| + sy), sx, sy = 1 where
+  /// the frame axis has priority over the face axis (strict ties).
+  static i64 zmin_of(int face, i64 xc, i64 yc);
+  /// The lowest pre phase of column (xc, yc) (face frame, z in [zmin, zin]) for inward W: the
+  /// inside points whose point minus W is outside form [lo, zin] (lo = zin + 1: none); nullopt
+  /// when they do not form an interval.
+  static std::optional<i64> lo_pre(i128 sigma2, i64 xc, i64 yc, i64 zmin, i64 zin, const Vec3& W);
 
  private:
   std::int64_t sigma_;

@@ -43,6 +43,7 @@ struct Counters : Visitable<Counters> {
   std::uint64_t group_resolves = 0;      ///< groups resolved specularly, pre velocities logged (a log entry)
   std::uint64_t group_bounces = 0;       ///< groups that bounced back (the fallback; a log entry)
   std::uint64_t wall_groups = 0;         ///< group members whose reflection at the same tick the group took in
+  std::uint64_t backscatters = 0;        ///< specular mode: pairs turned back in place (specular.hpp; forward)
 
   /// Calls f(name, count) for every counter, with the names of the diagnostics (redraws: the
   /// array by RedrawReason, index 0 unused).
@@ -60,6 +61,7 @@ struct Counters : Visitable<Counters> {
     f("group_resolves", c.group_resolves);
     f("group_bounces", c.group_bounces);
     f("wall_groups", c.wall_groups);
+    f("backscatters", c.backscatters);
   }
 };
 
@@ -84,6 +86,7 @@ template <std::size_t D>
 struct SnapshotN : Visitable<SnapshotN<D>> {
   UnitsN<D> units;                             ///< units and box
   Law law = Law::flux;                         ///< the pair operator's post-direction law
+  Mode mode = Mode::exact;                     ///< exact (the randomized operator) or specular (specular.hpp)
   std::uint32_t seed = 1;                      ///< Philox key {particle, seed}
   std::int64_t clock = 0;                      ///< the current tick
   std::int64_t origin = 0;                     ///< the tick of the initial state (no run back past it)
@@ -106,6 +109,7 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
   static void visit_fields(S& s, F& f) {
     f("units", s.units);
     f("law", s.law);
+    f("mode", s.mode);
     f("seed", s.seed);
     f("clock", s.clock);
     f("origin", s.origin);
@@ -133,7 +137,7 @@ bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
   const UnitsN<D> &u = a.units, &w = b.units;
   return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.bounce == w.bounce && u.vmax == w.vmax &&
          u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
-         a.law == b.law && a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
+         a.law == b.law && a.mode == b.mode && a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&
          a.groups == b.groups &&
          a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
