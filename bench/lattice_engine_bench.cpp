@@ -49,6 +49,7 @@ struct LatticeCase {
   bool walls = false;
   std::uint64_t seed = 1;
   int dim = 2;
+  revcol::Mode mode = revcol::Mode::exact;  // the lattice engine's mode; the float engine's (exact: the flux law)
 };
 
 // the initial placement: 2D as before; 3D: random_state's choice (rsa to 0.2, else FCC)
@@ -85,7 +86,7 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
     return true;
   });
   const la::LatticeStartN<D> st = la::random_start(cfg, c.n, c.phi, c.seed, init_of(c));
-  Engine e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
+  Engine e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units), 0, c.mode);
   if (shell >= 0.0) e.set_list_shell(shell);
   // warm up a collision per particle from the initialiser's lattice, then start the clock
   e.run(c.n, la::tick_limit - 1);
@@ -175,6 +176,7 @@ std::vector<Metric> run_float(const LatticeCase& c, std::uint64_t nc) {
   en::Config cfg;
   cfg.dim = c.dim;
   cfg.seed = static_cast<std::uint32_t>(c.seed);
+  cfg.mode = c.mode;
   const en::InitialState st = en::random_state(cfg, c.n, c.phi, c.seed, 0.0, init_of(c));
   auto sim = en::make_simulation(st.config, st.x, st.v);
   const double inf = std::numeric_limits<double>::infinity();
@@ -251,6 +253,20 @@ void add_lattice_benches(std::vector<Bench>& out) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_float(c, n); }});
   }
+  // specular dynamics (issue 53's table): the lattice engine's specular map, the lattice flux law
+  // and the float engine's specular mode on the same periodic gases (2D 0.5, 3D 0.3; N 1e4, 1e5);
+  // bench/specular_speed.py runs them interleaved
+  using revcol::Mode;
+  for (const auto& [dim, phi] : {std::pair{2, 0.5}, std::pair{3, 0.3}})
+    for (std::size_t n : {std::size_t{10000}, std::size_t{100000}}) {
+      const std::string tail = "/d" + std::to_string(dim) + "/n" + std::to_string(n) + (dim == 2 ? "/phi0.5" : "/phi0.3");
+      const LatticeCase spec{n, phi, false, 1, dim, Mode::specular}, flux{n, phi, false, 1, dim, Mode::exact};
+      out.push_back({"specular/lattice" + tail, "collisions/s", [spec](std::uint64_t k) {
+                       return spec.dim == 3 ? run_lattice<3>(spec, k) : run_lattice<2>(spec, k); }});
+      out.push_back({"specular/flux" + tail, "collisions/s", [flux](std::uint64_t k) {
+                       return flux.dim == 3 ? run_lattice<3>(flux, k) : run_lattice<2>(flux, k); }});
+      out.push_back({"specular/float" + tail, "collisions/s", [spec](std::uint64_t k) { return run_float(spec, k); }});
+    }
 }
 
 }  // namespace revcol::bench
