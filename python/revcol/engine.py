@@ -69,7 +69,8 @@ class Simulation(SimulationBase):
 
     ``engine="lattice"`` builds the lattice engine's simulation instead
     (:class:`revcol.lattice.LatticeSimulation`, or ``LatticeSimulation3D`` for (n, 3)
-    positions): both are a :class:`revcol.SimulationBase`.
+    positions): both are a :class:`revcol.SimulationBase`. Its ``mode`` is ``"exact"`` or
+    ``"specular"`` (deterministic specular dynamics, reversed bit for bit with no draws).
     """
 
     engine = "float"
@@ -77,7 +78,7 @@ class Simulation(SimulationBase):
     def __new__(cls, *args, engine: str = "float", **kwargs):
         # engine="lattice" hands the whole call to the lattice engine (revcol.lattice: disks, or
         # spheres for (n, 3) positions), which takes the same positions, velocities, box,
-        # boundary, diameter, law and seed
+        # boundary, diameter, mode (exact or specular), law and seed
         if engine != "float":
             x = np.asarray(args[0] if args else kwargs.get("positions", ()))
             return engine_class(engine, 3 if x.ndim == 2 and x.shape[1] == 3 else 2)(*args, **kwargs)
@@ -116,7 +117,7 @@ class Simulation(SimulationBase):
         all of one speed (``equal_speeds``). Other keywords go to the constructor (mode, law, ...);
         the same ``seed`` keys the collision streams. ``engine="lattice"``: the lattice engine's
         ``LatticeSimulation.random`` (dim 2) or ``LatticeSimulation3D.random`` (dim 3), reversed
-        bit for bit (``law`` and ``seed`` apply)."""
+        bit for bit (``mode``, ``"exact"`` or ``"specular"``, ``law`` and ``seed`` apply)."""
         phi = _packing_fraction(phi, packing_fraction)
         init = placement(init)
         if engine != "float":

@@ -14,6 +14,12 @@ or to any earlier collision count or time.
 A float start (``random`` or arrays) is quantized once; ``quantization`` reports the error. The
 round trip is exact from the quantized state on. Times in floats are ``clock * tick``.
 
+``mode="specular"`` runs deterministic specular hard-sphere dynamics instead: each pair
+collision reflects the relative velocity about the contact normal with an exact integer
+involution (the momentum exact, the energy to a few lattice units), carrying the sub-tick phase
+across; no random number is drawn, X never changes, and the run is still reversed bit for bit
+(docs/lattice.md "Specular dynamics"). The rare log then holds group collisions only.
+
     >>> from revcol.lattice import LatticeSimulation
     >>> sim = LatticeSimulation.random(n=100, phi=0.3, seed=1)
     >>> x0, v0 = sim.lattice_positions, sim.lattice_velocities
@@ -35,7 +41,11 @@ from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .simulation import SimulationBase, register_engine
 
-__all__ = ["LatticeSimulation", "LatticeSimulation3D"]
+__all__ = ["LatticeSimulation", "LatticeSimulation3D", "MODES"]
+
+#: the lattice engine's modes: "exact" (the randomized pair operator, drawing its post direction
+#: by ``law``) and "specular" (deterministic specular dynamics: no draws; docs/lattice.md)
+MODES = ("exact", "specular")
 
 _Boundary = Union[str, Sequence[str]]
 
@@ -44,6 +54,17 @@ def _boundary(boundary: _Boundary) -> list:
     """One boundary name or one per axis, as the binding takes them (the C++ parser,
     revcol/engine/boundary_kind.hpp, names a wrong one or a wrong count)."""
     return names(boundary, "boundary")
+
+
+def _mode(mode, law) -> str:
+    """``mode`` checked against ``law``: a ValueError naming ``mode`` unless it is one of
+    :data:`MODES`, or naming ``law`` when specular mode is given a law other than the default
+    (it draws no post direction, so no law applies)."""
+    if not isinstance(mode, str) or mode not in MODES:
+        raise ValueError(f"mode must be 'exact' or 'specular', got {mode!r}")
+    if mode == "specular" and law != "flux":
+        raise ValueError(f"law applies to mode='exact' only (specular mode draws nothing), got law={law!r}")
+    return mode
 
 
 def _tick(tick_bits: Optional[int]) -> int:
@@ -81,8 +102,12 @@ class LatticeSimulation(SimulationBase):
     Build from float arrays (``LatticeSimulation(positions, velocities, box)``, quantized once)
     or at random (``LatticeSimulation.random(n, phi=...)``, the float engine's initialiser then
     quantized). ``boundary``: ``"periodic"``, ``"wall"`` (specular) or ``"bounce"`` (bounce-back, v -> -v,
-    as the float engine's), one name or one per axis. ``law``: ``"flux"``
-    (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and X's
+    as the float engine's), one name or one per axis. ``mode``: ``"exact"`` (default: the
+    randomized pair operator, reversed bit for bit through its draws and the bits-back integer)
+    or ``"specular"`` (deterministic specular hard-sphere dynamics, bit-reversible with no random
+    numbers: the relative velocity reflected about the contact normal by an exact integer
+    involution; X never changes; docs/lattice.md "Specular dynamics"). ``law`` (exact mode only):
+    ``"flux"`` (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and X's
     first 256 bits. ``tick_bits`` T (16..26; default ``None``: automatic): a particle of rms speed
     moves 2^-T diameters per tick; a finer tick (larger T) makes redraws and group collisions (a
     third body within one tick) rarer at the cost of fewer bits of velocity resolution (2^(S-T)
@@ -101,14 +126,15 @@ class LatticeSimulation(SimulationBase):
     engine = "lattice"
 
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
-                 diameter: float = 1.0, law: str = "flux", seed: int = 1, tick_bits: Optional[int] = None,
-                 cell_bits: int = 16, search: Union[str, float] = "auto", _engine=None,
+                 diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
+                 tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto", _engine=None,
                  _quantization: Optional[dict] = None):
         if _engine is not None:
             self._e = _engine
             self._q = dict(_quantization or {})
             self._search = -1.0
             return
+        mode = _mode(mode, law)
         shell = _shell(search)
         x = real_array(positions, "positions")
         v = real_array(velocities, "velocities")
@@ -120,11 +146,12 @@ class LatticeSimulation(SimulationBase):
             raise ValueError(f"box must be one length or three (3D), got shape {box.shape}")
         start = getattr(_core, _QUANTIZE[dim])(x, v, [float(b) for b in np.broadcast_to(box, (dim,))],
                                                _boundary(boundary), diameter, _tick(tick_bits), cell_bits)
-        self._init_from_start(start, law, seed, dim, shell)
+        self._init_from_start(start, law, seed, dim, shell, mode)
 
-    def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2, shell: float = -1.0) -> None:
+    def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2, shell: float = -1.0,
+                         mode: str = "exact") -> None:
         engine = getattr(_core, _ENGINE[dim])
-        self._e = engine(start["units"], start["x"], start["v"], seed, name(law, "law"))
+        self._e = engine(start["units"], start["x"], start["v"], seed, name(law, "law"), mode=mode)
         self._q = {"max_position_error": start["max_position_error"],
                    "max_velocity_error": start["max_velocity_error"]}
         self._search = -1.0
@@ -138,7 +165,7 @@ class LatticeSimulation(SimulationBase):
 
     @classmethod
     def random(cls, n: int, dim: Optional[int] = None, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
-               diameter: float = 1.0, seed: int = 1, init: str = "auto", law: str = "flux",
+               diameter: float = 1.0, seed: int = 1, init: str = "auto", mode: str = "exact", law: str = "flux",
                tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
                packing_fraction: Optional[float] = None) -> "LatticeSimulation":
         """n disks (spheres for LatticeSimulation3D) at area (volume) fraction ``phi`` (or
@@ -147,8 +174,10 @@ class LatticeSimulation(SimulationBase):
         jittered crystal, square in 2D and face-centred cubic in 3D; ``"auto"`` picks; the old
         name ``"lattice"`` still works, with a DeprecationWarning; Gaussian velocities with zero
         momentum, kT = 1), quantized once. The same ``seed`` keys the streams. ``dim`` (default:
-        the class's, 2 or 3) must be the class's; the other keywords as the constructor's."""
+        the class's, 2 or 3) must be the class's; the other keywords (``mode``, ``law``, ...) as
+        the constructor's."""
         phi = _packing_fraction(phi, packing_fraction)
+        mode = _mode(mode, law)
         init = placement(init)
         shell = _shell(search)
         dim = cls._DIM if dim is None else dim
@@ -160,7 +189,7 @@ class LatticeSimulation(SimulationBase):
         start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, init,
                                                    _tick(tick_bits), cell_bits)
         sim = cls.__new__(cls)
-        sim._init_from_start(start, law, seed, dim, shell)
+        sim._init_from_start(start, law, seed, dim, shell, mode)
         return sim
 
     # --- running ---------------------------------------------------------------------------
@@ -275,6 +304,12 @@ class LatticeSimulation(SimulationBase):
         return tuple(self._e.units["boundary"])
 
     @property
+    def mode(self) -> str:
+        """``"exact"`` (the randomized pair operator) or ``"specular"`` (deterministic specular
+        dynamics, no draws); kept in snapshots and checkpoints."""
+        return str(self._e.mode)
+
+    @property
     def units(self) -> dict:
         """S, sigma, L, boundary (per axis its kind), wall (per axis: walls), vmax, length_unit, tick."""
         return dict(self._e.units)
@@ -302,7 +337,9 @@ class LatticeSimulation(SimulationBase):
         """Energy drift (relative and in lattice units), momentum drift per axis (lattice
         units), X's bit length, rare-log entries (redraw counts, and group collisions: a third body
         within one tick; ``group_resolves``, ``group_bounces``, ``wall_groups``), redraws by reason,
-        multi-body and wall-body ticks, events by type, memory, and the quantization errors."""
+        ``backscatters`` (specular mode: pairs turned back in place, a rare case; 0 in exact
+        mode), multi-body and wall-body ticks, events by type, memory, and the quantization
+        errors."""
         d = dict(self._e.diagnostics())
         d.update(self._q)
         return d
@@ -310,7 +347,7 @@ class LatticeSimulation(SimulationBase):
     # --- checkpoints -----------------------------------------------------------------------
 
     def snapshot(self) -> dict:
-        """The full state (units, positions at the clock, velocities, stream counters, X's
+        """The full state (units, mode, positions at the clock, velocities, stream counters, X's
         words, rare log, clock, collision count) as numpy arrays and numbers, and the neighbour
         search asked (``"search"``: the list shell in diameters, -1 automatic, 0 the cell grid)."""
         s = dict(self._e.snapshot())
@@ -320,8 +357,9 @@ class LatticeSimulation(SimulationBase):
 
     @classmethod
     def from_snapshot(cls, snapshot: dict) -> "LatticeSimulation":
-        """Rebuilds from ``snapshot()``; the run resumes bit for bit. A 3D snapshot (``dim`` 3)
-        gives a LatticeSimulation3D whichever class is asked."""
+        """Rebuilds from ``snapshot()``; the run resumes bit for bit, in the snapshot's mode (one
+        written before specular mode existed has no ``mode`` and is exact). A 3D snapshot (``dim``
+        3) gives a LatticeSimulation3D whichever class is asked."""
         st = dict(snapshot)
         q = st.pop("quantization", None)
         shell = _snapshot_shell(st.pop("search", -1.0))  # written before it existed: automatic
@@ -403,9 +441,10 @@ class LatticeSimulation3D(LatticeSimulation):
     (``LatticeSimulation3D.random(n, phi=...)``: the float engine's 3D ``random_state``, random
     sequential addition up to a volume fraction 0.2, else a jittered face-centred cubic
     crystal). ``boundary``:
-    one name or three. The pair operator is ``LatticePair3D`` (the polar angle by whole-cell
-    lifting rotations, the azimuth by bits-back over the exact rows of its cell;
-    docs/lattice.md); ``cell_bits`` sets its 2^cell_bits polar cells per turn. Snapshots carry
+    one name or three. The exact mode's pair operator is ``LatticePair3D`` (the polar angle by
+    whole-cell lifting rotations, the azimuth by bits-back over the exact rows of its cell;
+    docs/lattice.md); ``cell_bits`` sets its 2^cell_bits polar cells per turn. ``mode="specular"``
+    runs deterministic specular sphere dynamics (no draws), reversed bit for bit as well. Snapshots carry
     ``dim`` = 3 and (n, 3) arrays.
 
         >>> from revcol.lattice import LatticeSimulation3D

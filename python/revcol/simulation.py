@@ -6,8 +6,10 @@
 velocities, box, ``boundary``, ``diameter``, ``law``, ``seed``), the same ``random``, ``run``,
 ``run_back``, state properties, observation (``observe``, :mod:`revcol.observe`), attached
 actions (``attach``), checkpoints (``snapshot``, ``save``, ``load``) and pickling. Each engine
-adds its own options (the float engine's ``mode``, ``groups``, ``generator``; the lattice's
-``tick_bits``, ``cell_bits``, ``search``) and readings (the lattice's integer state).
+adds its own options (the float engine's ``groups``, ``generator``; the lattice's
+``tick_bits``, ``cell_bits``, ``search``) and readings (the lattice's integer state). Both take
+``mode``: the float engine ``"exact"``, ``"paper"`` or ``"specular"``, the lattice ``"exact"``
+or ``"specular"`` (deterministic specular dynamics, reversed bit for bit with no draws).
 
 ``Simulation(..., engine="lattice")`` and ``Simulation.random(..., engine="lattice")`` build
 the lattice engine's class through the registry below, which each engine's module fills in
@@ -34,8 +36,8 @@ from .observe import Observing
 __all__ = ["SimulationBase", "ENGINES", "register_engine", "engine_class"]
 
 #: the engines a simulation can run on: "float" (any d; exact, paper and specular modes;
-#: reverses within a round-off horizon) and "lattice" (d = 2, 3; integer state; reverses bit
-#: for bit at any length)
+#: reverses within a round-off horizon) and "lattice" (d = 2, 3; exact and specular modes;
+#: integer state; reverses bit for bit at any length)
 ENGINES = ("float", "lattice")
 
 # engine name -> a function of the dimension giving its class (filled in by engine.py, lattice.py)

@@ -34,7 +34,7 @@ LEGAL = {
     ("lattice", "quantization.max_position_error", "huge"): "a reported error, finite",
     ("lattice", "quantization.max_velocity_error", "huge"): "a reported error, finite",
     **{("lattice", k, "missing"): "written before the entry existed: a default" for k in
-       ("engine", "group_kind", "group_v", "units.tick_bits", "units.cell_bits", "units.boundary",
+       ("engine", "mode", "group_kind", "group_v", "units.tick_bits", "units.cell_bits", "units.boundary",
         "quantization.max_position_error", "quantization.max_velocity_error", "search")},
 }
 
