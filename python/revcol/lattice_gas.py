@@ -9,7 +9,9 @@ sub-tick phase and realises the torus shift exactly), the rare log and the clock
 count). Every collision is an exact integer bijection, so the reversal restores each of them
 exactly, for any number of collisions; the float start is quantized once (its error is
 reported) and the round trip is exact from the quantized state on. :func:`restored` compares
-each part of the state exactly; the round trip passes when every part is equal.
+each part of the state exactly; the round trip passes when every part is equal. In specular
+mode (``[collisions] mode = "specular"``) no number is drawn and X never changes; the report
+counts the backscatters (pairs the specular map turned back in place).
 
 The run goes forward in chunks (about 200 of them, at most 10^4 collisions each; the lattice
 engine's run is the same in chunks as in one call) so that Ctrl-C stops it between chunks and
@@ -285,6 +287,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
                   "tick_bits": units["tick_bits"], "cell_bits": units["cell_bits"],
                   "length_unit": units["length_unit"], "L": list(units["L"])},
         "search": sim.search,  # the neighbour search in use: "cells" or the lists' shell in diameters
+        "mode": sim.mode,
         "quantization": sim.quantization,
         "collisions_forward": done, "collisions_back": run.back, "per_particle": 2.0 * done / n,
         "time_start": 0.0, "time_turn": run.t_turn, "time_end": sim.time, "clock_turn": run.clock_turn,
@@ -304,6 +307,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "log_entries_turn": entries_turn, "log_bytes_turn": bytes_turn,
         "log_entries_end": entries_end, "log_bytes_end": bytes_end,
         "group_resolves": int(d_turn["group_resolves"]), "group_bounces": int(d_turn["group_bounces"]),
+        "backscatters": int(d_turn["backscatters"]),  # specular mode: pairs turned back in place
         "log_entries_per_collision": per(entries_turn),
         "redraws": redraws, "redraws_total": sum(redraws.values()), "redraws_per_collision": per(sum(redraws.values())),
         "multi_body": int(d_turn["multi_body"]), "wall_body": int(d_turn["wall_body"]),

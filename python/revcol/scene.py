@@ -7,7 +7,7 @@ A scene is one of three kinds (``[scene] kind``):
   float engine (``revcol.Simulation``, 1-3D, exact within a horizon) unless ``[collisions]
   engine = "lattice"`` (``revcol.lattice.LatticeSimulation``, 2D, or ``LatticeSimulation3D``,
   3D: integer state, exact for any number of collisions; exact mode, flux or uniform law,
-  Philox per-particle streams);
+  Philox per-particle streams, or specular mode, deterministic specular dynamics with no draws);
 - ``"reversal"``: the paper's reversal illustration for a named case (2 or 3 particles,
   momentum and energy held, velocities only: no positions are built), ``revcol verify``'s
   machinery;
@@ -49,10 +49,12 @@ file and the replacement.
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
 
     [collisions]
-    engine = "float"              # gas only: "float" | "lattice" (2D and 3D, exact mode, Philox
-                                  # per_particle; its default generator is then "philox")
-    mode = "exact"                # "exact" | "paper" (gas: 1D and 2D, the engine's limit)
-    law = "flux"                  # exact mode: "flux" | "uniform"
+    engine = "float"              # gas only: "float" | "lattice" (2D and 3D, exact or specular mode,
+                                  # Philox per_particle; its default generator is then "philox")
+    mode = "exact"                # "exact" | "paper" (gas: 1D and 2D, the float engine's limit) |
+                                  # "specular" (gas only, either engine: deterministic specular
+                                  # dynamics, no draws; on the lattice reversed bit for bit)
+    law = "flux"                  # exact mode only: "flux" | "uniform"
     bits = 40                     # K, bits per chart coordinate, 8..52 (not statesave, not lattice)
     tick_bits = 20                # engine = "lattice" only: 16..26 (default automatic), a particle of
                                   # rms speed moves 2^-tick_bits diameters per tick
@@ -115,14 +117,14 @@ from . import _core
 from ._toml import read_toml, shipped_dirs
 from .engine import Simulation
 from .lattice import LatticeSimulation
-from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINES, KINDS,  # noqa: F401 (__all__)
-                           LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES, SceneError, _check,
-                           _fail, _modernize)
+from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINE_MODES,  # noqa: F401 (__all__)
+                           ENGINES, KINDS, LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES,
+                           SceneError, _check, _check_mode, _fail, _modernize)
 from .statesave import variants as statesave_variants
 from .verify import verify_cases
 
 __all__ = ["Scene", "SceneError", "load_scene", "scene_from_dict", "engine_options", "lattice_options", "with_engine",
-           "with_lattice_options", "DEFAULT_SCENE", "KINDS", "ENGINES"]
+           "with_mode", "with_lattice_options", "DEFAULT_SCENE", "KINDS", "ENGINES", "ENGINE_MODES"]
 
 @dataclass(frozen=True)
 class Scene:
@@ -255,8 +257,10 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
 
     mode = get("collisions", "mode", "exact")
     law = get("collisions", "law", "flux")
-    if mode == "paper" and ("collisions", "law") in values:
+    if mode != "exact" and ("collisions", "law") in values:
         raise _fail(source, "[collisions] law", "applies to mode = 'exact' only")
+    if kind != "gas":  # specular mode runs gases only
+        _check_mode(source, "[collisions] mode", kind, "float", 0, mode)
 
     if kind == "reversal":
         return _reversal(source, get, common, mode, law, out)
@@ -333,10 +337,7 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
             raise _fail(source, f"[collisions] {key}", "applies to engine = 'lattice' only (the float engine has no "
                         "ticks, direction cells or list shells)")
 
-    paper_dims = tuple(LIMITS["paper_mode_dimensions"])
-    if mode == "paper" and d not in paper_dims:
-        raise _fail(source, "[collisions] mode", f"'paper' runs gases in {' and '.join(f'{k}D' for k in paper_dims)} "
-                    f"only (it has no invertible {d}D pair operator), got dimension {d}")
+    _check_mode(source, "[collisions] mode", "gas", engine, d, mode)
 
     nc, t_end = get("run", "collisions"), get("run", "time")
     if nc is not None and t_end is not None:
@@ -386,13 +387,13 @@ def _observe(source: str, values: dict, d: int, n: int, bounds, engine: str) -> 
 
 
 def _check_lattice(source: str, d: int, mode: str, generator: str, streams: str, bits_given: bool) -> None:
-    """The combinations the lattice engine runs: 2D and 3D, exact mode (flux or uniform law),
-    Philox per-particle streams, no chart bits; anything else is a SceneError naming the field."""
+    """The combinations the lattice engine runs: 2D and 3D, exact mode (flux or uniform law) or
+    specular mode, Philox per-particle streams, no chart bits; anything else is a SceneError
+    naming the field."""
     why = "engine = 'lattice'"
     if d not in (2, 3):
         raise _fail(source, "[system] dimension", f"{why} runs 2D and 3D gases, got dimension {d}")
-    if mode != "exact":
-        raise _fail(source, "[collisions] mode", f"{why} runs exact mode only (flux or uniform law), got {mode!r}")
+    _check_mode(source, "[collisions] mode", "gas", "lattice", d, mode)
     if generator != "philox":
         raise _fail(source, "[rng] generator", f"{why} draws from Philox per-particle streams, got {generator!r}")
     if streams != "per_particle":
@@ -427,6 +428,25 @@ def with_engine(scene: Scene, engine: str) -> Scene:
     if scene.initial_state is not None:
         _check_initial(scene.source, out, *read_initial(scene.source, scene.initial_state, scene.dimension))
     return out
+
+
+def with_mode(scene: Scene, mode: str, engine: str | None = None) -> Scene:
+    """``scene`` in another collision mode (``revcol run`` and ``revcol simulate``'s ``--mode``), on
+    ``engine`` when given (``--engine``: the pair is checked together, as :func:`with_engine`),
+    checked as a scene file saying ``[collisions] mode = ...`` would be, but for a law: a scene
+    that names the default (flux) runs in any mode, another law (uniform) in exact mode only."""
+    src, allowed = scene.source, SCHEMA["collisions"]["mode"][1]
+    if scene.kind != "gas":
+        raise SceneError(f"{src}: --mode applies to 'gas' scenes, not {scene.kind!r}")
+    if mode not in allowed:
+        raise SceneError(f"{src}: --mode must be one of {', '.join(map(repr, allowed))}, got {mode!r}")
+    if mode != "exact" and scene.law != "flux":
+        raise SceneError(f"{src}: --mode {mode}: the scene's [collisions] law = {scene.law!r} applies to "
+                         "mode = 'exact' only")
+    engine = engine or scene.engine
+    if engine in ENGINE_MODES:  # else with_engine names the engine
+        _check_mode(src, "--mode", "gas", engine, scene.dimension, mode)
+    return with_engine(dataclasses.replace(scene, mode=mode), engine)
 
 
 def _reversal(source, get, common, mode, law, out) -> Scene:
@@ -499,8 +519,8 @@ def engine_options(scene: Scene) -> dict[str, Any]:
 
 def lattice_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.lattice.LatticeSimulation` that a gas scene sets."""
-    return dict(boundary=list(scene.boundaries), diameter=scene.diameter, law=scene.law, seed=scene.seed,
-                tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search)
+    return dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
+                seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search)
 
 
 def with_lattice_options(scene: Scene, *, tick_bits: int | None = None, cell_bits: int | None = None,

@@ -11,14 +11,19 @@ from typing import Any
 
 from . import _core
 
-__all__ = ["KINDS", "ENGINES", "LIMITS", "DEFAULT_SCENE", "SCHEMA", "USES", "DEPRECATED", "LATTICE_FIELDS",
-           "SceneError"]
+__all__ = ["KINDS", "ENGINES", "ENGINE_MODES", "LIMITS", "DEFAULT_SCENE", "SCHEMA", "USES", "DEPRECATED",
+           "LATTICE_FIELDS", "SceneError"]
 
 #: the kinds of scene
 KINDS = ("gas", "reversal", "statesave")
 
 #: the engines a gas scene can run on (``[collisions] engine``)
 ENGINES = ("float", "lattice")
+
+#: the collision modes (``[collisions] mode``) each engine runs gases in: the float engine's
+#: exact, paper (1D and 2D) and specular operators; the lattice's exact operator and its
+#: deterministic specular map (revcol.lattice.MODES). Reversal and statesave scenes: exact, paper.
+ENGINE_MODES = {"float": ("exact", "paper", "specular"), "lattice": ("exact", "specular")}
 
 
 #: the engine's limits and names (revcol/engine/limits.hpp), the one source of truth
@@ -51,7 +56,7 @@ SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
     },
     "collisions": {
         "engine": ("str", ENGINES),
-        "mode": ("str", ("exact", "paper")),
+        "mode": ("str", ("exact", "paper", "specular")),
         "law": ("str", ("flux", "uniform")),
         "bits": ("int", tuple(LIMITS["bits"])),
         # the lattice engine's (revcol/lattice/units.hpp, engine_core.hpp set_list_shell)
@@ -135,6 +140,22 @@ class SceneError(ValueError):
 
 def _fail(source: str, where: str, msg: str) -> SceneError:
     return SceneError(f"{source}: {where}: {msg}")
+
+
+def _check_mode(source: str, where: str, kind: str, engine: str, d: int, mode: str) -> None:
+    """The collision modes a scene's kind, engine and dimension run: specular in gas scenes
+    only, the lattice without paper mode, paper mode in the engine's dimensions (``where``
+    names the field or option in the SceneError)."""
+    if kind != "gas":
+        if mode == "specular":
+            raise _fail(source, where, f"'specular' runs gas scenes only, not kind = {kind!r} (exact or paper)")
+        return
+    if mode not in ENGINE_MODES[engine]:
+        raise _fail(source, where, f"engine = {engine!r} runs {' and '.join(ENGINE_MODES[engine])} modes, got {mode!r}")
+    paper_dims = tuple(LIMITS["paper_mode_dimensions"])
+    if mode == "paper" and d not in paper_dims:
+        raise _fail(source, where, f"'paper' runs gases in {' and '.join(f'{k}D' for k in paper_dims)} "
+                    f"only (it has no invertible {d}D pair operator), got dimension {d}")
 
 
 def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: Any) -> Any:

@@ -180,7 +180,7 @@ def test_fuzz_generators(kind, a, b, n):
        diameter=st.one_of(st.just(1.0), real_arg), seed=st.one_of(st.integers(0, 5), int_arg),
        energy=st.one_of(st.none(), real_arg), mode=st.sampled_from(["exact", "paper", "specular", "x"]))
 def test_fuzz_simulation_construction(engine, n, dim, phi, boundary, diameter, seed, energy, mode):
-    kw = {} if engine == "lattice" else {"energy": energy, "mode": mode}
+    kw = {"mode": mode} if engine == "lattice" else {"energy": energy, "mode": mode}
     s = attempt(lambda: Simulation.random(n, dim, phi, boundary=boundary, diameter=diameter, seed=seed,
                                           engine=engine, **kw))
     if s is not None:
@@ -259,7 +259,7 @@ def test_fuzz_scene_files(data, tmp_path_factory):
             value = data.draw(st.one_of(
                 st.integers(-3, 3000), st.floats(-1e3, 1e3, allow_nan=False), st.sampled_from(
                     ["1e-320", "1e300", "2147483648", '"gas"', '"../../x"', '"wall"', "[5, 5]", "[1e12, 1e12]",
-                     '"lattice"', "true", "-1", "nan", "inf", '"/etc/x"', "[[[[1]]]]"])))
+                     '"lattice"', '"specular"', '"paper"', "true", "-1", "nan", "inf", '"/etc/x"', "[[[[1]]]]"])))
             lines.append(f"{k} = {value}")
     path = folder / "s.toml"
     path.write_text("\n".join(lines) + "\n")

@@ -156,7 +156,7 @@ def test_an_engine_error_is_reported_and_fails(tmp_path, capsys, monkeypatch):
     ("[system]\ndimension = 1\nparticles = 10\npacking_fraction = 0.1\n[collisions]\nengine = 'lattice'\n",
      "[system] dimension: engine = 'lattice' runs 2D and 3D gases, got dimension 1"),
     ("[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.1\n[collisions]\nengine = 'lattice'\nmode = 'paper'\n",
-     "[collisions] mode: engine = 'lattice' runs exact mode only"),
+     "[collisions] mode: engine = 'lattice' runs exact and specular modes, got 'paper'"),
     ("[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.1\n[collisions]\nengine = 'lattice'\n"
      "[rng]\ngenerator = 'clcg4'\n", "[rng] generator: engine = 'lattice' draws from Philox per-particle streams"),
     ("[system]\ndimension = 2\nparticles = 10\npacking_fraction = 0.1\n[collisions]\nengine = 'lattice'\n"

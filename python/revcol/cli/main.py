@@ -1,10 +1,12 @@
 """The ``revcol`` command line.
 
     revcol run [SCENE.toml] [--json FILE] [--plot DIR] [--trajectory FILE.xyz|.gsd] [--collisions N] [--seed S]
-               [--engine float|lattice] [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]
+               [--engine float|lattice] [--mode exact|paper|specular]
+               [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]
     revcol run [SCENE.toml] --horizon [--seeds K] [--max-collisions N] [--engine float] [--json FILE] [--plot DIR]
     revcol simulate [SCENE] [--collisions N | --time T] [--trajectory FILE --every K|--every-time T] [--checkpoint DIR
                --checkpoint-every K] [--resume CHECKPOINT] [--species Ar] [--json FILE]   (forward only)
+               [--engine float|lattice] [--mode exact|paper|specular]
                [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]   (lattice engine)
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
@@ -92,6 +94,17 @@ def _lattice_flags(p: argparse.ArgumentParser) -> None:
                    "'cells', or lists with a shell of S diameters, 0.02..2; the run is the same bit for bit")
 
 
+#: the collision modes --mode takes (a scene's [collisions] mode; the engine's own are checked with the scene)
+MODES = ("exact", "paper", "specular")
+
+
+def _mode_flag(p: argparse.ArgumentParser) -> None:
+    """``--mode``, overriding the scene's [collisions] mode (checked as the scene file would be)."""
+    p.add_argument("--mode", choices=MODES, help="run a gas scene in this collision mode instead of its [collisions] "
+                   "mode: exact, paper (float engine, 1D and 2D) or specular (deterministic specular dynamics, no "
+                   "draws; on the lattice engine reversed bit for bit); a law the scene names needs exact")
+
+
 def _did_you_mean(word: str, candidates) -> str:
     """`` (did you mean 'x'?)`` for the closest candidate to a mistyped ``word``, or ``""``."""
     close = difflib.get_close_matches(word, [str(c) for c in candidates], n=1, cutoff=0.6)
@@ -158,6 +171,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--engine", choices=("float", "lattice"),
                    help="run a gas scene on this engine instead of its [collisions] engine (with --horizon: "
                    "--engine float measures the float engine's horizon for a lattice scene's gas)")
+    _mode_flag(r)
     r.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
     _lattice_flags(r)
     _simulate_parser(sub)
@@ -227,6 +241,7 @@ def _simulate_parser(sub) -> None:
     s.add_argument("--resume", metavar="FILE", help="continue from a checkpoint of this scene (bit for bit)")
     s.add_argument("--seed", type=_seed, metavar="S", help="seed instead of the scene's [rng] seed")
     s.add_argument("--engine", choices=("float", "lattice"), help="run the scene on this engine instead")
+    _mode_flag(s)
     s.add_argument("--species", default="Ar", metavar="X", help="the trajectory's chemical element symbol "
                    "(default Ar; ASE reads element symbols only)")
     s.add_argument("--json", metavar="FILE", help="write the report as JSON ('-': to standard output, and the "
@@ -249,7 +264,7 @@ def _simulate(args: argparse.Namespace) -> int:
             report = simulate(scene, collisions=args.collisions, time=args.time, trajectory=args.trajectory,
                               every=args.every, checkpoints=args.checkpoint, checkpoint_every=args.checkpoint_every,
                               resume=args.resume, seed=args.seed, engine=args.engine, species=args.species,
-                              tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search,
+                              tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search, mode=args.mode,
                               json_path=None if to_stdout else args.json,
                               progress=False if args.no_progress else None, every_time=args.every_time)
     except (SceneError, OSError) as e:

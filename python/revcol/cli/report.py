@@ -95,7 +95,7 @@ def _search(search) -> str:
 
 def _lattice_lines(r: dict) -> list[str]:
     """A lattice-engine round trip: what came back bit for bit, X's size, the rare log,
-    redraws, multi-body ticks, drifts, rates and memory."""
+    redraws, backscatters (specular mode), multi-body ticks, drifts, rates and memory."""
     u, q, x, n = r["units"], r["quantization"], r["bits_back"], max(r["collisions_forward"], 1)
     ok = r["restored"]
     same = ", ".join(f"{_PARTS[k]} {'yes' if v else 'NO'}" for k, v in ok.items())
@@ -108,7 +108,8 @@ def _lattice_lines(r: dict) -> list[str]:
     lines = [
         f"  engine           lattice: sigma = 2^{u['S']} lattice units per diameter, a tick = {u['tick']:.3g} time "
         f"units (a typical particle moves 2^-{u['tick_bits']} sigma per tick), 2^{u['cell_bits']} direction cells",
-        f"  settings         tick_bits {u['tick_bits']}, cell_bits {u['cell_bits']}, search {_search(r.get('search'))}",
+        f"  settings         mode {r.get('mode', 'exact')}, tick_bits {u['tick_bits']}, cell_bits {u['cell_bits']}, "
+        f"search {_search(r.get('search'))}",
         f"  start            quantized once: positions within {_err(q['max_position_error'], 'diameters')}, "
         f"velocities within {_err(q['max_velocity_error'], 'v_rms')}; exact from there on",
         f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:,.4g} per particle) to "
@@ -125,6 +126,8 @@ def _lattice_lines(r: dict) -> list[str]:
         f"resolved, {_n(r['group_bounces'], 'group bounce')}); "
         f"{_n(r['log_entries_end'], 'entry', 'entries')} ({r['log_bytes_end']} bytes) after reversal",
         f"  redraws          {r['redraws_total']:,} ({r['redraws_total'] / n:.2g} per collision): {redraws}",
+        *([f"  backscatters     {r['backscatters']:,} ({r['backscatters'] / n:.2g} per collision): specular pairs "
+           "turned back in place"] if r.get("mode") == "specular" else []),
         f"  multi-body       {_n(r['multi_body'], 'tick')} with three bodies ({r['multi_body'] / n:.2g} per "
         f"collision), {r['wall_body']} with a wall and a body ({r['wall_body'] / n:.2g} per collision)",
         f"  energy drift     {r['energy_drift_turn']:+.2g} at the turn, {r['energy_drift_end']:+.2g} after reversal   "

@@ -10,7 +10,7 @@ import warnings
 
 from .._io import jsonable
 from ..observe import report_lines
-from ..scene import Scene, SceneError, load_scene, with_engine, with_lattice_options
+from ..scene import Scene, SceneError, load_scene, with_engine, with_lattice_options, with_mode
 from ..studies.scenes import run_scene
 from .report import format_report
 
@@ -33,10 +33,14 @@ def run_command(args: argparse.Namespace) -> int:
             warnings.showwarning = _warn_line
             scene, engine = args.scene, args.engine
             lattice = dict(tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search)
-            if any(v is not None for v in lattice.values()):  # on the engine the scene runs on (--engine too)
+            if args.mode is not None or any(v is not None for v in lattice.values()):
+                # on the engine the scene runs on (--engine too), in the mode it runs (--mode too)
                 scene = load_scene(scene)
-                scene, engine = (with_engine(scene, engine) if engine else scene), None
-                scene = with_lattice_options(scene, **lattice)
+                if args.mode is not None:
+                    scene = with_mode(scene, args.mode, engine)
+                elif engine:
+                    scene = with_engine(scene, engine)
+                scene, engine = with_lattice_options(scene, **lattice), None
             if to_stdout:  # the scene's own [output] json is replaced by standard output
                 scene = dataclasses.replace(scene if isinstance(scene, Scene) else load_scene(scene), json=None)
             report = run_scene(scene, json_path=None if to_stdout else args.json, plot=args.plot,

@@ -49,7 +49,7 @@ from ..lattice_gas import geometry as lattice_geometry
 from ..observe import report_lines
 from ..progress import Bar, Interrupt, peak_rss
 from ..roundtrip import geometry
-from ..scene import Scene, SceneError, load_scene, with_engine, with_lattice_options
+from ..scene import Scene, SceneError, load_scene, with_engine, with_lattice_options, with_mode
 from ..trajectory import _species, check_format, open_trajectory  # revcol simulate writes frames
 
 __all__ = ["simulate", "format_simulate"]
@@ -122,9 +122,19 @@ def _build(scene: Scene, resume):
         return build_simulation(scene)
     cls = LatticeSimulation if scene.engine == "lattice" else Simulation
     try:
-        return cls.load(resume)
+        sim = cls.load(resume)
     except (ValueError, KeyError, TypeError) as e:
         raise SceneError(f"{scene.source}: --resume {os.fspath(resume)!r}: {e}") from None
+    mode = _mode(sim)
+    if mode != scene.mode:  # the checkpoint's dynamics go on; a scene asking for others is a mistake
+        raise SceneError(f"{scene.source}: --resume {os.fspath(resume)!r}: the checkpoint runs {mode} mode, the "
+                         f"scene {scene.mode} mode (--mode {mode} resumes it)")
+    return sim
+
+
+def _mode(sim) -> str:
+    """The collision mode an engine runs (the float engine's from its snapshot)."""
+    return sim.mode if isinstance(sim, LatticeSimulation) else str(sim.snapshot().get("mode", "exact"))
 
 
 class _Production:
@@ -255,9 +265,11 @@ class _Production:
         ran = self.done - self.start
         return {
             "kind": "simulate", "revcol_version": __version__, "scene": scene.to_dict(), "summary": scene.summary(),
-            "engine": scene.engine, "particles": sim.n, "dimension": sim.dim,
+            "engine": scene.engine, "mode": scene.mode, "particles": sim.n, "dimension": sim.dim,
             "lattice": {"tick_bits": sim.units["tick_bits"], "cell_bits": sim.units["cell_bits"],
                         "search": sim.search} if self.lattice else None,
+            # the lattice's specular pairs turned back in place (specular.hpp); None on the float engine
+            "backscatters": int(d["backscatters"]) if self.lattice else None,
             "resumed_from": None if resume is None else os.fspath(resume),
             "collisions": ran, "net_collisions": self.done, "collisions_per_particle": 2.0 * ran / sim.n,
             "time_start": self.t_start, "time_end": sim.time,
@@ -281,17 +293,21 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
              resume: str | os.PathLike | None = None, seed: int | None = None, engine: str | None = None,
              species: str = "Ar", precise: bool = False, json_path: str | os.PathLike | None = None,
              progress: bool | None = None, every_time: float | None = None, tick_bits: int | None = None,
-             cell_bits: int | None = None, search: str | float | None = None) -> dict:
+             cell_bits: int | None = None, search: str | float | None = None, mode: str | None = None) -> dict:
     """Runs a gas scene forward only (see the module's docstring) and returns the report; with
     ``json_path`` also writes it (atomically). ``species`` names the trajectory's element,
     ``precise`` adds float64 positions to a GSD trajectory; ``every_time`` writes frames at the
     multiples of that time instead of every ``every`` collisions. ``tick_bits``, ``cell_bits``,
     ``search``: the lattice engine's options instead of the scene's (a resumed run keeps its
-    checkpoint's units, tick and cells, and takes a new search). A bad option raises
+    checkpoint's units, tick and cells, and takes a new search). ``mode``: the collision mode
+    instead of the scene's ``[collisions] mode`` (``"exact"``, ``"paper"``: float engine, 1D and
+    2D, or ``"specular"``; a resumed run must be in its checkpoint's). A bad option raises
     SceneError before anything runs."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
-    if engine is not None:
+    if mode is not None:
+        scene = with_mode(scene, mode, engine)
+    elif engine is not None:
         scene = with_engine(scene, engine)
     scene = with_lattice_options(scene, tick_bits=tick_bits, cell_bits=cell_bits, search=search)
     if resume is not None and (tick_bits, cell_bits) != (None, None):
@@ -327,7 +343,8 @@ def format_simulate(r: dict) -> str:
     s = r["scene"]
     rate = r["collisions_per_s"]
     lines = [f"revcol simulate {s['name']}  ({s['source']})", f"  scene            {r['summary']}",
-             f"  engine           {r['engine']}" + (f"  (resumed from {r['resumed_from']})" if r["resumed_from"] else "")
+             f"  engine           {r['engine']}, {r.get('mode', 'exact')} mode"
+             + (f"  (resumed from {r['resumed_from']})" if r["resumed_from"] else "")
              + (f"  (tick_bits {r['lattice']['tick_bits']}, cell_bits {r['lattice']['cell_bits']}, search "
                 f"{r['lattice']['search']})" if r.get("lattice") else ""),
              f"  collisions       {r['collisions']:,} ({r['collisions_per_particle']:.3g} per particle; "
@@ -335,6 +352,8 @@ def format_simulate(r: dict) -> str:
              f"  time             {r['time_start']:.6g} -> {r['time_end']:.6g}",
              f"  wall             {r['wall_s']:.3g} s" + (f"  ({rate:,.0f} collisions/s)" if rate else ""),
              f"  energy drift     {r['energy_drift']:.3g}  ((E - E0) / E0)"]
+    if r.get("mode") == "specular" and r.get("backscatters") is not None:
+        lines.append(f"  backscatters     {r['backscatters']:,} (specular pairs turned back in place)")
     if r["trajectory"]:
         lines.append(f"  trajectory       {r['trajectory']}  ({r['trajectory_frames']} frames)")
     if r["checkpoints"]:
