@@ -95,7 +95,7 @@ def _search(search) -> str:
 
 def _lattice_lines(r: dict) -> list[str]:
     """A lattice-engine round trip: what came back bit for bit, X's size, the rare log,
-    redraws, backscatters (specular mode), multi-body ticks, drifts, rates and memory."""
+    redraws (specular mode: refusals) and backscatters, multi-body ticks, drifts, rates and memory."""
     u, q, x, n = r["units"], r["quantization"], r["bits_back"], max(r["collisions_forward"], 1)
     ok = r["restored"]
     same = ", ".join(f"{_PARTS[k]} {'yes' if v else 'NO'}" for k, v in ok.items())
@@ -125,7 +125,10 @@ def _lattice_lines(r: dict) -> list[str]:
         f"turn, {r['log_entries_per_collision']:.2g} per collision ({_n(r['group_resolves'], 'group collision')} "
         f"resolved, {_n(r['group_bounces'], 'group bounce')}); "
         f"{_n(r['log_entries_end'], 'entry', 'entries')} ({r['log_bytes_end']} bytes) after reversal",
-        f"  redraws          {r['redraws_total']:,} ({r['redraws_total'] / n:.2g} per collision): {redraws}",
+        # specular mode draws nothing: its counters are the map's refusals, each resolved as a group
+        (f"  refusals         {r['redraws_total']:,} ({r['redraws_total'] / n:.2g} per collision; no redraws in specular "
+         f"mode, each went to the group rule): {redraws}" if r.get("mode") == "specular" else
+         f"  redraws          {r['redraws_total']:,} ({r['redraws_total'] / n:.2g} per collision): {redraws}"),
         *([f"  backscatters     {r['backscatters']:,} ({r['backscatters'] / n:.2g} per collision): specular pairs "
            "turned back in place"] if r.get("mode") == "specular" else []),
         f"  multi-body       {_n(r['multi_body'], 'tick')} with three bodies ({r['multi_body'] / n:.2g} per "
