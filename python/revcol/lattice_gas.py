@@ -101,9 +101,11 @@ def restored(start: dict, end: dict) -> dict[str, bool]:
 
 
 def log_size(state: dict) -> tuple[int, int]:
-    """(entries, bytes) of the rare log in a state: redraw entries plus group collisions, and the
-    bytes its arrays take in a checkpoint."""
-    entries = len(state["log_index"]) + len(state["group_index"])
+    """(entries, bytes) of the rare log in a state: its collisions (one entry each in
+    ``log_index``: those that needed redraws, and the group collisions, whose records are in the
+    group arrays besides), as ``diagnostics()["log_entries"]``, and the bytes its arrays take in a
+    checkpoint."""
+    entries = len(state["log_index"])
     return entries, int(sum(np.asarray(state[k]).nbytes for k in _LOG_KEYS))
 
 

@@ -14,6 +14,7 @@ import pytest
 import revcol
 from revcol.cli.main import main as cli_main
 from revcol.lattice import MODES, LatticeSimulation, LatticeSimulation3D
+from revcol.lattice_gas import log_size
 from revcol.scene import SceneError, load_scene, scene_from_dict, with_engine, with_mode
 from revcol.studies.scenes import run_scene
 
@@ -67,6 +68,7 @@ def test_round_trip_through_backscatters_and_group_collisions(cls, seed):
     assert d["backscatters"] >= 1
     # the rare log holds group collisions only (no redraws in specular mode)
     assert d["group_log_entries"] == d["log_entries"] >= 1 and not np.asarray(turn["log_redraws"]).any()
+    assert log_size(turn)[0] == d["log_entries"]  # the report counts each group collision once
     sim.run_back()
     assert same_state(sim.snapshot(), start)
     assert sim.diagnostics()["log_entries"] == 0
