@@ -3,13 +3,14 @@ LatticeSimulation3D, volume fractions instead of area fractions). Writes
 bench/results/lattice_validation_*.json.
 
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py matrix [--collisions 1e7]
-        [--n 1000 10000] [--phi 0.1 0.3 0.5 0.7] [--boundary wall periodic] [--out matrix]
+        [--n 1000 10000] [--phi 0.1 0.3 0.5 0.7] [--boundary wall periodic bounce] [--mode exact|specular] [--out matrix]
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py equilibrium [--n 1000] [--phi 0.5]
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py failures [--phi 0.5 0.7] [--seeds 4] [--collisions 2e6] --out failures
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py gas --n 1000 --phi 0.3 --boundary wall --collisions 1e5
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py probe --n 1000 --phi 0.7 --boundary wall --collisions 3e6 --ticks 20 22 24 --cells 20 16 --out probe
 
-matrix: every gas (N x area fraction x boundary, flux law) in its own subprocess (``gas``), one
+matrix: every gas (N x area fraction x boundary; the flux law, or the deterministic specular map
+with ``--mode specular``) in its own subprocess (``gas``), one
 at a time. The child runs C collisions forward, taking a snapshot at C/2, then runs back to C/2
 and compares with that snapshot bit for bit (the midpoint check), then back to 0 and compares
 with the start: positions, velocities, stream counters (RNG), the bits-back integer X, clock,
@@ -228,7 +229,7 @@ def _after_failure(sim, f: dict):
 
 
 def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, samples: int = 100,
-            law: str = "flux", tick_bits: int = 0, cell_bits: int = 16) -> dict:
+            law: str = "flux", tick_bits: int = 0, cell_bits: int = 16, mode: str = "exact") -> dict:
     """One gas: C collisions forward (snapshot at C/2), back to C/2 (compared), back to 0
     (compared). Returns the row (see the module doc). If the engine fails on the way forward, the
     row says so (``completed`` false, ``forward_error``) and the checks run on the collisions done,
@@ -236,7 +237,7 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     LatticeSimulation = _sim_cls()
     load0 = os.getloadavg()
     sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi), law=law,
-                                   tick_bits=tick_bits or None, cell_bits=cell_bits)
+                                   tick_bits=tick_bits or None, cell_bits=cell_bits, mode=mode)
     s0 = sim.snapshot()
     units = sim.units
     wall = [bool(w) for w in units["wall"]]
@@ -261,7 +262,8 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     log_held = d_end["log_entries"]  # every entry, group bounces included (they are keyed in the same log)
     cc = max(c, 1)
     row = {
-        "dim": DIM, "n": n, "phi": phi, "boundary": boundary, "law": law, "seed": seed, "collisions_asked": int(collisions),
+        "dim": DIM, "n": n, "phi": phi, "boundary": boundary, "mode": mode, "law": law, "seed": seed,
+        "collisions_asked": int(collisions), "backscatters": d_end.get("backscatters"),
         "collisions": c, "completed": f["error"] is None, "forward_error": f["error"],
         "run_back_from_failure": f.get("run_back_from_failure"), "collisions_checked_back": checked,
         "collisions_per_particle": 2.0 * c / n,
@@ -295,17 +297,17 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
 
 def _child(args) -> int:
     row = run_gas(args.n, args.phi, args.boundary, int(float(args.collisions)), args.seed,
-                  tick_bits=args.tick_bits, cell_bits=args.cell_bits)
+                  tick_bits=args.tick_bits, cell_bits=args.cell_bits, mode=args.mode)
     print("ROW " + json.dumps(row), flush=True)
     return 0
 
 
 def run_child(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, tick_bits: int = 0,
-              cell_bits: int = 16) -> dict:
+              cell_bits: int = 16, mode: str = "exact") -> dict:
     """``run_gas`` in a fresh subprocess; adds the child's ru_maxrss (wait4) and exit status."""
     cmd = [sys.executable, os.path.abspath(__file__), "gas", "--n", str(n), "--phi", str(phi),
            "--boundary", boundary, "--collisions", str(int(collisions)), "--seed", str(seed),
-           "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits), "--dim", str(DIM)]
+           "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits), "--dim", str(DIM), "--mode", mode]
     t0 = time.time()
     with tempfile.TemporaryFile(mode="w+") as ferr:
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=ferr, text=True)
@@ -328,12 +330,13 @@ def matrix(args) -> dict:
     c = int(float(args.collisions))
     path = os.path.join(RESULTS, f"lattice_validation_{args.out}.json")
     res = {"command": " ".join([os.path.basename(sys.executable)] + sys.argv), "commit": _git_commit(),
-           "build": _build_info(), "dim": DIM, "collisions": c, "law": "flux", "seed": args.seed, "tick_bits": args.tick_bits,
+           "build": _build_info(), "dim": DIM, "collisions": c, "mode": args.mode, "law": "flux", "seed": args.seed,
+           "tick_bits": args.tick_bits,
            "cell_bits": args.cell_bits, "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "rows": []}
     for phi in args.phi:  # in the order given: a run cut short still covers both N
         for n in args.n:
             for b in args.boundary:
-                row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits)
+                row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits, args.mode)
                 res["rows"].append(row)
                 res["updated_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
                 _write_atomic(path, res)
@@ -616,7 +619,9 @@ def main(argv=None) -> int:
     ap.add_argument("--collisions", default="1e7")
     ap.add_argument("--n", type=int, nargs="+", default=None, help="matrix default 1000 10000; equilibrium 1000")
     ap.add_argument("--phi", type=float, nargs="+", default=None, help="matrix default 0.1 0.3 0.5 0.7; equilibrium 0.5")
-    ap.add_argument("--boundary", nargs="+", default=["wall", "periodic"], choices=["wall", "periodic"])
+    ap.add_argument("--boundary", nargs="+", default=["wall", "periodic"], choices=["wall", "periodic", "bounce"])
+    ap.add_argument("--mode", default="exact", choices=["exact", "specular"],
+                    help="matrix, gas: the lattice engine's mode (exact: the flux law; specular: the deterministic map)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--tick-bits", type=int, default=0,
                     help="matrix, gas: a typical particle moves 2^-T D per tick (0: automatic, the engine's default)")

@@ -12,7 +12,10 @@ are independent trajectories after.
     python -m revcol.studies.engine_agreement --json bench/results/engine_agreement.json
 
 runs the issue's cases (N = 1000; 2D area fraction 0.5, 3D volume fraction 0.3); ``--collisions``
-and ``--n`` make it shorter (the CI test runs a reduced form of ``compare``).
+and ``--n`` make it shorter (the CI test runs a reduced form of ``compare``). ``--mode specular``
+compares the two engines' specular dynamics instead (the lattice's deterministic map against the
+float engine's reflection: bench/results/engine_agreement_specular.json), ``--cases`` and
+``--seeds`` choose the gases.
 """
 from __future__ import annotations
 
@@ -33,8 +36,8 @@ __all__ = ["compare", "main"]
 
 
 def _run(engine: str, dim: int, phi: float, n: int, collisions: int, warm: int, frames: int, groups: int,
-         seed: int, bins: int) -> dict:
-    sim = Simulation.random(n=n, dim=dim, phi=phi, seed=seed, engine=engine)
+         seed: int, bins: int, mode: str = "exact") -> dict:
+    sim = Simulation.random(n=n, dim=dim, phi=phi, seed=seed, engine=engine, mode=mode)
     sim.run(collisions=warm)
     sim.observe()
     per = max(1, collisions // frames)
@@ -65,17 +68,17 @@ def _run(engine: str, dim: int, phi: float, n: int, collisions: int, warm: int, 
 
 
 def compare(dim: int, phi: float, n: int = 1000, collisions: int = 2_000_000, warm: Optional[int] = None,
-            frames: int = 100, groups: int = 10, seed: int = 1, bins: int = 100) -> dict:
-    """Both engines on one gas (periodic, flux law): Z, collision rate and g(D+) with their
-    errors, and their differences in combined standard errors (``sigmas``: |a - b| /
-    sqrt(e_a^2 + e_b^2))."""
+            frames: int = 100, groups: int = 10, seed: int = 1, bins: int = 100, mode: str = "exact") -> dict:
+    """Both engines on one gas (periodic; ``mode`` "exact", the flux law, or "specular" on both):
+    Z, collision rate and g(D+) with their errors, and their differences in combined standard
+    errors (``sigmas``: |a - b| / sqrt(e_a^2 + e_b^2))."""
     warm = 20 * n if warm is None else warm
-    runs = {e: _run(e, dim, phi, n, collisions, warm, frames, groups, seed, bins) for e in ("float", "lattice")}
+    runs = {e: _run(e, dim, phi, n, collisions, warm, frames, groups, seed, bins, mode) for e in ("float", "lattice")}
     sig = {}
     for q in ("z", "collision_rate", "g_contact"):
         (a, ea), (b, eb) = runs["float"][q], runs["lattice"][q]
         sig[q] = abs(a - b) / math.hypot(ea, eb) if ea > 0 or eb > 0 else float("inf")
-    return {"dim": dim, "phi": phi, "n": n, "seed": seed, "float": runs["float"], "lattice": runs["lattice"],
+    return {"dim": dim, "phi": phi, "n": n, "seed": seed, "mode": mode, "float": runs["float"], "lattice": runs["lattice"],
             "sigmas": sig}
 
 
@@ -93,15 +96,22 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--n", type=int, default=1000)
     ap.add_argument("--collisions", type=int, default=2_000_000)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--seeds", type=int, default=1, help="independent gases per case (seed, seed + 1, ...)")
+    ap.add_argument("--mode", choices=("exact", "specular"), default="exact",
+                    help="exact: the flux law on both engines; specular: specular dynamics on both")
+    ap.add_argument("--cases", nargs="+", default=["2:0.5", "3:0.3"], help="dim:phi pairs")
     ap.add_argument("--json", help="write the results here (atomically)")
     a = ap.parse_args(argv)
     results = []
-    for dim, phi in ((2, 0.5), (3, 0.3)):
-        res = compare(dim, phi, n=a.n, collisions=a.collisions, seed=a.seed)
-        results.append(res)
-        print(f"{dim}D phi {phi}, N = {a.n}, {res['float']['collisions']} collisions each")
-        for line in _lines(res):
-            print(line)
+    for spec in a.cases:
+        dim, phi = int(spec.split(":")[0]), float(spec.split(":")[1])
+        for seed in range(a.seed, a.seed + a.seeds):
+            res = compare(dim, phi, n=a.n, collisions=a.collisions, seed=seed, mode=a.mode)
+            results.append(res)
+            print(f"{dim}D phi {phi}, N = {a.n}, seed {seed}, {a.mode}: {res['float']['collisions']} collisions each",
+                  flush=True)
+            for line in _lines(res):
+                print(line)
     worst = max(max(r["sigmas"].values()) for r in results)
     print(f"largest difference: {worst:.2f} standard errors ({'within' if worst < 3 else 'BEYOND'} 3)")
     if a.json:
