@@ -81,6 +81,11 @@ py::dict observation_dict(const engine::Observation& o) {
   d["msd_time"] = array(o.msd_time);
   d["msd"] = array(o.msd);
   d["vacf"] = array(o.vacf);
+  // the Helfand moment: (block ends, components), at msd_time
+  const auto hc = static_cast<py::ssize_t>(o.helfand_components);
+  py::array_t<double> h({hc > 0 ? static_cast<py::ssize_t>(o.helfand.size()) / hc : 0, hc});
+  if (!o.helfand.empty()) std::memcpy(h.mutable_data(), o.helfand.data(), o.helfand.size() * sizeof(double));
+  d["helfand"] = h;
   return d;
 }
 

@@ -105,6 +105,7 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
   }
   start_ = x;
   start_v_ = v;
+  hc_ = dim * (dim - 1) / 2;
   if (c.pair_bins > 0) pair_t_.assign(n_ * n_, t);
   cur_ = empty_block(t);
   set_fast_until();
@@ -244,6 +245,7 @@ void Observer::end_block() {
     }
   msd_t_.push_back(te - t_start_);
   msd_.push_back(msd / static_cast<double>(n_));
+  if (helf_kept_) helf_rec_.insert(helf_rec_.end(), helf_.begin(), helf_.begin() + hc_);  // integrated to te above
   if (!start_v_.empty()) {  // velocities are constant on segments: the segment's is the one at te
     double c = 0.0;
     for (std::size_t i = 0; i < n_; ++i)
@@ -300,18 +302,21 @@ void Observer::pair_d(double t, int a, int b, const double* va, const double* vb
   cur_.parts += 2;
 }
 
-// r . Delta p_a of a pair at the positions just closed, into the open block.
+// r . Delta p_a of a pair at the positions just closed, into the open block, and r_a Delta
+// p_b into the Helfand moment.
 template <int Dim>
 [[gnu::always_inline]] inline void Observer::virial(int a, int b, const double* va) {
-  double w = 0.0;
+  double w = 0.0, r[Dim], dp[Dim];
   for (int k = 0; k < Dim; ++k) {
     // the nearest image (|r| = D < L / 2; fold_ is 0 on walled axes), rounding q to the
     // nearest whole number by adding and subtracting 1.5 2^52 (|q| < 2^51; no branch)
     const double r0 = seg_[a].x[k] - seg_[b].x[k], q = r0 * inv_box_[k];
-    const double r = r0 - fold_[k] * ((q + kRound) - kRound);
-    w += r * (va[k] - seg_[a].v[k]);
+    r[k] = r0 - fold_[k] * ((q + kRound) - kRound);
+    dp[k] = va[k] - seg_[a].v[k];
+    w += r[k] * dp[k];
   }
   cur_.w += w;
+  helfand_add<Dim>(r, dp);
 }
 
 // Any pair collision: blocks ended, pair distances, the record, slab crossings.

@@ -14,13 +14,24 @@ void Observer::group(double t, int n, const int* ids, const double* x, const dou
   reach(t);
   for (int u = 0; u < n; ++u) {
     const int i = ids[u];
-    for (int k = 0; k < dim_; ++k) cur_.w += x[u * dim_ + k] * (v[u * dim_ + k] - seg_[i].v[k]);
+    group_virial(i, x + u * dim_, v + u * dim_);
     close<3>(i, t);
     close_pairs(i, t);
   }
   for (int u = 0; u < n; ++u) set_velocity<0>(ids[u], v + u * dim_);
   ++cur_.groups;
   cur_.parts += static_cast<std::uint64_t>(n);
+}
+
+// A group member i at x (image-consistent) going to velocity v: x . Delta p to the virial,
+// x_a Delta p_b to the Helfand moment (their sums over members are the same for any image).
+void Observer::group_virial(int i, const double* x, const double* v) {
+  double dp[3];
+  for (int k = 0; k < dim_; ++k) {
+    dp[k] = v[k] - seg_[i].v[k];
+    cur_.w += x[k] * dp[k];
+  }
+  helfand_add<0>(x, dp);
 }
 
 void Observer::wall(double t, int i, const double* v) {
@@ -60,13 +71,15 @@ void Observer::pair_at(double t, int a, int b, const double* xa, const double* x
   close<3>(b, t);
   close_pairs(a, t);
   close_pairs(b, t);
-  double w = 0.0;
+  double w = 0.0, r[3], dp[3];
   for (int k = 0; k < dim_; ++k) {
-    double r = xa[k] - xb[k];
-    if (!walls_[k]) r -= box_[k] * std::nearbyint(r * inv_box_[k]);  // the nearest image
-    w += r * (va[k] - seg_[a].v[k]);
+    r[k] = xa[k] - xb[k];
+    if (!walls_[k]) r[k] -= box_[k] * std::nearbyint(r[k] * inv_box_[k]);  // the nearest image
+    dp[k] = va[k] - seg_[a].v[k];
+    w += r[k] * dp[k];
   }
   cur_.w += w;
+  helfand_add<0>(r, dp);
   place(a, xa);
   place(b, xb);
   if (cfg_.collision_record) [[unlikely]] record_pair(a, b, va, vb);
@@ -82,7 +95,7 @@ void Observer::group_at(double t, int n, const int* ids, const double* x, const 
     const int i = ids[u];
     close<3>(i, t);
     close_pairs(i, t);
-    for (int k = 0; k < dim_; ++k) cur_.w += x[u * dim_ + k] * (v[u * dim_ + k] - seg_[i].v[k]);
+    group_virial(i, x + u * dim_, v + u * dim_);
   }
   for (int u = 0; u < n; ++u) {
     place(ids[u], x + u * dim_);

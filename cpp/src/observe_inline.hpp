@@ -45,9 +45,15 @@ using namespace observe_detail;  // NOLINT: the observer's own sources only
 template <int K>
 [[gnu::always_inline]] inline void Observer::set_velocity(int i, const double* v) {
   Segment& s = seg_[i];
+  const int d = K > 0 ? K : dim_;
+  if (d >= 2) vv_off_[0] += v[0] * v[1] - s.v[0] * s.v[1];  // sum_i v_ia v_ib (Helfand), before s.v changes
+  if (d >= 3) {
+    vv_off_[1] += v[0] * v[2] - s.v[0] * s.v[2];
+    vv_off_[2] += v[1] * v[2] - s.v[1] * s.v[2];
+  }
   double v2 = v[0] * v[0];  // (what 0 + v[0]^2 gives, a square being never -0)
   s.v[0] = v[0];
-  for (int k = 1; k < (K > 0 ? K : dim_); ++k) {
+  for (int k = 1; k < d; ++k) {
     s.v[k] = v[k];
     v2 += v[k] * v[k];
   }
@@ -105,13 +111,26 @@ template <int K>
   if (cfg_.pair_bins > 0) pairs_to(i, t);  // out of line: the hooks' hot path keeps fewer registers
 }
 
-// The integrals of sum v^2 and sum |v| (constant between velocity changes) from the last
-// update to t, which becomes the last update.
+// The integrals of sum v^2, sum |v| and sum v_a v_b (constant between velocity changes) from
+// the last update to t, which becomes the last update. All three Helfand components always
+// (those beyond hc_ stay 0: no test of the dimension).
 [[gnu::always_inline]] inline void Observer::accumulate(double t) {
   const double dt = t - t_now_;
   cur_.k2 += v2_sum_ * dt;
   cur_.dist += speed_sum_ * dt;
+  for (int c = 0; c < 3; ++c) helf_[c] += vv_off_[c] * dt;
   t_now_ = t;
+}
+
+// The collision part of the Helfand moment: r_a Delta p_b for a < b (r, dp: d components).
+template <int K>
+[[gnu::always_inline]] inline void Observer::helfand_add(const double* r, const double* dp) {
+  const int d = K > 0 ? K : dim_;
+  if (d >= 2) helf_[0] += r[0] * dp[1];
+  if (d >= 3) {
+    helf_[1] += r[0] * dp[2];
+    helf_[2] += r[1] * dp[2];
+  }
 }
 
 [[gnu::always_inline]] inline void Observer::reach(double t) {

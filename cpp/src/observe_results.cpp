@@ -102,6 +102,8 @@ Observation Observer::results() const {
   o.msd_time = msd_t_;
   o.msd = msd_;
   o.vacf = vacf_;
+  o.helfand_components = hc_;
+  o.helfand = helf_rec_;
   return o;
 }
 

@@ -42,6 +42,11 @@ void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& coun
     reals.insert(reals.end(), start_v_.begin(), start_v_.end());
     reals.insert(reals.end(), vacf_.begin(), vacf_.end());
   }
+  if (!start_v_.empty() && helf_kept_) {  // the Helfand moment (absent in older snapshots; never without the VACF)
+    reals.insert(reals.end(), helf_.begin(), helf_.begin() + hc_);
+    reals.insert(reals.end(), vv_off_.begin(), vv_off_.begin() + hc_);
+    reals.insert(reals.end(), helf_rec_.begin(), helf_rec_.end());
+  }
 }
 
 Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint64_t>& counts, int dim,
@@ -83,7 +88,10 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   const std::size_t per_block = kBlockReals + 2 * cfg_.slabs + cfg_.speed_bins + cfg_.pair_bins;
   const std::size_t per_particle = 3 * d + 1 + (cfg_.slabs > 0 ? 1 : 0);
   const std::size_t size = kHeader + n_ * per_particle + np + (nb + 1) * per_block + 2 * nm;
-  require(reals.size() == size || reals.size() == size + n_ * d + nm,  // with the VACF, or without (older)
+  hc_ = dim * (dim - 1) / 2;
+  const std::size_t hc = static_cast<std::size_t>(hc_), vacf = size + n_ * d + nm, helf = vacf + hc * (2 + nm);
+  // with the VACF and the Helfand moment, with the VACF only, or neither (older snapshots)
+  require(reals.size() == helf || reals.size() == vacf || reals.size() == size,
           "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points)");
   require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
   bin_scale_ = cfg_.speed_bins / speed_max_;
@@ -144,6 +152,13 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   if (u < reals.size()) {  // the velocity autocorrelation (a snapshot without it resumes none)
     take(start_v_, n_ * d);
     take(vacf_, nm);
+  }
+  helf_kept_ = reals.size() == helf;  // the Helfand moment (a snapshot without it resumes none)
+  if (helf_kept_) {
+    for (std::size_t c = 0; c < hc; ++c) helf_[c] = reals[u + c];
+    for (std::size_t c = 0; c < hc; ++c) vv_off_[c] = reals[u + hc + c];  // the running sums as they were
+    u += 2 * hc;
+    take(helf_rec_, nm * hc);
   }
   v2_sum_ = reals[16];  // the running sums as they were (set_velocity above rebuilt them afresh)
   speed_sum_ = reals[17];

@@ -28,7 +28,9 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["Observing", "Estimate", "Profile", "Observation", "radial_distribution", "contact_value", "compressibility_from_contact", "report_lines", "OBSERVE_FIELDS"]
+__all__ = ["Observing", "Estimate", "Profile", "Observation", "radial_distribution", "contact_value",
+           "compressibility_from_contact", "report_lines", "OBSERVE_FIELDS", "helfand_increments", "helfand_viscosity",
+           "self_diffusion"]
 
 #: the arguments of ``Simulation.observe`` (and the fields of a scene's ``[observe]`` table)
 OBSERVE_FIELDS = ("block_time", "min_blocks", "slab_axis", "slabs", "speed_bins", "speed_max", "pair_bins",
@@ -120,8 +122,11 @@ class Observation:
     (:class:`Profile` or None): ``slab_density``, ``slab_temperature``, ``speed`` (probability
     density of the speed), ``pair_distance`` (of a pair's distance). ``msd_time``, ``msd``: the
     mean squared displacement (unwrapped) at each block end; ``vacf``: the velocity
-    autocorrelation (1/N) sum_i v_i(t_start) . v_i(t) at the same times (empty for an
-    observation resumed from a snapshot written before it existed). Any other entry the C++
+    autocorrelation (1/N) sum_i v_i(t_start) . v_i(t) at the same times; ``helfand``: the
+    Helfand moment of the shear stress at the same times, an array (block ends, d (d - 1) / 2)
+    of I_ab, a < b ((0, 1); (0, 1), (0, 2), (1, 2)), the integral of sum_i v_ia v_ib plus
+    sum r_a Delta p_b over collisions (:func:`helfand_viscosity`). Both are empty for an
+    observation resumed from a snapshot written before they existed. Any other entry the C++
     observer reports appears as an attribute of its own name. Counts: ``pair_collisions``,
     ``group_collisions``, ``particle_collisions``, ``wall_reflections``; ``t_start``, ``t_end``,
     ``blocks``, ``block_time``.
@@ -403,3 +408,135 @@ def _ball_inside(f: np.ndarray, L: np.ndarray, walls: np.ndarray, r: np.ndarray)
             p0, p1, p2 = (np.where(near, hk[k], rr) for k in range(3))
             out -= np.where(near, _beyond_two_3d(p0, p1, rr, s=p2), 0.0)
     return out
+
+
+# ------------------------------------------------------------------ transport from block ends
+def _as_list(observations) -> list:
+    """One observation (anything with ``msd_time``) or a sequence of them, as a list."""
+    return [observations] if hasattr(observations, "msd_time") else list(observations)
+
+
+def _records(observations, key: str) -> tuple[float, list[np.ndarray]]:
+    """(h, rows): each observation's record ``key`` (msd or helfand) at the block ends on its
+    coarsest spacing h (blocks merge as a run grows, so early ends are finer; every end lies
+    on the later grids), with the start (t = 0, value 0) prepended; one h for all."""
+    obs = _as_list(observations)
+    if not obs:
+        raise ValueError("no observations")
+    hs, rows = [], []
+    for o in obs:
+        t, y = np.asarray(o.msd_time, dtype=float), np.asarray(getattr(o, key), dtype=float)
+        y = y.reshape(len(y), -1)
+        if len(t) < 3 or len(y) != len(t):
+            raise ValueError(f"an observation has {len(y)} {key} points at {len(t)} block ends; "
+                             "need 3 or more of each (run longer, or a snapshot from before it existed)")
+        h = t[-1] - t[-2]
+        on = np.abs(t / h - np.round(t / h)) < 1e-6
+        hs.append(h)
+        rows.append(np.vstack([np.zeros((1, y.shape[1])), y[on]]))
+    if max(hs) > min(hs) * (1 + 1e-6):
+        raise ValueError(f"the observations' block spacings differ ({min(hs):.6g} .. {max(hs):.6g}): "
+                         "observe every window with the same block_time and length")
+    return float(hs[0]), rows
+
+
+def _msi(rows: list[np.ndarray], kmax: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sums of squared increments per lag 1..kmax and component over every origin, and counts."""
+    c = rows[0].shape[1]
+    sq, num = np.zeros((kmax, c)), np.zeros(kmax)
+    for y in rows:
+        for k in range(1, min(kmax, len(y) - 1) + 1):
+            d = y[k:] - y[:-k]
+            sq[k - 1] += (d * d).sum(axis=0)
+            num[k - 1] += len(d)
+    return sq, num
+
+
+def helfand_increments(observations, lag_max: float) -> tuple[np.ndarray, np.ndarray]:
+    """The mean-square increment <(I_ab(t + tau) - I_ab(t))^2> of the Helfand moment over all
+    time origins at block ends (of one observation, or pooled over several windows of equal
+    block time): (lags tau up to ``lag_max``, an array (lags, components))."""
+    h, rows = _records(observations, "helfand")
+    kmax = int(np.floor(lag_max / h + 1e-9))
+    if kmax < 1:
+        raise ValueError(f"lag_max = {lag_max} is shorter than the block spacing {h:.6g}")
+    sq, num = _msi(rows, kmax)
+    ok = num > 0
+    return h * np.arange(1, kmax + 1)[ok], sq[ok] / num[ok, None]
+
+
+def helfand_viscosity(observations, volume: float, lag_min: float, lag_max: float,
+                      temperature: Optional[float] = None, batches: int = 8) -> Estimate:
+    """Shear viscosity by the Einstein-Helfand method, from the Helfand moments an observation
+    records at its block ends (``Observation.helfand``; unit masses, k_B = 1):
+
+        eta = lim_{tau -> inf} <(I_ab(t + tau) - I_ab(t))^2> / (2 V k T tau),
+
+    I_ab(t) = int_0^t sum_i v_ia v_ib dt' + sum_{collisions up to t} r_a Delta p_b (an
+    extensive moment, hence 1/V). The mean-square increment is averaged over every time origin
+    at a block end and, per component, fitted by a straight line (least squares, with an
+    intercept: the stress correlation's decay leaves an offset) over the lags in [``lag_min``,
+    ``lag_max``], which must lie where it is linear (the stress autocorrelation decayed: a few
+    time units in sqrt(m D^2 / kT) for hard spheres up to packing 0.45, longer nearer
+    freezing); eta_ab = slope / (2 V T), and the value is the mean over the components a < b.
+
+    ``observations``: one observation, or several windows of one run or of several runs (each
+    started by ``observe(block_time=...)`` with the same block time; increments are taken
+    within a window only). Blocks merge as a run grows (the spacing doubles); only the ends on
+    the coarsest spacing are used, so observe in windows of fewer than 256 blocks to keep the
+    spacing. ``temperature``: default the observations' mean. ``volume``: the box's.
+
+    Error: the windows in ``batches`` contiguous groups (one observation: its record cut into
+    ``batches`` pieces), eta of each group from its own increments (mean over components), and
+    the standard error of the group values (s / sqrt(groups)); nan with fewer than 2 groups.
+    Periodic boxes only: walls exchange momentum with the gas and their impulses do not enter
+    I (the observer records the moment in a closed box too, but this formula does not apply)."""
+    obs = _as_list(observations)
+    if temperature is None:
+        temperature = float(np.mean([o.temperature.value for o in obs]))
+    if not 0.0 < lag_min < lag_max:
+        raise ValueError(f"need 0 < lag_min < lag_max, got {lag_min}, {lag_max}")
+    h, rows = _records(obs, "helfand")
+    kmax = int(np.floor(lag_max / h + 1e-9))
+    lags = h * np.arange(1, kmax + 1)
+    fit = lags >= lag_min - 1e-9 * h
+    if np.count_nonzero(fit) < 2:
+        raise ValueError(f"fewer than 2 lags in [{lag_min}, {lag_max}] at a block spacing of {h:.6g}")
+    scale = 2.0 * float(volume) * float(temperature)
+
+    def eta(group: list[np.ndarray]) -> float:
+        sq, num = _msi(group, kmax)
+        use = fit & (num > 0)
+        if np.count_nonzero(use) < 2:
+            raise ValueError("a window is shorter than lag_max: longer windows, or fewer batches")
+        m = sq[use] / num[use, None]
+        return float(np.mean(np.polyfit(lags[use], m, 1)[0])) / scale
+
+    if len(rows) == 1 and batches > 1:  # one record: cut it into pieces (increments within a piece)
+        cuts = np.array_split(np.arange(len(rows[0])), batches)
+        groups = [[rows[0][c[0]:c[-1] + 2]] for c in cuts if len(c)]
+    else:
+        groups = [[rows[u] for u in idx] for idx in np.array_split(np.arange(len(rows)), min(batches, len(rows)))]
+    vals = np.array([eta(g) for g in groups])
+    err = float(vals.std(ddof=1) / np.sqrt(len(vals))) if len(vals) > 1 else math.nan
+    return Estimate(eta(rows), err)
+
+
+def self_diffusion(observations, start: float = 0.5, batches: Optional[int] = None) -> Estimate:
+    """Self-diffusion D from the mean squared displacement an observation records at its block
+    ends from its own start (one origin, averaged over the particles): D = slope / (2 d) of a
+    least-squares line through the points from ``start`` x its length to its end. Several
+    observations (windows of one run, each started by ``observe``, or several runs): the mean
+    of their D, and its standard error from ``batches`` contiguous groups of them (default one
+    per observation): s / sqrt(groups) of the group means (nan for one group)."""
+    obs = _as_list(observations)
+    vals = []
+    for o in obs:
+        t, m = np.asarray(o.msd_time, dtype=float), np.asarray(o.msd, dtype=float)
+        sel = t >= start * t[-1]
+        if np.count_nonzero(sel) < 2:
+            raise ValueError("fewer than 2 MSD points in the fitted part: run longer")
+        vals.append(np.polyfit(t[sel], m[sel], 1)[0] / (2.0 * o.dim))
+    v = np.asarray(vals)
+    g = np.array([q.mean() for q in np.array_split(v, min(batches or len(v), len(v)))])
+    return Estimate(float(v.mean()), float(g.std(ddof=1) / np.sqrt(len(g))) if len(g) > 1 else math.nan)

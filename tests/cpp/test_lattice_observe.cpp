@@ -1,7 +1,8 @@
 // Tests of observation on the lattice engine (engine_core.hpp's observer hooks feeding
 // revcol/engine/observe.hpp): the observer's virial, kinetic integral and wall terms equal a
 // direct sum over the engine's own velocity changes (its event records, exact integers) to
-// 1e-9 relative; the hooks see every collision and reflection; an observed run is the same
+// 1e-9 relative, and so does the Helfand moment at every block end (relative to the sum of
+// its terms' sizes); the hooks see every collision and reflection; an observed run is the same
 // run as an unobserved one and still reverses bit for bit; run_back and restore end it.
 #include <cmath>
 #include <cstdlib>
@@ -17,12 +18,13 @@ namespace {
 
 template <std::size_t D>
 BasicEngine<std::conditional_t<D == 2, LatticePair2D, LatticePair3D>, BitsBack> make(std::size_t n, double phi, bool walls,
-                                                                                      std::uint32_t seed) {
+                                                                                      std::uint32_t seed,
+                                                                                      bool specular = false) {
   LatticeConfigN<D> c;
   c.wall = filled<D>(walls);
   c.seed = seed;
   const LatticeStartN<D> s = random_start(c, n, phi, seed);
-  return {s.units, s.x, s.v, seed, operator_for(s.units)};
+  return {s.units, s.x, s.v, seed, operator_for(s.units), 0, specular ? revcol::Mode::specular : revcol::Mode::exact};
 }
 
 // The direct sums over a trajectory's event records, in lattice units (long double: a term
@@ -85,6 +87,68 @@ Direct<E::D> direct_sums(const E& e, const std::vector<EventRecordN<E::D>>& even
 
 double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
 
+// The Helfand moment I_ab (a < b) at each time of `times` (float units, the observer's block
+// ends) straight from the event records, in lattice units (long double; exact integers but
+// for the fractional tick of a block end): the integral of sum v_a v_b over the ticks plus
+// r_a dv_b per pair (nearest image), x_a dv_b summed over a group's members (one image).
+// Also the sum of |terms| up to each time (the scale of the round-off).
+template <class E>
+std::pair<std::vector<long double>, std::vector<long double>> direct_helfand(
+    const E& e, const std::vector<EventRecordN<E::D>>& events, std::int64_t t0, const std::vector<VecN<E::D>>& v0,
+    const std::vector<double>& times) {
+  constexpr std::size_t D = E::D, C = D * (D - 1) / 2;
+  const UnitsN<D>& u = e.units();
+  constexpr std::size_t A[3] = {0, 0, 1}, B[3] = {1, 2, 2};
+  std::array<long double, 3> off{}, I{}, scale{};  // sum v_a v_b now; the moment; sum of |terms|
+  for (const auto& v : v0)
+    for (std::size_t c = 0; c < C; ++c) off[c] += static_cast<long double>(v[A[c]]) * v[B[c]];
+  std::vector<long double> out, mag;
+  long double t = static_cast<long double>(t0);
+  std::size_t next = 0;
+  auto fly = [&](long double to) {
+    for (std::size_t c = 0; c < C; ++c) {
+      I[c] += off[c] * (to - t);
+      scale[c] += std::fabs(off[c] * (to - t));
+    }
+    t = to;
+  };
+  auto kick = [&](std::size_t c, long double q) {
+    I[c] += q;
+    scale[c] += std::fabs(q);
+  };
+  for (double tq : times) {
+    const long double end = static_cast<long double>(tq) / static_cast<long double>(u.tick);
+    for (; next < events.size() && static_cast<long double>(events[next].tick) < end; ++next) {
+      const auto& r = events[next];
+      fly(static_cast<long double>(r.tick));
+      for (std::size_t m = 0; m < r.ids.size(); ++m)
+        for (std::size_t c = 0; c < C; ++c)
+          off[c] += static_cast<long double>(r.v_after[m][A[c]]) * r.v_after[m][B[c]] -
+                    static_cast<long double>(r.v_before[m][A[c]]) * r.v_before[m][B[c]];
+      if (r.kind == EventRecordN<D>::pair) {
+        VecN<D> d;
+        for (std::size_t k = 0; k < D; ++k) d[k] = u.wall[k] ? r.x[0][k] - r.x[1][k] : min_image(r.x[0][k] - r.x[1][k], u.L[k]);
+        for (std::size_t c = 0; c < C; ++c)
+          kick(c, static_cast<long double>(d[A[c]]) * static_cast<long double>(r.v_after[0][B[c]] - r.v_before[0][B[c]]));
+      } else if (r.kind == EventRecordN<D>::group) {
+        for (std::size_t m = 0; m < r.ids.size(); ++m) {
+          VecN<D> x = r.x[m];
+          for (std::size_t k = 0; k < D; ++k)
+            if (!u.wall[k] && m > 0) x[k] = r.x[0][k] + min_image(r.x[m][k] - r.x[0][k], u.L[k]);
+          for (std::size_t c = 0; c < C; ++c)
+            kick(c, static_cast<long double>(x[A[c]]) * static_cast<long double>(r.v_after[m][B[c]] - r.v_before[m][B[c]]));
+        }
+      }  // walls: no term (observe.hpp)
+    }
+    fly(end);
+    for (std::size_t c = 0; c < C; ++c) {
+      out.push_back(I[c]);
+      mag.push_back(scale[c]);
+    }
+  }
+  return {out, mag};
+}
+
 // observe `collisions` collisions; the observer's results against the direct sums
 template <class E>
 void check_direct(E e, std::uint64_t warm, std::uint64_t collisions, const char* what) {
@@ -127,6 +191,19 @@ void check_direct(E e, std::uint64_t warm, std::uint64_t collisions, const char*
       CHECK(rel(o.pressure_wall[k].value, static_cast<double>(d.wall_dp[k]) * (l / tk) / (2.0 * tau * area)) < 1e-9);
     }
   }
+  // the Helfand moment at every block end: I (float units) = I (lattice units) x length_unit^2 / tick
+  std::vector<double> ends;
+  for (double q : o.msd_time) ends.push_back(o.t_start + q);
+  const auto [hd, hmag] = direct_helfand(e, events, t0, v0, ends);
+  CHECK(o.helfand_components == static_cast<int>(D * (D - 1) / 2));
+  CHECK(o.helfand.size() == hd.size() && ends.size() >= 8);
+  double worst = 0.0;
+  for (std::size_t q = 0; q < hd.size() && q < o.helfand.size(); ++q) {
+    const double want = static_cast<double>(hd[q]) * l * l / tk, mag = static_cast<double>(hmag[q]) * l * l / tk;
+    worst = std::max(worst, std::fabs(o.helfand[q] - want) / mag);
+  }
+  CHECK(worst < 1e-9);
+  if (std::getenv("REVCOL_TEST_VERBOSE")) std::printf("  %s: Helfand worst |observed - direct| / sum|terms| %.3g\n", what, worst);
   if (std::getenv("REVCOL_TEST_VERBOSE") || !(rel(o.compressibility.value - 1.0, w / k2) < 1e-9))
     std::printf("  %s: %llu pairs, %llu walls, %llu groups; Z - 1 observed %.15g, direct %.15g; T %.15g vs %.15g\n", what,
                 static_cast<unsigned long long>(d.pairs), static_cast<unsigned long long>(d.walls),
@@ -147,6 +224,11 @@ TEST_CASE("observer = direct sum: 2D walls, area fraction 0.3 (wall virial and w
 TEST_CASE("observer = direct sum: 3D periodic 0.3 and 3D walls 0.3") {
   check_direct(make<3>(150, 0.3, false, 5), 2000, 8000, "3D periodic 0.3");
   check_direct(make<3>(120, 0.3, true, 6), 2000, 8000, "3D walls 0.3");
+}
+
+TEST_CASE("observer = direct sum in specular mode: 3D periodic 0.45 and 2D walls 0.4") {
+  check_direct(make<3>(200, 0.45, false, 9, true), 2000, 20000, "3D periodic 0.45 specular");
+  check_direct(make<2>(150, 0.4, true, 10, true), 2000, 8000, "2D walls 0.4 specular");
 }
 
 TEST_CASE("an observed run is the unobserved run, and reverses bit for bit; run_back ends the observation") {

@@ -57,7 +57,8 @@ bool same(const Observation& a, const Observation& b) {
   for (const auto m : {&Observation::slab_density, &Observation::slab_temperature, &Observation::speed,
                        &Observation::pair_distance})
     ok = ok && same(a.*m, b.*m);
-  return ok && same(a.msd_time, b.msd_time) && same(a.msd, b.msd);
+  return ok && same(a.msd_time, b.msd_time) && same(a.msd, b.msd) && same(a.vacf, b.vacf) &&
+         a.helfand_components == b.helfand_components && same(a.helfand, b.helfand);
 }
 
 }  // namespace
@@ -122,7 +123,9 @@ TEST_CASE("periodic free flight: unwrapped mean squared displacement, blocks of 
   for (std::size_t k = 0; k < o.msd.size(); ++k) {
     CHECK_NEAR(o.msd_time[k], 2.0 * (k + 1), 1e-12);
     CHECK_NEAR(o.msd[k], 1.25 * o.msd_time[k] * o.msd_time[k], 1e-9);
+    CHECK_NEAR(o.helfand[k], 0.5 * o.msd_time[k], 1e-12);  // I_xy = integral of v_x v_y: no collisions
   }
+  CHECK(o.helfand_components == 1 && o.helfand.size() == 21);
   CHECK(o.blocks == 21);  // min_blocks 16: 21 complete blocks stay as they are
   CHECK_NEAR(o.temperature.error, 0.0, 1e-15);
   for (int k = 0; k < 4; ++k) CHECK_NEAR(o.slab_density.value[k], 1.0 / 9.0, 1e-12);

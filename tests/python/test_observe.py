@@ -68,7 +68,11 @@ def _direct_sums(sim, collisions, D=1.0):
     def nearest(r):
         return np.where(per, r - box * np.round(r / box), r)
 
-    out = {"w": 0.0, "w_wall": 0.0, "k2": 0.0, "dp": np.zeros(sim.dim)}
+    out = {"w": 0.0, "w_wall": 0.0, "k2": 0.0, "dp": np.zeros(sim.dim), "steps": []}
+    pairs = [(a, b) for a in range(sim.dim) for b in range(a + 1, sim.dim)]  # the Helfand components
+
+    def off(v):  # sum_i v_ia v_ib per component a < b
+        return np.array([np.sum(v[:, a] * v[:, b]) for a, b in pairs])
 
     def walls(q, dv):  # a reflection's impulse dv (walled axes only) on q
         for k in np.nonzero(dv != 0.0)[0]:
@@ -102,8 +106,33 @@ def _direct_sums(sim, collisions, D=1.0):
             if q != i and q != j:
                 walls(q, v1[q] - v0[q])
         out["k2"] += np.sum(v0 * v0) * (tc - t0) + np.sum(v1 * v1) * (t1 - tc)  # walls keep |v|
+        # the Helfand moment's pieces (periodic boxes: no other velocity change in the step)
+        out["steps"].append((t0, tc, t1, off(v0), off(v1), np.array([rc[a] * dv_i[b] for a, b in pairs])))
         x0, v0, t0, c0 = x1, v1, t1, c1
     return out
+
+
+def _helfand_at(steps, te):
+    """The direct Helfand moment (per component) at time te from _direct_sums' steps, and the
+    sum of its terms' sizes (the scale of round-off)."""
+    I, size = 0.0, 0.0
+    for t0, tc, t1, pre, post, kick in steps:
+        if te <= t0:
+            break
+        parts = [pre * (min(te, tc) - t0)]
+        if te > tc:
+            parts += [kick, post * (min(te, t1) - tc)]
+        for q in parts:
+            I, size = I + q, size + np.abs(q)
+    return I, size
+
+
+def _check_helfand(o, steps):
+    """Every recorded I_ab equals the direct sum at its block end to 1e-9 of its terms' sizes."""
+    assert o.helfand.shape == (len(o.msd_time), o.dim * (o.dim - 1) // 2) and len(o.msd_time) > 5
+    for t, got in zip(o.msd_time, o.helfand):
+        want, size = _helfand_at(steps, o.t_start + t)
+        assert np.all(np.abs(got - want) <= 1e-9 * size), (got, want)
 
 
 def _observed_sums(o, box):
@@ -148,7 +177,21 @@ def test_observed_virial_equals_the_direct_sum_over_collisions(phi, boundary, mo
             assert seen["dp"] == pytest.approx(direct["dp"], rel=1e-9)
         else:
             assert direct["w_wall"] == 0.0 and seen["w_wall"] == pytest.approx(0.0, abs=1e-12 * direct["k2"])
+            _check_helfand(o, direct["steps"])
     assert whole.observation().blocks >= 16
+
+
+def test_helfand_moment_equals_the_direct_sum_3d():
+    """3D specular spheres, periodic: the three recorded I_xy, I_xz, I_yz at every block end
+    equal the direct sums over the engine's collisions (the kinetic integral between them and
+    r_a Delta p_b at contact); the collisions' terms are symmetric (central impulses)."""
+    sim = revcol.Simulation.random(n=150, dim=3, phi=0.35, mode="specular", seed=4)
+    sim.run(collisions=2000)
+    sim.observe(block_time=0.01)
+    direct = _direct_sums(sim, 1500)
+    o = sim.observation()
+    _check_helfand(o, direct["steps"])
+    assert np.all(np.abs(o.helfand[-1]) > 0)
 
 
 @pytest.mark.parametrize("kwargs, error, word", [
@@ -250,11 +293,20 @@ def test_velocity_autocorrelation_at_block_ends():
     # snapshots: kept; an older observer entry (without start velocities and VACF) resumes without it
     snap = sim.snapshot()
     assert np.array_equal(revcol.Simulation.from_snapshot(snap).observation().vacf, o.vacf)
+    # the Helfand moment follows: its values and running sums (1 each in 2D), then its record
+    helf = 2 + len(o.helfand)
+    assert np.array_equal(revcol.Simulation.from_snapshot(snap).observation().helfand, o.helfand)
     old = dict(snap)
-    old["observer"] = np.asarray(snap["observer"])[: -(sim.n * sim.dim + len(o.vacf))]
+    old["observer"] = np.asarray(snap["observer"])[: -(sim.n * sim.dim + len(o.vacf) + helf)]
     resumed = revcol.Simulation.from_snapshot(old)
-    assert resumed.observing and len(resumed.observation().vacf) == 0
+    assert resumed.observing and len(resumed.observation().vacf) == 0 and len(resumed.observation().helfand) == 0
     assert np.array_equal(resumed.observation().msd, o.msd)
+    no_helfand = dict(snap)  # written with the VACF, before the Helfand moment
+    no_helfand["observer"] = np.asarray(snap["observer"])[:-helf]
+    resumed = revcol.Simulation.from_snapshot(no_helfand)
+    assert np.array_equal(resumed.observation().vacf, o.vacf) and resumed.observation().helfand.shape == (0, 1)
+    resumed.run(collisions=500)
+    assert len(resumed.observation().helfand) == 0 and len(resumed.observation().vacf) > len(o.vacf)
 
 
 def _batched_rdf(points, box, batches, **kw):
@@ -385,3 +437,37 @@ def test_observation_takes_a_result_it_does_not_know():
     assert o.new_estimate == Estimate(1.5, 0.25) and np.array_equal(o.new_series, [1.0, 2.0])
     d = o.to_dict()
     assert d["new_estimate"] == [1.5, 0.25] and d["new_series"] == [1.0, 2.0] and d["vacf"] == o.vacf.tolist()
+
+
+def test_helfand_viscosity_and_self_diffusion_on_known_walks():
+    """helfand_viscosity on synthetic windows: I a random walk with <dI^2> = 2 V T eta dt per
+    component recovers eta within 4 of its standard errors (batches of windows), and the
+    errors are about the spread of independent repeats; self_diffusion the same for an MSD
+    2 d D t. Mismatched block spacings and too short lags are named errors."""
+    from types import SimpleNamespace
+    from revcol.observe import helfand_viscosity, self_diffusion
+
+    rng = np.random.default_rng(5)
+    V, T, eta, h, D = 50.0, 1.3, 0.7, 0.1, 0.2
+
+    def window(points=200):
+        steps = rng.normal(0.0, np.sqrt(2 * V * T * eta * h), size=(points, 3))
+        t = h * np.arange(1, points + 1)
+        msd = 6 * D * t + rng.normal(0.0, 0.05, size=points)
+        return SimpleNamespace(msd_time=t, helfand=np.cumsum(steps, axis=0), msd=msd, dim=3,
+                               temperature=Estimate(T, 0.0))
+
+    runs = [helfand_viscosity([window() for _ in range(24)], V, 1.0, 3.0, batches=8) for _ in range(12)]
+    vals, errs = np.array([r.value for r in runs]), np.array([r.error for r in runs])
+    assert np.all(np.abs(vals - eta) < 4 * errs)
+    assert 0.5 < np.mean(errs) / np.std(vals, ddof=1) < 2.0
+    one = helfand_viscosity(window(4000), V, 1.0, 3.0, temperature=T)  # one record, cut into pieces
+    assert abs(one.value - eta) < 4 * one.error
+    d = self_diffusion([window() for _ in range(10)])
+    assert abs(d.value - D) < 4 * d.error and d.error < 0.01
+    bad = window()
+    bad.msd_time = bad.msd_time * 2
+    with pytest.raises(ValueError, match="spacings"):
+        helfand_viscosity([window(), bad], V, 1.0, 3.0)
+    with pytest.raises(ValueError, match="lags"):
+        helfand_viscosity([window()], V, 1.01, 1.05)

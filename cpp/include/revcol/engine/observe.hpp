@@ -60,6 +60,22 @@
 // Cost: measured with callgrind in docs/physics.md (off: one pointer test per velocity
 // change in the engine's hooks, note_pair / note_wall, out of line and cold).
 //
+// Shear stress: the Helfand moment (Einstein-Helfand viscosity). For every off-diagonal
+// pair of axes a < b (component c: (0,1) in 2D; (0,1), (0,2), (1,2) in 3D), unit masses,
+//     I_ab(t) = integral_{t_start}^t sum_i v_ia v_ib dt' + sum_{collisions up to t} r_a Delta p_b,
+// r = x_a - x_b the pair's separation as the virial takes it (nearest image) and Delta p
+// the first member's change; a group adds sum_u x_u,a Delta p_u,b (its positions of one
+// image, as the virial). sum_i v_ia v_ib is a running sum like sum v^2, integrated exactly
+// between velocity changes. I_ab is recorded at each block end (the MSD's times); its
+// increments give the shear viscosity eta = <(I(t + tau) - I(t))^2> / (2 V k T tau) at long
+// tau (revcol.observe.helfand_viscosity). Wall impulses do not enter: a closed box exchanges
+// momentum with its walls and the formula is for periodic boxes (the moment is recorded
+// anyway). A randomized law's impulse is not along r, so there r_a Delta p_b != r_b Delta p_a;
+// the specular gas's is (central impulses). Cost (3D): 6 products per changed velocity (the
+// new v_a v_b less the old), 3 per pair collision and 3 per hook's time step; measured +26
+// (2D) and +57 (3D) instructions per observed float collision, +70 per lattice one in 3D
+// (callgrind, docs/physics.md).
+//
 // Energy: K2 uses the running sum of v^2, so the temperature is 2 E / (d N) of the energy
 // the particles have, and its block error is round-off (E is conserved).
 //
@@ -139,6 +155,9 @@ struct Observation {
   std::vector<double> msd_time, msd; ///< mean squared displacement (unwrapped) at each block end
   std::vector<double> vacf;          ///< velocity autocorrelation (1/N) sum_i v_i(t_start) . v_i(t) at each block end (msd_time);
                                      ///< empty for an observation resumed from a snapshot that did not keep it
+  int helfand_components = 0;        ///< c = d (d - 1) / 2 off-diagonal pairs a < b: (0,1); (0,1), (0,2), (1,2)
+  std::vector<double> helfand;       ///< the Helfand moment I_ab at each block end (msd_time), c per point (row-major);
+                                     ///< empty for an observation resumed from a snapshot that did not keep it
 };
 
 /// The accumulator behind Simulation::observe (any d; the engine calls the hooks).
@@ -161,7 +180,9 @@ class Observer {
   /// open one (t0, t1, k2, w, w_wall, dist, wall_dp[3], slab_t, slab_k2, speed, pair);
   /// msd_t_, msd_; then start_v_ (n x dim) and vacf_ (one per MSD point), absent in
   /// snapshots written before the velocity autocorrelation existed (a resumed observation
-  /// then reports none). counts: per block (the same order) pairs, groups, parts, walls.
+  /// then reports none); then the Helfand moment's running values and running sums of v_a v_b
+  /// (c each, c = d (d - 1) / 2) and its record (c per MSD point), absent in snapshots written
+  /// before it existed (a resumed observation then reports none). counts: per block (the same order) pairs, groups, parts, walls.
   /// Integers among the reals are exact (all far below 2^53).
   void save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const;
 
@@ -219,6 +240,9 @@ class Observer {
   void fly(Segment& s, double t, double dt);
   template <int Dim>
   void virial(int a, int b, const double* va);
+  template <int K>
+  void helfand_add(const double* r, const double* dp);
+  void group_virial(int i, const double* x, const double* v);
   template <int Dim>
   [[gnu::noinline]] void pair_general(double t, int a, int b, const double* va, const double* vb);
   template <int K>
@@ -252,6 +276,11 @@ class Observer {
   Block cur_;                   // the open block
   std::vector<double> msd_t_, msd_;
   std::vector<double> start_v_, vacf_;  // velocities at the start (n x dim; empty: not kept), VACF per block end
+  int hc_ = 0;                             // Helfand components d (d - 1) / 2
+  std::array<double, 3> vv_off_{};         // sum_i v_ia v_ib per component (0 beyond hc_)
+  std::array<double, 3> helf_{};           // the Helfand moment up to t_now_
+  bool helf_kept_ = true;                  // false: resumed from a snapshot without it
+  std::vector<double> helf_rec_;           // I_ab at each block end (hc_ per MSD point)
 
   // --- the collision record (see the header comment) ---
  public:
