@@ -50,6 +50,8 @@ Generator parse_generator(const std::string& s) {
 Mode parse_engine_mode(const std::string& s) {
   Mode m;
   if (detail::engine_only_mode(s, m)) return m;
+  if (s != "exact" && s != "paper")  // the engine's message names its modes too (parse_mode knows two)
+    throw InvalidArgument("mode must be 'exact', 'paper' or 'specular', got '" + s + "'");
   return parse_mode(s);
 }
 

@@ -17,8 +17,10 @@ round trip is exact from the quantized state on. Times in floats are ``clock * t
 ``mode="specular"`` runs deterministic specular hard-sphere dynamics instead: each pair
 collision reflects the relative velocity about the contact normal with an exact integer
 involution (the momentum exact, the energy to a few lattice units), carrying the sub-tick phase
-across; no random number is drawn, X never changes, and the run is still reversed bit for bit
-(docs/lattice.md "Specular dynamics"). The rare log then holds group collisions only.
+across; no random number is drawn and X does not change, and the run is still reversed bit for
+bit (docs/specular.md). The rare log holds the rare cases: group collisions (a third body within
+one tick) and, rarer, a post centre beyond a wall within the tick, drawn by the randomized
+operator (``diagnostics()["drawn_fallbacks"]``).
 
     >>> from revcol.lattice import LatticeSimulation
     >>> sim = LatticeSimulation.random(n=100, phi=0.3, seed=1)
@@ -106,7 +108,7 @@ class LatticeSimulation(SimulationBase):
     randomized pair operator, reversed bit for bit through its draws and the bits-back integer)
     or ``"specular"`` (deterministic specular hard-sphere dynamics, bit-reversible with no random
     numbers: the relative velocity reflected about the contact normal by an exact integer
-    involution; X never changes; docs/lattice.md "Specular dynamics"). ``law`` (exact mode only):
+    involution; nothing drawn but the rare logged fallback; docs/specular.md). ``law`` (exact mode only):
     ``"flux"`` (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and X's
     first 256 bits. ``tick_bits`` T (16..26; default ``None``: automatic): a particle of rms speed
     moves 2^-T diameters per tick; a finer tick (larger T) makes redraws and group collisions (a

@@ -10,8 +10,8 @@ count). Every collision is an exact integer bijection, so the reversal restores 
 exactly, for any number of collisions; the float start is quantized once (its error is
 reported) and the round trip is exact from the quantized state on. :func:`restored` compares
 each part of the state exactly; the round trip passes when every part is equal. In specular
-mode (``[collisions] mode = "specular"``) no number is drawn and X never changes; the report
-counts the backscatters (pairs the specular map turned back in place).
+mode (``[collisions] mode = "specular"``) no number is drawn (but for the rare logged fallback)
+and the report counts the backscatters (pairs the specular map turned back in place).
 
 The run goes forward in chunks (about 200 of them, at most 10^4 collisions each; the lattice
 engine's run is the same in chunks as in one call) so that Ctrl-C stops it between chunks and

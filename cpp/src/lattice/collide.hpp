@@ -93,6 +93,15 @@ void BasicEngine<Op, Bits, Queue>::collide_forward(int i, int j, std::int64_t a)
   journal(i);
   journal(j);
   if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
+  collide_drawn(i, j, a, false);
+}
+
+// The randomized operator with redraws (exact mode; in specular mode the fallback of a refused
+// post state, `fallback`: its log entry is written even with no redraw, which tells the
+// reverse that this collision drew). Returns false only for a fallback whose group is
+// impossible too (nothing changed); exact mode's group failure throws.
+template <class Op, class Bits, class Queue>
+bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, bool fallback) {
   const Vec pre_a[2] = {pos(i, a), pos(j, a)};
   bool multi = false;
   const std::uint64_t ctr0 = ctr_[i];
@@ -104,10 +113,7 @@ void BasicEngine<Op, Bits, Queue>::collide_forward(int i, int j, std::int64_t a)
   Bits out;
   std::uint32_t redraws = 0;
   for (;;) {
-    if (static_cast<std::int64_t>(redraws) > max_redraws) {
-      group_collide(i, j, a, ctr0, reasons);
-      return;
-    }
+    if (static_cast<std::int64_t>(redraws) > max_redraws) return group_collide(i, j, a, ctr0, reasons, !fallback);
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
     const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_, xi2, xj2, vi2, vj2, out);
     int why = static_cast<int>(rf);
@@ -122,15 +128,17 @@ void BasicEngine<Op, Bits, Queue>::collide_forward(int i, int j, std::int64_t a)
     ++redraws;
   }
   if (multi) ++cnt_.multi_body;
-  if (redraws > 0) {
+  if (redraws > 0 || fallback) {
     log_.push(ncoll_ + 1, redraws);
     ++cnt_.log_entries;
   }
+  if (fallback) ++cnt_.drawn_fallbacks;
   X_ = std::move(out);
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, i, j});
   if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
   apply(i, j, xi2, xj2, vi2, vj2, a);
+  return true;
 }
 
 template <class Op, class Bits, class Queue>
@@ -139,7 +147,7 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
     group_back(i, j, a, *g);
     return;
   }
-  if (mode_ == Mode::specular) {
+  if (mode_ == Mode::specular && log_.top(ncoll_) == nullptr) {  // (a log entry: a drawn fallback)
     back_specular(i, j, a);
     return;
   }
@@ -160,7 +168,11 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
 
 // Specular mode (specular.hpp): one deterministic post state. When the map refuses it or it
 // fails the acceptance test (a third body at a, a false tie at a-1, a wall, vmax) no redraw
-// exists: the collision goes to the group rule (a log entry, its reason counted in redraws).
+// exists: the collision goes to the group rule (a log entry, its reason counted in redraws),
+// except a post centre beyond a wall (a wall, the pair and the wall again within one tick),
+// which the group rule cannot always take back: that one is drawn by the randomized operator
+// with the particle's stream and X (collide_drawn, logged; counted in drawn_fallbacks). Either
+// rule is the other's fallback; only both failing is an error.
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a) {
   journal(i);
@@ -181,7 +193,11 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
     std::array<std::uint64_t, 8> reasons{};
     ++reasons[std::min(why, 7)];
     ++cnt_.redraws[std::min(why, 7)];
-    group_collide(i, j, a, ctr_[i], reasons);
+    if (why == redraw_outside) {
+      if (!collide_drawn(i, j, a, true)) group_collide(i, j, a, ctr_[i], reasons, true);
+    } else if (!group_collide(i, j, a, ctr_[i], reasons, false)) {
+      collide_drawn(i, j, a, true) || group_collide(i, j, a, ctr_[i], reasons, true);
+    }
     return;
   }
   if (multi) ++cnt_.multi_body;

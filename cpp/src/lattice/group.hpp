@@ -175,7 +175,7 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
 }
 
 template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons) {
+bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons, bool must) {
   // a member reflected at this very tick takes its line from before the reflection, and the
   // wall joins the group as a contact (resolve_velocities): the stall point is then a real point
   // inside the box, and the log's pre velocity is the one before the reflection
@@ -201,9 +201,11 @@ void BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
     ctr_[i] = ctr0;  // nothing changed
     ln_[i] = keep[0];
     ln_[j] = keep[1];
+    if (!must) return false;
     std::string why = "lattice engine: collision " + std::to_string(ncoll_ + 1) + " of particles " +
                       std::to_string(i) + ", " + std::to_string(j) + " at tick " + std::to_string(a) +
-                      (mode_ == Mode::specular ? std::string(" had its specular post state refused")
+                      (mode_ == Mode::specular ? std::string(" had its specular post state refused and no draw of the ") +
+                                                     "randomized operator in " + std::to_string(max_redraws) + " was acceptable"
                                                : " found no acceptable post state in " + std::to_string(max_redraws) + " redraws") +
                       ", and its group of " + std::to_string(g.size()) + " can neither resolve nor bounce back (";
     for (int k = 1; k < 8; ++k) why += std::string(redraw_names[k]) + " " + std::to_string(reasons[k]) + (k < 7 ? ", " : ")");
@@ -233,6 +235,7 @@ void BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
   }
   ++cnt_.collisions;
   for (int q : g) predict(q, a);
+  return true;
 }
 
 template <class Op, class Bits, class Queue>

@@ -359,13 +359,15 @@ class BasicEngine {
   void apply(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a);
   void collide_forward(int i, int j, std::int64_t a);
   void collide_back(int i, int j, std::int64_t a);
+  bool collide_drawn(int i, int j, std::int64_t a, bool fallback);
   void collide_specular(int i, int j, std::int64_t a);
   void back_specular(int i, int j, std::int64_t a);
 
   std::vector<int> group_of(int i, int j, std::int64_t a) const;
   std::vector<Vec> resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const;
   bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec>& post, std::vector<Vec>& vel) const;
-  void group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons);
+  // false when it can neither resolve nor bounce (nothing changed) and !must; must: throws then
+  bool group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons, bool must = true);
   void group_back(int i, int j, std::int64_t a, Group& entry);
 
   std::unique_ptr<engine::Observer> make_observer(const Units& u, const std::vector<Vec>& x, const std::vector<Vec>& v,

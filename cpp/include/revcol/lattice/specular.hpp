@@ -1,6 +1,6 @@
 // The deterministic specular pair operator of the lattice engine (2D disks and 3D spheres): true
 // hard-sphere dynamics, reversed bit for bit with no random numbers, no bits-back integer and no
-// log (docs/lattice.md "Specular dynamics").
+// log but for the rare cases the engine resolves (docs/specular.md; engine: src/lattice/collide.hpp).
 //
 // The event rule is the flux law's (LATTICE.md §2): a pair collides on the transition a-1 -> a,
 // the pre state being q = x_i - x_j at a-1 outside (|q|^2 >= sigma^2), w = v_i - v_j, the inside

@@ -44,6 +44,7 @@ struct Counters : Visitable<Counters> {
   std::uint64_t group_bounces = 0;       ///< groups that bounced back (the fallback; a log entry)
   std::uint64_t wall_groups = 0;         ///< group members whose reflection at the same tick the group took in
   std::uint64_t backscatters = 0;        ///< specular mode: pairs turned back in place (specular.hpp; forward)
+  std::uint64_t drawn_fallbacks = 0;     ///< specular mode: refused post states drawn by the randomized operator (logged)
 
   /// Calls f(name, count) for every counter, with the names of the diagnostics (redraws: the
   /// array by RedrawReason, index 0 unused).
@@ -62,6 +63,7 @@ struct Counters : Visitable<Counters> {
     f("group_bounces", c.group_bounces);
     f("wall_groups", c.wall_groups);
     f("backscatters", c.backscatters);
+    f("drawn_fallbacks", c.drawn_fallbacks);
   }
 };
 
