@@ -239,6 +239,165 @@ def echo_case(dim: int, phi: float, n: int, seed: int, t_end: float, frames: int
     return res
 
 
+class _LatticePair:
+    """A reference lattice gas and a perturbed copy, for the Benettin renormalization."""
+
+    def __init__(self, sim):
+        self.ref, self.metric = sim, _Metric(sim)
+        self.L = np.asarray(sim.units["L"], dtype=np.int64)
+        self.pert = None
+
+    def diff(self) -> tuple:
+        """(dx in diameters, dv in sqrt(kT/m)) and the integer differences (nearest image)."""
+        xr, vr = self.ref.lattice_positions, self.ref.lattice_velocities
+        xp, vp = self.pert.lattice_positions, self.pert.lattice_velocities
+        d = xp - xr
+        per = self.metric.periodic
+        d[:, per] -= np.round(d[:, per] / self.L[per]).astype(np.int64) * self.L[per]
+        return d, vp - vr
+
+    def distance(self) -> float:
+        d, dv = self.diff()
+        return math.hypot(float(np.sqrt((d.astype(float) ** 2).sum())) / self.metric.sigma,
+                          float(np.sqrt((dv.astype(float) ** 2).sum())) * self.metric.vunit)
+
+    def place(self, dx, dv) -> bool:
+        """The perturbed copy at the reference's state plus (dx, dv) (integers); False if refused
+        (a pair of the reference within the perturbation of contact: try again later)."""
+        snap = self.ref.snapshot()
+        x = np.asarray(snap["x"], dtype=np.int64) + dx
+        per = self.metric.periodic
+        x[:, per] %= self.L[per]
+        snap["x"], snap["v"] = x, np.asarray(snap["v"], dtype=np.int64) + dv
+        try:
+            self.pert = type(self.ref).from_snapshot(snap)
+        except ValueError:
+            return False
+        return True
+
+    def run(self, t: float) -> None:
+        self.ref.run(time=t)
+        self.pert.run(time=t)
+
+
+class _FloatPair:
+    """A reference float specular gas and a perturbed copy (each new copy's clock starts at 0)."""
+
+    def __init__(self, x, v, box, boundary):
+        self.box, self.boundary = np.asarray(box, dtype=float), list(boundary)
+        self.periodic = np.array([b == "periodic" for b in self.boundary])
+        self.ref = Simulation(x, v, self.box, boundary=self.boundary, mode="specular")
+        self.pert, self.offset = None, 0.0
+
+    def diff(self) -> tuple:
+        d = np.asarray(self.pert.positions) - np.asarray(self.ref.positions)
+        d = np.where(self.periodic, d - np.round(d / self.box) * self.box, d)
+        return d, np.asarray(self.pert.velocities) - np.asarray(self.ref.velocities)
+
+    def distance(self) -> float:
+        d, dv = self.diff()
+        return math.hypot(float(np.sqrt((d * d).sum())), float(np.sqrt((dv * dv).sum())))
+
+    def place(self, dx, dv) -> bool:
+        x = np.asarray(self.ref.positions) + dx
+        x = np.where(self.periodic, np.mod(x, self.box), x)
+        try:
+            self.pert = Simulation(x, np.asarray(self.ref.velocities) + dv, self.box, boundary=self.boundary,
+                                   mode="specular")
+        except ValueError:
+            return False
+        self.offset = self.ref.time
+        return True
+
+    def run(self, t: float) -> None:
+        self.ref.run(time=t)
+        self.pert.run(time=t - self.offset)
+
+
+def benettin(pair, t_total: float, dt: float, d0: float = 1e-6, skip: float = 0.2, blocks: int = 10,
+             integer: bool = False, jump: float = 5.0) -> dict:
+    """The largest Lyapunov exponent by renormalization (Benettin et al.): the perturbed copy is
+    put back at distance d0 from the reference along its current difference every dt, and lambda
+    is the mean of ln(d / d0) / dt over the run after the first ``skip`` of it (the perturbation
+    first turns into the most unstable direction); its error is the standard error of
+    ``blocks`` block means. Distances combine positions (diameters) and velocities (sqrt(kT/m)).
+    On the lattice (``integer``) d0 = 1e-6 is far above the resolution (2^-T diameters)."""
+    rng = np.random.default_rng(12345)
+    n, dim = pair.ref.n, pair.ref.dim
+    t = pair.ref.time
+    sigma = pair.metric.sigma if integer else 1.0
+    for _ in range(20):  # a random direction; another if it moves a centre into a near-touching neighbour
+        u = rng.normal(size=(n, dim))
+        first = u / np.sqrt((u * u).sum()) * d0
+        if integer:
+            placed = pair.place(np.round(first * sigma).astype(np.int64), np.zeros((n, dim), dtype=np.int64))
+        else:
+            placed = pair.place(first, np.zeros((n, dim)))
+        if placed:
+            break
+    else:
+        raise RuntimeError(f"benettin: 20 first perturbations of size {d0} were refused")
+    logs, steps, start, refused = [], int(round(t_total / dt)), pair.distance(), 0
+    jumps = []  # (time, ln growth) of the steps beyond e^jump (see lambda_linear)
+    for k in range(steps):
+        t += dt
+        pair.run(t)
+        d = pair.distance()
+        logs.append(math.log(d / start))
+        if logs[-1] > jump:
+            jumps.append((t, logs[-1]))
+        dx, dv = pair.diff()
+        f = d0 / d
+        if integer:
+            ok = pair.place(np.round(dx * f).astype(np.int64), np.round(dv * f).astype(np.int64))
+        else:
+            ok = pair.place(dx * f, dv * f)
+        start = pair.distance() if ok else d  # refused: the copy runs on from where it is
+        refused += 0 if ok else 1
+    used = np.asarray(logs[int(skip * len(logs)):]) / dt
+    means = [float(b.mean()) for b in np.array_split(used, blocks)]
+    # linear steps only: a step that grew the perturbation by more than e^jump is a collision one
+    # copy had and the other missed (a grazing one, or on the lattice one whose normal moved by
+    # the map's error), not the instability's linear growth; lambda_linear leaves them out
+    lin = used[used * dt <= jump]
+    lmeans = [float(b.mean()) for b in np.array_split(lin, blocks)]
+    return {"lambda": float(used.mean()), "error": float(np.std(means, ddof=1) / math.sqrt(blocks)),
+            "lambda_linear": float(lin.mean()), "error_linear": float(np.std(lmeans, ddof=1) / math.sqrt(blocks)),
+            "steps_left_out": int(len(used) - len(lin)),
+            "renormalizations": steps, "refused": refused, "jumps": jumps[:50], "n_jumps": len(jumps), "dt": dt,
+            "d0": d0, "time": t_total}
+
+
+def lyapunov_scan(dim: int, phi: float, n: int, seed: int, d0s: Sequence[float], t_mft: float = 60.0,
+                  dt_mft: float = 0.25, warm: float = 5.0) -> dict:
+    """Benettin's lambda on the lattice specular gas and on the float specular gas from the same
+    start, for each perturbation size d0: the lattice's map carries a deterministic error of
+    order 2^-T of the relative velocity per collision (the column's normal is within one tick's
+    travel of the contact's), so below some d0 that error, not the instability, grows the
+    perturbation; above it both engines must give one lambda until d0 is large enough to change
+    which collisions happen."""
+    base = lattice_gas(dim, n, phi, seed)
+    base.run(time=warm)
+    c0, t0 = base.collisions, base.time
+    probe = type(base).from_snapshot(base.snapshot())
+    probe.run(collisions=20 * n)
+    rate = 2.0 * (probe.collisions - c0) / (n * (probe.time - t0))
+    snap = base.snapshot()
+    rows = []
+    for d0 in d0s:
+        w0 = time.perf_counter()
+        lat = benettin(_LatticePair(type(base).from_snapshot(snap)), t_mft / rate, dt_mft / rate, d0=d0, integer=True)
+        s2 = type(base).from_snapshot(snap)
+        flt = benettin(_FloatPair(np.asarray(s2.positions), np.asarray(s2.velocities), s2.box, s2.boundary),
+                       t_mft / rate, dt_mft / rate, d0=d0)
+        rows.append({"d0": d0, "lattice": lat, "float": flt, "seconds": time.perf_counter() - w0,
+                     "sd": abs(lat["lambda"] - flt["lambda"]) / math.hypot(lat["error"], flt["error"]),
+                     "sd_linear": abs(lat["lambda_linear"] - flt["lambda_linear"]) / math.hypot(lat["error_linear"],
+                                                                                              flt["error_linear"])})
+    return {"dim": dim, "phi": phi, "n": n, "seed": seed, "collision_rate": rate, "tick_bits": int(snap["units"]["tick_bits"]),
+            "rows": rows}
+
+
 def _summary(cases: list) -> dict:
     """lambda per (dim, phi): mean and standard error over seeds, per method; per mean free time."""
     out = {}
@@ -260,31 +419,105 @@ def _summary(cases: list) -> dict:
     return out
 
 
-def plot(cases: list, path: str) -> None:
-    """ln distance against the time run back, one panel per dimension (the first seed)."""
+def _scan_summary(scans: list) -> dict:
+    """Per (dim, phi) and d0: lambda of each engine, mean and standard error over seeds, and
+    their difference in combined standard errors."""
+    out = {}
+    for key in sorted({(s["dim"], s["phi"]) for s in scans}):
+        group = [s for s in scans if (s["dim"], s["phi"]) == key]
+        rows = {}
+        for k, d0 in enumerate(r["d0"] for r in group[0]["rows"]):
+            row = {}
+            for eng in ("lattice", "float"):
+                for key_, err_key in (("lambda", "error"), ("lambda_linear", "error_linear")):
+                    vals = [s["rows"][k][eng][key_] for s in group]
+                    err = (float(np.std(vals, ddof=1) / math.sqrt(len(vals))) if len(vals) > 1
+                           else group[0]["rows"][k][eng][err_key])
+                    row.setdefault(eng, {})[key_] = float(np.mean(vals))
+                    row[eng][err_key] = err
+                row[eng]["steps_left_out"] = int(sum(s["rows"][k][eng]["steps_left_out"] for s in group))
+            for key_, err_key, out_key in (("lambda", "error", "sd"), ("lambda_linear", "error_linear", "sd_linear")):
+                row[out_key] = abs(row["lattice"][key_] - row["float"][key_]) / math.hypot(row["lattice"][err_key],
+                                                                                           row["float"][err_key])
+            rows[f"{d0:g}"] = row
+        rate = float(np.mean([s["collision_rate"] for s in group]))
+        out[f"{key[0]}D phi {key[1]}"] = {"seeds": len(group), "collision_rate": rate, "by_d0": rows}
+    return out
+
+
+def plot(cases: list, path: str, lyapunov: Optional[dict] = None, show=("2:0.5", "3:0.3")) -> None:
+    """Top: distance from the forward run against the time run back (the first seed of each
+    case in ``show``); bottom: Benettin's lambda against the perturbation size on both engines."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    firsts = {}
-    for c in cases:
-        firsts.setdefault(c["dim"], c)
-    fig, axes = plt.subplots(1, len(firsts), figsize=(5.5 * len(firsts), 4.2), squeeze=False)
-    for ax, (dim, c) in zip(axes[0], sorted(firsts.items())):
-        floor = 1e-18
+    picks = []
+    for spec in show:
+        dim, phi = int(spec.split(":")[0]), float(spec.split(":")[1])
+        found = [c for c in cases if c["dim"] == dim and abs(c["phi"] - phi) < 1e-12]
+        if found:
+            picks.append(found[0])
+    rows = 2 if lyapunov else 1
+    fig, axes = plt.subplots(rows, max(len(picks), 1), figsize=(5.6 * max(len(picks), 1), 4.2 * rows), squeeze=False)
+    floor = 1e-18
+    for ax, c in zip(axes[0], picks):
         la = c["lattice"]
-        ax.semilogy(la["time_back"][:len(la["dx"])], np.maximum(la["dx"], floor), label="lattice specular, one unit moved at the turn")
-        ax.semilogy(c["float_echo"]["time_back"], np.maximum(c["float_echo"]["dx"], floor), label="float specular, unperturbed")
+        ax.semilogy(la["time_back"][:len(la["dx"])], np.maximum(la["dx"], floor),
+                    label="lattice specular, one unit of velocity changed at the turn")
+        ax.semilogy(c["float_echo"]["time_back"], np.maximum(c["float_echo"]["dx"], floor),
+                    label="float specular, unperturbed (its round-off)")
         if "flux" in c and c["flux"]["dx"]:
-            ax.semilogy(c["flux"]["time_back"], np.maximum(c["flux"]["dx"], floor), label="lattice flux law, one unit moved")
-        ax.semilogy(la["time_back"], [floor] * len(la["time_back"]), "k:", label="lattice specular, unperturbed: 0 (bit for bit)")
-        fit = la.get("fit")
-        if fit:
-            ax.set_title(f"{dim}D, phi {c['phi']}, N {c['n']}: lambda = {fit['rate']:.2f} (sigma sqrt(m/kT))^-1", fontsize=9)
+            ax.semilogy(c["flux"]["time_back"], np.maximum(c["flux"]["dx"], floor),
+                        label="lattice flux law, one unit changed (until refused)")
+        ax.semilogy(la["time_back"], [floor] * len(la["time_back"]), "k:",
+                    label="lattice specular, unperturbed: 0, bit for bit")
+        ax.set_title(f"{c['dim']}D, packing fraction {c['phi']}, N = {c['n']}", fontsize=9)
         ax.set_xlabel("time run back (sigma sqrt(m/kT))")
         ax.set_ylabel("distance from the forward run (diameters)")
-        ax.legend(fontsize=7, loc="lower right")
+        ax.legend(fontsize=6.5, loc="lower right")
+    if lyapunov:
+        for ax, dim in zip(axes[1], sorted({c["dim"] for c in picks})):
+            for k, (key, row) in enumerate(sorted(lyapunov.items())):
+                if not key.startswith(f"{dim}D"):
+                    continue
+                d0 = np.array([float(x) for x in row["by_d0"]])
+                for eng, mk in (("lattice", "o-"), ("float", "s--")):
+                    y = np.array([r[eng]["lambda_linear"] for r in row["by_d0"].values()])
+                    e = np.array([r[eng]["error_linear"] for r in row["by_d0"].values()])
+                    ax.errorbar(d0, y, yerr=e, fmt=mk, color=f"C{k}", ms=4, capsize=2,
+                                label=f"{key.split(' ', 1)[1]}, {eng}")
+            ax.set_xscale("log")
+            ax.set_xlabel("perturbation size d0 (diameters)")
+            ax.set_ylabel("lambda (Benettin, linear steps; (sigma sqrt(m/kT))^-1)")
+            ax.set_title(f"{dim}D: largest Lyapunov exponent, lattice and float", fontsize=9)
+            ax.legend(fontsize=6.5, ncol=2)
     fig.tight_layout()
     save_figure(fig, path)
+
+
+def _compact(cases: list) -> list:
+    """The cases as written to JSON: every seed's fits and checks, the curves of seed 1 only
+    (the figure's), their values to 5 significant digits."""
+    def rnd(x):
+        if isinstance(x, float):
+            return float(f"{x:.5g}")
+        if isinstance(x, list):
+            return [rnd(v) for v in x]
+        if isinstance(x, dict):
+            return {k: rnd(v) for k, v in x.items()}
+        return x
+    out = []
+    for c in cases:
+        c = dict(c)
+        for key in ("lattice", "lattice_forward", "float_forward", "float_echo", "flux"):
+            if key not in c:
+                continue
+            if c["seed"] != 1:
+                c[key] = {k: v for k, v in c[key].items() if not isinstance(v, list)}
+            else:  # at most about 200 points a curve
+                c[key] = {k: (v[::max(1, len(v) // 200)] if isinstance(v, list) else v) for k, v in c[key].items()}
+        out.append(rnd(c))
+    return out
 
 
 def _commit() -> str:
@@ -307,9 +540,16 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--fit-lo", type=float, default=1e-12)
     ap.add_argument("--fit-hi", type=float, default=1e-3)
     ap.add_argument("--no-flux", action="store_true", help="skip the flux-law echo")
+    ap.add_argument("--d0", type=float, nargs="*", default=[1e-6, 1e-5, 3e-5, 1e-4],
+                    help="Benettin perturbation sizes (diameters); none: skip the scan")
     ap.add_argument("--json", help="write the results here (atomically)")
     ap.add_argument("--plot", help="write the figure here")
+    ap.add_argument("--replot", help="only draw --plot from this study's JSON")
     a = ap.parse_args(argv)
+    if a.replot:
+        saved = json.load(open(a.replot))
+        plot(saved["cases"], a.plot, saved.get("lyapunov"))
+        return 0
     cases, w0, load0 = [], time.perf_counter(), os.getloadavg()
     for spec in a.cases:
         dim, phi = int(spec.split(":")[0]), float(spec.split(":")[1])
@@ -327,17 +567,28 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                   f"{c['exact']['frames_exact']}/{c['exact']['frames']}, echo lambda "
                   f"{fit['rate'] if fit else float('nan'):.3f}, float lambda "
                   f"{(c['float_forward']['fit'] or {}).get('rate', float('nan')):.3f}, {c['seconds']:.1f} s", flush=True)
+    scans = []
+    for spec in a.cases if a.d0 else []:
+        dim, phi = int(spec.split(":")[0]), float(spec.split(":")[1])
+        for seed in range(1, a.seeds + 1):
+            sc = lyapunov_scan(dim, phi, a.n, seed, a.d0)
+            scans.append(sc)
+            print(f"{dim}D phi {phi} seed {seed} Benettin: " + "; ".join(
+                f"d0 {r['d0']:.0e}: lattice {r['lattice']['lambda_linear']:.2f}+-{r['lattice']['error_linear']:.2f} "
+                f"({r['lattice']['steps_left_out']} out) float {r['float']['lambda_linear']:.2f}"
+                f"+-{r['float']['error_linear']:.2f} ({r['float']['steps_left_out']} out)" for r in sc["rows"]), flush=True)
     summary = _summary(cases)
     for k, row in summary.items():
         print(k, json.dumps({m: row[m] for m in row if m in ("echo", "float_forward", "echo_vs_float_sd", "all_exact")}))
     if a.json:
         out = {"command": "python -m revcol.studies.echo " + " ".join(sys.argv[1:] if argv is None else list(argv)),
                "commit": _commit(), "loadavg_start": list(load0), "loadavg_end": list(os.getloadavg()),
-               "wall_s": time.perf_counter() - w0, "summary": summary, "cases": cases}
+               "wall_s": time.perf_counter() - w0, "summary": summary, "lyapunov": _scan_summary(scans),
+               "scans": scans, "cases": _compact(cases)}
         with atomic_open(a.json) as f:
             f.write(json.dumps(out, indent=1) + "\n")
     if a.plot:
-        plot(cases, a.plot)
+        plot(cases, a.plot, _scan_summary(scans) if scans else None)
     return 0 if all(r["all_exact"] for r in summary.values()) else 1
 
 
