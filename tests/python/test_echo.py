@@ -36,3 +36,16 @@ def test_fit_rate_recovers_a_known_slope():
     f = fit_rate(t, d, 1e-7, 1e-2)
     assert f is not None and math.isclose(f["rate"], 2.5, rel_tol=1e-9)
     assert fit_rate(t, np.zeros_like(t), 1e-7, 1e-2) is None
+
+
+@pytest.mark.parametrize("dim,phi", [(2, 0.5), (3, 0.3)])
+def test_benettin_exponent_of_the_lattice_is_the_float_gas_s(dim, phi):
+    # N = 100, 40 mean free times: at d0 = 1e-4 diameters the two engines' exponents agree within
+    # 3 combined standard errors; at d0 = 1e-6 the lattice map's 2^-T normal error adds growth
+    # (the study's table: bench/results/loschmidt_echo.json, docs/specular.md)
+    from revcol.studies.echo import lyapunov_scan
+    sc = lyapunov_scan(dim, phi, 100, 2, [1e-6, 1e-4], t_mft=40)
+    small, big = sc["rows"]
+    assert big["sd_linear"] < 3.0, big
+    assert small["lattice"]["lambda_linear"] > big["lattice"]["lambda_linear"]
+    assert abs(small["float"]["lambda_linear"] - big["float"]["lambda_linear"]) < 0.1 * big["float"]["lambda_linear"]
