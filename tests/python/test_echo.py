@@ -43,7 +43,7 @@ def test_benettin_exponent_of_the_lattice_is_the_float_gas_s(dim, phi):
     # N = 100, 40 mean free times: at d0 = 1e-4 diameters the two engines' exponents agree within
     # 3 combined standard errors; at d0 = 1e-6 the lattice map's 2^-T normal error adds growth
     # (the study's table: bench/results/loschmidt_echo.json, docs/specular.md)
-    from revcol.studies.echo import lyapunov_scan
+    from revcol.studies.lyapunov import lyapunov_scan
     sc = lyapunov_scan(dim, phi, 100, 2, [1e-6, 1e-4], t_mft=40)
     small, big = sc["rows"]
     assert big["sd_linear"] < 3.0, big
