@@ -3,7 +3,7 @@ lattice engine's specular mode against the float engine's specular mode, 3D, per
 Enskog's values as the scale (docs/physics.md, "Transport in the specular gas").
 
     PYTHONPATH=build-dev/pkg python -m revcol.studies.transport_specular [--n 1000] \\
-        [--phi 0.2 0.3 0.4 0.45] [--seeds 4] [--time 5000] [--out bench/results/transport_specular.json]
+        [--phi 0.2 0.3 0.4 0.45] [--seeds 4] [--first-seed 1] [--time 5000] [--out transport_specular.json]
 
 Each run (engine, packing fraction, seed): N spheres from the same random start (``random(...,
 seed)``: the lattice quantizes the float engine's start once; the trajectories are independent
@@ -136,6 +136,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--n", type=int, default=1000)
     ap.add_argument("--phi", type=float, nargs="+", default=[0.2, 0.3, 0.4, 0.45])
     ap.add_argument("--seeds", type=int, default=4)
+    ap.add_argument("--first-seed", type=int, default=1, help="seeds first-seed .. first-seed + seeds - 1")
     ap.add_argument("--time", type=float, default=5000.0, help="observed time per seed (time units)")
     ap.add_argument("--block", type=float, default=0.16, help="block time (time units)")
     ap.add_argument("--equilibrate", type=float, default=100.0, help="collisions per particle before observing")
@@ -156,7 +157,7 @@ def main(argv: list[str] | None = None) -> None:
         os.replace(tmp, a.out)
 
     kw = dict(duration=a.time, block=a.block, equilibrate=a.equilibrate, lag_min=a.lag_min, lag_max=a.lag_max)
-    seeds = list(range(1, a.seeds + 1))
+    seeds = list(range(a.first_seed, a.first_seed + a.seeds))
     res = study(a.n, a.phi, seeds, progress=lambda s: print(s, flush=True),
                 on_row=lambda rows: write({"rows": rows, "partial": True}), **kw)
     write(res)
