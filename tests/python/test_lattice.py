@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import revcol
-from revcol.lattice import LatticeSimulation
+from revcol.lattice import LatticeSimulation, LatticeSimulation3D
 
 
 def _same(a: dict, b: dict) -> bool:
@@ -207,3 +207,46 @@ def test_a_bad_boundary_name_is_named_by_the_one_parser():
         revcol.Simulation.random(n=50, dim=2, phi=0.3, engine="lattice", boundary="walls")
     with pytest.raises(ValueError, match="one name or 2"):
         revcol.Simulation.random(n=50, dim=2, phi=0.3, engine="lattice", boundary=["wall"] * 3)
+
+
+@pytest.mark.parametrize("cls,phi,mode", [(LatticeSimulation, 0.6, "exact"), (LatticeSimulation3D, 0.4, "exact"),
+                                          (LatticeSimulation, 0.6, "specular")])
+def test_every_snapshot_loads_even_between_two_collisions_of_one_tick(cls, phi, mode):
+    """A run stops after a collision; other collisions of that tick may still be pending, so a
+    pair can overlap at the clock. The snapshot is valid (the engine finds those collisions on
+    restore) and must load: at a coarse tick (2^-16) that happens every few hundred collisions.
+    Each snapshot of 1600 consecutive collisions loads, and from every 200th the loaded run goes
+    on exactly as the uninterrupted one; a pair overlapping one tick earlier too is still refused."""
+    sim = cls.random(200, phi=phi, seed=2, boundary="periodic", tick_bits=16, mode=mode)
+    L, s2 = np.asarray(sim.units["L"], dtype=float), float(sim.units["sigma"]) ** 2
+    pending, expected = 0, {}
+    for k in range(1, 1601):
+        sim.run(collisions=1)
+        if k in expected:  # a copy loaded 300 collisions ago and run on: the uninterrupted state
+            x, v = expected.pop(k)
+            assert np.array_equal(sim.lattice_positions, x) and np.array_equal(sim.lattice_velocities, v)
+        snap = sim.snapshot()
+        copy = cls.from_snapshot(snap)  # raised "particles i and j overlap" before
+        x = sim.lattice_positions.astype(float)
+        d = x[:, None, :] - x[None, :, :]
+        d -= np.round(d / L) * L
+        pending += int(((d ** 2).sum(-1)[np.triu_indices(len(x), 1)] < s2 * (1 - 1e-12)).any())
+        if k % 200 == 0:
+            copy.run(collisions=300)
+            expected[k + 300] = (copy.lattice_positions, copy.lattice_velocities)
+    assert pending > 0  # the case this test is about did occur
+    # the original run, continued, equals a copy loaded at the end
+    end = cls.from_snapshot(sim.snapshot())
+    sim.run(collisions=500)
+    end.run(collisions=500)
+    assert np.array_equal(sim.lattice_positions, end.lattice_positions)
+    # an overlap that is not a pending collision (apart one tick earlier) is still refused by name
+    snap = sim.snapshot()
+    x = np.array(snap["x"], dtype=np.int64)
+    v = np.array(snap["v"], dtype=np.int64)
+    x[1] = x[0]
+    x[1][0] = (x[1][0] + int(sim.units["sigma"]) // 2) % int(sim.units["L"][0])
+    v[1] = v[0]  # moving together: they overlapped one tick before too
+    snap["x"], snap["v"] = x, v
+    with pytest.raises(ValueError, match="overlap, and did one tick before"):
+        cls.from_snapshot(snap)

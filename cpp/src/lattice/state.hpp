@@ -14,7 +14,7 @@ namespace revcol::lattice {
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
-  validate_state(s.units, s.x, s.v);
+  validate_state(s.units, s.x, s.v, true);  // collisions may be pending at the clock (rebuild finds them)
   require(s.streams.size() == s.x.size(), "lattice snapshot: streams must hold one counter per particle");
   {
     // energy is kept by every collision to the lattice's rounding (~1e-11 relative over 10^4

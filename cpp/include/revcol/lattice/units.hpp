@@ -131,9 +131,12 @@ QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, con
 
 /// Checks an integer state: positions inside [0, L) (and inside the walls), |v| <= vmax per axis,
 /// sqrt(sum |v|^2) <= vmax, and no pair overlapping (|r|^2 < sigma^2); throws InvalidArgument
-/// naming the first problem. O(N) with a hash grid.
+/// naming the first problem. O(N) with a hash grid. `pending` (a snapshot's state): a pair that
+/// overlaps but was apart one tick earlier (x - v) is a collision pending at the clock (a run
+/// stops after a collision, other collisions of that tick still to come) and is accepted.
 template <std::size_t Dim>
-void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v);
+void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v,
+                    bool pending = false);
 
 /// Kinetic energy sum |v|^2 in 128 bits (lattice units).
 template <std::size_t Dim>
