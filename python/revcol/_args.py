@@ -67,7 +67,10 @@ def packing_fraction(phi, packing_fraction, default: float = 0.3):
 
 
 def real_array(a, name: str) -> np.ndarray:
-    """``a`` as a float64 array; a TypeError naming ``name`` when it is not one."""
+    """``a`` as a float64 array; a TypeError naming ``name`` when it is not one (complex numbers
+    included: converting them would drop the imaginary part)."""
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} must be an array of real numbers, got complex values")
     try:
         return np.asarray(a, dtype=float)
     except (TypeError, ValueError) as e:

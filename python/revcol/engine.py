@@ -120,6 +120,7 @@ class Simulation(SimulationBase):
         bit for bit (``mode``, ``"exact"`` or ``"specular"``, ``law`` and ``seed`` apply)."""
         phi = _packing_fraction(phi, packing_fraction)
         init = placement(init)
+        n, dim = integer(n, "n", 1), integer(dim, "dim", 1, 3)  # not a bool, not 2.0 (a named error)
         if engine != "float":
             lat = engine_class(engine, dim)
             if energy is not None or equal_speeds:

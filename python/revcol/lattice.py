@@ -178,6 +178,9 @@ class LatticeSimulation(SimulationBase):
         momentum, kT = 1), quantized once. The same ``seed`` keys the streams. ``dim`` (default:
         the class's, 2 or 3) must be the class's; the other keywords (``mode``, ``law``, ...) as
         the constructor's."""
+        n = integer(n, "n", 1)  # not a bool or a float (a named error)
+        if dim is not None:
+            dim = integer(dim, "dim", 1, 3)
         phi = _packing_fraction(phi, packing_fraction)
         mode = _mode(mode, law)
         init = placement(init)

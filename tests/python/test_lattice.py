@@ -250,3 +250,20 @@ def test_every_snapshot_loads_even_between_two_collisions_of_one_tick(cls, phi, 
     snap["x"], snap["v"] = x, v
     with pytest.raises(ValueError, match="overlap, and did one tick before"):
         cls.from_snapshot(snap)
+
+
+def test_random_and_arrays_refuse_a_float_dim_a_bool_n_and_complex_values():
+    # issue 59's small cases: each a named TypeError (not "can't multiply sequence", not n = 1,
+    # not a ComplexWarning that drops the imaginary part)
+    for engine in ("float", "lattice"):
+        with pytest.raises(TypeError, match="dim must be an integer"):
+            revcol.Simulation.random(100, dim=2.0, phi=0.3, engine=engine)
+        with pytest.raises(TypeError, match="n must be an integer, got bool"):
+            revcol.Simulation.random(True, dim=2, phi=0.3, engine=engine)
+    with pytest.raises(TypeError, match="n must be an integer"):
+        LatticeSimulation3D.random(True, phi=0.3)
+    x = np.array([[1.0, 1.0], [3.0, 3.0]]) + 0j
+    with pytest.raises(TypeError, match="positions must be an array of real numbers, got complex"):
+        LatticeSimulation(x, np.zeros((2, 2)), 10.0)
+    with pytest.raises(TypeError, match="positions must be an array of real numbers, got complex"):
+        revcol.Simulation(x, np.zeros((2, 2)), 10.0)
