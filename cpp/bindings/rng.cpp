@@ -210,7 +210,15 @@ void register_rng(py::module_& m) {
            }),
            py::arg("key") = py::make_tuple(0, 0), py::arg("counter") = 0,
            "A stream with this key (two 32-bit words) whose next draw is draw `counter`.")
-      .def("next", &Philox::next, "Return draw at(counter) and increment the counter.")
+      .def(
+          "next",
+          [](Philox& g) {
+            // the counter is 64 bits: the draw at 2^64 - 1 would wrap it to 0, after which prev()
+            // could never return it (the stream would lose its place); refused, nothing changed
+            if (g.counter() == kMaxU64) throw InvalidArgument("Philox: the stream is at its last counter (2^64 - 1); next() would wrap it to 0");
+            return g.next();
+          },
+          "Return draw at(counter) and increment the counter; ValueError at counter 2^64 - 1 (it would wrap).")
       .def("prev", &Philox::prev,
            "Decrement the counter and return that draw (the value the last next() returned); ValueError at 0.")
       .def(
@@ -218,7 +226,13 @@ void register_rng(py::module_& m) {
           "Draw k, in (0, 1), without changing the counter.")
       .def(
           "next_many",
-          [](Philox& g, PyInt n) { return draw_many<true>(g, to_count(n)); },
+          [](Philox& g, PyInt n) {
+            const std::size_t count = to_count(n);
+            if (count > kMaxU64 - g.counter())
+              throw InvalidArgument("Philox: " + std::to_string(count) + " draws from counter " + std::to_string(g.counter()) +
+                                    " would pass 2^64 - 1 and wrap the counter");
+            return draw_many<true>(g, count);
+          },
           py::arg("n"), "n draws as a float64 array, in draw order (same as n calls of next()).")
       .def(
           "prev_many",

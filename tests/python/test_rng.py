@@ -221,3 +221,19 @@ def test_rng_module_reexports():
     assert rng.__all__ == ["CLCG4", "Philox", "philox4x32"]
     assert rng.CLCG4 is revcol.CLCG4 and rng.Philox is revcol.Philox
     assert rng.philox4x32 is revcol.philox4x32
+
+
+def test_philox_refuses_to_wrap_its_counter():
+    # issue 59: next() at counter 2^64 - 1 wrapped to 0, and prev() then refused; now refused, nothing changed
+    top = 2**64 - 1
+    p = revcol.Philox(key=(3, 4), counter=top)
+    with pytest.raises(ValueError, match="last counter"):
+        p.next()
+    assert p.counter == top
+    assert p.prev() == p.at(top - 1) and p.counter == top - 1
+    assert p.next() == p.at(top - 1) and p.counter == top
+    q = revcol.Philox(key=(3, 4), counter=top - 2)
+    with pytest.raises(ValueError, match="wrap"):
+        q.next_many(3)
+    assert q.counter == top - 2
+    assert list(q.next_many(2)) == [q.at(top - 2), q.at(top - 1)] and q.counter == top
