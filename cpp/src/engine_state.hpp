@@ -149,9 +149,15 @@ EngineImpl<Dim, Op>::EngineImpl(const Snapshot& s, Op op) : cfg_(s.config), n_(s
             "snapshot: ev_partner of a collision outside [0, n)");
     // a wall event's partner is 2 axis + (upper wall), on an axis with walls (issue 17: a forged
     // partner wrote out of bounds)
-    require(s.ev_kind[i] != kWall || (s.ev_partner[i] >= 0 && s.ev_partner[i] < 2 * Dim &&
-                                      has_walls(cfg_.boundary[static_cast<std::size_t>(s.ev_partner[i] / 2)])),
-            "snapshot: ev_partner: wall event on an axis without walls (partner must be 2 axis + upper)");
+    if (s.ev_kind[i] == kWall) {  // (issue 59: one message said "an axis without walls" for both cases)
+      require(s.ev_partner[i] >= 0 && s.ev_partner[i] < 2 * Dim, [&] {
+        return "snapshot: ev_partner of a wall event must be 2 axis + (upper wall), in [0, " + std::to_string(2 * Dim) +
+               "), got " + std::to_string(s.ev_partner[i]);
+      });
+      require(has_walls(cfg_.boundary[static_cast<std::size_t>(s.ev_partner[i] / 2)]), [&] {
+        return "snapshot: ev_partner: a wall event on axis " + std::to_string(s.ev_partner[i] / 2) + ", which has no walls";
+      });
+    }
     require(!std::isnan(s.ev_t[i]), "snapshot: ev_t (an event time) is NaN");
     bk_[i].ev = Ev{s.ev_t[i], static_cast<std::int32_t>(s.ev_kind[i]), static_cast<std::int32_t>(s.ev_partner[i]),
                 s.ev_stamp[i]};

@@ -113,3 +113,20 @@ def test_every_damaged_entry_is_refused_by_name_or_legal(engine, tmp_path):
             pass
     assert not problems, "\n".join(problems)
     assert refused > 50 and loaded == sum(1 for k in LEGAL if k[0] == engine), (refused, loaded)
+
+
+def test_a_forged_wall_partner_is_named_for_what_it_is():
+    # issue 59: both forgeries said "wall event on an axis without walls"
+    import revcol
+    s = revcol.Simulation.random(50, dim=2, phi=0.3, boundary=["wall", "periodic"], seed=1)
+    s.run(collisions=100)
+    d = s.snapshot()
+    kind, partner = np.array(d["ev_kind"]), np.array(d["ev_partner"])
+    kind[0], partner[0] = 0, 2  # a wall event on axis 1, which is periodic
+    d["ev_kind"], d["ev_partner"] = kind, partner
+    with pytest.raises(ValueError, match="a wall event on axis 1, which has no walls"):
+        revcol.Simulation.from_snapshot(d)
+    partner[0] = 7
+    d["ev_partner"] = partner
+    with pytest.raises(ValueError, match=r"must be 2 axis \+ \(upper wall\), in \[0, 4\), got 7"):
+        revcol.Simulation.from_snapshot(d)
