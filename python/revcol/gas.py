@@ -70,6 +70,10 @@ def _engine(scene: Scene, where: str, make: Callable[[], Simulation]) -> Simulat
     try:
         return make()
     except ValueError as e:
+        # speeds out of the engine's range come from the scene's kinetic energy when it gives one
+        # (issue 59: kinetic_energy = 1e-320 was reported under packing_fraction)
+        if scene.kinetic_energy is not None and ("velocity" in str(e) or "speed" in str(e)):
+            where = "[system] kinetic_energy"
         raise SceneError(f"{scene.source}: {where}: {e}") from None
 
 

@@ -279,3 +279,12 @@ def test_engine_field_and_the_lattice_defaults():
     assert "lattice engine, exact/uniform" in lat.summary() and lat.to_dict()["engine"] == "lattice"
     with pytest.raises(SceneError, match=r"\[collisions\] engine: does not apply to kind = 'statesave'"):
         scene_from_dict({"scene": {"kind": "statesave"}, "collisions": {"engine": "lattice"}})
+
+
+def test_a_kinetic_energy_out_of_the_engines_speed_range_is_named(tmp_path):
+    # issue 59: reported under [system] packing_fraction
+    from revcol.gas import build_simulation
+    scene = load_scene(write(tmp_path, "[system]\ndimension = 2\nparticles = 20\npacking_fraction = 0.2\n"
+                                       "kinetic_energy = 1e-320\n"))
+    with pytest.raises(SceneError, match=r"\[system\] kinetic_energy: largest velocity component"):
+        build_simulation(scene)
