@@ -206,25 +206,27 @@ void add_lattice_benches(std::vector<Bench>& out) {
     const char* name;
     LatticeCase c;
   };
-  // the lattice engine (periodic at N = 1e4 and 1e5, area fractions 0.3 and 0.5; walls at 1e4)
+  // the lattice engine (periodic at N = 1e4 and 1e5, area fractions 0.3 and 0.5, and 1e6 at 0.5; walls at 1e4)
   // and the float engine on the same periodic gases (lattice/float/...), for the table
   static const Named named[] = {{"lattice/periodic/n10000/phi0.3", {10000, 0.3, false, 1}},
                                 {"lattice/periodic/n10000/phi0.5", {10000, 0.5, false, 1}},
                                 {"lattice/periodic/n100000/phi0.3", {100000, 0.3, false, 1}},
                                 {"lattice/periodic/n100000/phi0.5", {100000, 0.5, false, 1}},
+                                {"lattice/periodic/n1000000/phi0.5", {1000000, 0.5, false, 1}},
                                 {"lattice/walls/n10000/phi0.3", {10000, 0.3, true, 1}},
                                 {"lattice/walls/n10000/phi0.5", {10000, 0.5, true, 1}}};
   for (const Named& m : named) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice<2>(c, n); }});
   }
-  // the 3D engine (spheres) at N = 1e4, volume fractions 0.1, 0.3 and 0.45, and the float engine on
+  // the 3D engine (spheres) at N = 1e4, volume fractions 0.1, 0.3 and 0.45 (1e6 at 0.3), and the float engine on
   // the same 3D gases
   static const Named named3[] = {{"lattice3d/periodic/n10000/phi0.1", {10000, 0.1, false, 1, 3}},
                                  {"lattice3d/periodic/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
                                  {"lattice3d/periodic/n10000/phi0.45", {10000, 0.45, false, 1, 3}},
                                  {"lattice3d/walls/n10000/phi0.3", {10000, 0.3, true, 1, 3}},
-                                 {"lattice3d/periodic/n1000/phi0.3", {1000, 0.3, false, 1, 3}}};
+                                 {"lattice3d/periodic/n1000/phi0.3", {1000, 0.3, false, 1, 3}},
+                                 {"lattice3d/periodic/n1000000/phi0.3", {1000000, 0.3, false, 1, 3}}};
   for (const Named& m : named3) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice<3>(c, n); }});

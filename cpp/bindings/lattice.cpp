@@ -159,35 +159,52 @@ template <class T, std::size_t K>
 void put(py::dict& d, const char* key, const std::array<T, K>& a) { d[key] = flat_array(a.data(), K); }
 void put(py::dict& d, const char* key, const std::vector<std::uint64_t>& v) { d[key] = flat_array(v.data(), v.size()); }
 void put(py::dict& d, const char* key, const std::vector<double>& v) { d[key] = flat_array(v.data(), v.size()); }
-// the rare log as two arrays: log_index (collision index) and log_redraws
-void put(py::dict& d, const char*, const std::vector<std::pair<std::uint64_t, std::uint32_t>>& log) {
-  std::vector<std::uint64_t> li, lr;
-  for (const auto& e : log) {
-    li.push_back(e.first);
-    lr.push_back(e.second);
+// the particles' bits-back integers as two arrays: bits (every particle's words, low first,
+// particle after particle) and bits_size (words per particle)
+void put(py::dict& d, const char*, const std::vector<std::vector<std::uint64_t>>& bits) {
+  std::vector<std::uint64_t> w, n;
+  for (const auto& x : bits) {
+    n.push_back(x.size());
+    w.insert(w.end(), x.begin(), x.end());
   }
-  d["log_index"] = flat_array(li.data(), li.size());
+  d["bits"] = flat_array(w.data(), w.size());
+  d["bits_size"] = flat_array(n.data(), n.size());
+}
+// the rare log as three arrays: log_particle (the drawer), log_count (its collision count
+// after the collision) and log_redraws
+void put(py::dict& d, const char*, const std::vector<la::LogEntry>& log) {
+  std::vector<std::uint64_t> lp, lc, lr;
+  for (const auto& e : log) {
+    lp.push_back(e.particle);
+    lc.push_back(e.count);
+    lr.push_back(e.redraws);
+  }
+  d["log_particle"] = flat_array(lp.data(), lp.size());
+  d["log_count"] = flat_array(lc.data(), lc.size());
   d["log_redraws"] = flat_array(lr.data(), lr.size());
 }
-// the group entries as six arrays: group_index, group_drawer, group_size, group_members,
-// group_kind (0 bounce, 1 resolve) and group_v (the pre velocities of the resolves)
+// the group entries as seven arrays: group_drawer, group_draws, group_size, group_members,
+// group_counts (per member, its count after the group), group_kind (0 bounce, 1 resolve) and
+// group_v (the pre velocities of the resolves)
 template <std::size_t D>
 void put(py::dict& d, const char*, const std::vector<la::GroupEntryN<D>>& groups) {
-  std::vector<std::uint64_t> gi;
+  std::vector<std::uint64_t> gn, gc;
   std::vector<std::int64_t> gd, gs, gm, gk;
   std::vector<la::VecN<D>> gv;
   for (const auto& g : groups) {
-    gi.push_back(g.index);
     gd.push_back(g.drawer);
+    gn.push_back(g.draws);
     gs.push_back(static_cast<std::int64_t>(g.members.size()));
     gk.push_back(g.pre_v.empty() ? 0 : 1);
     for (int m : g.members) gm.push_back(m);
+    gc.insert(gc.end(), g.counts.begin(), g.counts.end());
     gv.insert(gv.end(), g.pre_v.begin(), g.pre_v.end());
   }
-  d["group_index"] = flat_array(gi.data(), gi.size());
   d["group_drawer"] = flat_array(gd.data(), gd.size());
+  d["group_draws"] = flat_array(gn.data(), gn.size());
   d["group_size"] = flat_array(gs.data(), gs.size());
   d["group_members"] = flat_array(gm.data(), gm.size());
+  d["group_counts"] = flat_array(gc.data(), gc.size());
   d["group_kind"] = flat_array(gk.data(), gk.size());
   d["group_v"] = vec_array(gv);
 }
@@ -226,32 +243,51 @@ void take(const py::dict& d, const char* key, std::array<T, K>& a) {
   });
   for (std::size_t k = 0; k < K; ++k) a[k] = v[k];
 }
-void take(const py::dict& d, const char*, std::vector<std::pair<std::uint64_t, std::uint32_t>>& log) {
-  const auto li = get_flat<std::uint64_t>(d, "log_index");
+void take(const py::dict& d, const char*, std::vector<std::vector<std::uint64_t>>& bits) {
+  const auto w = get_flat<std::uint64_t>(d, "bits");
+  const auto n = get_flat<std::uint64_t>(d, "bits_size");
+  std::size_t at = 0;
+  for (std::uint64_t k : n) {
+    require(k <= w.size() - at, "lattice checkpoint: bits is shorter than bits_size says");
+    bits.emplace_back(w.begin() + static_cast<std::ptrdiff_t>(at), w.begin() + static_cast<std::ptrdiff_t>(at + k));
+    at += static_cast<std::size_t>(k);
+  }
+  require(at == w.size(), "lattice checkpoint: bits is longer than bits_size says");
+}
+void take(const py::dict& d, const char*, std::vector<la::LogEntry>& log) {
+  const auto lp = get_flat<std::uint64_t>(d, "log_particle");
+  const auto lc = get_flat<std::uint64_t>(d, "log_count");
   const auto lr = get_flat<std::uint64_t>(d, "log_redraws");
-  require(li.size() == lr.size(), "lattice checkpoint: log_index and log_redraws differ in length");
-  for (std::size_t k = 0; k < li.size(); ++k) log.emplace_back(li[k], static_cast<std::uint32_t>(lr[k]));
+  require(lp.size() == lc.size() && lp.size() == lr.size(), "lattice checkpoint: log_particle, log_count and log_redraws differ in length");
+  for (std::size_t k = 0; k < lp.size(); ++k) {
+    require(lp[k] <= 0xFFFFFFFFull && lr[k] <= 0xFFFFFFFFull, "lattice checkpoint: a rare-log entry out of range");
+    log.push_back(la::LogEntry{static_cast<std::uint32_t>(lp[k]), lc[k], static_cast<std::uint32_t>(lr[k])});
+  }
 }
 template <std::size_t D>
 void take(const py::dict& d, const char*, std::vector<la::GroupEntryN<D>>& groups) {
-  const auto gi = get_flat<std::uint64_t>(d, "group_index");
   const auto gd = get_flat<std::int64_t>(d, "group_drawer");
+  const auto gn = get_flat<std::uint64_t>(d, "group_draws");
   const auto gs = get_flat<std::int64_t>(d, "group_size");
   const auto gm = get_flat<std::int64_t>(d, "group_members");
-  require(gi.size() == gd.size() && gi.size() == gs.size(), "lattice checkpoint: group arrays differ in length");
-  // group_kind and group_v arrived with the group resolve; a checkpoint without them holds bounces only
-  const auto gk = d.contains("group_kind") ? get_flat<std::int64_t>(d, "group_kind") : std::vector<std::int64_t>(gi.size(), 0);
-  const auto gv = d.contains("group_v") ? checkpoint_entry("group_v", [&] { return vecs<D>(int_array(d["group_v"], "group_v"), "group_v"); })
-                                        : std::vector<la::VecN<D>>{};
-  require(gk.size() == gi.size(), "lattice checkpoint: group_kind and group_index differ in length");
+  const auto gc = get_flat<std::uint64_t>(d, "group_counts");
+  const auto gk = get_flat<std::int64_t>(d, "group_kind");
+  require(d.contains("group_v"), "lattice checkpoint is missing 'group_v'");
+  const auto gv = checkpoint_entry("group_v", [&] { return vecs<D>(int_array(d["group_v"], "group_v"), "group_v"); });
+  require(gd.size() == gn.size() && gd.size() == gs.size() && gd.size() == gk.size(), "lattice checkpoint: group arrays differ in length");
+  require(gm.size() == gc.size(), "lattice checkpoint: group_members and group_counts differ in length");
   std::size_t at = 0, atv = 0;
-  for (std::size_t k = 0; k < gi.size(); ++k) {
+  for (std::size_t k = 0; k < gd.size(); ++k) {
     require(gs[k] >= 2 && at + static_cast<std::size_t>(gs[k]) <= gm.size(), "lattice checkpoint: group_members too short");
     require(gk[k] == 0 || gk[k] == 1, "lattice checkpoint: group_kind must be 0 (bounce) or 1 (resolve)");
+    require(gd[k] >= 0 && gd[k] <= 0x7FFFFFFF && gn[k] <= 0xFFFFFFFFull, "lattice checkpoint: a group entry out of range");
+    for (std::size_t q = at; q < at + static_cast<std::size_t>(gs[k]); ++q)
+      require(gm[q] >= 0 && gm[q] <= 0x7FFFFFFF, "lattice checkpoint: a group member out of range");
     la::GroupEntryN<D> e;
-    e.index = gi[k];
     e.drawer = static_cast<int>(gd[k]);
+    e.draws = static_cast<std::uint32_t>(gn[k]);
     e.members.assign(gm.begin() + static_cast<std::ptrdiff_t>(at), gm.begin() + static_cast<std::ptrdiff_t>(at + gs[k]));
+    e.counts.assign(gc.begin() + static_cast<std::ptrdiff_t>(at), gc.begin() + static_cast<std::ptrdiff_t>(at + gs[k]));
     if (gk[k] == 1) {
       require(atv + static_cast<std::size_t>(gs[k]) <= gv.size(), "lattice checkpoint: group_v too short");
       e.pre_v.assign(gv.begin() + static_cast<std::ptrdiff_t>(atv), gv.begin() + static_cast<std::ptrdiff_t>(atv + gs[k]));
@@ -293,6 +329,13 @@ template <std::size_t D>
 la::SnapshotN<D> snapshot_from(const py::dict& d) {
   la::SnapshotN<D> s;
   if constexpr (D == 3) require(get<int>(d, "dim") == 3, "lattice checkpoint: dim must be 3 for the 3D engine");
+  // before per-particle state (revcol 0.x: one global bits-back integer, the rare log keyed by
+  // the global collision index) a checkpoint cannot resume bit for bit: the draws it would make
+  // and the keys its reverse would read are not the ones its bits describe
+  require(!d.contains("log_index"),
+          "lattice checkpoint: written by an older revcol (one bits-back integer for the whole gas, the rare log keyed by the "
+          "global collision index); this version keeps them per particle and cannot resume it bit for bit. Start a new run "
+          "from its positions and velocities (revcol.lattice.restart_from_legacy)");
   s.visit([&](const char* key, auto& v) {
     if (observer_entry(key) && !d.contains(key)) return;  // none running (or an older checkpoint)
     take(d, key, v);
@@ -488,6 +531,19 @@ void register_lattice(py::module_& m) {
   m.def("lattice3d_quantize", &quantize_d<3>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
         py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
         "3D units from the box and rms speed, and one quantization of (n, 3) arrays: {units, x, v, errors}.");
+  m.def(
+      "lattice_initial_bits",
+      [](PyInt n_arg, PyInt seed_arg) {
+        const auto n = to_int<std::uint64_t>(n_arg, "n", 0, 0x7FFFFFFFull);
+        const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
+        std::vector<std::vector<std::uint64_t>> bits;
+        for (std::uint64_t p = 0; p < n; ++p) bits.push_back(la::initial_bits(static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(seed)));
+        py::dict d;
+        put(d, "bits", bits);
+        return d;
+      },
+      py::arg("n"), py::arg("seed"),
+      "The n particles' initial bits-back integers for a seed, as a checkpoint holds them: {bits, bits_size}.");
   register_engine<la::LatticeEngine>(m, "LatticeEngine", "The 2D lattice engine (revcol/lattice/engine.hpp).");
   register_engine<la::LatticeEngine3D>(m, "LatticeEngine3D", "The 3D lattice engine, spheres (revcol/lattice/engine.hpp).");
 }

@@ -43,7 +43,7 @@ from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, stamped, write_npz_atomic
 from .simulation import SimulationBase, register_engine
 
-__all__ = ["LatticeSimulation", "LatticeSimulation3D", "MODES"]
+__all__ = ["LatticeSimulation", "LatticeSimulation3D", "MODES", "restart_from_legacy"]
 
 #: the lattice engine's modes: "exact" (the randomized pair operator, drawing its post direction
 #: by ``law``) and "specular" (deterministic specular dynamics: no draws; docs/lattice.md)
@@ -109,8 +109,8 @@ class LatticeSimulation(SimulationBase):
     or ``"specular"`` (deterministic specular hard-sphere dynamics, bit-reversible with no random
     numbers: the relative velocity reflected about the contact normal by an exact integer
     involution; nothing drawn but the rare logged fallback; docs/specular.md). ``law`` (exact mode only):
-    ``"flux"`` (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and X's
-    first 256 bits. ``tick_bits`` T (16..26; default ``None``: automatic): a particle of rms speed
+    ``"flux"`` (default) or ``"uniform"``. ``seed`` keys the Philox streams ``{particle, seed}`` and each
+    particle's bits-back integer X (its first 128 bits). ``tick_bits`` T (16..26; default ``None``: automatic): a particle of rms speed
     moves 2^-T diameters per tick; a finer tick (larger T) makes redraws and group collisions (a
     third body within one tick) rarer at the cost of fewer bits of velocity resolution (2^(S-T)
     units for the rms speed, S set by the box). The automatic tick keeps 30 bits:
@@ -406,21 +406,59 @@ class LatticeSimulation(SimulationBase):
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "LatticeSimulation":
-        """Reads a state written by ``save``."""
-        st: dict = {}
-        for k, a in read_checkpoint(path, "lattice").items():
-            val = a.item() if a.ndim == 0 else a
-            if "." in k:
-                outer, inner = k.split(".", 1)
-                if isinstance(val, np.ndarray) and outer == "units":
-                    val = tuple(val.tolist())
-                st.setdefault(outer, {})[inner] = val
-            else:
-                st[k] = val
-        return cls.from_snapshot(st)
+        """Reads a state written by ``save``. A checkpoint of an older revcol (one bits-back
+        integer for the whole gas) is refused: :func:`restart_from_legacy` starts a new run from it."""
+        return cls.from_snapshot(_read_state(path))
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n={self.n}, collisions={self.collisions}, clock={self.clock})"
+
+
+def _read_state(path: Union[str, os.PathLike]) -> dict:
+    """A checkpoint written by ``save`` as a snapshot dict (nested ``a.b`` keys rebuilt)."""
+    st: dict = {}
+    for k, a in read_checkpoint(path, "lattice").items():
+        val = a.item() if a.ndim == 0 else a
+        if "." in k:
+            outer, inner = k.split(".", 1)
+            if isinstance(val, np.ndarray) and outer == "units":
+                val = tuple(val.tolist())
+            st.setdefault(outer, {})[inner] = val
+        else:
+            st[k] = val
+    return st
+
+
+#: what a checkpoint of an older revcol kept whole: its physical state and settings
+_LEGACY_KEPT = ("engine", "dim", "units", "law", "mode", "seed", "clock", "x", "v", "streams", "energy0", "momentum0",
+                "quantization", "search")
+
+
+def restart_from_legacy(source: Union[str, os.PathLike, dict]) -> "LatticeSimulation":
+    """A new run from a checkpoint (path or snapshot dict) written by a revcol that kept one
+    bits-back integer for the whole gas and keyed its rare log by the global collision index.
+    Such a state cannot resume bit for bit here (its draws and its reverse's keys are those of
+    the old layout), so this keeps its physical state (positions, velocities, clock, stream
+    counters, units, mode, seed) and starts afresh at its clock: origin = clock, no collisions,
+    every particle's X its initial bits (:func:`revcol._core.lattice_initial_bits`), an empty rare
+    log. The run cannot go back before that point (the old run's history is not in the new
+    layout). A checkpoint of this version raises ``ValueError`` (load it with ``load``)."""
+    st = dict(source) if isinstance(source, dict) else _read_state(source)
+    if "log_index" not in st:
+        raise ValueError("restart_from_legacy: this checkpoint is of the current layout: load it with LatticeSimulation.load")
+    missing = [k for k in ("units", "x", "v", "clock", "seed", "streams", "energy0", "momentum0") if k not in st]
+    if missing:
+        raise ValueError(f"restart_from_legacy: the checkpoint lacks {', '.join(missing)}")
+    new = {k: st[k] for k in _LEGACY_KEPT if k in st}
+    n, dim = len(np.asarray(st["x"])), int(np.asarray(st.get("dim", 2)))
+    new.update(_core.lattice_initial_bits(n, int(np.asarray(st["seed"]))))
+    new["origin"], new["collisions"] = new["clock"], 0
+    new["particle_collisions"] = np.zeros(n, dtype=np.uint64)
+    empty_u, empty_i = np.zeros(0, dtype=np.uint64), np.zeros(0, dtype=np.int64)
+    new.update(log_particle=empty_u, log_count=empty_u, log_redraws=empty_u, group_drawer=empty_i, group_draws=empty_u,
+               group_size=empty_i, group_members=empty_i, group_counts=empty_u, group_kind=empty_i,
+               group_v=np.zeros((0, dim), dtype=np.int64))
+    return LatticeSimulation.from_snapshot(new)
 
 
 def _snapshot_shell(value) -> float:

@@ -48,11 +48,11 @@ RESTORED_PARTS: dict[str, tuple[str, ...]] = {
     "positions": ("x",),
     "velocities": ("v",),
     "rng_counters": ("streams",),
-    "bits_back": ("bits",),
+    "bits_back": ("bits", "bits_size"),
     "clock": ("clock", "origin"),
-    "collision_count": ("collisions",),
-    "rare_log": ("log_index", "log_redraws", "group_index", "group_drawer", "group_size", "group_members",
-                 "group_kind", "group_v"),
+    "collision_count": ("collisions", "particle_collisions"),
+    "rare_log": ("log_particle", "log_count", "log_redraws", "group_drawer", "group_draws", "group_size",
+                 "group_members", "group_counts", "group_kind", "group_v"),
 }
 
 _LOG_KEYS = RESTORED_PARTS["rare_log"]
@@ -101,11 +101,11 @@ def restored(start: dict, end: dict) -> dict[str, bool]:
 
 
 def log_size(state: dict) -> tuple[int, int]:
-    """(entries, bytes) of the rare log in a state: its collisions (one entry each in
-    ``log_index``: those that needed redraws, and the group collisions, whose records are in the
-    group arrays besides), as ``diagnostics()["log_entries"]``, and the bytes its arrays take in a
+    """(entries, bytes) of the rare log in a state: its collisions (one entry each: those that
+    needed redraws, keyed in ``log_particle``/``log_count``, and the group collisions, in
+    ``group_drawer``), as ``diagnostics()["log_entries"]``, and the bytes its arrays take in a
     checkpoint."""
-    entries = len(state["log_index"])
+    entries = len(state["log_particle"]) + len(state["group_drawer"])
     return entries, int(sum(np.asarray(state[k]).nbytes for k in _LOG_KEYS))
 
 
@@ -305,7 +305,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "interrupted": run.interrupted, "engine_error": run.engine_error,
         "observe": run.observation.to_dict() if run.observation is not None else None,
         "bits_back": {"start": run.bits0, "turn": int(d_turn["bits_length"]), "end": int(d_end["bits_length"]),
-                      "max": run.bits_max, "sampled_every": run.every},
+                      "max": run.bits_max, "sampled_every": run.every, "particles": sim.n},
         "log_entries_turn": entries_turn, "log_bytes_turn": bytes_turn,
         "log_entries_end": entries_end, "log_bytes_end": bytes_end,
         "group_resolves": int(d_turn["group_resolves"]), "group_bounces": int(d_turn["group_bounces"]),

@@ -53,6 +53,13 @@ inline revcol::lattice::BitsBack random_bits(std::mt19937_64& rng, int bits) {
   return revcol::lattice::BitsBack(w);
 }
 
+/// The bit lengths of a snapshot's per-particle X, summed.
+inline std::size_t total_bits(const std::vector<std::vector<std::uint64_t>>& bits) {
+  std::size_t b = 0;
+  for (const auto& w : bits) b += revcol::lattice::BitsBack(w).bit_length();
+  return b;
+}
+
 /// Kolmogorov's limiting p-value of the KS statistic d over n samples (Stephens' correction).
 inline double ks_pvalue(double d, std::size_t n) {
   const double sn = std::sqrt(static_cast<double>(n));

@@ -199,4 +199,32 @@ TEST_CASE("BitsBack: bad input throws and changes nothing") {
   CHECK(X == X0);
 }
 
+TEST_CASE("BitsBack: the same value whether its words are inline (up to 4) or on the heap; copies and moves keep it") {
+  std::mt19937_64 rng(11);
+  BitsBack X = random_x(rng, 100);  // inline
+  std::vector<std::uint64_t> idx;
+  for (int k = 0; k < 40; ++k) {  // to ~500 bits: on the heap
+    idx.push_back(rng() % 1000003);
+    X.push_uniform(idx.back(), 1000003);
+  }
+  CHECK(X.bit_length() > 4 * 64);
+  CHECK(X.heap_bytes() > 0);
+  const BitsBack Y = X;                      // a copy of a heap value
+  CHECK(Y == X);
+  CHECK(BitsBack::from_hex(X.to_hex()) == X);
+  BitsBack Z = std::move(X);                 // a move takes the words
+  CHECK(Z == Y);
+  CHECK(X.is_zero());
+  BitsBack W = random_x(rng, 64);
+  W = Z;                                     // copy-assigned over an inline value
+  CHECK(W == Y);
+  for (int k = 39; k >= 0; --k) CHECK(Z.pop_uniform(1000003) == idx[static_cast<std::size_t>(k)]);
+  CHECK(Z.bit_length() <= 100);               // back to the start value, still equal by value
+  BitsBack V(Z.words());                      // the same value built inline
+  CHECK(V == Z);
+  CHECK(V.heap_bytes() == 0);
+  W = std::move(V);                          // move-assigned over a heap value
+  CHECK(W == Z);
+}
+
 CHECK_MAIN()

@@ -77,10 +77,11 @@ STATE_PARTS = {
     "positions": ["x"],
     "velocities": ["v"],
     "rng_counters": ["streams"],
-    "bits_back_X": ["bits"],
+    "bits_back_X": ["bits", "bits_size"],
     "clock": ["clock", "origin"],
-    "collision_count": ["collisions"],
-    "rare_log": ["log_index", "log_redraws", "group_index", "group_drawer", "group_size", "group_members"],
+    "collision_count": ["collisions", "particle_collisions"],
+    "rare_log": ["log_particle", "log_count", "log_redraws", "group_drawer", "group_draws", "group_size", "group_members",
+                 "group_counts"],
 }
 
 
@@ -514,24 +515,31 @@ def _third_bodies(sim, i: int, j: int, a: int) -> list:
     return out
 
 
-def group_census(state: dict, top: int = 3) -> dict:
+def group_census(state: dict, top: int = 3, window: int = 100) -> dict:
     """The group collisions held in a state's rare log (resolves and bounces): how often the same
-    members met as a group (the most frequent groups, the collision indices of their first and
-    last), and the most group collisions within any 10^5 consecutive collisions (the same
-    members again and again is a trap)."""
-    idx = np.asarray(state["group_index"], dtype=np.int64)
+    members met as a group (the most frequent groups, with the first member's collision counts
+    at the first and last of them), and the most group collisions of one particle within any
+    ``window`` consecutive collisions of its own (the same members again and again is a trap).
+    The rare log is keyed per particle (particle, its collision count), so that is the clock."""
     sizes = np.asarray(state["group_size"], dtype=np.int64)
     members = np.asarray(state["group_members"], dtype=np.int64)
+    counts = np.asarray(state["group_counts"], dtype=np.int64)
     starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-    by = {}
-    for k, s0, m in zip(idx.tolist(), starts.tolist(), sizes.tolist()):
-        by.setdefault(tuple(members[s0:s0 + m].tolist()), []).append(k)
+    by, per = {}, {}
+    for s0, m in zip(starts.tolist(), sizes.tolist()):
+        g = tuple(members[s0:s0 + m].tolist())
+        by.setdefault(g, []).append(int(counts[s0]))
+        for p, c in zip(g, counts[s0:s0 + m].tolist()):
+            per.setdefault(p, []).append(c)
     common = sorted(by.items(), key=lambda kv: -len(kv[1]))[:top]
-    window = int(np.max(np.searchsorted(idx, idx + 100000) - np.arange(idx.size))) if idx.size else 0
-    kind = np.asarray(state.get("group_kind", np.zeros(idx.size)), dtype=np.int64)
-    return {"groups": int(idx.size), "resolves": int(np.sum(kind == 1)), "bounces": int(np.sum(kind == 0)),
-            "distinct_groups": len(by), "most_groups_in_1e5_collisions": window,
-            "most_frequent": [{"members": list(g), "times": len(ks), "first": ks[0], "last": ks[-1]}
+    most = 0
+    for cs in per.values():
+        c = np.sort(np.asarray(cs, dtype=np.int64))
+        most = max(most, int(np.max(np.searchsorted(c, c + window) - np.arange(c.size))))
+    kind = np.asarray(state.get("group_kind", np.zeros(sizes.size)), dtype=np.int64)
+    return {"groups": int(sizes.size), "resolves": int(np.sum(kind == 1)), "bounces": int(np.sum(kind == 0)),
+            "distinct_groups": len(by), f"most_groups_of_one_particle_in_{window}_of_its_collisions": most,
+            "most_frequent": [{"members": list(g), "times": len(ks), "first": min(ks), "last": max(ks)}
                               for g, ks in common]}
 
 

@@ -23,9 +23,7 @@ LEGAL = {
     ("float", "momentum0", "huge"): "walls on every axis: momentum is not conserved, so not checked",
     **{("float", k, "missing"): "written before the entry existed: a default" for k in
        ("centre", "generator", "streams", "trace")},
-    ("lattice", "bits", "truncated"): "the bits-back integer: any integer is a state (a shorter one too)",
-    ("lattice", "bits", "huge"): "the bits-back integer: any integer is a state",
-    ("lattice", "collisions", "huge"): "a count",
+    ("lattice", "bits", "huge"): "the bits-back integers: any integers are a state",
     ("lattice", "streams", "huge"): "Philox counters: any value",
     ("lattice", "momentum0", "huge"): "not conserved (walls, group bounces), so not checked",
     ("lattice", "units.L", "huge"): "2^62 is a box length the lattice's range holds (validate(u))",
@@ -34,7 +32,7 @@ LEGAL = {
     ("lattice", "quantization.max_position_error", "huge"): "a reported error, finite",
     ("lattice", "quantization.max_velocity_error", "huge"): "a reported error, finite",
     **{("lattice", k, "missing"): "written before the entry existed: a default" for k in
-       ("engine", "mode", "group_kind", "group_v", "units.tick_bits", "units.cell_bits", "units.boundary",
+       ("engine", "mode", "units.tick_bits", "units.cell_bits", "units.boundary",
         "quantization.max_position_error", "quantization.max_velocity_error", "search")},
 }
 

@@ -15,7 +15,8 @@ from revcol.lattice_gas import build_lattice
 from revcol.scene import SceneError, load_scene, scene_from_dict, with_engine, with_lattice_options
 
 # every part of the state a run changes (the neighbour search is not one of them)
-STATE = ("x", "v", "streams", "bits", "clock", "collisions", "log_index", "log_redraws", "group_index")
+STATE = ("x", "v", "streams", "bits", "bits_size", "clock", "collisions", "particle_collisions", "log_particle",
+         "log_count", "log_redraws", "group_drawer", "group_counts")
 
 
 def _gas(engine="lattice", dim=2, **collisions):

@@ -115,14 +115,15 @@ def test_third_bodies_measures_a_gap_in_ticks_of_travel():
 
 
 def test_group_census_finds_the_same_members_meeting_again():
-    state = {"group_index": np.array([5, 7, 200007, 200009, 200011]),
-             "group_size": np.array([2, 3, 3, 3, 3]),
+    state = {"group_size": np.array([2, 3, 3, 3, 3]),
              "group_kind": np.array([1, 1, 0, 1, 0]),
-             "group_members": np.array([1, 2, 4, 5, 6, 7, 8, 9, 7, 8, 9, 7, 8, 9])}
+             "group_members": np.array([1, 2, 4, 5, 6, 7, 8, 9, 7, 8, 9, 7, 8, 9]),
+             "group_counts": np.array([5, 9, 3, 4, 8, 900, 905, 901, 950, 955, 951, 990, 995, 991])}
     c = lv.group_census(state)
     assert c["groups"] == 5 and c["resolves"] == 3 and c["bounces"] == 2 and c["distinct_groups"] == 3
-    assert c["most_frequent"][0] == {"members": [7, 8, 9], "times": 3, "first": 200007, "last": 200011}
-    assert c["most_groups_in_1e5_collisions"] == 3
+    assert c["most_frequent"][0] == {"members": [7, 8, 9], "times": 3, "first": 900, "last": 990}
+    assert c["most_groups_of_one_particle_in_100_of_its_collisions"] == 3
+    assert lv.group_census(state, window=60)["most_groups_of_one_particle_in_60_of_its_collisions"] == 2
 
 
 class _Dim3:

@@ -61,6 +61,7 @@ def test_lattice_scenes_reduced_bit_for_bit(path, tmp_path, capsys):
     assert r["error_x"] == 0.0 and r["error_v"] == 0.0 and r["energy_drift_end"] == 0.0
     x = r["bits_back"]
     assert x["start"] == x["end"] and x["max"] >= max(x["start"], x["turn"])
+    assert x["start"] == 128 * x["particles"]  # one X per particle, 128 bits each at the start
     assert r["log_entries_end"] == 0 and r["log_bytes_end"] == 0
     assert set(r["redraws"]) >= {"cell_readback", "overlap_after", "ghost_tie"}
     assert r["forward_per_s"] > 0 and r["reverse_per_s"] > 0 and r["peak_rss_bytes"] > 0

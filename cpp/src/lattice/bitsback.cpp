@@ -26,7 +26,66 @@ inline u64 div_step(u64 hi, u64 lo, u64 d, u64& rem) {
 
 }  // namespace
 
-BitsBack::BitsBack(std::vector<std::uint64_t> words) : words_(std::move(words)) { trim(); }
+BitsBack::BitsBack(const std::vector<std::uint64_t>& words) {
+  for (std::uint64_t w : words) push_word(w);
+  trim();
+}
+
+BitsBack::BitsBack(const BitsBack& o) {
+  const std::uint64_t* w = o.data();
+  for (std::uint32_t k = 0; k < o.n_; ++k) push_word(w[k]);
+}
+
+BitsBack::BitsBack(BitsBack&& o) noexcept { steal(o); }
+
+void BitsBack::steal(BitsBack& o) noexcept {  // (this holds no heap words)
+  n_ = o.n_;
+  cap_ = o.cap_;
+  if (o.cap_ > kInline) {
+    heap_ = o.heap_;
+    o.cap_ = kInline;
+    o.n_ = 0;
+  } else {
+    std::copy(o.inl_, o.inl_ + o.n_, inl_);
+  }
+}
+
+BitsBack& BitsBack::operator=(const BitsBack& o) {
+  if (this == &o) return *this;
+  n_ = 0;
+  const std::uint64_t* w = o.data();
+  for (std::uint32_t k = 0; k < o.n_; ++k) push_word(w[k]);
+  return *this;
+}
+
+BitsBack& BitsBack::operator=(BitsBack&& o) noexcept {
+  if (this == &o) return *this;
+  release();
+  steal(o);
+  return *this;
+}
+
+void BitsBack::release() noexcept {
+  if (cap_ > kInline) delete[] heap_;
+  cap_ = kInline;
+  n_ = 0;
+}
+
+void BitsBack::push_word(std::uint64_t w) {
+  if (n_ == cap_) {
+    const std::uint32_t cap = 2 * cap_;
+    auto* h = new std::uint64_t[cap];
+    std::copy(data(), data() + n_, h);
+    if (cap_ > kInline) delete[] heap_;
+    heap_ = h;
+    cap_ = cap;
+  }
+  data()[n_++] = w;
+}
+
+bool operator==(const BitsBack& a, const BitsBack& b) noexcept {
+  return a.n_ == b.n_ && std::equal(a.data(), a.data() + a.n_, b.data());
+}
 
 BitsBack BitsBack::from_hex(const std::string& hex) {
   std::size_t i = (hex.size() >= 2 && hex[0] == '0' && (hex[1] == 'x' || hex[1] == 'X')) ? 2 : 0;
@@ -45,40 +104,44 @@ BitsBack BitsBack::from_hex(const std::string& hex) {
 }
 
 std::string BitsBack::to_hex() const {
-  if (words_.empty()) return "0x0";
+  if (n_ == 0) return "0x0";
   static const char* digits = "0123456789abcdef";
   std::string s;
-  for (std::size_t k = words_.size(); k-- > 0;)
-    for (int n = 15; n >= 0; --n) s.push_back(digits[(words_[k] >> (4 * n)) & 15]);
+  const std::uint64_t* w = data();
+  for (std::size_t k = n_; k-- > 0;)
+    for (int n = 15; n >= 0; --n) s.push_back(digits[(w[k] >> (4 * n)) & 15]);
   const std::size_t first = s.find_first_not_of('0');
   return "0x" + s.substr(first);
 }
 
-void BitsBack::trim() {
-  while (!words_.empty() && words_.back() == 0) words_.pop_back();
+void BitsBack::trim() noexcept {
+  const std::uint64_t* w = data();
+  while (n_ > 0 && w[n_ - 1] == 0) --n_;
 }
 
 void BitsBack::mul_add(std::uint64_t m, std::uint64_t a) {
   u64 carry = a;
-  for (u64& w : words_) {
-    const u128 t = static_cast<u128>(w) * m + carry;
-    w = static_cast<u64>(t);
+  u64* w = data();
+  for (std::uint32_t k = 0; k < n_; ++k) {
+    const u128 t = static_cast<u128>(w[k]) * m + carry;
+    w[k] = static_cast<u64>(t);
     carry = static_cast<u64>(t >> 64);
   }
-  if (carry != 0) words_.push_back(carry);
+  if (carry != 0) push_word(carry);
   trim();
 }
 
-std::uint64_t BitsBack::divmod(std::uint64_t d) {
+std::uint64_t BitsBack::divmod(std::uint64_t d) noexcept {
   u64 rem = 0;
-  for (std::size_t k = words_.size(); k-- > 0;) words_[k] = div_step(rem, words_[k], d, rem);
+  u64* w = data();
+  for (std::size_t k = n_; k-- > 0;) w[k] = div_step(rem, w[k], d, rem);
   trim();
   return rem;
 }
 
 void BitsBack::set_low48(std::uint64_t s) {
-  if (words_.empty()) words_.push_back(0);
-  words_[0] = (words_[0] & ~rans_mask) | s;
+  if (n_ == 0) push_word(0);
+  data()[0] = (data()[0] & ~rans_mask) | s;
   trim();
 }
 
@@ -103,10 +166,11 @@ void BitsBack::pop_rans(std::uint64_t c, std::uint64_t f) {
   const u64 s = low48();
   require(f >= 1 && c <= s && s - c < f, "BitsBack::pop_rans: the low 48 bits are not in [c, c+f)");
   // X = f * (X >> 48) + s - c
-  const std::size_t n = words_.size();
+  const std::size_t n = n_;
+  u64* w = data();
   for (std::size_t k = 0; k < n; ++k) {
-    const u64 hi = (k + 1 < n) ? words_[k + 1] : 0;
-    words_[k] = (words_[k] >> 48) | (hi << 16);
+    const u64 hi = (k + 1 < n) ? w[k + 1] : 0;
+    w[k] = (w[k] >> 48) | (hi << 16);
   }
   trim();
   mul_add(f, s - c);
@@ -123,8 +187,8 @@ void BitsBack::sub_low48(std::uint64_t g) {
 }
 
 std::size_t BitsBack::bit_length() const {
-  if (words_.empty()) return 0;
-  return 64 * (words_.size() - 1) + (64 - static_cast<std::size_t>(__builtin_clzll(words_.back())));
+  if (n_ == 0) return 0;
+  return 64 * (n_ - 1) + (64 - static_cast<std::size_t>(__builtin_clzll(data()[n_ - 1])));
 }
 
 }  // namespace revcol::lattice

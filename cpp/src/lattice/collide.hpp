@@ -115,7 +115,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   for (;;) {
     if (static_cast<std::int64_t>(redraws) > max_redraws) return group_collide(i, j, a, ctr0, reasons, !fallback);
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
-    const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_, xi2, xj2, vi2, vj2, out);
+    const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_[i], xi2, xj2, vi2, vj2, out);
     int why = static_cast<int>(rf);
     if (why == 0) {
       xi2 = shifted(xj, xi2);
@@ -128,12 +128,16 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
     ++redraws;
   }
   if (multi) ++cnt_.multi_body;
-  if (redraws > 0 || fallback) {
-    log_.push(ncoll_ + 1, redraws);
+  if (redraws > 0 || fallback) [[unlikely]] {
+    const LogKey key{static_cast<std::uint32_t>(i), pc_[i] + 1};
+    log_.emplace(key, redraws);
+    if (!undo_epoch_.empty()) undo_log_.push_back(key);
     ++cnt_.log_entries;
   }
   if (fallback) ++cnt_.drawn_fallbacks;
-  X_ = std::move(out);
+  X_[i] = std::move(out);
+  ++pc_[i];
+  ++pc_[j];
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, i, j});
   if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
@@ -143,25 +147,33 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
-  if (Group* g = groups_.top(ncoll_)) {
-    group_back(i, j, a, *g);
-    return;
+  // i's last collision (forward) is the one undone here: its key is (i, i's count)
+  const LogKey key{static_cast<std::uint32_t>(i), pc_[i]};
+  if (!groups_.empty()) [[unlikely]] {
+    if (const auto it = groups_.find(key); it != groups_.end()) {
+      const std::shared_ptr<Group> g = it->second;  // (group_back erases its keys)
+      group_back(i, j, a, *g);
+      return;
+    }
   }
-  if (mode_ == Mode::specular && log_.top(ncoll_) == nullptr) {  // (a log entry: a drawn fallback)
+  const auto logged = log_.empty() ? log_.end() : log_.find(key);
+  if (mode_ == Mode::specular && logged == log_.end()) {  // (a log entry: a drawn fallback)
     back_specular(i, j, a);
     return;
   }
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
-  const std::uint32_t* logged = log_.top(ncoll_);
-  const std::uint32_t redraws = logged ? *logged : 0;
+  const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
   if (ctr_[i] < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
   const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i] - 1);
   Vec xi0, xj0, vi0, vj0;
-  op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, X_, xi0, xj0, vi0, vj0);
+  if (pc_[i] == 0 || pc_[j] == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
+  op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, X_[i], xi0, xj0, vi0, vj0);
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
   ctr_[i] -= 1 + redraws;
-  if (logged) log_.pop();
+  if (logged != log_.end()) log_.erase(logged);
+  --pc_[i];
+  --pc_[j];
   --ncoll_;
   apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
 }
@@ -202,6 +214,8 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
   }
   if (multi) ++cnt_.multi_body;
   if (tr.backscatter) ++cnt_.backscatters;
+  ++pc_[i];
+  ++pc_[j];
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, i, j});
   if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
@@ -215,8 +229,11 @@ void BasicEngine<Op, Bits, Queue>::back_specular(int i, int j, std::int64_t a) {
   Vec xi0, xj0, vi0, vj0;
   if (spec_.pair_unmap(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi0, xj0, vi0, vj0) != Refusal::none)
     throw std::logic_error("lattice engine: the specular map refused a post state it wrote (a bug)");
+  if (pc_[i] == 0 || pc_[j] == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
+  --pc_[i];
+  --pc_[j];
   --ncoll_;
   apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
 }

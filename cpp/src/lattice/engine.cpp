@@ -15,14 +15,10 @@ namespace revcol::lattice {
 
 template class BasicEngine<LatticePair2D, BitsBack>;
 
-std::vector<std::uint64_t> initial_bits(std::uint32_t seed) {
-  std::vector<std::uint64_t> w;
-  for (std::uint32_t k = 0; k < 2; ++k) {
-    const auto b = rng::philox4x32_10({k, 0U, 0U, 0U}, {0xFFFFFFFFU, seed});
-    w.push_back((std::uint64_t{b[0]} << 32) | b[1]);
-    w.push_back((std::uint64_t{b[2]} << 32) | b[3]);
-  }
-  w.back() |= std::uint64_t{1} << 63;  // exactly 256 bits
+std::vector<std::uint64_t> initial_bits(std::uint32_t p, std::uint32_t seed) {
+  const auto b = rng::philox4x32_10({0U, 0U, 1U, 0U}, {p, seed});
+  std::vector<std::uint64_t> w{(std::uint64_t{b[0]} << 32) | b[1], (std::uint64_t{b[2]} << 32) | b[3]};
+  w.back() |= std::uint64_t{1} << 63;  // exactly 128 bits
   return w;
 }
 
@@ -74,7 +70,7 @@ DiagnosticsN<Eng::D> diagnostics_of(const Eng& e) {
   d.energy_drift = E0 > 0 ? dE / static_cast<double>(E0) : 0.0;
   const auto P = Eng::momentum_of(e.velocities());
   for (std::size_t k = 0; k < Eng::D; ++k) d.momentum_drift[k] = static_cast<double>(P[k] - e.momentum0(static_cast<int>(k)));
-  d.bits_length = e.bits().bit_length();
+  d.bits_length = e.bits_length();
   d.log_entries = e.log_size();
   d.collisions = e.collisions();
   d.clock = e.clock();

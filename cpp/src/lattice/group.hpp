@@ -216,9 +216,16 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
   if (resolve)
     for (int q : g) pre_v.push_back(ln_[q].v);
   ++ncoll_;
-  log_.push(ncoll_, static_cast<std::uint32_t>(ctr_[i] - ctr0));
+  std::vector<std::uint64_t> counts;
+  for (int q : g) counts.push_back(++pc_[q]);
+  auto entry = std::make_shared<Group>(Group{i, static_cast<std::uint32_t>(ctr_[i] - ctr0), g, counts, std::move(pre_v)});
+  for (std::size_t m = 0; m < g.size(); ++m) {
+    const LogKey key{static_cast<std::uint32_t>(g[m]), counts[m]};
+    groups_.emplace(key, entry);
+    if (!undo_epoch_.empty()) undo_groups_.push_back(key);
+  }
+  ++ngroups_;
   ++cnt_.log_entries;
-  groups_.push(ncoll_, Group{i, g, std::move(pre_v)});
   ++cnt_.multi_body;
   ++(resolve ? cnt_.group_resolves : cnt_.group_bounces);
   for (int s = 0; s < 2; ++s)
@@ -244,8 +251,9 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Grou
   if (std::find(g.begin(), g.end(), i) == g.end() || std::find(g.begin(), g.end(), j) == g.end()) {
     throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
   }
-  const std::uint32_t* logged = log_.top(ncoll_);
-  const std::uint32_t draws = logged ? *logged : 0;
+  for (std::size_t m = 0; m < g.size(); ++m)
+    if (pc_[g[m]] != entry.counts[m]) throw std::logic_error("lattice engine: the reverse met a group before a member's later collision (a bug)");
+  const std::uint32_t draws = entry.draws;
   const int drawer = entry.drawer;
   if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
   const std::vector<Vec> pre_v = entry.pre_v;  // forward frame; empty: a bounce (a copy: popped below)
@@ -259,8 +267,11 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Grou
     ++slot_[static_cast<std::size_t>(g[m])].ver;
   }
   ctr_[drawer] -= draws;
-  if (logged) log_.pop();
-  groups_.pop();  // entry, the top
+  for (int q : g) {
+    groups_.erase(LogKey{static_cast<std::uint32_t>(q), pc_[q]});  // entry is gone after the last
+    --pc_[q];
+  }
+  --ngroups_;
   --ncoll_;
   ++cnt_.collisions;
   for (int q : g) predict(q, a);

@@ -12,6 +12,58 @@
 
 namespace revcol::lattice {
 
+// The rare log of a snapshot against its per-particle counts: every key (particle, count) names
+// a collision the particle has had (1 <= count <= its count), no key twice, entries and groups
+// in key order, and the counts add up: each pair collision counts for two particles, each group
+// for its members, so sum(counts) = 2 collisions + sum over groups (members - 2).
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::check_log(const Snapshot& s) const {
+  const std::size_t n = s.x.size();
+  require(s.particle_collisions.size() == n, "lattice snapshot: particle_collisions must hold one count per particle");
+  require(s.bits.size() == n, "lattice snapshot: bits must hold one bits-back integer per particle");
+  std::map<LogKey, int> seen;  // 0 a redraw entry, 1 a group member
+  auto key_ok = [&](std::size_t p, std::uint64_t c) { return p < n && c >= 1 && c <= s.particle_collisions[p]; };
+  for (std::size_t k = 0; k < s.log.size(); ++k) {
+    const LogEntry& e = s.log[k];
+    require(key_ok(e.particle, e.count), "lattice snapshot: a rare-log entry names a collision its particle has not had");
+    require(k == 0 || LogKey{s.log[k - 1].particle, s.log[k - 1].count} < LogKey{e.particle, e.count},
+            "lattice snapshot: rare-log entries must be in (particle, count) order, each once");
+    seen.emplace(LogKey{e.particle, e.count}, 0);
+  }
+  u128 extra = 0;
+  for (std::size_t k = 0; k < s.groups.size(); ++k) {
+    const auto& e = s.groups[k];
+    const std::size_t m = e.members.size();
+    require(m >= 2 && m <= 64 && e.counts.size() == m, "lattice snapshot: a group entry needs 2-64 members, one count each");
+    require(e.pre_v.empty() || e.pre_v.size() == m, "lattice snapshot: a group entry needs one pre velocity per member (or none: a bounce)");
+    bool has_drawer = false;
+    std::uint64_t drawer_count = 0;
+    for (std::size_t q = 0; q < m; ++q) {
+      const int p = e.members[q];
+      require(p >= 0 && (q == 0 || e.members[q - 1] < p), "lattice snapshot: a group's members must ascend, each once");
+      require(key_ok(static_cast<std::size_t>(p), e.counts[q]), "lattice snapshot: a group entry names a collision its member has not had");
+      require(seen.emplace(LogKey{static_cast<std::uint32_t>(p), e.counts[q]}, 1).second,
+              "lattice snapshot: two rare-log entries name the same collision of a particle");
+      if (p == e.drawer) has_drawer = true, drawer_count = e.counts[q];
+    }
+    require(has_drawer, "lattice snapshot: a group's drawer must be one of its members");
+    if (k > 0) {
+      const auto& f = s.groups[k - 1];
+      const auto fc = f.counts[static_cast<std::size_t>(std::find(f.members.begin(), f.members.end(), f.drawer) - f.members.begin())];
+      require(LogKey{static_cast<std::uint32_t>(f.drawer), fc} < LogKey{static_cast<std::uint32_t>(e.drawer), drawer_count},
+              "lattice snapshot: group entries must be in (drawer, count) order");
+    }
+    for (const Vec& w : e.pre_v)
+      for (std::size_t a = 0; a < D; ++a)
+        require(w[a] >= -s.units.vmax && w[a] <= s.units.vmax, "lattice snapshot: a group entry's pre velocity is faster than vmax");
+    extra += m - 2;
+  }
+  u128 sum = 0;
+  for (std::uint64_t c : s.particle_collisions) sum += c;
+  require(sum == 2 * static_cast<u128>(s.collisions) + extra,
+          "lattice snapshot: particle_collisions do not add up to collisions (2 per pair collision, 1 per group member)");
+}
+
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
   validate_state(s.units, s.x, s.v, true);  // collisions may be pending at the clock (rebuild finds them)
@@ -25,24 +77,7 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
     const double E0 = static_cast<double>((static_cast<u128>(s.energy0[1]) << 64) | s.energy0[0]);
     require(std::fabs(E - E0) <= 1e-6 * E0, "lattice snapshot: energy0 is not the sum |v|^2 of v (1e-6 relative)");
   }
-  // the logs are stacks keyed by collision index (engine/logs.hpp): strictly increasing keys
-  // within [1, collisions], so that the reverse meets each entry on top at its collision
-  for (std::size_t k = 0; k < s.log.size(); ++k)
-    require(s.log[k].first >= 1 && s.log[k].first <= s.collisions && (k == 0 || s.log[k - 1].first < s.log[k].first),
-            "lattice snapshot: rare-log indices must increase within [1, collisions]");
-  for (std::size_t k = 1; k < s.groups.size(); ++k)
-    require(s.groups[k - 1].index < s.groups[k].index, "lattice snapshot: group entries' indices must increase");
-  for (const auto& e : s.groups) {
-    require(e.index >= 1 && e.index <= s.collisions && e.members.size() >= 2 && e.drawer >= 0 &&
-                static_cast<std::size_t>(e.drawer) < s.x.size(),
-            "lattice snapshot: a group entry out of range");
-    require(e.pre_v.empty() || e.pre_v.size() == e.members.size(),
-            "lattice snapshot: a group entry needs one pre velocity per member (or none: a bounce)");
-    for (int m : e.members) require(m >= 0 && static_cast<std::size_t>(m) < s.x.size(), "lattice snapshot: a group member out of range");
-    for (const Vec& w : e.pre_v)
-      for (std::size_t k = 0; k < D; ++k)
-        require(w[k] >= -s.units.vmax && w[k] <= s.units.vmax, "lattice snapshot: a group entry's pre velocity is faster than vmax");
-  }
+  check_log(s);
   require(s.origin <= s.clock && tick_limit / 2 > s.clock && s.origin > -tick_limit / 2,
           "lattice snapshot: origin <= clock within +-2^60 required");
   require(s.law == law(), "lattice snapshot: its law is not the operator's");
@@ -70,9 +105,12 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   s.x = positions();
   s.v = velocities();
   s.streams = ctr_;
-  s.bits = X_.words();
-  s.log.assign(log_.items().begin(), log_.items().end());
-  for (const auto& [k, g] : groups_.items()) s.groups.push_back(GroupEntry{k, g.drawer, g.members, g.pre_v});
+  s.particle_collisions = pc_;
+  s.bits.resize(X_.size());
+  for (std::size_t p = 0; p < X_.size(); ++p) s.bits[p] = X_[p].words();
+  for (const auto& [k, r] : log_) s.log.push_back(LogEntry{k.first, k.second, r});
+  for (const auto& [k, g] : groups_)  // each group once, under its drawer's key
+    if (k.first == static_cast<std::uint32_t>(g->drawer)) s.groups.push_back(GroupEntry{g->drawer, g->draws, g->members, g->counts, g->pre_v});
   s.energy0 = energy0_;
   s.momentum0 = momentum0_;
   s.counters = cnt_;
@@ -91,11 +129,18 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s) {
   for (std::size_t p = 0; p < n; ++p) ln_[p] = Line{s.x[p], s.v[p], s.clock};
   slot_.assign(n, Slot{});
   ctr_ = s.streams;
-  X_ = Bits(s.bits);
+  pc_ = s.particle_collisions;
+  X_.clear();
+  X_.reserve(n);
+  for (const auto& w : s.bits) X_.emplace_back(w);
   log_.clear();
-  for (const auto& e : s.log) log_.push(e.first, e.second);
+  for (const LogEntry& e : s.log) log_.emplace(LogKey{e.particle, e.count}, e.redraws);
   groups_.clear();
-  for (const auto& e : s.groups) groups_.push(e.index, Group{e.drawer, e.members, e.pre_v});
+  for (const auto& e : s.groups) {
+    auto g = std::make_shared<Group>(Group{e.drawer, e.draws, e.members, e.counts, e.pre_v});
+    for (std::size_t m = 0; m < e.members.size(); ++m) groups_.emplace(LogKey{static_cast<std::uint32_t>(e.members[m]), e.counts[m]}, g);
+  }
+  ngroups_ = s.groups.size();
   clock_ = s.clock;
   origin_ = s.origin;
   ncoll_ = s.collisions;
@@ -186,7 +231,8 @@ void BasicEngine<Op, Bits, Queue>::begin_undo() {
     epoch_ = 1;
   }
   undo_.clear();
-  undo_X_ = X_;
+  undo_log_.clear();
+  undo_groups_.clear();
   undo_cnt_ = cnt_;
   undo_clock_ = clock_;
   undo_ncoll_ = ncoll_;
@@ -198,15 +244,22 @@ void BasicEngine<Op, Bits, Queue>::undo() {
     ln_[sv.p] = sv.line;
     pre_wall_[sv.p] = sv.pre_wall;
     ctr_[sv.p] = sv.ctr;
+    pc_[sv.p] = sv.pc;
+    X_[sv.p] = sv.X;
     wall_tick_[sv.p] = sv.wall_tick;
     ++slot_[static_cast<std::size_t>(sv.p)].ver;
   }
   undo_.clear();
-  X_ = undo_X_;
   cnt_ = undo_cnt_;
   clock_ = undo_clock_;
-  log_.truncate_after(undo_ncoll_);  // the forward run only adds keys
-  groups_.truncate_after(undo_ncoll_);
+  for (const LogKey& k : undo_log_) log_.erase(k);  // the forward run only adds keys
+  for (const LogKey& k : undo_groups_) {
+    const auto it = groups_.find(k);
+    if (it != groups_.end() && it->first.first == static_cast<std::uint32_t>(it->second->drawer)) --ngroups_;
+    if (it != groups_.end()) groups_.erase(it);
+  }
+  undo_log_.clear();
+  undo_groups_.clear();
   ncoll_ = undo_ncoll_;
   rebuild();
 }
@@ -236,15 +289,21 @@ auto BasicEngine<Op, Bits, Queue>::auto_list_shell() const noexcept -> double {
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::memory_bytes() const noexcept -> std::size_t {
   const std::size_t n = ln_.size();
-  return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec) * 2 + 8) + queue_.memory_bytes() + grid_.memory_bytes() + nl_.memory_bytes() +
-         log_.size() * sizeof(std::pair<std::uint64_t, std::uint32_t>) + group_bytes() + X_.words().size() * 8 + undo_.capacity() * sizeof(Saved) +
-         undo_epoch_.capacity() * sizeof(std::uint32_t);
+  std::size_t heap = 0;
+  for (const Bits& x : X_) heap += x.heap_bytes();
+  return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec) * 2 + 8 + sizeof(Bits) + 8) + heap + queue_.memory_bytes() +
+         grid_.memory_bytes() + nl_.memory_bytes() + log_.size() * (48 + sizeof(LogKey) + 8) + group_bytes() +
+         undo_.capacity() * sizeof(Saved) + undo_epoch_.capacity() * sizeof(std::uint32_t);
 }
 
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::group_bytes() const noexcept -> std::size_t {
   std::size_t b = 0;
-  for (const auto& [k, g] : groups_.items()) b += 48 + g.members.size() * sizeof(int) + g.pre_v.size() * sizeof(Vec);
+  for (const auto& [k, g] : groups_) {
+    b += 48 + sizeof(LogKey) + 16;  // the map node of this key
+    if (k.first == static_cast<std::uint32_t>(g->drawer))
+      b += sizeof(Group) + 16 + g->members.size() * (sizeof(int) + 8) + g->pre_v.size() * sizeof(Vec);
+  }
   return b;
 }
 

@@ -93,6 +93,12 @@ def _search(search) -> str:
     return f"neighbour lists, shell {search:.3g} diameters"
 
 
+def _per(x: dict) -> str:
+    """' (k per particle)' when the report knows the particle count (one X per particle)."""
+    n = x.get("particles")
+    return f" ({x['start'] / n:.4g} per particle)" if n else ""
+
+
 def _lattice_lines(r: dict) -> list[str]:
     """A lattice-engine round trip: what came back bit for bit, X's size, the rare log,
     redraws (specular mode: refusals) and backscatters, multi-body ticks, drifts, rates and memory."""
@@ -119,8 +125,8 @@ def _lattice_lines(r: dict) -> list[str]:
         f"{r['clock_end']:,}) in {_duration(r['reverse_s'])}: {_si(r['reverse_per_s'])} collisions/s "
         f"({_si(r['reverse_per_cpu_s'])} per CPU second)",
         f"  restored         {'bit for bit' if r['bit_for_bit'] else 'NOT bit for bit'}: {same}",
-        f"  bits-back X      {x['start']} bits at the start, {x['turn']} at the turn, {x['end']} after reversal; "
-        f"max {x['max']} (sampled every {x['sampled_every']:,} collisions)",
+        f"  bits-back X      {x['start']:,} bits over all particles at the start{_per(x)}, {x['turn']:,} at the turn, "
+        f"{x['end']:,} after reversal; max {x['max']:,} (sampled every {x['sampled_every']:,} collisions)",
         f"  rare log         {_n(r['log_entries_turn'], 'entry', 'entries')} ({r['log_bytes_turn']} bytes) at the "
         f"turn, {r['log_entries_per_collision']:.2g} per collision ({_n(r['group_resolves'], 'group collision')} "
         f"resolved, {_n(r['group_bounces'], 'group bounce')}); "

@@ -12,6 +12,11 @@
 // sequence of them run backwards restores X bit for bit. Pushes grow X by about log2(m) or
 // log2(M/f) bits, pops shrink it by as much: X stays bounded when these balance on average
 // (the flux law) and drifts otherwise (the uniform law).
+//
+// Storage: up to four words inline, more on the heap; the value is the same either way
+// (equality compares values). The engine holds one X per particle, about 128 bits that move by
+// a bit or two per collision; within a collision the pushes take it to about 210 bits before the
+// pops bring it back, so four words keep every step off the heap (test_lattice_local).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -27,9 +32,14 @@ class BitsBack {
   static constexpr std::uint64_t rans_total = 1ULL << 48;     ///< M
   static constexpr std::uint64_t rans_mask = rans_total - 1;  ///< M - 1
 
-  BitsBack() = default;
+  BitsBack() noexcept {}
   /// X from words (least significant first); leading zero words are dropped.
-  explicit BitsBack(std::vector<std::uint64_t> words);
+  explicit BitsBack(const std::vector<std::uint64_t>& words);
+  BitsBack(const BitsBack& o);
+  BitsBack(BitsBack&& o) noexcept;
+  BitsBack& operator=(const BitsBack& o);
+  BitsBack& operator=(BitsBack&& o) noexcept;
+  ~BitsBack() { release(); }
   /// X from a hexadecimal string ("0x" prefix optional, "0" or "" for zero); throws on a bad digit.
   static BitsBack from_hex(const std::string& hex);
   /// X as lower-case hexadecimal with "0x" (the same text as Python's hex()).
@@ -42,24 +52,37 @@ class BitsBack {
   /// rANS pop, the inverse of push_rans(c, f): needs c <= low48() < c + f.
   void pop_rans(std::uint64_t c, std::uint64_t f);
   /// X mod 2^48: the rANS state a pop decodes.
-  std::uint64_t low48() const { return words_.empty() ? 0 : (words_[0] & rans_mask); }
+  std::uint64_t low48() const { return n_ == 0 ? 0 : (data()[0] & rans_mask); }
   /// The torus shift: the low 48 bits s become (s + g) mod 2^48, the rest of X is kept (g < 2^48).
   void add_low48(std::uint64_t g);
   /// The inverse shift: s becomes (s - g) mod 2^48 (g < 2^48).
   void sub_low48(std::uint64_t g);
 
   std::size_t bit_length() const;                            ///< bits of X (0 for zero)
-  const std::vector<std::uint64_t>& words() const { return words_; }  ///< for snapshots
-  bool is_zero() const { return words_.empty(); }            ///< X == 0
-  /// Equal values (the word vectors are canonical).
-  friend bool operator==(const BitsBack& a, const BitsBack& b) { return a.words_ == b.words_; }
+  std::vector<std::uint64_t> words() const { return {data(), data() + n_}; }  ///< for snapshots
+  std::size_t size() const noexcept { return n_; }           ///< words held (no leading zero word)
+  bool is_zero() const { return n_ == 0; }                   ///< X == 0
+  /// Bytes on the heap (0 while X fits inline).
+  std::size_t heap_bytes() const noexcept { return cap_ > kInline ? cap_ * sizeof(std::uint64_t) : 0; }
+  /// Equal values (the words are canonical).
+  friend bool operator==(const BitsBack& a, const BitsBack& b) noexcept;
 
  private:
-  void trim();                                       // drop leading zero words
+  static constexpr std::uint32_t kInline = 4;
+  std::uint64_t* data() noexcept { return cap_ > kInline ? heap_ : inl_; }
+  const std::uint64_t* data() const noexcept { return cap_ > kInline ? heap_ : inl_; }
+  void push_word(std::uint64_t w);                   // append a most significant word
+  void release() noexcept;                           // free the heap words (if any)
+  void steal(BitsBack& o) noexcept;                  // take o's words (o left zero)
+  void trim() noexcept;                              // drop leading zero words
   void mul_add(std::uint64_t m, std::uint64_t a);    // X = X*m + a
-  std::uint64_t divmod(std::uint64_t d);             // X = X div d, returns X mod d (d >= 1)
+  std::uint64_t divmod(std::uint64_t d) noexcept;    // X = X div d, returns X mod d (d >= 1)
   void set_low48(std::uint64_t s);                   // replace the low 48 bits by s < 2^48
-  std::vector<std::uint64_t> words_;
+  std::uint32_t n_ = 0, cap_ = kInline;              // words held; capacity (kInline: inline)
+  union {
+    std::uint64_t inl_[kInline];
+    std::uint64_t* heap_;
+  };
 };
 
 }  // namespace revcol::lattice

@@ -91,7 +91,7 @@ struct DiagnosticsN {
   double energy_drift = 0.0;               ///< (E - E0) / E0, E = sum |v|^2 in lattice units
   double energy_drift_units = 0.0;         ///< E - E0 in lattice units^2 / tick^2
   std::array<double, D> momentum_drift{};  ///< P - P0 per axis, lattice units per tick
-  std::size_t bits_length = 0;             ///< bit length of X
+  std::size_t bits_length = 0;             ///< the particles' X, bit lengths summed
   std::size_t log_entries = 0;             ///< rare-log entries held
   std::uint64_t collisions = 0;            ///< collisions since the start
   std::int64_t clock = 0;                  ///< the tick

@@ -6,9 +6,14 @@
 // snapshots are one code for both (per-axis loops over D; a wall is a flat plane per axis).
 //
 // State: per particle an anchor position (integer, wrapped into the box) at an anchor tick, an
-// integer velocity, a line version (bumped when the line changes) and a Philox stream counter; the
-// clock; the bits-back integer X; the rare log; the collision count. Free flight is exact:
-// x(t) = x_a + v (t - t_a), wrapped on periodic axes.
+// integer velocity, a line version (bumped when the line changes), a Philox stream counter, a
+// bits-back integer X (about 128 bits) and a collision count; the clock; the rare log; the
+// collision count. Free flight is exact: x(t) = x_a + v (t - t_a), wrapped on periodic axes.
+// Every collision reads and writes only its particles' state: the pair operator runs on the
+// drawing particle's X (the lower index i of the pair), and the rare log and the group entries
+// are keyed by (particle, that particle's collision count after the collision), never by a global
+// index. So collisions in different places commute, and a state cut into regions is the same
+// state (ARCHITECTURE.md, "Per-particle state"); the global collision count is the sum.
 //
 // Event rule. Invariant: no pair overlaps at any integer tick, and every centre is inside [h, H] on
 // wall axes. A pair collides on the transition a-1 -> a where a is the first tick at which its
@@ -56,6 +61,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <stdexcept>
@@ -96,8 +102,9 @@ inline std::uint64_t draw48(std::uint32_t p, std::uint32_t seed, std::uint64_t k
   const auto w = rng::philox4x32_10({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k >> 32), 0U, 0U}, {p, seed});
   return (std::uint64_t{w[0]} << 16) | (w[1] >> 16);
 }
-/// The 256 initial bits of X for a seed: four words from stream key {2^32 - 1, seed}.
-std::vector<std::uint64_t> initial_bits(std::uint32_t seed);
+/// The 128 initial bits of particle p's X: Philox4x32-10 block (0, 0, 1, 0) under key {p, seed}
+/// (no draw48 block has a nonzero third word), top bit set (exactly 128 bits).
+std::vector<std::uint64_t> initial_bits(std::uint32_t p, std::uint32_t seed);
 
 /// The lattice engine's event machinery over a pair operator Op (pair_forward / pair_reverse as
 /// LatticePair2D or LatticePair3D; the dimension is the operator's) and a bits-back integer Bits
@@ -113,7 +120,7 @@ class BasicEngine {
   using Snapshot = SnapshotN<D>;    ///< the state
   using GroupEntry = GroupEntryN<D>;  ///< a group collision in the rare log
 
-  /// An engine on a validated integer state at tick clock, X from initial_bits(seed); mode
+  /// An engine on a validated integer state at tick clock, each X from initial_bits(p, seed); mode
   /// exact (the operator Op, randomized) or specular (the deterministic map of specular.hpp: no
   /// draws, X never changes).
   BasicEngine(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, Op op,
@@ -132,7 +139,9 @@ class BasicEngine {
     s.x = std::move(x);
     s.v = std::move(v);
     s.streams.assign(s.x.size(), 0);
-    s.bits = initial_bits(seed);
+    s.particle_collisions.assign(s.x.size(), 0);
+    s.bits.resize(s.x.size());
+    for (std::size_t p = 0; p < s.x.size(); ++p) s.bits[p] = initial_bits(static_cast<std::uint32_t>(p), seed);
     const u128 e = kinetic2(s.v);
     s.energy0 = {static_cast<std::uint64_t>(e), static_cast<std::uint64_t>(e >> 64)};
     const auto p = momentum_of(s.v);
@@ -192,10 +201,19 @@ class BasicEngine {
   std::int64_t clock() const noexcept { return clock_; }                ///< the current tick
   std::int64_t origin() const noexcept { return origin_; }              ///< the initial tick
   std::uint64_t collisions() const noexcept { return ncoll_; }          ///< collisions since the start
-  const Bits& bits() const noexcept { return X_; }                      ///< the bits-back integer
+  const Bits& bits(int p) const { return X_.at(static_cast<std::size_t>(p)); }  ///< particle p's bits-back integer
+  /// The bit lengths of every particle's X, summed.
+  std::size_t bits_length() const noexcept {
+    std::size_t b = 0;
+    for (const Bits& x : X_) b += x.bit_length();
+    return b;
+  }
+  /// Particle p's collisions since the start (pairs and groups it took part in, net of reverses).
+  std::uint64_t particle_collisions(int p) const { return pc_.at(static_cast<std::size_t>(p)); }
   const Counters& counters() const noexcept { return cnt_; }            ///< statistics
-  std::size_t log_size() const noexcept { return log_.size(); }         ///< rare-log entries held (redraws)
-  std::size_t group_log_size() const noexcept { return groups_.size(); }  ///< group collisions held in the log
+  /// Rare-log entries held: the collisions that redrew (or were drawn in specular mode) and the groups.
+  std::size_t log_size() const noexcept { return log_.size() + ngroups_; }
+  std::size_t group_log_size() const noexcept { return ngroups_; }      ///< group collisions held in the log
   const Units& units() const noexcept { return u_; }                    ///< units and box
   std::size_t size() const noexcept { return ln_.size(); }               ///< N
   std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
@@ -271,6 +289,7 @@ class BasicEngine {
   };
 
   void load(const Snapshot& s);
+  void check_log(const Snapshot& s) const;  // the rare log against the per-particle counts
 
   // ---- geometry of the lines ----
   [[gnu::always_inline]] Vec pos(int p, std::int64_t t) const noexcept {
@@ -438,13 +457,14 @@ class BasicEngine {
   struct Saved {
     int p;
     Line line, pre_wall;
-    std::uint64_t ctr;
+    std::uint64_t ctr, pc;
     std::int64_t wall_tick;
+    Bits X;
   };
   std::vector<Saved> undo_;
   std::vector<std::uint32_t> undo_epoch_;  // per particle: the run() that journaled it
   std::uint32_t epoch_ = 0;
-  Bits undo_X_;
+  std::vector<LogKey> undo_log_, undo_groups_;  // rare-log and group keys this run() added
   Counters undo_cnt_;
   std::int64_t undo_clock_ = 0;
   std::uint64_t undo_ncoll_ = 0;
@@ -453,7 +473,7 @@ class BasicEngine {
   void journal(int p) {
     if (undo_epoch_.empty() || undo_epoch_[p] == epoch_) return;
     undo_epoch_[p] = epoch_;
-    undo_.push_back(Saved{p, ln_[p], pre_wall_[p], ctr_[p], wall_tick_[p]});
+    undo_.push_back(Saved{p, ln_[p], pre_wall_[p], ctr_[p], pc_[p], wall_tick_[p], X_[p]});
   }
   void undo();
   std::vector<std::uint64_t> ctr_;
@@ -466,14 +486,21 @@ class BasicEngine {
     Type type = none;
   };
   std::vector<Slot> slot_;
-  Bits X_;
-  engine::KeyedStack<std::uint64_t, std::uint32_t> log_;  // collision index -> redraws (the rare log)
+  std::vector<Bits> X_;            // per particle: the bits-back integer (the drawer's runs the operator)
+  std::vector<std::uint64_t> pc_;  // per particle: its collisions (the rare log's keys)
+  // the rare log: (drawer, its count after the collision) -> redraws, for the collisions that
+  // redrew (and, specular mode, the drawn fallbacks)
+  std::map<LogKey, std::uint32_t> log_;
   struct Group {
-    int drawer;                 // whose stream the tried draws came from
-    std::vector<int> members;   // ascending
-    std::vector<Vec> pre_v;     // exact pre velocities (a resolve) or empty (a bounce)
+    int drawer;                         // whose stream the tried draws came from
+    std::uint32_t draws;                // draws tried before the group
+    std::vector<int> members;           // ascending
+    std::vector<std::uint64_t> counts;  // per member: its count after the group (its key)
+    std::vector<Vec> pre_v;             // exact pre velocities (a resolve) or empty (a bounce)
   };
-  engine::KeyedStack<std::uint64_t, Group> groups_;  // collision index -> group collision
+  // group collisions, under every member's key (member, its count after the group)
+  std::map<LogKey, std::shared_ptr<Group>> groups_;
+  std::size_t ngroups_ = 0;
   std::int64_t clock_ = 0, origin_ = 0;
   std::uint64_t ncoll_ = 0;
   std::array<std::uint64_t, 2> energy0_{};

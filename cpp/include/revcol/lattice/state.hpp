@@ -67,17 +67,32 @@ struct Counters : Visitable<Counters> {
   }
 };
 
+/// The key of a rare-log entry: (particle, that particle's collision count right after the
+/// collision). Per particle, never global: collisions in different places commute.
+using LogKey = std::pair<std::uint32_t, std::uint64_t>;
+
+/// A rare-log entry: a pair collision that redrew (or, specular mode, was drawn), keyed by its
+/// drawer (the pair's lower index) and the drawer's collision count after it.
+struct LogEntry {
+  std::uint32_t particle = 0;  ///< the drawer
+  std::uint64_t count = 0;     ///< its collision count right after the collision (>= 1)
+  std::uint32_t redraws = 0;   ///< redraws before the accepted draw
+  bool operator==(const LogEntry&) const = default;
+};
+
 /// A group collision in the rare log: a pair that no draw could resolve because a third body (or
 /// more) is met within the same tick. Its members stay at their tick a-1 positions ("stall") and
 /// either take the velocities of a specular resolution (pre_v holds their exact pre velocities,
 /// so the reverse restores them) or, when that post state would break the event rule, bounce
-/// back (every velocity negated, an involution: pre_v empty).
+/// back (every velocity negated, an involution: pre_v empty). Keyed by every member's
+/// (member, count after), so the reverse finds it from whichever member pair it meets.
 template <std::size_t D>
 struct GroupEntryN {
-  std::uint64_t index = 0;       ///< collision index (1-based)
-  int drawer = 0;                ///< whose stream the tried draws came from
-  std::vector<int> members;      ///< ascending
-  std::vector<VecN<D>> pre_v;    ///< members' exact pre velocities (a resolve); empty: a bounce
+  int drawer = 0;                     ///< whose stream the tried draws came from (a member)
+  std::uint32_t draws = 0;            ///< draws tried before the group
+  std::vector<int> members;           ///< ascending
+  std::vector<std::uint64_t> counts;  ///< per member: its collision count right after the group
+  std::vector<VecN<D>> pre_v;         ///< members' exact pre velocities (a resolve); empty: a bounce
   bool operator==(const GroupEntryN&) const = default;
 };
 /// A 2D group entry.
@@ -96,9 +111,10 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
   std::vector<VecN<D>> x;                      ///< positions at the clock
   std::vector<VecN<D>> v;                      ///< velocities
   std::vector<std::uint64_t> streams;          ///< per-particle Philox counters
-  std::vector<std::uint64_t> bits;             ///< the bits-back integer X, 64-bit words, low first
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> log;  ///< rare log: collision index -> redraws
-  std::vector<GroupEntryN<D>> groups;          ///< rare log: group collisions (resolves and bounces)
+  std::vector<std::uint64_t> particle_collisions;  ///< per particle: its collisions since the start
+  std::vector<std::vector<std::uint64_t>> bits;  ///< per particle: its bits-back integer X, 64-bit words, low first
+  std::vector<LogEntry> log;                   ///< rare log, by (particle, count) ascending
+  std::vector<GroupEntryN<D>> groups;          ///< group collisions, by (drawer, its count) ascending
   std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
   std::array<std::int64_t, 2 * D> momentum0{};  ///< initial momentum per axis (128 bits: low, high)
   Counters counters;                           ///< statistics (not compared by same_state)
@@ -119,6 +135,7 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
     f("x", s.x);
     f("v", s.v);
     f("streams", s.streams);
+    f("particle_collisions", s.particle_collisions);
     f("bits", s.bits);
     f("log", s.log);
     f("groups", s.groups);
@@ -140,7 +157,8 @@ bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
   return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.bounce == w.bounce && u.vmax == w.vmax &&
          u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
          a.law == b.law && a.mode == b.mode && a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
-         a.x == b.x && a.v == b.v && a.streams == b.streams && a.bits == b.bits && a.log == b.log &&
+         a.x == b.x && a.v == b.v && a.streams == b.streams && a.particle_collisions == b.particle_collisions &&
+         a.bits == b.bits && a.log == b.log &&
          a.groups == b.groups &&
          a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
 }
