@@ -2,7 +2,8 @@
 // state"): a collision reads and writes only its own particles' velocities, stream counters,
 // bits-back integers and collision counts; the rare log is keyed by (particle, its count), every
 // key names a collision that particle had and the counts add up; a snapshot that breaks those
-// rules is refused with the state unchanged; each X stays near its 128 start bits.
+// rules is refused with the state unchanged; each X stays near its 128 start bits; two gases
+// far apart in one box leave each other's particles exactly as each alone would.
 #include <cstdio>
 #include <set>
 #include <string>
@@ -158,6 +159,79 @@ TEST_CASE("each particle's X stays near its 128 start bits (the flux law's balan
     CHECK(lo >= 120 && hi <= 136);
     CHECK(heap == 0);
   }
+}
+
+// Two gases in one box, A on the left and B on the right, too far apart to meet before tick T:
+// the run of A and B together leaves every particle of A in exactly the state that A's run
+// alone leaves it in (B's particles present but at rest), and the same for B. With one X for
+// the whole gas (the older layout) B's collisions changed A's draws; per-particle state makes
+// the state of a region independent of what happens elsewhere, as the parallel engine needs.
+template <std::size_t D>
+void check_cut(std::size_t n, double phi, std::uint32_t seed) {
+  LatticeConfigN<D> c;
+  c.tick_bits = 16;
+  for (std::size_t k = 0; k < D; ++k) c.wall[k] = true;
+  c.seed = seed;
+  const LatticeStartN<D> s0 = random_start(c, n, phi, seed);
+  // the same gas twice, B shifted by the box length and a gap of 40 diameters, quantized once
+  const double len = s0.units.length_unit, L0 = static_cast<double>(s0.units.L[0]) * len, gap = 40.0;
+  std::vector<double> xf, vf;
+  for (int copy = 0; copy < 2; ++copy)
+    for (std::size_t p = 0; p < n; ++p)
+      for (std::size_t k = 0; k < D; ++k) {
+        xf.push_back(static_cast<double>(s0.x[p][k]) * len + (k == 0 && copy == 1 ? L0 + gap : 0.0));
+        vf.push_back(static_cast<double>(s0.v[p][k]) * len / s0.units.tick);
+      }
+  for (std::size_t k = 0; k < D; ++k) c.box[k] = static_cast<double>(s0.units.L[k]) * len;
+  c.box[0] = 2.0 * L0 + gap;
+  const LatticeStartN<D> s = quantize_start(c, xf, vf);
+  const UnitsN<D>& u = s.units;
+  const std::vector<VecN<D>>& x = s.x;
+  const std::vector<VecN<D>>& v = s.v;
+  // a typical particle moves 2 sigma by then (2^tick_bits ticks per sigma); the 40 sigma gap is
+  // not crossed (if it were, the states below would differ and the test fail, not pass)
+  const std::int64_t T = std::int64_t{2} << u.tick_bits;
+  auto run = [&](bool a_moves, bool b_moves) {
+    std::vector<VecN<D>> w = v;
+    for (std::size_t p = 0; p < 2 * n; ++p)
+      if ((p < n && !a_moves) || (p >= n && !b_moves)) w[p] = VecN<D>{};
+    EngineOf<D> e(u, x, w, seed, operator_for(u));
+    e.run(~std::uint64_t{0}, T);
+    return e.snapshot();
+  };
+  const SnapshotN<D> ab = run(true, true), a = run(true, false), b = run(false, true);
+  auto same_particles = [&](const SnapshotN<D>& one, std::size_t lo, std::size_t hi) {
+    bool ok = true;
+    for (std::size_t p = lo; p < hi; ++p) {
+      const bool same = ab.x[p] == one.x[p] && ab.v[p] == one.v[p] && ab.streams[p] == one.streams[p] && ab.bits[p] == one.bits[p] &&
+                        ab.particle_collisions[p] == one.particle_collisions[p];
+      if (!same && ok)
+        std::printf("    particle %zu differs: x %d v %d streams %d bits %d count %d\n", p, ab.x[p] == one.x[p], ab.v[p] == one.v[p],
+                    ab.streams[p] == one.streams[p], ab.bits[p] == one.bits[p], ab.particle_collisions[p] == one.particle_collisions[p]);
+      ok = ok && same;
+    }
+    std::vector<LogEntry> mine, theirs;
+    for (const LogEntry& l : ab.log)
+      if (l.particle >= lo && l.particle < hi) mine.push_back(l);
+    for (const LogEntry& l : one.log)
+      if (l.particle >= lo && l.particle < hi) theirs.push_back(l);
+    if (!(mine == theirs))
+      for (const auto* L : {&mine, &theirs})
+        for (const LogEntry& l : *L) std::printf("    log (%u, %llu) %u\n", l.particle, static_cast<unsigned long long>(l.count), l.redraws);
+    return ok && mine == theirs;
+  };
+  std::printf("  %zuD, 2 x %zu at %.2f, %lld ticks: %llu collisions together, %llu + %llu apart; log %zu = %zu + %zu\n", D, n, phi,
+              static_cast<long long>(T), static_cast<unsigned long long>(ab.collisions), static_cast<unsigned long long>(a.collisions),
+              static_cast<unsigned long long>(b.collisions), ab.log.size(), a.log.size(), b.log.size());
+  CHECK(a.collisions > 4 * n && b.collisions > 4 * n);
+  CHECK(ab.collisions == a.collisions + b.collisions);
+  CHECK(same_particles(a, 0, n));
+  CHECK(same_particles(b, n, 2 * n));
+}
+
+TEST_CASE("a region's state does not depend on what happens elsewhere: two far gases together equal each alone") {
+  check_cut<2>(300, 0.6, 21);
+  check_cut<3>(300, 0.4, 22);
 }
 
 int main() { return check::run_all(); }
