@@ -159,17 +159,6 @@ template <class T, std::size_t K>
 void put(py::dict& d, const char* key, const std::array<T, K>& a) { d[key] = flat_array(a.data(), K); }
 void put(py::dict& d, const char* key, const std::vector<std::uint64_t>& v) { d[key] = flat_array(v.data(), v.size()); }
 void put(py::dict& d, const char* key, const std::vector<double>& v) { d[key] = flat_array(v.data(), v.size()); }
-// the particles' bits-back integers as two arrays: bits (every particle's words, low first,
-// particle after particle) and bits_size (words per particle)
-void put(py::dict& d, const char*, const std::vector<std::vector<std::uint64_t>>& bits) {
-  std::vector<std::uint64_t> w, n;
-  for (const auto& x : bits) {
-    n.push_back(x.size());
-    w.insert(w.end(), x.begin(), x.end());
-  }
-  d["bits"] = flat_array(w.data(), w.size());
-  d["bits_size"] = flat_array(n.data(), n.size());
-}
 // the rare log as three arrays: log_particle (the drawer), log_count (its collision count
 // after the collision) and log_redraws
 void put(py::dict& d, const char*, const std::vector<la::LogEntry>& log) {
@@ -242,17 +231,6 @@ void take(const py::dict& d, const char* key, std::array<T, K>& a) {
            std::to_string(v.size());
   });
   for (std::size_t k = 0; k < K; ++k) a[k] = v[k];
-}
-void take(const py::dict& d, const char*, std::vector<std::vector<std::uint64_t>>& bits) {
-  const auto w = get_flat<std::uint64_t>(d, "bits");
-  const auto n = get_flat<std::uint64_t>(d, "bits_size");
-  std::size_t at = 0;
-  for (std::uint64_t k : n) {
-    require(k <= w.size() - at, "lattice checkpoint: bits is shorter than bits_size says");
-    bits.emplace_back(w.begin() + static_cast<std::ptrdiff_t>(at), w.begin() + static_cast<std::ptrdiff_t>(at + k));
-    at += static_cast<std::size_t>(k);
-  }
-  require(at == w.size(), "lattice checkpoint: bits is longer than bits_size says");
 }
 void take(const py::dict& d, const char*, std::vector<la::LogEntry>& log) {
   const auto lp = get_flat<std::uint64_t>(d, "log_particle");
@@ -536,10 +514,15 @@ void register_lattice(py::module_& m) {
       [](PyInt n_arg, PyInt seed_arg) {
         const auto n = to_int<std::uint64_t>(n_arg, "n", 0, 0x7FFFFFFFull);
         const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
-        std::vector<std::vector<std::uint64_t>> bits;
-        for (std::uint64_t p = 0; p < n; ++p) bits.push_back(la::initial_bits(static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(seed)));
+        std::vector<std::uint64_t> bits, size;
+        for (std::uint64_t p = 0; p < n; ++p) {
+          const auto w = la::initial_bits(static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(seed));
+          bits.insert(bits.end(), w.begin(), w.end());
+          size.push_back(w.size());
+        }
         py::dict d;
         put(d, "bits", bits);
+        put(d, "bits_size", size);
         return d;
       },
       py::arg("n"), py::arg("seed"),

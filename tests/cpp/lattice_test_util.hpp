@@ -54,9 +54,10 @@ inline revcol::lattice::BitsBack random_bits(std::mt19937_64& rng, int bits) {
 }
 
 /// The bit lengths of a snapshot's per-particle X, summed.
-inline std::size_t total_bits(const std::vector<std::vector<std::uint64_t>>& bits) {
+template <class Snapshot>
+std::size_t total_bits(const Snapshot& s) {
   std::size_t b = 0;
-  for (const auto& w : bits) b += revcol::lattice::BitsBack(w).bit_length();
+  for (const auto& w : bits_per_particle(s)) b += revcol::lattice::BitsBack(w).bit_length();  // (by ADL: lattice/state.hpp)
   return b;
 }
 

@@ -105,7 +105,7 @@ void round_trip(E& e, std::uint64_t collisions, const char* what) {
   std::printf(", energy drift %.2e", (E1 - E0) / E0);
   std::printf(", log %llu, multi-body %llu, wall-body %llu, X %zu -> %zu bits\n",
               static_cast<unsigned long long>(c.log_entries), static_cast<unsigned long long>(c.multi_body),
-              static_cast<unsigned long long>(c.wall_body), lattice_test::total_bits(s0.bits), lattice_test::total_bits(s1.bits));
+              static_cast<unsigned long long>(c.wall_body), lattice_test::total_bits(s0), lattice_test::total_bits(s1));
 }
 
 }  // namespace

@@ -253,8 +253,8 @@ TEST_CASE("3D engine: N = 64..1000, volume fractions 0.1, 0.3, 0.45, periodic an
     std::snprintf(what, sizeof what, "N=%zu phi=%.2f %s", c.n, c.phi,
                   c.wall == per ? "periodic" : c.wall == walls ? "walls" : "walls in z");
     print_counters(what, e, c.collisions);
-    std::printf("    X %zu -> %zu bits, dE/E %.2e, log held %zu (groups %zu), S = %d, T = %d\n", lattice_test::total_bits(s0.bits),
-                lattice_test::total_bits(s1.bits), dE, e.log_size(), e.group_log_size(), s0.units.S, s0.units.tick_bits);
+    std::printf("    X %zu -> %zu bits, dE/E %.2e, log held %zu (groups %zu), S = %d, T = %d\n", lattice_test::total_bits(s0),
+                lattice_test::total_bits(s1), dE, e.log_size(), e.group_log_size(), s0.units.S, s0.units.tick_bits);
     CHECK(e.log_size() == e.counters().log_entries);
     if (c.wall != per) CHECK(e.counters().walls > 0);
     // back to the midpoint: the forward run's snapshot there, bit for bit

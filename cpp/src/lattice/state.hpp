@@ -20,7 +20,12 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::check_log(const Snapshot& s) const {
   const std::size_t n = s.x.size();
   require(s.particle_collisions.size() == n, "lattice snapshot: particle_collisions must hold one count per particle");
-  require(s.bits.size() == n, "lattice snapshot: bits must hold one bits-back integer per particle");
+  require(s.bits_size.size() == n, "lattice snapshot: bits_size must hold one bits-back integer's size per particle");
+  {
+    u128 words = 0;
+    for (std::uint64_t k : s.bits_size) words += k;
+    require(words == s.bits.size(), "lattice snapshot: bits must hold the words bits_size says, no more, no fewer");
+  }
   std::map<LogKey, int> seen;  // 0 a redraw entry, 1 a group member
   auto key_ok = [&](std::size_t p, std::uint64_t c) { return p < n && c >= 1 && c <= s.particle_collisions[p]; };
   for (std::size_t k = 0; k < s.log.size(); ++k) {
@@ -106,8 +111,12 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   s.v = velocities();
   s.streams = ctr_;
   s.particle_collisions = pc_;
-  s.bits.resize(X_.size());
-  for (std::size_t p = 0; p < X_.size(); ++p) s.bits[p] = X_[p].words();
+  s.bits_size.resize(X_.size());
+  for (std::size_t p = 0; p < X_.size(); ++p) {
+    const auto w = X_[p].words();
+    s.bits.insert(s.bits.end(), w.begin(), w.end());
+    s.bits_size[p] = w.size();
+  }
   for (const auto& [k, r] : log_) s.log.push_back(LogEntry{k.first, k.second, r});
   for (const auto& [k, g] : groups_)  // each group once, under its drawer's key
     if (k.first == static_cast<std::uint32_t>(g->drawer)) s.groups.push_back(GroupEntry{g->drawer, g->draws, g->members, g->counts, g->pre_v});
@@ -132,7 +141,11 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s) {
   pc_ = s.particle_collisions;
   X_.clear();
   X_.reserve(n);
-  for (const auto& w : s.bits) X_.emplace_back(w);
+  std::size_t at = 0;
+  for (std::uint64_t k : s.bits_size) {
+    X_.emplace_back(std::vector<std::uint64_t>(s.bits.begin() + static_cast<std::ptrdiff_t>(at), s.bits.begin() + static_cast<std::ptrdiff_t>(at + k)));
+    at += static_cast<std::size_t>(k);
+  }
   log_.clear();
   for (const LogEntry& e : s.log) log_.emplace(LogKey{e.particle, e.count}, e.redraws);
   groups_.clear();

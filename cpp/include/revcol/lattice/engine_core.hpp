@@ -140,8 +140,11 @@ class BasicEngine {
     s.v = std::move(v);
     s.streams.assign(s.x.size(), 0);
     s.particle_collisions.assign(s.x.size(), 0);
-    s.bits.resize(s.x.size());
-    for (std::size_t p = 0; p < s.x.size(); ++p) s.bits[p] = initial_bits(static_cast<std::uint32_t>(p), seed);
+    for (std::size_t p = 0; p < s.x.size(); ++p) {
+      const auto w = initial_bits(static_cast<std::uint32_t>(p), seed);
+      s.bits.insert(s.bits.end(), w.begin(), w.end());
+      s.bits_size.push_back(w.size());
+    }
     const u128 e = kinetic2(s.v);
     s.energy0 = {static_cast<std::uint64_t>(e), static_cast<std::uint64_t>(e >> 64)};
     const auto p = momentum_of(s.v);

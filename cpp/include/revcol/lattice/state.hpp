@@ -112,7 +112,8 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
   std::vector<VecN<D>> v;                      ///< velocities
   std::vector<std::uint64_t> streams;          ///< per-particle Philox counters
   std::vector<std::uint64_t> particle_collisions;  ///< per particle: its collisions since the start
-  std::vector<std::vector<std::uint64_t>> bits;  ///< per particle: its bits-back integer X, 64-bit words, low first
+  std::vector<std::uint64_t> bits;             ///< every particle's bits-back integer X in turn, 64-bit words, low first
+  std::vector<std::uint64_t> bits_size;        ///< per particle: the words of its X in `bits`
   std::vector<LogEntry> log;                   ///< rare log, by (particle, count) ascending
   std::vector<GroupEntryN<D>> groups;          ///< group collisions, by (drawer, its count) ascending
   std::array<std::uint64_t, 2> energy0{};      ///< initial sum |v|^2 (128 bits: low, high word)
@@ -137,6 +138,7 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
     f("streams", s.streams);
     f("particle_collisions", s.particle_collisions);
     f("bits", s.bits);
+    f("bits_size", s.bits_size);
     f("log", s.log);
     f("groups", s.groups);
     f("energy0", s.energy0);
@@ -158,9 +160,21 @@ bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
          u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
          a.law == b.law && a.mode == b.mode && a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.particle_collisions == b.particle_collisions &&
-         a.bits == b.bits && a.log == b.log &&
+         a.bits == b.bits && a.bits_size == b.bits_size && a.log == b.log &&
          a.groups == b.groups &&
          a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
+}
+
+/// Particle by particle, the words of each X in a snapshot (bits split by bits_size).
+template <std::size_t D>
+std::vector<std::vector<std::uint64_t>> bits_per_particle(const SnapshotN<D>& s) {
+  std::vector<std::vector<std::uint64_t>> out;
+  std::size_t at = 0;
+  for (std::uint64_t k : s.bits_size) {
+    out.emplace_back(s.bits.begin() + static_cast<std::ptrdiff_t>(at), s.bits.begin() + static_cast<std::ptrdiff_t>(at + k));
+    at += static_cast<std::size_t>(k);
+  }
+  return out;
 }
 
 /// -a, per component.
