@@ -104,7 +104,7 @@ template <class Op, class Bits, class Queue>
 bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, bool fallback) {
   const Vec pre_a[2] = {pos(i, a), pos(j, a)};
   bool multi = false;
-  const std::uint64_t ctr0 = ctr_[i];
+  const std::uint64_t ctr0 = own_[i].ctr;
   std::array<std::uint64_t, 8> reasons{};
   // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
   // values stay within a few sigma of 0 whatever the box
@@ -114,8 +114,8 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   std::uint32_t redraws = 0;
   for (;;) {
     if (static_cast<std::int64_t>(redraws) > max_redraws) return group_collide(i, j, a, ctr0, reasons, !fallback);
-    const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i]++);
-    const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, X_[i], xi2, xj2, vi2, vj2, out);
+    const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, own_[i].ctr++);
+    const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi2, xj2, vi2, vj2, out);
     int why = static_cast<int>(rf);
     if (why == 0) {
       xi2 = shifted(xj, xi2);
@@ -129,15 +129,15 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   }
   if (multi) ++cnt_.multi_body;
   if (redraws > 0 || fallback) [[unlikely]] {
-    const LogKey key{static_cast<std::uint32_t>(i), pc_[i] + 1};
+    const LogKey key{static_cast<std::uint32_t>(i), own_[i].pc + 1};
     log_.emplace(key, redraws);
     if (!undo_epoch_.empty()) undo_log_.push_back(key);
     ++cnt_.log_entries;
   }
   if (fallback) ++cnt_.drawn_fallbacks;
-  X_[i] = std::move(out);
-  ++pc_[i];
-  ++pc_[j];
+  own_[i].X = std::move(out);
+  ++own_[i].pc;
+  ++own_[j].pc;
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, i, j});
   if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
@@ -148,7 +148,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   // i's last collision (forward) is the one undone here: its key is (i, i's count)
-  const LogKey key{static_cast<std::uint32_t>(i), pc_[i]};
+  const LogKey key{static_cast<std::uint32_t>(i), own_[i].pc};
   if (!groups_.empty()) [[unlikely]] {
     if (const auto it = groups_.find(key); it != groups_.end()) {
       const std::shared_ptr<Group> g = it->second;  // (group_back erases its keys)
@@ -163,17 +163,17 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   }
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
   const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
-  if (ctr_[i] < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
-  const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, ctr_[i] - 1);
+  if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+  const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, own_[i].ctr - 1);
   Vec xi0, xj0, vi0, vj0;
-  if (pc_[i] == 0 || pc_[j] == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
-  op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, X_[i], xi0, xj0, vi0, vj0);
+  if (own_[i].pc == 0 || own_[j].pc == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
+  op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi0, xj0, vi0, vj0);
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
-  ctr_[i] -= 1 + redraws;
+  own_[i].ctr -= 1 + redraws;
   if (logged != log_.end()) log_.erase(logged);
-  --pc_[i];
-  --pc_[j];
+  --own_[i].pc;
+  --own_[j].pc;
   --ncoll_;
   apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
 }
@@ -206,16 +206,16 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
     ++reasons[std::min(why, 7)];
     ++cnt_.redraws[std::min(why, 7)];
     if (why == redraw_outside) {
-      if (!collide_drawn(i, j, a, true)) group_collide(i, j, a, ctr_[i], reasons, true);
-    } else if (!group_collide(i, j, a, ctr_[i], reasons, false)) {
-      collide_drawn(i, j, a, true) || group_collide(i, j, a, ctr_[i], reasons, true);
+      if (!collide_drawn(i, j, a, true)) group_collide(i, j, a, own_[i].ctr, reasons, true);
+    } else if (!group_collide(i, j, a, own_[i].ctr, reasons, false)) {
+      collide_drawn(i, j, a, true) || group_collide(i, j, a, own_[i].ctr, reasons, true);
     }
     return;
   }
   if (multi) ++cnt_.multi_body;
   if (tr.backscatter) ++cnt_.backscatters;
-  ++pc_[i];
-  ++pc_[j];
+  ++own_[i].pc;
+  ++own_[j].pc;
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, i, j});
   if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
@@ -229,11 +229,11 @@ void BasicEngine<Op, Bits, Queue>::back_specular(int i, int j, std::int64_t a) {
   Vec xi0, xj0, vi0, vj0;
   if (spec_.pair_unmap(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi0, xj0, vi0, vj0) != Refusal::none)
     throw std::logic_error("lattice engine: the specular map refused a post state it wrote (a bug)");
-  if (pc_[i] == 0 || pc_[j] == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
+  if (own_[i].pc == 0 || own_[j].pc == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
-  --pc_[i];
-  --pc_[j];
+  --own_[i].pc;
+  --own_[j].pc;
   --ncoll_;
   apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
 }

@@ -198,7 +198,7 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
     ok = group_post(g, a, false, post, vel);
   }
   if (!ok) {
-    ctr_[i] = ctr0;  // nothing changed
+    own_[i].ctr = ctr0;  // nothing changed
     ln_[i] = keep[0];
     ln_[j] = keep[1];
     if (!must) return false;
@@ -217,8 +217,8 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
     for (int q : g) pre_v.push_back(ln_[q].v);
   ++ncoll_;
   std::vector<std::uint64_t> counts;
-  for (int q : g) counts.push_back(++pc_[q]);
-  auto entry = std::make_shared<Group>(Group{i, static_cast<std::uint32_t>(ctr_[i] - ctr0), g, counts, std::move(pre_v)});
+  for (int q : g) counts.push_back(++own_[q].pc);
+  auto entry = std::make_shared<Group>(Group{i, static_cast<std::uint32_t>(own_[i].ctr - ctr0), g, counts, std::move(pre_v)});
   for (std::size_t m = 0; m < g.size(); ++m) {
     const LogKey key{static_cast<std::uint32_t>(g[m]), counts[m]};
     groups_.emplace(key, entry);
@@ -252,10 +252,10 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Grou
     throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
   }
   for (std::size_t m = 0; m < g.size(); ++m)
-    if (pc_[g[m]] != entry.counts[m]) throw std::logic_error("lattice engine: the reverse met a group before a member's later collision (a bug)");
+    if (own_[g[m]].pc != entry.counts[m]) throw std::logic_error("lattice engine: the reverse met a group before a member's later collision (a bug)");
   const std::uint32_t draws = entry.draws;
   const int drawer = entry.drawer;
-  if (ctr_[drawer] < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+  if (own_[drawer].ctr < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
   const std::vector<Vec> pre_v = entry.pre_v;  // forward frame; empty: a bounce (a copy: popped below)
   std::vector<Vec> pre(g.size());
   for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
@@ -266,10 +266,10 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Grou
     sync(g[m]);
     ++slot_[static_cast<std::size_t>(g[m])].ver;
   }
-  ctr_[drawer] -= draws;
+  own_[drawer].ctr -= draws;
   for (int q : g) {
-    groups_.erase(LogKey{static_cast<std::uint32_t>(q), pc_[q]});  // entry is gone after the last
-    --pc_[q];
+    groups_.erase(LogKey{static_cast<std::uint32_t>(q), own_[q].pc});  // entry is gone after the last
+    --own_[q].pc;
   }
   --ngroups_;
   --ncoll_;

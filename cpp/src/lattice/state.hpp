@@ -109,11 +109,13 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   s.collisions = ncoll_;
   s.x = positions();
   s.v = velocities();
-  s.streams = ctr_;
-  s.particle_collisions = pc_;
-  s.bits_size.resize(X_.size());
-  for (std::size_t p = 0; p < X_.size(); ++p) {
-    const auto w = X_[p].words();
+  s.streams.resize(own_.size());
+  s.particle_collisions.resize(own_.size());
+  s.bits_size.resize(own_.size());
+  for (std::size_t p = 0; p < own_.size(); ++p) {
+    s.streams[p] = own_[p].ctr;
+    s.particle_collisions[p] = own_[p].pc;
+    const auto w = own_[p].X.words();
     s.bits.insert(s.bits.end(), w.begin(), w.end());
     s.bits_size[p] = w.size();
   }
@@ -137,14 +139,14 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s) {
   ln_.resize(n);
   for (std::size_t p = 0; p < n; ++p) ln_[p] = Line{s.x[p], s.v[p], s.clock};
   slot_.assign(n, Slot{});
-  ctr_ = s.streams;
-  pc_ = s.particle_collisions;
-  X_.clear();
-  X_.reserve(n);
+  own_.assign(n, Own{});
   std::size_t at = 0;
-  for (std::uint64_t k : s.bits_size) {
-    X_.emplace_back(std::vector<std::uint64_t>(s.bits.begin() + static_cast<std::ptrdiff_t>(at), s.bits.begin() + static_cast<std::ptrdiff_t>(at + k)));
-    at += static_cast<std::size_t>(k);
+  for (std::size_t p = 0; p < n; ++p) {
+    const auto k = static_cast<std::size_t>(s.bits_size[p]);
+    own_[p].X = Bits(std::vector<std::uint64_t>(s.bits.begin() + static_cast<std::ptrdiff_t>(at), s.bits.begin() + static_cast<std::ptrdiff_t>(at + k)));
+    own_[p].ctr = s.streams[p];
+    own_[p].pc = s.particle_collisions[p];
+    at += k;
   }
   log_.clear();
   for (const LogEntry& e : s.log) log_.emplace(LogKey{e.particle, e.count}, e.redraws);
@@ -256,9 +258,9 @@ void BasicEngine<Op, Bits, Queue>::undo() {
   for (const Saved& sv : undo_) {
     ln_[sv.p] = sv.line;
     pre_wall_[sv.p] = sv.pre_wall;
-    ctr_[sv.p] = sv.ctr;
-    pc_[sv.p] = sv.pc;
-    X_[sv.p] = sv.X;
+    own_[sv.p].X = sv.X;
+    own_[sv.p].ctr = sv.ctr;
+    own_[sv.p].pc = sv.pc;
     wall_tick_[sv.p] = sv.wall_tick;
     ++slot_[static_cast<std::size_t>(sv.p)].ver;
   }
@@ -303,8 +305,8 @@ template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::memory_bytes() const noexcept -> std::size_t {
   const std::size_t n = ln_.size();
   std::size_t heap = 0;
-  for (const Bits& x : X_) heap += x.heap_bytes();
-  return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + 8 + sizeof(Vec) * 2 + 8 + sizeof(Bits) + 8) + heap + queue_.memory_bytes() +
+  for (const Own& o : own_) heap += o.X.heap_bytes();
+  return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + sizeof(Vec) * 2 + 8 + sizeof(Own)) + heap + queue_.memory_bytes() +
          grid_.memory_bytes() + nl_.memory_bytes() + log_.size() * (48 + sizeof(LogKey) + 8) + group_bytes() +
          undo_.capacity() * sizeof(Saved) + undo_epoch_.capacity() * sizeof(std::uint32_t);
 }

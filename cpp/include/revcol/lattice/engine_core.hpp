@@ -204,15 +204,15 @@ class BasicEngine {
   std::int64_t clock() const noexcept { return clock_; }                ///< the current tick
   std::int64_t origin() const noexcept { return origin_; }              ///< the initial tick
   std::uint64_t collisions() const noexcept { return ncoll_; }          ///< collisions since the start
-  const Bits& bits(int p) const { return X_.at(static_cast<std::size_t>(p)); }  ///< particle p's bits-back integer
+  const Bits& bits(int p) const { return own_.at(static_cast<std::size_t>(p)).X; }  ///< particle p's bits-back integer
   /// The bit lengths of every particle's X, summed.
   std::size_t bits_length() const noexcept {
     std::size_t b = 0;
-    for (const Bits& x : X_) b += x.bit_length();
+    for (const Own& o : own_) b += o.X.bit_length();
     return b;
   }
   /// Particle p's collisions since the start (pairs and groups it took part in, net of reverses).
-  std::uint64_t particle_collisions(int p) const { return pc_.at(static_cast<std::size_t>(p)); }
+  std::uint64_t particle_collisions(int p) const { return own_.at(static_cast<std::size_t>(p)).pc; }
   const Counters& counters() const noexcept { return cnt_; }            ///< statistics
   /// Rare-log entries held: the collisions that redrew (or were drawn in specular mode) and the groups.
   std::size_t log_size() const noexcept { return log_.size() + ngroups_; }
@@ -220,7 +220,12 @@ class BasicEngine {
   const Units& units() const noexcept { return u_; }                    ///< units and box
   std::size_t size() const noexcept { return ln_.size(); }               ///< N
   std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
-  const std::vector<std::uint64_t>& streams() const noexcept { return ctr_; }  ///< stream counters
+  /// The stream counters.
+  std::vector<std::uint64_t> streams() const {
+    std::vector<std::uint64_t> c;
+    for (const Own& o : own_) c.push_back(o.ctr);
+    return c;
+  }
   const Op& op() const noexcept { return op_; }                         ///< the pair operator
   /// The operator's post-direction law (an operator without one, a test's, counts as flux).
   Law law() const noexcept {
@@ -457,12 +462,21 @@ class BasicEngine {
   std::vector<std::int64_t> wall_tick_;
   std::vector<Line> pre_wall_;  // a particle's line before its reflection at wall_tick_ (that tick only)
   // ---- the forward run's undo journal (run(): an engine error restores the state) ----
-  struct Saved {
+  // one particle's own draws and count: its stream counter, bits-back integer and collision
+  // count, together in one cache line (a collision of i < j reads i's whole record and j's
+  // count; apart they were four lines: docs/lattice.md "The bits-back integers")
+  struct alignas(64) Own {
+    Bits X;                 // the bits-back integer (the drawer's runs the operator)
+    std::uint64_t ctr = 0;  // the Philox stream counter
+    std::uint64_t pc = 0;   // collisions (the rare log's keys)
+  };
+  std::vector<Own> own_;
+  struct Saved {  // (Own's fields, not its 64-byte alignment: the journal may hold every particle)
     int p;
     Line line, pre_wall;
-    std::uint64_t ctr, pc;
     std::int64_t wall_tick;
     Bits X;
+    std::uint64_t ctr, pc;
   };
   std::vector<Saved> undo_;
   std::vector<std::uint32_t> undo_epoch_;  // per particle: the run() that journaled it
@@ -476,10 +490,9 @@ class BasicEngine {
   void journal(int p) {
     if (undo_epoch_.empty() || undo_epoch_[p] == epoch_) return;
     undo_epoch_[p] = epoch_;
-    undo_.push_back(Saved{p, ln_[p], pre_wall_[p], ctr_[p], pc_[p], wall_tick_[p], X_[p]});
+    undo_.push_back(Saved{p, ln_[p], pre_wall_[p], wall_tick_[p], own_[p].X, own_[p].ctr, own_[p].pc});
   }
   void undo();
-  std::vector<std::uint64_t> ctr_;
   // one particle's event bookkeeping, together in memory (the loop reads it per event, and the
   // partner's version): its version (bumped at every change of its line), its scheduled event's
   // type and partner, and the versions both had when it was scheduled (stale if either moved on)
@@ -489,8 +502,6 @@ class BasicEngine {
     Type type = none;
   };
   std::vector<Slot> slot_;
-  std::vector<Bits> X_;            // per particle: the bits-back integer (the drawer's runs the operator)
-  std::vector<std::uint64_t> pc_;  // per particle: its collisions (the rare log's keys)
   // the rare log: (drawer, its count after the collision) -> redraws, for the collisions that
   // redrew (and, specular mode, the drawn fallbacks)
   std::map<LogKey, std::uint32_t> log_;
