@@ -409,6 +409,7 @@ def equilibrium_gas(n: int, phi: float, seed: int, relax: float, gap: float, sna
     speeds = []
     for _ in range(snapshots):
         lat.run(collisions=int(gap * per))
+        flt.run(collisions=int(gap * per))  # the same age at the batches: a walled gas is still relaxing
         speeds.append(np.linalg.norm(lat.velocities, axis=1))
     lat_run = lambda collisions=None, time=None: lat.run(collisions=collisions, time=time)["collisions"]
     flt_run = lambda collisions=None, time=None: int(flt.run(collisions=collisions, time=time)["collisions"])
