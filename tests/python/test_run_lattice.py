@@ -72,7 +72,7 @@ def test_lattice_scenes_reduced_bit_for_bit(path, tmp_path, capsys):
     assert cli_main(["run", str(p), "--no-progress"]) == 0
     text = capsys.readouterr().out
     for needle in ("restored         bit for bit: positions yes, velocities yes, RNG counters yes, "
-                   "bits-back integer yes, clock yes", "bits-back X ", "rare log ", "redraws ", "multi-body ",
+                   "bits-back integers yes, clock yes", "bits-back X ", "rare log ", "redraws ", "multi-body ",
                    "energy drift ", "momentum drift ", "quantized once", "collisions/s", "peak RSS",
                    "result           PASSED: restored bit for bit"):
         assert needle in text, needle

@@ -82,7 +82,7 @@ def _n(count: int, one: str, many: str | None = None) -> str:
 
 
 _PARTS = {"positions": "positions", "velocities": "velocities", "rng_counters": "RNG counters",
-          "bits_back": "bits-back integer", "clock": "clock", "collision_count": "collision count",
+          "bits_back": "bits-back integers", "clock": "clock", "collision_count": "collision counts",
           "rare_log": "rare log"}
 
 
