@@ -19,7 +19,6 @@ import datetime as dt
 import math
 import os
 import sys
-import tempfile
 import time as _time
 from pathlib import Path
 from typing import Any, Callable
@@ -27,6 +26,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import _core, plots
+from ._outputs import Input, Output, check_outputs
 from .engine import Simulation
 from .lattice_gas import _LatticeRun, build_lattice
 from .progress import Bar, Interrupt, peak_rss
@@ -364,20 +364,8 @@ def check_memory(scene: Scene) -> None:
 
 def check_output(source: str, what: str, path, folder: bool) -> None:
     """Raises SceneError naming ``what`` unless ``path`` can be written: not the scene file, not a
-    folder where a file goes (or the reverse), its folder creatable and writable (tried)."""
-    if path is None:
-        return
-    p = Path(path).resolve()
-    if source and Path(source).is_file() and p == Path(source).resolve():
-        raise SceneError(f"{source}: {what}: {p} is the scene file itself")
-    if folder and p.exists() and not p.is_dir():
-        raise SceneError(f"{source}: {what}: {p} exists and is not a folder")
-    if not folder and p.is_dir():
-        raise SceneError(f"{source}: {what}: {p} is a folder, not a file")
-    parent = p if folder else p.parent
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=parent):
-            pass
-    except OSError as e:
-        raise SceneError(f"{source}: {what}: cannot write into {parent} ({e.strerror or e})") from None
+    folder where a file goes (or the reverse), its folder creatable and writable (tried). One
+    output alone; a run checks all of its outputs against all of its inputs at once
+    (:func:`revcol._outputs.check_outputs`, which this calls)."""
+    inputs = [Input("the scene file itself", source)] if source and Path(source).is_file() else []
+    check_outputs(source, [Output(what, path, folder)], inputs)

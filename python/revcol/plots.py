@@ -27,11 +27,25 @@ from ._io import save_figure
 from .roundtrip import BAR
 from .scene import SceneError
 
-__all__ = ["FORMATS", "require_matplotlib", "check_format", "plot_gas", "plot_lattice_gas", "plot_horizon"]
+__all__ = ["FORMATS", "FIGURES", "figure_names", "require_matplotlib", "check_format", "plot_gas",
+           "plot_lattice_gas", "plot_horizon"]
 
 #: the file formats of the figures (``--plot-format``)
 FORMATS = ("png", "pdf", "svg")
 _EPS = float(np.finfo(float).eps)
+
+#: the figures each run writes into its plot folder, by name (the format is the suffix): the float
+#: engine's gas (plot_gas), the lattice's (plot_lattice_gas), the horizon (plot_horizon) and a
+#: statesave scene's (revcol.studies.paper_scenes); what a run's outputs are checked against its
+#: inputs with (revcol._outputs; tests/python/test_output_guard.py holds them to what is written)
+FIGURES = {"gas": ("roundtrip_error", "energy_drift", "snapshots"),
+           "lattice": ("energy_drift", "bits_back", "snapshots"),
+           "horizon": ("horizon",), "statesave": ("statesave",)}
+
+
+def figure_names(run: str, fmt: str = "png") -> frozenset[str]:
+    """The file names a run (a key of :data:`FIGURES`) writes into its plot folder."""
+    return frozenset(f"{stem}.{fmt}" for stem in FIGURES[run])
 
 
 def require_matplotlib() -> None:

@@ -15,14 +15,17 @@ keeps the numbering of the run it resumes):
 - ``checkpoints`` (a folder): ``checkpoint-<net collisions>.npz`` at every multiple of
   ``checkpoint_every`` and at the end; ``resume`` continues from one bit for bit (the run that
   resumes from checkpoint k and goes on to n collisions ends in the state of one that never
-  stopped);
+  stopped), and writes none at k itself (a run that does no collision: k is the file it resumed
+  from, never written over);
 - a scene's ``[observe]`` table (either engine): the forward run is observed and its values go in
   the report (``report["observe"]``, :mod:`revcol.observe`).
 
 Ctrl-C (SIGINT) stops the run between events (float engine) or between chunks of at most
 10^4 collisions (lattice engine); the last frame and checkpoint are written, the trajectory
 is closed, and the report says ``interrupted``. Every option is checked before anything runs;
-a bad one raises :class:`revcol.scene.SceneError` naming it.
+a bad one raises :class:`revcol.scene.SceneError` naming it, and so does an output that names an
+input (the scene, its initial state, the checkpoint resumed from) or another output
+(:mod:`revcol._outputs`).
 
     >>> r = simulate("spheres-3d", collisions=2000, progress=False)
     >>> r["collisions"], r["net_collisions"], r["interrupted"]
@@ -43,7 +46,8 @@ from .._args import integer
 from .._io import write_json
 from .._version import __version__
 from ..engine import Simulation
-from ..gas import build_simulation, check_memory, check_output
+from .._outputs import Output, check_outputs, checkpoint_names, run_inputs
+from ..gas import build_simulation, check_memory
 from ..lattice import LatticeSimulation
 from ..lattice_gas import geometry as lattice_geometry
 from ..observe import report_lines
@@ -141,8 +145,8 @@ class _Production:
     """One forward run with its outputs; ``go`` runs it, ``report`` describes it."""
 
     def __init__(self, scene: Scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
-                 species: str, precise: bool, every_time: float | None = None):
-        self.scene, self.sim = scene, sim
+                 species: str, precise: bool, every_time: float | None = None, resumed: bool = False):
+        self.scene, self.sim, self.resumed = scene, sim, resumed
         self.lattice = scene.engine == "lattice"
         self.start = self.done = _net(sim)
         self.target = None if collisions is None else self.start + int(collisions)
@@ -192,6 +196,9 @@ class _Production:
             self.last_frame = (self.done, sim.time)
 
     def checkpoint(self) -> None:
+        if self.resumed and self.done == self.start:
+            # no collision since the resumed checkpoint: its count is that file's (never written over, issue 59)
+            return
         if self.checkpoints is not None and (not self.written_ckpt or not self.written_ckpt[-1].endswith(
                 f"-{self.done:012d}.npz")):
             path = self.checkpoints / f"checkpoint-{self.done:012d}.npz"
@@ -317,19 +324,27 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
     json_path = json_path if json_path is not None else scene.json
     collisions, time, trajectory, every, checkpoints, checkpoint_every = _options(
         scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume, every_time)
-    for what, path, folder in (("--json", json_path, False), ("--trajectory", trajectory, False),
-                               ("--checkpoint", checkpoints, True)):
-        check_output(scene.source, what, path, folder)
     try:
         _species(species)
     except ValueError as e:
         raise SceneError(f"{scene.source}: --species: {e}") from None
     check_memory(scene)
-    sim = _build(scene, resume)
+    # the checkpoint resumed from is read first: its count numbers the checkpoints the run may write
+    sim = _build(scene, resume) if resume is not None else None
+    start = 0 if sim is None else _net(sim)
+    first = 0 if sim is None else start + 1  # a resumed run writes none at its start (_Production.checkpoint)
+    # no output may name an input or another output (issue 59); every one writable (issue 17)
+    names = checkpoint_names(first, None if collisions is None else start + int(collisions))
+    check_outputs(scene.source, [Output("[output] json / --json", json_path),
+                                 Output("[output] trajectory / --trajectory", trajectory),
+                                 Output("[output] checkpoints / --checkpoint", checkpoints, folder=True, match=names)],
+                  run_inputs(scene, resume))
+    if sim is None:
+        sim = _build(scene, None)
     if resume is not None and search is not None:  # the checkpoint holds its own; a new one is the same run
         sim.search = scene.search
     run = _Production(scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
-                      species, precise, every_time)
+                      species, precise, every_time, resumed=resume is not None)
     run.go(sys.stdout.isatty() if progress is None else progress)
     r = run.report(resume)
     if json_path is not None:

@@ -56,8 +56,9 @@ import os
 from pathlib import Path
 
 from .._io import write_json
-from ..gas import check_memory, check_output, run_gas
-from ..plots import check_format, plot_horizon, require_matplotlib
+from .._outputs import Output, check_outputs, checkpoint_names, run_inputs
+from ..gas import check_memory, run_gas
+from ..plots import check_format, figure_names, plot_horizon, require_matplotlib
 from ..scene import Scene, SceneError, load_scene, with_engine
 from .horizon import horizon
 from .paper_scenes import run_reversal, run_statesave
@@ -106,11 +107,9 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
         require_matplotlib()
         check_format(plot_format)
     # every output and the memory are checked before anything runs: a run must not be lost to
-    # an unwritable report at its end (issue 17)
-    for what, path, folder in (("[output] json / --json", json_path, False), ("[output] plot / --plot", plot, True),
-                               ("[output] trajectory / --trajectory", trajectory, False),
-                               ("[output] checkpoints", getattr(scene, "checkpoints", None), True)):
-        check_output(scene.source, what, path, folder)
+    # an unwritable report at its end (issue 17), nor overwrite its own inputs (issue 59)
+    outputs = _outputs(scene, json_path, plot, trajectory, horizon_seeds is not None, plot_format)
+    check_outputs(scene.source, outputs, run_inputs(scene))
     if scene.kind == "gas":
         check_memory(scene)
     if horizon_seeds is not None:
@@ -127,3 +126,17 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
         r["written"].append(str(json_path))
         write_json(r, json_path)
     return r
+
+
+def _outputs(scene: Scene, json_path, plot, trajectory, horizon: bool, plot_format: str) -> list[Output]:
+    """What a run writes: its report, its trajectory, the figures its plot folder gets, and the
+    checkpoints of a gas's forward run (``checkpoint-<n>.npz`` at every multiple n of the interval
+    up to N_c; a horizon writes none)."""
+    figures = "horizon" if horizon else ("lattice" if scene.engine == "lattice" else scene.kind)
+    ckpt = scene.kind == "gas" and not horizon and scene.checkpoint_interval > 0
+    return [Output("[output] json / --json", json_path),
+            Output("[output] plot / --plot", plot, folder=True,
+                   names=figure_names(figures, plot_format) if figures != "reversal" else frozenset()),
+            Output("[output] trajectory / --trajectory", trajectory),
+            Output("[output] checkpoints", scene.checkpoints, folder=True, names=frozenset(),
+                   match=checkpoint_names(1, scene.collisions, scene.checkpoint_interval) if ckpt else None)]

@@ -10,6 +10,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from .._outputs import Input, Output, refuse_collisions
+from .output import output_names
 from .spec import SCENE_PARAMS, STUDIES, Point, Sweep, SweepError, load_sweep, sweep_from_dict, sweep_names
 from .tasks import execute
 
@@ -42,6 +44,22 @@ def sweep(spec: Sweep | str | os.PathLike, *, out: str | os.PathLike | None = No
     out = Path(out) if out is not None else Path.cwd() / "out" / "sweeps" / spec.name
     if out.exists() and not out.is_dir():
         raise SweepError(f"{out}: exists and is not a folder")
+    _refuse_overwriting_inputs(spec, out)
     return execute(spec, out, workers=workers, scheduler=scheduler,
                    scheduler_file=None if scheduler_file is None else str(scheduler_file), client=client,
                    progress=progress, stop_after=stop_after, log=log or (lambda line: None), on_result=on_result)
+
+
+def _refuse_overwriting_inputs(spec: Sweep, out: Path) -> None:
+    """SweepError when the sweep would write over its sweep file, its scene or a point's initial
+    state (issue 59; the points themselves write nothing, revcol.sweep.spec)."""
+    inputs = [Input("the sweep file itself", spec.source)] if Path(spec.source).is_file() else []
+    if spec.scene_name not in ("default", "-") and Path(spec.scene_name).is_file():  # not the built-in, not none
+        inputs.append(Input("the sweep's scene file ([sweep] scene)", spec.scene_name))
+    states = {os.fspath(p.scene.initial_state) for p in spec.points if p.scene is not None and p.scene.initial_state}
+    inputs += [Input("a point's initial state file ([system] initial_state)", s) for s in sorted(states)]
+    top, points = output_names(spec)
+    refuse_collisions(spec.source, [Output("the output folder (--out)", out, folder=True, names=top),
+                                    Output("the output folder's points/", out / "points", folder=True,
+                                           names=points)],
+                      inputs, SweepError)

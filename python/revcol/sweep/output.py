@@ -22,7 +22,7 @@ from .._version import __version__
 from ..plots import _pyplot
 from ..roundtrip import BAR, combine_seeds
 
-__all__ = ["gather", "combine_horizon", "table_rows"]
+__all__ = ["gather", "combine_horizon", "table_rows", "output_names"]
 
 # report keys left out of the table: long text, or lists
 _SKIP = {"summary", "written", "error_definitions"}
@@ -189,6 +189,13 @@ def _figures(spec, out: Path, combined: list[dict]) -> list[str]:
         written.append(str(path))
     return written
 
+
+
+def output_names(spec) -> tuple[frozenset[str], frozenset[str]]:
+    """The file names a sweep writes into its folder (table, summary, figures) and into its
+    ``points`` folder (one per point): what revcol._outputs checks against the sweep's inputs."""
+    top = frozenset(f"{spec.name}{end}" for end in (".csv", ".parquet", ".json", "-error.png", "-horizon.png"))
+    return top, frozenset(point_path(Path("."), p.hash).name for p in spec.points)
 
 
 def point_path(out: Path, h: str) -> Path:
