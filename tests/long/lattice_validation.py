@@ -116,12 +116,15 @@ def _git_commit() -> str:
 
 
 def _build_info() -> dict:
-    """The module the run imports, and any uncommitted change to tracked files (the build may
+    """The module the run imports, and any uncommitted change to the tracked code (the build may
     carry a local line, e.g. module.cpp's registration of the lattice binding)."""
     from revcol import _core
     path = _core.__file__
     try:
-        diff = subprocess.run(["git", "diff", "HEAD"], cwd=HERE, capture_output=True, text=True, check=True).stdout
+        # the code that builds and runs the module, not the results and docs beside it (a results
+        # file rewritten during a run made this diff, and the child's peak RSS, grow to 100 MB)
+        diff = subprocess.run(["git", "diff", "HEAD", "--", "cpp", "python", "CMakeLists.txt", "pyproject.toml", "tests/long"],
+                              cwd=HERE, capture_output=True, text=True, check=True).stdout
     except (OSError, subprocess.CalledProcessError):
         diff = "unknown"
     return {"core": path, "core_mtime": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(os.path.getmtime(path))),
