@@ -88,3 +88,35 @@ def placement(init, stacklevel: int = 3) -> str:
                       "'lattice' names the integer engine)", DeprecationWarning, stacklevel=stacklevel)
         return "crystal"
     return init
+
+
+#: a size's suffixes: powers of 1024, as coreutils reads ``20G`` (``KiB`` ... ``TiB`` the same)
+SIZE_UNITS = {"": 1, "k": 1 << 10, "m": 1 << 20, "g": 1 << 30, "t": 1 << 40}
+
+
+def size(x, what: str) -> int:
+    """A size in bytes: an integer >= 0, or a string: a number with an optional suffix K, M, G or T
+    (powers of 1024; ``KiB``, ``MiB``, ``GiB``, ``TiB`` the same; ``20G``, ``1.5T``), or ``"none"``.
+    0 and ``"none"`` give 0, which callers read as "no limit". ValueError naming ``what`` otherwise."""
+    if isinstance(x, bool) or not isinstance(x, (int, str)):
+        raise ValueError(f"{what} must be a size in bytes (an integer, or a string such as '20G'), got {x!r}")
+    if isinstance(x, int):
+        if x < 0:
+            raise ValueError(f"{what} must be a size >= 0 bytes (0: no limit), got {x}")
+        return x
+    text = x.strip().lower()
+    if text == "none":
+        return 0
+    for unit in ("ib", "i"):  # KiB, Ki: the same as K
+        if text.endswith(unit) and text[-len(unit) - 1:-len(unit)] in "kmgt" and len(text) > len(unit) + 1:
+            text = text[:-len(unit)]
+            break
+    number, unit = (text[:-1], text[-1]) if text[-1:] in "kmgt" and text[-1:] else (text, "")
+    try:
+        v = float(number)
+    except ValueError:
+        v = math.nan
+    if not (math.isfinite(v) and v >= 0) or "_" in number:
+        raise ValueError(f"{what} must be a size: bytes, or a number with K, M, G or T (powers of 1024; e.g. "
+                         f"'20G'), or 0 or 'none' for no limit; got {x!r}")
+    return int(round(v * SIZE_UNITS[unit]))

@@ -19,7 +19,7 @@ from . import _core
 from ._version import __version__
 
 __all__ = ["write_npz_atomic", "atomic_open", "save_figure", "read_checkpoint", "STAMP_KEYS", "jsonable",
-           "write_json"]
+           "write_json", "named_os_error"]
 
 #: keys a checkpoint file carries besides the snapshot: what wrote it
 STAMP_KEYS = ("revcol_version", "revcol_build", "revcol_engine")
@@ -46,11 +46,21 @@ def _open_permissions(path: str) -> None:
     os.chmod(path, 0o666 & ~mask)
 
 
+def named_os_error(e: OSError, path: Union[str, os.PathLike], doing: str = "") -> OSError:
+    """``e`` as an OSError of its errno that names ``path`` (and what was being done): a write that
+    fails on a full disk raises ``[Errno 28] No space left on device`` naming no file (issue 59)."""
+    what = (e.strerror or str(e) or type(e).__name__) + (f" ({doing})" if doing else "")
+    if e.errno is None:
+        return OSError(f"{what}: {os.fspath(path)!r}")
+    return OSError(e.errno, what, os.fspath(path))
+
+
 @contextlib.contextmanager
 def atomic_open(path: Union[str, os.PathLike], mode: str = "w", **kwargs) -> Iterator[IO]:
     """A file to write ``path`` through: a temporary file beside it, fsynced and renamed over
     ``path`` when the block ends without an exception; removed otherwise, leaving any previous
-    file at ``path`` whole. Every output the CLI writes goes through here (issue 17)."""
+    file at ``path`` whole. Every output the CLI writes goes through here (issue 17). An OSError
+    that names no file (a write or flush on a full disk) is raised again naming ``path`` (issue 59)."""
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
@@ -64,11 +74,13 @@ def atomic_open(path: Union[str, os.PathLike], mode: str = "w", **kwargs) -> Ite
             os.fsync(f.fileno())
         os.replace(tmp, path)
         _fsync_folder(folder)
-    except BaseException:
+    except BaseException as e:
         try:
             os.unlink(tmp)
         except OSError:
             pass
+        if isinstance(e, OSError) and e.filename is None:
+            raise named_os_error(e, path, "writing it; the partial file is removed") from e
         raise
 
 

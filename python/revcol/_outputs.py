@@ -16,39 +16,62 @@ links, case-insensitive file systems). It refuses, with one line naming both rol
   for a count the run can reach, ``energy_drift.png``), not any file that lives there;
 - two outputs that name one file (or a file that a folder output would write).
 
-:func:`check_outputs` then checks that each output can be written (not a folder where a file
-goes or the reverse, its folder created and a file written there on trial).
+:func:`check_outputs` then checks the outputs' size (:func:`check_sizes`): each output may carry
+an estimate of the bytes its writer will write over the run (:class:`Size`, from
+:mod:`revcol._output_size`), and a run whose outputs come to more than the output limit
+(``--max-output`` / ``[output] max_output``, :data:`DEFAULT_MAX_OUTPUT` unless told) or more than
+the free space of the file system they go to is refused with one line naming the largest writer,
+its estimate and the limit or the free space. Last, each output must be writable (not a folder
+where a file goes or the reverse, its folder created and a file written there on trial).
 """
 from __future__ import annotations
 
 import os
 import re
+import shutil
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Sequence
 
+from ._args import size as _size
 from .scene_schema import SceneError
 
 if TYPE_CHECKING:
     from .scene import Scene
 
-__all__ = ["Output", "Input", "checkpoint_names", "run_inputs", "refuse_collisions", "check_outputs"]
+__all__ = ["Output", "Input", "Size", "checkpoint_names", "run_inputs", "refuse_collisions", "check_outputs",
+           "check_sizes", "output_limit", "human", "estimates", "DEFAULT_MAX_OUTPUT"]
+
+#: the output limit of a run unless ``--max-output`` or ``[output] max_output`` says otherwise: 10 GiB,
+#: far above what the example scenes write (kilobytes to a few megabytes) and far below a full disk
+DEFAULT_MAX_OUTPUT = 10 << 30
 
 #: the name every checkpoint writer gives its files: ``checkpoint-<net collisions, 12 digits>.npz``
 _CHECKPOINT = re.compile(r"checkpoint-(\d{12,})\.npz")
 
 
 @dataclass(frozen=True)
+class Size:
+    """The bytes an output's writer is estimated to write over the run, and how they were counted
+    (``"2,003 frames of 1,000 particles, about 105 bytes a particle"``)."""
+
+    bytes: float
+    how: str
+
+
+@dataclass(frozen=True)
 class Output:
     """One output of a run: ``what`` names it in messages (``"[output] json / --json"``); a
-    ``folder`` writes the file names in ``names``, or those ``match`` accepts (None and None: none)."""
+    ``folder`` writes the file names in ``names``, or those ``match`` accepts (None and None: none);
+    ``size``: the estimate of its bytes (None: not estimated)."""
 
     what: str
     path: str | os.PathLike | None
     folder: bool = False
     names: frozenset[str] | None = None
     match: Callable[[str], bool] | None = None
+    size: Size | None = None
 
     def writes(self, name: str) -> bool:
         """Whether this folder's writer may put a file called ``name`` in it."""
@@ -189,11 +212,84 @@ def _check_writable(source: str, o: Output, error: type[Exception]) -> None:
         raise error(f"{source}: {o.what}: cannot write into {parent} ({e.strerror or e})") from None
 
 
+def human(n: float) -> str:
+    """Bytes in binary units, three digits: ``"1.5 GiB"``, ``"91 TiB"``, ``"512 B"``."""
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if abs(n) < 1024 or unit == "PiB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.3g} {unit}"
+        n /= 1024
+    raise AssertionError
+
+
+def output_limit(source: str, given, scene_value: int | None) -> int:
+    """The output limit in bytes (0: none): ``given`` (``--max-output``: bytes, or a string such as
+    ``"20G"`` or ``"none"``), else the scene's ``[output] max_output``, else :data:`DEFAULT_MAX_OUTPUT`.
+    A bad value raises SceneError naming ``--max-output``."""
+    if given is None:
+        return DEFAULT_MAX_OUTPUT if scene_value is None else scene_value
+    try:
+        return _size(given, "--max-output")
+    except ValueError as e:
+        raise SceneError(f"{source}: {e}") from None
+
+
+def _existing(path: Path) -> Path:
+    """``path`` or its nearest folder that exists (an output's folder may not be made yet)."""
+    p = path.resolve()
+    while not p.exists() and p != p.parent:
+        p = p.parent
+    return p
+
+
+def _over(o: Output, total: float, many: bool, there: str = "") -> str:
+    """The start of a refusal: the largest writer, its estimate, and the run's total (``there``)."""
+    assert o.size is not None
+    rest = f"; the run's outputs{there} come to about {human(total)}" if many and total > o.size.bytes else ""
+    return f"{o.what} would write about {human(o.size.bytes)} ({o.size.how}){rest}"
+
+
+def check_sizes(source: str, outputs: Iterable[Output], limit: int | None = None,
+                error: type[Exception] = SceneError) -> None:
+    """Raises ``error`` (one line) when the outputs' estimated bytes, summed, exceed ``limit``
+    (None: :data:`DEFAULT_MAX_OUTPUT`; 0: no limit), or when those going to one file system exceed
+    its free space (``shutil.disk_usage`` of the output's folder, or of its nearest existing parent).
+    Creates nothing."""
+    sized = [o for o in outputs if o.path is not None and o.size is not None]
+    if not sized:
+        return
+    limit = DEFAULT_MAX_OUTPUT if limit is None else limit
+    total = sum(o.size.bytes for o in sized if o.size is not None)
+    big = max(sized, key=lambda o: o.size.bytes if o.size is not None else 0.0)
+    if limit and total > limit:
+        raise error(f"{source}: {_over(big, total, len(sized) > 1)}: more than the output limit of {human(limit)} "
+                    "(--max-output or [output] max_output: a size such as 20G, or none): refusing to start")
+    places: dict[int, tuple[Path, list[Output]]] = {}
+    for o in sized:
+        where = _existing(Path(_path(o)) if o.folder else Path(_path(o)).parent)
+        places.setdefault(os.stat(where).st_dev, (where, []))[1].append(o)
+    for where, outs in places.values():
+        need = sum(o.size.bytes for o in outs if o.size is not None)
+        free = shutil.disk_usage(where).free
+        if need > free:
+            big = max(outs, key=lambda o: o.size.bytes if o.size is not None else 0.0)
+            raise error(f"{source}: {_over(big, need, len(outs) > 1, ' on that file system')}: more than the "
+                        f"{human(free)} free on the file system of {where}: refusing to start")
+
+
+def estimates(outputs: Iterable[Output]) -> dict[str, dict[str, Any]]:
+    """The estimated sizes, for a report: ``{what: {"path", "bytes", "how"}}`` of each output with both."""
+    return {o.what: {"path": os.fspath(o.path), "bytes": int(round(o.size.bytes)), "how": o.size.how}
+            for o in outputs if o.path is not None and o.size is not None}
+
+
 def check_outputs(source: str, outputs: Iterable[Output], inputs: Sequence[Input],
-                  error: type[Exception] = SceneError) -> None:
-    """Every output of a run checked before it runs: :func:`refuse_collisions` (nothing created
-    when it refuses), then each one writable (its folder created)."""
+                  error: type[Exception] = SceneError, max_output: int | None = None) -> None:
+    """Every output of a run checked before it runs: :func:`refuse_collisions`, then the sizes
+    against ``max_output`` (None: :data:`DEFAULT_MAX_OUTPUT`; 0: no limit) and the free space
+    (:func:`check_sizes`; nothing created when either refuses), then each one writable (its
+    folder created)."""
     outs = [o for o in outputs if o.path is not None]
     refuse_collisions(source, outs, inputs, error)
+    check_sizes(source, outs, max_output, error)
     for o in outs:
         _check_writable(source, o, error)

@@ -322,11 +322,18 @@ def run_gas(scene: Scene, *, plot: str | os.PathLike | None = None,
 def round_trip(run, plot, figures: str, plot_format: str = "png") -> dict:
     """Forward, turn, back (Ctrl-C counted throughout), the report, and with ``plot`` the
     figures drawn by ``revcol.plots.<figures>``. ``run`` is a gas run (this module's, or the
-    lattice engine's in :mod:`revcol.lattice_gas`)."""
-    with Interrupt() as stop:
-        run.forward(stop)
-        run.turn()
-        run.reverse(stop, stop.presses)
+    lattice engine's in :mod:`revcol.lattice_gas`). An error that ends the run (an output that
+    cannot be written: a full disk) closes the trajectory on its way out (:meth:`close_quietly`:
+    its frames kept, or no partial file left)."""
+    try:
+        with Interrupt() as stop:
+            run.forward(stop)
+            run.turn()
+            run.reverse(stop, stop.presses)
+    except BaseException:
+        if run.writer is not None:
+            run.writer.close_quietly()
+        raise
     report = run.report()
     if plot is not None:
         sim = run.sim

@@ -86,6 +86,8 @@ file and the replacement.
     trajectory = "run.xyz"        # gas: extended XYZ (OVITO) or .gsd
     trajectory_every = 100        # gas: collisions between frames
     checkpoints = "checkpoints"   # gas: where checkpoint_interval writes (default ./NAME-checkpoints)
+    max_output = "10G"            # gas: refuse a run whose outputs are estimated to need more (K, M, G, T:
+                                  # powers of 1024; 0 or "none": no limit; default 10G; --max-output)
 
     [observe]                     # gas, either engine: observables of the forward run (revcol.observe);
                                   # the table alone observes the scalars; its values go in the report
@@ -169,6 +171,7 @@ class Scene:
     trajectory: Path | None = None
     trajectory_every: int = 100
     checkpoints: Path | None = None
+    max_output: int | None = None  # [output] max_output in bytes, 0: no limit (None: revcol._outputs' default)
     observe: dict[str, Any] | None = None  # [observe]: Simulation.observe's arguments (None: no table)
     name: str = "scene"
     description: str = ""
@@ -367,7 +370,8 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         streams=get("rng", "streams", "per_particle"), collisions=nc, time=t_end,
         checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
         json=out("json"), plot=out("plot"), trajectory=trajectory,
-        trajectory_every=get("output", "trajectory_every", 100), observe=observe, **common)
+        trajectory_every=get("output", "trajectory_every", 100), max_output=get("output", "max_output"),
+        observe=observe, **common)
     if arrays is not None:
         _check_initial(source, scene, *arrays)
     return scene

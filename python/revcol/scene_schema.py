@@ -10,6 +10,7 @@ import warnings
 from typing import Any
 
 from . import _core
+from ._args import size
 
 __all__ = ["KINDS", "ENGINES", "ENGINE_MODES", "LIMITS", "DEFAULT_SCENE", "SCHEMA", "USES", "DEPRECATED",
            "LATTICE_FIELDS", "SceneError"]
@@ -88,6 +89,7 @@ SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "trajectory": ("str", None),
         "trajectory_every": ("int", (1, None)),
         "checkpoints": ("str", None),
+        "max_output": ("size", None),  # bytes, or "20G" (K, M, G, T: powers of 1024); 0 or "none": no limit
     },
     "observe": {
         "block_time": ("float", (0.0, None)),
@@ -184,6 +186,11 @@ def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: An
         if allowed is not None and value not in allowed:
             raise _fail(source, where, f"must be one of {', '.join(map(repr, allowed))}, got {value!r}")
         return value
+    if kind == "size":  # the output limit: bytes or a string such as "20G" (revcol._outputs)
+        try:
+            return size(value, f"{where}:")
+        except ValueError as e:
+            raise SceneError(f"{source}: {e}") from None
     if kind == "search":  # "auto", "cells" or a neighbour-list shell in diameters
         if value in ("auto", "cells") or (not isinstance(value, (bool, str)) and isinstance(value, (int, float))
                                          and allowed[0] <= value <= allowed[1]):

@@ -51,6 +51,7 @@ GSD frames follow HOOMD's conventions: the box is centred on the origin (positio
 """
 from __future__ import annotations
 
+import io
 import os
 import tempfile
 import warnings
@@ -59,8 +60,10 @@ from typing import Sequence
 
 import numpy as np
 
+from ._io import named_os_error
+
 __all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS", "ELEMENTS", "net_collisions",
-           "read_gsd"]
+           "read_gsd", "frame_size"]
 
 #: suffix -> what writes it
 FORMATS = {".xyz": "extended XYZ (OVITO, ASE)", ".gsd": "GSD (HOOMD-blue; needs the gsd package)"}
@@ -96,17 +99,32 @@ def net_collisions(sim) -> int:
 
 class _Writer:
     """What both writers share: a frame of a simulation by calling the writer (so that a writer
-    can be attached to one: ``sim.attach(writer, every=1000)``), and ``close``."""
+    can be attached to one: ``sim.attach(writer, every=1000)``), ``close``, and what a failed
+    write does (issue 59): an ``OSError`` while writing or closing (a full disk: ENOSPC) removes
+    the partial file and is raised again naming the trajectory's path, so that neither a
+    ``.revcol-*.part`` file nor a file with half a frame is left behind."""
 
     path: Path
     _tmp: str
+    frames: int
+    closed: bool = False
 
     def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
+        """Appends a frame (``collisions``: the net count; ``phase``: ``"forward"`` or ``"reverse"``)."""
+        if self.closed:
+            raise ValueError(f"trajectory {str(self.path)!r} is closed")
+        try:
+            self._write(positions, velocities, time, collisions, phase)
+        except OSError as e:
+            raise self._failed(e, f"writing frame {self.frames + 1} of the trajectory") from e
+        self.frames += 1
+
+    def _write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
         raise NotImplementedError
 
     def __call__(self, sim, phase: str = "forward") -> None:
         """Writes the current state of ``sim`` as a frame (its clock and net collision count)."""
-        if getattr(self, "closed", False):
+        if self.closed:
             raise ValueError(f"trajectory {str(self.path)!r} is closed (detach it from the simulation)")
         self.write(sim.positions, sim.velocities, sim.time, net_collisions(sim), phase)
 
@@ -114,10 +132,38 @@ class _Writer:
         raise NotImplementedError
 
     def close(self) -> None:
-        """Closes the file and moves it into place; frames written so far are kept."""
-        self._close_file()
+        """Closes the file and moves it into place; frames written so far are kept. Does nothing
+        when the writer is closed already (a failed write closed it and removed its file)."""
+        if self.closed:
+            return
+        try:
+            self._close_file()
+            self.closed = True
+            _publish(self._tmp, self.path)
+        except OSError as e:
+            raise self._failed(e, f"closing the trajectory after {self.frames} frames") from e
+
+    def close_quietly(self) -> None:
+        """:meth:`close` after another error ended the run: the frames so far are kept when the
+        file can be closed; when it cannot, the partial file is removed and this second error is
+        dropped (the first one is the one to report)."""
+        try:
+            self.close()
+        except OSError:
+            pass
+
+    def _failed(self, e: OSError, doing: str) -> OSError:
+        """After ``e``: the file closed and removed, and the error naming the trajectory's path."""
         self.closed = True
-        _publish(self._tmp, self.path)
+        try:
+            self._close_file()
+        except Exception:  # noqa: BLE001 - the file is being thrown away; the first error is reported
+            pass
+        try:
+            os.unlink(self._tmp)
+        except OSError:
+            pass
+        return named_os_error(e, self.path, f"{doing}; the partial file is removed")
 
 
 class XYZWriter(_Writer):
@@ -128,28 +174,69 @@ class XYZWriter(_Writer):
         self.path = Path(path)
         self.dim = len(box)
         self.species = _species(species)
-        # 2D (and 1D, shown as 2D): a zero third vector and pbc F on z, as ASE writes a 2D cell
-        lengths = list(box) + [diameter] * max(0, 2 - len(box)) + [0.0] * (3 - max(2, len(box)))
-        pbc = [bool(p) for p in periodic] + [False] * (3 - len(box))
-        lattice = " ".join(f"{lengths[i] if i == j else 0.0:.17g}" for i in range(3) for j in range(3))
-        self._head = (f'Lattice="{lattice}" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1 '
-                      f'pbc="{" ".join("T" if p else "F" for p in pbc)}"')
+        self._head = _xyz_head(box, periodic, diameter)
         self._radius = 0.5 * diameter
         self.frames = 0
         self._tmp = _part(self.path)
-        self._f = open(self._tmp, "w")
+        self._f = _opened(self._tmp, self.path, lambda: open(self._tmp, "w"))
 
-    def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
-        x, v = _pad3(positions), _pad3(velocities)
-        n = x.shape[0]
-        rows = np.empty((n, 7))
-        rows[:, :3], rows[:, 3:6], rows[:, 6] = x, v, self._radius
-        self._f.write(f"{n}\n{self._head} Time={time:.17g} Collisions={int(collisions)} Phase=\"{phase}\"\n")
-        np.savetxt(self._f, rows, fmt=self.species + " %.12g" * 7)
-        self.frames += 1
+    def _write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
+        _xyz_frame(self._f, self._head, self.species, self._radius, positions, velocities, time, collisions, phase)
 
     def _close_file(self) -> None:
         self._f.close()
+
+
+def _xyz_head(box: Sequence[float], periodic: Sequence[bool], diameter: float) -> str:
+    """The extended XYZ header's cell and columns. 2D (and 1D, shown as 2D): a zero third vector and
+    pbc F on z, as ASE writes a 2D cell."""
+    lengths = list(box) + [diameter] * max(0, 2 - len(box)) + [0.0] * (3 - max(2, len(box)))
+    pbc = [bool(p) for p in periodic] + [False] * (3 - len(box))
+    lattice = " ".join(f"{lengths[i] if i == j else 0.0:.17g}" for i in range(3) for j in range(3))
+    return (f'Lattice="{lattice}" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1 '
+            f'pbc="{" ".join("T" if p else "F" for p in pbc)}"')
+
+
+def _xyz_frame(f, head: str, species: str, radius: float, positions, velocities, time: float, collisions: int,
+               phase: str) -> None:
+    """One extended XYZ frame written to ``f`` (the writer's format, and :func:`frame_size`'s sample)."""
+    x, v = _pad3(positions), _pad3(velocities)
+    n = x.shape[0]
+    rows = np.empty((n, 7))
+    rows[:, :3], rows[:, 3:6], rows[:, 6] = x, v, radius
+    f.write(f"{n}\n{head} Time={time:.17g} Collisions={int(collisions)} Phase=\"{phase}\"\n")
+    np.savetxt(f, rows, fmt=species + " %.12g" * 7)
+
+
+#: GSD bytes per particle of a frame after the first (gsd writes a chunk only where it differs
+#: from the first frame's): float32 positions and velocities, 3 x 4 bytes each; int32 image flags,
+#: 3 x 4, once a particle has crossed a periodic axis; float64 positions, 3 x 8, when ``precise``
+GSD_PARTICLE_BYTES = {"position": 12, "velocity": 12, "image": 12, "precise": 24}
+#: GSD bytes of a frame besides its particles: the box, step and logs, and one index entry per
+#: chunk (measured: 390 bytes with gsd 5; taken as 512)
+GSD_FRAME_BYTES = 512
+
+
+def frame_size(path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool], diameter: float,
+               positions, velocities, *, species: str = "Ar", precise: bool = False, time: float = 0.0,
+               collisions: int = 0) -> tuple[float, float]:
+    """(bytes of a frame besides its particles, bytes per particle) of a frame in the format of
+    ``path``, as its writer writes it. Extended XYZ: measured on a sample frame of these
+    ``positions`` and ``velocities`` (any number of rows) formatted by the writer's own code, so
+    the line length is that of the numbers a run prints (%.12g of each coordinate); ``time`` and
+    ``collisions`` as in the header of the frames to come. GSD: :data:`GSD_PARTICLE_BYTES` (image
+    flags counted when an axis is periodic) and :data:`GSD_FRAME_BYTES`."""
+    if Path(path).suffix.lower() == ".gsd":
+        per = GSD_PARTICLE_BYTES
+        b = per["position"] + per["velocity"] + (per["image"] if any(periodic) else 0)
+        return float(GSD_FRAME_BYTES), float(b + (per["precise"] if precise else 0))
+    f = io.StringIO()
+    _xyz_frame(f, _xyz_head(box, periodic, diameter), _species(species), 0.5 * diameter, positions, velocities,
+               time, collisions, "forward")
+    text = f.getvalue().encode()
+    n = max(1, np.asarray(positions).shape[0])
+    header = text.index(b"\n", text.index(b"\n") + 1) + 1
+    return float(header), (len(text) - header) / n
 
 
 class _Unwrap:
@@ -206,10 +293,13 @@ class GSDWriter(_Writer):
         self._net: int | None = None
         self.frames = 0
         self._tmp = _part(self.path)
-        try:
-            self._f = gsd.hoomd.open(self._tmp, mode="w")
-        except ValueError:  # gsd < 3 spells the modes "wb"
-            self._f = gsd.hoomd.open(self._tmp, mode="wb")
+
+        def make():
+            try:
+                return gsd.hoomd.open(self._tmp, mode="w")
+            except ValueError:  # gsd < 3 spells the modes "wb"
+                return gsd.hoomd.open(self._tmp, mode="wb")
+        self._f = _opened(self._tmp, self.path, make)
 
     def _next_step(self, collisions: int) -> int:
         """Collisions done in both directions: the step never decreases through a reversal."""
@@ -220,7 +310,7 @@ class GSDWriter(_Writer):
         self._net = collisions
         return self._step
 
-    def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
+    def _write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
         frame_cls = getattr(self._hoomd, "Frame", None) or self._hoomd.Snapshot
         f = frame_cls()
         collisions = int(collisions)
@@ -252,7 +342,6 @@ class GSDWriter(_Writer):
         f.log["revcol/reverse"] = np.array([phase == "reverse"], dtype=np.uint8)
         f.log["revcol/walls"] = self._walls.copy()
         self._f.append(f)
-        self.frames += 1
 
     def _close_file(self) -> None:
         self._f.close()
@@ -294,6 +383,19 @@ def _part(path: Path) -> str:
     fd, tmp = tempfile.mkstemp(prefix=".revcol-", suffix=path.suffix + ".part", dir=path.parent)
     os.close(fd)
     return tmp
+
+
+def _opened(tmp: str, path: Path, make):
+    """``make()``, the writer's file on ``tmp``; when it cannot be opened, ``tmp`` is removed and the
+    error names ``path``."""
+    try:
+        return make()
+    except OSError as e:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise named_os_error(e, path, "opening the trajectory") from e
 
 
 def _publish(tmp: str, path: Path) -> None:

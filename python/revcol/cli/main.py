@@ -1,12 +1,12 @@
 """The ``revcol`` command line.
 
     revcol run [SCENE.toml] [--json FILE] [--plot DIR] [--trajectory FILE.xyz|.gsd] [--collisions N] [--seed S]
-               [--engine float|lattice] [--mode exact|paper|specular]
+               [--engine float|lattice] [--mode exact|paper|specular] [--max-output SIZE]
                [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]
     revcol run [SCENE.toml] --horizon [--seeds K] [--max-collisions N] [--engine float] [--json FILE] [--plot DIR]
     revcol simulate [SCENE] [--collisions N | --time T] [--trajectory FILE --every K|--every-time T] [--checkpoint DIR
                --checkpoint-every K] [--resume CHECKPOINT] [--species Ar] [--json FILE]   (forward only)
-               [--engine float|lattice] [--mode exact|paper|specular]
+               [--engine float|lattice] [--mode exact|paper|specular] [--max-output SIZE]
                [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]   (lattice engine)
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
@@ -105,6 +105,14 @@ def _mode_flag(p: argparse.ArgumentParser) -> None:
                    "draws; on the lattice engine reversed bit for bit); a law the scene names needs exact")
 
 
+def _max_output_flag(p: argparse.ArgumentParser) -> None:
+    """``--max-output``, overriding the scene's [output] max_output (checked by the run: exit 2 naming it)."""
+    p.add_argument("--max-output", metavar="SIZE", help="refuse to start when the outputs (trajectory, checkpoints, "
+                   "report, figures) are estimated to need more than SIZE: bytes or K, M, G, T (powers of 1024), "
+                   "e.g. 20G; 0 or none: no limit (default: the scene's [output] max_output, else 10G). A run "
+                   "whose outputs would not fit in the free space is refused too")
+
+
 def _did_you_mean(word: str, candidates) -> str:
     """`` (did you mean 'x'?)`` for the closest candidate to a mistyped ``word``, or ``""``."""
     close = difflib.get_close_matches(word, [str(c) for c in candidates], n=1, cutoff=0.6)
@@ -172,6 +180,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="run a gas scene on this engine instead of its [collisions] engine (with --horizon: "
                    "--engine float measures the float engine's horizon for a lattice scene's gas)")
     _mode_flag(r)
+    _max_output_flag(r)
     r.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
     _lattice_flags(r)
     _simulate_parser(sub)
@@ -242,6 +251,7 @@ def _simulate_parser(sub) -> None:
     s.add_argument("--seed", type=_seed, metavar="S", help="seed instead of the scene's [rng] seed")
     s.add_argument("--engine", choices=("float", "lattice"), help="run the scene on this engine instead")
     _mode_flag(s)
+    _max_output_flag(s)
     s.add_argument("--species", default="Ar", metavar="X", help="the trajectory's chemical element symbol "
                    "(default Ar; ASE reads element symbols only)")
     s.add_argument("--json", metavar="FILE", help="write the report as JSON ('-': to standard output, and the "
@@ -265,7 +275,7 @@ def _simulate(args: argparse.Namespace) -> int:
                               every=args.every, checkpoints=args.checkpoint, checkpoint_every=args.checkpoint_every,
                               resume=args.resume, seed=args.seed, engine=args.engine, species=args.species,
                               tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search, mode=args.mode,
-                              json_path=None if to_stdout else args.json,
+                              json_path=None if to_stdout else args.json, max_output=args.max_output,
                               progress=False if args.no_progress else None, every_time=args.every_time)
     except (SceneError, OSError) as e:
         print(f"revcol simulate: error: {e}", file=sys.stderr)

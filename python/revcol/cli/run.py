@@ -48,7 +48,7 @@ def run_command(args: argparse.Namespace) -> int:
                                horizon_seeds=(args.seeds or 1) if args.horizon else None,
                                max_collisions=args.max_collisions, collisions=args.collisions, seed=args.seed,
                                engine=engine, progress=False if args.no_progress else None,
-                               plot_format=args.plot_format)
+                               plot_format=args.plot_format, max_output=args.max_output)
     except SceneError as e:
         print(f"revcol run: error: {e}", file=sys.stderr)
         return 2

@@ -46,7 +46,9 @@ from .._args import integer
 from .._io import write_json
 from .._version import __version__
 from ..engine import Simulation
-from .._outputs import Output, check_outputs, checkpoint_names, run_inputs
+from .._output_size import (checkpoints_size, production_checkpoints, production_frames, report_size,
+                            trajectory_size)
+from .._outputs import Output, check_outputs, checkpoint_names, estimates, output_limit, run_inputs
 from ..gas import build_simulation, check_memory
 from ..lattice import LatticeSimulation
 from ..lattice_gas import geometry as lattice_geometry
@@ -235,6 +237,7 @@ class _Production:
         total = float(self.target - self.start) if self.target is not None else float(self.t_end - self.t_start)
         bar = Bar(progress, total, "simulate", "coll" if self.target is not None else "t")
         tick = _time.perf_counter()
+        failed = True  # an error (a full disk: ENOSPC) must not be masked by closing the trajectory
         try:
             with Interrupt() as stop:
                 self.frame()
@@ -259,11 +262,15 @@ class _Production:
                         self.checkpoint()
                 self.frame()
                 self.checkpoint()
+            failed = False
         finally:
             self.wall_s = _time.perf_counter() - tick
             bar.close()
             if self.writer is not None:
-                self.writer.close()
+                if failed:
+                    self.writer.close_quietly()
+                else:
+                    self.writer.close()
 
     def report(self, resume) -> dict[str, Any]:
         sim, scene = self.sim, self.scene
@@ -300,7 +307,8 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
              resume: str | os.PathLike | None = None, seed: int | None = None, engine: str | None = None,
              species: str = "Ar", precise: bool = False, json_path: str | os.PathLike | None = None,
              progress: bool | None = None, every_time: float | None = None, tick_bits: int | None = None,
-             cell_bits: int | None = None, search: str | float | None = None, mode: str | None = None) -> dict:
+             cell_bits: int | None = None, search: str | float | None = None, mode: str | None = None,
+             max_output: int | str | None = None) -> dict:
     """Runs a gas scene forward only (see the module's docstring) and returns the report; with
     ``json_path`` also writes it (atomically). ``species`` names the trajectory's element,
     ``precise`` adds float64 positions to a GSD trajectory; ``every_time`` writes frames at the
@@ -308,8 +316,10 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
     ``search``: the lattice engine's options instead of the scene's (a resumed run keeps its
     checkpoint's units, tick and cells, and takes a new search). ``mode``: the collision mode
     instead of the scene's ``[collisions] mode`` (``"exact"``, ``"paper"``: float engine, 1D and
-    2D, or ``"specular"``; a resumed run must be in its checkpoint's). A bad option raises
-    SceneError before anything runs."""
+    2D, or ``"specular"``; a resumed run must be in its checkpoint's). ``max_output``: the outputs'
+    limit in bytes (``"20G"``; 0 or ``"none"``: none) instead of the scene's ``[output] max_output``
+    or 10 GiB; the outputs' estimated sizes (``report["output_estimate"]``) must fit it and the free
+    space. A bad option raises SceneError before anything runs."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     if mode is not None:
@@ -328,17 +338,16 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
         _species(species)
     except ValueError as e:
         raise SceneError(f"{scene.source}: --species: {e}") from None
+    limit = output_limit(scene.source, max_output, scene.max_output)
     check_memory(scene)
     # the checkpoint resumed from is read first: its count numbers the checkpoints the run may write
     sim = _build(scene, resume) if resume is not None else None
     start = 0 if sim is None else _net(sim)
-    first = 0 if sim is None else start + 1  # a resumed run writes none at its start (_Production.checkpoint)
-    # no output may name an input or another output (issue 59); every one writable (issue 17)
-    names = checkpoint_names(first, None if collisions is None else start + int(collisions))
-    check_outputs(scene.source, [Output("[output] json / --json", json_path),
-                                 Output("[output] trajectory / --trajectory", trajectory),
-                                 Output("[output] checkpoints / --checkpoint", checkpoints, folder=True, match=names)],
-                  run_inputs(scene, resume))
+    # no output may name an input or another output (issue 59), nor outgrow the limit or the free
+    # space (issue 59); every one writable (issue 17)
+    outputs = _outputs(scene, sim, start, collisions, time, json_path, trajectory, every, every_time, checkpoints,
+                       checkpoint_every, species, precise)
+    check_outputs(scene.source, outputs, run_inputs(scene, resume), max_output=limit)
     if sim is None:
         sim = _build(scene, None)
     if resume is not None and search is not None:  # the checkpoint holds its own; a new one is the same run
@@ -347,10 +356,32 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
                       species, precise, every_time, resumed=resume is not None)
     run.go(sys.stdout.isatty() if progress is None else progress)
     r = run.report(resume)
+    r["output_estimate"] = estimates(outputs)
     if json_path is not None:
         r["written"].append(os.fspath(json_path))
         write_json(r, json_path)
     return r
+
+
+def _outputs(scene: Scene, sim, start: int, collisions, time, json_path, trajectory, every: int, every_time,
+             checkpoints, checkpoint_every: int, species: str, precise: bool) -> list[Output]:
+    """The run's outputs, each with its estimated size (:mod:`revcol._output_size`): the report, the
+    frames (the start, every ``every`` collisions or ``every_time``, the end) and the checkpoints
+    (every ``checkpoint_every`` collisions after ``start`` and the end; a resumed run writes none at
+    its start, :meth:`_Production.checkpoint`)."""
+    first = 0 if sim is None else start + 1
+    names = checkpoint_names(first, None if collisions is None else start + int(collisions))
+    traj = ckpt = None
+    if trajectory is not None:
+        frames = production_frames(scene, start, collisions, time, every, every_time, sim)
+        traj = trajectory_size(scene, trajectory, frames, sim=sim, species=species, precise=precise,
+                               collisions=start + (collisions or 0))
+    if checkpoints is not None:
+        ckpt = checkpoints_size(scene, *production_checkpoints(scene, start, collisions, time, checkpoint_every, sim),
+                                sim=sim)
+    return [Output("[output] json / --json", json_path, size=report_size(scene) if json_path is not None else None),
+            Output("[output] trajectory / --trajectory", trajectory, size=traj),
+            Output("[output] checkpoints / --checkpoint", checkpoints, folder=True, match=names, size=ckpt)]
 
 
 def format_simulate(r: dict) -> str:

@@ -56,7 +56,9 @@ import os
 from pathlib import Path
 
 from .._io import write_json
-from .._outputs import Output, check_outputs, checkpoint_names, run_inputs
+from .._output_size import (checkpoints_size, figures_size, report_size, round_trip_checkpoints, round_trip_frames,
+                            trajectory_size)
+from .._outputs import Output, check_outputs, checkpoint_names, estimates, output_limit, run_inputs
 from ..gas import check_memory, run_gas
 from ..plots import check_format, figure_names, plot_horizon, require_matplotlib
 from ..scene import Scene, SceneError, load_scene, with_engine
@@ -70,14 +72,17 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
               plot: str | os.PathLike | None = None, trajectory: str | os.PathLike | None = None,
               horizon_seeds: int | None = None, max_collisions: int = 1_000_000,
               collisions: int | None = None, seed: int | None = None, engine: str | None = None,
-              progress: bool | None = None, plot_format: str = "png") -> dict:
+              progress: bool | None = None, plot_format: str = "png", max_output: int | str | None = None) -> dict:
     """Runs any scene (a :class:`Scene`, a path, or None for the built-in default) and writes
     the outputs asked for (arguments here, else the scene's ``[output]``). ``collisions``
     overrides N_c (a gas's end time included); ``horizon_seeds`` measures the horizon over
     that many seeds instead of one round trip; ``plot_format``: the figures' file format
     (png, pdf or svg); ``engine`` (``"float"`` or ``"lattice"``) runs a
-    gas scene on that engine instead of its own. Returns the report; every output is checked
-    before anything runs, and a bad one raises :class:`SceneError`."""
+    gas scene on that engine instead of its own; ``max_output``: the outputs' limit in bytes
+    (``"20G"``; 0 or ``"none"``: none) instead of the scene's ``[output] max_output`` or 10 GiB.
+    Returns the report (``output_estimate``: the bytes each output was estimated to take); every
+    output, its estimated size and the free space are checked before anything runs, and a bad one
+    raises :class:`SceneError`."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     if engine is not None:
@@ -107,9 +112,10 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
         require_matplotlib()
         check_format(plot_format)
     # every output and the memory are checked before anything runs: a run must not be lost to
-    # an unwritable report at its end (issue 17), nor overwrite its own inputs (issue 59)
+    # an unwritable report at its end (issue 17), nor overwrite its own inputs, nor fill the disk (issue 59)
+    limit = output_limit(scene.source, max_output, scene.max_output)
     outputs = _outputs(scene, json_path, plot, trajectory, horizon_seeds is not None, plot_format)
-    check_outputs(scene.source, outputs, run_inputs(scene))
+    check_outputs(scene.source, outputs, run_inputs(scene), max_output=limit)
     if scene.kind == "gas":
         check_memory(scene)
     if horizon_seeds is not None:
@@ -122,6 +128,7 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
         r = run_statesave(scene, plot, progress, plot_format)
     else:
         r = run_gas(scene, plot=plot, trajectory=trajectory, progress=progress, plot_format=plot_format)
+    r["output_estimate"] = estimates(outputs)
     if json_path is not None:
         r["written"].append(str(json_path))
         write_json(r, json_path)
@@ -134,9 +141,13 @@ def _outputs(scene: Scene, json_path, plot, trajectory, horizon: bool, plot_form
     up to N_c; a horizon writes none)."""
     figures = "horizon" if horizon else ("lattice" if scene.engine == "lattice" else scene.kind)
     ckpt = scene.kind == "gas" and not horizon and scene.checkpoint_interval > 0
-    return [Output("[output] json / --json", json_path),
-            Output("[output] plot / --plot", plot, folder=True,
-                   names=figure_names(figures, plot_format) if figures != "reversal" else frozenset()),
-            Output("[output] trajectory / --trajectory", trajectory),
+    names = figure_names(figures, plot_format) if figures != "reversal" else frozenset()
+    return [Output("[output] json / --json", json_path, size=report_size(scene) if json_path is not None else None),
+            Output("[output] plot / --plot", plot, folder=True, names=names,
+                   size=figures_size(scene, len(names), plot_format) if plot is not None else None),
+            Output("[output] trajectory / --trajectory", trajectory,
+                   size=trajectory_size(scene, trajectory, round_trip_frames(scene), collisions=scene.collisions or 0)
+                   if trajectory is not None and scene.kind == "gas" and not horizon else None),
             Output("[output] checkpoints", scene.checkpoints, folder=True, names=frozenset(),
-                   match=checkpoint_names(1, scene.collisions, scene.checkpoint_interval) if ckpt else None)]
+                   match=checkpoint_names(1, scene.collisions, scene.checkpoint_interval) if ckpt else None,
+                   size=checkpoints_size(scene, *round_trip_checkpoints(scene)) if ckpt else None)]
