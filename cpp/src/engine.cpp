@@ -110,8 +110,8 @@ void check_overlaps(const Config& c, const std::vector<double>& x, std::size_t n
   std::array<int, 3> nc{1, 1, 1};
   std::array<double, 3> cw{1, 1, 1};
   std::size_t total = 1;
+  limits::capped_cell_counts(d, c.box.data(), c.diameter, limits::max_cells(n), nc.data());  // cells >= D
   for (int k = 0; k < d; ++k) {
-    nc[k] = std::max(1, static_cast<int>(std::floor(c.box[k] / c.diameter)));
     nc[k] = std::min(nc[k], 1 << 20);
     cw[k] = c.box[k] / nc[k];
     total *= static_cast<std::size_t>(nc[k]);

@@ -54,8 +54,8 @@ bool place_rsa(const Geometry& g, std::size_t n, Draws& pos, std::vector<double>
   int nc[3] = {1, 1, 1};
   double cw[3] = {1, 1, 1};
   std::size_t total = 1;
+  limits::capped_cell_counts(d, g.L, g.D, limits::max_cells(n), nc);  // cells >= D, at most max_cells(n) of them
   for (int k = 0; k < d; ++k) {
-    nc[k] = std::max(1, static_cast<int>(std::floor(g.L[k] / g.D)));
     cw[k] = g.L[k] / nc[k];
     total *= static_cast<std::size_t>(nc[k]);
   }

@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 #include "check.hpp"
+#include "revcol/engine/limits.hpp"
 
 using namespace revcol::engine;
 
@@ -248,3 +250,48 @@ TEST_CASE("1D rods beside each other: walls (ends listed once) and a ring (wrap 
 }
 
 CHECK_MAIN()
+
+// Issue 59: a sparse box's grid is capped at limits::max_list_cells(n) cells (wider cells), and
+// below the cap it is floor(L / reach) per axis as before. The lists stay exact: centres in a
+// cluster that straddles the periodic corner of a box of 10^5 (2D) and 10^4 (3D) reaches.
+TEST_CASE("sparse boxes: the grid is capped, unchanged below the cap, and the lists stay exact") {
+  int nc[3];
+  const double below[2] = {800.0, 800.0};  // 500^2 = 250 000 cells <= 2^18: unchanged
+  limits::capped_cell_counts(2, below, 1.6, limits::max_list_cells(10), nc);
+  CHECK(nc[0] == 500 && nc[1] == 500);
+  const double thin[3] = {1e9, 5.0, 3.0};  // the short axes keep their 3 and 1 cells
+  limits::capped_cell_counts(3, thin, 1.6, limits::max_list_cells(10), nc);
+  CHECK(nc[1] == 3 && nc[2] == 1 && nc[0] >= 1 && 3.0 * nc[0] <= limits::max_list_cells(10));
+  CHECK(thin[0] / nc[0] >= 1.6);
+  auto sparse = [&](auto dim_tag, double L, Boundary b) {
+    constexpr int Dim = decltype(dim_tag)::value;
+    const double reach = 1.6;
+    const Config c = box_config<Dim>(b, b, b, L);
+    const Boundaries<Dim> box(c);
+    const int n = Dim == 3 ? 300 : 120;
+    std::mt19937_64 rng(13);
+    std::uniform_real_distribution<double> u(-4.0, 4.0);
+    std::vector<double> x(n * Dim);
+    for (double& q : x) {
+      q = u(rng);
+      if (b == Boundary::periodic) q -= L * std::floor(q / L);  // around the corner 0 = L
+      else q = std::fabs(q);
+    }
+    NeighbourLists<Dim> nl;
+    nl.setup(n, box, reach, false);
+    CHECK(static_cast<double>(nl.cell_count()) <= limits::max_list_cells(n));
+    nl.set_centres(x);
+    nl.build([](int) { return 0.0; });
+    CHECK(nl.valid());
+    int pairs = 0;
+    for (int i = 0; i < n; ++i) {
+      CHECK(nl.count(i) == brute_count<Dim>(c, x, i, reach));
+      pairs += nl.count(i);
+    }
+    CHECK(pairs > n);  // a crowded cluster: the check has pairs to find
+  };
+  for (Boundary b : {Boundary::periodic, Boundary::wall}) {
+    sparse(std::integral_constant<int, 2>{}, 1.6e5, b);
+    sparse(std::integral_constant<int, 3>{}, 1.6e4, b);
+  }
+}

@@ -21,7 +21,9 @@
 // Collisions. Paper mode has pair operators in 1D (the exchange) and 2D (Procedures 1-2);
 // its 3D pair operator is not a bijection, so the engine refuses paper mode in 3D.
 #pragma once
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -72,6 +74,49 @@ inline std::string too_many_particles(int d, std::uint64_t n) {
 inline constexpr double kMaxBoxDiameters = 1073741824.0;  // 2^30
 /// True when an axis of length L is at most kMaxBoxDiameters diameters D long.
 constexpr bool box_ratio_fits(double L, double D) { return L / D <= kMaxBoxDiameters; }
+
+/// Most cells of an exact search grid over n particles (the random start's placement grid,
+/// the overlap check): max(8 n, 2^18). A sparse box takes wider cells instead, so memory stays
+/// O(N) at any density (issue 59: N = 10 at phi 1e-7 took 1.8 GB of empty placement cells).
+/// Which pairs these searches find does not depend on the cell width.
+constexpr double max_cells(std::size_t n) { return std::max(8.0 * static_cast<double>(n), 262144.0); }
+/// Most cells of the neighbour lists' grid over n particles: max(64 n, 2^18). Its cells also
+/// order the particles' storage and the scans, so the cap sits far below any density in use
+/// (it first binds below phi ~ 1e-3 in 2D, 5e-4 in 3D at the widest shells): every such gas
+/// keeps the grid it had.
+constexpr double max_list_cells(std::size_t n) { return std::max(64.0 * static_cast<double>(n), 262144.0); }
+
+/// Cells per axis (into nc[0..d)) of a grid of cells at least w wide over box lengths L[0..d):
+/// floor(L_k / w) (at least 1), exactly as before while their product is at most cap (one of
+/// the two above); past it the axes take fewer, wider cells until it is (never fewer than
+/// min(floor(L_k / w), 3), so an axis with 3 or more cells keeps 3: a neighbouring cell's
+/// image stays unique). Fewer cells of an axis only widen them, so the 3^d cells around a
+/// point still hold everything within w of it: a search over them finds the same pairs.
+inline void capped_cell_counts(int d, const double* L, double w, double cap, int* nc) {
+  double c[3] = {1, 1, 1}, least[3] = {1, 1, 1};
+  double total = 1.0;
+  for (int k = 0; k < d; ++k) {
+    c[k] = std::max(1.0, std::floor(L[k] / w));
+    least[k] = std::min(c[k], 3.0);
+    total *= c[k];
+  }
+  if (total > cap) {
+    const double f = std::pow(total / cap, 1.0 / d);
+    total = 1.0;
+    for (int k = 0; k < d; ++k) {
+      c[k] = std::max(least[k], std::floor(c[k] / f));
+      total *= c[k];
+    }
+    while (total > cap) {  // rounding or an axis held at its least: halve the axis with the most
+      int m = 0;
+      for (int k = 1; k < d; ++k) m = c[k] > c[m] ? k : m;
+      const double h = std::max(least[m], std::floor(c[m] / 2.0));
+      total = total / c[m] * h;
+      c[m] = h;
+    }
+  }
+  for (int k = 0; k < d; ++k) nc[k] = static_cast<int>(c[k]);
+}
 
 /// Largest |clock| in units of D / v_max: past it the clock's ulp (2^-52 |t|) exceeds 1e-6 of
 /// the time a particle takes to cross its own diameter, and events begin to share one clock

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "revcol/engine/boundary.hpp"
+#include "revcol/engine/limits.hpp"
 #include "revcol/engine/prefetch.hpp"
 
 namespace revcol::engine {
@@ -86,9 +87,13 @@ class NeighbourLists {
     adj_ = Dim == 1 && adjacent;
     total_cells_ = 1;
     cells_code_images_ = true;
+    // floor(L_k / reach) cells per axis, fewer (wider) in a box so sparse that they would
+    // exceed limits::max_list_cells(n): the same grid for every gas below that (issue 59)
+    double lengths[Dim];
+    for (int k = 0; k < Dim; ++k) lengths[k] = box.length(k);
+    limits::capped_cell_counts(Dim, lengths, reach, limits::max_list_cells(n), nc_.data());
     for (int k = 0; k < Dim; ++k) {
       const double L = box.length(k);
-      nc_[k] = std::max(1, static_cast<int>(std::floor(L / reach)));
       cw_[k] = L / nc_[k];
       if (box.periodic(k) && nc_[k] < 3) cells_code_images_ = false;
       stride_[k] = total_cells_;
