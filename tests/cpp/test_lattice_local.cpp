@@ -9,6 +9,7 @@
 #include <string>
 
 #include "check.hpp"
+#include "lattice_gas_util.hpp"
 #include "revcol/lattice/engine.hpp"
 
 using namespace revcol::lattice;
@@ -17,17 +18,11 @@ using revcol::Mode;
 
 namespace {
 
-template <std::size_t D>
-using EngineOf = std::conditional_t<D == 2, LatticeEngine, LatticeEngine3D>;
+using lattice_test::EngineOf;
 
 template <std::size_t D>
 EngineOf<D> make(std::size_t n, double phi, bool walls, std::uint32_t seed, int tick_bits, Mode mode = Mode::exact) {
-  LatticeConfigN<D> c;
-  c.tick_bits = tick_bits;
-  for (std::size_t k = 0; k < D; ++k) c.wall[k] = walls;
-  c.seed = seed;
-  const LatticeStartN<D> s = random_start(c, n, phi, seed);
-  return {s.units, s.x, s.v, seed, operator_for(s.units), 0, mode};
+  return lattice_test::make_gas<D>(n, phi, walls ? en::Boundary::wall : en::Boundary::periodic, seed, tick_bits, mode);
 }
 
 template <class Refuse>

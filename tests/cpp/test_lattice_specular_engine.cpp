@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "check.hpp"
+#include "lattice_gas_util.hpp"
 #include "revcol/lattice/engine.hpp"
 
 using namespace revcol::lattice;
@@ -14,20 +15,12 @@ using revcol::Mode;
 
 namespace {
 
-template <std::size_t D>
-using EngineOf = std::conditional_t<D == 2, LatticeEngine, LatticeEngine3D>;
+using lattice_test::EngineOf;
 
+// a specular gas (lattice_gas_util.hpp)
 template <std::size_t D>
 EngineOf<D> make(std::size_t n, double phi, en::Boundary kind, std::uint32_t seed, int tick_bits = default_tick_bits) {
-  LatticeConfigN<D> c;
-  c.tick_bits = tick_bits;
-  for (std::size_t k = 0; k < D; ++k) {
-    c.wall[k] = en::has_walls(kind);
-    c.bounce[k] = kind == en::Boundary::bounce;
-  }
-  c.seed = seed;
-  const LatticeStartN<D> s = random_start(c, n, phi, seed);
-  return {s.units, s.x, s.v, seed, operator_for(s.units), 0, Mode::specular};
+  return lattice_test::make_gas<D>(n, phi, kind, seed, tick_bits, Mode::specular);
 }
 
 // FNV-1a over positions, velocities, clock and collision count

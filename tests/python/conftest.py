@@ -1,3 +1,5 @@
+import os
+
 import numpy as np
 import pytest
 
@@ -18,3 +20,17 @@ def pre_states():
     # one nearly grazing state: approach speed 1e-9 of the relative speed
     states[-1] = (np.array([[-1e-9, 1.0], [0.0, 0.0]]), np.array([1.0, 0.0]))
     return states
+
+
+def run_cli(folder, args, capsys):
+    """``revcol ARGS --no-progress`` run in ``folder`` (a scene's [output] paths are taken under
+    the current directory): the exit status and standard error's lines (the output-guard and
+    output-size tests: ``from conftest import run_cli``)."""
+    from revcol.cli.main import main
+    cwd = os.getcwd()
+    os.chdir(folder)
+    try:
+        rc = main([str(a) for a in args] + ["--no-progress"])
+    finally:
+        os.chdir(cwd)
+    return rc, capsys.readouterr().err.strip().splitlines()

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import revcol
-from revcol.cli.main import main
+from conftest import run_cli as _cli
 from revcol.plots import figure_names
 
 PLAIN = "[system]\ndimension = 2\nparticles = 20\npacking_fraction = 0.2\n[collisions]\nengine = \"float\"\n" \
@@ -23,18 +23,6 @@ def _start(path):
     np.savez(path, positions=sim.positions, velocities=sim.velocities)
     box = ", ".join(repr(float(b)) for b in sim.box)
     return f"[system]\ndimension = 2\nbox = [{box}]\ninitial_state = \"{path.name}\"\n[run]\ncollisions = 20\n"
-
-
-def _cli(tmp_path, args, capsys):
-    """``revcol ARGS`` in ``tmp_path`` (a scene's [output] paths are taken under the current
-    directory); returns the exit status and standard error's lines."""
-    cwd = os.getcwd()
-    os.chdir(tmp_path)
-    try:
-        rc = main([str(a) for a in args] + ["--no-progress"])
-    finally:
-        os.chdir(cwd)
-    return rc, capsys.readouterr().err.strip().splitlines()
 
 
 def _tree(root):

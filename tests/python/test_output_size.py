@@ -18,7 +18,7 @@ import pytest
 import revcol._output_size
 import revcol._outputs
 import revcol.trajectory
-from revcol.cli.main import main
+from conftest import run_cli as _cli
 from revcol.cli.simulate import simulate
 from revcol.scene import SceneError, load_scene
 from revcol.studies.scenes import run_scene
@@ -31,17 +31,6 @@ ENOSPC = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 def _scene(tmp_path, engine="float", n=20, c=100, d=2, b="wall", extra=""):
     (tmp_path / "s.toml").write_text(GAS.format(d=d, n=n, b=b, engine=engine, c=c) + extra)
     return "s.toml"
-
-
-def _cli(tmp_path, args, capsys):
-    """``revcol ARGS`` in ``tmp_path``: the exit status and standard error's lines."""
-    cwd = os.getcwd()
-    os.chdir(tmp_path)
-    try:
-        rc = main([str(a) for a in args] + ["--no-progress"])
-    finally:
-        os.chdir(cwd)
-    return rc, capsys.readouterr().err.strip().splitlines()
 
 
 def _files(root):

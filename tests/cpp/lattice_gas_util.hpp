@@ -1,0 +1,32 @@
+// A lattice gas for the engine tests (test_lattice_local.cpp, test_lattice_specular_engine.cpp):
+// the engine of a dimension, and a random start with one boundary kind on every axis.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+#include "revcol/lattice/engine.hpp"
+
+namespace lattice_test {
+
+/// The lattice engine of dimension D (2: disks, 3: spheres).
+template <std::size_t D>
+using EngineOf = std::conditional_t<D == 2, revcol::lattice::LatticeEngine, revcol::lattice::LatticeEngine3D>;
+
+/// N particles at packing fraction phi, `kind` on every axis, the random start of `seed`, in `mode`.
+template <std::size_t D>
+EngineOf<D> make_gas(std::size_t n, double phi, revcol::engine::Boundary kind, std::uint32_t seed,
+                     int tick_bits = revcol::lattice::default_tick_bits, revcol::Mode mode = revcol::Mode::exact) {
+  namespace la = revcol::lattice;
+  la::LatticeConfigN<D> c;
+  c.tick_bits = tick_bits;
+  for (std::size_t k = 0; k < D; ++k) {
+    c.wall[k] = revcol::engine::has_walls(kind);
+    c.bounce[k] = kind == revcol::engine::Boundary::bounce;
+  }
+  c.seed = seed;
+  const la::LatticeStartN<D> s = la::random_start(c, n, phi, seed);
+  return {s.units, s.x, s.v, seed, la::operator_for(s.units), 0, mode};
+}
+
+}  // namespace lattice_test
