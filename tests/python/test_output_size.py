@@ -227,7 +227,8 @@ def test_simulates_estimates_are_within_a_factor_2_of_the_bytes_written(tmp_path
 
 
 @pytest.mark.parametrize("engine", ["float", "lattice"])
-def test_a_round_trips_estimates_are_within_a_factor_2_of_the_bytes_written(tmp_path, engine):
+def test_a_round_trips_estimates_are_within_a_factor_2_of_the_bytes_written(tmp_path, monkeypatch, engine):
+    monkeypatch.chdir(tmp_path)  # the scene's [output] checkpoints = "ck" is taken under the current directory
     _scene(tmp_path, engine, 200, 2000, extra="checkpoint_interval = 400\n[output]\ncheckpoints = \"ck\"\n"
            "trajectory_every = 100\n")
     r = run_scene(load_scene(tmp_path / "s.toml"), trajectory=tmp_path / "t.xyz", progress=False)
