@@ -38,6 +38,7 @@ void add_skip_benches(std::vector<Bench>& out);       ///< skip_bench.cpp: what 
 void add_lattice_op_benches(std::vector<Bench>& out);  ///< lattice_op_bench.cpp: the exact lattice pair operator
 void add_lattice_op3_benches(std::vector<Bench>& out); ///< lattice_op3_bench.cpp: the 3D lattice pair operator, its design study
 void add_lattice_benches(std::vector<Bench>& out);     ///< lattice_engine_bench.cpp: the 2D lattice engine
+void add_rollback_benches(std::vector<Bench>& out);    ///< lattice_rollback_bench.cpp: the lattice engine's journal and rollback
 void add_tradeoff_benches(std::vector<Bench>& out);    ///< tradeoff_bench.cpp: run time against error per operator and knob
 
 /// Seconds of the steady clock since t0.

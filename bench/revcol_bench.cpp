@@ -100,6 +100,7 @@ std::vector<Bench> all_benches() {
   revcol::bench::add_lattice_op_benches(out);
   revcol::bench::add_lattice_op3_benches(out);
   revcol::bench::add_lattice_benches(out);
+  revcol::bench::add_rollback_benches(out);
   revcol::bench::add_tradeoff_benches(out);
   return out;
 }

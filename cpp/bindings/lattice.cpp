@@ -457,6 +457,29 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
           },
           py::arg("to_collisions") = py::none(), py::arg("to_tick") = py::none(),
           "Back to collision count `to_collisions` or tick `to_tick` (default: the start).")
+      // ---- the processed-event journal (BasicEngine::keep_journal, rollback.hpp) ----
+      .def(
+          "keep_journal", [](P& p, bool on) { p.engine().keep_journal(on); }, py::arg("on"),
+          "Keeps (or stops keeping) the journal of processed events from the state on: rollback undoes them.")
+      .def_property_readonly("journaling", [](const P& p) { return p.engine().journaling(); })
+      .def_property_readonly("journal_start", [](const P& p) { return p.engine().journal_start(); },
+                             "The collision count at the journal's start (the earliest state rollback reaches).")
+      .def_property_readonly("journal_start_tick", [](const P& p) { return p.engine().journal_start_tick(); })
+      .def_property_readonly("journal_size", [](const P& p) { return p.engine().journal_size(); })
+      .def(
+          "rollback",
+          [](P& p, std::optional<PyInt> to_collisions_arg, std::optional<PyInt> to_tick_arg) {
+            const auto to_collisions = to_int<std::uint64_t>(to_collisions_arg, "to_collisions");
+            const auto to_tick = to_int<std::int64_t>(to_tick_arg, "to_tick");
+            require(to_collisions.has_value() != to_tick.has_value(), "rollback needs one of to_collisions= and to_tick=");
+            if (to_collisions) p.engine().rollback(*to_collisions);
+            else p.engine().rollback_to_tick(*to_tick);
+          },
+          py::arg("to_collisions") = py::none(), py::arg("to_tick") = py::none(),
+          "Undoes the journal's latest events: back to right after collision `to_collisions`, or to tick `to_tick`.")
+      .def(
+          "commit", [](P& p, PyInt collisions) { p.engine().commit(to_int<std::uint64_t>(collisions, "collisions")); },
+          py::arg("collisions"), "Forgets the journal up to that collision count (rollback goes no further back).")
       .def("snapshot", [](const P& p) { return snapshot_dict(p.engine().snapshot()); })
       .def_property_readonly("positions", [](const P& p) { return vec_array(p.engine().positions()); })
       .def_property_readonly("velocities", [](const P& p) { return vec_array(p.engine().velocities()); })

@@ -249,6 +249,42 @@ class LatticeSimulation(SimulationBase):
         self._e.run_back(target, tick)
         return {"collisions": int(before - self._e.collisions), "clock": self.clock, "time": self.time}
 
+    # --- rollback: the journal of processed events ------------------------------------------
+
+    def keep_journal(self, on: bool = True) -> None:
+        """Keeps (or stops keeping) the journal of the events processed from the current
+        state on, 24 bytes per event: :meth:`rollback` then undoes the latest events one by one,
+        each by its own reverse computation (nothing of the state is saved), in time
+        proportional to the events undone. The journal starts afresh at the state whenever the
+        search is rebuilt (``load``, ``run_back``, setting ``search``)."""
+        self._e.keep_journal(bool(on))
+
+    @property
+    def journal(self) -> dict:
+        """The journal: ``on``, ``start`` (the collision count rollback reaches back to),
+        ``start_clock`` and ``size`` (events held)."""
+        e = self._e
+        return {"on": bool(e.journaling), "start": int(e.journal_start), "start_clock": int(e.journal_start_tick),
+                "size": int(e.journal_size)}
+
+    def rollback(self, to_collision: Optional[int] = None, time: Optional[float] = None) -> dict:
+        """Undoes the journal's latest events: back to the state right after collision
+        ``to_collision``, or to ``time`` (rounded to a tick), bit for bit the state the forward
+        run had there. Needs :meth:`keep_journal`; no further back than ``journal["start"]``."""
+        if (to_collision is None) == (time is None):
+            raise ValueError("rollback needs one of to_collision= and time=")
+        before = self._e.collisions
+        if to_collision is not None:
+            self._e.rollback(integer(to_collision, "to_collision", 0), None)
+        else:
+            self._e.rollback(None, self._tick(time))
+        return {"collisions": int(before - self._e.collisions), "clock": self.clock, "time": self.time}
+
+    def commit(self, to_collision: int) -> None:
+        """Forgets the journal up to collision ``to_collision``: rollback goes no further back,
+        and the journal's memory is freed."""
+        self._e.commit(integer(to_collision, "to_collision", 0))
+
     # --- state -----------------------------------------------------------------------------
 
     @property

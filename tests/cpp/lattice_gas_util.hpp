@@ -1,8 +1,12 @@
-// A lattice gas for the engine tests (test_lattice_local.cpp, test_lattice_specular_engine.cpp):
-// the engine of a dimension, and a random start with one boundary kind on every axis.
+// A lattice gas for the engine tests (test_lattice_local.cpp, test_lattice_specular_engine.cpp,
+// test_lattice_rollback.cpp): the engine of a dimension, a random start with one boundary kind on
+// every axis, and a check that a call is refused with a given message.
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <string>
 #include <type_traits>
 
 #include "revcol/lattice/engine.hpp"
@@ -27,6 +31,18 @@ EngineOf<D> make_gas(std::size_t n, double phi, revcol::engine::Boundary kind, s
   c.seed = seed;
   const la::LatticeStartN<D> s = la::random_start(c, n, phi, seed);
   return {s.units, s.x, s.v, seed, la::operator_for(s.units), 0, mode};
+}
+
+/// True when f() throws an exception whose message contains `what` (another message is printed).
+template <class F>
+bool refused(F&& f, const std::string& what) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    if (std::string(e.what()).find(what) != std::string::npos) return true;
+    std::printf("    unexpected message: %s\n", e.what());
+  }
+  return false;
 }
 
 }  // namespace lattice_test

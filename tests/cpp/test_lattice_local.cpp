@@ -19,22 +19,11 @@ using revcol::Mode;
 namespace {
 
 using lattice_test::EngineOf;
+using lattice_test::refused;
 
 template <std::size_t D>
 EngineOf<D> make(std::size_t n, double phi, bool walls, std::uint32_t seed, int tick_bits, Mode mode = Mode::exact) {
   return lattice_test::make_gas<D>(n, phi, walls ? en::Boundary::wall : en::Boundary::periodic, seed, tick_bits, mode);
-}
-
-template <class Refuse>
-bool refused(Refuse&& f, const std::string& what) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    if (std::string(e.what()).find(what) != std::string::npos) return true;
-    std::printf("    unexpected message: %s\n", e.what());
-    return false;
-  }
-  return false;
 }
 
 // One collision at a time: the particles whose velocity, stream, X or count changed are the

@@ -9,4 +9,5 @@
 #include "loop.hpp"     // run, run_back, the event loop, wall reflections
 #include "collide.hpp"  // pair collisions: acceptance, redraws, the rare log, the reverse
 #include "group.hpp"    // a third body within one tick: group collisions
+#include "rollback.hpp"  // the journal: the latest events undone one by one
 #include "observe.hpp"  // the observer's hooks

@@ -231,6 +231,7 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
   for (int s = 0; s < 2; ++s)
     if (unreflected[s]) {
       wall_tick_[s == 0 ? i : j] = std::numeric_limits<std::int64_t>::min();  // the group took the reflection in
+      unreflected_ |= static_cast<std::uint8_t>(1u << s);  // (the journal's entry: its undo reflects again)
       ++cnt_.wall_groups;
     }
   if (trace != nullptr) trace->push_back({a, i, j});

@@ -65,20 +65,28 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
     }
     const std::int64_t t = queue_.time(p);
     ++cnt_.events;
+    const bool journal = jon_ && !back;
     if (!valid(p)) {
       ++cnt_.stale;
+      if (journal) jdone_.push_back(Done{t, queue_.kind(p), p, -1, none, 0});
       predict(p, t);
       continue;
     }
     const Slot& sp = slot_[static_cast<std::size_t>(p)];
     if (sp.type == cross) {
       ++cnt_.crossings;
+      if (journal) jdone_.push_back(Done{t, queue_.kind(p), p, -1, cross, 0});
       if (lists_) nl_.renew(p, pos(p, t));
       predict(p, t);
       continue;
     }
-    check_order(t, queue_.kind(p));
+    const std::int32_t kind = queue_.kind(p);
+    check_order(t, kind);
     if (sp.type == wall) {
+      if (journal) {
+        jwall_.push_back(WallDone{wall_tick_[p], pre_wall_[p]});
+        jdone_.push_back(Done{t, kind, p, -1, wall, 0});
+      }
       reflect(p, t);
       continue;
     }
@@ -92,7 +100,9 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
       }
       collide_back(i, j, t);
     } else {
+      unreflected_ = 0;
       collide_forward(i, j, t);
+      if (journal) jdone_.push_back(Done{t, kind, i, j, coll, unreflected_});
     }
     ++done;
     if (!back && done == want) {
@@ -124,20 +134,8 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   journal(p);
   Vec x = pos(p, a - 1), v = ln_[p].v;
-  Vec old_line_at_a = pos(p, a);
-  unsigned axes = 0;  // the walls it meets
-  bool whole = false;  // one of them bounces back
-  for (std::size_t k = 0; k < D; ++k)
-    if (u_.wall[k] && (x[k] + v[k] < hlo_ || x[k] + v[k] > hhi(static_cast<int>(k)))) {
-      axes |= 1u << k;
-      whole = whole || u_.bounce[k];
-    }
-  for (std::size_t k = 0; k < D; ++k) {
-    if (axes >> k & 1u) wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k)));
-    else if (!whole) x[k] += v[k];  // a bounce back: the other axes stall at their a-1 point
-    if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
-  }
-  if (whole) v = neg(ln_[p].v);
+  const Vec old_line_at_a = pos(p, a);
+  const unsigned axes = reflection(x, v);
   const Vec ghost = wrapped(sub(x, v));
   near(p, [&](int q) {
     if (q == p) return;
@@ -160,6 +158,25 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   wall_tick_[p] = a;
   ++cnt_.walls;
   predict(p, a);
+}
+
+template <class Op, class Bits, class Queue>
+unsigned BasicEngine<Op, Bits, Queue>::reflection(Vec& x, Vec& v) const noexcept {
+  unsigned axes = 0;  // the walls it meets
+  bool whole = false;  // one of them bounces back
+  for (std::size_t k = 0; k < D; ++k)
+    if (u_.wall[k] && (x[k] + v[k] < hlo_ || x[k] + v[k] > hhi(static_cast<int>(k)))) {
+      axes |= 1u << k;
+      whole = whole || u_.bounce[k];
+    }
+  const Vec v0 = v;
+  for (std::size_t k = 0; k < D; ++k) {
+    if (axes >> k & 1u) wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k)));
+    else if (!whole) x[k] += v[k];  // a bounce back: the other axes stall at their a-1 point
+    if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
+  }
+  if (whole) v = neg(v0);
+  return axes;
 }
 
 }  // namespace revcol::lattice

@@ -225,6 +225,7 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
   const std::int64_t lo = reversed_ ? clock_ + 1 : clock_;
   for (std::size_t p = 0; p < n; ++p) predict(static_cast<int>(p), lo);
   last_key_ = {std::numeric_limits<std::int64_t>::min(), 0};
+  restart_journal();  // a rollback can not cross a rebuild (every line anchored at the clock)
 }
 
 template <class Op, class Bits, class Queue>

@@ -59,6 +59,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <map>
@@ -166,6 +167,32 @@ class BasicEngine {
   /// Runs back to collision count `to_collisions` (the state the forward run had right after it,
   /// clock = its tick) or to tick `to_tick` (clock = to_tick), whichever comes first in reverse.
   void run_back(std::uint64_t to_collisions, std::int64_t to_tick, const std::function<bool()>& poll = {});
+
+  // ---- the processed-event journal: events undone one by one (rollback.hpp) ----
+  /// Keeps (true) or stops keeping (false) the journal of the events processed forward: per
+  /// queue pop 24 bytes (a reflection also the one-tick cache it replaces), from which rollback
+  /// undoes the latest events one by one in the forward frame, each by its own reverse
+  /// computation, in O(events undone). A rebuild of the search (restore, run_back,
+  /// set_list_shell, the undo of an engine error) restarts it at the state (ARCHITECTURE.md).
+  void keep_journal(bool on);
+  /// Whether the journal is kept.
+  bool journaling() const noexcept { return jon_; }
+  /// Rolls back to the state right after collision `collisions` (clock = its tick; the journal's
+  /// start when that is where the count is), bit for bit the forward run's state there; a run on
+  /// processes the same events. journal_start() <= collisions <= collisions(); ends observation.
+  void rollback(std::uint64_t collisions);
+  /// Rolls back to tick `tick` (every event after the tick undone; clock = tick): the state
+  /// run(until = tick) has. Requires the journal and journal_start_tick() <= tick <= clock().
+  void rollback_to_tick(std::int64_t tick);
+  /// Forgets the journal up to collision `collisions` (committed: rollback can go no further
+  /// back), freeing it. journal_start() <= collisions <= collisions().
+  void commit(std::uint64_t collisions);
+  /// The collision count at the journal's start (the earliest state rollback reaches).
+  std::uint64_t journal_start() const noexcept { return j_ncoll0_; }
+  /// The tick at the journal's start.
+  std::int64_t journal_start_tick() const noexcept { return j_clock0_; }
+  /// Entries held (queue pops since the journal's start).
+  std::size_t journal_size() const noexcept { return jdone_.size(); }
 
   /// The state (forward frame, positions at the clock).
   Snapshot snapshot() const;
@@ -365,6 +392,10 @@ class BasicEngine {
   std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target, const std::function<bool()>& poll);
 
   void reflect(int p, std::int64_t a);
+  // the reflection map of a line whose tick-(a-1) point is x with velocity v (beyond the walls of
+  // the returned axes at a): x becomes its point at a, v its velocity after (loop.hpp)
+  unsigned reflection(Vec& x, Vec& v) const noexcept;
+
 
   // ---- collisions ----
   // origin + d, wrapped on periodic axes (128-bit sum: no overflow whatever the box)
@@ -534,6 +565,35 @@ class BasicEngine {
   CellGridN<D> grid_;
   Queue queue_;
   std::pair<std::int64_t, std::int32_t> last_key_{};
+  // ---- the processed-event journal (rollback.hpp) ----
+  struct Done {        // one queue pop
+    std::int64_t t;    // its tick
+    std::int32_t kind;  // its queue kind
+    int p, q;          // the particle popped; a collision's pair (p < q)
+    Type type;         // none: a stale event recomputed
+    std::uint8_t unreflected;  // a group: bit 0 (p), bit 1 (q) took in their reflection at t
+  };
+  struct WallDone {  // a reflection's replaced one-tick cache
+    std::int64_t wall_tick;
+    Line pre_wall;
+  };
+  bool jon_ = false;
+  std::deque<Done> jdone_;
+  std::deque<WallDone> jwall_;  // one per wall entry of jdone_, in order
+  std::uint64_t j_ncoll0_ = 0;
+  std::int64_t j_clock0_ = 0;
+  std::pair<std::int64_t, std::int32_t> j_key0_{};
+  std::uint8_t unreflected_ = 0;  // the last group_collide's unreflected members (bits as Done's)
+  std::vector<int> jtouched_;     // rollback: the particles its undone span touched
+  std::vector<std::uint32_t> jmark_;
+  std::uint32_t jepoch_ = 0;
+  void restart_journal();
+  template <class Keep>
+  void unwind(Keep keep, std::int64_t clock);
+  void touch(int p);
+  void undo_wall(int p, std::int64_t a, const WallDone& w);
+  void undo_collision(int i, int j, std::int64_t a, std::uint8_t unreflected);
+  void undo_group(std::int64_t a, const Group& g, int i, int j, std::uint8_t unreflected);
 };
 
 }  // namespace revcol::lattice

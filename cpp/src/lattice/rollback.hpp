@@ -1,0 +1,228 @@
+// The lattice engine's rollback: the latest events undone one by one in the forward frame, each
+// by its own reverse computation, from the journal of queue pops (what a logical process of an
+// optimistic parallel run does with a straggler; ARCHITECTURE.md "Rollback").
+// Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
+// design); included by engine_impl.hpp, which the instantiating sources include.
+//
+// The undo of each event is the inverse of its forward map, read in the forward frame:
+//   pair      pair_reverse (or, specular mode, pair_unmap) of the post points at tick a and the
+//             post velocities gives the points at a-1 and the pre velocities (pair2d.hpp: the
+//             plain inverse of pair_forward); the drawer's stream steps back by 1 + the rare
+//             log's redraws, X takes back its bits, the log entry goes;
+//   group     the members' stall points (their points at a are their a-1 points) with the
+//             logged pre velocities (a resolve) or the negated ones (a bounce); the drawer's
+//             stream steps back by the draws tried; a member that took in its reflection at a
+//             is reflected again (the reflection's own entry undoes it next);
+//   wall      the reflection map on the time-reversed post line (its point at a, -v): the
+//             mirror is its own inverse (cell_grid.hpp), so it gives the point at a-1 and -v;
+//             the one-tick cache it replaced (wall tick, pre-wall line) comes back from the entry;
+//   neutral   (crossings, list renewals, stale recomputes) nothing physical.
+// Then every particle the undone span touched (popped, partners, group members) is anchored
+// at the new clock and predicted again, its version bumped so that any slot naming its
+// undone line is stale: the queue is again one whose least event is the next one (the argument
+// of the forward loop: a slot is never later than its particle's next event), so a run on from
+// the rolled-back state processes the same events as the sequential run did.
+#pragma once
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "revcol/lattice/engine_core.hpp"
+
+namespace revcol::lattice {
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::keep_journal(bool on) {
+  jon_ = on;
+  restart_journal();
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::restart_journal() {
+  jdone_.clear();
+  jwall_.clear();
+  j_ncoll0_ = ncoll_;
+  j_clock0_ = clock_;
+  j_key0_ = last_key_;
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::rollback(std::uint64_t collisions) {
+  require(jon_, "lattice rollback: the engine keeps no journal (keep_journal)");
+  require(collisions >= j_ncoll0_ && collisions <= ncoll_,
+          "lattice rollback: the target collision count must be in [journal_start, collisions] = [" +
+              std::to_string(j_ncoll0_) + ", " + std::to_string(ncoll_) + "]");
+  if (collisions == ncoll_) {
+    // already there unless events after the collision were processed: undo those
+    if (jdone_.empty() || jdone_.back().type == coll) return;
+  }
+  // keep the entries up to the target collision's own (the collision count after an entry is
+  // the count before the ones above it)
+  unwind([&](const Done& d) { return d.type == coll && ncoll_ == collisions; }, std::numeric_limits<std::int64_t>::min());
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::rollback_to_tick(std::int64_t tick) {
+  require(jon_, "lattice rollback: the engine keeps no journal (keep_journal)");
+  require(tick >= j_clock0_ && tick <= clock_, "lattice rollback: the target tick must be in [journal_start_tick, clock] = [" +
+                                                   std::to_string(j_clock0_) + ", " + std::to_string(clock_) + "]");
+  unwind([&](const Done& d) { return d.t <= tick; }, tick);
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::commit(std::uint64_t collisions) {
+  require(collisions >= j_ncoll0_ && collisions <= ncoll_,
+          "lattice commit: the collision count must be in [journal_start, collisions] = [" + std::to_string(j_ncoll0_) +
+              ", " + std::to_string(ncoll_) + "]");
+  std::uint64_t n = j_ncoll0_;
+  std::size_t k = 0, walls = 0;
+  while (n < collisions) {  // through the entry of collision `collisions`
+    const Done& d = jdone_[k++];
+    if (d.type == wall) ++walls;
+    if (d.type == coll) ++n;
+    if (n == collisions) {
+      j_clock0_ = d.t;
+      j_key0_ = {d.t, d.kind};
+    }
+  }
+  jdone_.erase(jdone_.begin(), jdone_.begin() + static_cast<std::ptrdiff_t>(k));
+  jwall_.erase(jwall_.begin(), jwall_.begin() + static_cast<std::ptrdiff_t>(walls));
+  j_ncoll0_ = collisions;
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::touch(int p) {
+  if (jmark_[static_cast<std::size_t>(p)] == jepoch_) return;
+  jmark_[static_cast<std::size_t>(p)] = jepoch_;
+  jtouched_.push_back(p);
+}
+
+// Undoes the journal's top entries until keep(top) (or the journal is empty), then predicts
+// the touched particles again at the new clock: the kept top entry's tick (or the journal's
+// start), unless `clock` (a tick target) is later.
+template <class Op, class Bits, class Queue>
+template <class Keep>
+void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
+  stop_observing();  // observation is forward only
+  if (jmark_.size() != ln_.size() || ++jepoch_ == 0) {
+    jmark_.assign(ln_.size(), 0);
+    jepoch_ = 1;
+  }
+  jtouched_.clear();
+  // (no engine error can come from here but a broken invariant, a bug: logic_error)
+  while (!jdone_.empty() && !keep(jdone_.back())) {
+    const Done d = jdone_.back();
+    jdone_.pop_back();
+    touch(d.p);
+    if (d.type == wall) {
+      undo_wall(d.p, d.t, jwall_.back());
+      jwall_.pop_back();
+    } else if (d.type == coll) {
+      touch(d.q);
+      undo_collision(d.p, d.q, d.t, d.unreflected);
+      if (trace != nullptr && !trace->empty()) trace->pop_back();
+    }
+  }
+  if (jdone_.empty()) {
+    clock_ = std::max(clock, j_clock0_);
+    last_key_ = j_key0_;
+  } else {
+    clock_ = std::max(clock, jdone_.back().t);
+    last_key_ = {jdone_.back().t, jdone_.back().kind};
+  }
+  // anchor every touched particle at the clock first (its cell or list ball as of the clock:
+  // a prediction reads its neighbours' cells), then predict each
+  for (int p : jtouched_) {
+    ++slot_[static_cast<std::size_t>(p)].ver;
+    reanchor(p, clock_);
+    sync(p);
+  }
+  for (int p : jtouched_) predict(p, clock_);
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::undo_wall(int p, std::int64_t a, const WallDone& w) {
+  Vec x = pos(p, a), v = neg(ln_[p].v);
+  if (reflection(x, v) == 0) throw std::logic_error("lattice rollback: a reflection's post line meets no wall (a bug)");
+  ln_[p] = Line{x, neg(v), a - 1};
+  pre_wall_[p] = w.pre_wall;
+  wall_tick_[p] = w.wall_tick;
+  sync(p);
+  ++cnt_.walls;
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, std::uint8_t unreflected) {
+  // i's last collision is the one undone here: its key is (i, i's count)
+  const LogKey key{static_cast<std::uint32_t>(i), own_[i].pc};
+  if (!groups_.empty()) [[unlikely]] {
+    if (const auto it = groups_.find(key); it != groups_.end()) {
+      const std::shared_ptr<Group> g = it->second;  // (undo_group erases its keys)
+      undo_group(a, *g, i, j, unreflected);
+      return;
+    }
+  }
+  if (own_[i].pc == 0 || own_[j].pc == 0) throw std::logic_error("lattice rollback: a collision count would step back past 0 (a bug)");
+  const auto logged = log_.empty() ? log_.end() : log_.find(key);
+  const Vec xj = pos(j, a), xi = diff(pos(i, a), xj), zero{};
+  Vec xi0, xj0, vi0, vj0;
+  if (mode_ == Mode::specular && logged == log_.end()) {  // (a log entry: a drawn fallback)
+    if (spec_.pair_unmap(xi, zero, ln_[i].v, ln_[j].v, xi0, xj0, vi0, vj0) != Refusal::none)
+      throw std::logic_error("lattice rollback: the specular map refused a post state it wrote (a bug)");
+  } else {
+    const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
+    if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice rollback: a stream would step back past draw 0 (a bug)");
+    const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, own_[i].ctr - 1);
+    op_.pair_reverse(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi0, xj0, vi0, vj0);
+    own_[i].ctr -= 1 + redraws;
+    if (logged != log_.end()) log_.erase(logged);
+  }
+  --own_[i].pc;
+  --own_[j].pc;
+  --ncoll_;
+  ln_[i] = Line{shifted(xj, xi0), vi0, a - 1};
+  ln_[j] = Line{shifted(xj, xj0), vj0, a - 1};
+  sync(i);
+  sync(j);
+  ++cnt_.collisions;
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::undo_group(std::int64_t a, const Group& entry, int i, int j, std::uint8_t unreflected) {
+  const std::vector<int> g = entry.members;  // (copies: the entry goes with its last key)
+  const std::vector<Vec> pre_v = entry.pre_v;
+  const int drawer = entry.drawer;
+  const std::uint32_t draws = entry.draws;
+  for (std::size_t m = 0; m < g.size(); ++m)
+    if (own_[g[m]].pc != entry.counts[m]) throw std::logic_error("lattice rollback: a group undone before a member's later collision (a bug)");
+  if (own_[drawer].ctr < draws) throw std::logic_error("lattice rollback: a stream would step back past draw 0 (a bug)");
+  for (std::size_t m = 0; m < g.size(); ++m) {
+    Line& l = ln_[g[m]];
+    // a member's point at a is its a-1 point (the stall)
+    l = Line{pos(g[m], a), pre_v.empty() ? neg(l.v) : pre_v[m], a - 1};
+    touch(g[m]);
+  }
+  own_[drawer].ctr -= draws;
+  for (int q : g) {
+    groups_.erase(LogKey{static_cast<std::uint32_t>(q), own_[q].pc});
+    --own_[q].pc;
+  }
+  --ngroups_;
+  --ncoll_;
+  // a member that took in its reflection at a: its line is the one before the reflection; the
+  // state between the reflection and the group had the reflected line and the reflection's cache
+  for (int s = 0; s < 2; ++s) {
+    if (!(unreflected >> s & 1u)) continue;
+    const int m = s == 0 ? i : j;
+    pre_wall_[m] = ln_[m];
+    Vec x = pos(m, a - 1), v = ln_[m].v;
+    if (reflection(x, v) == 0) throw std::logic_error("lattice rollback: a group member's reflection meets no wall (a bug)");
+    ln_[m] = Line{x, v, a};
+    wall_tick_[m] = a;
+  }
+  for (int q : g) sync(q);
+  ++cnt_.collisions;
+}
+
+}  // namespace revcol::lattice

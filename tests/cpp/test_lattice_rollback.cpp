@@ -1,0 +1,260 @@
+// Rollback (rollback.hpp): with the journal kept, the latest events are undone one by one in the
+// forward frame, and the state is bit for bit the one the forward run had at the target
+// (collision count or tick), in every mode the lattice has: 2D and 3D, periodic, specular and
+// bounce-back walls, exact and specular collisions, the cell grid and neighbour lists, forced
+// groups (resolved and bounced). Checked three ways: rollbacks to stored forward states and a run
+// on that rejoins the forward run; the rollback check of ROSS (each collision done, undone,
+// compared, done again); and a fuzz of random runs, rollbacks and commits against the forward
+// run's state hash at every collision count. Bad requests are refused with the state unchanged.
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "check.hpp"
+#include "lattice_gas_util.hpp"
+#include "revcol/lattice/engine.hpp"
+
+using namespace revcol::lattice;
+namespace en = revcol::engine;
+using revcol::Mode;
+
+namespace {
+
+using lattice_test::EngineOf;
+using lattice_test::refused;
+
+// FNV-1a over the state same_state compares (clock, collisions, x, v, streams, counts, X, log, groups)
+template <std::size_t D>
+std::uint64_t state_hash(const SnapshotN<D>& s) {
+  std::uint64_t h = 1469598103934665603ULL;
+  auto mix = [&](std::uint64_t w) {
+    for (int b = 0; b < 8; ++b) h = (h ^ ((w >> (8 * b)) & 0xffU)) * 1099511628211ULL;
+  };
+  mix(static_cast<std::uint64_t>(s.clock));
+  mix(s.collisions);
+  for (std::size_t p = 0; p < s.x.size(); ++p)
+    for (std::size_t k = 0; k < D; ++k) {
+      mix(static_cast<std::uint64_t>(s.x[p][k]));
+      mix(static_cast<std::uint64_t>(s.v[p][k]));
+    }
+  for (auto w : s.streams) mix(w);
+  for (auto w : s.particle_collisions) mix(w);
+  for (auto w : s.bits) mix(w);
+  for (auto w : s.bits_size) mix(w);
+  for (const LogEntry& e : s.log) {
+    mix(e.particle);
+    mix(e.count);
+    mix(e.redraws);
+  }
+  for (const auto& g : s.groups) {
+    mix(static_cast<std::uint64_t>(g.drawer));
+    mix(g.draws);
+    for (int m : g.members) mix(static_cast<std::uint64_t>(m));
+    for (auto c : g.counts) mix(c);
+    for (const auto& v : g.pre_v)
+      for (auto c : v) mix(static_cast<std::uint64_t>(c));
+  }
+  return h;
+}
+
+struct Scene {
+  const char* what;
+  std::size_t n;
+  double phi;
+  en::Boundary kind;
+  Mode mode;
+  double shell;     // < 0: the engine's choice; 0: cells; > 0: lists
+  int max_redraws;  // -1: every collision a group
+  bool resolve;     // groups resolve (else bounce)
+};
+
+template <std::size_t D>
+EngineOf<D> make(const Scene& sc, std::uint32_t seed) {
+  auto e = lattice_test::make_gas<D>(sc.n, sc.phi, sc.kind, seed, 16, sc.mode);
+  if (sc.shell >= 0.0) e.set_list_shell(sc.shell);
+  e.max_redraws = sc.max_redraws;
+  e.group_resolve = sc.resolve;
+  return e;
+}
+
+template <std::size_t D>
+void check_scene(const Scene& sc, std::uint64_t total, std::uint32_t seed) {
+  // the forward run's state (hash) after every collision, and whole snapshots at a few counts
+  auto r = make<D>(sc, seed);
+  std::vector<std::uint64_t> ref{state_hash(r.snapshot())};
+  std::vector<SnapshotN<D>> snaps{r.snapshot()};
+  const std::uint64_t every = total / 6;
+  for (std::uint64_t c = 1; c <= total; ++c) {
+    r.run(1, tick_limit - 1);
+    const auto s = r.snapshot();
+    ref.push_back(state_hash(s));
+    if (c % every == 0) snaps.push_back(s);
+  }
+  const auto cnt = r.counters();
+  const SnapshotN<D> end = r.snapshot();
+
+  // 1. rollbacks to stored states, latest first, then a run on that rejoins the forward run
+  auto e = make<D>(sc, seed);
+  e.keep_journal(true);
+  e.run(total, tick_limit - 1);
+  CHECK(same_state(e.snapshot(), end));
+  bool all = true;
+  for (std::size_t k = snaps.size(); k-- > 0;) {
+    e.rollback(snaps[k].collisions);
+    all = all && same_state(e.snapshot(), snaps[k]);
+  }
+  CHECK(all);
+  e.run(total, tick_limit - 1);
+  CHECK(same_state(e.snapshot(), end));
+
+  // 2. rollback to ticks: the state run(until = tick) has
+  int ticks_ok = 0, ticks = 0;
+  for (std::size_t k = snaps.size() - 1; k >= 1; --k) {
+    const std::int64_t t = (snaps[k].clock + snaps[k - 1].clock) / 2;
+    auto f = make<D>(sc, seed);
+    f.run(total, t);
+    e.rollback_to_tick(t);
+    ++ticks;
+    if (same_state(e.snapshot(), f.snapshot())) ++ticks_ok;
+  }
+  CHECK(ticks_ok == ticks);
+
+  // 3. ROSS's rollback check: every collision done, undone (compared), done again (compared)
+  auto c = make<D>(sc, seed);
+  c.keep_journal(true);
+  int ross_bad = 0;
+  const std::uint64_t ross = std::min<std::uint64_t>(total, 600);
+  for (std::uint64_t k = 1; k <= ross; ++k) {
+    c.run(1, tick_limit - 1);
+    c.rollback(k - 1);
+    if (state_hash(c.snapshot()) != ref[k - 1]) ++ross_bad;
+    c.run(1, tick_limit - 1);
+    if (state_hash(c.snapshot()) != ref[k]) ++ross_bad;
+  }
+  CHECK(ross_bad == 0);
+
+  // 4. a fuzz of runs, rollbacks and commits (the journal's start moves up), against the hashes
+  auto z = make<D>(sc, seed);
+  z.keep_journal(true);
+  std::mt19937_64 rng(seed * 7919ULL + 1);
+  int fuzz_bad = 0, rollbacks = 0, commits = 0;
+  for (int step = 0; step < 400; ++step) {
+    const std::uint64_t now = z.collisions();
+    const int op = static_cast<int>(rng() % 8);
+    if (op < 4 && now < total) {
+      z.run(1 + rng() % std::min<std::uint64_t>(60, total - now), tick_limit - 1);
+    } else if (op < 7) {
+      const std::uint64_t lo = z.journal_start();
+      z.rollback(lo + rng() % (now - lo + 1));
+      ++rollbacks;
+    } else {
+      const std::uint64_t lo = z.journal_start();
+      z.commit(lo + rng() % (now - lo + 1) / 2);
+      ++commits;
+    }
+    if (state_hash(z.snapshot()) != ref[z.collisions()]) ++fuzz_bad;
+  }
+  CHECK(fuzz_bad == 0);
+  z.run(total - z.collisions(), tick_limit - 1);
+  CHECK(same_state(z.snapshot(), end));
+  std::printf("  %s: %llu collisions (%llu walls, %llu groups, %llu of them with a reflection, %llu log entries); %zu rollbacks to states, %d to ticks, "
+              "%llu done-undone-redone, fuzz %d rollbacks %d commits: %s\n",
+              sc.what, static_cast<unsigned long long>(total), static_cast<unsigned long long>(cnt.walls),
+              static_cast<unsigned long long>(cnt.group_resolves + cnt.group_bounces),
+              static_cast<unsigned long long>(cnt.wall_groups), static_cast<unsigned long long>(cnt.log_entries), snaps.size(), ticks, static_cast<unsigned long long>(ross),
+              rollbacks, commits, all && ticks_ok == ticks && ross_bad == 0 && fuzz_bad == 0 ? "bit for bit" : "DIFFERENT");
+}
+
+}  // namespace
+
+TEST_CASE("2D rollback is exact: periodic, walls, bounce back; exact and specular; cells and lists") {
+  using B = en::Boundary;
+  check_scene<2>({"2D 0.5 periodic exact cells", 300, 0.5, B::periodic, Mode::exact, -1.0, 256, true}, 2400, 11);
+  check_scene<2>({"2D 0.6 walls exact", 300, 0.6, B::wall, Mode::exact, -1.0, 256, true}, 2400, 12);
+  check_scene<2>({"2D 0.5 bounce-back walls exact", 250, 0.5, B::bounce, Mode::exact, -1.0, 256, true}, 2000, 13);
+  check_scene<2>({"2D 0.5 walls specular", 300, 0.5, B::wall, Mode::specular, -1.0, 256, true}, 2400, 14);
+  check_scene<2>({"2D 0.4 periodic exact lists", 300, 0.4, B::periodic, Mode::exact, 0.6, 256, true}, 2000, 15);
+  check_scene<2>({"2D 0.4 walls forced groups (resolve)", 150, 0.4, B::wall, Mode::exact, -1.0, -1, true}, 900, 16);
+  check_scene<2>({"2D 0.4 periodic forced groups (bounce)", 150, 0.4, B::periodic, Mode::exact, -1.0, -1, false}, 900, 17);
+  check_scene<2>({"2D 0.7 walls exact", 400, 0.7, B::wall, Mode::exact, -1.0, 256, true}, 3000, 18);
+  check_scene<2>({"2D 0.7 bounce-back walls specular", 400, 0.7, B::bounce, Mode::specular, -1.0, 256, true}, 3000, 19);
+}
+
+TEST_CASE("3D rollback is exact: periodic, walls, bounce back; exact and specular; lists and cells") {
+  using B = en::Boundary;
+  check_scene<3>({"3D 0.4 periodic exact lists", 300, 0.4, B::periodic, Mode::exact, -1.0, 256, true}, 2400, 21);
+  check_scene<3>({"3D 0.4 walls exact", 300, 0.4, B::wall, Mode::exact, -1.0, 256, true}, 2400, 22);
+  check_scene<3>({"3D 0.4 bounce-back walls specular", 250, 0.4, B::bounce, Mode::specular, -1.0, 256, true}, 2000, 23);
+  check_scene<3>({"3D 0.3 walls exact cells", 250, 0.3, B::wall, Mode::exact, 0.0, 256, true}, 2000, 24);
+  check_scene<3>({"3D 0.3 walls forced groups", 150, 0.3, B::wall, Mode::exact, -1.0, -1, true}, 700, 25);
+  check_scene<3>({"3D 0.45 periodic exact", 300, 0.45, B::periodic, Mode::exact, -1.0, 256, true}, 3000, 26);
+  check_scene<3>({"3D 0.4 walls specular", 300, 0.4, B::wall, Mode::specular, -1.0, 256, true}, 3000, 27);
+}
+
+TEST_CASE("3D walls: collisions right after a reflection on one tick roll back exactly") {
+  // (test_lattice_engine3d.cpp: ~ every 30 000 collisions at N = 256, 0.45, walls, T = 16)
+  auto e = lattice_test::make_gas<3>(256, 0.45, en::Boundary::wall, 1, 16);
+  auto f = lattice_test::make_gas<3>(256, 0.45, en::Boundary::wall, 1, 16);  // forward only, lazily behind
+  e.keep_journal(true);
+  int seen = 0, bad = 0;
+  for (std::uint64_t k = 1; k <= 100000; ++k) {
+    const std::uint64_t before = e.counters().wall_body;
+    e.run(1, tick_limit - 1);
+    if (e.counters().wall_body == before) {
+      if (k % 1000 == 0) e.commit(k - 1000);
+      continue;
+    }
+    // undo it (the state before it as the forward run had it), back 200 more, then on again
+    ++seen;
+    const auto after = e.snapshot();
+    e.rollback(k - 1);
+    f.run(k - 1 - f.collisions(), tick_limit - 1);
+    if (!same_state(e.snapshot(), f.snapshot())) ++bad;
+    const std::uint64_t back = std::max<std::uint64_t>(e.journal_start(), k > 201 ? k - 201 : 0);
+    e.rollback(back);
+    e.run(k - back, tick_limit - 1);
+    if (!same_state(e.snapshot(), after)) ++bad;
+  }
+  std::printf("  N = 256, 0.45, walls: %d collisions right after a reflection in 10^5, rolled back and redone: %s\n", seen,
+              bad == 0 ? "bit for bit" : "DIFFERENT");
+  CHECK(seen >= 2);
+  CHECK(bad == 0);
+}
+
+TEST_CASE("rollback refuses what it can not do, the state unchanged") {
+  auto e = lattice_test::make_gas<2>(200, 0.5, en::Boundary::wall, 31, 16);
+  e.run(300, tick_limit - 1);
+  const auto s = e.snapshot();
+  CHECK(refused([&] { e.rollback(100); }, "keeps no journal"));
+  CHECK(refused([&] { e.rollback_to_tick(0); }, "keeps no journal"));
+  CHECK(same_state(e.snapshot(), s));
+  e.keep_journal(true);
+  CHECK(e.journal_start() == 300);
+  e.run(200, tick_limit - 1);
+  const auto s2 = e.snapshot();
+  CHECK(refused([&] { e.rollback(299); }, "[journal_start, collisions] = [300, 500]"));
+  CHECK(refused([&] { e.rollback(501); }, "[journal_start, collisions] = [300, 500]"));
+  CHECK(refused([&] { e.rollback_to_tick(s.clock - 1); }, "journal_start_tick"));
+  CHECK(refused([&] { e.rollback_to_tick(s2.clock + 1); }, "journal_start_tick"));
+  CHECK(refused([&] { e.commit(299); }, "lattice commit"));
+  CHECK(same_state(e.snapshot(), s2));
+  e.commit(400);
+  CHECK(e.journal_start() == 400);
+  CHECK(refused([&] { e.rollback(399); }, "[journal_start, collisions] = [400, 500]"));
+  e.rollback(400);
+  CHECK(e.collisions() == 400);
+  // an engine error mid-run restores the state and restarts the journal there
+  e.throw_at_collision = 450;
+  CHECK(refused([&] { e.run(100, tick_limit - 1); }, "test hook"));
+  CHECK(e.collisions() == 400);
+  CHECK(e.journal_start() == 400);
+  e.throw_at_collision = 0;
+  // a run back restarts the journal at the state it leaves
+  e.run(50, tick_limit - 1);
+  e.run_back(350, e.origin());
+  CHECK(e.journal_start() == 350);
+  CHECK(e.journal_size() == 0);
+  CHECK(refused([&] { e.rollback(349); }, "[journal_start, collisions] = [350, 350]"));
+}
+int main() { return check::run_all(); }
