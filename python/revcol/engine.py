@@ -43,7 +43,7 @@ import numpy as np
 from . import _core
 from ._args import integer, names, placement, real_array
 from ._args import packing_fraction as _packing_fraction
-from ._io import read_checkpoint, stamped, write_npz_atomic
+from ._io import read_checkpoint, write_checkpoint
 from .roundtrip import divergence_text
 from .simulation import SimulationBase, engine_class, register_engine
 
@@ -275,13 +275,15 @@ class Simulation(SimulationBase):
         return cls(None, None, None, _engine=_core.Engine.from_snapshot(dict(snapshot)))
 
     def save(self, path: Union[str, os.PathLike]) -> None:
-        """Writes the full state to ``path`` (numpy ``.npz``)."""
-        st = self.snapshot()
-        write_npz_atomic(path, stamped({k: np.asarray(v) for k, v in st.items()}, "float"))
+        """Writes the full state to ``path`` atomically (numpy ``.npz``, stamped, with a SHA-256
+        digest of its entries that ``load`` checks: :func:`revcol._io.write_checkpoint`)."""
+        write_checkpoint(path, self.snapshot(), "float")
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "Simulation":
-        """Reads a state written by ``save``."""
+        """Reads a state written by ``save``. A file whose digest does not match its entries raises
+        ``ValueError("checkpoint corrupted: digest mismatch in '<path>' ...")``; one written before
+        digests loads unchecked."""
         st = {k: (a.item() if a.ndim == 0 else a) for k, a in read_checkpoint(path, "float").items()}
         return cls.from_snapshot(st)
 

@@ -40,7 +40,7 @@ import numpy as np
 from . import _core
 from ._args import integer, name, names, placement, real, real_array
 from ._args import packing_fraction as _packing_fraction
-from ._io import read_checkpoint, stamped, write_npz_atomic
+from ._io import read_checkpoint, write_checkpoint
 from .simulation import SimulationBase, register_engine
 
 __all__ = ["LatticeSimulation", "LatticeSimulation3D", "MODES", "restart_from_legacy"]
@@ -430,7 +430,9 @@ class LatticeSimulation(SimulationBase):
         return sim
 
     def save(self, path: Union[str, os.PathLike]) -> None:
-        """Writes the full state to ``path`` atomically (numpy ``.npz``; nested dicts as ``a.b`` keys)."""
+        """Writes the full state to ``path`` atomically (numpy ``.npz``; nested dicts as ``a.b`` keys;
+        stamped, with a SHA-256 digest of its entries that ``load`` checks:
+        :func:`revcol._io.write_checkpoint`)."""
         flat = {}
         for k, v in self.snapshot().items():
             if isinstance(v, dict):
@@ -438,12 +440,14 @@ class LatticeSimulation(SimulationBase):
                     flat[f"{k}.{k2}"] = np.asarray(v2)
             else:
                 flat[k] = np.asarray(v)
-        write_npz_atomic(path, stamped(flat, "lattice"))
+        write_checkpoint(path, flat, "lattice")
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "LatticeSimulation":
-        """Reads a state written by ``save``. A checkpoint of an older revcol (one bits-back
-        integer for the whole gas) is refused: :func:`restart_from_legacy` starts a new run from it."""
+        """Reads a state written by ``save``. A file whose digest does not match its entries raises
+        ``ValueError("checkpoint corrupted: digest mismatch in '<path>' ...")`` (one written before
+        digests loads unchecked). A checkpoint of an older revcol (one bits-back integer for the
+        whole gas) is refused: :func:`restart_from_legacy` starts a new run from it."""
         return cls.from_snapshot(_read_state(path))
 
     def __repr__(self) -> str:

@@ -2,7 +2,10 @@
 truncated, made of strings, NaN, huge (2^62 or 1e300), a pickled object, or missing. Each
 damaged file must either be refused with a ValueError/TypeError whose message names the entry,
 or be one of the loads listed in LEGAL below (with the reason it is legal), and then run and run
-back without any other exception."""
+back without any other exception. Each damaged file is re-digested (``revcol._io.digested``, what
+``save`` does), so that the consistency checks behind the digest are what is tested here; a
+damaged file that keeps the old digest is refused by the digest first
+(tests/python/test_checkpoint_digest.py)."""
 import os
 import warnings
 
@@ -10,6 +13,7 @@ import numpy as np
 import pytest
 
 from revcol import Simulation
+from revcol._io import DIGEST_KEY, digested
 
 DAMAGES = ("truncated", "strings", "nan", "huge", "pickle", "missing")
 
@@ -64,7 +68,7 @@ def _cases(engine, tmp):
     with np.load(path) as z:
         data = {k: z[k] for k in z.files}
     for key in sorted(data):
-        if key.startswith("revcol_"):
+        if key.startswith("revcol_") or key == DIGEST_KEY:  # the digest's own damage: test_checkpoint_digest.py
             continue
         for damage in DAMAGES:
             bad = _damaged(data[key], damage)
@@ -84,10 +88,10 @@ def test_every_damaged_entry_is_refused_by_name_or_legal(engine, tmp_path):
         else:
             d[key] = bad
         q = tmp_path / "b.npz"
-        if damage == "pickle":
+        if damage == "pickle":  # refused on reading the entry, before the digest (objects have no digest)
             np.savez(q, **d, allow_pickle=True)
-        else:
-            np.savez(q, **d)
+        else:  # a digest that matches the damage: the entry's own check must refuse it
+            np.savez(q, **digested(d))
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
