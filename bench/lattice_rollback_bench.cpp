@@ -1,13 +1,16 @@
 // The rollback family of revcol-bench: what the lattice engine's journal and rollback
-// (rollback.hpp) cost, the two halves of a Time Warp logical process's reverse computation.
-// From a gas warmed up by a collision per particle, twice in turn (A B A B):
-//   A  run(n) forward without the journal;
-//   B  run(n) forward keeping the journal, then undo all n collisions: the first quarter one
-//      collision per rollback, the second 100 per rollback, the rest in one, back to the start.
-// Metrics (medians of the two turns): forward_per_s (A), forward_journal_per_s (B), and the
-// collisions undone per second at each rollback length (undo_per_s_L1, undo_per_s_L100,
-// undo_per_s_bulk); journal_bytes_per_collision; bit_exact (1 when B's forward state equals A's
-// and the rollbacks end at the start state, bit for bit); events_per_collision; n, phi.
+// (rollback.hpp) cost, the two halves of a Time Warp logical process's rollback, by reverse
+// computation (RC) and by the paper's two kinds of state saving (SS1: each touched particle's
+// whole record before every event; SS2: only the lines and X an event changes).
+// From a gas warmed up by a collision per particle, twice in turn (A RC SS1 SS2 A RC SS1 SS2):
+//   A   run(n) forward without the journal;
+//   RC, SS1, SS2  run(n) forward keeping the journal so, then undo all n collisions: the first
+//       quarter one collision per rollback, the second 100 per rollback, the rest in one.
+// Metrics (medians of the two turns): forward_per_s (A); per variant v in rc, ss1, ss2:
+// forward_v_per_s, undo_v_per_s_L1, undo_v_per_s_L100, undo_v_per_s_bulk (collisions undone
+// per second at each rollback length) and journal_v_bytes_per_collision (the journal's memory
+// after the forward run); bit_exact (1 when every variant's forward state equals A's and its
+// rollbacks end at the start state, bit for bit); events_per_collision; n, phi.
 //
 //   revcol-bench --bench rollback/ --collisions 1000000
 #include <algorithm>
@@ -44,7 +47,9 @@ std::vector<Metric> run_rollback(const RollbackCase& c, std::uint64_t nc) {
   e.run(c.n, la::tick_limit - 1);  // warm up
   const la::SnapshotN<D> s0 = e.snapshot();
   using clock = std::chrono::steady_clock;
-  std::vector<double> fwd, fwdj, l1, l100, bulk, bytes, events;
+  const la::Rollback hows[3] = {la::Rollback::reverse, la::Rollback::save_all, la::Rollback::save_changes};
+  const char* names[3] = {"rc", "ss1", "ss2"};
+  std::vector<double> fwd, events, fwdj[3], l1[3], l100[3], bulk[3], bytes[3];
   bool exact = true;
   for (int turn = 0; turn < 2; ++turn) {
     // A: forward, no journal
@@ -54,38 +59,44 @@ std::vector<Metric> run_rollback(const RollbackCase& c, std::uint64_t nc) {
     const std::uint64_t done = e.run(nc, la::tick_limit - 1);
     fwd.push_back(static_cast<double>(done) / seconds_since(t0));
     const la::SnapshotN<D> s1 = e.snapshot();
-    // B: forward with the journal, then undo it all
-    e.restore(s0);
-    e.keep_journal(true);
-    const std::uint64_t ev0 = e.counters().events;
-    t0 = clock::now();
-    e.run(nc, la::tick_limit - 1);
-    fwdj.push_back(static_cast<double>(done) / seconds_since(t0));
-    events.push_back(static_cast<double>(e.counters().events - ev0) / static_cast<double>(done));
-    bytes.push_back(static_cast<double>(e.journal_size()) * 24.0 / static_cast<double>(done));
-    exact = exact && la::same_state(e.snapshot(), s1);
-    const std::uint64_t top = e.collisions(), q = done / 4;
-    auto undo = [&](std::uint64_t to, std::uint64_t step) {
-      const std::uint64_t from = e.collisions();
-      const auto u0 = clock::now();
-      while (e.collisions() > to) e.rollback(e.collisions() - std::min(step, e.collisions() - to));
-      return static_cast<double>(from - to) / seconds_since(u0);
-    };
-    l1.push_back(undo(top - q, 1));
-    l100.push_back(undo(top - 2 * q, 100));
-    bulk.push_back(undo(s0.collisions, done));
-    exact = exact && la::same_state(e.snapshot(), s0);
+    for (int v = 0; v < 3; ++v) {
+      // forward with the journal, then undo it all
+      e.restore(s0);
+      e.keep_journal(true, hows[v]);
+      const std::uint64_t ev0 = e.counters().events;
+      t0 = clock::now();
+      e.run(nc, la::tick_limit - 1);
+      fwdj[v].push_back(static_cast<double>(done) / seconds_since(t0));
+      if (v == 0) events.push_back(static_cast<double>(e.counters().events - ev0) / static_cast<double>(done));
+      bytes[v].push_back(static_cast<double>(e.journal_bytes()) / static_cast<double>(done));
+      exact = exact && la::same_state(e.snapshot(), s1);
+      const std::uint64_t top = e.collisions(), q = done / 4;
+      auto undo = [&](std::uint64_t to, std::uint64_t step) {
+        const std::uint64_t from = e.collisions();
+        const auto u0 = clock::now();
+        while (e.collisions() > to) e.rollback(e.collisions() - std::min(step, e.collisions() - to));
+        return static_cast<double>(from - to) / seconds_since(u0);
+      };
+      l1[v].push_back(undo(top - q, 1));
+      l100[v].push_back(undo(top - 2 * q, 100));
+      bulk[v].push_back(undo(s0.collisions, done));
+      exact = exact && la::same_state(e.snapshot(), s0);
+    }
   }
-  return {{"forward_per_s", median(fwd)},
-          {"forward_journal_per_s", median(fwdj)},
-          {"undo_per_s_L1", median(l1)},
-          {"undo_per_s_L100", median(l100)},
-          {"undo_per_s_bulk", median(bulk)},
-          {"journal_bytes_per_collision", median(bytes)},
-          {"events_per_collision", median(events)},
-          {"bit_exact", exact ? 1.0 : 0.0},
-          {"n", static_cast<double>(c.n)},
-          {"phi", c.phi}};
+  std::vector<Metric> out{{"forward_per_s", median(fwd)}};
+  for (int v = 0; v < 3; ++v) {
+    const std::string n = names[v];
+    out.push_back({"forward_" + n + "_per_s", median(fwdj[v])});
+    out.push_back({"undo_" + n + "_per_s_L1", median(l1[v])});
+    out.push_back({"undo_" + n + "_per_s_L100", median(l100[v])});
+    out.push_back({"undo_" + n + "_per_s_bulk", median(bulk[v])});
+    out.push_back({"journal_" + n + "_bytes_per_collision", median(bytes[v])});
+  }
+  out.push_back({"events_per_collision", median(events)});
+  out.push_back({"bit_exact", exact ? 1.0 : 0.0});
+  out.push_back({"n", static_cast<double>(c.n)});
+  out.push_back({"phi", c.phi});
+  return out;
 }
 
 }  // namespace

@@ -459,8 +459,18 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
           "Back to collision count `to_collisions` or tick `to_tick` (default: the start).")
       // ---- the processed-event journal (BasicEngine::keep_journal, rollback.hpp) ----
       .def(
-          "keep_journal", [](P& p, bool on) { p.engine().keep_journal(on); }, py::arg("on"),
-          "Keeps (or stops keeping) the journal of processed events from the state on: rollback undoes them.")
+          "keep_journal",
+          [](P& p, bool on, const std::string& by) {
+            la::Rollback how = la::Rollback::reverse;
+            if (by == "save_all") how = la::Rollback::save_all;
+            else if (by == "save_changes") how = la::Rollback::save_changes;
+            else require(by == "reverse", "rollback by must be 'reverse', 'save_all' (SS1) or 'save_changes' (SS2), not '" + by + "'");
+            p.engine().keep_journal(on, how);
+          },
+          py::arg("on"), py::arg("by") = "reverse",
+          "Keeps (or stops keeping) the journal of processed events from the state on: rollback undoes them, by "
+          "reverse computation or (the comparison) by state saving.")
+      .def_property_readonly("journal_bytes", [](const P& p) { return p.engine().journal_bytes(); })
       .def_property_readonly("journaling", [](const P& p) { return p.engine().journaling(); })
       .def_property_readonly("journal_start", [](const P& p) { return p.engine().journal_start(); },
                              "The collision count at the journal's start (the earliest state rollback reaches).")

@@ -251,21 +251,24 @@ class LatticeSimulation(SimulationBase):
 
     # --- rollback: the journal of processed events ------------------------------------------
 
-    def keep_journal(self, on: bool = True) -> None:
+    def keep_journal(self, on: bool = True, by: str = "reverse") -> None:
         """Keeps (or stops keeping) the journal of the events processed from the current
         state on, 24 bytes per event: :meth:`rollback` then undoes the latest events one by one,
         each by its own reverse computation (nothing of the state is saved), in time
         proportional to the events undone. The journal starts afresh at the state whenever the
-        search is rebuilt (``load``, ``run_back``, setting ``search``)."""
-        self._e.keep_journal(bool(on))
+        search is rebuilt (``load``, ``run_back``, setting ``search``). ``by``: ``"reverse"``
+        (reverse computation), or state saving for the comparison: ``"save_all"`` (SS1, each
+        touched particle's whole record before every event) or ``"save_changes"`` (SS2, only the
+        lines and X an event changes)."""
+        self._e.keep_journal(bool(on), name(by, "by"))
 
     @property
     def journal(self) -> dict:
         """The journal: ``on``, ``start`` (the collision count rollback reaches back to),
-        ``start_clock`` and ``size`` (events held)."""
+        ``start_clock``, ``size`` (events held) and ``bytes`` (its memory)."""
         e = self._e
         return {"on": bool(e.journaling), "start": int(e.journal_start), "start_clock": int(e.journal_start_tick),
-                "size": int(e.journal_size)}
+                "size": int(e.journal_size), "bytes": int(e.journal_bytes)}
 
     def rollback(self, to_collision: Optional[int] = None, time: Optional[float] = None) -> dict:
         """Undoes the journal's latest events: back to the state right after collision

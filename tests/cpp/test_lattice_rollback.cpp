@@ -120,46 +120,47 @@ void check_scene(const Scene& sc, std::uint64_t total, std::uint32_t seed) {
   }
   CHECK(ticks_ok == ticks);
 
-  // 3. ROSS's rollback check: every collision done, undone (compared), done again (compared)
-  auto c = make<D>(sc, seed);
-  c.keep_journal(true);
-  int ross_bad = 0;
+  // 3. ROSS's rollback check: every collision done, undone (compared), done again (compared);
+  // 4. a fuzz of runs, rollbacks and commits (the journal's start moves up), against the hashes;
+  // both with rollback by reverse computation and by state saving (SS1, SS2)
+  int ross_bad = 0, fuzz_bad = 0, rollbacks = 0, commits = 0;
   const std::uint64_t ross = std::min<std::uint64_t>(total, 600);
-  for (std::uint64_t k = 1; k <= ross; ++k) {
-    c.run(1, tick_limit - 1);
-    c.rollback(k - 1);
-    if (state_hash(c.snapshot()) != ref[k - 1]) ++ross_bad;
-    c.run(1, tick_limit - 1);
-    if (state_hash(c.snapshot()) != ref[k]) ++ross_bad;
+  for (const Rollback how : {Rollback::reverse, Rollback::save_all, Rollback::save_changes}) {
+    auto c = make<D>(sc, seed);
+    c.keep_journal(true, how);
+    for (std::uint64_t k = 1; k <= ross; ++k) {
+      c.run(1, tick_limit - 1);
+      c.rollback(k - 1);
+      if (state_hash(c.snapshot()) != ref[k - 1]) ++ross_bad;
+      c.run(1, tick_limit - 1);
+      if (state_hash(c.snapshot()) != ref[k]) ++ross_bad;
+    }
+    auto z = make<D>(sc, seed);
+    z.keep_journal(true, how);
+    std::mt19937_64 rng(seed * 7919ULL + 1);
+    for (int step = 0; step < 400; ++step) {
+      const std::uint64_t now = z.collisions();
+      const int op = static_cast<int>(rng() % 8);
+      if (op < 4 && now < total) {
+        z.run(1 + rng() % std::min<std::uint64_t>(60, total - now), tick_limit - 1);
+      } else if (op < 7) {
+        const std::uint64_t lo = z.journal_start();
+        z.rollback(lo + rng() % (now - lo + 1));
+        ++rollbacks;
+      } else {
+        const std::uint64_t lo = z.journal_start();
+        z.commit(lo + rng() % (now - lo + 1) / 2);
+        ++commits;
+      }
+      if (state_hash(z.snapshot()) != ref[z.collisions()]) ++fuzz_bad;
+    }
+    z.run(total - z.collisions(), tick_limit - 1);
+    if (!same_state(z.snapshot(), end)) ++fuzz_bad;
   }
   CHECK(ross_bad == 0);
-
-  // 4. a fuzz of runs, rollbacks and commits (the journal's start moves up), against the hashes
-  auto z = make<D>(sc, seed);
-  z.keep_journal(true);
-  std::mt19937_64 rng(seed * 7919ULL + 1);
-  int fuzz_bad = 0, rollbacks = 0, commits = 0;
-  for (int step = 0; step < 400; ++step) {
-    const std::uint64_t now = z.collisions();
-    const int op = static_cast<int>(rng() % 8);
-    if (op < 4 && now < total) {
-      z.run(1 + rng() % std::min<std::uint64_t>(60, total - now), tick_limit - 1);
-    } else if (op < 7) {
-      const std::uint64_t lo = z.journal_start();
-      z.rollback(lo + rng() % (now - lo + 1));
-      ++rollbacks;
-    } else {
-      const std::uint64_t lo = z.journal_start();
-      z.commit(lo + rng() % (now - lo + 1) / 2);
-      ++commits;
-    }
-    if (state_hash(z.snapshot()) != ref[z.collisions()]) ++fuzz_bad;
-  }
   CHECK(fuzz_bad == 0);
-  z.run(total - z.collisions(), tick_limit - 1);
-  CHECK(same_state(z.snapshot(), end));
   std::printf("  %s: %llu collisions (%llu walls, %llu groups, %llu of them with a reflection, %llu log entries); %zu rollbacks to states, %d to ticks, "
-              "%llu done-undone-redone, fuzz %d rollbacks %d commits: %s\n",
+              "%llu done-undone-redone, fuzz %d rollbacks %d commits (RC, SS1, SS2): %s\n",
               sc.what, static_cast<unsigned long long>(total), static_cast<unsigned long long>(cnt.walls),
               static_cast<unsigned long long>(cnt.group_resolves + cnt.group_bounces),
               static_cast<unsigned long long>(cnt.wall_groups), static_cast<unsigned long long>(cnt.log_entries), snaps.size(), ticks, static_cast<unsigned long long>(ross),

@@ -19,14 +19,15 @@ def _same(a: dict, b: dict) -> bool:
     return all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in KEYS)
 
 
-def test_a_group_that_took_in_a_reflection_rolls_back_bit_for_bit():
+@pytest.mark.parametrize("by", ["reverse", "save_all", "save_changes"])
+def test_a_group_that_took_in_a_reflection_rolls_back_bit_for_bit(by):
     # the first collision of this state is a pair that meets a wall on the tick it collides: the
     # group takes the reflection in (test_lattice.py); its undo reflects the member again, and
-    # the reflection's own entry then undoes that
+    # the reflection's own entry then undoes that (by state saving: the saved lines, the wall tick)
     sim = LatticeSimulation.load(os.path.join(DATA, "wall_body_group_n1000_phi0.7.npz"))
     s0 = sim.snapshot()
-    sim.keep_journal()
-    assert sim.journal == {"on": True, "start": 0, "start_clock": s0["clock"], "size": 0}
+    sim.keep_journal(by=by)
+    assert sim.journal == {"on": True, "start": 0, "start_clock": s0["clock"], "size": 0, "bytes": 0}
     sim.run(collisions=1)
     assert sim.diagnostics()["wall_groups"] == 1
     s1 = sim.snapshot()
@@ -53,6 +54,20 @@ def test_3d_collisions_after_a_reflection_on_one_tick_roll_back():
         ref.run_back(to_collision=0)
         ref.run(collisions=k)
         assert _same(sim.snapshot(), ref.snapshot()), k
+
+
+def test_state_saving_holds_more_than_the_journal_of_reverse_computation():
+    sizes = {}
+    for by in ("reverse", "save_all", "save_changes"):
+        sim = LatticeSimulation3D.random(n=300, phi=0.3, seed=4)
+        sim.keep_journal(by=by)
+        sim.run(collisions=2000)
+        sizes[by] = sim.journal["bytes"]
+        s = sim.snapshot()
+        sim.run(collisions=500)
+        sim.rollback(to_collision=2000)
+        assert _same(sim.snapshot(), s)
+    assert sizes["reverse"] < sizes["save_changes"] < sizes["save_all"]
 
 
 def test_rollback_to_a_time_is_the_state_a_run_to_that_time_has():
@@ -86,6 +101,8 @@ def test_rollback_refusals_leave_the_state_unchanged():
         sim.rollback(to_collision=-1)
     with pytest.raises(ValueError, match="lattice commit"):
         sim.commit(301)
+    with pytest.raises(ValueError, match="rollback by must be"):
+        sim.keep_journal(by="ss3")
     assert _same(sim.snapshot(), s2)
     sim.rollback(to_collision=200)
     assert _same(sim.snapshot(), s)

@@ -114,7 +114,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   std::uint32_t redraws = 0;
   for (;;) {
     if (static_cast<std::int64_t>(redraws) > max_redraws) return group_collide(i, j, a, ctr0, reasons, !fallback);
-    const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, own_[i].ctr++);
+    const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr++);
     const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi2, xj2, vi2, vj2, out);
     int why = static_cast<int>(rf);
     if (why == 0) {
@@ -129,7 +129,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   }
   if (multi) ++cnt_.multi_body;
   if (redraws > 0 || fallback) [[unlikely]] {
-    const LogKey key{static_cast<std::uint32_t>(i), own_[i].pc + 1};
+    const LogKey key{static_cast<std::uint32_t>(gid(i)), own_[i].pc + 1};
     log_.emplace(key, redraws);
     if (!undo_epoch_.empty()) undo_log_.push_back(key);
     ++cnt_.log_entries;
@@ -139,7 +139,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   ++own_[i].pc;
   ++own_[j].pc;
   ++ncoll_;
-  if (trace != nullptr) trace->push_back({a, i, j});
+  if (trace != nullptr) trace->push_back({a, gid(i), gid(j)});
   if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
   apply(i, j, xi2, xj2, vi2, vj2, a);
   return true;
@@ -148,7 +148,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   // i's last collision (forward) is the one undone here: its key is (i, i's count)
-  const LogKey key{static_cast<std::uint32_t>(i), own_[i].pc};
+  const LogKey key{static_cast<std::uint32_t>(gid(i)), own_[i].pc};
   if (!groups_.empty()) [[unlikely]] {
     if (const auto it = groups_.find(key); it != groups_.end()) {
       const std::shared_ptr<Group> g = it->second;  // (group_back erases its keys)
@@ -164,7 +164,7 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
   const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
   if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
-  const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, own_[i].ctr - 1);
+  const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr - 1);
   Vec xi0, xj0, vi0, vj0;
   if (own_[i].pc == 0 || own_[j].pc == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
   op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi0, xj0, vi0, vj0);
@@ -217,7 +217,7 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
   ++own_[i].pc;
   ++own_[j].pc;
   ++ncoll_;
-  if (trace != nullptr) trace->push_back({a, i, j});
+  if (trace != nullptr) trace->push_back({a, gid(i), gid(j)});
   if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
   apply(i, j, xi2, xj2, vi2, vj2, a);
 }

@@ -136,7 +136,7 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
   auto member = [&](int q) { return std::find(g.begin(), g.end(), q) != g.end(); };
   for (;;) {
     if (g.size() > 16) return false;
-    std::sort(g.begin(), g.end());
+    std::sort(g.begin(), g.end(), [&](int a, int b) { return gid(a) < gid(b); });  // by particle id
     post.assign(g.size(), Vec{});
     for (std::size_t m = 0; m < g.size(); ++m) post[m] = pos(g[m], a - 1);
     if (resolve) {
@@ -212,15 +212,20 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
     throw std::runtime_error(why);
   }
   std::vector<Vec> pre_v;
-  for (int q : g) journal(q);
+  for (int q : g) {
+    journal(q);
+    if (jon_ && jhow_ != Rollback::reverse && !reversed_ && q != i && q != j) save_state(q);  // (i, j: saved by the loop)
+  }
   if (resolve)
     for (int q : g) pre_v.push_back(ln_[q].v);
   ++ncoll_;
   std::vector<std::uint64_t> counts;
   for (int q : g) counts.push_back(++own_[q].pc);
-  auto entry = std::make_shared<Group>(Group{i, static_cast<std::uint32_t>(own_[i].ctr - ctr0), g, counts, std::move(pre_v)});
+  std::vector<int> ids;  // (the entry holds particle ids)
+  for (int q : g) ids.push_back(gid(q));
+  auto entry = std::make_shared<Group>(Group{gid(i), static_cast<std::uint32_t>(own_[i].ctr - ctr0), ids, counts, std::move(pre_v)});
   for (std::size_t m = 0; m < g.size(); ++m) {
-    const LogKey key{static_cast<std::uint32_t>(g[m]), counts[m]};
+    const LogKey key{static_cast<std::uint32_t>(ids[m]), counts[m]};
     groups_.emplace(key, entry);
     if (!undo_epoch_.empty()) undo_groups_.push_back(key);
   }
@@ -234,7 +239,7 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
       unreflected_ |= static_cast<std::uint8_t>(1u << s);  // (the journal's entry: its undo reflects again)
       ++cnt_.wall_groups;
     }
-  if (trace != nullptr) trace->push_back({a, i, j});
+  if (trace != nullptr) trace->push_back({a, gid(i), gid(j)});
   if (obs_ || events) [[unlikely]] note_group(a, g, post, vel);
   for (std::size_t m = 0; m < g.size(); ++m) {
     ln_[g[m]] = Line{post[m], vel[m], a};
@@ -248,14 +253,15 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Group& entry) {
-  const std::vector<int> g = entry.members;
+  std::vector<int> g;  // the members' local indices
+  for (int q : entry.members) g.push_back(static_cast<int>(local(q)));
   if (std::find(g.begin(), g.end(), i) == g.end() || std::find(g.begin(), g.end(), j) == g.end()) {
     throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
   }
   for (std::size_t m = 0; m < g.size(); ++m)
     if (own_[g[m]].pc != entry.counts[m]) throw std::logic_error("lattice engine: the reverse met a group before a member's later collision (a bug)");
   const std::uint32_t draws = entry.draws;
-  const int drawer = entry.drawer;
+  const auto drawer = local(entry.drawer);
   if (own_[drawer].ctr < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
   const std::vector<Vec> pre_v = entry.pre_v;  // forward frame; empty: a bounce (a copy: popped below)
   std::vector<Vec> pre(g.size());
@@ -269,7 +275,7 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Grou
   }
   own_[drawer].ctr -= draws;
   for (int q : g) {
-    groups_.erase(LogKey{static_cast<std::uint32_t>(q), own_[q].pc});  // entry is gone after the last
+    groups_.erase(LogKey{static_cast<std::uint32_t>(gid(q)), own_[q].pc});  // entry is gone after the last
     --own_[q].pc;
   }
   --ngroups_;

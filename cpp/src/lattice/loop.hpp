@@ -68,14 +68,14 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
     const bool journal = jon_ && !back;
     if (!valid(p)) {
       ++cnt_.stale;
-      if (journal) jdone_.push_back(Done{t, queue_.kind(p), p, -1, none, 0});
+      if (journal) jdone_.push_back(Done{t, queue_.kind(p), p, -1, none, 0, 0});
       predict(p, t);
       continue;
     }
     const Slot& sp = slot_[static_cast<std::size_t>(p)];
     if (sp.type == cross) {
       ++cnt_.crossings;
-      if (journal) jdone_.push_back(Done{t, queue_.kind(p), p, -1, cross, 0});
+      if (journal) jdone_.push_back(Done{t, queue_.kind(p), p, -1, cross, 0, 0});
       if (lists_) nl_.renew(p, pos(p, t));
       predict(p, t);
       continue;
@@ -84,13 +84,17 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
     check_order(t, kind);
     if (sp.type == wall) {
       if (journal) {
+        jkept_ = 0;
+        if (jhow_ != Rollback::reverse) save_state(p);
         jwall_.push_back(WallDone{wall_tick_[p], pre_wall_[p]});
-        jdone_.push_back(Done{t, kind, p, -1, wall, 0});
+        jdone_.push_back(Done{t, kind, p, -1, wall, 0, jkept_});
       }
       reflect(p, t);
       continue;
     }
-    const int i = std::min(p, sp.partner), j = std::max(p, sp.partner);
+    // the pair's drawer i: the smaller particle id
+    const bool first = gid(p) < gid(sp.partner);
+    const int i = first ? p : sp.partner, j = first ? sp.partner : p;
     if (throw_at_collision != 0 && (back ? ncoll_ : ncoll_ + 1) == throw_at_collision)
       throw std::runtime_error("lattice engine: test hook at collision " + std::to_string(throw_at_collision));
     if (back) {
@@ -101,8 +105,13 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
       collide_back(i, j, t);
     } else {
       unreflected_ = 0;
+      jkept_ = 0;
+      if (journal && jhow_ != Rollback::reverse) {
+        save_state(i, true);
+        save_state(j);
+      }
       collide_forward(i, j, t);
-      if (journal) jdone_.push_back(Done{t, kind, i, j, coll, unreflected_});
+      if (journal) jdone_.push_back(Done{t, kind, i, j, coll, unreflected_, jkept_});
     }
     ++done;
     if (!back && done == want) {

@@ -54,8 +54,11 @@ void BasicEngine<Op, Bits, Queue>::stop_observing() {
 // only when asked for.
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::record(int kind, std::int64_t a, const std::vector<int>& ids, const std::vector<Vec>& x, const std::vector<Vec>& v, unsigned axes) {
-  EventRecordN<D> r{a, kind, axes, ids, x, {}, v};
-  for (int q : ids) r.v_before.push_back(ln_[q].v);
+  EventRecordN<D> r{a, kind, axes, {}, x, {}, v};  // by particle id
+  for (int q : ids) {
+    r.ids.push_back(gid(q));
+    r.v_before.push_back(ln_[q].v);
+  }
   events->push_back(std::move(r));
 }
 
@@ -70,7 +73,7 @@ template <class Op, class Bits, class Queue>
     v[k] = to_speed(vi[k]);
     v[D + k] = to_speed(vj[k]);
   }
-  obs_->pair_at(time_of(a), i, j, x, x + D, v, v + D);
+  obs_->pair_at(time_of(a), gid(i), gid(j), x, x + D, v, v + D);
 }
 
 template <class Op, class Bits, class Queue>
@@ -82,7 +85,7 @@ template <class Op, class Bits, class Queue>
     x[k] = to_length(xp[k]);
     v[k] = to_speed(vp[k]);
   }
-  obs_->wall_at(time_of(a), p, x, v, axes);
+  obs_->wall_at(time_of(a), gid(p), x, v, axes);
 }
 
 template <class Op, class Bits, class Queue>
@@ -91,13 +94,15 @@ template <class Op, class Bits, class Queue>
   if (!obs_) return;
   const std::size_t n = g.size();
   std::vector<double> x(n * D), v(n * D);
+  std::vector<int> ids(n);
+  for (std::size_t m = 0; m < n; ++m) ids[m] = gid(g[m]);
   for (std::size_t m = 0; m < n; ++m)
     for (std::size_t k = 0; k < D; ++k) {
       // positions image-consistent about the first member's
       x[m * D + k] = to_length(m > 0 ? xg[0][k] + diff(xg[m], xg[0])[k] : xg[m][k]);
       v[m * D + k] = to_speed(vg[m][k]);
     }
-  obs_->group_at(time_of(a), static_cast<int>(n), g.data(), x.data(), v.data());
+  obs_->group_at(time_of(a), static_cast<int>(n), ids.data(), x.data(), v.data());
 }
 
 }  // namespace revcol::lattice

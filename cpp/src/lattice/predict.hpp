@@ -36,7 +36,9 @@ void BasicEngine<Op, Bits, Queue>::schedule(int p, Type type, std::int64_t t, st
   b.partner = partner;
   b.vself = b.ver;
   b.vpart = partner >= 0 ? slot_[static_cast<std::size_t>(partner)].ver : 0;
-  if (type == none) queue_.erase(p); else queue_.set(p, t, kind);
+  if (type == none) queue_.erase(p);
+  else if (gid_.empty()) queue_.set(p, t, kind);
+  else queue_.set(p, t, kind, gid(p));  // ties by particle id
 }
 
 template <class Op, class Bits, class Queue>
@@ -46,18 +48,18 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
   std::array<int, D> c{};
   if (lists_) {  // the renewal: when the line leaves the ball about p's list centre
     const std::int64_t dt = nl_.exit_ticks(p, ln_[p].x, ln_[p].v);
-    if (dt > 0) b.offer(lo + dt, 0, cross, -1);
+    if (dt > 0) b.offer(lo + dt, 0, cross, -1, -1);
   } else {
     c = grid_.coords(grid_.cell_of_particle(p));
   }
   for (std::size_t k = 0; k < D; ++k) {
     if (!lists_) {
       const std::int64_t dt = grid_.exit_ticks(static_cast<int>(k), c[k], ln_[p].x[k], ln_[p].v[k]);
-      if (dt > 0) b.offer(lo + dt, 0, cross, -1);
+      if (dt > 0) b.offer(lo + dt, 0, cross, -1, -1);
     }
     if (u_.wall[k]) {
       const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(static_cast<int>(k)));
-      if (dw >= 0) b.offer(lo + dw, wall_kind(), wall, -1);
+      if (dw >= 0) b.offer(lo + dw, wall_kind(), wall, -1, -1);
     }
   }
   scan(p, lo, b);
@@ -69,7 +71,7 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
     // which re-predict) could choose the partner; measured once in 6.6 x 10^6 collisions
     const Slot& sq = slot_[static_cast<std::size_t>(b.q)];
     if (!queue_.scheduled(b.q) ||
-        std::tie(b.t, b.k, p) < std::tuple<std::int64_t, std::int32_t, int>(queue_.time(b.q), queue_.kind(b.q), sq.partner)) {
+        std::make_tuple(b.t, b.k, gid(p)) < std::make_tuple(queue_.time(b.q), queue_.kind(b.q), sq.partner >= 0 ? gid(sq.partner) : -1)) {
       schedule(b.q, coll, b.t, b.k, p);
     }
   }
@@ -99,7 +101,7 @@ void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) {
       tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_);
     }
     if (tau >= 0) {
-      b.offer(lo + tau, coll_kind(p, q), coll, q);
+      b.offer(lo + tau, coll_kind(p, q), coll, q, gid(q));
       tb = static_cast<double>(b.t - lo);
     }
   };

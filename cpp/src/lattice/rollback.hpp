@@ -33,15 +33,104 @@
 namespace revcol::lattice {
 
 template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::keep_journal(bool on) {
+void BasicEngine<Op, Bits, Queue>::keep_journal(bool on, Rollback how) {
+  require(how == Rollback::reverse || how == Rollback::save_all || how == Rollback::save_changes,
+          "lattice journal: rollback by reverse computation, save_all (SS1) or save_changes (SS2)");
   jon_ = on;
+  jhow_ = how;
   restart_journal();
+}
+
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::journal_bytes() const noexcept -> std::size_t {
+  std::size_t b = jdone_.size() * sizeof(Done) + jwall_.size() * sizeof(WallDone) + jss1_.size() * sizeof(Saved) +
+                  jss2_.size() * sizeof(std::pair<int, Line>) + jss2x_.size() * sizeof(Bits);
+  for (const Saved& s : jss1_) b += s.X.heap_bytes();
+  for (const Bits& x : jss2x_) b += x.heap_bytes();
+  return b;
+}
+
+// State saving: p's state before the event under way (SS1 its whole record; SS2 its line, and
+// the drawer's X).
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::save_state(int p, bool drawer) {
+  if (jhow_ == Rollback::save_all) {
+    jss1_.push_back(Saved{p, ln_[p], pre_wall_[p], wall_tick_[p], own_[p].X, own_[p].ctr, own_[p].pc});
+  } else {
+    jss2_.emplace_back(p, ln_[p]);
+    if (drawer) jss2x_.push_back(own_[p].X);
+  }
+  ++jkept_;
+}
+
+// State saving: the undo of a wall or collision entry from the states saved before it (SS1), or
+// from the lines and X saved and the counters stepped back (SS2); the log entries it wrote go.
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::restore_kept(const Done& d) {
+  std::vector<int> members;  // SS2: whose counts step back
+  std::uint64_t back = 0;    // SS2: the draws the drawer's stream steps back
+  if (d.type == coll) {
+    const int i = d.p;
+    const LogKey key{static_cast<std::uint32_t>(gid(i)), own_[i].pc};
+    const auto it = groups_.empty() ? groups_.end() : groups_.find(key);
+    if (it != groups_.end()) {
+      const std::shared_ptr<Group> g = it->second;
+      for (int q : g->members) {
+        members.push_back(static_cast<int>(local(q)));
+        groups_.erase(LogKey{static_cast<std::uint32_t>(q), own_[members.back()].pc});
+      }
+      back = g->draws;
+      --ngroups_;
+    } else {
+      members = {i, d.q};
+      const auto logged = log_.find(key);
+      const bool drawn = mode_ == Mode::exact || logged != log_.end();
+      back = drawn ? 1 + (logged != log_.end() ? logged->second : 0) : 0;
+      if (logged != log_.end()) log_.erase(logged);
+    }
+    --ncoll_;
+    ++cnt_.collisions;
+  } else {
+    ++cnt_.walls;
+  }
+  if (jhow_ == Rollback::save_all) {
+    for (int k = 0; k < d.kept; ++k) {
+      const Saved& s = jss1_.back();
+      ln_[s.p] = s.line;
+      pre_wall_[s.p] = s.pre_wall;
+      wall_tick_[s.p] = s.wall_tick;
+      own_[s.p].X = s.X;
+      own_[s.p].ctr = s.ctr;
+      own_[s.p].pc = s.pc;
+      touch(s.p);
+      sync(s.p);
+      jss1_.pop_back();
+    }
+    return;
+  }
+  for (int k = 0; k < d.kept; ++k) {
+    const auto& [p, line] = jss2_.back();
+    ln_[p] = line;
+    touch(p);
+    sync(p);
+    jss2_.pop_back();
+  }
+  if (d.type != coll) return;
+  own_[d.p].X = jss2x_.back();
+  jss2x_.pop_back();
+  own_[d.p].ctr -= back;  // (i is the drawer of a pair and of its group)
+  for (int q : members) --own_[q].pc;
+  for (int s = 0; s < 2; ++s)
+    if (d.unreflected >> s & 1u) wall_tick_[s == 0 ? d.p : d.q] = d.t;  // the group had taken the reflection in
 }
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::restart_journal() {
   jdone_.clear();
   jwall_.clear();
+  jss1_.clear();
+  jss2_.clear();
+  jss2x_.clear();
   j_ncoll0_ = ncoll_;
   j_clock0_ = clock_;
   j_key0_ = last_key_;
@@ -76,11 +165,12 @@ void BasicEngine<Op, Bits, Queue>::commit(std::uint64_t collisions) {
           "lattice commit: the collision count must be in [journal_start, collisions] = [" + std::to_string(j_ncoll0_) +
               ", " + std::to_string(ncoll_) + "]");
   std::uint64_t n = j_ncoll0_;
-  std::size_t k = 0, walls = 0;
+  std::size_t k = 0, walls = 0, kept = 0, xs = 0;
   while (n < collisions) {  // through the entry of collision `collisions`
     const Done& d = jdone_[k++];
+    kept += d.kept;
     if (d.type == wall) ++walls;
-    if (d.type == coll) ++n;
+    if (d.type == coll) ++n, ++xs;
     if (n == collisions) {
       j_clock0_ = d.t;
       j_key0_ = {d.t, d.kind};
@@ -88,6 +178,11 @@ void BasicEngine<Op, Bits, Queue>::commit(std::uint64_t collisions) {
   }
   jdone_.erase(jdone_.begin(), jdone_.begin() + static_cast<std::ptrdiff_t>(k));
   jwall_.erase(jwall_.begin(), jwall_.begin() + static_cast<std::ptrdiff_t>(walls));
+  if (jhow_ == Rollback::save_all) jss1_.erase(jss1_.begin(), jss1_.begin() + static_cast<std::ptrdiff_t>(kept));
+  if (jhow_ == Rollback::save_changes) {
+    jss2_.erase(jss2_.begin(), jss2_.begin() + static_cast<std::ptrdiff_t>(kept));
+    jss2x_.erase(jss2x_.begin(), jss2x_.begin() + static_cast<std::ptrdiff_t>(xs));
+  }
   j_ncoll0_ = collisions;
 }
 
@@ -115,6 +210,19 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
     const Done d = jdone_.back();
     jdone_.pop_back();
     touch(d.p);
+    if (jhow_ != Rollback::reverse && (d.type == wall || d.type == coll)) {  // state saving
+      if (d.type == coll) touch(d.q);
+      restore_kept(d);
+      if (d.type == wall) {
+        if (jhow_ == Rollback::save_changes) {  // (SS1's record holds the cache)
+          pre_wall_[d.p] = jwall_.back().pre_wall;
+          wall_tick_[d.p] = jwall_.back().wall_tick;
+        }
+        jwall_.pop_back();
+      }
+      if (d.type == coll && trace != nullptr && !trace->empty()) trace->pop_back();
+      continue;
+    }
     if (d.type == wall) {
       undo_wall(d.p, d.t, jwall_.back());
       jwall_.pop_back();
@@ -155,7 +263,7 @@ void BasicEngine<Op, Bits, Queue>::undo_wall(int p, std::int64_t a, const WallDo
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, std::uint8_t unreflected) {
   // i's last collision is the one undone here: its key is (i, i's count)
-  const LogKey key{static_cast<std::uint32_t>(i), own_[i].pc};
+  const LogKey key{static_cast<std::uint32_t>(gid(i)), own_[i].pc};
   if (!groups_.empty()) [[unlikely]] {
     if (const auto it = groups_.find(key); it != groups_.end()) {
       const std::shared_ptr<Group> g = it->second;  // (undo_group erases its keys)
@@ -173,7 +281,7 @@ void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, 
   } else {
     const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
     if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice rollback: a stream would step back past draw 0 (a bug)");
-    const std::uint64_t g = draw48(static_cast<std::uint32_t>(i), seed_, own_[i].ctr - 1);
+    const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr - 1);
     op_.pair_reverse(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi0, xj0, vi0, vj0);
     own_[i].ctr -= 1 + redraws;
     if (logged != log_.end()) log_.erase(logged);
@@ -190,9 +298,10 @@ void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, 
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::undo_group(std::int64_t a, const Group& entry, int i, int j, std::uint8_t unreflected) {
-  const std::vector<int> g = entry.members;  // (copies: the entry goes with its last key)
+  std::vector<int> g;  // the members' local indices (copies: the entry goes with its last key)
+  for (int q : entry.members) g.push_back(static_cast<int>(local(q)));
   const std::vector<Vec> pre_v = entry.pre_v;
-  const int drawer = entry.drawer;
+  const auto drawer = local(entry.drawer);
   const std::uint32_t draws = entry.draws;
   for (std::size_t m = 0; m < g.size(); ++m)
     if (own_[g[m]].pc != entry.counts[m]) throw std::logic_error("lattice rollback: a group undone before a member's later collision (a bug)");
@@ -205,7 +314,7 @@ void BasicEngine<Op, Bits, Queue>::undo_group(std::int64_t a, const Group& entry
   }
   own_[drawer].ctr -= draws;
   for (int q : g) {
-    groups_.erase(LogKey{static_cast<std::uint32_t>(q), own_[q].pc});
+    groups_.erase(LogKey{static_cast<std::uint32_t>(gid(q)), own_[q].pc});
     --own_[q].pc;
   }
   --ngroups_;

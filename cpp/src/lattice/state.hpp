@@ -70,8 +70,16 @@ void BasicEngine<Op, Bits, Queue>::check_log(const Snapshot& s) const {
 }
 
 template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
+void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<std::uint32_t>& order) {
   validate_state(s.units, s.x, s.v, true);  // collisions may be pending at the clock (rebuild finds them)
+  if (!order.empty()) {
+    require(order.size() == s.x.size(), "lattice: an order must name every particle once (a permutation of [0, N))");
+    std::vector<char> seen(order.size(), 0);
+    for (std::uint32_t q : order) {
+      require(q < order.size() && !seen[q], "lattice: an order must name every particle once (a permutation of [0, N))");
+      seen[q] = 1;
+    }
+  }
   require(s.streams.size() == s.x.size(), "lattice snapshot: streams must hold one counter per particle");
   {
     // energy is kept by every collision to the lattice's rounding (~1e-11 relative over 10^4
@@ -92,7 +100,7 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s) {
   std::unique_ptr<engine::Observer> resumed;
   require(!s.observer.empty() || s.observer_counts.empty(), "lattice snapshot: observer_counts without observer");
   if (!s.observer.empty()) resumed = make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);
-  load(s);
+  load(s, order);
   observer_ = std::move(resumed);  // none: an observation of the old state ends
   obs_ = observer_.get();
 }
@@ -109,15 +117,15 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   s.collisions = ncoll_;
   s.x = positions();
   s.v = velocities();
-  s.streams.resize(own_.size());
+  s.streams = streams();
   s.particle_collisions.resize(own_.size());
   s.bits_size.resize(own_.size());
-  for (std::size_t p = 0; p < own_.size(); ++p) {
-    s.streams[p] = own_[p].ctr;
-    s.particle_collisions[p] = own_[p].pc;
-    const auto w = own_[p].X.words();
+  for (std::size_t q = 0; q < own_.size(); ++q) {  // by particle id
+    const Own& o = own_[local(static_cast<int>(q))];
+    s.particle_collisions[q] = o.pc;
+    const auto w = o.X.words();
     s.bits.insert(s.bits.end(), w.begin(), w.end());
-    s.bits_size[p] = w.size();
+    s.bits_size[q] = w.size();
   }
   for (const auto& [k, r] : log_) s.log.push_back(LogEntry{k.first, k.second, r});
   for (const auto& [k, g] : groups_)  // each group once, under its drawer's key
@@ -130,23 +138,81 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
 }
 
 template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s) {
+auto BasicEngine<Op, Bits, Queue>::positions() const -> std::vector<Vec> {
+  std::vector<Vec> out(ln_.size());
+  for (std::size_t p = 0; p < ln_.size(); ++p) out[static_cast<std::size_t>(gid(static_cast<int>(p)))] = pos(static_cast<int>(p), clock_);
+  return out;
+}
+
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::velocities() const -> std::vector<Vec> {
+  std::vector<Vec> out(ln_.size());
+  for (std::size_t p = 0; p < ln_.size(); ++p) out[static_cast<std::size_t>(gid(static_cast<int>(p)))] = ln_[p].v;
+  return out;
+}
+
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::streams() const -> std::vector<std::uint64_t> {
+  std::vector<std::uint64_t> c(own_.size());
+  for (std::size_t p = 0; p < own_.size(); ++p) c[static_cast<std::size_t>(gid(static_cast<int>(p)))] = own_[p].ctr;
+  return c;
+}
+
+// A new state: the particles' streams at 0, their X from initial_bits, energy and momentum recorded.
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::fresh(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed,
+                                         std::int64_t clock, Mode mode) const -> Snapshot {
+  check_operator(u);
+  require(mode == Mode::exact || mode == Mode::specular, "lattice: mode must be 'exact' or 'specular'");
+  validate_state(u, x, v);
+  require(clock > -tick_limit / 2 && clock < tick_limit / 2, "lattice: the start tick must be within +-2^60");
+  Snapshot s;
+  s.units = u;
+  s.law = law();
+  s.mode = mode;
+  s.seed = seed;
+  s.clock = s.origin = clock;
+  s.x = std::move(x);
+  s.v = std::move(v);
+  s.streams.assign(s.x.size(), 0);
+  s.particle_collisions.assign(s.x.size(), 0);
+  for (std::size_t p = 0; p < s.x.size(); ++p) {
+    const auto w = initial_bits(static_cast<std::uint32_t>(p), seed);
+    s.bits.insert(s.bits.end(), w.begin(), w.end());
+    s.bits_size.push_back(w.size());
+  }
+  const u128 e = kinetic2(s.v);
+  s.energy0 = {static_cast<std::uint64_t>(e), static_cast<std::uint64_t>(e >> 64)};
+  const auto p = momentum_of(s.v);
+  for (std::size_t k = 0; k < D; ++k) {
+    s.momentum0[2 * k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(static_cast<u128>(p[k])));
+    s.momentum0[2 * k + 1] = static_cast<std::int64_t>(p[k] >> 64);
+  }
+  return s;
+}
+
+// The state of a validated snapshot, local index p holding particle order[p] (empty: p).
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s, const std::vector<std::uint32_t>& order) {
   u_ = s.units;
   seed_ = s.seed;
   mode_ = s.mode;
   if (mode_ == Mode::specular) spec_ = Specular(u_.sigma);
   const std::size_t n = s.x.size();
+  gid_.assign(order.begin(), order.end());
+  lid_.assign(order.empty() ? 0 : n, 0);
+  for (std::size_t p = 0; p < gid_.size(); ++p) lid_[static_cast<std::size_t>(gid_[p])] = static_cast<int>(p);
+  std::vector<std::size_t> at(n + 1, 0);  // where each particle's words start in s.bits
+  for (std::size_t q = 0; q < n; ++q) at[q + 1] = at[q] + static_cast<std::size_t>(s.bits_size[q]);
   ln_.resize(n);
-  for (std::size_t p = 0; p < n; ++p) ln_[p] = Line{s.x[p], s.v[p], s.clock};
   slot_.assign(n, Slot{});
   own_.assign(n, Own{});
-  std::size_t at = 0;
   for (std::size_t p = 0; p < n; ++p) {
-    const auto k = static_cast<std::size_t>(s.bits_size[p]);
-    own_[p].X = Bits(std::vector<std::uint64_t>(s.bits.begin() + static_cast<std::ptrdiff_t>(at), s.bits.begin() + static_cast<std::ptrdiff_t>(at + k)));
-    own_[p].ctr = s.streams[p];
-    own_[p].pc = s.particle_collisions[p];
-    at += k;
+    const auto q = static_cast<std::size_t>(gid(static_cast<int>(p)));
+    ln_[p] = Line{s.x[q], s.v[q], s.clock};
+    own_[p].X = Bits(std::vector<std::uint64_t>(s.bits.begin() + static_cast<std::ptrdiff_t>(at[q]), s.bits.begin() + static_cast<std::ptrdiff_t>(at[q + 1])));
+    own_[p].ctr = s.streams[q];
+    own_[p].pc = s.particle_collisions[q];
   }
   log_.clear();
   for (const LogEntry& e : s.log) log_.emplace(LogKey{e.particle, e.count}, e.redraws);
@@ -219,7 +285,7 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
   for (std::size_t p = 0; p < n; ++p) sync(static_cast<int>(p));
   // first bucket width: ~2^tick_bits ticks per mean free time per particle, over N particles
   // (the queue adapts it; a speed setting only)
-  queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << u_.tick_bits) / static_cast<std::int64_t>(n)));
+  queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << u_.tick_bits) / static_cast<std::int64_t>(n)), !gid_.empty());
   // forward: events at the clock may still be pending (a run stopped after a collision);
   // reverse: the clock's tick is done (see run_back), the search starts one tick later
   const std::int64_t lo = reversed_ ? clock_ + 1 : clock_;
@@ -309,7 +375,8 @@ auto BasicEngine<Op, Bits, Queue>::memory_bytes() const noexcept -> std::size_t 
   for (const Own& o : own_) heap += o.X.heap_bytes();
   return n * (2 * sizeof(Vec) + 4 * 8 + 3 * 8 + sizeof(Vec) * 2 + 8 + sizeof(Own)) + heap + queue_.memory_bytes() +
          grid_.memory_bytes() + nl_.memory_bytes() + log_.size() * (48 + sizeof(LogKey) + 8) + group_bytes() +
-         undo_.capacity() * sizeof(Saved) + undo_epoch_.capacity() * sizeof(std::uint32_t);
+         undo_.capacity() * sizeof(Saved) + undo_epoch_.capacity() * sizeof(std::uint32_t) +
+         (gid_.capacity() + lid_.capacity()) * sizeof(int);
 }
 
 template <class Op, class Bits, class Queue>

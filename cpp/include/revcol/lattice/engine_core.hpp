@@ -127,39 +127,18 @@ class BasicEngine {
   BasicEngine(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, Op op,
               std::int64_t clock = 0, Mode mode = Mode::exact)
       : op_(std::move(op)) {
-    check_operator(u);
-    require(mode == Mode::exact || mode == Mode::specular, "lattice: mode must be 'exact' or 'specular'");
-    validate_state(u, x, v);
-    require(clock > -tick_limit / 2 && clock < tick_limit / 2, "lattice: the start tick must be within +-2^60");
-    Snapshot s;
-    s.units = u;
-    s.law = law();
-    s.mode = mode;
-    s.seed = seed;
-    s.clock = s.origin = clock;
-    s.x = std::move(x);
-    s.v = std::move(v);
-    s.streams.assign(s.x.size(), 0);
-    s.particle_collisions.assign(s.x.size(), 0);
-    for (std::size_t p = 0; p < s.x.size(); ++p) {
-      const auto w = initial_bits(static_cast<std::uint32_t>(p), seed);
-      s.bits.insert(s.bits.end(), w.begin(), w.end());
-      s.bits_size.push_back(w.size());
-    }
-    const u128 e = kinetic2(s.v);
-    s.energy0 = {static_cast<std::uint64_t>(e), static_cast<std::uint64_t>(e >> 64)};
-    const auto p = momentum_of(s.v);
-    for (std::size_t k = 0; k < D; ++k) {
-      s.momentum0[2 * k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(static_cast<u128>(p[k])));
-      s.momentum0[2 * k + 1] = static_cast<std::int64_t>(p[k] >> 64);
-    }
-    load(s);
+    load(fresh(u, std::move(x), std::move(v), seed, clock, mode));
   }
   /// An engine resuming a snapshot bit for bit.
   BasicEngine(const Snapshot& s, Op op) : op_(std::move(op)) { restore(s); }
+  /// The same, its particles stored in another order: local index p holds particle order[p] (a
+  /// permutation of [0, N)). Every key, draw, tie and output is by particle id, so the run is
+  /// the same bit for bit (the parallel engine's logical processes hold their particles so).
+  BasicEngine(const Snapshot& s, Op op, const std::vector<std::uint32_t>& order) : op_(std::move(op)) { restore(s, order); }
 
-  /// Replaces the state by a snapshot (validated first: on bad input nothing changes).
-  void restore(const Snapshot& s);
+  /// Replaces the state by a snapshot (validated first: on bad input nothing changes); `order`
+  /// (optional): the particle each local index holds, a permutation of [0, N).
+  void restore(const Snapshot& s, const std::vector<std::uint32_t>& order = {});
 
   /// Runs forward until `collisions` more collisions (clock = the last one's tick) or up to tick
   /// `until` (clock = until), whichever comes first. Returns the collisions done.
@@ -174,9 +153,13 @@ class BasicEngine {
   /// undoes the latest events one by one in the forward frame, each by its own reverse
   /// computation, in O(events undone). A rebuild of the search (restore, run_back,
   /// set_list_shell, the undo of an engine error) restarts it at the state (ARCHITECTURE.md).
-  void keep_journal(bool on);
+  /// `how`: reverse computation, or state saving (SS1, SS2) for the comparison (state.hpp).
+  void keep_journal(bool on, Rollback how = Rollback::reverse);
   /// Whether the journal is kept.
   bool journaling() const noexcept { return jon_; }
+  Rollback rollback_by() const noexcept { return jhow_; }  ///< how a rollback restores the state
+  /// Bytes the journal holds (its entries and, state saving, the saved states).
+  std::size_t journal_bytes() const noexcept;
   /// Rolls back to the state right after collision `collisions` (clock = its tick; the journal's
   /// start when that is where the count is), bit for bit the forward run's state there; a run on
   /// processes the same events. journal_start() <= collisions <= collisions(); ends observation.
@@ -216,22 +199,14 @@ class BasicEngine {
   /// Lattice units per tick as a float speed.
   double to_speed(std::int64_t v) const noexcept { return static_cast<double>(v) * (u_.length_unit / u_.tick); }
 
-  /// Positions at the clock, wrapped.
-  std::vector<Vec> positions() const {
-    std::vector<Vec> out(ln_.size());
-    for (std::size_t p = 0; p < ln_.size(); ++p) out[p] = pos(static_cast<int>(p), clock_);
-    return out;
-  }
-  /// Velocities (a copy).
-  std::vector<Vec> velocities() const {
-    std::vector<Vec> out(ln_.size());
-    for (std::size_t p = 0; p < ln_.size(); ++p) out[p] = ln_[p].v;
-    return out;
-  }
+  /// Positions at the clock, wrapped, by particle id.
+  std::vector<Vec> positions() const;
+  /// Velocities by particle id (a copy).
+  std::vector<Vec> velocities() const;
   std::int64_t clock() const noexcept { return clock_; }                ///< the current tick
   std::int64_t origin() const noexcept { return origin_; }              ///< the initial tick
   std::uint64_t collisions() const noexcept { return ncoll_; }          ///< collisions since the start
-  const Bits& bits(int p) const { return own_.at(static_cast<std::size_t>(p)).X; }  ///< particle p's bits-back integer
+  const Bits& bits(int p) const { return own_[local(p)].X; }  ///< particle p's bits-back integer
   /// The bit lengths of every particle's X, summed.
   std::size_t bits_length() const noexcept {
     std::size_t b = 0;
@@ -239,7 +214,7 @@ class BasicEngine {
     return b;
   }
   /// Particle p's collisions since the start (pairs and groups it took part in, net of reverses).
-  std::uint64_t particle_collisions(int p) const { return own_.at(static_cast<std::size_t>(p)).pc; }
+  std::uint64_t particle_collisions(int p) const { return own_[local(p)].pc; }
   const Counters& counters() const noexcept { return cnt_; }            ///< statistics
   /// Rare-log entries held: the collisions that redrew (or were drawn in specular mode) and the groups.
   std::size_t log_size() const noexcept { return log_.size() + ngroups_; }
@@ -247,12 +222,8 @@ class BasicEngine {
   const Units& units() const noexcept { return u_; }                    ///< units and box
   std::size_t size() const noexcept { return ln_.size(); }               ///< N
   std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
-  /// The stream counters.
-  std::vector<std::uint64_t> streams() const {
-    std::vector<std::uint64_t> c;
-    for (const Own& o : own_) c.push_back(o.ctr);
-    return c;
-  }
+  /// The stream counters by particle id.
+  std::vector<std::uint64_t> streams() const;
   const Op& op() const noexcept { return op_; }                         ///< the pair operator
   /// The operator's post-direction law (an operator without one, a test's, counts as flux).
   Law law() const noexcept {
@@ -312,18 +283,19 @@ class BasicEngine {
   enum Type : std::uint8_t { none = 0, cross = 1, wall = 2, coll = 3 };
   struct Group;  // a group collision in the rare log (below)
   // a prediction's best event so far, in the slot order (tick, kind, other particle)
-  struct Best {
+  struct Best {  // (the other particle by id: gq; q its local index)
     std::int64_t t = std::numeric_limits<std::int64_t>::max();
     std::int32_t k = 0;
     Type type = none;
-    int q = -1;
-    void offer(std::int64_t t2, std::int32_t k2, Type ty, int q2) noexcept {
+    int q = -1, gq = -1;
+    void offer(std::int64_t t2, std::int32_t k2, Type ty, int q2, int gq2) noexcept {
       if (t2 >= tick_limit) return;
-      if (std::tie(t2, k2, q2) < std::tie(t, k, q) || type == none) t = t2, k = k2, type = ty, q = q2;
+      if (std::tie(t2, k2, gq2) < std::tie(t, k, gq) || type == none) t = t2, k = k2, type = ty, q = q2, gq = gq2;
     }
   };
 
-  void load(const Snapshot& s);
+  void load(const Snapshot& s, const std::vector<std::uint32_t>& order = {});
+  Snapshot fresh(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, std::int64_t clock, Mode mode) const;
   void check_log(const Snapshot& s) const;  // the rare log against the per-particle counts
 
   // ---- geometry of the lines ----
@@ -368,9 +340,16 @@ class BasicEngine {
   }
 
   // ---- keys ----
+  // the particle id of local index p, and the local index of particle id q (identity unless the
+  // engine was given an order): every key, draw, tie and output is by id
+  int gid(int p) const noexcept { return gid_.empty() ? p : gid_[static_cast<std::size_t>(p)]; }
+  std::size_t local(int q) const {
+    require(q >= 0 && static_cast<std::size_t>(q) < ln_.size(), "lattice: no such particle id");
+    return lid_.empty() ? static_cast<std::size_t>(q) : static_cast<std::size_t>(lid_[static_cast<std::size_t>(q)]);
+  }
   std::int32_t n32() const noexcept { return static_cast<std::int32_t>(ln_.size()); }
   std::int32_t coll_kind(int a, int b) const noexcept {
-    const int lo = std::min(a, b);
+    const int lo = std::min(gid(a), gid(b));
     return reversed_ ? 1 + (n32() - 1 - lo) : 2 + lo;
   }
   std::int32_t wall_kind() const noexcept { return reversed_ ? n32() + 1 : 1; }
@@ -565,20 +544,29 @@ class BasicEngine {
   CellGridN<D> grid_;
   Queue queue_;
   std::pair<std::int64_t, std::int32_t> last_key_{};
+  std::vector<int> gid_, lid_;  // local index -> particle id and back (empty: the identity)
   // ---- the processed-event journal (rollback.hpp) ----
   struct Done {        // one queue pop
     std::int64_t t;    // its tick
     std::int32_t kind;  // its queue kind
-    int p, q;          // the particle popped; a collision's pair (p < q)
+    int p, q;          // the particle popped; a collision: its drawer (the smaller id) and partner
     Type type;         // none: a stale event recomputed
     std::uint8_t unreflected;  // a group: bit 0 (p), bit 1 (q) took in their reflection at t
+    std::uint8_t kept;         // state saving: the particle states saved before it
   };
   struct WallDone {  // a reflection's replaced one-tick cache
     std::int64_t wall_tick;
     Line pre_wall;
   };
   bool jon_ = false;
+  Rollback jhow_ = Rollback::reverse;
   std::deque<Done> jdone_;
+  std::deque<Saved> jss1_;                   // SS1: whole records, before each event
+  std::deque<std::pair<int, Line>> jss2_;    // SS2: the touched lines, before each event
+  std::deque<Bits> jss2x_;                   // SS2: a collision's drawer's X, before it
+  std::uint8_t jkept_ = 0;                   // states saved for the event under way
+  void save_state(int p, bool drawer = false);  // state saving: p's state before the event under way
+  void restore_kept(const Done& d);
   std::deque<WallDone> jwall_;  // one per wall entry of jdone_, in order
   std::uint64_t j_ncoll0_ = 0;
   std::int64_t j_clock0_ = 0;

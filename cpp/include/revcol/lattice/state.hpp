@@ -30,6 +30,13 @@ inline constexpr const char* redraw_names[8] = {"",           "cell_readback", "
                                                  "out_of_domain", "overlap_after", "ghost_tie",   "outside"};
 
 /// Event and rare-case counts, cumulative over both directions (not part of the physical state).
+/// How a rollback restores what the undone events changed (BasicEngine::keep_journal): by reverse
+/// computation (nothing of the state saved: the paper's RC), or by state saving, the paper's two
+/// variants on a per-particle engine: SS1 saves each touched particle's whole record before
+/// every event (line, stream counter, X, count, wall cache), SS2 only what the event changes
+/// and no counter can give back (the touched lines and the drawer's X; the counters step back).
+enum class Rollback : std::uint8_t { reverse = 0, save_all = 1, save_changes = 2 };
+
 struct Counters : Visitable<Counters> {
   std::uint64_t events = 0;              ///< queue pops
   std::uint64_t collisions = 0;          ///< collisions applied (forward and reverse)
