@@ -163,10 +163,10 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   }
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
   const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
-  if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+  if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) inconsistent("particle " + std::to_string(gid(i)) + "'s stream would step back past draw 0", i, j);
   const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr - 1);
   Vec xi0, xj0, vi0, vj0;
-  if (own_[i].pc == 0 || own_[j].pc == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
+  if (own_[i].pc == 0 || own_[j].pc == 0) inconsistent("a collision count would step back past 0", i, j);
   op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi0, xj0, vi0, vj0);
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
@@ -228,8 +228,8 @@ void BasicEngine<Op, Bits, Queue>::back_specular(int i, int j, std::int64_t a) {
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
   Vec xi0, xj0, vi0, vj0;
   if (spec_.pair_unmap(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi0, xj0, vi0, vj0) != Refusal::none)
-    throw std::logic_error("lattice engine: the specular map refused a post state it wrote (a bug)");
-  if (own_[i].pc == 0 || own_[j].pc == 0) throw std::logic_error("lattice engine: a collision count would step back past 0 (a bug)");
+    inconsistent("the specular map refuses the post state it is to take back", i, j);
+  if (own_[i].pc == 0 || own_[j].pc == 0) inconsistent("a collision count would step back past 0", i, j);
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
   --own_[i].pc;

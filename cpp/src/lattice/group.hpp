@@ -256,13 +256,13 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Grou
   std::vector<int> g;  // the members' local indices
   for (int q : entry.members) g.push_back(static_cast<int>(local(q)));
   if (std::find(g.begin(), g.end(), i) == g.end() || std::find(g.begin(), g.end(), j) == g.end()) {
-    throw std::logic_error("lattice engine: the reverse met a group at another pair (a bug)");
+    inconsistent("the reverse met a group at another pair", i, j);
   }
   for (std::size_t m = 0; m < g.size(); ++m)
-    if (own_[g[m]].pc != entry.counts[m]) throw std::logic_error("lattice engine: the reverse met a group before a member's later collision (a bug)");
+    if (own_[g[m]].pc != entry.counts[m]) inconsistent("the reverse met a group before a member's later collision", i, j);
   const std::uint32_t draws = entry.draws;
   const auto drawer = local(entry.drawer);
-  if (own_[drawer].ctr < draws) throw std::logic_error("lattice engine: a stream would step back past draw 0 (a bug)");
+  if (own_[drawer].ctr < draws) inconsistent("a group's drawer's stream would step back past draw 0", i, j);
   const std::vector<Vec> pre_v = entry.pre_v;  // forward frame; empty: a bounce (a copy: popped below)
   std::vector<Vec> pre(g.size());
   for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);

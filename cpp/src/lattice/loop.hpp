@@ -124,7 +124,8 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::check_order(std::int64_t t, std::int32_t k) {
   if (std::make_pair(t, k) < last_key_)
-    throw std::logic_error("lattice engine: events out of order (a bug): (tick " + std::to_string(t) + ", kind " +
+    throw std::logic_error(std::string(reversed_ ? "lattice engine: inconsistent state (a damaged or edited checkpoint, or a bug): events out of order: (tick "
+                                                   : "lattice engine: events out of order (a bug): (tick ") + std::to_string(t) + ", kind " +
                            std::to_string(k) + ") after (tick " + std::to_string(last_key_.first) + ", kind " +
                            std::to_string(last_key_.second) + "), collision " + std::to_string(ncoll_));
   last_key_ = {t, k};

@@ -371,6 +371,13 @@ class BasicEngine {
   std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target, const std::function<bool()>& poll);
 
   void reflect(int p, std::int64_t a);
+  // a state the reverse cannot take back (a loaded state no run wrote): an error naming it, the
+  // collision and the pair; run_back restores the state it began with
+  [[noreturn, gnu::cold]] void inconsistent(const std::string& what, int i, int j) const {
+    throw std::logic_error("lattice engine: inconsistent state (a damaged or edited checkpoint, or a bug): " + what +
+                           ", undoing collision " + std::to_string(ncoll_) + " of particles " + std::to_string(gid(i)) +
+                           " and " + std::to_string(gid(j)));
+  }
   // the reflection map of a line whose tick-(a-1) point is x with velocity v (beyond the walls of
   // the returned axes at a): x becomes its point at a, v its velocity after (loop.hpp)
   unsigned reflection(Vec& x, Vec& v) const noexcept;
