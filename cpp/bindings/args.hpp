@@ -201,9 +201,19 @@ std::vector<T> checkpoint_array(pybind11::handle obj, const std::string& key) {
   }
 }
 
+/// Set while a Ctrl-C that revcol.progress.Interrupt counted is unhandled (_core.request_stop);
+/// read and written with the GIL held. That handler swallows the signal, so PyErr_CheckSignals
+/// alone returns 0 and a run that never reaches its progress callback (one particle: no
+/// collisions) would go on after the press (issue 59).
+inline bool& stop_requested() {
+  static bool flag = false;
+  return flag;
+}
+
 /// A long run's poll (engine::Poll): false once a signal handler (Ctrl-C) left a Python
-/// exception pending; the run stops at a valid point and the caller raises it.
-inline bool poll_signals() { return PyErr_CheckSignals() == 0; }
+/// exception pending, the run stops at a valid point and the caller raises it; or once a
+/// counted Ctrl-C asked runs to stop, the run stops there and returns as at its end.
+inline bool poll_signals() { return PyErr_CheckSignals() == 0 && !stop_requested(); }
 
 /// A study's interrupt check (revcol/interrupt.hpp) for a loop that runs with the GIL
 /// released: takes the GIL and says stop once Ctrl-C left a KeyboardInterrupt pending (the

@@ -416,6 +416,12 @@ void register_engine(py::module_& m) {
       },
       py::arg("dim"), py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"), py::arg("seed"),
       py::arg("energy"), py::arg("init"), py::arg("equal_speeds"));
+  // the counted Ctrl-C (revcol.progress.Interrupt) that both engines' polls read (args.hpp)
+  m.def(
+      "request_stop", [](bool on) { stop_requested() = on; }, py::arg("on"),
+      "True: every run under way, and every run started until it is set False again, stops at its next poll.");
+  m.def(
+      "stop_requested", [] { return stop_requested(); }, "Whether request_stop(True) is in force.");
 }
 
 }  // namespace revcol::bind

@@ -298,6 +298,8 @@ class Engine(_ObserveMethods):
 
 def engine_random_state(dim: _Int, n: _Int, phi: _Float, boundary: Sequence[str], diameter: _Float, seed: _Int,
                         energy: _Float, init: str, equal_speeds: bool) -> tuple[_F64, _F64, list[float]]: ...
+def request_stop(on: bool) -> None: ...  # both engines' runs stop at their next poll (Ctrl-C counted)
+def stop_requested() -> bool: ...
 
 # ---- cpp/bindings/engine_init.cpp: the engine's random start and its limits.
 

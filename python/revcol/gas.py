@@ -329,7 +329,7 @@ def round_trip(run, plot, figures: str, plot_format: str = "png") -> dict:
         with Interrupt() as stop:
             run.forward(stop)
             run.turn()
-            run.reverse(stop, stop.presses)
+            run.reverse(stop, stop.resume())  # back from where a Ctrl-C stopped the forward run
     except BaseException:
         if run.writer is not None:
             run.writer.close_quietly()

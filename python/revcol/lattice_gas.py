@@ -367,6 +367,8 @@ def _horizon_seeds(scene: Scene, seeds: int, grid: list[int], rows: dict, bar: B
                 done += int(sim.run(collisions=nc - done)["collisions"])
                 clone = LatticeSimulation.from_snapshot(sim.snapshot())
                 clone.run_back()
+                if stop.presses:  # Ctrl-C stopped the run or its reversal short of N_c: not counted
+                    return
                 ok = all(restored(s0, clone.snapshot()).values())
             except RuntimeError as e:
                 ok = False

@@ -1,6 +1,9 @@
 """Ctrl-C reaches every run (issue 17): a SIGINT during run or run_back, on either engine, stops
 the run at a valid point within a fraction of a second and raises KeyboardInterrupt; the
-simulation goes on from there (the lattice engine still returns to its start bit for bit)."""
+simulation goes on from there (the lattice engine still returns to its start bit for bit). Under the CLI's handler
+(revcol.progress.Interrupt), which counts presses instead of raising, the first one stops the
+run too, collisions or not, and the report is written (issue 59)."""
+import json
 import os
 import signal
 import subprocess
@@ -103,3 +106,44 @@ def test_ctrl_c_stops_a_study(what, tmp_path):
     assert rc == 0 and "interrupted" in text, text
     if what == "wordstream":
         assert "consistent" in text, text
+
+
+CLI = r"""
+import sys
+from revcol.cli.main import main
+from revcol.progress import Interrupt
+
+enter = Interrupt.__enter__
+
+
+def enter_and_say_ready(self):  # "ready" once the run's Ctrl-C handler is in place, never before
+    out = enter(self)
+    print("ready", flush=True)
+    return out
+
+
+Interrupt.__enter__ = enter_and_say_ready
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+@pytest.mark.parametrize("command", ["simulate", "run"])
+@pytest.mark.parametrize("engine", ["float", "lattice"])
+def test_the_first_ctrl_c_stops_a_run_without_collisions(engine, command, tmp_path):
+    """Issue 59: one particle in a periodic box never collides, so the run never reached the
+    progress callback that reads the counted press; the first two Ctrl-C did nothing and the
+    third ended it with a traceback and no report. One SIGINT now stops it at the engine's
+    next poll, with the report written and the exit status of an interrupted run."""
+    scene = tmp_path / "one.toml"
+    scene.write_text(f'[system]\ndimension = 2\nparticles = 1\npacking_fraction = 0.01\nboundaries = "periodic"\n'
+                     f'[collisions]\nengine = "{engine}"\n[run]\ntime = 1e9\n')
+    report = tmp_path / "r.json"
+    # `revcol run` then goes back from where it stopped, as long again as it went forward
+    rc, text = _interrupt(tmp_path, CLI, [command, str(scene), "--json", str(report), "--no-progress"],
+                          after_s=0.5, wait_s=10)
+    assert rc == 130 and "Traceback" not in text and "interrupted" in text, text
+    r = json.loads(report.read_text())
+    if command == "simulate":
+        assert r["interrupted"] and r["collisions"] == 0 and 0 < r["time_end"] < 1e9, r
+    else:
+        assert r["interrupted"] == "forward" and r["collisions_forward"] == 0 and r["passed"], r

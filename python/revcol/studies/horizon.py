@@ -62,13 +62,16 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
                     done += int(sim.run(collisions=nc - done)["collisions"])
                     clone = Simulation.from_snapshot(sim.snapshot())
                     clone.run_back(on_divergence="ignore")
+                    if stop.presses:  # Ctrl-C stopped the run or its reversal short of N_c: no point
+                        break
                     ex, ev = round_trip_errors(clone.positions, clone.velocities, x0, v0, box, periodic)
                     errs.append((ex, ev))
                     done_pts += 1
                     bar.to(done_pts)
                     if max(ex, ev) >= o1 or stop.presses:
                         break
-                per_seed.append(errs)
+                if errs or not stop.presses:
+                    per_seed.append(errs)
                 if stop.presses:
                     break
             interrupted = stop.presses > 0
