@@ -6,6 +6,7 @@
 // on that rejoins the forward run; the rollback check of ROSS (each collision done, undone,
 // compared, done again); and a fuzz of random runs, rollbacks and commits against the forward
 // run's state hash at every collision count. Bad requests are refused with the state unchanged.
+#include <array>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -167,6 +168,46 @@ void check_scene(const Scene& sc, std::uint64_t total, std::uint32_t seed) {
               rollbacks, commits, all && ticks_ok == ticks && ross_bad == 0 && fuzz_bad == 0 ? "bit for bit" : "DIFFERENT");
 }
 
+// rollback_before the key of collision n + 1, (tick, 2 + its drawer, its drawer), for n through the
+// run, latest first: the collision count is n, and a run on rejoins the forward run's hashes;
+// rollback_before (t, 0, 0) is the state run(until = t - 1) has
+template <std::size_t D>
+void check_keys(const Scene& sc, std::uint64_t total) {
+  auto r = make<D>(sc, 51);
+  std::vector<std::array<std::int64_t, 3>> trace;
+  r.trace = &trace;
+  std::vector<std::uint64_t> ref{state_hash(r.snapshot())};
+  for (std::uint64_t c = 1; c <= total; ++c) {
+    r.run(1, tick_limit - 1);
+    ref.push_back(state_hash(r.snapshot()));
+  }
+  auto e = make<D>(sc, 51);
+  e.keep_journal(true);
+  e.run(total, tick_limit - 1);
+  int bad = 0, tried = 0;
+  for (std::uint64_t n = total - 1; n >= 100; n -= 97) {
+    const auto& k = trace[n];  // collision n + 1: (tick, i, j), i the smaller id
+    e.rollback_before(k[0], static_cast<std::int32_t>(2 + k[1]), static_cast<std::int32_t>(k[1]));
+    ++tried;
+    if (e.collisions() != n) ++bad;
+    e.run(1, tick_limit - 1);  // that collision again, and the run rejoins
+    if (state_hash(e.snapshot()) != ref[n + 1]) ++bad;
+    e.rollback(n);
+    if (state_hash(e.snapshot()) != ref[n]) ++bad;
+  }
+  // (t, 0, 0): the state run(until = t - 1) has
+  const std::int64_t t = trace[total / 3][0];
+  auto f = make<D>(sc, 51);
+  f.run(total, t - 1);
+  e.run(total - e.collisions(), tick_limit - 1);
+  e.rollback_before(t, 0, 0);
+  if (!same_state(e.snapshot(), f.snapshot())) ++bad;
+  e.run(total - e.collisions(), tick_limit - 1);
+  if (state_hash(e.snapshot()) != ref[total]) ++bad;
+  std::printf("  %s: %d rollbacks before a collision's key, one before a tick: %s\n", sc.what, tried, bad == 0 ? "bit for bit" : "DIFFERENT");
+  CHECK(bad == 0);
+}
+
 }  // namespace
 
 TEST_CASE("2D rollback is exact: periodic, walls, bounce back; exact and specular; cells and lists") {
@@ -223,6 +264,16 @@ TEST_CASE("3D walls: collisions right after a reflection on one tick roll back e
   CHECK(bad == 0);
 }
 
+TEST_CASE("rollback before a key (a straggler's): the events before it kept, a run on rejoins the forward run") {
+  using B = en::Boundary;
+  for (const Scene& sc : {Scene{"2D 0.6 walls", 300, 0.6, B::wall, Mode::exact, -1.0, 256, true},
+                          Scene{"3D 0.4 periodic", 300, 0.4, B::periodic, Mode::exact, -1.0, 256, true},
+                          Scene{"2D 0.4 forced groups", 150, 0.4, B::wall, Mode::exact, -1.0, -1, true}}) {
+    if (std::string(sc.what).rfind("3D", 0) == 0) check_keys<3>(sc, 1500);
+    else check_keys<2>(sc, 1500);
+  }
+}
+
 TEST_CASE("rollback refuses what it can not do, the state unchanged") {
   auto e = lattice_test::make_gas<2>(200, 0.5, en::Boundary::wall, 31, 16);
   e.run(300, tick_limit - 1);
@@ -239,6 +290,7 @@ TEST_CASE("rollback refuses what it can not do, the state unchanged") {
   CHECK(refused([&] { e.rollback_to_tick(s.clock - 1); }, "journal_start_tick"));
   CHECK(refused([&] { e.rollback_to_tick(s2.clock + 1); }, "journal_start_tick"));
   CHECK(refused([&] { e.commit(299); }, "lattice commit"));
+  CHECK(refused([&] { e.rollback_before(s.clock, 0, 0); }, "(journal_start_tick, clock + 1]"));
   CHECK(same_state(e.snapshot(), s2));
   e.commit(400);
   CHECK(e.journal_start() == 400);

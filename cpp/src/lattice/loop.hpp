@@ -111,7 +111,7 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
         save_state(j);
       }
       collide_forward(i, j, t);
-      if (journal) jdone_.push_back(Done{t, kind, i, j, coll, unreflected_, jkept_});
+      if (journal) jdone_.push_back(Done{t, kind, i, j, coll, static_cast<std::uint8_t>(unreflected_ | (p == j ? 4u : 0u)), jkept_});
     }
     ++done;
     if (!back && done == want) {

@@ -27,6 +27,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include "revcol/lattice/engine_core.hpp"
 
@@ -157,6 +158,16 @@ void BasicEngine<Op, Bits, Queue>::rollback_to_tick(std::int64_t tick) {
   require(tick >= j_clock0_ && tick <= clock_, "lattice rollback: the target tick must be in [journal_start_tick, clock] = [" +
                                                    std::to_string(j_clock0_) + ", " + std::to_string(clock_) + "]");
   unwind([&](const Done& d) { return d.t <= tick; }, tick);
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::rollback_before(std::int64_t tick, std::int32_t kind, std::int32_t id) {
+  require(jon_, "lattice rollback: the engine keeps no journal (keep_journal)");
+  require(tick > j_clock0_ && tick <= clock_ + 1, "lattice rollback: the key's tick must be in (journal_start_tick, clock + 1] = (" +
+                                                       std::to_string(j_clock0_) + ", " + std::to_string(clock_ + 1) + "]");
+  const auto key = std::make_tuple(tick, kind, id);
+  // (the entries are in the queue's order: a collision under the particle whose slot came up)
+  unwind([&](const Done& d) { return std::make_tuple(d.t, d.kind, gid(d.unreflected & 4u ? d.q : d.p)) < key; }, tick - 1);
 }
 
 template <class Op, class Bits, class Queue>

@@ -167,6 +167,11 @@ class BasicEngine {
   /// Rolls back to tick `tick` (every event after the tick undone; clock = tick): the state
   /// run(until = tick) has. Requires the journal and journal_start_tick() <= tick <= clock().
   void rollback_to_tick(std::int64_t tick);
+  /// Rolls back every event whose key (tick, kind, particle id) is at least (tick, kind, id): a
+  /// straggler's rollback (the queue's order: a collision's id is the one of the pair whose slot
+  /// came up). Clock = the last kept event's tick, or tick - 1. Requires the journal and a key
+  /// after the journal's start.
+  void rollback_before(std::int64_t tick, std::int32_t kind, std::int32_t id);
   /// Forgets the journal up to collision `collisions` (committed: rollback can go no further
   /// back), freeing it. journal_start() <= collisions <= collisions().
   void commit(std::uint64_t collisions);
@@ -558,7 +563,7 @@ class BasicEngine {
     std::int32_t kind;  // its queue kind
     int p, q;          // the particle popped; a collision: its drawer (the smaller id) and partner
     Type type;         // none: a stale event recomputed
-    std::uint8_t unreflected;  // a group: bit 0 (p), bit 1 (q) took in their reflection at t
+    std::uint8_t unreflected;  // a group: bit 0 (p), bit 1 (q) took in their reflection at t; bit 2: q was popped
     std::uint8_t kept;         // state saving: the particle states saved before it
   };
   struct WallDone {  // a reflection's replaced one-tick cache
