@@ -12,6 +12,53 @@
 
 namespace revcol::lattice {
 
+// ---- geometry of the lines ----
+template <class Op, class Bits, class Queue>
+[[gnu::always_inline]] auto BasicEngine<Op, Bits, Queue>::pos(int p, std::int64_t t) const noexcept -> Vec {
+  Vec out;
+  const std::int64_t dt = t - ln_[p].ta;
+  for (std::size_t k = 0; k < D; ++k) {
+    std::int64_t m, y;
+    // fast path (measure before changing): the displacement fits int64 and at most one wrap
+    if (!__builtin_mul_overflow(ln_[p].v[k], dt, &m) && !__builtin_add_overflow(ln_[p].x[k], m, &y)) {
+      if (u_.wall[k]) {
+        out[k] = y;
+        continue;
+      }
+      if (y >= u_.L[k]) y -= u_.L[k];
+      else if (y < 0) y += u_.L[k];
+      if (y >= 0 && y < u_.L[k]) {
+        out[k] = y;
+        continue;
+      }
+    }
+    const i128 z = static_cast<i128>(ln_[p].x[k]) + static_cast<i128>(ln_[p].v[k]) * dt;
+    out[k] = u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
+  }
+  return out;
+}
+
+// Ticks from the anchor to the first at which the line's centre is in the next slab along the
+// regions' axis (set_regions), or -1 (still, or no face ahead before a wall).
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::region_ticks(const Line& l) const noexcept -> std::int64_t {
+  const auto k = static_cast<std::size_t>(rax_);
+  const std::int64_t x = l.x[k], v = l.v[k];
+  if (v == 0) return -1;
+  const bool wrap_axis = !u_.wall[k];
+  if (v > 0) {  // the first face above x: x + v t >= F
+    const auto it = std::upper_bound(faces_.begin(), faces_.end(), x);
+    if (it == faces_.end() && !wrap_axis) return -1;
+    const i128 f = it != faces_.end() ? i128{*it} : i128{faces_.front()} + u_.L[k];
+    return static_cast<std::int64_t>((f - x + v - 1) / v);
+  }
+  // the slab's lower face: x + v t < F
+  auto it = std::upper_bound(faces_.begin(), faces_.end(), x);
+  if (it == faces_.begin() && !wrap_axis) return -1;
+  const i128 f = it != faces_.begin() ? i128{*(it - 1)} : i128{faces_.back()} - u_.L[k];
+  return static_cast<std::int64_t>((i128{x} - f) / -v + 1);
+}
+
 // ---- prediction ----
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::reanchor(int p, std::int64_t t) {
@@ -51,6 +98,15 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
     if (dt > 0) b.offer(lo + dt, 0, cross, -1, -1);
   } else {
     c = grid_.coords(grid_.cell_of_particle(p));
+  }
+  if (rax_ >= 0) {  // slabs: the neutral event of entering the next one, and a change at lo
+    const std::int64_t dr = region_ticks(ln_[p]);
+    if (dr > 0) b.offer(lo + dr, 0, cross, -1, -1);
+    const int r = region_of(ln_[p].x);
+    if (r != region_[static_cast<std::size_t>(p)]) {
+      if (migrations != nullptr && !reversed_ && !unwinding_) migrations->push_back({lo, gid(p), region_[static_cast<std::size_t>(p)], r});
+      region_[static_cast<std::size_t>(p)] = r;
+    }
   }
   for (std::size_t k = 0; k < D; ++k) {
     if (!lists_) {

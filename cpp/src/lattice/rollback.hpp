@@ -257,7 +257,9 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
     reanchor(p, clock_);
     sync(p);
   }
+  unwinding_ = true;
   for (int p : jtouched_) predict(p, clock_);
+  unwinding_ = false;
 }
 
 template <class Op, class Bits, class Queue>

@@ -198,6 +198,10 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s, const std::vector<std
   seed_ = s.seed;
   mode_ = s.mode;
   if (mode_ == Mode::specular) spec_ = Specular(u_.sigma);
+  if (rax_ >= 0 && faces_.back() >= u_.L[static_cast<std::size_t>(rax_)]) {  // slabs of another box
+    rax_ = -1;
+    faces_.clear();
+  }
   const std::size_t n = s.x.size();
   gid_.assign(order.begin(), order.end());
   lid_.assign(order.empty() ? 0 : n, 0);
@@ -289,6 +293,9 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
   // forward: events at the clock may still be pending (a run stopped after a collision);
   // reverse: the clock's tick is done (see run_back), the search starts one tick later
   const std::int64_t lo = reversed_ ? clock_ + 1 : clock_;
+  region_.clear();  // each particle's slab at the clock (set_regions)
+  if (rax_ >= 0)
+    for (std::size_t p = 0; p < n; ++p) region_.push_back(region_of(ln_[p].x));
   for (std::size_t p = 0; p < n; ++p) predict(static_cast<int>(p), lo);
   last_key_ = {std::numeric_limits<std::int64_t>::min(), 0};
   restart_journal();  // a rollback can not cross a rebuild (every line anchored at the clock)
@@ -343,6 +350,23 @@ void BasicEngine<Op, Bits, Queue>::undo() {
   undo_log_.clear();
   undo_groups_.clear();
   ncoll_ = undo_ncoll_;
+  rebuild();
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::set_regions(int axis, std::vector<std::int64_t> faces) {
+  if (faces.empty()) {
+    rax_ = -1;
+    faces_.clear();
+  } else {
+    require(axis >= 0 && axis < static_cast<int>(D), "lattice regions: the axis must be 0, 1 or (3D) 2");
+    const std::int64_t L = u_.L[static_cast<std::size_t>(axis)];
+    for (std::size_t k = 0; k < faces.size(); ++k)
+      require(faces[k] >= 0 && faces[k] < L && (k == 0 || faces[k - 1] < faces[k]),
+              "lattice regions: the faces must ascend within [0, L) of their axis, each once");
+    rax_ = axis;
+    faces_ = std::move(faces);
+  }
   rebuild();
 }
 

@@ -258,6 +258,16 @@ class BasicEngine {
   /// auto_list_shell(), cells in 2D. Either search finds the same collisions: the state, the
   /// trace and the bits are the same; only the speed and the neutral-event counts differ.
   void set_list_shell(double s);
+  /// Slabs along `axis` between `faces` (ascending, in [0, L); the last slab wraps round to the
+  /// first on a periodic axis), or none (empty): each particle's slab is kept as of its last
+  /// event (region()), with a neutral event at the tick its centre enters another slab, and a
+  /// collision or reflection that moves it across a face counts at its tick: the migrations a
+  /// decomposition of the box sees, each at its key. Never changes which collisions happen.
+  void set_regions(int axis, std::vector<std::int64_t> faces);
+  /// Particle id's slab (set_regions; 0 without slabs).
+  int region(int id) const { return region_.empty() ? 0 : region_[local(id)]; }
+  /// When set, every forward change of a particle's slab is appended: (tick, particle id, from, to).
+  std::vector<std::array<std::int64_t, 4>>* migrations = nullptr;
   /// The search in use: 0 the cell grid, 1 lists (the relative vector imaged per pair: a
   /// periodic axis shorter than about 2 (R + 2 h)), 2 lists with the centre offsets.
   int neighbour_search() const noexcept { return lists_ ? (direct_ ? 2 : 1) : 0; }
@@ -304,29 +314,8 @@ class BasicEngine {
   void check_log(const Snapshot& s) const;  // the rare log against the per-particle counts
 
   // ---- geometry of the lines ----
-  [[gnu::always_inline]] Vec pos(int p, std::int64_t t) const noexcept {
-    Vec out;
-    const std::int64_t dt = t - ln_[p].ta;
-    for (std::size_t k = 0; k < D; ++k) {
-      std::int64_t m, y;
-      // fast path (measure before changing): the displacement fits int64 and at most one wrap
-      if (!__builtin_mul_overflow(ln_[p].v[k], dt, &m) && !__builtin_add_overflow(ln_[p].x[k], m, &y)) {
-        if (u_.wall[k]) {
-          out[k] = y;
-          continue;
-        }
-        if (y >= u_.L[k]) y -= u_.L[k];
-        else if (y < 0) y += u_.L[k];
-        if (y >= 0 && y < u_.L[k]) {
-          out[k] = y;
-          continue;
-        }
-      }
-      const i128 z = static_cast<i128>(ln_[p].x[k]) + static_cast<i128>(ln_[p].v[k]) * dt;
-      out[k] = u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
-    }
-    return out;
-  }
+  // p's point at tick t on its line, wrapped on periodic axes (predict.hpp)
+  [[gnu::always_inline]] Vec pos(int p, std::int64_t t) const noexcept;
   Vec diff(const Vec& a, const Vec& b) const noexcept {
     Vec r;
     for (std::size_t k = 0; k < D; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
@@ -557,6 +546,17 @@ class BasicEngine {
   Queue queue_;
   std::pair<std::int64_t, std::int32_t> last_key_{};
   std::vector<int> gid_, lid_;  // local index -> particle id and back (empty: the identity)
+  // slabs (set_regions): the axis (-1: none), the faces, each particle's slab as of its anchor
+  int rax_ = -1;
+  std::vector<std::int64_t> faces_;
+  std::vector<int> region_;
+  bool unwinding_ = false;  // a rollback's predictions record no migration
+  int region_of(const Vec& x) const noexcept {
+    const auto it = std::upper_bound(faces_.begin(), faces_.end(), x[static_cast<std::size_t>(rax_)]);
+    const int m = static_cast<int>(faces_.size());
+    return (static_cast<int>(it - faces_.begin()) - 1 + m) % m;
+  }
+  std::int64_t region_ticks(const Line& l) const noexcept;  // ticks to the next face, -1: none
   // ---- the processed-event journal (rollback.hpp) ----
   struct Done {        // one queue pop
     std::int64_t t;    // its tick
