@@ -144,11 +144,19 @@ void register_pair2d(py::module_& m) {
              std::vector<PairV<2>> pv = pairs_from(v, rows);
              const auto nv = normals_from(n, pv.size());
              py::array_t<double> out(static_cast<py::ssize_t>(pv.size()));
-             for (std::size_t b = 0; b < pv.size(); ++b) out.mutable_data()[b] = op.chart(pv[b], nv[b]);
+             for (std::size_t b = 0; b < pv.size(); ++b) {
+               try {
+                 out.mutable_data()[b] = op.chart(pv[b], nv[b]);
+               } catch (const InvalidArgument& e) {
+                 throw InvalidArgument((rows.batched ? "entry " + std::to_string(b) + ": " : std::string()) + e.what());
+               }
+             }
              return out;
            },
            py::arg("velocities"), py::arg("normal"),
-           "Exact mode's chart coordinate in [0, 1] of separating states (uniform under the law).")
+           "Exact mode's chart coordinate in [0, 1] of post states (uniform under the law), one per entry.\n"
+           "Defined on a.w >= 0 (w = v_i - v_j; grazing gives 0 or 1): an approaching state, a zero\n"
+           "relative velocity or a non-finite one raises InvalidArgument (a ValueError) naming the entry.")
       .def_property_readonly("mode", [](const Pair2D& op) { return to_string(op.mode()); })
       .def_property_readonly("law", [](const Pair2D& op) { return to_string(op.law()); })
       .def_property_readonly("bits", &Pair2D::bits)

@@ -145,12 +145,19 @@ void register_collision(py::module_& m) {
              const std::size_t B = rows.count, nd = op.particles() * op.dim(), k = op.draws();
              Array out(rows.batched ? batched({op.draws()}, B) : Shape{op.draws()});
              for (std::size_t b = 0; b < B; ++b) {
-               const std::vector<double> cb = op.chart(v.data() + b * nd);
-               std::copy(cb.begin(), cb.end(), out.mutable_data() + b * k);
+               try {
+                 const std::vector<double> cb = op.chart(v.data() + b * nd);
+                 std::copy(cb.begin(), cb.end(), out.mutable_data() + b * k);
+               } catch (const InvalidArgument& e) {
+                 throw InvalidArgument((rows.batched ? "entry " + std::to_string(b) + ": " : std::string()) + e.what());
+               }
              }
              return out;
            },
-           py::arg("velocities"), "Chart coordinates in [0, 1] of post states: uniform under the law.")
+           py::arg("velocities"),
+           "Chart coordinates in [0, 1] of post states: uniform under the law. Defined where every contact\n"
+           "separates or grazes: an approaching contact, a zero relative speed or a non-finite velocity\n"
+           "raises InvalidArgument (a ValueError) naming the entry and the contact.")
       .def("quantize",
            [](const Collision& c, const ArrayArg& v_arg, std::optional<ArrayArg> mo_arg, std::optional<ArrayArg> en_arg) {
              const auto v = to_array(v_arg, "velocities");

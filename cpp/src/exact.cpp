@@ -455,6 +455,19 @@ bool ExactCollision::logs(const double* post) const { return needs_log(post); }
 
 std::vector<double> ExactCollision::chart(const double* post) const {
   check_common(post, nullptr);
+  const std::vector<double> sp = normal_speeds(post);
+  for (int k = 0; k < m_; ++k) {
+    require(sp[k] >= 0.0, [&] {
+      return "chart: contact " + std::to_string(k) + " (" + std::to_string(contacts_[k].i) + ", " +
+             std::to_string(contacts_[k].j) + ") approaches (normal relative velocity " + str(sp[k]) +
+             " < 0): the chart is defined on post-collision states, every contact separating or grazing";
+    });
+  }
+  return chart_unchecked(post);
+}
+
+std::vector<double> ExactCollision::chart_unchecked(const double* post) const {
+  check_common(post, nullptr);
   Point p;
   encode(relative(post), p);
   return std::vector<double>(p.c.begin(), p.c.begin() + (D_ - 1));

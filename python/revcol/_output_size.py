@@ -15,6 +15,12 @@ limit and with the free space of the file system they go to.
   (:func:`state_bytes`); measured once per configuration in a process.
 - **JSON report** and **figures**: fixed allowances (:data:`REPORT_BYTES`, :data:`FIGURE_BYTES`),
   with a share per histogram bin and, for vector figures, per particle drawn.
+- **A sweep** (``revcol sweep``): its points write no trajectory, checkpoint or figure of their
+  own (revcol.sweep.spec strips them), only their reports, ``points/HASH.json``: one report
+  allowance per point still to run (:func:`sweep_points_size`); and the sweep's table, summary and
+  figures (:func:`sweep_files_size`: :data:`SWEEP_ROW_BYTES` a point for the table, a report
+  allowance and :data:`SWEEP_SUMMARY_BYTES_PER_POINT` a point for the summary, a figure allowance
+  for each of the horizon study's two figures).
 
 A run stopped by time has no collision count to read: its collisions (or, for frames every
 ``every_time`` of a run of N collisions, its time) are the expected ones, from the Enskog
@@ -37,13 +43,14 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._outputs import Size
+from ._outputs import Size, human
 from .gas import build_simulation
 from .scene import Scene, read_initial
 
 __all__ = ["collision_rate", "expected_collisions", "round_trip_frames", "round_trip_checkpoints",
            "production_frames", "production_checkpoints", "trajectory_size", "state_bytes", "checkpoints_size",
-           "report_size", "figures_size", "REPORT_BYTES", "FIGURE_BYTES", "SAMPLE_PARTICLES", "SAMPLE_ROWS"]
+           "report_size", "figures_size", "sweep_points_size", "sweep_files_size", "REPORT_BYTES", "FIGURE_BYTES",
+           "SWEEP_ROW_BYTES", "SWEEP_SUMMARY_BYTES_PER_POINT", "SAMPLE_PARTICLES", "SAMPLE_ROWS"]
 
 #: the JSON report's allowance (measured: 3-19 KB for the example scenes), and per histogram bin
 REPORT_BYTES = 256 << 10
@@ -53,6 +60,10 @@ REPORT_BYTES_PER_BIN = 256
 #: end; measured about 400 bytes a particle in SVG)
 FIGURE_BYTES = 1 << 20
 FIGURE_BYTES_PER_PARTICLE = 512
+#: a sweep's table, per point: its CSV row and its Parquet row (measured: CSV rows of 300-800 bytes)
+SWEEP_ROW_BYTES = 8 << 10
+#: a sweep's summary, per point besides the report allowance: a missing, failed or combined entry
+SWEEP_SUMMARY_BYTES_PER_POINT = 1 << 10
 #: the particle counts whose saved states give a checkpoint's bytes as a + b N
 SAMPLE_PARTICLES = (32, 64)
 #: the particles of the sample frame whose extended XYZ lines are measured
@@ -267,3 +278,24 @@ def figures_size(scene: Scene, count: int, fmt: str) -> Size:
     """The figures' allowance: ``count`` figures, and every particle drawn in a vector format."""
     vector = FIGURE_BYTES_PER_PARTICLE * scene.particles if fmt in ("svg", "pdf") else 0
     return Size(count * FIGURE_BYTES + vector, f"a fixed allowance for {count} {fmt} figures")
+
+
+def sweep_points_size(scenes: list[Scene | None]) -> Size | None:
+    """The reports of a sweep's points still to run (``points/HASH.json``), one per scene given
+    (None: a study without a scene), each :func:`report_size`'s allowance; None when none is left."""
+    if not scenes:
+        return None
+    each = [report_size(s).bytes if s is not None else float(REPORT_BYTES) for s in scenes]
+    size = f"about {human(each[0])} each" if min(each) == max(each) else \
+        f"{human(min(each))} to {human(max(each))} each"
+    return Size(sum(each), f"{_count(len(each), 'point report')} still to run, {size} (a fixed allowance for a "
+                "report, and a share per histogram bin)")
+
+
+def sweep_files_size(points: int, figures: int) -> Size:
+    """A sweep's table (CSV and Parquet), summary and ``figures`` figures, over ``points`` points."""
+    table = SWEEP_ROW_BYTES * points
+    summary = REPORT_BYTES + SWEEP_SUMMARY_BYTES_PER_POINT * points
+    figs = f" and {figures} figures" if figures else ""
+    return Size(table + summary + figures * FIGURE_BYTES,
+                f"the table of {_count(points, 'point')}, the summary{figs}: fixed allowances")

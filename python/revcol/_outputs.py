@@ -249,11 +249,11 @@ def _over(o: Output, total: float, many: bool, there: str = "") -> str:
 
 
 def check_sizes(source: str, outputs: Iterable[Output], limit: int | None = None,
-                error: type[Exception] = SceneError) -> None:
+                error: type[Exception] = SceneError, flag: str = "--max-output or [output] max_output") -> None:
     """Raises ``error`` (one line) when the outputs' estimated bytes, summed, exceed ``limit``
     (None: :data:`DEFAULT_MAX_OUTPUT`; 0: no limit), or when those going to one file system exceed
     its free space (``shutil.disk_usage`` of the output's folder, or of its nearest existing parent).
-    Creates nothing."""
+    ``flag``: where the limit is set, for the message. Creates nothing."""
     sized = [o for o in outputs if o.path is not None and o.size is not None]
     if not sized:
         return
@@ -262,7 +262,7 @@ def check_sizes(source: str, outputs: Iterable[Output], limit: int | None = None
     big = max(sized, key=lambda o: o.size.bytes if o.size is not None else 0.0)
     if limit and total > limit:
         raise error(f"{source}: {_over(big, total, len(sized) > 1)}: more than the output limit of {human(limit)} "
-                    "(--max-output or [output] max_output: a size such as 20G, or none): refusing to start")
+                    f"({flag}: a size such as 20G, or none): refusing to start")
     places: dict[int, tuple[Path, list[Output]]] = {}
     for o in sized:
         where = _existing(Path(_path(o)) if o.folder else Path(_path(o)).parent)

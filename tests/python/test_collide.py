@@ -109,6 +109,59 @@ def test_bad_batch_entry_named_and_nothing_drawn():
     assert gen.counter == 0
 
 
+# chart() of valid post states, as computed before the domain check (issue 59): rows i, j; normal (-1, 0)
+CHART_STATES = np.array([[[-1.0, 0.0], [1.0, 0.0]], [[-1.0, 0.5], [1.0, 0.0]], [[-0.7, -2.0], [0.3, 0.25]],
+                         [[0.0, 1.0], [0.0, -1.0]], [[-2.5, 1e-3], [0.5, -4.0]]])
+CHART_VALUES = {"flux": [0.5, 0.3787321874818335, 0.9569057743101286, 0.0, 0.0999640086384162],
+                "uniform": [0.5, 0.4220208696226307, 0.8668750612523435, 0.0, 0.20479457362354675]}
+
+
+@pytest.mark.parametrize("mode", ["exact", "paper"])
+@pytest.mark.parametrize("law", ["flux", "uniform"])
+def test_chart_values_of_post_states_unchanged(mode, law):
+    """Separating states (and the grazing one, row 3: the chart's end 0) give the values they did
+    before the domain check, bit for bit; paper mode reads exact mode's chart."""
+    op = revcol.Pair2D(mode=mode, law=law)
+    assert op.chart(CHART_STATES, [-1.0, 0.0]).tolist() == CHART_VALUES[law]
+    assert op.chart(CHART_STATES[1], [-1.0, 0.0]).tolist() == [CHART_VALUES[law][1]]
+
+
+@pytest.mark.parametrize("law", ["flux", "uniform"])
+@pytest.mark.parametrize("v,match", [
+    ([[1.0, 0.0], [-1.0, 0.0]], "approaches along the contact normal .normal relative velocity -2 < 0"),  # was 0.5 / -0.5
+    ([[1.0, -0.5], [-1.0, 0.0]], "approaches along the contact normal"),
+    ([[1e-3, 0.0], [0.0, 0.0]], "approaches along the contact normal"),
+    ([[0.0, 0.0], [0.0, 0.0]], "zero relative speed"),                          # was NaN (flux), 0.5 (uniform)
+    ([[1.0, 1.0], [1.0, 1.0]], "zero relative speed"),
+    ([[-1e-200, 0.0], [0.0, 0.0]], "relative speed too small"),                 # was NaN (flux)
+    ([[np.nan, 0.0], [1.0, 0.0]], "finite"),
+    ([[np.inf, 0.0], [1.0, 0.0]], "finite"),
+])
+def test_chart_refuses_states_outside_its_domain(law, v, match):
+    """Issue 59: chart() of an approaching state returned 0.5 (flux, head-on; uniform: -0.5, outside
+    [0, 1]) and NaN at zero relative velocity; both raise a ValueError naming the problem now."""
+    op = revcol.Pair2D(law=law)
+    with pytest.raises(ValueError, match=match):
+        op.chart(np.array(v), [-1.0, 0.0])
+    batch = np.stack([CHART_STATES[0], np.array(v), CHART_STATES[1]])
+    with pytest.raises(ValueError, match="entry 1: .*" + match):
+        op.chart(batch, [-1.0, 0.0])
+
+
+def test_chart_of_forward_posts_and_of_negated_pre_states():
+    """What the studies chart stays in the domain: every forward post (a draw anywhere in [0, 1])
+    and the negation of every pre state."""
+    rng = np.random.default_rng(11)
+    v = rng.normal(size=(20_000, 2, 2))
+    n = np.array([-1.0, 0.0])
+    v = v[(v[:, 0] - v[:, 1]) @ n < 0]
+    for law in ("flux", "uniform"):
+        op = revcol.Pair2D(law=law)
+        post = op.forward(v, n, g=rng.random(len(v)))
+        for c in (op.chart(post, n), op.chart(-v, n)):
+            assert np.all((c >= 0.0) & (c <= 1.0))
+
+
 def test_exactly_one_random_source_and_valid_options():
     op = revcol.Pair2D()
     v, n = np.array([[1.0, 0.0], [-1.0, 0.0]]), [-1.0, 0.0]

@@ -184,6 +184,46 @@ def test_cradle_and_validation():
     assert gen.state == revcol.CLCG4().state  # nothing drawn by the failures
 
 
+# chart() of separating states, as computed before the domain check (issue 59)
+CHART_CASES = {
+    "pair2d": ([[-0.45, -0.22], [-2.02, -0.23]], {"flux": [0.14870566769338495], "uniform": [0.2520274240873925]}),
+    "triple2d-c1": ([[-0.18, 0.54], [1.94, -0.27], [-0.24, 1.0]],
+                    {"flux": [0.09123430243709732, 0.288305972095718, 0.40881100131753323],
+                     "uniform": [0.09123430243709732, 0.288305972095718, 0.4224032241331185]}),
+    "pair3d": ([[2.04, -2.56, 0.42], [-0.57, -0.45, -0.22]],
+               {"flux": [0.9628912607719851, 0.5265275866198968], "uniform": [0.8073637125876464, 0.5265275866198968]}),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CHART_CASES))
+@pytest.mark.parametrize("law", ["flux", "uniform"])
+def test_chart_domain(name, law):
+    """Issue 59 (the sibling of Pair2D.chart): a state with an approaching contact was charted
+    (pair2d's head-on approach to 0.85); it raises naming the contact now. Separating states give
+    the values they did before, and zero relative speed is refused as before."""
+    op = revcol.Collision.named(name, law=law)
+    v, want = CHART_CASES[name]
+    v = np.array(v)
+    assert op.chart(v).tolist() == want[law]
+    with pytest.raises(ValueError, match=r"chart: contact \d .* approaches .normal relative velocity -"):
+        op.chart(np.stack([v, v]) * np.array([1.0, -1.0])[:, None, None])
+    with pytest.raises(ValueError, match="entry 1: chart: contact"):
+        op.chart(np.stack([v, -v]))
+    with pytest.raises(ValueError, match="zero relative speed"):
+        op.chart(np.ones_like(v))
+    with pytest.raises(ValueError, match="finite"):
+        op.chart(np.full_like(v, np.nan))
+
+
+def test_chart_of_a_state_with_one_contact_approaching():
+    """One contact approaching and the others separating is outside the cone too."""
+    op = revcol.Collision.named("triple2d-c1")
+    v = np.array([[0.19, 1.11], [-0.21, -0.93], [0.58, 0.58]])
+    assert min(op.normal_speeds(v)) < 0 < max(op.normal_speeds(v))
+    with pytest.raises(ValueError, match=r"chart: contact 0 \(1, 0\) approaches"):
+        op.chart(v)
+
+
 def test_named_verify_cases_exact():
     for c in revcol.named_cases():
         r = revcol.verify(c["name"], collisions=2000, mode="exact", seed=1)

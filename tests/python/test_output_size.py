@@ -247,3 +247,76 @@ def test_a_run_to_a_time_is_estimated_from_the_enskog_rate(tmp_path, engine):
     assert "collisions expected in t = 4 at the Enskog collision rate" in how
     f = _factors(r)
     assert all(0.5 < x < 2.0 for x in f.values()), f
+
+
+# --- revcol sweep: the same estimates over every point ------------------------------------------
+
+SWEEP = "[sweep]\nname = \"sz\"\nstudy = \"run\"\n[vary]\nseed = {{start = 0, count = {k}}}\n" \
+        "[options]\nparticles = 20\ncollisions = 100\n{extra}"
+
+
+def _sweep_file(tmp_path, k, extra=""):
+    (tmp_path / "sz.toml").write_text(SWEEP.format(k=k, extra=extra))
+    return "sz.toml"
+
+
+def test_a_small_sweep_under_the_limit_runs_and_its_summary_has_the_estimate(tmp_path, capsys):
+    f = _sweep_file(tmp_path, 2)
+    rc, err = _cli(tmp_path, ["sweep", f, "--workers", "0", "--out", "o", "--max-output", "2M"], capsys)
+    assert rc == 0, err
+    summary = json.loads((tmp_path / "o" / "sz.json").read_text())
+    est = summary["output_estimate"]
+    assert set(est) == {"the output folder's points/", "the output folder (--out)"}
+    points = est["the output folder's points/"]
+    assert points["bytes"] == 2 * revcol._output_size.REPORT_BYTES and "2 point reports still to run" in points["how"]
+    written = sum(p.stat().st_size for p in (tmp_path / "o" / "points").glob("*.json"))
+    assert 0 < written < points["bytes"]  # an allowance: the reports of 20 disks are about 20 kB
+    # run again: nothing left to run, so no point report is estimated
+    rc, err = _cli(tmp_path, ["sweep", f, "--workers", "0", "--out", "o", "--max-output", "300K"], capsys)
+    assert rc == 0, err
+    assert set(json.loads((tmp_path / "o" / "sz.json").read_text())["output_estimate"]) == {"the output folder (--out)"}
+
+
+def test_a_sweep_over_the_default_limit_is_refused_with_its_estimate_and_nothing_written(tmp_path, capsys):
+    # a point writes only its report (no trajectory, checkpoint or figure: revcol.sweep.spec strips
+    # them); 48 reports with 2^20 speed bins each are estimated at 12 GiB, over the default 10 GiB
+    f = _sweep_file(tmp_path, 48, "\"observe.speed_bins\" = 1048576\n")
+    rc, err = _cli(tmp_path, ["sweep", f, "--workers", "0", "--out", "o"], capsys)
+    assert rc == 2 and len(err) == 1, err
+    assert err[0].startswith("revcol sweep: error: sz.toml: the output folder's points/ would write about 12 GiB "
+                             "(48 point reports still to run, about 256 MiB each"), err
+    assert "more than the output limit of 10 GiB (--max-output: a size such as 20G, or none): refusing to start" \
+        in err[0], err
+    assert _files(tmp_path) == ["sz.toml"]
+
+
+def test_sweep_max_output_refuses_and_none_allows(tmp_path, capsys, monkeypatch):
+    f = _sweep_file(tmp_path, 3)  # 3 x 256 KiB of reports, the table and the summary: about 1 MiB
+    for limit in ("500K", "512000"):
+        rc, err = _cli(tmp_path, ["sweep", f, "--workers", "0", "--out", "o", "--max-output", limit], capsys)
+        assert rc == 2 and len(err) == 1 and "more than the output limit of 500 KiB" in err[0], err
+        assert "the output folder's points/ would write about 768 KiB (3 point reports" in err[0], err
+        assert "; the run's outputs come to about 1.0" in err[0], err
+    rc, err = _cli(tmp_path, ["sweep", f, "--workers", "0", "--out", "o", "--max-output", "lots"], capsys)
+    assert rc == 2 and "--max-output must be a size" in err[0], err
+    assert _files(tmp_path) == ["sz.toml"]
+    # no limit: the free space still counts
+    monkeypatch.setattr(revcol._outputs.shutil, "disk_usage",
+                        lambda path: shutil._ntuple_diskusage(100 << 30, 100 << 30, 100 << 10))
+    rc, err = _cli(tmp_path, ["sweep", f, "--workers", "0", "--out", "o", "--max-output", "none"], capsys)
+    assert rc == 2 and f"more than the 100 KiB free on the file system of {tmp_path}" in err[0], err
+    monkeypatch.undo()
+    rc, err = _cli(tmp_path, ["sweep", f, "--workers", "0", "--out", "o", "--max-output", "none"], capsys)
+    assert rc == 0, err
+    assert len(list((tmp_path / "o" / "points").glob("*.json"))) == 3
+
+
+def test_sweep_estimate_functions():
+    from revcol._output_size import sweep_files_size, sweep_points_size
+
+    assert sweep_points_size([]) is None
+    s = sweep_points_size([None, None])  # the studies without a scene: the report allowance each
+    assert s.bytes == 2 * revcol._output_size.REPORT_BYTES and s.how.startswith("2 point reports still to run")
+    files = sweep_files_size(10, 2)
+    assert files.bytes == (10 * revcol._output_size.SWEEP_ROW_BYTES + revcol._output_size.REPORT_BYTES
+                           + 10 * revcol._output_size.SWEEP_SUMMARY_BYTES_PER_POINT + 2 * revcol._output_size.FIGURE_BYTES)

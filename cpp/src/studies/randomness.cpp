@@ -216,7 +216,7 @@ std::unique_ptr<Source> exact_case(const NamedCase& nc, const StreamConfig& c) {
         return true;
       },
       [mapper](const std::vector<double>& post, double* u) {
-        const std::vector<double> ch = mapper->chart(post.data());
+        const std::vector<double> ch = mapper->chart_unchecked(post.data());
         for (std::size_t k = 0; k < ch.size(); ++k) u[k] = ch[k];
       });
 }
@@ -246,7 +246,7 @@ std::unique_ptr<Source> paper_chain(const paper::PaperCase& pc, const StreamConf
       [pred](const State& post) { return pred.separates(post); },
       [mapper](const State& post, double* u) {
         const std::vector<double> f = A::flat(post);
-        const std::vector<double> ch = mapper->chart(f.data());
+        const std::vector<double> ch = mapper->chart_unchecked(f.data());
         for (std::size_t k = 0; k < ch.size(); ++k) u[k] = ch[k];
       });
 }

@@ -15,6 +15,7 @@
     revcol study equilibrium small|dense|walls|mc|mc-compare|figures|table ...   (= python -m revcol.studies.equilibrium ...)
     revcol study stability [--full] [--json FILE] [--markdown]   (= python -m revcol.studies.stability ...)
     revcol sweep SWEEP.toml|NAME [--out DIR] [--workers K | --scheduler tcp://HOST:PORT | --scheduler-file F]
+                 [--max-output SIZE]
     revcol --version
 
 Manners (issue 19): a mistyped subcommand, choice or option gets a "did you mean" suggestion
@@ -309,6 +310,10 @@ def _sweep_parser(sub) -> None:
     where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on this running Dask scheduler's workers")
     where.add_argument("--scheduler-file", metavar="FILE", help="run on the Dask cluster this scheduler file names")
     s.add_argument("--no-progress", action="store_true", help="no progress bar (off anyway when not a terminal)")
+    s.add_argument("--max-output", metavar="SIZE", help="refuse to start when the sweep's outputs (a report per point "
+                   "still to run, the table, the summary, the figures) are estimated to need more than SIZE: bytes "
+                   "or K, M, G, T (powers of 1024), e.g. 20G; 0 or none: no limit (default 10G). A sweep whose "
+                   "outputs would not fit in the free space is refused too")
 
 
 def _sweep(args: argparse.Namespace) -> int:
@@ -319,7 +324,7 @@ def _sweep(args: argparse.Namespace) -> int:
     try:
         summary = sweep(args.sweep_file, out=args.out, workers=args.workers, scheduler=args.scheduler,
                         scheduler_file=args.scheduler_file, progress=False if args.no_progress else None,
-                        log=lambda line: print(line, file=sys.stderr))
+                        log=lambda line: print(line, file=sys.stderr), max_output=args.max_output)
     except (SweepError, OSError) as e:
         print(f"revcol sweep: error: {e}", file=sys.stderr)
         return 2

@@ -10,8 +10,10 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .._outputs import Input, Output, refuse_collisions
-from .output import output_names
+from .._output_size import sweep_files_size, sweep_points_size
+from .._outputs import Input, Output, check_sizes, estimates, output_limit, refuse_collisions
+from ..scene_schema import SceneError
+from .output import output_names, read_point
 from .spec import SCENE_PARAMS, STUDIES, Point, Sweep, SweepError, load_sweep, sweep_from_dict, sweep_names
 from .tasks import execute
 
@@ -21,7 +23,8 @@ __all__ = ["SweepError", "Sweep", "Point", "load_sweep", "sweep_from_dict", "swe
 
 def sweep(spec: Sweep | str | os.PathLike, *, out: str | os.PathLike | None = None, workers: int | None = None,
           scheduler: str | None = None, scheduler_file: str | os.PathLike | None = None, client=None,
-          progress: bool | None = None, stop_after: int | None = None, log=None, on_result=None) -> dict:
+          progress: bool | None = None, stop_after: int | None = None, log=None, on_result=None,
+          max_output: int | str | None = None) -> dict:
     """Runs a sweep (a :class:`Sweep` or a sweep file) and returns its summary (also written to
     ``out/NAME.json``, with the table ``out/NAME.csv``).
 
@@ -30,7 +33,10 @@ def sweep(spec: Sweep | str | os.PathLike, *, out: str | os.PathLike | None = No
     cluster instead; ``client``: an existing ``distributed.Client``. ``stop_after``: stop once that
     many points have finished in this call (the rest stay to do: run again to resume). ``log``: a
     callable taking a line of text (default: nothing printed); ``on_result``: called here with
-    ``{"index", "hash", "point"}`` as each point's file is written."""
+    ``{"index", "hash", "point"}`` as each point's file is written. ``max_output``: the limit on the
+    bytes the sweep is estimated to write (``"20G"``; 0 or ``"none"``: none; default 10 GiB, as for
+    ``revcol run``); a sweep over it, or over the free space, is refused before any point runs, and
+    the summary's ``output_estimate`` gives the estimates (:mod:`revcol._output_size`)."""
     if not isinstance(spec, Sweep):
         spec = load_sweep(spec)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
@@ -45,9 +51,26 @@ def sweep(spec: Sweep | str | os.PathLike, *, out: str | os.PathLike | None = No
     if out.exists() and not out.is_dir():
         raise SweepError(f"{out}: exists and is not a folder")
     _refuse_overwriting_inputs(spec, out)
+    try:
+        limit = output_limit(spec.source, max_output, None)
+    except SceneError as e:
+        raise SweepError(str(e)) from None
+    outputs = _outputs(spec, out)
+    check_sizes(spec.source, outputs, limit, SweepError, flag="--max-output")
     return execute(spec, out, workers=workers, scheduler=scheduler,
                    scheduler_file=None if scheduler_file is None else str(scheduler_file), client=client,
-                   progress=progress, stop_after=stop_after, log=log or (lambda line: None), on_result=on_result)
+                   progress=progress, stop_after=stop_after, log=log or (lambda line: None), on_result=on_result,
+                   output_estimate=estimates(outputs))
+
+
+def _outputs(spec: Sweep, out: Path) -> list[Output]:
+    """What the sweep writes, each with its estimated bytes (issue 59; revcol._output_size): a
+    report for each point not yet written (points/HASH.json: a point writes nothing else), and the
+    table, the summary and, for the horizon study, its two figures."""
+    todo = [p.scene for p in spec.points if read_point(out, p.hash) is None]
+    return [Output("the output folder's points/", out / "points", folder=True, size=sweep_points_size(todo)),
+            Output("the output folder (--out)", out, folder=True,
+                   size=sweep_files_size(len(spec.points), 2 if spec.study == "horizon" else 0))]
 
 
 def _refuse_overwriting_inputs(spec: Sweep, out: Path) -> None:

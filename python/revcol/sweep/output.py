@@ -120,8 +120,9 @@ def _groups(spec, points: list[dict]) -> list[dict]:
     return out
 
 
-def gather(spec, out: Path, state, *, reused: int, seconds: float, load, log) -> dict:
-    """Writes ``NAME.csv`` (+ ``.parquet``), the figures and ``NAME.json``; returns the summary."""
+def gather(spec, out: Path, state, *, reused: int, seconds: float, load, log, output_estimate: dict | None = None) -> dict:
+    """Writes ``NAME.csv`` (+ ``.parquet``), the figures and ``NAME.json``; returns the summary
+    (``output_estimate``: the bytes each output was estimated to take, checked before the start)."""
     points, missing = [], []
     for p in spec.points:
         d = read_point(out, p.hash)
@@ -136,7 +137,8 @@ def gather(spec, out: Path, state, *, reused: int, seconds: float, load, log) ->
         "interrupted": state.interrupted, "complete": not missing, "cluster": state.cluster,
         "seconds": seconds, "loadavg_start": list(load[0]), "loadavg_end": list(load[1]),
         "cpu_count": os.cpu_count(), "revcol": __version__, "combined": combined, "table": written,
-        "figures": figures, "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+        "figures": figures, "output_estimate": output_estimate or {},
+        "date": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
     }
     with atomic_open(out / f"{spec.name}.json") as f:
         json.dump(summary, f, indent=1, default=str)

@@ -80,8 +80,10 @@ class _State:
 
 
 def execute(spec, out: Path, *, workers, scheduler, scheduler_file, client, progress, stop_after,
-            log: Callable[[str], None], on_result: Callable[[dict], None] | None = None) -> dict:
-    """Runs the points of ``spec`` not yet in ``out``, then gathers the table and the summary."""
+            log: Callable[[str], None], on_result: Callable[[dict], None] | None = None,
+            output_estimate: dict | None = None) -> dict:
+    """Runs the points of ``spec`` not yet in ``out``, then gathers the table and the summary
+    (``output_estimate``: the outputs' estimated bytes, for the summary)."""
     todo = [p for p in spec.points if read_point(out, p.hash) is None]
     reused = len(spec.points) - len(todo)
     load0, t0 = os.getloadavg(), time.perf_counter()
@@ -112,7 +114,7 @@ def execute(spec, out: Path, *, workers, scheduler, scheduler_file, client, prog
         for b in bars:
             b.close()
     return gather(spec, out, state, reused=reused, seconds=time.perf_counter() - t0, load=(load0, os.getloadavg()),
-                  log=log)
+                  log=log, output_estimate=output_estimate)
 
 
 def _serial(spec, todo, state: _State, finished) -> None:

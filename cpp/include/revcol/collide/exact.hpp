@@ -100,8 +100,14 @@ class ExactCollision {
   /// The bound, in cells, on how far each chart coordinate of `post` can move when its
   /// velocities are rounded (the rare log fires above 1/4).
   std::vector<double> recovery_bound(const double* post) const;
-  /// Chart coordinates in [0,1] of a post state (D-1 values; uniform under the law).
+  /// Chart coordinates in [0,1] of a post state (D-1 values; uniform under the law). The
+  /// chart is defined on the closed cone P of post states, every contact separating or grazing
+  /// (normal relative velocity >= 0); throws InvalidArgument for a contact that approaches,
+  /// and as every operator does for a velocity that is not finite or a zero relative speed.
   std::vector<double> chart(const double* post) const;
+  /// chart() without the cone check: the randomness study's reading of every post state its
+  /// chain accepts, including one the rare log serves with a contact rounded a hair inside.
+  std::vector<double> chart_unchecked(const double* post) const;
   /// The pre state as a reversal restores it: its cells decoded at their centres.
   void quantize(const double* pre, double* out, const Held* held = nullptr) const;
   /// Normal relative velocities r_k . (v_i - v_j) of a state, from the differences (exactly

@@ -3,7 +3,10 @@
 // (everything validated before anything changes).
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstddef>
+#include <cstdio>
+#include <string>
 
 #include "revcol/collide/batch.hpp"
 #include "revcol/collide/pair2d_exact.hpp"
@@ -61,11 +64,25 @@ class Pair2D {
     paper_.check_pre(pre, n, inv);
     return pre;
   }
-  /// Exact mode's chart coordinate of a separating post state, in [0, 1] (for coverage).
+  /// Exact mode's chart coordinate of a post state, in [0, 1] (for coverage). The chart is
+  /// defined on the closed half circle a.w >= 0 (a grazing state gives 0 or 1); throws
+  /// InvalidArgument, naming the problem, for a velocity the operators refuse (not finite,
+  /// zero or too small a relative speed) and for an approaching state (a.w < 0), where the
+  /// formula would give a number outside the chart (flux: 0.5 head-on; uniform: beyond [0, 1]).
   double chart(const PairV<2>& post, const std::array<double, 2>& n) const {
     const Frame2 f(n);
     const auto w = relative(post);
-    return exact_.chart(f.normal_part(w), f.tangent_part(w), std::sqrt(w[0] * w[0] + w[1] * w[1]));
+    const double n2 = w[0] * w[0] + w[1] * w[1];
+    const double cm[2] = {0.5 * (post.i[0] + post.j[0]), 0.5 * (post.i[1] + post.j[1])};
+    require_speed_range(post, w, n2, cm);
+    const double p = f.normal_part(w);
+    require(p >= 0.0, [&] {
+      char num[32];
+      std::snprintf(num, sizeof num, "%.6g", p);
+      return std::string("chart: the state approaches along the contact normal (normal relative velocity ") + num +
+             " < 0): the chart is defined on post-collision states, a.w >= 0";
+    });
+    return exact_.chart(p, f.tangent_part(w), std::sqrt(n2));
   }
 
  private:
