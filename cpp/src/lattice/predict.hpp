@@ -14,7 +14,7 @@ namespace revcol::lattice {
 
 // ---- geometry of the lines ----
 template <class Op, class Bits, class Queue>
-[[gnu::always_inline]] auto BasicEngine<Op, Bits, Queue>::pos(int p, std::int64_t t) const noexcept -> Vec {
+[[gnu::always_inline]] inline auto BasicEngine<Op, Bits, Queue>::pos(int p, std::int64_t t) const noexcept -> Vec {
   Vec out;
   const std::int64_t dt = t - ln_[p].ta;
   for (std::size_t k = 0; k < D; ++k) {

@@ -315,7 +315,7 @@ class BasicEngine {
 
   // ---- geometry of the lines ----
   // p's point at tick t on its line, wrapped on periodic axes (predict.hpp)
-  [[gnu::always_inline]] Vec pos(int p, std::int64_t t) const noexcept;
+  [[gnu::always_inline]] inline Vec pos(int p, std::int64_t t) const noexcept;
   Vec diff(const Vec& a, const Vec& b) const noexcept {
     Vec r;
     for (std::size_t k = 0; k < D; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
