@@ -102,7 +102,8 @@ class ExactCollision {
   std::vector<double> recovery_bound(const double* post) const;
   /// Chart coordinates in [0,1] of a post state (D-1 values; uniform under the law). The
   /// chart is defined on the closed cone P of post states, every contact separating or grazing
-  /// (normal relative velocity >= 0); throws InvalidArgument for a contact that approaches,
+  /// (normal relative velocity >= 0, to the state's own rounding); throws InvalidArgument for a
+  /// contact that approaches beyond it,
   /// and as every operator does for a velocity that is not finite or a zero relative speed.
   std::vector<double> chart(const double* post) const;
   /// chart() without the cone check: the randomness study's reading of every post state its
