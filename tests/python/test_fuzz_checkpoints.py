@@ -63,7 +63,7 @@ def test_a_flipped_byte_under_the_old_digest_is_refused_by_name(tmp_path):
     sim.run(collisions=30)
     path = tmp_path / "c.npz"
     sim.save(path)
-    fc._tamper(path, "flip_keep_digest", np.random.default_rng(0), sim.n)
+    fc.tamper(path, "flip_keep_digest", np.random.default_rng(0), sim.n)
     with pytest.raises(ValueError, match="digest mismatch"):
         type(sim).load(path)
 
