@@ -389,7 +389,11 @@ void register_engine(py::module_& m) {
                                return p;
                              })
       .def("diagnostics", &PyEngine::diagnostics)
-      .def("snapshot", &PyEngine::snapshot);
+      .def("snapshot", &PyEngine::snapshot)
+      .def(
+          "fault", [](const PyEngine& e) { return e.sim().fault(); },
+          "The first way the state fails the event loop's invariants at the clock (particles overlap, one beyond its "
+          "list's reach, a missed event), or ''; load refuses a snapshot with one, and save a state with one.");
   // ---- observation (observe.cpp, revcol/engine/observe.hpp) ----
   def_observe(engine_class, [](PyEngine& e) -> en::Simulation& { return e.sim(); });
 

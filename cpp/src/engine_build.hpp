@@ -3,8 +3,10 @@
 // instantiates it for its dimension (one file per dimension, compiled in parallel).
 #pragma once
 #include <memory>
+#include <string>
 #include <vector>
 
+#include "engine_check.hpp"
 #include "engine_collide.hpp"
 #include "engine_impl.hpp"
 #include "engine_state.hpp"
@@ -23,7 +25,13 @@ std::unique_ptr<Simulation> make_engine(const Config& c, const std::vector<doubl
 template <int Dim>
 std::unique_ptr<Simulation> restore_engine(const Snapshot& s) {
   return with_operator<Dim>(s.config, [&](auto op) -> std::unique_ptr<Simulation> {
-    return std::make_unique<EngineImpl<Dim, decltype(op)>>(s, std::move(op));
+    auto e = std::make_unique<EngineImpl<Dim, decltype(op)>>(s, std::move(op));
+    // the saved schedule and list centres are trusted (bit for bit resumption): they must fit
+    // the particles (issue 59: a forged one ran on and passed particles through each other)
+    const std::string fault = e->fault();
+    require(fault.empty(), [&] { return "snapshot: the schedule (ev_t, ev_kind, ev_partner, ev_stamp, centre) does not fit "
+                                        "the particles (x, v, t_local): " + fault; });
+    return e;
   });
 }
 

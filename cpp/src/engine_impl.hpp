@@ -166,6 +166,10 @@ class EngineImpl final : public Simulation {
     // back at the start time, every collision must be undone
     if (clock_ == start_ && net_ != 0) trace_.diverge(net_, Divergence::sequence);
     check_conservation();
+    // a reversed run that leaves the forward trajectory can pass particles through each other
+    // (a particle's local time is ahead of its clock until its next reversed event, and no
+    // collision before it is predicted): the end state says so (issue 59)
+    if (trace_.reason() == Divergence::none && !first_overlap().empty()) trace_.diverge(net_, Divergence::overlap);
     r.diverged = before == Divergence::none && trace_.reason() != Divergence::none;
     if (clock_ == 0.0) clock_ = 0.0;  // -0 from the negations reads as 0
     r.time = clock_;
@@ -197,6 +201,9 @@ class EngineImpl final : public Simulation {
 
   Diagnostics diagnostics() const override;  // engine_state.hpp
   Snapshot snapshot() const override;        // engine_state.hpp
+  std::string fault() const override;  // engine_check.hpp
+  std::string schedule_fault() const;  // engine_check.hpp
+  std::string first_overlap() const;   // engine_check.hpp
   void observe(const ObserveConfig& c) override;  // engine_collide.hpp
   const Observer* observer() const override { return observer_.get(); }
   bool observing() const override { return obs_ != nullptr; }

@@ -134,6 +134,10 @@ EngineImpl<Dim, Op>::EngineImpl(const Snapshot& s, Op op) : cfg_(s.config), n_(s
   // before the neighbour lists) starts them where the particles are and predicts anew
   const bool old_format = s.centre.empty();
   nl_.set_centres(old_format ? positions() : s.centre);
+  // each centre where its particle is, wrapped into the box as a renewal wraps it (issue 59:
+  // a position at the clock just outside a periodic box made a centre outside it)
+  if (old_format)
+    for (std::size_t i = 0; i < n_; ++i) move_centre(static_cast<int>(i), clock_);
   WallLog::fields(wlog_, [&](const char* key, auto& field) { s.field(key, field); });
   ExactPreLog::fields(pre_, [&](const char* key, auto& field) { s.field(key, field); });
   double vmax = 0.0;

@@ -120,7 +120,7 @@ CollisionTrace CollisionTrace::load(const std::vector<std::uint64_t>& a, std::si
   t.suspect_ = static_cast<std::int64_t>(a[2]);
   t.misses_ = a[3];
   t.reorderings_ = a[4];
-  require(a[5] <= static_cast<std::uint64_t>(Divergence::momentum), "checkpoint: trace reason must be 0..4");
+  require(a[5] <= static_cast<std::uint64_t>(Divergence::overlap), "checkpoint: trace reason must be 0..5");
   t.reason_ = static_cast<Divergence>(a[5]);
   // mismatches in a row go with the first one's count, and reach kConfirm only after a divergence
   require((t.misses_ == 0) == (t.suspect_ == kNever) && (t.misses_ < kConfirm || t.reason_ != Divergence::none),

@@ -276,7 +276,16 @@ class Simulation(SimulationBase):
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the full state to ``path`` atomically (numpy ``.npz``, stamped, with a SHA-256
-        digest of its entries that ``load`` checks: :func:`revcol._io.write_checkpoint`)."""
+        digest of its entries that ``load`` checks: :func:`revcol._io.write_checkpoint`). A state
+        no run can continue (particles overlapping after a ``run_back`` that left the forward
+        trajectory) raises ``ValueError`` and writes nothing: ``load`` would refuse it."""
+        fault = self._e.fault()
+        if fault:
+            d = self._e.diagnostics()
+            why = (f"; run_back diverged at forward collision {d['diverged_at']:,} ({d['divergence']})"
+                   if d["divergence"] != "none" else "")
+            raise ValueError(f"cannot save {os.fspath(path)!r}: {fault}{why}. No run continues from this state, so no "
+                             "checkpoint of it is written: go back to an earlier checkpoint")
         write_checkpoint(path, self.snapshot(), "float")
 
     @classmethod

@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "check.hpp"
@@ -45,6 +47,16 @@ std::unique_ptr<Simulation> gas(int d, std::size_t n, std::uint64_t seed, Bounda
   c.boundary = {b, b, b};
   const InitialState st = random_state(c, n, 0.3, seed);
   return make_simulation(st.config, st.x, st.v);
+}
+
+// Whether restoring snap throws InvalidArgument whose message contains `what`.
+bool refused_with(const Snapshot& snap, const std::string& what) {
+  try {
+    restore_simulation(snap);
+  } catch (const InvalidArgument& e) {
+    return std::string(e.what()).find(what) != std::string::npos;
+  }
+  return false;
 }
 
 }  // namespace
@@ -146,13 +158,13 @@ TEST_CASE("engine: stop_on_divergence stops where the divergence is found") {
   CHECK(g.net_collisions > 0);
 }
 
-TEST_CASE("engine: a velocity changed at the turn is refused, or found on the way back") {
+TEST_CASE("engine: a velocity changed at the turn is refused, whatever its energy says") {
   auto s = gas(2, 200, 6);
   s->run(2000, kInf);
   Snapshot snap = s->snapshot();
   snap.v[0] *= 1.001;  // a forged checkpoint: its energy is not energy0
   CHECK_THROWS_AS(restore_simulation(snap), InvalidArgument);
-  // forged with a consistent energy0 and momentum0: the reversal leaves the forward trajectory
+  // forged with a consistent energy0 and momentum0: particle 0's scheduled events no longer fit
   double e = 0.0, p0 = 0.0, p1 = 0.0;
   for (std::size_t i = 0; i < snap.n; ++i) {
     e += 0.5 * (snap.v[2 * i] * snap.v[2 * i] + snap.v[2 * i + 1] * snap.v[2 * i + 1]);
@@ -161,10 +173,79 @@ TEST_CASE("engine: a velocity changed at the turn is refused, or found on the wa
   }
   snap.energy0 = e;
   snap.momentum0 = {p0, p1, 0.0};
-  auto t = restore_simulation(snap);
-  const RunResult r = t->run_back(kAll, t->start_time());
-  CHECK(r.diverged);
-  CHECK(t->diagnostics().divergence == Divergence::sequence);
+  CHECK(refused_with(snap, "does not fit the particles"));
+}
+
+TEST_CASE("engine: forged draws load, and the run back they mislead says it diverged") {
+  for (int d : {2, 3}) {
+    auto s = gas(d, 200, 6);
+    s->run(1000, kInf);
+    for (std::size_t k = 0; k < 200; k += 20) {
+      Snapshot snap = s->snapshot();
+      snap.rng[k] += 1;  // one stream one draw on: nothing in the state can tell
+      auto t = restore_simulation(snap);
+      CHECK(t->fault().empty());
+      const RunResult r = t->run_back(kAll, t->start_time());
+      CHECK(r.diverged);  // the trace, or particles overlapping where it ended
+      const Divergence why = t->diagnostics().divergence;
+      CHECK(why == Divergence::sequence || why == Divergence::overlap);
+      if (why == Divergence::overlap) CHECK(!t->fault().empty());
+    }
+  }
+}
+
+TEST_CASE("engine: a schedule or list centres that do not fit the particles are refused, naming the fault") {
+  for (int d : {2, 3}) {
+    auto s = gas(d, 300, 9, Boundary::wall);
+    s->run(1500, kInf);
+    const Snapshot good = s->snapshot();
+    CHECK(s->fault().empty());
+    // a live scheduled collision moved later: the pair meets before it
+    Snapshot a = good;
+    for (std::size_t i = 0; i < a.n; ++i)
+      if (a.ev_kind[i] == 2 && a.ev_t[i] < kInf) {
+        const auto j = static_cast<std::size_t>(a.ev_partner[i]);
+        a.ev_t[i] += 0.5;
+        if (a.ev_kind[j] == 2 && static_cast<std::size_t>(a.ev_partner[j]) == i) a.ev_t[j] += 0.5;
+        break;
+      }
+    CHECK(refused_with(a, "does not fit the particles"));
+    // a list centre a diameter off its particle
+    Snapshot b = good;
+    b.centre[0] += good.config.diameter * (b.centre[0] < 0.5 * good.config.box[0] ? 1.0 : -1.0);
+    CHECK(refused_with(b, "beyond its reach"));
+    // two particles' positions swapped (their schedules trusted): refused
+    Snapshot c = good;
+    for (int k = 0; k < d; ++k) std::swap(c.x[k], c.x[static_cast<std::size_t>(d) * 7 + k]);
+    CHECK(refused_with(c, "snapshot:"));
+    // every event of every particle at infinity: nothing would ever happen
+    Snapshot e = good;
+    for (auto& t : e.ev_t) t = kInf;
+    CHECK(refused_with(e, "before its scheduled event"));
+  }
+}
+
+TEST_CASE("engine: every state a run reaches passes the check, forward and back (no false refusal)") {
+  for (int d : {2, 3}) {
+    Config c;
+    c.dim = d;
+    c.boundary = {Boundary::wall, Boundary::periodic, Boundary::bounce};
+    const InitialState st = random_state(c, 200, d == 2 ? 0.45 : 0.3, 12);
+    auto s = make_simulation(st.config, st.x, st.v);
+    int refused = 0;
+    for (int step = 0; step < 300; ++step) {
+      s->run(7, kInf);
+      if (!s->fault().empty()) ++refused;
+      auto r = restore_simulation(s->snapshot());
+      CHECK(r->snapshot().ev_t == s->snapshot().ev_t);
+    }
+    for (int step = 0; step < 100; ++step) {
+      s->run_back(5, -kInf);
+      if (!s->fault().empty()) ++refused;
+    }
+    CHECK(refused == 0);
+    CHECK(s->diagnostics().divergence == Divergence::none);
+  }
 }
 
 TEST_CASE("engine: the trace survives a checkpoint (walled box), and one without it starts a new one") {

@@ -16,22 +16,11 @@ from revcol.studies import fuzz_checkpoints as fc
 
 EXAMPLES = int(os.environ.get("REVCOL_FUZZ_CHECKPOINT_EXAMPLES", "400"))
 
-#: failures of seed 59 not fixed yet, by example index (replay: python -m
-#: revcol.studies.fuzz_checkpoints --seed 59 --replay INDEX); the reduced run must find exactly these
-KNOWN = {
-    # a float checkpoint with two particles' x, v, t_local and rng swapped loads, and run_back then
-    # moves particles through each other (0.93 D apart) without reporting a divergence: a state
-    # the engine's own from_snapshot refuses (the stream counter is the cause: FORGED_FLOAT below)
-    179: "invalid_state",
-}
-
-
 def test_the_reduced_property_run_finds_no_failure():
     t0 = time.time()
     s = fc.run(EXAMPLES, seed=59, batch=200)
     assert s["examples"] == EXAMPLES
-    found = {r["index"]: r["failure"] for r in s["failure_records"]}
-    assert found == {i: k for i, k in KNOWN.items() if i < EXAMPLES}, s["failure_records"][:5]
+    assert s["all_passed"] and not s["failure_records"], s["failure_records"][:5]
     # every tamper is drawn, and the run exercises refusals, identical loads and changed loads
     assert set(s["loads_per_tamper"]) == set(fc.TAMPERS)
     assert all(s["outcomes"].get(k, 0) > 0 for k in ("refused", "identical", "changed")), s["outcomes"]
@@ -85,29 +74,29 @@ def _rng_one_on(z):
     z["rng"][1] += np.uint64(1)
 
 
-# float checkpoints the loader accepts (re-digested) from which the engine reaches a state its own
-# from_snapshot refuses (particles through each other, or a list centre outside the box), found by
-# the property run (examples 179, 5159, 30751, 33807 of seed 59, minimized): (gas, edit, what is run)
+# forged float checkpoints (re-digested) that the property run found loading, and the engine then
+# passing particles through each other unreported (examples 179, 5159, 30751, 33807 of seed 59,
+# minimized): (gas, edit, what is run, what must happen). A schedule or list centres that do not fit
+# the particles are refused at load; forged draws or a forged mode cannot be seen in the file, and the
+# run_back they mislead reports its divergence ("particles overlap") where it ends
 FORGED_FLOAT = {
     "rng_counter_one_on": (dict(n=18, dim=3, phi=0.235, boundary=["bounce", "wall", "wall"], seed=1009,
-                                law="uniform", before=42), _rng_one_on, "run_back"),
+                                law="uniform", before=42), _rng_one_on, "run_back", "diverged"),
     "specular_mode_read_as_exact": (dict(n=60, dim=2, phi=0.3, seed=7, mode="specular", before=180),
-                                    _specular_as_exact, "run_back"),
-    "list_centres_as_int32": (dict(n=60, dim=2, phi=0.3, seed=7, before=180), _centre_int32, "run"),
-    "list_centres_dropped": (dict(n=119, dim=2, phi=0.2, seed=1, before=100), _drop_centre, "nothing"),
+                                    _specular_as_exact, "run_back", "diverged"),
+    "list_centres_as_int32": (dict(n=60, dim=2, phi=0.3, seed=7, before=180), _centre_int32, "run", "refused"),
+    "list_centres_dropped": (dict(n=119, dim=2, phi=0.2, seed=1, before=100), _drop_centre, "nothing", "loads"),
 }
 
 
-@pytest.mark.xfail(strict=True, raises=ValueError, reason="issue 59 findings: the float loader accepts these forged entries, and the "
-                   "engine then reaches a state its own from_snapshot refuses, reporting no divergence")
 @pytest.mark.parametrize("name", sorted(FORGED_FLOAT))
-def test_a_forged_float_checkpoint_is_refused_or_runs_into_no_state_the_engine_refuses(name, tmp_path):
+def test_a_forged_float_checkpoint_is_refused_or_its_divergence_reported(name, tmp_path):
     import warnings
 
     import revcol
     from revcol._io import digested
 
-    gas, edit, then = FORGED_FLOAT[name]
+    gas, edit, then, expect = FORGED_FLOAT[name]
     gas = dict(gas)
     n, dim, phi, before = gas.pop("n"), gas.pop("dim"), gas.pop("phi"), gas.pop("before")
     s = revcol.Simulation.random(n, dim, phi, **gas)
@@ -117,14 +106,24 @@ def test_a_forged_float_checkpoint_is_refused_or_runs_into_no_state_the_engine_r
     z = dict(np.load(path))
     edit(z)
     np.savez(path, **digested(z))
-    try:
-        t = revcol.Simulation.load(path)
-    except ValueError:
-        return  # refused by name: fixed
+    if expect == "refused":
+        with pytest.raises(ValueError, match=r"schedule .* does not fit the particles .* beyond its reach"):
+            revcol.Simulation.load(path)
+        return
+    t = revcol.Simulation.load(path)
+    assert t._e.fault() == ""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         r = {"run": lambda: t.run(collisions=30), "run_back": lambda: t.run_back(collisions=30),
              "nothing": lambda: {}}[then]()
-    if r.get("diverged"):
-        return  # reported: fixed
-    revcol.Simulation.from_snapshot(t.snapshot())  # raises: particles overlap / a list centre outside the box
+    if expect == "diverged":
+        assert r["diverged"] and t.diagnostics()["divergence"] == "particles overlap"
+        with pytest.raises(ValueError, match="overlap"):  # a state no run continues: refused by name
+            revcol.Simulation.from_snapshot(t.snapshot())
+        with pytest.raises(ValueError, match=r"cannot save .* overlap.*run_back diverged at forward collision"):
+            t.save(tmp_path / "after.npz")
+        assert not (tmp_path / "after.npz").exists()
+    else:  # the centres recomputed where the particles are, inside the box: a state that reloads
+        revcol.Simulation.from_snapshot(t.snapshot())
+        t.run(collisions=200)
+        assert t._e.fault() == ""

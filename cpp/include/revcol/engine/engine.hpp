@@ -373,6 +373,11 @@ class Simulation {
   virtual Snapshot snapshot() const = 0;
   /// Approximate bytes held by the engine's arrays.
   virtual std::size_t memory_bytes() const = 0;
+  /// The first way the state fails the event loop's invariants at the clock, or "": two
+  /// particles overlap, a particle is beyond its list's reach, or the schedule (event times,
+  /// list centres) misses an event (cpp/src/engine_check.hpp). restore_simulation refuses a
+  /// snapshot with one; a run_back ending with overlaps reports a divergence.
+  virtual std::string fault() const = 0;
   /// Starts observing the forward run from the clock (revcol/engine/observe.hpp), replacing
   /// any earlier observation; a bad config throws InvalidArgument and changes nothing.
   virtual void observe(const ObserveConfig& c) = 0;

@@ -56,15 +56,17 @@ enum class Divergence : std::int64_t {
   operator_ = 2,  ///< the operator refused a post state (it can only come from elsewhere)
   energy = 3,     ///< energy off its start value
   momentum = 4,   ///< momentum on a periodic axis off its start value
+  overlap = 5,    ///< particles overlap where a reversed run ended (it left the forward path)
 };
 
-/// "none", "collision sequence", "operator refused", "energy", "momentum".
+/// "none", "collision sequence", "operator refused", "energy", "momentum", "particles overlap".
 inline const char* to_string(Divergence d) {
   switch (d) {
     case Divergence::sequence: return "collision sequence";
     case Divergence::operator_: return "operator refused";
     case Divergence::energy: return "energy";
     case Divergence::momentum: return "momentum";
+    case Divergence::overlap: return "particles overlap";
     default: return "none";
   }
 }
