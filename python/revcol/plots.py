@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._extras import install_hint
 from ._io import save_figure
 from .roundtrip import BAR
 from .scene import SceneError
@@ -53,7 +54,7 @@ def require_matplotlib() -> None:
     try:
         import matplotlib  # noqa: F401
     except ImportError:
-        raise SceneError("--plot needs matplotlib (pip install matplotlib)") from None
+        raise SceneError(f"--plot needs matplotlib, which is not installed: {install_hint('matplotlib')}") from None
 
 
 def check_format(fmt: str) -> str:

@@ -568,14 +568,16 @@ def find_scene(name: str) -> Path | None:
 
 
 def load_scene(path: str | Path | None = None) -> Scene:
-    """Reads and validates a scene file, or a shipped scene by name when no such file exists;
-    ``None`` gives the built-in default scene. Its relative input paths are read beside the
+    """Reads and validates a scene file, or a shipped scene by name (or as ``scenes/NAME.toml``)
+    when no such file exists; ``None`` gives the built-in default scene. Its relative input paths are read beside the
     file, its relative ``[output]`` paths under the current directory."""
     if path is None:
         return scene_from_dict(DEFAULT_SCENE, "<default scene>")
     p = Path(path)
     if not p.is_file():
-        found = None if p.exists() else find_scene(str(path))
+        # a name, or scenes/NAME.toml as the docs write it: the shipped scene, in a clone or not
+        name = p.name if p.parent == Path("scenes") else str(path)
+        found = None if p.exists() else find_scene(name)
         if found is None:
             close = difflib.get_close_matches(p.stem, scene_names(), n=1)
             hint = f"; did you mean {close[0]!r}?" if close else ""

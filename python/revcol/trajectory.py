@@ -60,6 +60,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ._extras import install_hint
 from ._io import named_os_error
 
 __all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS", "ELEMENTS", "net_collisions",
@@ -435,4 +436,4 @@ def check_format(path: str | os.PathLike) -> None:
             import gsd.hoomd  # noqa: F401
         except ImportError:
             raise ValueError(f"trajectory {str(path)!r}: writing .gsd needs the gsd package "
-                             "(pip install gsd), or write extended XYZ (.xyz) instead") from None
+                             f"({install_hint('gsd')}), or write extended XYZ (.xyz) instead") from None

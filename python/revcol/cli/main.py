@@ -22,7 +22,9 @@ Manners (issue 19): a mistyped subcommand, choice or option gets a "did you mean
 (difflib; argparse's own ``suggest_on_error`` exists from Python 3.14 only) and the usage of the
 subcommand it was given to; ``--json -`` writes the JSON report to standard output (the text
 report then goes to standard error); a closed pipe (``revcol ... | head -1``) ends the command
-quietly with status 141 (128 + SIGPIPE, as a Unix tool killed by SIGPIPE), no traceback.
+quietly with status 141 (128 + SIGPIPE, as a Unix tool killed by SIGPIPE), no traceback; an
+optional package that is missing (matplotlib, gsd, Dask, scipy) is one line naming the extra that
+installs it (``pip install 'revcol[plot]'``, revcol._extras) and status 2.
 """
 from __future__ import annotations
 
@@ -34,6 +36,7 @@ import os
 import sys
 import warnings
 
+from .._extras import missing_extra
 from .._io import atomic_open, jsonable
 from .._version import __version__
 from ..scene import SceneError, load_scene
@@ -342,6 +345,14 @@ def main(argv: list[str] | None = None) -> int:
     try:
         try:
             return _main(argv)
+        except ImportError as e:  # an optional package missing: one line naming its extra, exit 2
+            message = missing_extra(e)
+            if message is None:
+                raise
+            words = sys.argv[1:] if argv is None else list(argv)
+            command = " ".join(words[:2] if words[:1] == ["study"] else words[:1])
+            print(f"revcol{' ' + command if command else ''}: error: {message}", file=sys.stderr)
+            return 2
         finally:  # a pipe closed early shows here, not at the interpreter's exit
             sys.stdout.flush()
     except BrokenPipeError:

@@ -359,6 +359,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(table(runs, a.detail))
         return 0
     if a.cmd == "marginals":
+        import scipy.stats  # noqa: F401 (the studies extra): missing, it is refused before any work
         res = []
         for f in a.files:
             for r in json.load(open(f))["runs"]:
@@ -377,6 +378,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         cfg = _gas_options({"case": a.case, "mode": a.mode, "law": a.law, "rng": a.rng, "seed": a.seed}, gas)
         print(json.dumps(dict(write_words(a.path, int(a.words), **cfg), config=cfg)))
         return 0
+    import scipy.stats  # noqa: F401,F811 (the studies extra): missing, it is refused before any battery runs
     if not has_dieharder():
         print("dieharder is not installed (apt-get install dieharder; scripts/setup.sh does it)",
               file=sys.stderr)

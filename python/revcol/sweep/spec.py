@@ -395,10 +395,11 @@ def sweep_names() -> list[str]:
 
 
 def load_sweep(path: str | os.PathLike) -> Sweep:
-    """Reads and validates a sweep file, or a sweep shipped with revcol by name when no such
-    file exists (:class:`SweepError` naming the problem)."""
+    """Reads and validates a sweep file, or a sweep shipped with revcol by name (or as
+    ``sweeps/NAME.toml``) when no such file exists (:class:`SweepError` naming the problem)."""
     p = Path(path)
-    if not p.exists() and p.parent == Path(".") and "/" not in str(path):
+    # a name, or sweeps/NAME.toml as the docs write it: the shipped sweep, in a clone or not
+    if not p.exists() and (p.parent == Path("sweeps") or (p.parent == Path(".") and "/" not in str(path))):
         stem = p.stem if p.suffix == ".toml" else p.name
         found = [d / f"{stem}.toml" for d in sweep_dirs() if (d / f"{stem}.toml").is_file()]
         if found:
