@@ -349,7 +349,8 @@ def lattice_horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000
             bar.close()
         interrupted = stop.presses > 0
     table = [r for r in rows.values() if r["seeds"]]
-    return {"kind": "horizon", "engine": "lattice", "scene": scene.to_dict(), "summary": scene.summary(),
+    length = f"round trips of up to {grid[-1]:,} collisions"  # not the scene's own [run] length
+    return {"kind": "horizon", "engine": "lattice", "scene": scene.to_dict(), "summary": scene.summary(length),
             "seeds": seeds, "seed_first": scene.seed, "max_collisions": int(max_collisions), "rows": table,
             "passed": all(r["bit_for_bit"] == r["seeds"] for r in table),
             "horizon_reached": False, "interrupted": "horizon" if interrupted else None,

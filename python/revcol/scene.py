@@ -178,8 +178,9 @@ class Scene:
     source: str = "<built-in>"
     extra: dict[str, Any] = field(default_factory=dict)
 
-    def summary(self) -> str:
-        """One line describing the scene, for reports."""
+    def summary(self, length: str | None = None) -> str:
+        """One line describing the scene, for reports; ``length`` replaces the scene's own run
+        length (``"20,000 collisions"``: revcol simulate runs its own)."""
         law = f"/{self.law}" if self.mode == "exact" else ""
         if self.kind == "reversal":
             return (f"{self.name}: the paper's reversal illustration, case {self.case}, {self.mode}{law}, "
@@ -190,7 +191,7 @@ class Scene:
                     f"{self.collisions:,} collisions, {'lazy' if self.lazy else 'eager'} transport, "
                     f"{self.mode}{law}, {self.generator} seed {self.seed}")
         box = " x ".join(f"{b:g}" for b in self.box)
-        end = f"{self.collisions:,} collisions" if self.collisions is not None else f"t = {self.time:g}"
+        end = length or (f"{self.collisions:,} collisions" if self.collisions is not None else f"t = {self.time:g}")
         engine = "lattice engine, " if self.engine == "lattice" else ""
         return (f"{self.name}: {self.particles} particles in {self.dimension}D, sigma = {self.diameter:g}, "
                 f"box {box} ({', '.join(self.boundaries)}), {engine}{self.mode}{law}, {self.generator} "

@@ -103,3 +103,38 @@ def test_piped_into_head(tmp_path):
     assert re.match(r"revcol verify pair2d ", p.stdout) and p.stdout.count("\n") == 1
     assert "Traceback" not in p.stderr and "BrokenPipe" not in p.stderr
     assert p.returncode in (0, 141)  # 141 when head left before the report was written
+
+
+# --- issue 58: help texts and summary lines that say what runs ---------------------------------
+
+@pytest.mark.parametrize("study", ["randomness", "equilibrium", "stability"])
+def test_a_study_s_help_names_the_command_it_was_given(study, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["study", study, "--help"])
+    assert e.value.code == 0
+    assert capsys.readouterr().out.startswith(f"usage: revcol study {study} ")
+
+
+def test_verify_help_says_what_it_does_and_its_exit_codes(capsys):
+    with pytest.raises(SystemExit):
+        main(["verify", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "reversal illustrations" in out and "Exit 0 when it passes, 1 when it fails, 2 on a bad option" in out
+
+
+@pytest.mark.parametrize("length, said", [(["--collisions", "2e3"], "2,000 collisions"),
+                                          (["--time", "0.25"], "a time of 0.25")])
+def test_simulate_s_summary_gives_the_length_it_runs(length, said, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.toml").write_text(SMALL)  # its own [run] length is 40 collisions
+    assert main(["simulate", "s.toml", *length, "--no-progress"]) == 0
+    scene_line = next(line for line in capsys.readouterr().out.splitlines() if line.lstrip().startswith("scene"))
+    assert scene_line.endswith(said) and "40 collisions" not in scene_line
+
+
+def test_a_horizon_s_summary_gives_its_round_trips(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.toml").write_text(SMALL.replace("collisions = 40", "collisions = 1000000"))
+    assert main(["run", "s.toml", "--horizon", "--engine", "lattice", "--no-progress"]) == 0
+    scene_line = next(line for line in capsys.readouterr().out.splitlines() if line.lstrip().startswith("scene"))
+    assert "round trips of up to" in scene_line and "1,000,000" not in scene_line

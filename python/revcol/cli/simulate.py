@@ -272,13 +272,19 @@ class _Production:
                 else:
                     self.writer.close()
 
+    def length(self) -> str:
+        """This run's length as asked (the scene's own [run] length is not what simulate runs)."""
+        if self.target is not None:
+            return f"{self.target - self.start:,} collisions"
+        return f"a time of {self.t_end - self.t_start:g}"
+
     def report(self, resume) -> dict[str, Any]:
         sim, scene = self.sim, self.scene
         d = sim.diagnostics()
         obs = sim.observation() if scene.observe is not None else None
         ran = self.done - self.start
         return {
-            "kind": "simulate", "revcol_version": __version__, "scene": scene.to_dict(), "summary": scene.summary(),
+            "kind": "simulate", "revcol_version": __version__, "scene": scene.to_dict(), "summary": scene.summary(self.length()),
             "engine": scene.engine, "mode": scene.mode, "particles": sim.n, "dimension": sim.dim,
             "lattice": {"tick_bits": sim.units["tick_bits"], "cell_bits": sim.units["cell_bits"],
                         "search": sim.search} if self.lattice else None,

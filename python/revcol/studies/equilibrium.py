@@ -433,9 +433,9 @@ def _run_info(argv: Sequence[str], t0: float) -> dict[str, Any]:
             "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
+def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m revcol.studies.equilibrium") -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    ap = argparse.ArgumentParser(prog="python -m revcol.studies.equilibrium", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="what", required=True)
     a = sub.add_parser("small", help="(a) two particles in a closed box against the exact equilibrium")
     a.add_argument("--collisions", type=int, default=4_000_000)

@@ -79,7 +79,8 @@ def horizon(scene: Scene, *, seeds: int = 1, max_collisions: int = 1_000_000, o1
         bar.close()
     rows, h = combine_seeds(grid, n, per_seed)
     reached = any(max(r["error_x"], r["error_v"]) > BAR for r in rows)
-    return {"kind": "horizon", "scene": scene.to_dict(), "summary": scene.summary(), "seeds": len(per_seed),
+    length = f"round trips of up to {grid[-1]:,} collisions" if grid else None  # not the scene's [run] length
+    return {"kind": "horizon", "scene": scene.to_dict(), "summary": scene.summary(length), "seeds": len(per_seed),
             "seed_first": scene.seed, "max_collisions": int(max_collisions), "o1": o1, "bar": BAR,
             "rows": rows, "horizon_collisions": h, "horizon_per_particle": 2.0 * h / n,
             "horizon_reached": reached, "interrupted": "horizon" if interrupted else None,

@@ -298,10 +298,10 @@ def _gas_options(cfg: dict, gas: Optional[dict]) -> dict:
     return dict(cfg, particles=int(g["particles"]), fraction=float(g["fraction"]), warmup=float(g["warmup"]))
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
+def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m revcol.studies.randomness") -> int:
     """The command line (see the module docstring)."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    ap = argparse.ArgumentParser(prog="python -m revcol.studies.randomness", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--words", type=float, default=3e6)

@@ -505,8 +505,8 @@ def run(names: Sequence[str] = OPERATORS, classes: Sequence[str] = CLASSES, *, f
     return out
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m revcol.studies.stability", description=__doc__.split("\n\n")[0])
+def main(argv: Optional[Sequence[str]] = None, prog: str = "python -m revcol.studies.stability") -> int:
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     ap.add_argument("--full", action="store_true", help="the bench counts (else the CI's reduced counts)")
     ap.add_argument("--operators", nargs="*", default=list(OPERATORS), choices=OPERATORS, metavar="OP",
                     help="operators to run (default: all): " + ", ".join(OPERATORS))
