@@ -213,3 +213,19 @@ def test_a_writer_attached_to_a_lattice_simulation(tmp_path):
         sim.detach(w)
     sim.run_back()
     assert sim.collisions == 0
+
+
+def test_ase_reads_the_velocities_with_unit_masses(tmp_path):
+    # docs/run.md "Trajectories in other tools": ASE keeps the file's velo column as an array;
+    # with revcol's unit masses set, its velocities and kinetic energy are revcol's
+    ase_io = pytest.importorskip("ase.io")
+    s = revcol.Simulation.random(30, 3, 0.2, seed=4)
+    s.run(collisions=50)
+    w = open_trajectory(tmp_path / "t.xyz", s.box, s.periodic, 1.0)
+    w.write(s.positions, s.velocities, s.time, s.collisions, "forward")
+    w.close()
+    atoms = ase_io.read(str(tmp_path / "t.xyz"))
+    atoms.set_masses(np.ones(len(atoms)))
+    atoms.set_velocities(atoms.arrays["velo"])
+    assert np.abs(atoms.get_velocities() - s.velocities).max() < 1e-9
+    assert atoms.get_kinetic_energy() == pytest.approx(s.diagnostics()["energy"], rel=1e-9)
