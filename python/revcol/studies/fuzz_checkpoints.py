@@ -45,7 +45,7 @@ Properties, each example:
    different state (``missed_refusal`` otherwise);
 7. a state the engine reaches is one it accepts: ``save`` succeeds, and ``from_snapshot(snapshot())``
    and ``load`` of its own ``save`` succeed (``invalid_state`` otherwise); the one exception is a
-   float state after a ``run_back`` that reported its divergence as "particles overlap", which
+   float state with overlapping particles after a ``run_back`` that reported a divergence, which
    both refuse by name.
 
     python -m revcol.studies.fuzz_checkpoints --examples 100000 --seed 59 --json bench/results/checkpoint_property_run.json
@@ -276,9 +276,11 @@ def _run_back(sim, k: int):
 
 
 def _reported_overlap(sim) -> bool:
-    """Whether the float engine reported a run_back that ended with particles overlapping (it
-    left the forward trajectory): a state it then neither saves nor restores, by name."""
-    return sim.engine != "lattice" and sim.diagnostics().get("divergence") == "particles overlap"
+    """Whether the float engine reported a divergence (its first reason: "particles overlap", or
+    one found earlier, such as the collision sequence) and its particles overlap: a run_back that
+    left the forward trajectory, into a state it then neither saves nor restores, by name."""
+    return (sim.engine != "lattice" and sim.diagnostics().get("divergence") is not None
+            and "overlap" in sim._e.fault())
 
 
 def _operations(rng, sim, reference, lattice: bool, folder: Path, index: int, rec: dict, log: list) -> None:
