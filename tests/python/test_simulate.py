@@ -191,3 +191,24 @@ def test_ctrl_c_stops_cleanly_with_the_outputs_closed(tmp_path, capsys, monkeypa
     assert counts[0] == 0 and counts[-1] == r["collisions"] and len(counts) == r["trajectory_frames"]
     assert [os.path.basename(c) for c in r["checkpoints"]][-1] == f"checkpoint-{r['collisions']:012d}.npz"
     assert signal.getsignal(signal.SIGINT) is before
+
+
+@pytest.mark.parametrize("text", [FLOAT, LATTICE], ids=["float", "lattice"])
+def test_a_scene_s_outputs_are_revcol_run_s_simulate_writes_what_it_is_asked(tmp_path, capsys, monkeypatch, text):
+    # issue 58: a shipped scene's demo [output] (a frame and a checkpoint every 1000 collisions)
+    # had carried over into simulate and filled ./out; now only the options write, and the
+    # report says which of the scene's outputs it left to revcol run
+    monkeypatch.chdir(tmp_path)
+    s = scene_file(tmp_path, text.replace("collisions = 500\n", "collisions = 500\ncheckpoint_interval = 100\n")
+                   + "[output]\njson = \"scene.json\"\ntrajectory = \"scene.xyz\"\ncheckpoints = \"scene-ck\"\n")
+    assert cli_main(["simulate", s, "--collisions", "300", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+    assert "not written      the scene's [output] json, [output] trajectory, [output] checkpoints" in out
+    # asked on the command line: written, the checkpoints as a count and a folder
+    assert cli_main(["simulate", s, "--collisions", "300", "--checkpoint", "ck", "--trajectory", "t.xyz",
+                     "--every", "100", "--json", "r.json", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "written          t.xyz, r.json, 3 checkpoints in ck/" in out  # every 100 (the scene's interval)
+    assert json.load(open("r.json"))["scene_outputs_not_written"] == ["json", "trajectory", "checkpoints"]
+    assert not (tmp_path / "scene.xyz").exists() and not (tmp_path / "scene-ck").exists()

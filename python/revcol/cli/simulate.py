@@ -3,9 +3,11 @@ trajectory frames, checkpoints and the scene's observables (``revcol run`` is th
 forward-and-back job; this one never reverses, so its length has no round-off horizon).
 
 The run goes ``collisions`` more collisions or ``time`` more units of time (else the scene's
-``[run]`` collisions or time), on the scene's engine (float or lattice). Outputs are driven
-by triggers in *net collisions* (the engine's count since the scene's start, so a resumed run
-keeps the numbering of the run it resumes):
+``[run]`` collisions or time), on the scene's engine (float or lattice). It writes the outputs
+its arguments ask for (a scene's ``[output]`` json, trajectory and checkpoints are ``revcol
+run``'s: the report lists them as ``scene_outputs_not_written``), driven by triggers in *net
+collisions* (the engine's count since the scene's start, so a resumed run keeps the numbering
+of the run it resumes):
 
 - ``trajectory`` (``.xyz`` or ``.gsd``, :mod:`revcol.trajectory`): a frame at the start, at
   every multiple of ``every`` collisions (or, with ``every_time`` T instead, at every multiple
@@ -93,9 +95,10 @@ def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, che
                 integer(k, name, lo=1)
         except (TypeError, ValueError):
             raise SceneError(f"{src}: {name} must be a positive integer, got {k!r}") from None
-    trajectory = trajectory if trajectory is not None else scene.trajectory
+    # the scene's [output] trajectory, checkpoints and json are revcol run's: simulate writes what
+    # its options ask for (issue 58: a shipped scene's demo outputs filled ./out with a GB)
     if every is not None and trajectory is None:
-        raise SceneError(f"{src}: --every needs --trajectory (or the scene's [output] trajectory)")
+        raise SceneError(f"{src}: --every needs --trajectory")
     if every_time is not None:
         if isinstance(every_time, bool) or not isinstance(every_time, (int, float)) or \
                 not (math.isfinite(every_time) and every_time > 0):
@@ -103,13 +106,13 @@ def _options(scene: Scene, collisions, time, trajectory, every, checkpoints, che
         if every is not None:
             raise SceneError(f"{src}: --every and --every-time: give one frame trigger, not both")
         if trajectory is None:
-            raise SceneError(f"{src}: --every-time needs --trajectory (or the scene's [output] trajectory)")
+            raise SceneError(f"{src}: --every-time needs --trajectory")
         every = 0  # no collision trigger
     every = every if every is not None else scene.trajectory_every
-    checkpoints = checkpoints if checkpoints is not None else scene.checkpoints
     if checkpoint_every is not None and checkpoints is None:
-        raise SceneError(f"{src}: --checkpoint-every needs --checkpoint DIR (or the scene's [output] checkpoints)")
-    checkpoint_every = checkpoint_every if checkpoint_every is not None else scene.checkpoint_interval
+        raise SceneError(f"{src}: --checkpoint-every needs --checkpoint DIR")
+    if checkpoints is not None and not checkpoint_every:
+        checkpoint_every = scene.checkpoint_interval  # a setting, not an output: the scene's default
     if checkpoints is not None and not checkpoint_every:
         raise SceneError(f"{src}: --checkpoint needs --checkpoint-every K (or the scene's [run] checkpoint_interval)")
     if trajectory is not None:
@@ -337,7 +340,8 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
         raise SceneError(f"{scene.source}: --tick-bits, --cell-bits: a resumed run keeps its checkpoint's units")
     if seed is not None:
         scene = dataclasses.replace(scene, seed=int(seed))
-    json_path = json_path if json_path is not None else scene.json
+    not_written = [name for name, v in (("json", scene.json), ("trajectory", scene.trajectory),
+                                        ("checkpoints", scene.checkpoints)) if v is not None]
     collisions, time, trajectory, every, checkpoints, checkpoint_every = _options(
         scene, collisions, time, trajectory, every, checkpoints, checkpoint_every, resume, every_time)
     try:
@@ -363,6 +367,7 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
     run.go(sys.stdout.isatty() if progress is None else progress)
     r = run.report(resume)
     r["output_estimate"] = estimates(outputs)
+    r["scene_outputs_not_written"] = not_written
     if json_path is not None:
         r["written"].append(os.fspath(json_path))
         write_json(r, json_path)
@@ -419,5 +424,19 @@ def format_simulate(r: dict) -> str:
     if r["observe"]:
         lines += report_lines(r["observe"])
     if r["written"]:
-        lines.append("  written          " + " ".join(r["written"]))
+        lines.append("  written          " + _written(r))
+    if r.get("scene_outputs_not_written"):
+        names = ", ".join(f"[output] {k}" for k in r["scene_outputs_not_written"])
+        lines.append(f"  not written      the scene's {names} (revcol run's; simulate writes what --json, "
+                     "--trajectory and --checkpoint ask for)")
     return "\n".join(lines)
+
+
+def _written(r: dict) -> str:
+    """The files written, the checkpoints as a count and a folder (a long run writes thousands)."""
+    ckpts = set(r["checkpoints"])
+    parts = [w for w in r["written"] if w not in ckpts]
+    if ckpts:
+        folder = os.path.dirname(r["checkpoints"][-1]) or "."
+        parts.append(f"{len(ckpts)} checkpoint{'s' if len(ckpts) != 1 else ''} in {folder}{os.sep}")
+    return ", ".join(parts)
