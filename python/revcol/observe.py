@@ -23,10 +23,13 @@ The observation is forward only: ``run_back`` ends it (its results stay readable
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from typing import Any, Optional, Sequence
 
 import numpy as np
+
+from .progress import Bar
 
 __all__ = ["Observing", "Estimate", "Profile", "Observation", "radial_distribution", "contact_value",
            "compressibility_from_contact", "report_lines", "OBSERVE_FIELDS", "helfand_increments", "helfand_viscosity",
@@ -230,7 +233,7 @@ def report_lines(d: dict[str, Any]) -> list[str]:
 
 def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Optional[float] = None,
                         periodic: Optional[Sequence[bool]] = None, use_freud: Optional[bool] = None,
-                        diameter: Optional[float] = None):
+                        diameter: Optional[float] = None, progress: Optional[bool] = None):
     """g(r) averaged over frames (an array (F, n, d) or one frame (n, d)).
 
     Periodic box (``periodic`` None or all True): freud (``freud.density.RDF``) when installed
@@ -249,6 +252,7 @@ def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Op
     integrals done by 24-point Gauss-Legendre, relative error below 1e-8). So an ideal gas in a
     walled box has g = 1 at every r, not the periodic formula's dip near r_max. ``r_max`` at
     most half the region's shortest side (each axis cuts a shell at one wall at most).
+    ``progress``: a bar over the frames (None: on a terminal, for 50 frames or more).
     Returns (r centres, g)."""
     x = np.asarray(frames, dtype=float)
     if x.ndim == 2:
@@ -277,8 +281,19 @@ def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Op
     r_max = limit if r_max is None else float(r_max)
     if not 0 < r_max <= limit + 1e-12:
         raise ValueError(f"r_max must be in (0, {'L' if not walls.any() else 'L - D'}/2 = {limit:g}], got {r_max}")
+    if progress is None:
+        progress = sys.stdout.isatty() and x.shape[0] >= 50
+    bar = Bar(progress, float(x.shape[0]), "g(r)", "frame")
+    try:
+        return _rdf(x, L, bins, r_max, walls, use_freud, bar)
+    finally:
+        bar.close()
+
+
+def _rdf(x: np.ndarray, L: np.ndarray, bins: int, r_max: float, walls: np.ndarray, use_freud, bar):
+    d = x.shape[2]
     if walls.any():
-        return _rdf_numpy(x, L, bins, r_max, walls)
+        return _rdf_numpy(x, L, bins, r_max, walls, bar)
     freud = None
     if use_freud is not False:
         try:
@@ -289,12 +304,13 @@ def radial_distribution(frames, box: Sequence[float], bins: int = 100, r_max: Op
     if freud is not None:
         fbox = freud.box.Box.from_box(list(L) + ([0.0] if d == 2 else []))
         rdf = freud.density.RDF(bins=bins, r_max=r_max, normalization_mode="finite_size")
-        for f in x:
+        for k, f in enumerate(x):
             pts = np.zeros((f.shape[0], 3))
             pts[:, :d] = f - 0.5 * L
             rdf.compute((fbox, fbox.wrap(pts)), reset=False)
+            bar.to(k + 1)
         return np.asarray(rdf.bin_centers), np.asarray(rdf.rdf)
-    return _rdf_numpy(x, L, bins, r_max, walls)
+    return _rdf_numpy(x, L, bins, r_max, walls, bar)
 
 
 def contact_value(r, g, diameter: float = 1.0, width: float = 0.2, order: int = 2) -> float:
@@ -316,22 +332,38 @@ def compressibility_from_contact(g_contact: float, packing_fraction: float, dim:
     return 1.0 + 2.0 ** (dim - 1) * float(packing_fraction) * float(g_contact)
 
 
-def _rdf_numpy(x: np.ndarray, L: np.ndarray, bins: int, r_max: float, walls: np.ndarray):
+def _pair_counts(f: np.ndarray, L: np.ndarray, edges: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """Ordered pairs (i != j) of one frame per distance bin (minimum image on periodic axes).
+    Each unordered pair once (rows lo..hi against lo..n, above the diagonal), the distances
+    within the last edge only through the histogram: the counts of every ordered pair, in 0.4 of
+    the time (issue 58: 624 frames of 1000 walled disks had taken 90 s)."""
+    n = f.shape[0]
+    r_max = float(edges[-1])
+    counts = np.zeros(len(edges) - 1, dtype=np.int64)
+    rows = max(1, 2_000_000 // max(n, 1))
+    wrap = np.where(walls, 0.0, 1.0)
+    for lo in range(0, n, rows):
+        hi = min(n, lo + rows)
+        dr = f[lo:hi, None, :] - f[None, lo:, :]
+        if not walls.all():
+            dr -= wrap * L * np.round(dr / L)
+        r2 = np.einsum("ijk,ijk->ij", dr, dr)
+        keep = r2 <= r_max * r_max
+        keep[:, :hi - lo] &= np.triu(np.ones((hi - lo, hi - lo), dtype=bool), 1)  # j > i
+        counts += np.histogram(np.sqrt(r2[keep]), bins=edges)[0]
+    return 2 * counts
+
+
+def _rdf_numpy(x: np.ndarray, L: np.ndarray, bins: int, r_max: float, walls: np.ndarray, bar=None):
     F, n, d = x.shape
     edges = np.linspace(0.0, r_max, bins + 1)
-    counts = np.zeros(bins)
-    rows = max(1, 2_000_000 // max(n, 1))
-    wrap = np.where(walls, 0.0, 1.0)  # the minimum image on periodic axes only
+    counts = np.zeros(bins, dtype=np.int64)
     inside = np.zeros(bins + 1)  # sum over reference particles of the ball volume inside the region
-    for f in x:
-        for lo in range(0, n, rows):
-            a = f[lo:lo + rows]
-            dr = a[:, None, :] - f[None, :, :]
-            dr -= wrap * L * np.round(dr / L)
-            r = np.sqrt((dr * dr).sum(-1))
-            r = r[r > 0]  # not i with itself
-            counts += np.histogram(r, bins=edges)[0]
+    for k, f in enumerate(x):
+        counts += _pair_counts(f, L, edges, walls)
         inside += _ball_inside(f, L, walls, edges).sum(axis=0) if walls.any() else n * _ball(edges, d)
+        if bar is not None:
+            bar.to(k + 1)
     rho = (n - 1) / float(np.prod(L))  # the other particles' density: g -> 1 at large r for any n
     ideal = rho * np.diff(inside)  # ordered pairs: each pair counted from both ends
     return 0.5 * (edges[1:] + edges[:-1]), counts / ideal
