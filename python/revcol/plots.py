@@ -7,6 +7,8 @@ axes with their quantities and units (lengths in the scene's units, the particle
 drawn to scale), a colourbar wherever colour carries a value, periodic axes drawn dashed and
 walls solid, log axes that never invent a value (an exact zero is drawn as an open marker on
 the axis floor, and the legend says so), legends inside the axes, no tables inside figures.
+Titles are short (:func:`short_title`: scene, N, dimension, packing fraction, engine, mode); the
+scene's whole summary goes into the file's metadata (PNG and SVG ``Description``, PDF ``Subject``).
 
 1D gases are drawn in phase space (position against velocity): a line of rods shows nothing.
 3D gases are drawn as a slice through the middle of the box (the spheres' cross sections in
@@ -18,7 +20,6 @@ is already in use); :func:`require_matplotlib` checks for it before a run starts
 from __future__ import annotations
 
 import sys
-import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -111,7 +112,7 @@ def plot_gas(r: dict, out: Path, start, turn, end, fmt: str = "png") -> list[str
     plt = _pyplot()
     out.mkdir(parents=True, exist_ok=True)
     written = []
-    title = textwrap.fill(r["summary"], 110)
+    title = short_title(r)
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     c = [p["collisions"] for p in r["curve"]]
@@ -122,10 +123,10 @@ def plot_gas(r: dict, out: Path, start, turn, end, fmt: str = "png") -> list[str
     _mark_zeros(ax, zeros, min([y for y in ex + ev if y > 0] + [BAR]))
     ax.set_xlabel("collisions forward (each point: forward to here, then back to the start)")
     ax.set_ylabel("round-trip error (relative)")
-    ax.set_title(title, fontsize=7)
+    ax.set_title(title, fontsize=9)
     _finish(ax)
     fig.tight_layout()
-    written.append(_save(fig, out / f"roundtrip_error.{fmt}", plt))
+    written.append(_save(fig, out / f"roundtrip_error.{fmt}", plt, r))
 
     written.append(_energy_figure(r, out, plt, title, fmt, exact=False))
     written.append(_snapshots_figure(r, out, plt, title, start, turn, end, fmt))
@@ -141,7 +142,7 @@ def plot_lattice_gas(r: dict, out: Path, start, turn, end, fmt: str = "png") -> 
     round trip is bit for bit. Returns the paths."""
     plt = _pyplot()
     out.mkdir(parents=True, exist_ok=True)
-    title = textwrap.fill(r["summary"], 110)
+    title = short_title(r)
     written = [_energy_figure(r, out, plt, title, fmt, exact=True)]
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -153,10 +154,10 @@ def plot_lattice_gas(r: dict, out: Path, start, turn, end, fmt: str = "png") -> 
             label=f"sum of the particles' X bit lengths, less its start ({at0})")
     ax.set_xlabel("collisions forward")
     ax.set_ylabel("bits-back integers: bits gained since the start")
-    ax.set_title(title, fontsize=7)
+    ax.set_title(title, fontsize=9)
     _finish(ax)
     fig.tight_layout()
-    written.append(_save(fig, out / f"bits_back.{fmt}", plt))
+    written.append(_save(fig, out / f"bits_back.{fmt}", plt, r))
     written.append(_snapshots_figure(r, out, plt, title, start, turn, end, fmt))
     return written
 
@@ -179,10 +180,10 @@ def _energy_figure(r: dict, out: Path, plt, title: str, fmt: str, exact: bool) -
         ax.set_ylabel(f"energy drift (E - E0) / E0  [eps = {_EPS:.2e}]")
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set_xlabel(f"collisions forward ({len(es)} samples)")
-    ax.set_title(title, fontsize=7)
+    ax.set_title(title, fontsize=9)
     _finish(ax)
     fig.tight_layout()
-    return _save(fig, out / f"energy_drift.{fmt}", plt)
+    return _save(fig, out / f"energy_drift.{fmt}", plt, r)
 
 
 def _snapshots_figure(r: dict, out: Path, plt, title: str, start, turn, end, fmt: str) -> str:
@@ -211,11 +212,14 @@ def _snapshots_figure(r: dict, out: Path, plt, title: str, start, turn, end, fmt
                "spheres at the start)"
     else:
         view = "disks to scale"
-    bounds = ", ".join(f"{'xyz'[k]}: {'periodic (dashed)' if periodic[k] else 'walls (solid)'}" for k in range(min(d, 2)))
-    fig.suptitle(f"{title}\n{view}; {bounds}", fontsize=7)
+    bounds = ", ".join(f"{'xyz'[k]}: {'periodic (dashed)' if periodic[k] else 'walls (solid)'}"
+                       for k in range(min(d, 2)))
+    if d == 3:  # the slice's own axis: not drawn, but named
+        bounds += f", z: {'periodic' if periodic[2] else 'walls'}"
+    fig.suptitle(f"{title}\n{view}; {bounds}", fontsize=9)
     if mappable is not None:
-        fig.colorbar(mappable, ax=axes.ravel().tolist(), shrink=0.85, label="speed |v|")
-    return _save(fig, out / f"snapshots.{fmt}", plt)
+        fig.colorbar(mappable, ax=axes.ravel().tolist(), shrink=0.85, label="speed |v| / sqrt(kT / m)")
+    return _save(fig, out / f"snapshots.{fmt}", plt, r)
 
 
 def _slice_count(x, box, sigma) -> int:
@@ -306,17 +310,35 @@ def plot_horizon(r: dict, out: Path, fmt: str = "png") -> list[str]:
     ax.axhline(BAR, color="k", ls=":", lw=1, label="bar 1e-9")
     if r["horizon_collisions"]:
         ax.axvline(r["horizon_per_particle"], color="C2", ls="--", lw=1,
-                   label=f"horizon: N_c = {r['horizon_collisions']:,}")
+                   label=f"horizon: {r['horizon_per_particle']:.3g} collisions per particle "
+                         f"(N_c = {r['horizon_collisions']:,})")
     _mark_zeros(ax, zeros, min([y for y in values if y > 0] + [BAR]))
     ax.set_xlabel("collisions per particle (2 N_c / N), forward then back")
     ax.set_ylabel(f"round-trip error, relative (worst of {r['seeds']} seed{'s' if r['seeds'] > 1 else ''})")
-    ax.set_title(textwrap.fill(r["summary"], 110), fontsize=7)
+    ax.set_title(short_title(r), fontsize=9)
     _finish(ax)
     fig.tight_layout()
-    return [_save(fig, out / f"horizon.{fmt}", plt)]
+    return [_save(fig, out / f"horizon.{fmt}", plt, r)]
 
 
-def _save(fig, path: Path, plt) -> str:
-    save_figure(fig, path, dpi=150)
+def short_title(r: dict) -> str:
+    """A figure's title: the scene's name and the few facts that tell its figures apart; the whole
+    summary goes into the file's metadata (:func:`_save`)."""
+    sc = r.get("scene", {})
+    d, n = sc.get("dimension"), sc.get("particles")
+    body = {1: "rods", 2: "disks", 3: "spheres"}.get(d, "particles")
+    phi = f", phi = {sc['packing_fraction']:.3g}" if sc.get("packing_fraction") else ""
+    engine = "lattice" if sc.get("engine") == "lattice" else "float"
+    law = f"/{sc['law']}" if sc.get("mode") == "exact" and sc.get("law") else ""
+    return f"{sc.get('name', 'scene')}: {n:,} {body} in {d}D{phi}, {engine} engine, {sc.get('mode', 'exact')}{law}" \
+        if n and d else str(sc.get("name", "scene"))
+
+
+def _save(fig, path: Path, plt, r: dict | None = None) -> str:
+    meta = None
+    if r is not None and r.get("summary"):  # the whole scene summary: out of the picture, in the file
+        meta = {"Title": short_title(r),
+                ("Subject" if path.suffix.lower() == ".pdf" else "Description"): r["summary"]}
+    save_figure(fig, path, dpi=150, metadata=meta)
     plt.close(fig)
     return str(path)

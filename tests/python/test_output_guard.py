@@ -58,11 +58,27 @@ def checkpointed(tmp_path, capsys):
     return tmp_path
 
 
-@pytest.mark.parametrize("command", ["run", "simulate"])
-def test_a_scene_json_naming_its_initial_state_is_refused(tmp_path, capsys, command):
+def test_a_scene_json_naming_its_initial_state_is_refused(tmp_path, capsys):
     # was: the initial state replaced by the JSON report
     (tmp_path / "s.toml").write_text(_start(tmp_path / "start.npz") + '[output]\njson = "start.npz"\n')
-    _refused(tmp_path, [command, "s.toml"], capsys, "[output] json", "start.npz", "initial state file")
+    _refused(tmp_path, ["run", "s.toml"], capsys, "[output] json", "start.npz", "initial state file")
+
+
+def _not_written(tmp_path, args, capsys):
+    """Runs ``args`` (revcol simulate), expects exit 0 with the scene's [output] json named as not
+    written, and every file that was there before unchanged."""
+    before = _tree(tmp_path)
+    rc, err = _cli(tmp_path, args, capsys)
+    assert rc == 0, err
+    after = _tree(tmp_path)
+    assert {k: after[k] for k in before} == before
+    return after
+
+
+def test_simulate_never_writes_a_scene_s_json_so_it_cannot_name_an_input(tmp_path, capsys):
+    # a scene's [output] is revcol run's (issue 58): simulate leaves it out, the input keeps its bytes
+    (tmp_path / "s.toml").write_text(_start(tmp_path / "start.npz") + '[output]\njson = "start.npz"\n')
+    _not_written(tmp_path, ["simulate", "s.toml"], capsys)
 
 
 @pytest.mark.parametrize("how", ["--json", "[output] json"])
@@ -71,9 +87,10 @@ def test_the_checkpoint_a_run_resumes_from_is_never_an_output(checkpointed, caps
     args = ["simulate", "plain.toml", "--resume", f"ckd/{CKPT}"]
     if how == "--json":
         args += ["--json", f"ckd/{CKPT}"]
-    else:
+        _refused(checkpointed, args, capsys, how, CKPT, "the checkpoint the run resumes from (--resume)")
+    else:  # a scene's [output] is revcol run's: simulate does not write it (issue 58)
         (checkpointed / "plain.toml").write_text(PLAIN + f'[output]\njson = "ckd/{CKPT}"\n')
-    _refused(checkpointed, args, capsys, how, CKPT, "the checkpoint the run resumes from (--resume)")
+        _not_written(checkpointed, args, capsys)
 
 
 def test_an_output_named_through_a_symlink_to_an_input_is_refused(tmp_path, capsys):

@@ -95,8 +95,9 @@ def test_max_output_refuses_and_allows(tmp_path, capsys):
 def test_the_scene_key_sets_the_limit_and_the_option_overrides_it(tmp_path, capsys):
     s = _scene(tmp_path, "lattice", extra="[output]\ntrajectory = \"t.xyz\"\ntrajectory_every = 1\n"
                "max_output = \"10K\"\n")
-    for command in ("run", "simulate"):
-        rc, err = _cli(tmp_path, [command, s], capsys)
+    # simulate writes its options' outputs only (issue 58); the scene's limit holds for them too
+    for args in (["run", s], ["simulate", s, "--trajectory", "t.xyz", "--every", "1"]):
+        rc, err = _cli(tmp_path, args, capsys)
         assert rc == 2 and "more than the output limit of 10 KiB" in err[0], err
     assert not (tmp_path / "t.xyz").exists()
     rc, err = _cli(tmp_path, ["run", s, "--max-output", "none"], capsys)
@@ -189,7 +190,8 @@ def test_a_full_disk_under_a_checkpoint_names_it_and_leaves_no_temporary(tmp_pat
     monkeypatch.setattr(revcol._output_size, "state_bytes", lambda scene: (1e4, 200.0))
     s = _scene(tmp_path, engine, c=400, extra="checkpoint_interval = 100\n[output]\ncheckpoints = \"ck\"\n"
                "trajectory = \"t.xyz\"\ntrajectory_every = 50\n")
-    rc, err = _cli(tmp_path, [command, s], capsys)
+    asked = ["--checkpoint", "ck", "--trajectory", "t.xyz", "--every", "50"] if command == "simulate" else []
+    rc, err = _cli(tmp_path, [command, s, *asked], capsys)
     assert rc == 2 and len(err) == 1, err
     assert "[Errno 28] No space left on device" in err[0] and "checkpoint-000000000200.npz" in err[0], err
     assert os.listdir(tmp_path / "ck") == ["checkpoint-000000000100.npz"]

@@ -50,12 +50,12 @@ def _snapshot_axes(monkeypatch):
     kept = {}
     real = plots._save
 
-    def keep(fig, path, plt_):
+    def keep(fig, path, plt_, r=None):
         if path.name.startswith("snapshots"):
             kept["fig"] = fig
             plots.save_figure(fig, path)
             return str(path)
-        return real(fig, path, plt_)
+        return real(fig, path, plt_, r)
 
     monkeypatch.setattr(plots, "_save", keep)
     return kept
@@ -68,7 +68,7 @@ def test_periodic_edges_dashed_walls_solid_and_a_colourbar(tmp_path, monkeypatch
     fig = kept["fig"]
     panels = [ax for ax in fig.axes if ax.get_label() != "<colorbar>"]
     assert len(panels) == 3 and len(fig.axes) == 4  # three snapshots and one colourbar
-    assert fig.axes[-1].get_ylabel() == "speed |v|"
+    assert fig.axes[-1].get_ylabel() == "speed |v| / sqrt(kT / m)"
     ax = panels[0]
     assert ax.get_xlabel().startswith("x (length units") and ax.get_ylabel().startswith("y (length units")
     styles = {}
@@ -100,7 +100,7 @@ def test_1d_phase_space_and_3d_slice(tmp_path, monkeypatch):
 
 def test_log_axes_mark_exact_zeros(tmp_path, monkeypatch):
     kept = {}
-    monkeypatch.setattr(plots, "_save", lambda fig, path, plt_: kept.setdefault("fig", fig) and str(path))
+    monkeypatch.setattr(plots, "_save", lambda fig, path, plt_, r=None: kept.setdefault("fig", fig) and str(path))
     r = {"summary": "synthetic", "seeds": 1, "horizon_collisions": None, "horizon_per_particle": None,
          "rows": [{"per_particle": 1.0, "error_x": 0.0, "error_v": 0.0},
                   {"per_particle": 2.0, "error_x": 3e-14, "error_v": 0.0},

@@ -210,11 +210,13 @@ def plot(report: dict, path: str | os.PathLike) -> None:
                Line2D([], [], color="k", lw=0.8, label=f"range of {report['repeats']} interleaved repeats"),
                Patch(color="C2", label="bytes saved (hatched: projected, skipped)"),
                Patch(color="C3", label="peak RSS (fresh process)")]
-    fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=8, frameon=False)
+    # at most 3 entries a row: five in one row were wider than a figure of two columns (issue 58:
+    # "ard time" at the left edge)
+    fig.legend(handles=handles, loc="lower center", ncol=min(3, max(2, ncol + 1)), fontsize=8, frameon=False)
     lazy = report["transport"] == "lazy"
     fig.suptitle(f"State saving vs reverse computation, {'lazy' if lazy else 'eager'} transport, "
                  f"N_c = {report['collisions']:,}, mode {'/'.join(report['modes'])}"
                  + (f" ({report['law']} law)" if "exact" in modes else ""), fontsize=11)
-    fig.tight_layout(rect=(0, 0.05, 1, 0.96))
+    fig.tight_layout(rect=(0, 0.09, 1, 0.96))
     save_figure(fig, path, dpi=130)
     plt.close(fig)
