@@ -108,3 +108,19 @@ def test_every_documented_command_runs(tmp_path):
 ])
 def test_the_reduction(words, want):
     assert reduced(words) == want
+
+
+def test_the_quickstart_runs_and_prints_what_it_shows(tmp_path, monkeypatch, capsys):
+    # docs/quickstart.md: its python blocks in order in one namespace; what they print must be the
+    # indented output blocks of the page, line for line (the lattice engine's bits are the same on
+    # every build, and so are the observables' sums)
+    text = (ROOT / "docs" / "quickstart.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    shown = [ln[4:] for part in re.split(r"```python\n.*?```", text, flags=re.S)[1:]
+             for ln in part.strip("\n").split("\n\n")[0].splitlines() if ln.startswith("    ")]
+    monkeypatch.chdir(tmp_path)
+    ns: dict = {}
+    for b in blocks:
+        exec(compile(b, "docs/quickstart.md", "exec"), ns)
+    assert capsys.readouterr().out.splitlines() == shown
+    assert len(shown) == 11 and (tmp_path / "gas.npz").is_file()
