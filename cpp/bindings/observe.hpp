@@ -1,6 +1,10 @@
 // The observation's binding (revcol/engine/observe.hpp): its config from named Python
 // arguments and its results as a dict. The Engine class (engine.cpp) registers the methods.
 #pragma once
+#include <algorithm>
+#include <vector>
+
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include "args.hpp"
@@ -35,6 +39,19 @@ void def_observe(pybind11::class_<Self, Extra...>& cls, Get get) {
              const engine::Observer* o = get(s).observer();
              if (o == nullptr) return py::none();
              return observation_dict(o->results());
+           })
+      .def("observed_positions",
+           [get](Self& s) -> py::object {
+             const engine::Observer* o = get(s).observer();
+             if (o == nullptr || !get(s).observing()) return py::none();
+             double t;  // the engine's clock in the observer's units (the lattice's ticks as time)
+             if constexpr (requires { get(s).time_of(get(s).clock()); }) t = get(s).time_of(get(s).clock());
+             else t = get(s).time();
+             const std::vector<double> u = o->unwrapped(t);
+             const auto n = static_cast<py::ssize_t>(o->size());
+             py::array_t<double> a({n, static_cast<py::ssize_t>(u.size()) / n});
+             std::copy(u.begin(), u.end(), a.mutable_data());
+             return a;
            })
       .def("stop_observing", [get](Self& s) { get(s).stop_observing(); })
       .def_property_readonly("observing", [get](Self& s) { return get(s).observing(); });

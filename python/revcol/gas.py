@@ -116,12 +116,15 @@ class _GasRun:
                 self.plot_t = [self.t0 + (self.t_end - self.t0) * k / 10 for k in range(1, 10)]
         self.writer = None
         self.frames_t: list[float] = []
+        self.images: list = []  # each forward frame's image flags: its reverse twin's (the same time)
+        self.quarters: list = []
         if trajectory is not None:
             from .trajectory import open_trajectory  # the writers only when a run writes frames
 
+            if scene.observe is None and self.periodic.any():
+                sim.observe()  # the observer's unwrapped positions give the frames' image flags (not reported)
             self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter)
-            self.writer.write(self.x0, self.v0, self.t0, 0, "forward")
-            self.frames_t.append(self.t0)
+            self.forward_frame(0)
         self.curve: list[dict] = []
         self.energy_series: list[tuple[int, float]] = [(0, 0.0)] if plot is not None else []
         self.written_ckpt: list[str] = []
@@ -187,8 +190,7 @@ class _GasRun:
             sim.save(path)
             self.written_ckpt.append(str(path))
         if self.writer is not None and not finished and done % self.traj_every == 0 and done > 0:
-            self.writer.write(sim.positions, sim.velocities, sim.time, done, "forward")
-            self.frames_t.append(sim.time)
+            self.forward_frame(done)
         if finished:
             return True
         if (done in self.plot_c) or (self.plot_t and sim.time in self.plot_t):
@@ -208,8 +210,30 @@ class _GasRun:
         if self.plot is not None:
             self.energy_series.append((self.done, float(self.diag_turn["energy_drift"])))
         if self.writer is not None and (not self.frames_t or self.frames_t[-1] != self.t_turn):
-            self.writer.write(sim.positions, sim.velocities, self.t_turn, self.done, "forward")
-            self.frames_t.append(self.t_turn)
+            self.forward_frame(self.done)
+
+    def forward_frame(self, done: int) -> None:
+        from .trajectory import true_images
+
+        sim = self.sim
+        x = sim.positions
+        self.images.append(true_images(sim, x))
+        # which quarter of each periodic axis it is in: its reverse twin, back within the round-off
+        # horizon, may sit just across a boundary from it (one image away)
+        self.quarters.append(np.floor(4.0 * x / self.box).astype(np.int8))
+        self.frames_t.append(sim.time)
+        self.writer.write(x, sim.velocities, sim.time, done, "forward", image=self.images[-1])
+
+    def reverse_image(self, x: np.ndarray, t: float):
+        """The image flags of a reverse frame at a forward frame's time: that frame's, less one
+        where a particle came back just across the lower boundary and plus one across the upper
+        (a twin within a quarter box of it); None at any other time (the writer infers them)."""
+        if t not in self.frames_t or self.images[0] is None:
+            return None
+        k = self.frames_t.index(t)
+        q, low, high = self.quarters[k], x < 0.25 * self.box, x >= 0.75 * self.box
+        shift = np.where((q == 3) & low, 1, 0) - np.where((q == 0) & high, 1, 0)
+        return self.images[k] + np.where(self.periodic, shift, 0)
 
     def reverse(self, stop: Interrupt, presses_at_turn: int) -> None:
         """Back to the start: in chunks (each run_back re-predicts every event, about the cost
@@ -237,8 +261,10 @@ class _GasRun:
                 self.reverse_s += _time.perf_counter() - tick
                 self.back += int(r["collisions"])
                 bar.to(self.back)
-                if self.writer is not None:
-                    self.writer.write(sim.positions, sim.velocities, sim.time, done - self.back, "reverse")
+                if self.writer is not None:  # at a forward frame's time: that frame's flags
+                    x = sim.positions
+                    self.writer.write(x, sim.velocities, sim.time, done - self.back, "reverse",
+                                      image=self.reverse_image(x, sim.time))
         finally:
             bar.close()
             if self.writer is not None:

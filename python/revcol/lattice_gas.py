@@ -137,9 +137,12 @@ class _LatticeRun:
         self.traj_every = scene.trajectory_every if trajectory is not None else 0
         self.trajectory, self.writer = trajectory, None
         self.frames: list[int] = []
+        self.images: list = []  # each forward frame's image flags: its reverse twin's (the same state)
         if trajectory is not None:
             from .trajectory import open_trajectory  # the writers only when a run writes frames
 
+            if scene.observe is None and self.periodic.any():
+                sim.observe()  # the observer's unwrapped positions give the frames' image flags (not reported)
             self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter)
             self.frame(0, "forward")
         self.energy_series: list[tuple[int, float]] = [(0, 0.0)]
@@ -151,10 +154,16 @@ class _LatticeRun:
         self.engine_error: str | None = None
 
     def frame(self, collisions: int, phase: str) -> None:
-        sim = self.sim
-        self.writer.write(sim.positions, sim.velocities, sim.time, collisions, phase)
+        from .trajectory import true_images
+
+        sim, x = self.sim, self.sim.positions
         if phase == "forward":
+            image = true_images(sim, x)
             self.frames.append(collisions)
+            self.images.append(image)
+        else:  # back at a forward frame's count, bit for bit: that frame's flags
+            image = self.images[self.frames.index(collisions)] if collisions in self.frames else None
+        self.writer.write(x, sim.velocities, sim.time, collisions, phase, image=image)
 
     def sample(self, collisions: int) -> None:
         d = self.sim.diagnostics()

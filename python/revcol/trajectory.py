@@ -32,11 +32,14 @@ GSD frames follow HOOMD's conventions: the box is centred on the origin (positio
   padding axis) and 0 where it is periodic: HOOMD boxes are always periodic, so a reader must
   take the walls from here (docs/run.md);
 - ``particles.image`` counts each particle's crossings of each periodic axis, so
-  x + image * L is its unwrapped position (MSD across periodic boundaries). The writer sees
-  only frames: it takes each particle's jump between consecutive frames as the minimum image,
-  which is exact while no particle moves more than L/2 along an axis between two frames. It
-  warns (RuntimeWarning, once) when some particle's minimum-image jump exceeds L/4 along a
-  periodic axis: frames that sparse may hide a crossing (write frames more often);
+  x + image * L is its unwrapped position (MSD across periodic boundaries). When the frame
+  comes with them (``write(..., image=)``; a writer called on an observing simulation, and
+  ``revcol run`` / ``revcol simulate``, which observe while they write frames: :func:`true_images`)
+  they are the engine's own, exact at any frame spacing. Otherwise the writer sees only frames:
+  it takes each particle's jump between consecutive frames as the minimum image, which is
+  exact while no particle moves more than L/2 along an axis between two frames, and warns
+  (RuntimeWarning, once) when some particle's minimum-image jump exceeds L/4 along a periodic
+  axis: frames that sparse may hide a crossing (write frames more often, or observe);
 - ``particles.diameter`` the diameter, ``particles.types`` the species;
 - with ``precise=True``, ``log/particles/revcol/position`` holds the float64 positions (same
   centred frame) that ``particles.position`` (float32 in HOOMD's schema) rounds.
@@ -64,7 +67,7 @@ from ._extras import install_hint
 from ._io import named_os_error
 
 __all__ = ["open_trajectory", "check_format", "XYZWriter", "GSDWriter", "FORMATS", "ELEMENTS", "net_collisions",
-           "read_gsd", "frame_size"]
+           "read_gsd", "frame_size", "true_images"]
 
 #: suffix -> what writes it
 FORMATS = {".xyz": "extended XYZ (OVITO, ASE)", ".gsd": "GSD (HOOMD-blue; needs the gsd package)"}
@@ -109,11 +112,15 @@ class _Writer:
     _tmp: str
     frames: int
     closed: bool = False
+    _image: np.ndarray | None = None
 
-    def write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
-        """Appends a frame (``collisions``: the net count; ``phase``: ``"forward"`` or ``"reverse"``)."""
+    def write(self, positions, velocities, time: float, collisions: int, phase: str, image=None) -> None:
+        """Appends a frame (``collisions``: the net count; ``phase``: ``"forward"`` or ``"reverse"``;
+        ``image``: the particles' periodic crossings (n x d integers, :func:`true_images`), else
+        the GSD writer infers them from consecutive frames)."""
         if self.closed:
             raise ValueError(f"trajectory {str(self.path)!r} is closed")
+        self._image = None if image is None else np.asarray(image, dtype=np.int64)
         try:
             self._write(positions, velocities, time, collisions, phase)
         except OSError as e:
@@ -127,7 +134,8 @@ class _Writer:
         """Writes the current state of ``sim`` as a frame (its clock and net collision count)."""
         if self.closed:
             raise ValueError(f"trajectory {str(self.path)!r} is closed (detach it from the simulation)")
-        self.write(sim.positions, sim.velocities, sim.time, net_collisions(sim), phase)
+        x = sim.positions
+        self.write(x, sim.velocities, sim.time, net_collisions(sim), phase, image=true_images(sim, x))
 
     def _close_file(self) -> None:
         raise NotImplementedError
@@ -240,14 +248,40 @@ def frame_size(path: str | os.PathLike, box: Sequence[float], periodic: Sequence
     return float(header), (len(text) - header) / n
 
 
+def true_images(sim, positions=None) -> np.ndarray | None:
+    """The particles' periodic crossings since the observation began (n x d integers), from the
+    observer, which never wraps its positions: (unwrapped - wrapped) / L on periodic axes, 0 on
+    walled ones; None when ``sim`` is not observing. Exact at any frame spacing (the inferred
+    flags assume less than L/2 between frames)."""
+    e = getattr(sim, "_e", None)
+    u = e.observed_positions() if e is not None and hasattr(e, "observed_positions") else None
+    if u is None:
+        return None
+    x = np.asarray(sim.positions if positions is None else positions, dtype=float)
+    box = np.asarray(sim.box, dtype=float)
+    per = np.asarray(sim.periodic, dtype=bool)
+    return np.where(per, np.rint((u - x) / box), 0.0).astype(np.int64)
+
+
 class _Unwrap:
-    """Image flags from consecutive wrapped frames: each jump taken as the minimum image."""
+    """Image flags from consecutive wrapped frames: each jump taken as the minimum image; or
+    given (:func:`true_images`), offset so that they go on from the frames before."""
 
     def __init__(self, box: np.ndarray, periodic: np.ndarray):
         self.box, self.periodic = box, periodic
         self.prev: np.ndarray | None = None
         self.image: np.ndarray | None = None
+        self.offset: np.ndarray | None = None  # the given flags' offset from this writer's
         self.warned = False
+
+    def given(self, x: np.ndarray, image: np.ndarray) -> np.ndarray:
+        """The image flags (n, 3) of frame ``x`` from the given crossings (n x d)."""
+        img = _pad3(image).astype(np.int64)
+        if self.offset is None or self.offset.shape != img.shape:  # go on from the inferred frames before, if any
+            self.offset = self.update(x) - img if self.prev is not None else np.zeros_like(img)
+        self.image = img + self.offset
+        self.prev = x.copy()
+        return self.image
 
     def update(self, x: np.ndarray) -> np.ndarray:
         """The image flags (n, 3) after frame ``x`` (engine coordinates, padded to 3)."""
@@ -322,7 +356,7 @@ class GSDWriter(_Writer):
         f.configuration.dimensions = self._dimensions
         f.configuration.step = self._next_step(collisions)
         raw = _pad3(positions)
-        image = self._unwrap.update(raw)
+        image = self._unwrap.update(raw) if self._image is None else self._unwrap.given(raw, self._image)
         x = raw.copy()
         x[:, 0] -= 0.5 * lx
         x[:, 1] -= 0.5 * ly
@@ -342,6 +376,7 @@ class GSDWriter(_Writer):
         f.log["revcol/direction"] = np.array([-1 if phase == "reverse" else 1], dtype=np.int8)
         f.log["revcol/reverse"] = np.array([phase == "reverse"], dtype=np.uint8)
         f.log["revcol/walls"] = self._walls.copy()
+        f.log["revcol/box"] = self._lengths.astype(np.float64)  # configuration.box is float32
         self._f.append(f)
 
     def _close_file(self) -> None:
@@ -363,7 +398,10 @@ def read_gsd(path: str | os.PathLike) -> dict:
     first = frames[0]
     walls = np.asarray(first.log["revcol/walls"], dtype=bool) if "revcol/walls" in first.log else None
     d = 3 if first.configuration.dimensions == 3 else 2
-    box = np.asarray(first.configuration.box[:d], dtype=float)
+    # the float64 lengths where the writer logged them (configuration.box is float32: an unwrapped
+    # position 7 box lengths out was 1.3e-6 off, and a precise position re-centred 2e-7 off)
+    box = np.asarray(first.log["revcol/box"] if "revcol/box" in first.log else first.configuration.box,
+                     dtype=float)[:d]
     precise = "particles/revcol/position" in first.log
     pos = np.array([np.asarray(fr.log["particles/revcol/position"] if precise else fr.particles.position,
                                dtype=float)[:, :d] for fr in frames])

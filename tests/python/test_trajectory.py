@@ -229,3 +229,43 @@ def test_ase_reads_the_velocities_with_unit_masses(tmp_path):
     atoms.set_velocities(atoms.arrays["velo"])
     assert np.abs(atoms.get_velocities() - s.velocities).max() < 1e-9
     assert atoms.get_kinetic_energy() == pytest.approx(s.diagnostics()["energy"], rel=1e-9)
+
+
+@pytest.mark.parametrize("engine", ["float", "lattice"])
+def test_sparse_frames_carry_the_engine_s_own_image_flags(tmp_path, engine):
+    # issue 58: frames 200 collisions per particle apart (particles cross the box several times
+    # between two) written from an observing simulation: their flags are the observer's crossings,
+    # so the frames' unwrapped positions are the observer's, and their MSD equals its MSD to 1e-12;
+    # a dense trajectory of the same run, whose inferred flags are exact, agrees at every shared frame
+    pytest.importorskip("gsd.hoomd")
+    from revcol.trajectory import read_gsd, true_images
+    sims = [revcol.Simulation.random(60, 2, 0.2, seed=8, engine=engine) for _ in range(2)]
+    sparse = open_trajectory(tmp_path / "sparse.gsd", sims[0].box, sims[0].periodic, 1.0, precise=True)
+    dense = open_trajectory(tmp_path / "dense.gsd", sims[1].box, sims[1].periodic, 1.0, precise=True)
+    sims[0].observe()
+    seen = []  # the observer's own unwrapped positions at each sparse frame
+
+    def look(sim):
+        seen.append(sim._e.observed_positions())
+    for s, w, every, also in ((sims[0], sparse, 6000, look), (sims[1], dense, 20, None)):
+        w(s)  # the first frame, at the start
+        s.attach(w, every=every)
+        if also is not None:
+            also(s)
+            s.attach(also, every=every)
+    for s in sims:
+        s.run(collisions=30_000)
+    u = seen[-1]
+    assert np.abs(true_images(sims[0])).max() >= 2  # crossings, several box lengths: sparse indeed
+    for w in (sparse, dense):
+        w.close()
+    a, b = read_gsd(tmp_path / "sparse.gsd"), read_gsd(tmp_path / "dense.gsd")
+    assert len(seen) == len(a["net_collisions"]) == 6  # at 0, 6000, ..., 30000
+    assert np.abs(a["unwrapped"][-1] - u).max() < 1e-9
+    # the MSD from the first frame to the last, from the file and from the observer
+    msd_frames = float(np.mean(np.sum((a["unwrapped"][-1] - a["unwrapped"][0]) ** 2, axis=1)))
+    msd_observer = float(np.mean(np.sum((u - seen[0]) ** 2, axis=1)))
+    assert msd_frames == pytest.approx(msd_observer, rel=1e-12)
+    shared = np.isin(b["net_collisions"], a["net_collisions"])
+    assert shared.sum() == len(a["net_collisions"])  # the same run: the same states at the same counts
+    assert np.array_equal(b["image"][shared], a["image"])

@@ -58,7 +58,7 @@ from ..observe import report_lines
 from ..progress import Bar, Interrupt, peak_rss
 from ..roundtrip import geometry
 from ..scene import Scene, SceneError, load_scene, with_engine, with_lattice_options, with_mode
-from ..trajectory import _species, check_format, open_trajectory  # revcol simulate writes frames
+from ..trajectory import _species, check_format, open_trajectory, true_images  # revcol simulate writes frames
 
 __all__ = ["simulate", "format_simulate"]
 
@@ -172,6 +172,10 @@ class _Production:
                                           precise=precise)
         if scene.observe is not None:
             sim.observe(**scene.observe)
+        elif self.writer is not None and any(periodic):
+            # the observer never wraps its positions: the frames' image flags are its crossings,
+            # exact at any frame spacing (issue 58); its values are not reported
+            sim.observe()
         self.interrupted, self.engine_error, self.stalled, self.wall_s = False, None, False, 0.0
 
     def advance_frame_time(self) -> None:
@@ -197,7 +201,8 @@ class _Production:
     def frame(self) -> None:
         sim = self.sim
         if self.writer is not None and self.last_frame != (self.done, sim.time):
-            self.writer.write(sim.positions, sim.velocities, sim.time, self.done, "forward")
+            x = sim.positions
+            self.writer.write(x, sim.velocities, sim.time, self.done, "forward", image=true_images(sim, x))
             self.last_frame = (self.done, sim.time)
 
     def checkpoint(self) -> None:
@@ -355,7 +360,11 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
     start = 0 if sim is None else _net(sim)
     # no output may name an input or another output (issue 59), nor outgrow the limit or the free
     # space (issue 59); every one writable (issue 17)
-    outputs = _outputs(scene, sim, start, collisions, time, json_path, trajectory, every, every_time, checkpoints,
+    # frames on a periodic axis are written with the observer running (their image flags), and so
+    # the checkpoints then hold its state too: estimated as such
+    observed = scene if scene.observe is not None or trajectory is None or "periodic" not in scene.boundaries \
+        else dataclasses.replace(scene, observe={})
+    outputs = _outputs(observed, sim, start, collisions, time, json_path, trajectory, every, every_time, checkpoints,
                        checkpoint_every, species, precise)
     check_outputs(scene.source, outputs, run_inputs(scene, resume), max_output=limit)
     if sim is None:

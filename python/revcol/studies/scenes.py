@@ -114,7 +114,11 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
     # every output and the memory are checked before anything runs: a run must not be lost to
     # an unwritable report at its end (issue 17), nor overwrite its own inputs, nor fill the disk (issue 59)
     limit = output_limit(scene.source, max_output, scene.max_output)
-    outputs = _outputs(scene, json_path, plot, trajectory, horizon_seeds is not None, plot_format)
+    # frames on a periodic axis are written with the observer running (their image flags), and so
+    # the checkpoints then hold its state too: estimated as such
+    observed = scene if scene.observe is not None or trajectory is None or "periodic" not in scene.boundaries \
+        else dataclasses.replace(scene, observe={})
+    outputs = _outputs(observed, json_path, plot, trajectory, horizon_seeds is not None, plot_format)
     check_outputs(scene.source, outputs, run_inputs(scene), max_output=limit)
     if scene.kind == "gas":
         check_memory(scene)

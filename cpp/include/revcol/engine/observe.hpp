@@ -212,6 +212,20 @@ class Observer {
   void sync(double t);
   /// The results up to the last hook or sync.
   Observation results() const;
+  /// Each particle's unwrapped position at time t, at or after its last velocity change
+  /// (n x dim): its position at the start of the observation plus every displacement since,
+  /// never wrapped. Less the engine's wrapped position, a whole number of box lengths on each
+  /// periodic axis: its image flags (revcol.trajectory writes them). Between events, and
+  /// mid-run (an attached action), any time from the last event on: segments stay open.
+  /// Particles observed.
+  std::size_t size() const { return n_; }
+  std::vector<double> unwrapped(double t) const {
+    std::vector<double> out(n_ * static_cast<std::size_t>(dim_));
+    for (std::size_t i = 0; i < n_; ++i)
+      for (int k = 0; k < dim_; ++k) out[i * static_cast<std::size_t>(dim_) + static_cast<std::size_t>(k)] =
+          pos(static_cast<int>(i), k, t);
+    return out;
+  }
 
  private:
   struct Segment {
