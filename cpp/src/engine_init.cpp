@@ -131,8 +131,13 @@ double nearest_site(int d, const double* a) {
   return std::min(s0, s0 / std::sqrt(2.0) * std::sqrt(0.5 * (1.0 + r * r)));
 }
 
-// A jittered crystal into x (n x d); false when the sites are closer than D.
-bool place_crystal(const Geometry& g, std::size_t n, Draws& pos, std::vector<double>& x) {
+// A jittered crystal into x (n x d); false when the sites are closer than D. `tight`: on a
+// walled axis the outer layers lie on the walls' margins (spacing (hi - lo) / (m - 1/2) in 3D,
+// (hi - lo) / (m - 1) in 2D, against (hi - lo) / m with half a layer's gap at each wall): the
+// last resort of a dense walled start (issue 58: spheres-3d, 1000 spheres with walls on z, did
+// not fit above volume fraction 0.6). It is tried only when the other placements fail, so every
+// start that fitted before is the same, bit for bit.
+bool place_crystal(const Geometry& g, std::size_t n, Draws* pos, std::vector<double>* x, bool tight) {
   const int d = g.d;
   const int basis = d == 3 ? 4 : 1;
   int m[3] = {1, 1, 1};
@@ -144,6 +149,12 @@ bool place_crystal(const Geometry& g, std::size_t n, Draws& pos, std::vector<dou
   bool cube = true;
   for (int k = 1; k < d; ++k) cube = cube && g.L[k] == g.L[0];
   double ak[3] = {1.0, 1.0, 1.0};
+  // layer spans of a cell along an axis: the sites' offsets are 0 and 1/2 (3D) or 0 (2D) tight
+  const double last = d == 3 ? 0.5 : 0.0;
+  auto spacing = [&](int k, int mk) {
+    const bool t = tight && g.wall[k] && mk + last > 1.0;
+    return (g.hi[k] - g.lo[k]) / (t ? mk - 1 + last : mk);
+  };
   // The cell counts per axis that hold N: `same`, the same m on every axis (what random_state
   // always did in a cube); else refine the axis whose refined spacing stays widest (ties: the
   // lowest axis), the counts that hold N with the largest smallest spacing. True when the
@@ -157,15 +168,16 @@ bool place_crystal(const Geometry& g, std::size_t n, Draws& pos, std::vector<dou
       }
       int best = 0;
       for (int k = 1; k < d; ++k)
-        if ((g.hi[k] - g.lo[k]) / (m[k] + 1) > (g.hi[best] - g.lo[best]) / (m[best] + 1)) best = k;
+        if (spacing(k, m[k] + 1) > spacing(best, m[best] + 1)) best = k;
       ++m[best];
     }
-    for (int k = 0; k < d; ++k) ak[k] = (g.hi[k] - g.lo[k]) / m[k];
+    for (int k = 0; k < d; ++k) ak[k] = spacing(k, m[k]);
     return nearest_site(d, ak) >= g.D * (1.0 + limits::kLatticeGap);
   };
   // a cube whose equal counts crowd the sites (walls shrink the usable box: 1000 spheres at
   // volume fraction 0.45 in a walled cube) takes unequal counts (6 x 6 x 7 cells there)
   if (!counts(cube) && !(cube && counts(false))) return false;
+  if (pos == nullptr) return true;  // whether it fits, placing nothing (densest_crystal)
   const double nearest = nearest_site(d, ak);
   const double jitter = 0.49 * (nearest - g.D) / std::sqrt(static_cast<double>(d));
   static constexpr double fcc[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
@@ -173,7 +185,7 @@ bool place_crystal(const Geometry& g, std::size_t n, Draws& pos, std::vector<dou
   std::vector<std::size_t> idx(sites);
   std::iota(idx.begin(), idx.end(), std::size_t{0});
   for (std::size_t i = 0; i < n; ++i) {  // partial Fisher-Yates
-    const std::size_t j = i + static_cast<std::size_t>(pos.u() * static_cast<double>(sites - i));
+    const std::size_t j = i + static_cast<std::size_t>(pos->u() * static_cast<double>(sites - i));
     std::swap(idx[i], idx[std::min(j, sites - 1)]);
   }
   std::sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(n));
@@ -184,11 +196,12 @@ bool place_crystal(const Geometry& g, std::size_t n, Draws& pos, std::vector<dou
     for (int k = 0; k < d; ++k) {
       const int ck = static_cast<int>(q % static_cast<std::size_t>(m[k]));
       q /= static_cast<std::size_t>(m[k]);
-      const double off = d == 3 ? fcc[b][k] + 0.25 : 0.5;
-      double p = g.lo[k] + (ck + off) * ak[k] + jitter * (2.0 * pos.u() - 1.0);
+      const bool t = tight && g.wall[k] && m[k] + last > 1.0;
+      const double off = t ? (d == 3 ? fcc[b][k] : 0.0) : d == 3 ? fcc[b][k] + 0.25 : 0.5;
+      double p = g.lo[k] + (ck + off) * ak[k] + jitter * (2.0 * pos->u() - 1.0);
       p = std::clamp(p, g.lo[k], g.hi[k]);
       if (p >= g.L[k]) p -= g.L[k];
-      x[i * d + k] = p;
+      (*x)[i * d + k] = p;
     }
   }
   return true;
@@ -230,6 +243,27 @@ void draw_velocities(int d, std::size_t n, std::uint64_t seed, double energy, bo
   for (auto& q : v) q *= scale;
 }
 
+// The packing fraction (3 significant digits, rounded down) of the densest box of c's shape
+// and boundaries, scaled alike on every axis, in which a crystal of n fits (either placement).
+double densest_crystal(const Config& c, std::size_t n) {
+  auto fits = [&](double scale) {
+    Config s = c;
+    for (int k = 0; k < c.dim; ++k) s.box[k] = c.box[k] * scale;
+    const Geometry g(s);
+    return place_crystal(g, n, nullptr, nullptr, false) || place_crystal(g, n, nullptr, nullptr, true);
+  };
+  double lo = 1.0, hi = 2.0;  // fits(hi): the box twice as long on every axis
+  while (!fits(hi) && hi < 1e6) hi *= 2.0;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (fits(mid) ? hi : lo) = mid;
+  }
+  double vol = 1.0;
+  for (int k = 0; k < c.dim; ++k) vol *= c.box[k] * hi;
+  const double phi = static_cast<double>(n) * particle_volume(c.dim, c.diameter) / vol;
+  return std::floor(phi * 1000.0) / 1000.0;
+}
+
 // The start in c's box (validated by the caller): the preferred placement, then under
 // `fallback` the other one; each placement restarts the position stream.
 InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, double energy, bool rsa,
@@ -238,17 +272,20 @@ InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, do
   InitialState s;
   s.x.assign(n * c.dim, 0.0);
   s.v.assign(n * c.dim, 0.0);
-  auto place = [&](bool use_rsa) {
+  auto place = [&](bool use_rsa, bool tight = false) {
     Draws pos(0xFFFFFF00u, seed);
-    return use_rsa ? place_rsa(g, n, pos, s.x) : place_crystal(g, n, pos, s.x);
+    return use_rsa ? place_rsa(g, n, pos, s.x) : place_crystal(g, n, &pos, &s.x, tight);
   };
-  if (!place(rsa) && !(fallback && place(!rsa))) {
+  bool walled = false;
+  for (int k = 0; k < c.dim; ++k) walled = walled || g.wall[k];
+  if (!place(rsa) && !(fallback && place(!rsa)) && !((!rsa || fallback) && walled && place(false, true))) {
     if (rsa && !fallback)
       throw InvalidArgument("random sequential addition did not place every particle; use init='crystal'");
     throw InvalidArgument(std::to_string(n) + " particles of diameter " + num(c.diameter) +
                           " do not fit on a crystal in this box (nearest sites closer than D)" +
                           (fallback ? ", nor by random sequential addition" : "") +
-                          ": make the box larger or the packing fraction lower");
+                          ": make the box larger or the packing fraction lower (with these boundaries a crystal of " +
+                          std::to_string(n) + " fits up to a packing fraction of " + num(densest_crystal(c, n)) + ")");
   }
   draw_velocities(c.dim, n, seed, energy, equal_speeds, s.v);
   s.config = c;

@@ -196,10 +196,15 @@ TEST_CASE("random_start: N that does not fit, and bad input, are clear errors") 
   const Config c = box_config({5.0, 6.0, 9.0}, {Boundary::wall, Boundary::periodic, Boundary::wall});
   CHECK(error_of([&] { random_start(c, 500, 1); }).find("500 particles of diameter 1") != std::string::npos);
   CHECK(error_of([&] { random_start(c, 500, 1); }).find("do not fit") != std::string::npos);
-  // under the packing-fraction limit, but no crystal of spacing > D holds 9 disks in 3.5 x 3.5 walls
+  // under the packing-fraction limit, but no crystal of spacing > D holds 10 disks in 3.5 x 3.5
+  // walls (centres in [0.5, 3]); 9 fit on the crystal whose outer rows lie on the walls' margins
+  // (spacing 1.25), the last resort of a walled start (issue 58), and the error names the densest
   const Config small = box_config({3.5, 3.5}, {Boundary::wall});
-  CHECK(error_of([&] { random_start(small, 9, 1, 0.0, "crystal"); }).find("do not fit on a crystal") !=
-        std::string::npos);
+  const std::string why = error_of([&] { random_start(small, 10, 1, 0.0, "crystal"); });
+  CHECK(why.find("do not fit on a crystal") != std::string::npos);
+  CHECK(why.find("fits up to a packing fraction of") != std::string::npos);
+  const InitialState nine = random_start(small, 9, 1, 0.0, "crystal");
+  CHECK(shape(nine.config, nine).min_gap >= 1.0);
   CHECK(error_of([&] { random_start(c, 0, 1); }).find("N = 0") != std::string::npos);
   CHECK(error_of([&] { random_start(c, 10, 1ull << 32); }).find("seed") != std::string::npos);
   CHECK(error_of([&] { random_start(c, 10, 1, 0.0, "grid"); }).find("init must be") != std::string::npos);
