@@ -165,12 +165,15 @@ def plot_lattice_gas(r: dict, out: Path, start, turn, end, fmt: str = "png") -> 
 def _energy_figure(r: dict, out: Path, plt, title: str, fmt: str, exact: bool) -> str:
     """The energy's relative drift in units of the double's epsilon (float engine: round-off is
     all there is to see, and this is the scale on which it is visible), or the lattice
-    engine's exact integer energy (a drift that is 0 at every sample, said so in words)."""
+    engine's: an exact integer map of each pair that keeps its energy to the velocity lattice's
+    resolution, a random walk of about 2^-30 of a pair's energy per collision (docs/lattice.md;
+    a drift that is 0 at every sample is said so in words)."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
     es = np.array(r["energy_series"], dtype=float).reshape(-1, 2)
     style = "o-" if len(es) < 30 else "-"
     if exact:
-        ax.plot(es[:, 0], es[:, 1], style, lw=1, ms=3, label="(E - E0) / E0")
+        ax.plot(es[:, 0], es[:, 1], style, lw=1, ms=3,
+                label="(E - E0) / E0 (a walk at the velocity lattice's resolution; reversed exactly)")
         ax.set_ylabel("energy drift (E - E0) / E0")
         if not np.any(es[:, 1]):
             ax.text(0.5, 0.6, f"exactly 0 at all {len(es)} samples\n(integer energy)", transform=ax.transAxes,

@@ -11,9 +11,12 @@ Extended XYZ, one frame (species: a chemical element symbol, ``"Ar"`` unless tol
 maps the species column to elements and fails on another name)::
 
     3
-    Lattice="10 0 0 0 10 0 0 0 0" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1 Time=0.5 Collisions=100 Phase="forward" pbc="T T F"
-    Ar 1.5 2.5 0 0.1 -0.3 0 0.5
+    Lattice="10 0 0 0 10 0 0 0 0" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1:image:I:3 Time=0.5 Collisions=100 Phase="forward" pbc="T T F"
+    Ar 1.5 2.5 0 0.1 -0.3 0 0.5 1 0 0
     ...
+
+The last three columns (``image``, a periodic box only) are the particle's crossings of each
+axis, as GSD's ``particles.image`` below: ``pos + image * L`` is its unwrapped position.
 
 The cell spans [0, L_k] per axis (OVITO's default origin). A 2D gas has a third cell vector
 of zero length and ``pbc`` F on z (what ASE writes for a 2D cell; OVITO detects the
@@ -185,12 +188,23 @@ class XYZWriter(_Writer):
         self.species = _species(species)
         self._head = _xyz_head(box, periodic, diameter)
         self._radius = 0.5 * diameter
+        per = np.zeros(3, dtype=bool)
+        per[: self.dim] = [bool(p) for p in periodic]
+        lengths3 = np.ones(3)
+        lengths3[: self.dim] = np.asarray(box, dtype=float)
+        # a periodic box's frames carry their image flags (the last column), as GSD's
+        self._unwrap = _Unwrap(lengths3, per) if per.any() else None
         self.frames = 0
         self._tmp = _part(self.path)
         self._f = _opened(self._tmp, self.path, lambda: open(self._tmp, "w"))
 
     def _write(self, positions, velocities, time: float, collisions: int, phase: str) -> None:
-        _xyz_frame(self._f, self._head, self.species, self._radius, positions, velocities, time, collisions, phase)
+        image = None
+        if self._unwrap is not None:
+            raw = _pad3(positions)
+            image = self._unwrap.update(raw) if self._image is None else self._unwrap.given(raw, self._image)
+        _xyz_frame(self._f, self._head, self.species, self._radius, positions, velocities, time, collisions, phase,
+                   image)
 
     def _close_file(self) -> None:
         self._f.close()
@@ -202,19 +216,23 @@ def _xyz_head(box: Sequence[float], periodic: Sequence[bool], diameter: float) -
     lengths = list(box) + [diameter] * max(0, 2 - len(box)) + [0.0] * (3 - max(2, len(box)))
     pbc = [bool(p) for p in periodic] + [False] * (3 - len(box))
     lattice = " ".join(f"{lengths[i] if i == j else 0.0:.17g}" for i in range(3) for j in range(3))
-    return (f'Lattice="{lattice}" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1 '
+    image = ":image:I:3" if any(pbc) else ""  # periodic crossings per axis (a periodic box only)
+    return (f'Lattice="{lattice}" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1{image} '
             f'pbc="{" ".join("T" if p else "F" for p in pbc)}"')
 
 
 def _xyz_frame(f, head: str, species: str, radius: float, positions, velocities, time: float, collisions: int,
-               phase: str) -> None:
-    """One extended XYZ frame written to ``f`` (the writer's format, and :func:`frame_size`'s sample)."""
+               phase: str, image=None) -> None:
+    """One extended XYZ frame written to ``f`` (the writer's format, and :func:`frame_size`'s sample);
+    ``image`` (n x 3 integers) when the header has the image column."""
     x, v = _pad3(positions), _pad3(velocities)
     n = x.shape[0]
-    rows = np.empty((n, 7))
+    rows = np.empty((n, 7 if image is None else 10))
     rows[:, :3], rows[:, 3:6], rows[:, 6] = x, v, radius
+    if image is not None:
+        rows[:, 7:] = image
     f.write(f"{n}\n{head} Time={time:.17g} Collisions={int(collisions)} Phase=\"{phase}\"\n")
-    np.savetxt(f, rows, fmt=species + " %.12g" * 7)
+    np.savetxt(f, rows, fmt=species + " %.12g" * 7 + ("" if image is None else " %d %d %d"))
 
 
 #: GSD bytes per particle of a frame after the first (gsd writes a chunk only where it differs
@@ -240,8 +258,9 @@ def frame_size(path: str | os.PathLike, box: Sequence[float], periodic: Sequence
         b = per["position"] + per["velocity"] + (per["image"] if any(periodic) else 0)
         return float(GSD_FRAME_BYTES), float(b + (per["precise"] if precise else 0))
     f = io.StringIO()
+    sample = np.full((np.asarray(positions).shape[0], 3), -99) if any(periodic) else None  # 3 characters a flag
     _xyz_frame(f, _xyz_head(box, periodic, diameter), _species(species), 0.5 * diameter, positions, velocities,
-               time, collisions, "forward")
+               time, collisions, "forward", sample)
     text = f.getvalue().encode()
     n = max(1, np.asarray(positions).shape[0])
     header = text.index(b"\n", text.index(b"\n") + 1) + 1

@@ -269,3 +269,32 @@ def test_sparse_frames_carry_the_engine_s_own_image_flags(tmp_path, engine):
     shared = np.isin(b["net_collisions"], a["net_collisions"])
     assert shared.sum() == len(a["net_collisions"])  # the same run: the same states at the same counts
     assert np.array_equal(b["image"][shared], a["image"])
+
+
+def test_xyz_frames_of_a_periodic_box_carry_the_same_image_flags_as_gsd(tmp_path):
+    # the XYZ writer's image column (a periodic box only): the flags GSD writes for the same frames
+    pytest.importorskip("gsd.hoomd")
+    from revcol.trajectory import read_gsd
+    s = revcol.Simulation.random(40, 2, 0.2, seed=5, boundary=["periodic", "wall"])
+    s.observe()
+    ws = [open_trajectory(tmp_path / f"t.{ext}", s.box, s.periodic, 1.0) for ext in ("xyz", "gsd")]
+    for w in ws:
+        w(s)
+        s.attach(w, every=4000)
+    s.run(collisions=20_000)
+    for w in ws:
+        w.close()
+    lines = (tmp_path / "t.xyz").read_text().splitlines()
+    assert "Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1:image:I:3" in lines[1]
+    frames, i = [], 0
+    while i < len(lines):
+        n = int(lines[i])
+        frames.append(np.array([[int(w) for w in ln.split()[8:11]] for ln in lines[i + 2:i + 2 + n]]))
+        i += n + 2
+    g = read_gsd(tmp_path / "t.gsd")
+    assert len(frames) == len(g["image"]) == 6
+    assert np.abs(g["image"]).max() >= 1 and all(np.array_equal(a[:, :2], b) for a, b in zip(frames, g["image"]))
+    walled = open_trajectory(tmp_path / "w.xyz", [5.0, 5.0], [False, False], 1.0)
+    walled.write(np.array([[1.0, 1.0]]), np.zeros((1, 2)), 0.0, 0, "forward")
+    walled.close()
+    assert ":image:" not in (tmp_path / "w.xyz").read_text().splitlines()[1]
