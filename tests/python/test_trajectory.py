@@ -102,11 +102,13 @@ def test_gsd_of_a_round_trip_has_a_monotonic_step_direction_and_images_back_at_z
 
 def test_extended_xyz_reads_in_ase_as_a_2d_cell(tmp_path):
     ase_io = pytest.importorskip("ase.io")
+    from revcol.trajectory import true_images
     sim = revcol.Simulation.random(30, 2, 0.2, seed=2, boundary=["periodic", "wall"])
+    sim.observe()  # the frames' image flags from the observer (sparse frames: no inference, no warning)
     w = open_trajectory(tmp_path / "t.xyz", sim.box, sim.periodic, 1.0)
     shots = []
     for k in range(4):
-        w.write(sim.positions, sim.velocities, sim.time, 20 * k, "forward")
+        w.write(sim.positions, sim.velocities, sim.time, 20 * k, "forward", image=true_images(sim))
         shots.append((sim.positions, sim.velocities, sim.time))
         sim.run(collisions=20)
     w.close()
@@ -119,6 +121,7 @@ def test_extended_xyz_reads_in_ase_as_a_2d_cell(tmp_path):
         np.testing.assert_allclose(a.positions[:, :2], x, rtol=1e-11)
         assert not a.positions[:, 2].any()
         np.testing.assert_allclose(a.arrays["velo"][:, :2], v, rtol=1e-11)
+        assert a.arrays["image"].shape == (30, 3) and not a.arrays["image"][:, 1:].any()  # y walled, no z
         assert a.info["Time"] == t and a.info["Phase"] == "forward"
 
 
