@@ -116,8 +116,10 @@ class _GasRun:
                 self.plot_t = [self.t0 + (self.t_end - self.t0) * k / 10 for k in range(1, 10)]
         self.writer = None
         self.frames_t: list[float] = []
-        self.images: list = []  # each forward frame's image flags: its reverse twin's (the same time)
-        self.quarters: list = []
+        # each forward frame's image flags and the quarter of the box each particle is in, by the
+        # frame's time: its reverse twin's (reverse frames are taken at the forward frames' times)
+        self.images: dict = {}
+        self.quarters: dict = {}
         if trajectory is not None:
             from .trajectory import open_trajectory  # the writers only when a run writes frames
 
@@ -217,23 +219,22 @@ class _GasRun:
 
         sim = self.sim
         x = sim.positions
-        self.images.append(true_images(sim, x))
+        self.images[sim.time] = true_images(sim, x)
         # which quarter of each periodic axis it is in: its reverse twin, back within the round-off
         # horizon, may sit just across a boundary from it (one image away)
-        self.quarters.append(np.floor(4.0 * x / self.box).astype(np.int8))
+        self.quarters[sim.time] = np.floor(4.0 * x / self.box).astype(np.int8)
         self.frames_t.append(sim.time)
-        self.writer.write(x, sim.velocities, sim.time, done, "forward", image=self.images[-1])
+        self.writer.write(x, sim.velocities, sim.time, done, "forward", image=self.images[sim.time])
 
     def reverse_image(self, x: np.ndarray, t: float):
         """The image flags of a reverse frame at a forward frame's time: that frame's, less one
         where a particle came back just across the lower boundary and plus one across the upper
         (a twin within a quarter box of it); None at any other time (the writer infers them)."""
-        if t not in self.frames_t or self.images[0] is None:
+        if self.images.get(t) is None:
             return None
-        k = self.frames_t.index(t)
-        q, low, high = self.quarters[k], x < 0.25 * self.box, x >= 0.75 * self.box
+        q, low, high = self.quarters[t], x < 0.25 * self.box, x >= 0.75 * self.box
         shift = np.where((q == 3) & low, 1, 0) - np.where((q == 0) & high, 1, 0)
-        return self.images[k] + np.where(self.periodic, shift, 0)
+        return self.images[t] + np.where(self.periodic, shift, 0)
 
     def reverse(self, stop: Interrupt, presses_at_turn: int) -> None:
         """Back to the start: in chunks (each run_back re-predicts every event, about the cost

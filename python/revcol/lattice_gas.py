@@ -137,7 +137,7 @@ class _LatticeRun:
         self.traj_every = scene.trajectory_every if trajectory is not None else 0
         self.trajectory, self.writer = trajectory, None
         self.frames: list[int] = []
-        self.images: list = []  # each forward frame's image flags: its reverse twin's (the same state)
+        self.images: dict = {}  # each forward frame's image flags by its count: its reverse twin's (the same state)
         if trajectory is not None:
             from .trajectory import open_trajectory  # the writers only when a run writes frames
 
@@ -160,9 +160,9 @@ class _LatticeRun:
         if phase == "forward":
             image = true_images(sim, x)
             self.frames.append(collisions)
-            self.images.append(image)
+            self.images[collisions] = image
         else:  # back at a forward frame's count, bit for bit: that frame's flags
-            image = self.images[self.frames.index(collisions)] if collisions in self.frames else None
+            image = self.images.get(collisions)
         self.writer.write(x, sim.velocities, sim.time, collisions, phase, image=image)
 
     def sample(self, collisions: int) -> None:
