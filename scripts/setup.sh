@@ -33,6 +33,6 @@ $py -m pip install -q --disable-pip-version-check \
   "scikit-build-core>=0.11" "pybind11>=2.12" "cmake>=3.20" ninja numpy "scipy>=1.8" "pytest>=7" "matplotlib>=3.5" "tqdm>=4.60" "gsd>=3" "ase>=3.22" "freud-analysis>=3" "mypy>=1.10" "hypothesis>=6.80" "dask[distributed]>=2024.1"
 # no build isolation: the tools above are in .venv; build/{wheel_tag} is reused between runs
 # (pyproject sets no build-dir, so a plain `pip wheel .` builds out of tree)
-echo "setup: building revcol, its C++ core and Python module (the first time about 5 minutes on 2 cores; then only what changed)"
+echo "setup: building revcol, its C++ core and Python module (the first time 2-5 minutes on 2 cores; then only what changed)"
 $py -m pip install -q --disable-pip-version-check --no-build-isolation --no-deps -C build-dir=build/{wheel_tag} .
 echo "setup: ok ($($py -c 'import revcol, sys; print("revcol", revcol.__version__, "python", sys.version.split()[0])'), $((SECONDS - t0)) s)"
