@@ -120,7 +120,7 @@ class _Writer:
     def write(self, positions, velocities, time: float, collisions: int, phase: str, image=None) -> None:
         """Appends a frame (``collisions``: the net count; ``phase``: ``"forward"`` or ``"reverse"``;
         ``image``: the particles' periodic crossings (n x d integers, :func:`true_images`), else
-        the GSD writer infers them from consecutive frames)."""
+        the writer infers them from consecutive frames; a walled box's XYZ has no image column)."""
         if self.closed:
             raise ValueError(f"trajectory {str(self.path)!r} is closed")
         self._image = None if image is None else np.asarray(image, dtype=np.int64)
