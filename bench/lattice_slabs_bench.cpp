@@ -48,8 +48,8 @@ std::vector<Metric> run_slabs(const SlabCase& c, std::uint64_t nc) {
   const std::int64_t L = s0.units.L[0];
   const double reach = static_cast<double>(s0.units.sigma) + 4.0 * static_cast<double>(s0.units.vmax);
   using clock = std::chrono::steady_clock;
-  // the rate without slabs from the same restored state as every K below: a restore rebuilds the
-  // engine's arrays in order, and at N = 10^6 that alone was 1.2x the warm-up's rate (3D), which
+  // the rate without slabs from the same restored state as every K below: a restore builds the
+  // engine's structures afresh, and at N = 10^6 that alone ran 1.3x the warm-up's rate (3D), which
   // a base taken straight after the warm-up had counted as the slabs' doing
   e.restore(s0);
   auto t0 = clock::now();
