@@ -32,7 +32,7 @@ from .lattice_gas import _LatticeRun, build_lattice
 from .progress import Bar, Interrupt, peak_rss
 from ._version import __version__
 from .roundtrip import BAR, ERROR_DEFINITIONS, geometry, round_trip_errors
-from .scene import Scene, SceneError, engine_options, read_initial
+from .scene import Scene, SceneError, engine_options, observes_frames, read_initial
 
 __all__ = ["build_simulation", "run_gas", "round_trip", "list_renewals", "BYTES_PER_PARTICLE", "check_memory",
            "check_output"]
@@ -123,7 +123,7 @@ class _GasRun:
         if trajectory is not None:
             from .trajectory import open_trajectory  # the writers only when a run writes frames
 
-            if scene.observe is None and self.periodic.any():
+            if observes_frames(scene, trajectory):
                 sim.observe()  # the observer's unwrapped positions give the frames' image flags (not reported)
             self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter)
             self.forward_frame(0)

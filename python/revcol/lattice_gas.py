@@ -38,7 +38,7 @@ from .lattice import LatticeSimulation, LatticeSimulation3D
 from .progress import Bar, Interrupt, peak_rss
 from ._version import __version__
 from .roundtrip import BAR, round_trip_errors
-from .scene import Scene, SceneError, lattice_options, read_initial
+from .scene import Scene, SceneError, lattice_options, observes_frames, read_initial
 
 __all__ = ["build_lattice", "lattice_horizon", "restored", "RESTORED_PARTS",
            "LATTICE_HORIZON_GRID"]
@@ -141,7 +141,7 @@ class _LatticeRun:
         if trajectory is not None:
             from .trajectory import open_trajectory  # the writers only when a run writes frames
 
-            if scene.observe is None and self.periodic.any():
+            if observes_frames(scene, trajectory):
                 sim.observe()  # the observer's unwrapped positions give the frames' image flags (not reported)
             self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter)
             self.frame(0, "forward")

@@ -557,6 +557,12 @@ def scene_names() -> list[str]:
     return sorted({p.stem for d in scene_dirs() for p in d.glob("*.toml")})
 
 
+def observes_frames(scene: Scene, trajectory) -> bool:
+    """Whether a run writing ``trajectory`` observes (unreported, in its checkpoints) for the image
+    flags of a periodic box's frames: when the scene's own ``[observe]`` does not already."""
+    return trajectory is not None and scene.observe is None and "periodic" in scene.boundaries
+
+
 def find_scene(name: str) -> Path | None:
     """The shipped scene file called ``name`` (``"spheres-3d"`` or ``"spheres-3d.toml"``), or None."""
     stem = name[:-5] if name.endswith(".toml") else name

@@ -57,7 +57,7 @@ from ..lattice_gas import geometry as lattice_geometry
 from ..observe import report_lines
 from ..progress import Bar, Interrupt, peak_rss
 from ..roundtrip import geometry
-from ..scene import Scene, SceneError, load_scene, with_engine, with_lattice_options, with_mode
+from ..scene import Scene, SceneError, load_scene, observes_frames, with_engine, with_lattice_options, with_mode
 from ..trajectory import _species, check_format, open_trajectory, true_images  # revcol simulate writes frames
 
 __all__ = ["simulate", "format_simulate"]
@@ -172,9 +172,7 @@ class _Production:
                                           precise=precise)
         if scene.observe is not None:
             sim.observe(**scene.observe)
-        elif self.writer is not None and any(periodic):
-            # the observer never wraps its positions: the frames' image flags are its crossings,
-            # exact at any frame spacing (issue 58); its values are not reported
+        elif observes_frames(scene, trajectory):  # the frames' image flags: its crossings (not reported)
             sim.observe()
         self.interrupted, self.engine_error, self.stalled, self.wall_s = False, None, False, 0.0
 
@@ -360,10 +358,8 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
     start = 0 if sim is None else _net(sim)
     # no output may name an input or another output (issue 59), nor outgrow the limit or the free
     # space (issue 59); every one writable (issue 17)
-    # frames on a periodic axis are written with the observer running (their image flags), and so
-    # the checkpoints then hold its state too: estimated as such
-    observed = scene if scene.observe is not None or trajectory is None or "periodic" not in scene.boundaries \
-        else dataclasses.replace(scene, observe={})
+    # a run that observes for its frames' image flags keeps the observer in its checkpoints too
+    observed = dataclasses.replace(scene, observe={}) if observes_frames(scene, trajectory) else scene
     outputs = _outputs(observed, sim, start, collisions, time, json_path, trajectory, every, every_time, checkpoints,
                        checkpoint_every, species, precise)
     check_outputs(scene.source, outputs, run_inputs(scene, resume), max_output=limit)

@@ -61,7 +61,7 @@ from .._output_size import (checkpoints_size, figures_size, report_size, round_t
 from .._outputs import Output, check_outputs, checkpoint_names, estimates, output_limit, run_inputs
 from ..gas import check_memory, run_gas
 from ..plots import check_format, figure_names, plot_horizon, require_matplotlib
-from ..scene import Scene, SceneError, load_scene, with_engine
+from ..scene import Scene, SceneError, load_scene, observes_frames, with_engine
 from .horizon import horizon
 from .paper_scenes import run_reversal, run_statesave
 
@@ -114,10 +114,8 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
     # every output and the memory are checked before anything runs: a run must not be lost to
     # an unwritable report at its end (issue 17), nor overwrite its own inputs, nor fill the disk (issue 59)
     limit = output_limit(scene.source, max_output, scene.max_output)
-    # frames on a periodic axis are written with the observer running (their image flags), and so
-    # the checkpoints then hold its state too: estimated as such
-    observed = scene if scene.observe is not None or trajectory is None or "periodic" not in scene.boundaries \
-        else dataclasses.replace(scene, observe={})
+    # a run that observes for its frames' image flags keeps the observer in its checkpoints too
+    observed = dataclasses.replace(scene, observe={}) if observes_frames(scene, trajectory) else scene
     outputs = _outputs(observed, json_path, plot, trajectory, horizon_seeds is not None, plot_format)
     check_outputs(scene.source, outputs, run_inputs(scene), max_output=limit)
     if scene.kind == "gas":
