@@ -206,12 +206,14 @@ void add_lattice_benches(std::vector<Bench>& out) {
     const char* name;
     LatticeCase c;
   };
-  // the lattice engine (periodic at N = 1e4 and 1e5, area fractions 0.3 and 0.5, and 1e6 at 0.5; walls at 1e4)
-  // and the float engine on the same periodic gases (lattice/float/...), for the issue's table
+  // the lattice engine (periodic at N = 1e4 and 1e5, area fractions 0.3, 0.5 and 0.7, and 1e6 at 0.5; walls at
+  // 1e4) and the float engine on the same periodic gases (lattice/float/...), for the 2D table (issue 57)
   static const Named named[] = {{"lattice/periodic/n10000/phi0.3", {10000, 0.3, false, 1}},
                                 {"lattice/periodic/n10000/phi0.5", {10000, 0.5, false, 1}},
+                                {"lattice/periodic/n10000/phi0.7", {10000, 0.7, false, 1}},
                                 {"lattice/periodic/n100000/phi0.3", {100000, 0.3, false, 1}},
                                 {"lattice/periodic/n100000/phi0.5", {100000, 0.5, false, 1}},
+                                {"lattice/periodic/n100000/phi0.7", {100000, 0.7, false, 1}},
                                 {"lattice/periodic/n1000000/phi0.5", {1000000, 0.5, false, 1}},
                                 {"lattice/walls/n10000/phi0.3", {10000, 0.3, true, 1}},
                                 {"lattice/walls/n10000/phi0.5", {10000, 0.5, true, 1}}};
@@ -249,8 +251,10 @@ void add_lattice_benches(std::vector<Bench>& out) {
   }
   static const Named floats[] = {{"lattice/float/n10000/phi0.3", {10000, 0.3, false, 1}},
                                  {"lattice/float/n10000/phi0.5", {10000, 0.5, false, 1}},
+                                 {"lattice/float/n10000/phi0.7", {10000, 0.7, false, 1}},
                                  {"lattice/float/n100000/phi0.3", {100000, 0.3, false, 1}},
-                                 {"lattice/float/n100000/phi0.5", {100000, 0.5, false, 1}}};
+                                 {"lattice/float/n100000/phi0.5", {100000, 0.5, false, 1}},
+                                 {"lattice/float/n100000/phi0.7", {100000, 0.7, false, 1}}};
   for (const Named& m : floats) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_float(c, n); }});

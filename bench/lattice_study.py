@@ -4,7 +4,7 @@ revcol-bench. Writes bench/results/lattice_throughput.json (2D) or lattice_throu
     python3 bench/lattice_study.py throughput [--bin build-dev/revcol-bench] [--collisions 2e5] [--rounds 5] [--cpu 1] [--dim 3]
 
 throughput: the lattice engine and, timed the same way, the float engine on the same periodic
-gases (N = 1e4 and 1e5, area fractions 0.3 and 0.5; revcol-bench lattice/periodic/... and
+gases (N = 1e4 and 1e5, area fractions 0.3, 0.5 and 0.7; revcol-bench lattice/periodic/... and
 lattice/float/...), interleaved: every round runs each case once per engine, alternating which goes
 first, one process per run pinned to one core, the load average recorded before each run.
 Collisions per second forward and reverse (wall clock and CPU time), medians and ranges over
@@ -32,7 +32,7 @@ RESULTS = os.path.join(HERE, "results")
 
 
 #: the gases of the issue's table: (N, area fraction); periodic, lattice and float side by side
-THROUGHPUT_CASES = [(10000, "0.3"), (10000, "0.5"), (100000, "0.3"), (100000, "0.5")]
+THROUGHPUT_CASES = [(10000, "0.3"), (10000, "0.5"), (10000, "0.7"), (100000, "0.3"), (100000, "0.5"), (100000, "0.7")]
 #: the 3D gases (N, volume fraction) with both engines in revcol-bench (lattice3d/...)
 THROUGHPUT_CASES_3D = [(1000, "0.3"), (10000, "0.1"), (10000, "0.3"), (10000, "0.45")]
 

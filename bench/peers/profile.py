@@ -1,11 +1,12 @@
 """Where a collision's time goes: revcol's float engine beside FSmallenburg/EDMD, part by part
-(issue 21's profile table). Writes bench/results/peer_profile.json.
+(issue 21's profile table), and with ``--lattice`` the lattice engine's parts too (issue 57).
+Writes bench/results/peer_profile.json (``--json``).
 
     python bench/peers/profile.py [--n 10976] [--phi 0.30 0.45] [--collisions 1e6] [--cpu 1]
-        [--src bench/peers/src/EDMD] [--json bench/results/peer_profile.json]
+        [--lattice] [--src bench/peers/src/EDMD] [--json bench/results/peer_profile.json]
 
-Both codes run on the same equilibrated fluid as in ``fs_edmd.py`` (its state, its patched peer,
-its revcol child: 2e5 untimed collisions, then 1e6 timed; revcol also runs them back), each a
+The codes run on the same equilibrated fluid as in ``fs_edmd.py`` (its state, its patched peer,
+its revcol children: 2e5 untimed collisions, then 1e6 timed; revcol also runs them back), each a
 fresh process pinned to ``--cpu`` under ``perf record -e cpu-clock``, ``--runs`` times each,
 interleaved; the samples are summed over the runs and the time per collision is the runs'
 median. Every sample in the
@@ -29,6 +30,15 @@ The parts (the issue's table):
 - **bookkeeping**: the rest of the event loop and the collision's frame (revcol ``loop``,
   ``collide``; FS ``update``);
 - **other**: any sample no part claims.
+
+The lattice engine's parts (``LATTICE_RULES``; its run back must end on its starting bits):
+**prediction: filter** (``predict``, ``scan``: the double-precision filter over the list),
+**prediction: exact search** (``first_overlap`` and its guess), **acceptance scans**
+(``post_reason``: third bodies at ticks a-1 and a), **group + redraws** (the group rule and the
+rare log's lookups), **operator + bits-back** (the pair operator, its direction cells and
+rotations, the bits-back integer, the draws), **renewal** (the neighbour lists and the
+re-anchoring), **queue** (``EventQueue`` and ``schedule``), **bookkeeping** (the loop, the
+collision's frame, ``apply``, walls), **other**.
 
 Needs ``perf`` (Debian: linux-perf) and binutils. Line-level attribution needs debug
 information, which changes no machine code: the peer is compiled here with its own flags plus
@@ -56,6 +66,9 @@ sys.path.insert(0, HERE)
 import fs_edmd  # noqa: E402
 
 PARTS = ("prediction", "renewal", "queue", "operator + RNG", "bookkeeping", "other")
+#: the lattice engine's parts (issue 57's table)
+LATTICE_PARTS = ("prediction: filter", "prediction: exact search", "acceptance scans", "group + redraws",
+                 "operator + bits-back", "renewal", "queue", "bookkeeping", "other")
 
 #: revcol: (part, regular expression on a demangled function name), tried in this order
 REVCOL_RULES = [
@@ -67,6 +80,27 @@ REVCOL_RULES = [
                    r"Pair2::"),
     ("bookkeeping", r"::collide\b|::loop\b|finish_collision|trace_collision|trace_point|prefetch_collision|"
                     r"validate_collision|pair_shift|wall_event|touch_walls|EngineImpl<.*>::advance\b|repredict"),
+]
+#: the lattice engine: (part, regular expression), tried in this order on each function of the
+#: chain, innermost first. Generic helpers (pos, diff, overlap, sync ...) match no rule, so the
+#: part that calls them claims them.
+LATTICE_RULES = [
+    ("queue", r"EventQueue<[^>]*>::|BasicEngine<.*>::schedule\b"),  # (not the engine's template argument)
+    ("group + redraws", r"group_collide|group_back|group_of|::Group\b|_Hashtable<revcol::lattice::LogKey|LogKey"),
+    # the operators' files (pair2d, pair3d, cells, bitsback, specular), their helpers by name
+    # (some in anonymous namespaces: addr2line names them bare or as "(anonymous namespace)::f")
+    ("operator + bits-back", r"LatticePair[23]D::|BitsBack::|Shear3::|LatticeSpecular<|draw48|[Pp]hilox|"
+                             r"(^|::)(dir_cell|face_of|flux_cum|flux_decode|half_cell|in_cell|in_coarse_cell|coarse_cell|"
+                             r"normal_cell|lo_pre3?|lo_post3?|boundary(_x|_y|_component|_octant)?|initial_bits|"
+                             r"angle_fx|atan2_guess|sincos_fx|octant_component|rot_coef|rotate|rotate_inv|isqrt_newton|"
+                             r"div_word|div_step|az_cell|chart_of|from_normal|to_normal|in_polar_cell|polar_cell|"
+                             r"make_column|row_of|make_frame|carry_phase|even_term|fix_ratio|pair_level(_back)?)(\(|<|$)"),
+    ("acceptance scans", r"::post_reason\b"),
+    ("prediction: exact search", r"(^|::)(first_overlap|first_overlap_d|guessed_tick|overlap_at)\b"),
+    ("renewal", r"NeighbourListsN<|CellGridN<|::reanchor\b"),
+    ("prediction: filter", r"BasicEngine<.*>::(scan|predict|region_ticks|Best::offer|coll_kind|wall_kind)\b|wall_ticks"),
+    ("bookkeeping", r"BasicEngine<.*>::(loop|collide_forward|collide_drawn|collide_back|collide_specular|back_specular|"
+                    r"apply|reflect|check_order|valid|journal|run|run_back|flip)\b"),
 ]
 #: FS (C functions): (part, exact names)
 FS_RULES = [
@@ -80,8 +114,9 @@ FS_RULES = [
 
 def part_of(chain: list, code: str) -> str:
     """The part a sample goes to: ``chain`` the functions at its address, innermost first (an
-    inlined call, then its caller ...); the first one a rule of ``code`` ('revcol' or 'fs')
-    claims decides, and 'other' when none does."""
+    inlined call, then its caller ...); the first one a rule of ``code`` ('revcol', 'lattice'
+    or 'fs') claims decides, and 'other' when none does."""
+    rules = LATTICE_RULES if code == "lattice" else REVCOL_RULES
     for name in chain:
         if code == "fs":
             base = name.split("(")[0].strip()
@@ -89,7 +124,7 @@ def part_of(chain: list, code: str) -> str:
                 if base in names:
                     return part
         else:
-            for part, rx in REVCOL_RULES:
+            for part, rx in rules:
                 if re.search(rx, name):
                     return part
     return "other"
@@ -178,7 +213,7 @@ def attribute(data: str, binary: str, code: str) -> dict:
         if sym in addr and off >= 0:
             where[(sym, off)] = addr[sym] + off
     chains = inline_chains(binary, sorted(set(where.values())))
-    parts = {p: 0 for p in PARTS}
+    parts = {p: 0 for p in (LATTICE_PARTS if code == "lattice" else PARTS)}
     for key, c in hits.items():
         chain = list(chains.get(where.get(key, -1), []))
         chain.append(plain.get(key[0], key[0]))  # the symbol perf names: the outermost function
@@ -200,10 +235,13 @@ def ns_per_part(parts: dict, ns_per_collision: float) -> dict:
     return {p: (ns_per_collision * c / n if n else 0.0) for p, c in parts.items()}
 
 
-_REVCOL_PROFILE_CHILD = fs_edmd._REVCOL_CHILD + """
+_CORE_LINE = """
 import revcol._core
 print("REVCOL_CORE " + revcol._core.__file__)
 """
+#: the timing children of fs_edmd.py, each also naming the _core module it imported
+_CHILDREN = {"revcol": (fs_edmd._REVCOL_CHILD + _CORE_LINE, "REVCOL_SELF"),
+             "lattice": (fs_edmd._LATTICE_CHILD + _CORE_LINE, "REVCOL_LATTICE")}
 
 
 def _merge(acc: Optional[dict], a: dict) -> dict:
@@ -218,8 +256,9 @@ def _merge(acc: Optional[dict], a: dict) -> dict:
 
 
 def profile_workload(n: int, phi: float, args, src: str, tmp: str) -> dict:
-    """``--runs`` interleaved runs of each code (peer, revcol; then revcol, peer; ...) on one
-    state: samples summed over the runs, the time per collision the median of the runs'."""
+    """``--runs`` interleaved runs of each code (peer, revcol[, lattice]; then the reverse
+    order; ...) on one state: samples summed over the runs, the time per collision the median
+    of the runs'. A lattice run back that does not end on its starting bits is an error."""
     import numpy as np
     st = fs_edmd.equilibrated_state(n, phi, args.warmup, max_per_particle=args.max_warmup)
     npz = os.path.join(tmp, f"state_{n}_{phi}.npz")
@@ -232,39 +271,48 @@ def profile_workload(n: int, phi: float, args, src: str, tmp: str) -> dict:
     env = dict(os.environ)
     if args.revcol_pkg:
         env["PYTHONPATH"] = os.path.abspath(args.revcol_pkg)
-    peer, mine, core = None, None, ""
-    peer_ns, my_ns, my_fwd, my_rev, loads = [], [], [], [], []
+    codes = ("peer", "revcol", "lattice") if args.lattice else ("peer", "revcol")
+    acc: dict = {c: None for c in codes}
+    ns: dict = {c: [] for c in codes}
+    fwd: dict = {c: [] for c in codes}
+    rev: dict = {c: [] for c in codes}
+    core, loads = "", []
 
-    def run_peer() -> None:
-        nonlocal peer
-        data = os.path.join(tmp, "peer.data")
-        out = perf_record([exe], data, args.cpu, cwd=run_dir)
-        line = next(l for l in out.splitlines() if l.startswith("REVCOL_PEER "))
-        peer_ns.append(1e9 * float(line.split()[2]) / int(line.split()[1]))
-        peer = _merge(peer, attribute(data, exe, "fs"))
-
-    def run_revcol() -> None:
-        nonlocal mine, core
-        data = os.path.join(tmp, "revcol.data")
-        out = perf_record([sys.executable, "-c", _REVCOL_PROFILE_CHILD, npz, str(warm), str(coll)], data, args.cpu,
-                          env=env)
-        me = json.loads(next(l for l in out.splitlines() if l.startswith("REVCOL_SELF "))[len("REVCOL_SELF "):])
+    def run(code: str) -> None:
+        nonlocal core
+        data = os.path.join(tmp, code + ".data")
+        if code == "peer":
+            out = perf_record([exe], data, args.cpu, cwd=run_dir)
+            line = next(l for l in out.splitlines() if l.startswith("REVCOL_PEER "))
+            ns["peer"].append(1e9 * float(line.split()[2]) / int(line.split()[1]))
+            acc["peer"] = _merge(acc["peer"], attribute(data, exe, "fs"))
+            return
+        script, tag = _CHILDREN[code]
+        out = perf_record([sys.executable, "-c", script, npz, str(warm), str(coll)], data, args.cpu, env=env)
+        me = json.loads(next(l for l in out.splitlines() if l.startswith(tag + " "))[len(tag) + 1:])
+        if code == "lattice" and not me["bit_exact"]:
+            raise RuntimeError(f"N = {n}, phi = {phi}: the lattice engine's run back did not end on its starting bits")
         core = next(l for l in out.splitlines() if l.startswith("REVCOL_CORE "))[len("REVCOL_CORE "):]
-        my_fwd.append(me["forward"])
-        my_rev.append(me["reverse"])
+        fwd[code].append(me["forward"])
+        rev[code].append(me["reverse"])
         # forward and reverse weighed by their run times: the mean time of a collision over both
-        my_ns.append(1e9 * (1.0 / me["forward"] + 1.0 / me["reverse"]) / 2.0)
-        mine = _merge(mine, attribute(data, core, "revcol"))
+        ns[code].append(1e9 * (1.0 / me["forward"] + 1.0 / me["reverse"]) / 2.0)
+        acc[code] = _merge(acc[code], attribute(data, core, code))
 
     for r in range(args.runs):
         loads.append(os.getloadavg()[0])
-        for f in ((run_peer, run_revcol) if r % 2 == 0 else (run_revcol, run_peer)):
-            f()
-    pn, mn = statistics.median(peer_ns), statistics.median(my_ns)
-    return {"n": n, "phi": phi, "s_bragg_after": st["s_bragg_after"], "fluid": st["fluid"], "load_before_runs": loads,
-            "peer": {"ns_per_collision": pn, "ns_per_collision_runs": peer_ns, **peer, "ns": ns_per_part(peer["parts"], pn)},
-            "revcol": {"ns_per_collision": mn, "ns_per_collision_runs": my_ns, "forward_per_s_runs": my_fwd,
-                       "reverse_per_s_runs": my_rev, "core": core, **mine, "ns": ns_per_part(mine["parts"], mn)}}
+        for code in (codes if r % 2 == 0 else codes[::-1]):
+            run(code)
+    out = {"n": n, "phi": phi, "s_bragg_after": st["s_bragg_after"], "fluid": st["fluid"], "load_before_runs": loads}
+    for code in codes:
+        med = statistics.median(ns[code])
+        out[code] = {"ns_per_collision": med, "ns_per_collision_runs": ns[code], **acc[code],
+                     "ns": ns_per_part(acc[code]["parts"], med)}
+        if code != "peer":
+            out[code].update({"forward_per_s_runs": fwd[code], "reverse_per_s_runs": rev[code], "core": core})
+    if args.lattice:
+        out["lattice"]["bit_exact"] = True
+    return out
 
 
 def main(argv: Optional[list] = None) -> int:
@@ -278,6 +326,8 @@ def main(argv: Optional[list] = None) -> int:
     ap.add_argument("--max-warmup", type=float, default=2000.0)
     ap.add_argument("--cpu", type=int, default=1, help="core each run is pinned to (-1: none)")
     ap.add_argument("--runs", type=int, default=3, help="interleaved runs of each code per workload")
+    ap.add_argument("--lattice", action="store_true",
+                    help="also profile revcol's lattice engine (3D, integer state) in the same rounds")
     ap.add_argument("--revcol-pkg", default="", help="a staged revcol package built with -g (default: the one imported)")
     ap.add_argument("--json", default=os.path.join(fs_edmd.RESULTS, "peer_profile.json"))
     args = ap.parse_args(argv)
@@ -301,6 +351,11 @@ def main(argv: Optional[list] = None) -> int:
                       f"(total {w['revcol']['ns_per_collision']:.0f} / {w['peer']['ns_per_collision']:.0f})")
                 for p in PARTS:
                     print(f"  {p:16s} {rv[p]:7.0f} {pr[p]:7.0f}")
+                if args.lattice:
+                    lt = w["lattice"]["ns"]
+                    print(f"  lattice engine (total {w['lattice']['ns_per_collision']:.0f}, run back bit-exact):")
+                    for p in LATTICE_PARTS:
+                        print(f"    {p:26s} {lt[p]:7.0f}")
     res["load_after"] = os.getloadavg()[0]
     fs_edmd._write_json(args.json, res)
     print(f"wrote {args.json}")

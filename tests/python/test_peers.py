@@ -189,6 +189,34 @@ def test_profile_puts_a_revcol_sample_in_the_part_of_its_innermost_claimed_funct
     assert prof.part_of(chain, "revcol") == part
 
 
+LATTICE = ("revcol::lattice::BasicEngine<revcol::lattice::LatticePair3D, revcol::lattice::BitsBack, "
+           "revcol::engine::EventQueue<long> >::")
+
+
+@pytest.mark.parametrize("chain, part", [
+    # the exact search inlined into the prediction's scan; the filter's own lines
+    (["revcol::lattice::first_overlap(std::array<long, 3ul> const&, ...)", LATTICE + "scan(int, long, Best&)"],
+     "prediction: exact search"),
+    ([LATTICE + "scan(int, long, Best&)", LATTICE + "predict(int, long)"], "prediction: filter"),
+    # a generic helper (pos) goes by its caller: the acceptance scan, the filter, the loop
+    ([LATTICE + "pos(int, long) const", LATTICE + "post_reason(int, int, ...) const"], "acceptance scans"),
+    ([LATTICE + "pos(int, long) const", LATTICE + "loop(...)"], "bookkeeping"),
+    (["revcol::lattice::BitsBack::push_rans(unsigned long, unsigned long)",
+      "revcol::lattice::LatticePair3D::forward(...) const", LATTICE + "collide_drawn(int, int, long, bool)"],
+     "operator + bits-back"),
+    (["revcol::lattice::draw48(unsigned int, unsigned int, unsigned long)", LATTICE + "collide_drawn(...)"],
+     "operator + bits-back"),
+    ([LATTICE + "group_collide(int, int, long, ...)"], "group + redraws"),
+    (["revcol::engine::EventQueue<long>::sift_up(int)", LATTICE + "schedule(int, Type, long, int, int)"], "queue"),
+    ([LATTICE + "schedule(int, Type, long, int, int)", LATTICE + "predict(int, long)"], "queue"),
+    (["revcol::lattice::NeighbourListsN<3ul>::renew(int, std::array<long, 3ul> const&)", LATTICE + "loop(...)"],
+     "renewal"),
+    (["memcpy"], "other"),
+])
+def test_profile_puts_a_lattice_sample_in_the_part_of_its_innermost_claimed_function(chain, part):
+    assert prof.part_of(chain, "lattice") == part
+
+
 @pytest.mark.parametrize("chain, part", [
     (["findcollision", "findcollisions", "collision"], "prediction"),  # inlined into the collision
     (["update", "collision"], "bookkeeping"),
@@ -228,3 +256,25 @@ def test_profile_without_the_peer_says_where_it_goes_and_measures_nothing(tmp_pa
     assert prof.main(["--src", str(tmp_path / "nowhere"), "--json", str(out)]) == 0
     assert "git clone https://github.com/FSmallenburg/EDMD" in capsys.readouterr().out
     assert not out.exists()
+
+
+MSPEC = importlib.util.spec_from_file_location("peer_memory", os.path.join(HERE, "..", "..", "bench", "peers", "memory.py"))
+mem = importlib.util.module_from_spec(MSPEC)
+MSPEC.loader.exec_module(mem)
+
+
+def test_memory_without_the_peer_says_where_it_goes_and_measures_nothing(tmp_path, capsys):
+    out = tmp_path / "memory.json"
+    assert mem.main(["--src", str(tmp_path / "nowhere"), "--json", str(out)]) == 0
+    assert "git clone https://github.com/FSmallenburg/EDMD" in capsys.readouterr().out
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("engine", ["lattice", "float"])
+def test_memory_child_reports_its_resident_set_and_the_engines_count(tmp_path, engine):
+    st = mem.start(64, 0.3)
+    npz = tmp_path / "s.npz"
+    np.savez(npz, **st)
+    r = mem.child_memory(engine, str(npz), 1.0)
+    assert r["rss"] > 10 * 2**20  # an interpreter with numpy and revcol loaded
+    assert 64 * 100 < r["engine_bytes"] < r["rss"]
