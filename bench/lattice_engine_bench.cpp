@@ -75,22 +75,42 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
   // shell=S sets the neighbour search (set_list_shell: 0 the cell grid, S > 0 lists, < 0 automatic)
   // observe=1 observes the timed forward run's scalars, 2 also a 50-bin speed histogram and 10
   // slabs (revcol/engine/observe.hpp; run_back ends it: the reverse is unobserved)
+  // shuffle=1 stores the particles in a random order after the warm-up (the start's ids are in
+  // space order; a long run loses that order): the cost of memory order (the bits are the same)
   double shell = -1.0;
-  int observe = 0;
-  apply_settings("REVCOL_LATTICE", "tick_bits, cell_bits, shell, observe", [&](const std::string& k, const std::string& v) {
+  // resort=K: set_resort(K) (events per particle between re-sorts of the storage; 0 never)
+  int observe = 0, shuffle = 0, resort = -1;
+  apply_settings("REVCOL_LATTICE", "tick_bits, cell_bits, shell, observe, shuffle, resort", [&](const std::string& k, const std::string& v) {
     if (k == "tick_bits") cfg.tick_bits = std::stoi(v);
     else if (k == "cell_bits") cfg.cell_bits = std::stoi(v);
     else if (k == "shell") shell = std::stod(v);
     else if (k == "observe") observe = std::stoi(v);
+    else if (k == "shuffle") shuffle = std::stoi(v);
+    else if (k == "resort") resort = std::stoi(v);
     else return false;
     return true;
   });
   const la::LatticeStartN<D> st = la::random_start(cfg, c.n, c.phi, c.seed, init_of(c));
   Engine e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units), 0, c.mode);
   if (shell >= 0.0) e.set_list_shell(shell);
+  e.set_resort(resort);
   // warm up a collision per particle from the initialiser's lattice, then start the clock
   e.run(c.n, la::tick_limit - 1);
   const la::SnapshotN<D> s0 = e.snapshot();
+  if (shuffle != 0) {
+    std::vector<std::uint32_t> order(c.n);
+    for (std::size_t i = 0; i < c.n; ++i) order[i] = static_cast<std::uint32_t>(i);
+    std::uint64_t z = 0x9e3779b97f4a7c15ULL;  // Fisher-Yates with a fixed splitmix64 stream
+    for (std::size_t i = c.n - 1; i > 0; --i) {
+      z += 0x9e3779b97f4a7c15ULL;
+      std::uint64_t r = z;
+      r = (r ^ (r >> 30)) * 0xbf58476d1ce4e5b9ULL;
+      r = (r ^ (r >> 27)) * 0x94d049bb133111ebULL;
+      r ^= r >> 31;
+      std::swap(order[i], order[r % (i + 1)]);
+    }
+    e.restore(s0, order);
+  }
   const la::Counters k0 = e.counters();
   if (observe > 0) {
     en::ObserveConfig oc;
@@ -130,6 +150,7 @@ std::vector<Metric> run_lattice(const LatticeCase& c, std::uint64_t nc) {
           {"bits_length", static_cast<double>(d1.bits_length)},
           {"energy_drift", d1.energy_drift},
           {"engine_bytes", static_cast<double>(e.memory_bytes())},
+          {"resorts", static_cast<double>(e.resorts())},
           {"n", static_cast<double>(c.n)},
           {"phi", c.phi}};
 }
@@ -221,13 +242,15 @@ void add_lattice_benches(std::vector<Bench>& out) {
     const LatticeCase c = m.c;
     out.push_back({m.name, "collisions/s", [c](std::uint64_t n) { return run_lattice<2>(c, n); }});
   }
-  // the 3D engine (spheres) at N = 1e4, volume fractions 0.1, 0.3 and 0.45 (1e6 at 0.3), and the float engine on
+  // the 3D engine (spheres) at N = 1e4, volume fractions 0.1, 0.3 and 0.45 (1e5 at 0.3 and 0.45, 1e6 at 0.3), and the float engine on
   // the same 3D gases
   static const Named named3[] = {{"lattice3d/periodic/n10000/phi0.1", {10000, 0.1, false, 1, 3}},
                                  {"lattice3d/periodic/n10000/phi0.3", {10000, 0.3, false, 1, 3}},
                                  {"lattice3d/periodic/n10000/phi0.45", {10000, 0.45, false, 1, 3}},
                                  {"lattice3d/walls/n10000/phi0.3", {10000, 0.3, true, 1, 3}},
                                  {"lattice3d/periodic/n1000/phi0.3", {1000, 0.3, false, 1, 3}},
+                                 {"lattice3d/periodic/n100000/phi0.3", {100000, 0.3, false, 1, 3}},
+                                 {"lattice3d/periodic/n100000/phi0.45", {100000, 0.45, false, 1, 3}},
                                  {"lattice3d/periodic/n1000000/phi0.3", {1000000, 0.3, false, 1, 3}}};
   for (const Named& m : named3) {
     const LatticeCase c = m.c;

@@ -93,6 +93,85 @@ TEST_CASE("an engine's particle order changes nothing: the same collisions, the 
   check_order<3>(lattice_test::make_gas<3>(150, 0.3, B::periodic, 46, 16), 600, 6, "3D 0.3 periodic, every collision a group", -1);
 }
 
+namespace {
+
+// The periodic re-sort (engine_core.hpp set_resort, state.hpp resort), forced every neutral
+// event per particle, against an engine that never re-sorts: the same collisions, event records,
+// observation and bits forward and back; an engine error mid-run undone (the undo journal
+// follows its particles); none while a journal is kept.
+template <std::size_t D>
+void check_resort(EngineOf<D> e, std::uint64_t collisions, const char* what, int max_redraws = 256) {
+  e.max_redraws = max_redraws;
+  e.run(e.size(), tick_limit - 1);
+  const SnapshotN<D> s0 = e.snapshot();
+  EngineOf<D> a(s0, operator_for(s0.units, s0.law)), b(s0, operator_for(s0.units, s0.law));
+  for (auto* x : {&a, &b}) x->max_redraws = max_redraws;
+  a.set_resort(0);
+  b.set_resort(1);
+  std::vector<std::array<std::int64_t, 3>> ta, tb;
+  a.trace = &ta;
+  b.trace = &tb;
+  // an error part way: the run is undone, whatever the re-sorts moved
+  b.throw_at_collision = s0.collisions + collisions * 9 / 10;
+  CHECK(refused([&] { b.run(collisions, tick_limit - 1); }, "test hook"));
+  const std::uint64_t tried = b.resorts();
+  CHECK(tried > 0);
+  CHECK(same_state(b.snapshot(), s0));
+  b.throw_at_collision = 0;
+  tb.clear();
+  std::vector<EventRecordN<D>> ea, eb;
+  a.events = &ea;
+  b.events = &eb;
+  en::ObserveConfig oc;
+  oc.speed_bins = 20;
+  oc.slabs = 4;
+  a.observe(oc);
+  b.observe(oc);
+  a.run(collisions, tick_limit - 1);
+  b.run(collisions, tick_limit - 1);
+  bool events_same = ea.size() == eb.size() && !ea.empty();
+  for (std::size_t k = 0; events_same && k < ea.size(); ++k)
+    events_same = ea[k].ids == eb[k].ids && ea[k].x == eb[k].x && ea[k].v_after == eb[k].v_after && ea[k].v_before == eb[k].v_before;
+  const SnapshotN<D> sa = a.snapshot(), sb = b.snapshot();
+  const bool fwd = same_state(sa, sb) && ta == tb && events_same && !sa.observer.empty() && sa.observer == sb.observer;
+  a.events = b.events = nullptr;
+  CHECK(fwd);
+  const std::uint64_t forward_sorts = b.resorts() - tried;
+  CHECK(forward_sorts > 0);
+  a.run_back(s0.collisions, s0.clock);
+  b.run_back(s0.collisions, s0.clock);
+  const bool back = same_state(a.snapshot(), s0) && same_state(b.snapshot(), s0);
+  CHECK(back);
+  CHECK(b.resorts() > tried + forward_sorts);
+  CHECK(a.resorts() == 0);
+  // a kept journal holds local indices: no re-sort while it is kept
+  const std::uint64_t before = b.resorts();
+  b.keep_journal(true);
+  b.run(collisions, tick_limit - 1);
+  CHECK(b.resorts() == before);
+  std::printf("  %s: %llu collisions, %llu re-sorts forward and %llu back: forward %s, back %s\n", what,
+              static_cast<unsigned long long>(collisions), static_cast<unsigned long long>(forward_sorts),
+              static_cast<unsigned long long>(before - tried - forward_sorts), fwd ? "same" : "DIFFERENT",
+              back ? "same" : "DIFFERENT");
+}
+
+}  // namespace
+
+TEST_CASE("the periodic re-sort of the storage changes nothing: the same collisions, the same bits, forward and back") {
+  using B = en::Boundary;
+  check_resort<2>(lattice_test::make_gas<2>(300, 0.6, B::wall, 51, 16), 8000, "2D 0.6 walls exact (cells)");
+  check_resort<2>(lattice_test::make_gas<2>(300, 0.5, B::periodic, 52, 16, Mode::specular), 4000, "2D 0.5 periodic specular");
+  check_resort<3>(lattice_test::make_gas<3>(300, 0.4, B::periodic, 54, 16), 12000, "3D 0.4 periodic exact (lists)");
+  check_resort<3>(lattice_test::make_gas<3>(250, 0.3, B::bounce, 55, 16), 6000, "3D 0.3 bounce-back walls exact");
+  check_resort<3>(lattice_test::make_gas<3>(150, 0.3, B::periodic, 56, 16), 1200, "3D 0.3 periodic, every collision a group", -1);
+}
+
+TEST_CASE("a re-sort setting below -1 is refused") {
+  auto e = lattice_test::make_gas<2>(50, 0.3, en::Boundary::periodic, 8, 16);
+  CHECK(refused([&] { e.set_resort(-2); }, "resort must be >= -1"));
+  CHECK(e.resort_every() == 0);  // automatic: none below 32 768 particles
+}
+
 TEST_CASE("an order that is not a permutation is refused, the state unchanged") {
   auto e = lattice_test::make_gas<2>(50, 0.3, en::Boundary::periodic, 7, 16);
   e.run(100, tick_limit - 1);

@@ -64,6 +64,11 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
       return done;
     }
     const std::int64_t t = queue_.time(p);
+    // the periodic re-sort, between two ticks (every event before t done, none at t yet)
+    if (resort_at_ != 0 && cnt_.crossings >= resort_at_ && t > last_key_.first && !jon_) [[unlikely]] {
+      resort(t);
+      continue;
+    }
     ++cnt_.events;
     const bool journal = jon_ && !back;
     if (!valid(p)) {

@@ -100,7 +100,9 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<
   std::unique_ptr<engine::Observer> resumed;
   require(!s.observer.empty() || s.observer_counts.empty(), "lattice snapshot: observer_counts without observer");
   if (!s.observer.empty()) resumed = make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);
-  load(s, order);
+  // a large gas is stored in space order from the start (resort), unless an order is given
+  const bool sort = order.empty() && s.observer.empty() && (resort_every_ > 0 || (resort_every_ < 0 && s.x.size() >= kResortMinN));
+  load(s, sort ? space_order(s.units, s.x) : order);
   observer_ = std::move(resumed);  // none: an observation of the old state ends
   obs_ = observer_.get();
 }
@@ -232,6 +234,7 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s, const std::vector<std
   energy0_ = s.energy0;
   momentum0_ = s.momentum0;
   cnt_ = s.counters;
+  resort_at_ = next_resort();
   wall_tick_.assign(n, std::numeric_limits<std::int64_t>::min());
   pre_wall_.assign(n, Line{});
   reversed_ = false;
@@ -313,6 +316,70 @@ void BasicEngine<Op, Bits, Queue>::flip() {
   rebuild();
 }
 
+// The ids in space order: cells about two diameters wide in row-major order, ids ascending
+// within a cell (x: the positions by id, in the units u).
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::space_order(const Units& u, const std::vector<Vec>& x) -> std::vector<std::uint32_t> {
+  const std::size_t n = x.size();
+  std::array<std::int64_t, D> m{};
+  std::size_t cells = 1;
+  for (std::size_t k = 0; k < D; ++k) {
+    m[k] = std::clamp<std::int64_t>(u.L[k] / (2 * u.sigma), 1, 1024);
+    cells *= static_cast<std::size_t>(m[k]);
+  }
+  std::vector<std::uint32_t> key(n);
+  std::vector<std::size_t> start(cells + 1, 0);
+  for (std::size_t id = 0; id < n; ++id) {
+    std::size_t c = 0;
+    for (std::size_t k = 0; k < D; ++k) {
+      const i128 q = static_cast<i128>(x[id][k]) * m[k] / u.L[k];  // walls: within [0, L) too
+      c = c * static_cast<std::size_t>(m[k]) + static_cast<std::size_t>(std::clamp<i128>(q, 0, m[k] - 1));
+    }
+    key[id] = static_cast<std::uint32_t>(c);
+    ++start[c + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t id = 0; id < n; ++id) order[start[key[id]]++] = static_cast<std::uint32_t>(id);
+  return order;
+}
+
+// Stores the particles in space order and rebuilds the search at clock t - 1, between two
+// ticks: every event before t is done and none at t. A rebuild there is the one a run stopped
+// at t - 1 and resumed would do (forward: restore, which predicts from the clock; reverse:
+// run_back's flip, from the next tick), and storage order decides nothing (keys, draws, ties
+// and outputs are by id: an observation and the event records too), so the collisions and the
+// bits are unchanged. The run's undo journal follows its particles; the rollback journal holds
+// local indices, so the loop does not re-sort while it is kept.
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::resort(std::int64_t t) {
+  const std::size_t n = ln_.size();
+  clock_ = t - 1;
+  std::vector<Vec> x(n);
+  for (std::size_t id = 0; id < n; ++id) x[id] = pos(static_cast<int>(local(static_cast<int>(id))), clock_);
+  std::vector<std::uint32_t> order = space_order(u_, x);
+  std::vector<int> to(n);  // old local index -> new
+  for (std::size_t p = 0; p < n; ++p) to[local(static_cast<int>(order[p]))] = static_cast<int>(p);
+  auto permute = [&](auto& v) {
+    if (v.size() != n) return;
+    std::remove_reference_t<decltype(v)> w(n);
+    for (std::size_t p = 0; p < n; ++p) w[static_cast<std::size_t>(to[p])] = std::move(v[p]);
+    v.swap(w);
+  };
+  permute(ln_);
+  permute(own_);
+  permute(wall_tick_);
+  permute(pre_wall_);
+  permute(undo_epoch_);
+  for (Saved& sv : undo_) sv.p = to[static_cast<std::size_t>(sv.p)];
+  gid_.assign(order.begin(), order.end());
+  lid_.assign(n, 0);
+  for (std::size_t p = 0; p < n; ++p) lid_[static_cast<std::size_t>(gid_[p])] = static_cast<int>(p);
+  rebuild();
+  ++resorts_;
+  resort_at_ = next_resort();
+}
+
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::begin_undo() {
   if (undo_epoch_.size() != ln_.size() || ++epoch_ == 0) {  // new size, or the epoch wrapped
@@ -351,6 +418,7 @@ void BasicEngine<Op, Bits, Queue>::undo() {
   undo_groups_.clear();
   ncoll_ = undo_ncoll_;
   rebuild();
+  resort_at_ = next_resort();  // (the counters went back with the run)
 }
 
 template <class Op, class Bits, class Queue>

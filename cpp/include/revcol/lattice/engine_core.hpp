@@ -275,6 +275,19 @@ class BasicEngine {
   double list_shell() const noexcept { return lists_ ? 2.0 * static_cast<double>(nl_.radius()) / static_cast<double>(u_.sigma) : 0.0; }
   /// The automatic shell for this gas, in diameters (0: cells; see set_list_shell).
   double auto_list_shell() const noexcept;
+  /// The periodic re-sort of the particles' storage in space (state.hpp, resort): every `every`
+  /// neutral events (list renewals or cell crossings) per particle, between two ticks of a run or
+  /// run back that keeps no journal; 0 never, -1 automatic (kResortEvery from kResortMinN particles). The order in
+  /// which particles are stored changes no bit (test_lattice_order.cpp); it is a speed setting.
+  void set_resort(int every) {
+    require(every >= -1, "lattice: resort must be >= -1 (-1: chosen from N, 0: never)");
+    resort_every_ = every;
+    resort_at_ = next_resort();
+  }
+  /// Neutral events per particle between re-sorts in use (0: none).
+  int resort_every() const noexcept { return resort_every_ >= 0 ? resort_every_ : (ln_.size() >= kResortMinN ? kResortEvery : 0); }
+  /// Re-sorts done since construction.
+  std::uint64_t resorts() const noexcept { return resorts_; }
   /// Bytes held by the engine's arrays, queue, grid and log.
   std::size_t memory_bytes() const noexcept;
   /// Bytes held by the group entries of the rare log (map node, members, pre velocities).
@@ -535,6 +548,20 @@ class BasicEngine {
   // the neighbour search (set_list_shell): the cell grid of the particles, or neighbour lists
   static constexpr double kShellBase = 0.545, kShellSlope = 1.0, kShellMin = 0.6, kShellMax = 1.2;  // measured: docs/lattice.md
   double list_shell_ = -1.0;
+  // the periodic re-sort (resort), clocked by the neutral events (a particle's list renewal or
+  // cell crossing: distance travelled, which is what loses the order): from 32 768 particles,
+  // every 16 per particle, as the float engine (below that the state fits the caches; the cost
+  // and the gain measured: docs/lattice.md, "The storage order")
+  static constexpr std::size_t kResortMinN = 32768;
+  static constexpr int kResortEvery = 16;
+  int resort_every_ = -1;
+  std::uint64_t resort_at_ = 0, resorts_ = 0;  // the crossing count of the next re-sort (0: none)
+  std::uint64_t next_resort() const noexcept {
+    const int k = resort_every();
+    return k > 0 ? cnt_.crossings + static_cast<std::uint64_t>(k) * ln_.size() : 0;
+  }
+  [[gnu::noinline, gnu::cold]] void resort(std::int64_t t);
+  static std::vector<std::uint32_t> space_order(const Units& u, const std::vector<Vec>& x);
   bool lists_ = false, direct_ = false;
   NeighbourListsN<D> nl_;
   u128 sigma2_ = 0;
