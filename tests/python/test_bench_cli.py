@@ -95,3 +95,17 @@ def test_op_ab_times_two_revisions_in_one_binary():
     for op in ("pair2d", "pair3d"):
         line = next(x for x in r.stdout.splitlines() if x.startswith(op + " fwd"))
         assert "paired" in line and "| rev old" in line
+
+
+def test_lattice_bench_storage_order_settings_keep_the_round_trip_exact(tmp_path):
+    # lattice_study.py order: a random storage order (shuffle=1), re-sorted every neutral event per
+    # particle (resort=1); the run back must still end on the starting bits
+    import json
+    out = tmp_path / "b.json"
+    env = dict(os.environ, REVCOL_LATTICE="shuffle=1,resort=1")
+    r = subprocess.run([_bench_binary(), "--bench", "lattice3d/periodic/n1000/phi0.3", "--collisions", "20000",
+                        "--repeats", "1", "--json", str(out)], capture_output=True, text=True, timeout=300, env=env)
+    assert r.returncode == 0, r.stderr
+    m = {row["metric"]: row["median"] for row in json.loads(out.read_text())["results"]}
+    assert m["bit_exact"] == 1.0
+    assert m["resorts"] > 0
