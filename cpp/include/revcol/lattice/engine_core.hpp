@@ -276,9 +276,10 @@ class BasicEngine {
   /// The automatic shell for this gas, in diameters (0: cells; see set_list_shell).
   double auto_list_shell() const noexcept;
   /// The periodic re-sort of the particles' storage in space (state.hpp, resort): every `every`
-  /// neutral events (list renewals or cell crossings) per particle, between two ticks of a run or
-  /// run back that keeps no journal; 0 never, -1 automatic (kResortEvery from kResortMinN particles). The order in
-  /// which particles are stored changes no bit (test_lattice_order.cpp); it is a speed setting.
+  /// neutral events (list renewals or cell crossings) per particle, between two ticks of a run
+  /// or run back that keeps no journal; 0 never, -1 automatic (kResortEvery from kResortMinN
+  /// particles). The order in which particles are stored changes no bit
+  /// (test_lattice_order.cpp): it is a speed setting.
   void set_resort(int every) {
     require(every >= -1, "lattice: resort must be >= -1 (-1: chosen from N, 0: never)");
     resort_every_ = every;
