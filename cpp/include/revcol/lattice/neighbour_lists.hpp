@@ -19,10 +19,10 @@
 // anchor minus the centre), rounded down and checked with the exact integer predicate (halved
 // until it holds). An early renewal is harmless: renewals change no physical state, so the
 // collisions, the state and the bits are those of the cell grid's engine (tests compare them).
-// The centres live in a cell grid (cells at least R / 2 wide, 5^D of them scanned) read only by the
+// The centres live in a cell grid (cells at least R wide, 3^D of them scanned) read only by the
 // renewals; a cell's members are a chain through the particles' nodes (a node holds the centre
 // and the next member: one cache line per candidate, and a few bytes per cell for the sparse
-// cells of R / 2, where flat member slots took 1 MB at N = 10^4). The list test
+// cells, where flat member slots took 1 MB at N = 10^4). The list test
 // |c_p - c_q|^2 < R^2 is taken in double from the exact minimum-image differences: symmetric and
 // deterministic (the same values in either order), and R's margin is far beyond its rounding.
 // Each entry also keeps the image code of the pair (one byte): the periodic shift s with
@@ -98,7 +98,7 @@ class NeighbourListsN {
   double reach2_ = 0.0;  // R^2 in double: a symmetric, deterministic test (R holds a margin)
   void link(int p, int cell);    // p at the head of cell's chain
   void unlink(int p);            // p out of its cell's chain
-  CellGridN<Dim> grid_;          // the geometry of the centres' cells, >= R / 2 wide, span 2
+  CellGridN<Dim> grid_;          // the geometry of the centres' cells, >= R wide, span 1
   struct alignas(32) Node {
     Vec c;          // p's centre
     int next = -1;  // the next member of p's cell, -1 at the end
