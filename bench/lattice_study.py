@@ -67,6 +67,12 @@ def _bench_once(args, name: str, collisions: int, setting: str = "") -> dict:
     return {row["metric"]: row["median"] for row in res["results"] if row["bench"] == name}
 
 
+def _medians(runs: list, metrics) -> dict:
+    """Per metric, the median and range over runs (each a dict of metrics)."""
+    return {m: {"median": float(np.median([x[m] for x in runs])), "min": min(x[m] for x in runs),
+                "max": max(x[m] for x in runs)} for m in metrics}
+
+
 def throughput(args) -> dict:
     """Lattice and float engines on the same periodic gases, interleaved: each round runs every
     case once per engine, alternating which engine goes first, one process per run pinned to one
@@ -88,8 +94,7 @@ def throughput(args) -> dict:
                       f"(load {loads[-1]:.2f})", flush=True)
     summary, ratios = {}, {}
     for name, runs in raw.items():
-        summary[name] = {m: {"median": float(np.median([x[m] for x in runs])), "min": min(x[m] for x in runs),
-                             "max": max(x[m] for x in runs)} for m in METRICS}
+        summary[name] = _medians(runs, METRICS)
         for m in ("bit_exact", "log_entries", "redraws_per_collision", "multi_body", "events_per_collision"):
             if m in runs[0]:
                 summary[name][m] = [x[m] for x in runs]
@@ -131,9 +136,7 @@ def storage_order(args) -> dict:
             raw[k].append(m)
             print(f"round {r} {k:18s} forward {m['forward_per_s']:.4g}/s reverse {m['reverse_per_s']:.4g}/s "
                   f"re-sorts {m.get('resorts', 0):.0f} (load {loads[-1]:.2f})", flush=True)
-    summary = {k: {m: {"median": float(np.median([x[m] for x in runs])), "min": min(x[m] for x in runs),
-                       "max": max(x[m] for x in runs)} for m in ("forward_per_s", "reverse_per_s")}
-               for k, runs in raw.items()}
+    summary = {k: _medians(runs, ("forward_per_s", "reverse_per_s")) for k, runs in raw.items()}
     for k in summary:
         summary[k]["resorts"] = [x.get("resorts", 0) for x in raw[k]]
         summary[k]["over_space"] = {m: summary[k][m]["median"] / summary["space"][m]["median"]

@@ -1,6 +1,16 @@
-// The lattice engine's pair collisions: the forward acceptance test (redraws: operator refusals,
-// outside the walls or vmax, overlap of a third body at tick a, a false tie at a-1), the rare
-// log, and the reverse, which reads the log and steps the stream back.
+// The lattice engine's pair collisions: the forward acceptance test, the rare log, and the
+// reverse, which reads the log and steps the stream back.
+//
+// Forward acceptance (LATTICE.md §4): a candidate post state is redrawn (the drawing stream steps on)
+// when the operator refuses it, when a post centre is outside the walls or faster than vmax, when it
+// overlaps a third body at tick a, or when its new lines overlap a third body at tick a-1 (a false tie:
+// the reverse would meet that body first). The rare log holds the redraw count under the drawer's
+// key (its id, its collision count after); the reverse reads and erases it. Detected and resolved
+// by the rule, counted: three bodies within one tick (a third body's line overlapping a pre line at
+// tick a: the pre line belongs to the past of the reverse; group.hpp) and a wall and a body within
+// one tick (a collision right after a reflection on the same tick). Not resolved, an error naming it
+// (never a silent approximation): a reflected line whose tick a-1 point overlaps a body (the reverse
+// would meet the body first), and a collision out of redraws whose group has no post state either.
 // Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
 // design); included by engine_impl.hpp, which the instantiating sources include.
 #pragma once

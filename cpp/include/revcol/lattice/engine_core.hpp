@@ -27,16 +27,11 @@
 //
 // Neighbour search (set_list_shell): the cell grid (a particle's 3^D cells, a cell crossing a
 // neutral event) or neighbour lists with a shell (neighbour_lists.hpp, a list renewal the neutral
-// event of kind 0 instead); 3D uses lists by default. A prediction drops with a double-precision
-// filter the candidates that provably have no overlap tick before its best event so far and sends
-// the others to the exact search. Neither the search nor the filter changes which collisions
-// happen: the trace and the bits are those of the exhaustive search (test_lattice_lists). That
-// needs one order for a particle's slot whoever writes it: (tick, kind, other particle), in its
-// own prediction and in a partner's write alike, so a same-tick tie of two partners of one
-// particle (same lower index, same kind) goes to the smaller partner whatever order the
-// predictions came in (with (tick, kind) alone the first writer kept it, and the searches'
-// re-predictions differ: docs/lattice.md "Session 12").
-//
+// event of kind 0 instead); 3D uses lists by default. A double-precision filter drops the
+// candidates that provably have no overlap tick before the best event so far. Neither changes
+// which collisions happen (test_lattice_lists): a particle's slot has one order whoever writes
+// it, (tick, kind, other particle) (predict.hpp; docs/lattice.md "Finding the next event").
+
 // Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
 // collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
 // lo descending (kind 1 + (N - 1 - lo)), then walls (kind N + 1). So the reverse undoes each tick's
@@ -45,15 +40,8 @@
 // Reverse (the prototype's engine.py): negate velocities, anchor ticks and the clock, run the same
 // search, apply v -> -reverse(-v) at each collision with the streams stepping back, negate again.
 //
-// Forward acceptance (LATTICE.md §4): a candidate post state is redrawn (the drawing stream steps on)
-// when the operator refuses it, when a post centre is outside the walls or faster than vmax, when it
-// overlaps a third body at tick a, or when its new lines overlap a third body at tick a-1 (a false tie:
-// the reverse would meet that body first). The rare log maps the collision index to its redraw count;
-// the reverse reads and erases it. Detected and resolved by the rule, counted: three bodies within one
-// tick (a third body's line overlapping a pre line at tick a: the pre line belongs to the past of the
-// reverse) and a wall and a body within one tick (a collision right after a reflection on the same
-// tick). Not resolved, an error naming it (never a silent approximation): a reflected line whose tick
-// a-1 point overlaps a body (the reverse would meet the body first), and more than max_redraws redraws.
+// Forward acceptance (LATTICE.md §4), the redraws, the rare log and what is detected, resolved
+// or refused: src/lattice/collide.hpp.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -83,8 +71,8 @@
 #include "revcol/lattice/state.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
 #include "revcol/lattice/specular.hpp"
+#include "revcol/lattice/streams.hpp"
 #include "revcol/lattice/units.hpp"
-#include "revcol/rng/philox.hpp"
 
 namespace revcol::lattice {
 
@@ -96,16 +84,6 @@ constexpr std::size_t pair_dim(R (O::*)(const VecN<D>&, A...) const) noexcept {
 /// The dimension an engine over Op runs in (2 or 3).
 template <class Op>
 inline constexpr std::size_t op_dim = pair_dim(&Op::pair_forward);
-
-/// The 48-bit draw k of particle p's stream: Philox4x32-10 block (lo32(k), hi32(k), 0, 0) under
-/// key {p, seed}, bits w0 (32) and the top 16 of w1.
-inline std::uint64_t draw48(std::uint32_t p, std::uint32_t seed, std::uint64_t k) noexcept {
-  const auto w = rng::philox4x32_10({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(k >> 32), 0U, 0U}, {p, seed});
-  return (std::uint64_t{w[0]} << 16) | (w[1] >> 16);
-}
-/// The 128 initial bits of particle p's X: Philox4x32-10 block (0, 0, 1, 0) under key {p, seed}
-/// (no draw48 block has a nonzero third word), top bit set (exactly 128 bits).
-std::vector<std::uint64_t> initial_bits(std::uint32_t p, std::uint32_t seed);
 
 /// The lattice engine's event machinery over a pair operator Op (pair_forward / pair_reverse as
 /// LatticePair2D or LatticePair3D; the dimension is the operator's) and a bits-back integer Bits
@@ -275,20 +253,15 @@ class BasicEngine {
   double list_shell() const noexcept { return lists_ ? 2.0 * static_cast<double>(nl_.radius()) / static_cast<double>(u_.sigma) : 0.0; }
   /// The automatic shell for this gas, in diameters (0: cells; see set_list_shell).
   double auto_list_shell() const noexcept;
-  /// The periodic re-sort of the particles' storage in space (state.hpp, resort): every `every`
-  /// neutral events (list renewals or cell crossings) per particle, between two ticks of a run
-  /// or run back that keeps no journal; 0 never, -1 automatic (kResortEvery from kResortMinN
-  /// particles). The order in which particles are stored changes no bit
-  /// (test_lattice_order.cpp): it is a speed setting.
+  /// Re-sorts the storage in space every `every` neutral events per particle (state.hpp, resort;
+  /// 0 never, -1 automatic): a speed setting, no bit changes (test_lattice_order.cpp).
   void set_resort(int every) {
     require(every >= -1, "lattice: resort must be >= -1 (-1: chosen from N, 0: never)");
     resort_every_ = every;
     resort_at_ = next_resort();
   }
-  /// Neutral events per particle between re-sorts in use (0: none).
-  int resort_every() const noexcept { return resort_every_ >= 0 ? resort_every_ : (ln_.size() >= kResortMinN ? kResortEvery : 0); }
-  /// Re-sorts done since construction.
-  std::uint64_t resorts() const noexcept { return resorts_; }
+  int resort_every() const noexcept { return resort_every_for(ln_.size()); }  ///< in use (0: none)
+  std::uint64_t resorts() const noexcept { return resorts_; }  ///< re-sorts since construction
   /// Bytes held by the engine's arrays, queue, grid and log.
   std::size_t memory_bytes() const noexcept;
   /// Bytes held by the group entries of the rare log (map node, members, pre velocities).
@@ -549,14 +522,12 @@ class BasicEngine {
   // the neighbour search (set_list_shell): the cell grid of the particles, or neighbour lists
   static constexpr double kShellBase = 0.545, kShellSlope = 1.0, kShellMin = 0.6, kShellMax = 1.2;  // measured: docs/lattice.md
   double list_shell_ = -1.0;
-  // the periodic re-sort (resort), clocked by the neutral events (a particle's list renewal or
-  // cell crossing: distance travelled, which is what loses the order): from 32 768 particles,
-  // every 16 per particle, as the float engine (below that the state fits the caches; the cost
-  // and the gain measured: docs/lattice.md, "The storage order")
+  // the periodic re-sort (state.hpp, resort; docs/lattice.md "The storage order")
   static constexpr std::size_t kResortMinN = 32768;
   static constexpr int kResortEvery = 16;
   int resort_every_ = -1;
   std::uint64_t resort_at_ = 0, resorts_ = 0;  // the crossing count of the next re-sort (0: none)
+  int resort_every_for(std::size_t n) const noexcept { return resort_every_ >= 0 ? resort_every_ : (n >= kResortMinN ? kResortEvery : 0); }
   std::uint64_t next_resort() const noexcept {
     const int k = resort_every();
     return k > 0 ? cnt_.crossings + static_cast<std::uint64_t>(k) * ln_.size() : 0;
