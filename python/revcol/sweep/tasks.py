@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Callable
 
 from .._io import atomic_open, jsonable
-from ..progress import Bar
+from ..progress import Bar, Interrupt
 from ..scene import SceneError, scene_from_dict
 from .output import gather, point_path, read_point
 from . import studies as sceneless
@@ -200,7 +200,29 @@ def _resources(spec, client, todo, log) -> bool:
     return True
 
 
-def _distributed(spec, todo, state: _State, finished, *, workers, scheduler, scheduler_file, client, log) -> None:
+def _completed(ac, stop: Interrupt):
+    """The futures of ``ac`` as they finish, polled from this thread: a Ctrl-C (counted by ``stop``)
+    raises KeyboardInterrupt here, between two of Dask's calls, never inside one (distributed's
+    ``sync`` logs a NameError traceback when the interrupt lands before its future exists)."""
+    while True:
+        if stop.presses:
+            raise KeyboardInterrupt
+        batch = ac.next_batch(block=False)
+        if batch:
+            yield from batch
+        elif ac.is_empty():
+            return
+        else:
+            time.sleep(0.02)
+
+
+def _distributed(spec, todo, state: _State, finished, **how) -> None:
+    with Interrupt() as stop:  # SIGINT only counted while Dask's calls run; acted on between them
+        _distributed_run(spec, todo, state, finished, stop, **how)
+
+
+def _distributed_run(spec, todo, state: _State, finished, stop: Interrupt, *, workers, scheduler, scheduler_file,
+                     client, log) -> None:
     from distributed import as_completed  # optional (the sweep extra): Dask only when a sweep runs on it
 
     owned = []
@@ -224,7 +246,7 @@ def _distributed(spec, todo, state: _State, finished, *, workers, scheduler, sch
                               retries=spec.retries, resources={MEMORY: p.memory_bytes} if claim else None)
             futures[f] = p
         try:
-            for f in as_completed(list(futures)):
+            for f in _completed(as_completed(list(futures)), stop):
                 p = futures.pop(f)
                 try:
                     result = f.result()
