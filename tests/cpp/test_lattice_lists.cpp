@@ -84,8 +84,23 @@ void check_lists(const UnitsN<D>& u, const NeighbourListsN<D>& nl, const std::ve
   CHECK(bad == 0);
 }
 
+// the coded scan's lists are the minimum-image scan's: the same entries with the same codes
 template <std::size_t D>
-void lists_case(std::array<bool, D> wall, double length, std::size_t n, double shell, std::uint64_t seed, const char* what) {
+void same_lists(const NeighbourListsN<D>& a, const NeighbourListsN<D>& b, std::size_t n, const char* what) {
+  int bad = 0;
+  for (std::size_t p = 0; p < n; ++p) {
+    std::set<std::pair<int, int>> ea, eb;
+    for (int e = 0; e < a.size(static_cast<int>(p)); ++e) ea.insert({a.ids(static_cast<int>(p))[e], a.codes(static_cast<int>(p))[e]});
+    for (int e = 0; e < b.size(static_cast<int>(p)); ++e) eb.insert({b.ids(static_cast<int>(p))[e], b.codes(static_cast<int>(p))[e]});
+    bad += ea != eb ? 1 : 0;
+  }
+  if (bad != 0) std::fprintf(stderr, "%s: %d lists differ between the two scans\n", what, bad);
+  CHECK(bad == 0);
+}
+
+template <std::size_t D>
+void lists_case(std::array<bool, D> wall, double length, std::size_t n, double shell, std::uint64_t seed, bool coded,
+                const char* what) {
   const UnitsN<D> u = box_units<D>(wall, length, 50);
   std::mt19937_64 rng(seed);
   std::vector<VecN<D>> c(n);
@@ -93,11 +108,15 @@ void lists_case(std::array<bool, D> wall, double length, std::size_t n, double s
     for (std::size_t k = 0; k < D; ++k)
       x[k] = u.wall[k] ? u.sigma / 2 + static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(u.L[k] - u.sigma))
                        : static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(u.L[k]));
-  NeighbourListsN<D> nl;
+  NeighbourListsN<D> nl, plain;  // plain: the minimum-image scan of every candidate
   const std::int64_t h = static_cast<std::int64_t>(shell * 0.5 * static_cast<double>(u.sigma));
   nl.build(u, h, c);
+  plain.use_minimum_image_scan();
+  plain.build(u, h, c);
   CHECK(nl.reach() == u.sigma + 2 * h + 8 * u.vmax + 8);
+  CHECK(nl.coded() == coded && !plain.coded());
   check_lists(u, nl, c, what);
+  same_lists(nl, plain, c.size(), what);
   // random renewals: a centre moves by up to a diameter (wrapped, inside the walls)
   std::uniform_real_distribution<double> step(-1.0, 1.0);
   for (int round = 0; round < 3; ++round) {
@@ -110,8 +129,10 @@ void lists_case(std::array<bool, D> wall, double length, std::size_t n, double s
         c[p][k] = y;
       }
       nl.renew(p, c[p]);
+      plain.renew(p, c[p]);
     }
     check_lists(u, nl, c, what);
+    same_lists(nl, plain, c.size(), what);
   }
 }
 
@@ -190,11 +211,14 @@ TEST_CASE("min_image: (d mod L) folded at (L + 1) / 2, every d in (-L, L) of sma
 }
 
 TEST_CASE("neighbour lists: complete, symmetric and with exact image codes, built and after random renewals") {
-  lists_case<3>({false, false, false}, 9.0, 400, 0.3, 1, "3D periodic, shell 0.3");
-  lists_case<3>({true, true, true}, 8.0, 300, 0.8, 2, "3D walls, shell 0.8");
-  lists_case<3>({false, true, false}, 3.0, 40, 2.0, 3, "3D small periodic box, shell 2 (every cell a neighbour)");
-  lists_case<2>({false, false}, 20.0, 400, 0.5, 4, "2D periodic, shell 0.5");
-  lists_case<2>({true, false}, 15.0, 300, 0.1, 5, "2D slab, shell 0.1");
+  lists_case<3>({false, false, false}, 9.0, 400, 0.3, 1, true, "3D periodic, shell 0.3");
+  lists_case<3>({true, true, true}, 8.0, 300, 0.8, 2, true, "3D walls, shell 0.8");
+  lists_case<3>({false, true, false}, 3.0, 40, 2.0, 3, false, "3D small periodic box, shell 2 (every cell a neighbour)");
+  lists_case<3>({false, false, true}, 7.0, 300, 0.2, 6, true, "3D, 5 cells on the periodic axes, shell 0.2");
+  lists_case<3>({false, false, false}, 16.0, 1500, 1.0, 7, true, "3D periodic, shell 1");
+  lists_case<2>({false, false}, 20.0, 400, 0.5, 4, true, "2D periodic, shell 0.5");
+  lists_case<2>({true, false}, 15.0, 300, 0.1, 5, true, "2D slab, shell 0.1");
+  lists_case<2>({false, false}, 4.5, 12, 0.4, 8, false, "2D small periodic box (every cell a neighbour)");
 }
 
 TEST_CASE("neighbour lists: the renewal tick is never late and rarely early (brute force over the ticks)") {

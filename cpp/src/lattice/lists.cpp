@@ -24,6 +24,8 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
   // at 0.45, as most of the smaller cells are empty; at N = 10^5 level at 0.3, 0.97-0.98x at 0.45,
   // where the extra candidates miss the caches: docs/lattice.md "Speed against the float engine (3D)")
   grid_.build(u, n, reach_, 1, false);
+  coded_ = !minimum_image_;
+  for (std::size_t k = 0; k < Dim; ++k) coded_ = coded_ && !grid_.every_cell(static_cast<int>(k));
   std::size_t cells = 1;
   for (std::size_t k = 0; k < Dim; ++k) cells *= static_cast<std::size_t>(grid_.count(static_cast<int>(k)));
   head_.assign(cells, -1);
@@ -42,7 +44,100 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
 
 template <std::size_t Dim>
 template <class F>
+void NeighbourListsN<Dim>::scan_coded(int p, F&& f) const {
+  const Node& np = node_[static_cast<std::size_t>(p)];
+  const std::array<int, Dim> at = grid_.coords(np.cell);
+  // per axis, the neighbouring cells (index, the centre's image shift and its code bits, the
+  // squared gap from the centre to the cell); a cell whose points are all at least R (1 + 1e-9)
+  // + 2 away is skipped (for_cells_within's margin: it could hold no entry)
+  int idx[Dim][3], cnt[Dim];
+  std::int64_t shift[Dim][3];
+  unsigned bits[Dim][3];
+  double gap2[Dim][3];
+  const double lim = static_cast<double>(reach_) * (1.0 + 1e-9) + 2.0, lim2 = lim * lim;
+  for (std::size_t k = 0; k < Dim; ++k) {
+    const int nc = grid_.count(static_cast<int>(k)), c = at[k];
+    const std::int64_t x = np.c[k], lo = grid_.boundary(static_cast<int>(k), c), hi = grid_.boundary(static_cast<int>(k), c + 1);
+    cnt[k] = 0;
+    for (int off = -1; off <= 1; ++off) {
+      int a = c + off;
+      std::int64_t s = 0;
+      unsigned b = 0;
+      if (a < 0 || a >= nc) {
+        if (wall_[k]) continue;
+        // across the end: the cell's members seen at q + L (below 0) or q - L (past the end),
+        // that is c_p - c_q = m - L (code 2) or m + L (code 1) with m the difference used
+        s = a < 0 ? L_[k] : -L_[k];
+        b = (a < 0 ? 2u : 1u) << (2 * k);
+        a += a < 0 ? nc : -nc;
+      }
+      const std::int64_t gap = off < 0 ? x - (lo - 1) : off > 0 ? hi - x : 0;
+      const double g = static_cast<double>(gap);
+      idx[k][cnt[k]] = a;
+      shift[k][cnt[k]] = s;
+      bits[k][cnt[k]] = b;
+      gap2[k][cnt[k]++] = g * g;
+    }
+  }
+  // the live cells: their first member, the centre shifted to their image, the code
+  int cur[27], which[27], m = 0;
+  Vec cs[27];
+  unsigned code[27];
+  const auto cell = [&](const int (&i)[Dim]) {
+    double g = 0.0;
+    int flat = 0;
+    for (std::size_t k = 0; k < Dim; ++k) {
+      g += gap2[k][i[k]];
+      flat = flat * grid_.count(static_cast<int>(k)) + idx[k][i[k]];
+    }
+    const int h = head_[static_cast<std::size_t>(flat)];
+    if (h < 0 || g >= lim2) return;
+    unsigned b = 0;
+    for (std::size_t k = 0; k < Dim; ++k) {
+      cs[m][k] = np.c[k] + shift[k][i[k]];
+      b |= bits[k][i[k]];
+    }
+    code[m] = b;
+    which[m] = m;
+    cur[m++] = h;
+  };
+  if constexpr (Dim == 2) {
+    for (int a = 0; a < cnt[0]; ++a)
+      for (int b = 0; b < cnt[1]; ++b) cell({a, b});
+  } else {
+    for (int a = 0; a < cnt[0]; ++a)
+      for (int b = 0; b < cnt[1]; ++b)
+        for (int e = 0; e < cnt[2]; ++e) cell({a, b, e});
+  }
+  // the chains side by side, one link of each per round (the float engine's neighbours.hpp)
+  while (m > 0) {
+    int live = 0;
+    for (int u = 0; u < m; ++u) {
+      const int q = cur[u], w = which[u];
+      const Node& nq = node_[static_cast<std::size_t>(q)];
+      if (q != p) {
+        double dd = 0.0;
+        for (std::size_t k = 0; k < Dim; ++k) {
+          const double d = static_cast<double>(cs[w][k] - nq.c[k]);
+          dd += d * d;
+        }
+        if (dd < reach2_) f(q, static_cast<std::uint8_t>(code[w]));
+      }
+      cur[live] = nq.next;
+      which[live] = w;
+      live += nq.next >= 0 ? 1 : 0;
+    }
+    m = live;
+  }
+}
+
+template <std::size_t Dim>
+template <class F>
 void NeighbourListsN<Dim>::scan(int p, F&& f) const {
+  if (coded_) {
+    scan_coded(p, f);
+    return;
+  }
   const Node& np = node_[static_cast<std::size_t>(p)];
   const Vec& c = np.c;
   // only the cells that reach within R of c (the rest could hold no entry: the same lists)

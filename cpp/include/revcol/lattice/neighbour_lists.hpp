@@ -25,6 +25,10 @@
 // cells, where flat member slots took 1 MB at N = 10^4). The list test
 // |c_p - c_q|^2 < R^2 is taken in double from the exact minimum-image differences: symmetric and
 // deterministic (the same values in either order), and R's margin is far beyond its rounding.
+// With at least 5 cells on every periodic axis the image of a neighbouring cell is known from
+// its offset (scan_coded): a listed pair's minimum image is the one in the neighbouring cell, so
+// the differences, the test and the codes are those of the minimum-image scan, bit for bit,
+// without a branch per axis; the cells' chains are walked side by side (their misses overlap).
 // Each entry also keeps the image code of the pair (one byte): the periodic shift s with
 // c_p - c_q = (its minimum image) + s, from which the engine's prediction builds the relative
 // vector without looking for an image (engine_core.hpp). A renewal touches a neighbour's list
@@ -82,6 +86,10 @@ class NeighbourListsN {
   std::int64_t reach() const noexcept { return reach_; }
   /// Bytes held by the lists and the grid of centres.
   std::size_t memory_bytes() const noexcept;
+  /// Whether the scans know each neighbouring cell's image (>= 5 cells on every periodic axis).
+  bool coded() const noexcept { return coded_; }
+  /// Tests only, before build: every scan by the minimum-image test, as in a small periodic box.
+  void use_minimum_image_scan() noexcept { minimum_image_ = true; }
 
  private:
   Vec diff(const Vec& a, const Vec& b) const noexcept;
@@ -90,6 +98,10 @@ class NeighbourListsN {
   void recode(int p, int q, std::uint8_t code);   // q's code on p's list
   template <class F>
   void scan(int p, F&& f) const;                   // f(q, code) for every q within R of p's centre
+  template <class F>
+  void scan_coded(int p, F&& f) const;             // scan, each cell's image known (coded_)
+  bool coded_ = false;  // no periodic axis takes every cell as a neighbour (>= 5 cells on each)
+  bool minimum_image_ = false;  // use_minimum_image_scan
   void grow();
   std::array<std::int64_t, Dim> L_{};
   std::array<bool, Dim> wall_{};
