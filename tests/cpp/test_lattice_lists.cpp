@@ -276,6 +276,7 @@ struct Gas {
   int tick_bits;
   std::uint64_t collisions;
   bool groups;  // every collision a group collision (max_redraws = -1)
+  int shifted = -1;  // 1 / 0: the cell grid knows / does not know each neighbouring cell's image (-1: either)
 };
 
 // the reference: the cell grid, every candidate to the exact search
@@ -286,6 +287,11 @@ void run_equivalence(const Gas<D>& g) {
   cfg.seed = 7;
   if (g.tick_bits != 0) cfg.tick_bits = g.tick_bits;
   const LatticeStartN<D> st = random_start(cfg, g.n, g.phi, 7);
+  if (g.shifted >= 0) {  // the engine's cell grid (shell 0): the image-known filter, or the per-pair image
+    CellGridN<D> grid;
+    grid.build(st.units, g.n);
+    CHECK(grid.shifted() == (g.shifted == 1));
+  }
   auto make = [&](double shell, bool exhaustive) {
     Engine e(st.units, st.x, st.v, 7, operator_for(st.units));
     e.set_list_shell(shell);
@@ -327,7 +333,8 @@ void run_equivalence(const Gas<D>& g) {
 TEST_CASE("3D engine: lists (shells 0.02 .. 2, both paths) find exactly the exhaustive cell search's collisions, bit for bit") {
   const std::array<bool, 3> per{false, false, false}, walls{true, true, true}, slab{false, false, true};
   for (const Gas<3>& g : {Gas<3>{"N=1000 phi=0.3 periodic", 1000, 0.3, per, 0, 20000, false},
-                          Gas<3>{"N=64 phi=0.1 periodic (short box)", 64, 0.1, per, 0, 5000, false},
+                          Gas<3>{"N=64 phi=0.1 periodic (short box)", 64, 0.1, per, 0, 5000, false, 1},
+                          Gas<3>{"N=80 phi=0.4 periodic (every cell a neighbour)", 80, 0.4, per, 0, 3000, false, 0},
                           Gas<3>{"N=500 phi=0.45 walls", 500, 0.45, walls, 0, 15000, false},
                           Gas<3>{"N=500 phi=0.45 slab, T=16 (redraws)", 500, 0.45, slab, 16, 15000, false},
                           Gas<3>{"N=200 phi=0.3 walls, groups forced", 200, 0.3, walls, 0, 2000, true}})
@@ -336,8 +343,11 @@ TEST_CASE("3D engine: lists (shells 0.02 .. 2, both paths) find exactly the exha
 
 TEST_CASE("2D engine: lists find exactly the exhaustive cell search's collisions, bit for bit") {
   const std::array<bool, 2> per{false, false}, walls{true, true};
-  for (const Gas<2>& g : {Gas<2>{"2D N=1000 phi=0.5 periodic", 1000, 0.5, per, 0, 20000, false},
-                          Gas<2>{"2D N=400 phi=0.3 walls, T=16", 400, 0.3, walls, 16, 10000, false}})
+  const std::array<bool, 2> channel{false, true};
+  for (const Gas<2>& g : {Gas<2>{"2D N=1000 phi=0.5 periodic", 1000, 0.5, per, 0, 20000, false, 1},
+                          Gas<2>{"2D N=400 phi=0.3 walls, T=16", 400, 0.3, walls, 16, 10000, false, 1},
+                          Gas<2>{"2D N=300 phi=0.6 channel", 300, 0.6, channel, 0, 10000, false, 1},
+                          Gas<2>{"2D N=14 phi=0.5 periodic (every cell a neighbour)", 14, 0.5, per, 0, 3000, false, 0}})
     run_equivalence<2, LatticeEngine>(g);
 }
 

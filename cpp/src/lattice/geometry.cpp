@@ -373,9 +373,17 @@ void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmi
     scale_[k] = static_cast<double>(nc_[k]) / static_cast<double>(L_[k]);
     nbr_[k].assign(static_cast<std::size_t>(nc_[k]) * 8, 0);
     nbrn_[k].assign(static_cast<std::size_t>(nc_[k]), 0);
-    for (int c = 0; c < nc_[k]; ++c)
-      nbrn_[k][static_cast<std::size_t>(c)] =
-          static_cast<std::uint8_t>(axis_range(static_cast<int>(k), c, &nbr_[k][static_cast<std::size_t>(c) * 8]));
+    nbs_[k].assign(static_cast<std::size_t>(nc_[k]) * 8, 0);
+    for (int c = 0; c < nc_[k]; ++c) {
+      const std::size_t at = static_cast<std::size_t>(c) * 8;
+      nbrn_[k][static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(axis_range(static_cast<int>(k), c, &nbr_[k][at]));
+      // a neighbour reached across the end (periodic): below 0 its members are seen at x - L, so
+      // a point of c sees them at x_c + L - x; past the end at x_c - L - x (for_neighbours_shifted)
+      for (int i = 0; i < nbrn_[k][static_cast<std::size_t>(c)]; ++i) {
+        const int d = nbr_[k][at + static_cast<std::size_t>(i)] - c;
+        nbs_[k][at + static_cast<std::size_t>(i)] = all_[k] ? 0 : d > span_ ? L_[k] : d < -span_ ? -L_[k] : 0;
+      }
+    }
   }
   // disks with centres in a w0 x w1 cell, pairwise >= sigma apart: at most (ceil(w/sigma) + 1)^2
   // (spheres in 3D: the product over three axes)
@@ -456,7 +464,7 @@ void CellGridN<Dim>::remove(int p) {
 template <std::size_t Dim>
 std::size_t CellGridN<Dim>::memory_bytes() const noexcept {
   std::size_t b = (slots_.capacity() + where_.capacity() + slot_.capacity()) * sizeof(int) + count_.capacity() * 4;
-  for (std::size_t k = 0; k < Dim; ++k) b += nbr_[k].capacity() * sizeof(int) + nbrn_[k].capacity();
+  for (std::size_t k = 0; k < Dim; ++k) b += nbr_[k].capacity() * sizeof(int) + nbrn_[k].capacity() + nbs_[k].capacity() * 8;
   return b;
 }
 

@@ -200,6 +200,24 @@ void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) {
       const double c0 = rr - sigma2d_;
       exact(q, c0 / (std::sqrt(std::max(0.0, bb * bb - aa * c0)) - bb));
     }
+  } else if (!lists_ && shifted_ && !exhaustive_search) {
+    // cells, >= 5 on every periodic axis: each neighbouring cell's image is known, so r is the
+    // exact integer difference to that image, rounded once, less the partner's travel (no image
+    // to find and no edge: every candidate is within two cells, nearer than L / 2)
+    grid_.for_neighbours_shifted(grid_.cell_of_particle(p), [&](int q, const Vec& s) {
+      if (q == p) return;
+      const Line& lq = ln_[q];
+      const double dtq = static_cast<double>(lo - lq.ta);
+      double rr = 0.0, bb = 0.0, aa = 0.0;
+      for (std::size_t k = 0; k < D; ++k) {
+        const double r = static_cast<double>(lp.x[k] + s[k] - lq.x[k]) - static_cast<double>(lq.v[k]) * dtq;
+        const double w = static_cast<double>(lp.v[k] - lq.v[k]);
+        rr += r * r;
+        bb += r * w;
+        aa += w * w;
+      }
+      if (!beyond(rr, bb, aa, tb)) exact(q, std::numeric_limits<double>::quiet_NaN());
+    });
   } else {
     std::array<double, D> xp{};
     for (std::size_t k = 0; k < D; ++k) xp[k] = static_cast<double>(lp.x[k]);

@@ -273,7 +273,7 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
   lists_ = shell > 0.0;
   grid_ = CellGridN<D>{};
   nl_ = NeighbourListsN<D>{};
-  direct_ = false;
+  direct_ = shifted_ = false;
   if (lists_) {
     const double h = std::max(1.0, std::round(0.5 * shell * static_cast<double>(u_.sigma)));
     std::vector<Vec> centres(n);
@@ -287,6 +287,7 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
   } else {
     grid_.build(u_, n);
     for (std::size_t p = 0; p < n; ++p) grid_.insert(static_cast<int>(p), grid_.cell_id(ln_[p].x));
+    shifted_ = grid_.shifted();
   }
   lnd_.resize(n);
   for (std::size_t p = 0; p < n; ++p) sync(static_cast<int>(p));

@@ -130,6 +130,53 @@ class CellGridN {
         }
     }
   }
+  /// Whether no periodic axis takes every cell as a neighbour (each has >= 2 span + 3 cells): a
+  /// neighbouring cell's members are then seen at one image, for_neighbours_shifted's.
+  bool shifted() const noexcept {
+    bool ok = true;
+    for (std::size_t k = 0; k < Dim; ++k) ok = ok && !all_[k];
+    return ok;
+  }
+  /// for_neighbours (span 1, shifted()) with each cell's image: f(member, s), s[k] in {0, L_k,
+  /// -L_k}, so that x + s - x_member is the member's nearest image seen from a point x of cell id
+  /// (any point within two cells of x on every axis is nearer than L_k / 2 with >= 5 cells).
+  template <class F>
+  [[gnu::always_inline]] void for_neighbours_shifted(int id, F&& f) const {
+    // for_neighbours' tables, with the shift of each neighbouring cell beside its index
+    VecN<Dim> s{};
+    if constexpr (Dim == 2) {
+      const int c0 = id / nc_[1], c1 = id % nc_[1];
+      const int* a0 = &nbr_[0][static_cast<std::size_t>(c0) * 8];
+      const int* a1 = &nbr_[1][static_cast<std::size_t>(c1) * 8];
+      const std::int64_t* s0 = &nbs_[0][static_cast<std::size_t>(c0) * 8];
+      const std::int64_t* s1 = &nbs_[1][static_cast<std::size_t>(c1) * 8];
+      const int n0 = nbrn_[0][static_cast<std::size_t>(c0)], n1 = nbrn_[1][static_cast<std::size_t>(c1)];
+      for (int i = 0; i < n0; ++i)
+        for (int j = 0; j < n1; ++j) {
+          s = {s0[i], s1[j]};
+          for (std::size_t id2 = static_cast<std::size_t>(a0[i]) * nc_[1] + a1[j], k = 0, e = count_[id2]; k < e; ++k)
+            f(slots_[id2 * cap_ + k], s);
+        }
+    } else {
+      const std::array<int, Dim> c = coords(id);
+      const int* a0 = &nbr_[0][static_cast<std::size_t>(c[0]) * 8];
+      const int* a1 = &nbr_[1][static_cast<std::size_t>(c[1]) * 8];
+      const int* a2 = &nbr_[2][static_cast<std::size_t>(c[2]) * 8];
+      const std::int64_t* s0 = &nbs_[0][static_cast<std::size_t>(c[0]) * 8];
+      const std::int64_t* s1 = &nbs_[1][static_cast<std::size_t>(c[1]) * 8];
+      const std::int64_t* s2 = &nbs_[2][static_cast<std::size_t>(c[2]) * 8];
+      const int n0 = nbrn_[0][static_cast<std::size_t>(c[0])], n1 = nbrn_[1][static_cast<std::size_t>(c[1])];
+      const int n2 = nbrn_[2][static_cast<std::size_t>(c[2])];
+      for (int i = 0; i < n0; ++i)
+        for (int j = 0; j < n1; ++j) {
+          const std::size_t row = (static_cast<std::size_t>(a0[i]) * nc_[1] + a1[j]) * nc_[2];
+          for (int l = 0; l < n2; ++l) {
+            s = {s0[i], s1[j], s2[l]};
+            for (std::size_t id2 = row + a2[l], k = 0, e = count_[id2]; k < e; ++k) f(slots_[id2 * cap_ + k], s);
+          }
+        }
+    }
+  }
   /// As for_neighbours, but skips the neighbour cells that lie wholly beyond distance r of the
   /// point x (a position in [0, L) of flat cell id): a cell is skipped only when its exact
   /// integer bounds put every point of it at least r (1 + 1e-9) + 2 lattice units away (nearest
@@ -213,6 +260,7 @@ class CellGridN {
   std::array<double, Dim> scale_{};                    // nc / L: cell_of's first guess
   std::array<std::vector<int>, Dim> nbr_;              // per axis and cell: its neighbour cells (8 slots)
   std::array<std::vector<std::uint8_t>, Dim> nbrn_;    // per axis and cell: how many
+  std::array<std::vector<std::int64_t>, Dim> nbs_;     // per axis and cell: each neighbour's image shift
   std::array<bool, Dim> all_{};  // small periodic axis: every cell is a neighbour
   int span_ = 1;                 // neighbours: the cells within span_ per axis
   std::array<bool, Dim> wall_{};

@@ -539,6 +539,7 @@ class BasicEngine {
   u128 sigma2_ = 0;
   double sigma2d_ = 0.0, far2_ = 0.0;
   std::array<double, D> Ld_{}, invL_{}, edge_{};  // the prediction's filter: L, 1 / L, L / 2 less rounding
+  bool shifted_ = false;  // cells whose images are known (CellGridN::shifted)
   std::array<std::array<double, D>, 1u << (2 * D)> shift_{};  // a list entry's image shift by code (neighbour_lists.hpp)
   std::int64_t hlo_ = 0;
   CellGridN<D> grid_;
