@@ -100,8 +100,8 @@ void same_lists(const NeighbourListsN<D>& a, const NeighbourListsN<D>& b, std::s
 
 template <std::size_t D>
 void lists_case(std::array<bool, D> wall, double length, std::size_t n, double shell, std::uint64_t seed, bool coded,
-                const char* what) {
-  const UnitsN<D> u = box_units<D>(wall, length, 50);
+                const char* what, int S = 50) {
+  const UnitsN<D> u = box_units<D>(wall, length, S);
   std::mt19937_64 rng(seed);
   std::vector<VecN<D>> c(n);
   for (auto& x : c)
@@ -123,10 +123,10 @@ void lists_case(std::array<bool, D> wall, double length, std::size_t n, double s
     for (std::size_t m = 0; m < n; ++m) {
       const int p = static_cast<int>(rng() % n);
       for (std::size_t k = 0; k < D; ++k) {
-        std::int64_t y = c[p][k] + static_cast<std::int64_t>(step(rng) * static_cast<double>(u.sigma));
-        if (u.wall[k]) y = std::clamp(y, u.sigma / 2, u.L[k] - u.sigma / 2);
-        else y = wrap(y, u.L[k]);
-        c[p][k] = y;
+        // in 128 bits: a centre near L plus a diameter can pass 2^63 in the largest box
+        const i128 y = static_cast<i128>(c[p][k]) + static_cast<std::int64_t>(step(rng) * static_cast<double>(u.sigma));
+        if (u.wall[k]) c[p][k] = static_cast<std::int64_t>(std::clamp<i128>(y, u.sigma / 2, u.L[k] - u.sigma / 2));
+        else c[p][k] = wrap(y, u.L[k]);
       }
       nl.renew(p, c[p]);
       plain.renew(p, c[p]);
@@ -219,6 +219,9 @@ TEST_CASE("neighbour lists: complete, symmetric and with exact image codes, buil
   lists_case<2>({false, false}, 20.0, 400, 0.5, 4, true, "2D periodic, shell 0.5");
   lists_case<2>({true, false}, 15.0, 300, 0.1, 5, true, "2D slab, shell 0.1");
   lists_case<2>({false, false}, 4.5, 12, 0.4, 8, false, "2D small periodic box (every cell a neighbour)");
+  // a box near the coordinates' limit (L = 15.5 x 2^59 ~ 0.97 x 2^63, 5 cells a side): a centre
+  // of the first cell plus L would pass 2^63
+  lists_case<3>({false, false, false}, 15.5, 200, 2.0, 9, true, "3D periodic, L ~ 0.97 x 2^63", 59);
 }
 
 TEST_CASE("neighbour lists: the renewal tick is never late and rarely early (brute force over the ticks)") {

@@ -65,8 +65,8 @@ void NeighbourListsN<Dim>::scan_coded(int p, F&& f) const {
       unsigned b = 0;
       if (a < 0 || a >= nc) {
         if (wall_[k]) continue;
-        // across the end: the cell's members seen at q + L (below 0) or q - L (past the end),
-        // that is c_p - c_q = m - L (code 2) or m + L (code 1) with m the difference used
+        // across the end: the cell's members seen at c_q - L (below 0) or c_q + L (past the
+        // end), that is c_p - c_q = m - L (code 2) or m + L (code 1) with m the difference used
         s = a < 0 ? L_[k] : -L_[k];
         b = (a < 0 ? 2u : 1u) << (2 * k);
         a += a < 0 ? nc : -nc;
@@ -79,7 +79,7 @@ void NeighbourListsN<Dim>::scan_coded(int p, F&& f) const {
       gap2[k][cnt[k]++] = g * g;
     }
   }
-  // the live cells: their first member, the centre shifted to their image, the code
+  // the live cells: their first member, their image shift, the code
   int cur[27], which[27], m = 0;
   Vec cs[27];
   unsigned code[27];
@@ -94,7 +94,7 @@ void NeighbourListsN<Dim>::scan_coded(int p, F&& f) const {
     if (h < 0 || g >= lim2) return;
     unsigned b = 0;
     for (std::size_t k = 0; k < Dim; ++k) {
-      cs[m][k] = np.c[k] + shift[k][i[k]];
+      cs[m][k] = shift[k][i[k]];
       b |= bits[k][i[k]];
     }
     code[m] = b;
@@ -118,7 +118,8 @@ void NeighbourListsN<Dim>::scan_coded(int p, F&& f) const {
       if (q != p) {
         double dd = 0.0;
         for (std::size_t k = 0; k < Dim; ++k) {
-          const double d = static_cast<double>(cs[w][k] - nq.c[k]);
+          // (c_p - c_q) + s: in (-L, L), and a shift only brings it nearer 0 (no sum past 2^63)
+          const double d = static_cast<double>((np.c[k] - nq.c[k]) + cs[w][k]);
           dd += d * d;
         }
         if (dd < reach2_) f(q, static_cast<std::uint8_t>(code[w]));

@@ -210,7 +210,9 @@ void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) {
       const double dtq = static_cast<double>(lo - lq.ta);
       double rr = 0.0, bb = 0.0, aa = 0.0;
       for (std::size_t k = 0; k < D; ++k) {
-        const double r = static_cast<double>(lp.x[k] + s[k] - lq.x[k]) - static_cast<double>(lq.v[k]) * dtq;
+        // (x_p - x_q) + s: the difference is in (-L, L) and a shift only ever brings it nearer 0
+        // (+L for a partner near L seen from near 0), so no sum passes 2^63 however large L is
+        const double r = static_cast<double>((lp.x[k] - lq.x[k]) + s[k]) - static_cast<double>(lq.v[k]) * dtq;
         const double w = static_cast<double>(lp.v[k] - lq.v[k]);
         rr += r * r;
         bb += r * w;
