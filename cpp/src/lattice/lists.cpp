@@ -79,9 +79,10 @@ void NeighbourListsN<Dim>::scan_coded(int p, F&& f) const {
       gap2[k][cnt[k]++] = g * g;
     }
   }
-  // the live cells: their first member, their image shift, the code
+  // the live cells: their first member, the centre moved to their image (modulo 2^64: c + L can
+  // pass 2^63 in a box near the coordinates' limit; the difference below is exact), the code
   int cur[27], which[27], m = 0;
-  Vec cs[27];
+  std::uint64_t cs[27][Dim];
   unsigned code[27];
   const auto cell = [&](const int (&i)[Dim]) {
     double g = 0.0;
@@ -94,7 +95,7 @@ void NeighbourListsN<Dim>::scan_coded(int p, F&& f) const {
     if (h < 0 || g >= lim2) return;
     unsigned b = 0;
     for (std::size_t k = 0; k < Dim; ++k) {
-      cs[m][k] = shift[k][i[k]];
+      cs[m][k] = static_cast<std::uint64_t>(np.c[k]) + static_cast<std::uint64_t>(shift[k][i[k]]);
       b |= bits[k][i[k]];
     }
     code[m] = b;
@@ -118,8 +119,8 @@ void NeighbourListsN<Dim>::scan_coded(int p, F&& f) const {
       if (q != p) {
         double dd = 0.0;
         for (std::size_t k = 0; k < Dim; ++k) {
-          // (c_p - c_q) + s: in (-L, L), and a shift only brings it nearer 0 (no sum past 2^63)
-          const double d = static_cast<double>((np.c[k] - nq.c[k]) + cs[w][k]);
+          // c_p + s - c_q is in (-L, L): the difference modulo 2^64 read as signed is exact
+          const double d = static_cast<double>(static_cast<std::int64_t>(cs[w][k] - static_cast<std::uint64_t>(nq.c[k])));
           dd += d * d;
         }
         if (dd < reach2_) f(q, static_cast<std::uint8_t>(code[w]));
