@@ -73,6 +73,23 @@ def _medians(runs: list, metrics) -> dict:
                 "max": max(x[m] for x in runs)} for m in metrics}
 
 
+def _range(xs) -> dict:
+    return {"min": min(xs), "median": float(np.median(xs)), "max": max(xs)}
+
+
+def _commit() -> str:
+    return subprocess.run(["git", "-C", HERE, "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+
+
+def _save(res: dict, name: str) -> None:
+    """Writes bench/results/<name> atomically (a temporary file, then a rename)."""
+    path = os.path.join(RESULTS, name)
+    with open(path + ".tmp", "w") as f:
+        json.dump(res, f, indent=1)
+    os.replace(path + ".tmp", path)
+    print("wrote", path)
+
+
 def throughput(args) -> dict:
     """Lattice and float engines on the same periodic gases, interleaved: each round runs every
     case once per engine, alternating which engine goes first, one process per run pinned to one
@@ -103,16 +120,10 @@ def throughput(args) -> dict:
         ratios[f"n{n}/phi{phi}"] = {m: lat[m]["median"] / flo[m]["median"] for m in METRICS}
     res = {"command": " ".join(sys.argv), "dim": args.dim, "rounds": args.rounds, "collisions_per_run": base,
            "collisions_per_run_n100000": 2 * base, "cpu": args.cpu, "wall_seconds": time.time() - t0,
-           "load_before_runs": {"min": min(loads), "median": float(np.median(loads)), "max": max(loads)},
-           "summary": summary, "lattice_over_float": ratios, "raw": raw,
-           "commit": subprocess.run(["git", "-C", HERE, "rev-parse", "HEAD"], capture_output=True,
-                                    text=True).stdout.strip()}
+           "load_before_runs": _range(loads), "summary": summary, "lattice_over_float": ratios, "raw": raw,
+           "commit": _commit()}
     print(json.dumps(ratios, indent=1))
-    path = os.path.join(RESULTS, "lattice_throughput3d.json" if args.dim == 3 else "lattice_throughput.json")
-    with open(path + ".tmp", "w") as f:
-        json.dump(res, f, indent=1)
-    os.replace(path + ".tmp", path)
-    print("wrote", path)
+    _save(res, "lattice_throughput3d.json" if args.dim == 3 else "lattice_throughput.json")
     return res
 
 
@@ -143,16 +154,9 @@ def storage_order(args) -> dict:
                                     for m in ("forward_per_s", "reverse_per_s")}
     res = {"command": " ".join(sys.argv), "case": args.case, "collisions_per_run": n, "rounds": args.rounds,
            "cpu": args.cpu, "settings": ORDER_SETTINGS,
-           "load_before_runs": {"min": min(loads), "median": float(np.median(loads)), "max": max(loads)},
-           "summary": summary, "raw": raw,
-           "commit": subprocess.run(["git", "-C", HERE, "rev-parse", "HEAD"], capture_output=True,
-                                    text=True).stdout.strip()}
+           "load_before_runs": _range(loads), "summary": summary, "raw": raw, "commit": _commit()}
     print(json.dumps({k: v["over_space"] for k, v in summary.items()}, indent=1))
-    path = os.path.join(RESULTS, "lattice_storage_order.json")
-    with open(path + ".tmp", "w") as f:
-        json.dump(res, f, indent=1)
-    os.replace(path + ".tmp", path)
-    print("wrote", path)
+    _save(res, "lattice_storage_order.json")
     return res
 
 

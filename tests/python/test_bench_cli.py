@@ -1,4 +1,5 @@
 """The benchmark binary's command line: counts in float notation, bad values refused."""
+import json
 import os
 import subprocess
 import sys
@@ -100,7 +101,6 @@ def test_op_ab_times_two_revisions_in_one_binary():
 def test_lattice_bench_storage_order_settings_keep_the_round_trip_exact(tmp_path):
     # lattice_study.py order: a random storage order (shuffle=1), re-sorted every neutral event per
     # particle (resort=1); the run back must still end on the starting bits
-    import json
     out = tmp_path / "b.json"
     env = dict(os.environ, REVCOL_LATTICE="shuffle=1,resort=1")
     r = subprocess.run([_bench_binary(), "--bench", "lattice3d/periodic/n1000/phi0.3", "--collisions", "20000",

@@ -24,8 +24,7 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
   // at 0.45, as most of the smaller cells are empty; at N = 10^5 level at 0.3, 0.97-0.98x at 0.45,
   // where the extra candidates miss the caches: docs/lattice.md "Speed against the float engine (3D)")
   grid_.build(u, n, reach_, 1, false);
-  coded_ = !minimum_image_;
-  for (std::size_t k = 0; k < Dim; ++k) coded_ = coded_ && !grid_.every_cell(static_cast<int>(k));
+  coded_ = !minimum_image_ && grid_.shifted();
   std::size_t cells = 1;
   for (std::size_t k = 0; k < Dim; ++k) cells *= static_cast<std::size_t>(grid_.count(static_cast<int>(k)));
   head_.assign(cells, -1);

@@ -70,9 +70,6 @@ class CellGridN {
   void build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmin = 0, int span = 1, bool members = true);
   /// Number of cells along axis k.
   int count(int k) const noexcept { return nc_[k]; }
-  /// Whether every cell of axis k is a neighbour of every other (a periodic axis too short for
-  /// 2 span + 3 cells of the width asked).
-  bool every_cell(int k) const noexcept { return all_[k]; }
   /// Lower boundary of cell c (0 <= c <= nc) on axis k: floor(c L / nc).
   std::int64_t boundary(int k, int c) const noexcept { return bounds_[k][static_cast<std::size_t>(c)]; }
   /// The cell index on axis k of a position in [0, L): a double guess, corrected exactly against
