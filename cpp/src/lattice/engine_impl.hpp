@@ -11,3 +11,4 @@
 #include "group.hpp"    // a third body within one tick: group collisions
 #include "rollback.hpp"  // the journal: the latest events undone one by one
 #include "observe.hpp"  // the observer's hooks
+#include "lp_view.hpp"  // a logical process's view: messages written, particles parked

@@ -53,6 +53,10 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
   std::uint64_t done = 0;
   std::uint32_t since_poll = 0;
   for (;;) {
+    if (lp_ != nullptr && lp_stepped_) [[unlikely]] {  // a logical process's step: one queue pop
+      clock_ = lp_->key.t;
+      return done;
+    }
     const int p = queue_.top();
     if (poll && ++since_poll == kPollEvents && p >= 0) {
       // Ctrl-C: end at the tick before the next event, as run(until = that tick) would
@@ -71,6 +75,11 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
     }
     ++cnt_.events;
     const bool journal = jon_ && !back;
+    if (lp_ != nullptr) [[unlikely]] {
+      lp_stepped_ = true;
+      lp_->key = EventKey{t, queue_.kind(p), gid(p)};
+      lp_->type = valid(p) ? static_cast<LpNotes::Type>(slot_[static_cast<std::size_t>(p)].type) : LpNotes::none;
+    }
     if (!valid(p)) {
       ++cnt_.stale;
       if (journal) jdone_.push_back(Done{t, queue_.kind(p), p, -1, none, 0, 0});
@@ -117,6 +126,7 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
       }
       collide_forward(i, j, t);
       if (journal) jdone_.push_back(Done{t, kind, i, j, coll, static_cast<std::uint8_t>(unreflected_ | (p == j ? 4u : 0u)), jkept_});
+      if (lp_ != nullptr) [[unlikely]] lp_note(i, j);
     }
     ++done;
     if (!back && done == want) {

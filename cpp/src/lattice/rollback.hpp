@@ -132,6 +132,7 @@ void BasicEngine<Op, Bits, Queue>::restart_journal() {
   jss1_.clear();
   jss2_.clear();
   jss2x_.clear();
+  jlp_.clear();
   j_ncoll0_ = ncoll_;
   j_clock0_ = clock_;
   j_key0_ = last_key_;
@@ -163,11 +164,13 @@ void BasicEngine<Op, Bits, Queue>::rollback_to_tick(std::int64_t tick) {
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::rollback_before(std::int64_t tick, std::int32_t kind, std::int32_t id) {
   require(jon_, "lattice rollback: the engine keeps no journal (keep_journal)");
-  require(tick > j_clock0_ && tick <= clock_ + 1, "lattice rollback: the key's tick must be in (journal_start_tick, clock + 1] = (" +
-                                                       std::to_string(j_clock0_) + ", " + std::to_string(clock_ + 1) + "]");
-  const auto key = std::make_tuple(tick, kind, id);
+  // (a key on the journal's start tick is fine after the last event before the journal)
+  require((tick > j_clock0_ || (tick == j_clock0_ && std::make_pair(tick, kind) > j_key0_)) && tick <= clock_ + 1,
+          "lattice rollback: the key must come after the journal's start (tick " + std::to_string(j_clock0_) +
+              ", kind " + std::to_string(j_key0_.second) + ") and its tick be at most clock + 1 = " + std::to_string(clock_ + 1));
+  const EventKey key{tick, kind, id};
   // (the entries are in the queue's order: a collision under the particle whose slot came up)
-  unwind([&](const Done& d) { return std::make_tuple(d.t, d.kind, gid(d.unreflected & 4u ? d.q : d.p)) < key; }, tick - 1);
+  unwind([&](const Done& d) { return done_key(d) < key; }, tick - 1);
 }
 
 template <class Op, class Bits, class Queue>
@@ -221,6 +224,19 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
     const Done d = jdone_.back();
     jdone_.pop_back();
     touch(d.p);
+    if (d.type == lpw || d.type == lpp) {  // an LP's write or park: the state before it comes back
+      auto [was_parked, before] = std::move(jlp_.back());
+      jlp_.pop_back();
+      const bool parked = parked_[static_cast<std::size_t>(d.p)] != 0;
+      lp_set(d.p, before);
+      if (parked && was_parked == 0) lp_unpark(d.p);
+      if (!parked && was_parked != 0) {
+        parked_[static_cast<std::size_t>(d.p)] = 1;
+        grid_.remove(d.p);
+        schedule(d.p, none, 0, 0, -1);
+      }
+      continue;
+    }
     if (jhow_ != Rollback::reverse && (d.type == wall || d.type == coll)) {  // state saving
       if (d.type == coll) touch(d.q);
       restore_kept(d);
@@ -252,6 +268,9 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
   }
   // anchor every touched particle at the clock first (its cell or list ball as of the clock:
   // a prediction reads its neighbours' cells), then predict each
+  if (!parked_.empty())  // (an LP's parked particles have no place and no event)
+    jtouched_.erase(std::remove_if(jtouched_.begin(), jtouched_.end(), [&](int p) { return parked_[static_cast<std::size_t>(p)] != 0; }),
+                    jtouched_.end());
   for (int p : jtouched_) {
     ++slot_[static_cast<std::size_t>(p)].ver;
     reanchor(p, clock_);

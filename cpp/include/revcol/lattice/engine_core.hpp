@@ -25,12 +25,8 @@
 // q's slot when it is earlier there, so a pair's collision sits in both slots; an event whose versions
 // are stale is recomputed when it comes up.
 //
-// Neighbour search (set_list_shell): the cell grid (a particle's 3^D cells, a cell crossing a
-// neutral event) or neighbour lists with a shell (neighbour_lists.hpp, a list renewal the neutral
-// event of kind 0 instead); 3D uses lists by default. A double-precision filter drops the
-// candidates that provably have no overlap tick before the best event so far. Neither changes
-// which collisions happen (test_lattice_lists): a particle's slot has one order whoever writes
-// it, (tick, kind, other particle) (predict.hpp; docs/lattice.md "Finding the next event").
+// Neighbour search (set_list_shell): cells or neighbour lists, behind a double filter; neither
+// changes which collisions happen (predict.hpp; docs/lattice.md "Finding the next event").
 
 // Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
 // collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
@@ -39,9 +35,7 @@
 //
 // Reverse (the prototype's engine.py): negate velocities, anchor ticks and the clock, run the same
 // search, apply v -> -reverse(-v) at each collision with the streams stepping back, negate again.
-//
-// Forward acceptance (LATTICE.md §4), the redraws, the rare log and what is detected, resolved
-// or refused: src/lattice/collide.hpp.
+// Acceptance, redraws, the rare log: collide.hpp. A logical process's view: lp_view.hpp.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -68,6 +62,7 @@
 #include "revcol/visitable.hpp"
 #include "revcol/lattice/cell_grid.hpp"
 #include "revcol/lattice/geometry.hpp"
+#include "revcol/lattice/lp.hpp"
 #include "revcol/lattice/state.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
 #include "revcol/lattice/specular.hpp"
@@ -91,8 +86,7 @@ inline constexpr std::size_t op_dim = pair_dim(&Op::pair_forward);
 template <class Op, class Bits, class Queue = engine::EventQueue<std::int64_t>>
 class BasicEngine {
  public:
-  /// The dimension (2 or 3), from the operator.
-  static constexpr std::size_t D = op_dim<Op>;
+  static constexpr std::size_t D = op_dim<Op>;  ///< The dimension (2 or 3), from the operator.
   static_assert(D == 2 || D == 3, "the lattice engine runs in 2 or 3 dimensions");
   using Vec = VecN<D>;              ///< a position, velocity or relative vector
   using Units = UnitsN<D>;          ///< the units and box
@@ -107,8 +101,7 @@ class BasicEngine {
       : op_(std::move(op)) {
     load(fresh(u, std::move(x), std::move(v), seed, clock, mode));
   }
-  /// An engine resuming a snapshot bit for bit.
-  BasicEngine(const Snapshot& s, Op op) : op_(std::move(op)) { restore(s); }
+  BasicEngine(const Snapshot& s, Op op) : op_(std::move(op)) { restore(s); }  ///< An engine resuming a snapshot bit for bit.
   /// The same, its particles stored in another order: local index p holds particle order[p] (a
   /// permutation of [0, N)). Every key, draw, tie and output is by particle id, so the run is
   /// the same bit for bit (the parallel engine's logical processes hold their particles so).
@@ -133,11 +126,9 @@ class BasicEngine {
   /// set_list_shell, the undo of an engine error) restarts it at the state (ARCHITECTURE.md).
   /// `how`: reverse computation, or state saving (SS1, SS2) for the comparison (state.hpp).
   void keep_journal(bool on, Rollback how = Rollback::reverse);
-  /// Whether the journal is kept.
-  bool journaling() const noexcept { return jon_; }
+  bool journaling() const noexcept { return jon_; }  ///< Whether the journal is kept.
   Rollback rollback_by() const noexcept { return jhow_; }  ///< how a rollback restores the state
-  /// Bytes the journal holds (its entries and, state saving, the saved states).
-  std::size_t journal_bytes() const noexcept;
+  std::size_t journal_bytes() const noexcept;  ///< Bytes the journal holds (its entries and, state saving, the saved states).
   /// Rolls back to the state right after collision `collisions` (clock = its tick; the journal's
   /// start when that is where the count is), bit for bit the forward run's state there; a run on
   /// processes the same events. journal_start() <= collisions <= collisions(); ends observation.
@@ -155,13 +146,26 @@ class BasicEngine {
   void commit(std::uint64_t collisions);
   /// The collision count at the journal's start (the earliest state rollback reaches).
   std::uint64_t journal_start() const noexcept { return j_ncoll0_; }
-  /// The tick at the journal's start.
-  std::int64_t journal_start_tick() const noexcept { return j_clock0_; }
-  /// Entries held (queue pops since the journal's start).
-  std::size_t journal_size() const noexcept { return jdone_.size(); }
+  std::int64_t journal_start_tick() const noexcept { return j_clock0_; }  ///< The tick at the journal's start.
+  std::size_t journal_size() const noexcept { return jdone_.size(); }  ///< Entries held (queue pops since the journal's start).
 
-  /// The state (forward frame, positions at the clock).
-  Snapshot snapshot() const;
+  // ---- a logical process's view (lp_view.hpp; the parallel engine, timewarp.hpp) ----
+  using Record = ParticleRecordN<D, Bits>;  ///< one particle's whole state
+  Record record(int id) const;              ///< particle id's state (its line as anchored)
+  /// Makes this engine an LP's: the particles not `held[id]` parked (in no cell, no event), every
+  /// event noted in `notes`, the journal kept. Cells only (set_list_shell(0) first).
+  void lp_begin(const std::vector<std::uint8_t>& held, LpNotes* notes);
+  bool held(int id) const { return parked_.empty() || parked_[local(id)] == 0; }  ///< in the view
+  /// Particle id takes state r at key k (a message), held from then on; journaled, a rollback
+  /// to before k takes it back. lp_clear: false when it overlaps a body it may not (lp_view.hpp).
+  void lp_write(int id, const Record& r, const EventKey& k);
+  bool lp_clear(int id, const EventKey& k) const;
+  void lp_park(int id, const EventKey& k);  ///< particle id leaves the view at key k (journaled)
+  bool lp_next(EventKey& k);                ///< the next queue pop's key; false: none
+  void lp_step();                           ///< processes the next queue pop, one event
+  void commit_before(const EventKey& k);    ///< forgets the journal's entries before key k
+  EventKey last_key() const noexcept;       ///< the key of the journal's last entry (or its start)
+  Snapshot snapshot() const;  ///< The state (forward frame, positions at the clock).
   /// Starts observing the forward run from the clock (replacing any earlier observation):
   /// the float engine's observer (revcol/engine/observe.hpp) fed at every velocity change
   /// with the exact state converted once to float units (x length_unit, ticks x tick), the
@@ -171,21 +175,16 @@ class BasicEngine {
   void observe(const engine::ObserveConfig& c);
   /// The running or last observation (null before observe()).
   const engine::Observer* observer() const noexcept { return observer_.get(); }
-  /// Whether an observation is running.
-  bool observing() const noexcept { return obs_ != nullptr; }
-  /// Ends the observation at the clock; observer() still reads it.
-  void stop_observing();
+  bool observing() const noexcept { return obs_ != nullptr; }  ///< Whether an observation is running.
+  void stop_observing();  ///< Ends the observation at the clock; observer() still reads it.
   /// A tick as float time (the observer's clock).
   double time_of(std::int64_t tick) const noexcept { return static_cast<double>(tick) * u_.tick; }
-  /// Lattice units as a float length.
-  double to_length(std::int64_t x) const noexcept { return static_cast<double>(x) * u_.length_unit; }
+  double to_length(std::int64_t x) const noexcept { return static_cast<double>(x) * u_.length_unit; }  ///< Lattice units as a float length.
   /// Lattice units per tick as a float speed.
   double to_speed(std::int64_t v) const noexcept { return static_cast<double>(v) * (u_.length_unit / u_.tick); }
 
-  /// Positions at the clock, wrapped, by particle id.
-  std::vector<Vec> positions() const;
-  /// Velocities by particle id (a copy).
-  std::vector<Vec> velocities() const;
+  std::vector<Vec> positions() const;  ///< Positions at the clock, wrapped, by particle id.
+  std::vector<Vec> velocities() const;  ///< Velocities by particle id (a copy).
   std::int64_t clock() const noexcept { return clock_; }                ///< the current tick
   std::int64_t origin() const noexcept { return origin_; }              ///< the initial tick
   std::uint64_t collisions() const noexcept { return ncoll_; }          ///< collisions since the start
@@ -205,21 +204,18 @@ class BasicEngine {
   const Units& units() const noexcept { return u_; }                    ///< units and box
   std::size_t size() const noexcept { return ln_.size(); }               ///< N
   std::uint32_t seed() const noexcept { return seed_; }                 ///< stream seed
-  /// The stream counters by particle id.
-  std::vector<std::uint64_t> streams() const;
+  std::vector<std::uint64_t> streams() const;  ///< The stream counters by particle id.
   const Op& op() const noexcept { return op_; }                         ///< the pair operator
   /// The operator's post-direction law (an operator without one, a test's, counts as flux).
   Law law() const noexcept {
     if constexpr (requires { op_.law(); }) return op_.law();
     else return Law::flux;
   }
-  /// exact (the randomized operator Op) or specular (the deterministic map, specular.hpp).
-  Mode mode() const noexcept { return mode_; }
+  Mode mode() const noexcept { return mode_; }  ///< exact (the randomized operator Op) or specular (the deterministic map, specular.hpp).
   /// Redraws tried before a collision is resolved as a group bounce (group_bounce); -1 (tests
   /// only) resolves every collision so.
   int max_redraws = 256;
-  /// When false (tests only), every group collision bounces back instead of resolving.
-  bool group_resolve = true;
+  bool group_resolve = true;  ///< When false (tests only), every group collision bounces back instead of resolving.
   /// Tests only: when nonzero, applying collision index k (forward: the k-th; reverse: undoing
   /// the k-th) throws, to check that an engine error leaves the state as it was.
   std::uint64_t throw_at_collision = 0;
@@ -242,8 +238,7 @@ class BasicEngine {
   /// collision or reflection that moves it across a face counts at its tick: the migrations a
   /// decomposition of the box sees, each at its key. Never changes which collisions happen.
   void set_regions(int axis, std::vector<std::int64_t> faces);
-  /// Particle id's slab (set_regions; 0 without slabs).
-  int region(int id) const { return region_.empty() ? 0 : region_[local(id)]; }
+  int region(int id) const { return region_.empty() ? 0 : region_[local(id)]; }  ///< Particle id's slab (set_regions; 0 without slabs).
   /// When set, every forward change of a particle's slab is appended: (tick, particle id, from, to).
   std::vector<std::array<std::int64_t, 4>>* migrations = nullptr;
   /// The search in use: 0 the cell grid, 1 lists (the relative vector imaged per pair: a
@@ -251,8 +246,7 @@ class BasicEngine {
   int neighbour_search() const noexcept { return lists_ ? (direct_ ? 2 : 1) : 0; }
   /// The shell in use, in diameters (0: the cell grid).
   double list_shell() const noexcept { return lists_ ? 2.0 * static_cast<double>(nl_.radius()) / static_cast<double>(u_.sigma) : 0.0; }
-  /// The automatic shell for this gas, in diameters (0: cells; see set_list_shell).
-  double auto_list_shell() const noexcept;
+  double auto_list_shell() const noexcept;  ///< The automatic shell for this gas, in diameters (0: cells; see set_list_shell).
   /// Re-sorts the storage in space every `every` neutral events per particle (state.hpp, resort;
   /// 0 never, -1 automatic): a speed setting, no bit changes (test_lattice_order.cpp).
   void set_resort(int every) {
@@ -262,10 +256,8 @@ class BasicEngine {
   }
   int resort_every() const noexcept { return resort_every_for(ln_.size()); }  ///< in use (0: none)
   std::uint64_t resorts() const noexcept { return resorts_; }  ///< re-sorts since construction
-  /// Bytes held by the engine's arrays, queue, grid and log.
-  std::size_t memory_bytes() const noexcept;
-  /// Bytes held by the group entries of the rare log (map node, members, pre velocities).
-  std::size_t group_bytes() const noexcept;
+  std::size_t memory_bytes() const noexcept;  ///< Bytes held by the engine's arrays, queue, grid and log.
+  std::size_t group_bytes() const noexcept;  ///< Bytes held by the group entries of the rare log (map node, members, pre velocities).
   /// Momentum sum v per axis, 128 bits.
   static std::array<i128, D> momentum_of(const std::vector<Vec>& v) noexcept {
     std::array<i128, D> p{};
@@ -282,7 +274,7 @@ class BasicEngine {
   }
 
  private:
-  enum Type : std::uint8_t { none = 0, cross = 1, wall = 2, coll = 3 };
+  enum Type : std::uint8_t { none = 0, cross = 1, wall = 2, coll = 3, lpw = 4, lpp = 5 };  // lpw/lpp: an LP's write, park
   struct Group;  // a group collision in the rare log (below)
   // a prediction's best event so far, in the slot order (tick, kind, other particle)
   struct Best {  // (the other particle by id: gq; q its local index)
@@ -362,7 +354,6 @@ class BasicEngine {
   // the reflection map of a line whose tick-(a-1) point is x with velocity v (beyond the walls of
   // the returned axes at a): x becomes its point at a, v its velocity after (loop.hpp)
   unsigned reflection(Vec& x, Vec& v) const noexcept;
-
 
   // ---- collisions ----
   // origin + d, wrapped on periodic axes (128-bit sum: no overflow whatever the box)
@@ -580,6 +571,16 @@ class BasicEngine {
   void save_state(int p, bool drawer = false);  // state saving: p's state before the event under way
   void restore_kept(const Done& d);
   std::deque<WallDone> jwall_;  // one per wall entry of jdone_, in order
+  std::deque<std::pair<std::uint8_t, Record>> jlp_;  // per LP write or park: parked before, state before
+  std::vector<std::uint8_t> parked_;  // an LP's particles outside its view (empty: none)
+  LpNotes* lp_ = nullptr;
+  bool lp_stepped_ = false;  // lp_step: one event processed
+  EventKey done_key(const Done& d) const noexcept {
+    return {d.t, d.kind, d.type >= lpw ? d.q : gid(d.unreflected & 4u ? d.q : d.p)};
+  }
+  void lp_set(int p, const Record& r);
+  void lp_unpark(int p);
+  void lp_note(int i, int j);  // the collision's particles into lp_'s notes
   std::uint64_t j_ncoll0_ = 0;
   std::int64_t j_clock0_ = 0;
   std::pair<std::int64_t, std::int32_t> j_key0_{};

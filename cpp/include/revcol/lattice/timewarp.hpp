@@ -1,0 +1,526 @@
+// The parallel lattice engine: one gas cut into K slabs, each run by a logical process (LP)
+// ahead of the others (Time Warp), a straggler rolled back by the engine's own reverse
+// computation (no state saved per event), and the committed state the sequential engine's bit
+// for bit whatever K and the schedule (ARCHITECTURE.md "The parallel engine"; PARALLEL.md).
+//
+// Views. LP m owns the particles whose centres are in its slab [F_m, F_m+1) and holds those in
+// its band, the slab widened by W on each side (W = 3 sigma + 8 vmax: everything an event of an
+// owned particle reads, two bodies and a tick of travel from the slab); the others are parked
+// (lp_view.hpp). The slab and band faces cut the axis into fine regions, each with one owner and
+// a set of bands: ownership and views are functions of a centre's position, kept by the engine's
+// region machinery (set_regions) at the keys at which they change.
+//
+// Who computes what. Every LP processes every event of the particles it holds, in key order
+// (tick, kind, id). One of them is the event's authority: for a collision, the LP that owned the
+// key particle (the pair's lower id) before it; for a crossing or a wall, the particle's owner.
+// The authority's view holds everything the event reads (a collision of an owned particle reads
+// bodies within two diameters and a tick of travel of the slab; a group that reaches further
+// is refused when it would be committed), so its result is the sequential engine's once its view
+// is right. Every other LP's result is a guess. After a collision, the authority sends each
+// particle's whole post state to every other LP whose band held it before or holds it after; an
+// LP that guessed the same state (bit for bit) counts it confirmed, any other LP rolls back to
+// before the key and writes the state at the key instead of computing it. After a crossing or a
+// wall of an owned particle that enters another band, the owner sends it there. A particle
+// leaving a band is parked by the LP itself, at the key at which it leaves.
+//
+// Time Warp. A message whose key is at or before the LP's last processed key is a straggler
+// (unless it confirms a guess): the LP's engine runs back to before the key (rollback_before),
+// the messages it had taken in since go back to its input, and the messages it sent since are
+// cancelled by anti-messages (aggressive cancellation). GVT is the least key any LP could still
+// process or any message in flight carries; everything before it is committed: the journals and
+// message histories are forgotten there, and a guess not yet confirmed there is a protocol bug.
+//
+// Transport. This version runs the LPs on one thread, one step at a time, round robin or (fuzz)
+// in a random order with random message delays: the bits must not depend on either.
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <deque>
+#include <limits>
+#include <map>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "revcol/error.hpp"
+#include "revcol/lattice/engine.hpp"
+#include "revcol/lattice/lp.hpp"
+#include "revcol/lattice/state.hpp"
+
+namespace revcol::lattice {
+
+/// The counts of a parallel run (all LPs).
+struct TimeWarpStats {
+  std::uint64_t events = 0;     ///< queue pops that changed a state (rolled back ones too)
+  std::uint64_t stale = 0;      ///< queue pops of stale slots
+  std::uint64_t rollbacks = 0;  ///< rollbacks (stragglers and cancellations)
+  std::uint64_t undone = 0;     ///< journal entries they undid
+  std::uint64_t messages = 0;   ///< messages sent
+  std::uint64_t anti = 0;       ///< anti-messages sent
+  std::uint64_t confirmed = 0;  ///< messages that confirmed a guess
+  std::uint64_t written = 0;    ///< messages written into a view
+  std::uint64_t blocked = 0;    ///< writes that left a view inconsistent (the LP waited for a rollback)
+  std::uint64_t gvts = 0;       ///< GVT computations
+  std::vector<std::uint64_t> lp_events;  ///< per LP: events processed
+};
+
+template <class Engine>
+class TimeWarp {
+ public:
+  static constexpr std::size_t D = Engine::D;
+  using Vec = VecN<D>;
+  using Snapshot = SnapshotN<D>;
+  using Record = typename Engine::Record;
+
+  struct Config {
+    int lps = 2;                    ///< K, the logical processes (slabs)
+    int axis = 0;                   ///< the slabs' axis
+    std::uint64_t fuzz = 0;         ///< 0: round robin, messages delivered at once; else the seed of a random order and delays
+    int max_delay = 16;             ///< fuzz: a message waits up to this many scheduler steps
+    std::uint64_t gvt_every = 512;  ///< scheduler steps between GVT computations
+  };
+
+  /// K LPs on the state s (validated: bad input throws InvalidArgument, nothing is built).
+  TimeWarp(const Snapshot& s, const Config& c) : c_(c), rng_(c.fuzz) {
+    require(c.lps >= 1 && c.lps <= 64, "parallel lattice engine: 1 to 64 logical processes");
+    require(c.axis >= 0 && c.axis < static_cast<int>(D), "parallel lattice engine: the slabs' axis must be 0, 1 or (3D) 2");
+    require(c.max_delay >= 0 && c.gvt_every >= 1, "parallel lattice engine: max_delay >= 0 and gvt_every >= 1");
+    const auto& u = s.units;
+    const std::size_t ax = static_cast<std::size_t>(c.axis);
+    L_ = u.L[ax];
+    wall_ = u.wall[ax];
+    W_ = 3 * u.sigma + 8 * u.vmax;
+    reach_ = u.sigma + 4 * u.vmax;
+    // (a slab thinner than the band is fine: a band may then hold most of the box, or all of it)
+    require(L_ / c.lps >= 1, "parallel lattice engine: more logical processes than lattice units along the slabs' axis");
+    build_regions(c.lps);
+    horizon_ = s.clock;
+    for (int m = 0; m < c.lps; ++m) {
+      lps_.push_back(std::make_unique<Lp>(s));
+      Lp& lp = *lps_.back();
+      lp.me = m;
+      lp.eng.set_list_shell(0.0);
+      lp.eng.set_regions(c.axis, fine_);
+      std::vector<std::uint8_t> held(s.x.size());
+      for (std::size_t id = 0; id < held.size(); ++id) held[id] = in_view(m, lp.eng.region(static_cast<int>(id)));
+      lp.eng.migrations = &lp.notes.migrations;
+      lp.eng.lp_begin(held, &lp.notes);
+      lp.last = lp.eng.last_key();
+    }
+    stats_.lp_events.assign(static_cast<std::size_t>(c.lps), 0);
+  }
+
+  /// Runs every LP to tick `until` (no event after it), then commits: the state is the
+  /// sequential engine's run(until) bit for bit (snapshot()).
+  void run_until(std::int64_t until) {
+    require(until >= horizon_, "parallel lattice engine: the end tick is before the clock");
+    require(until < tick_limit, "parallel lattice engine: the end tick is beyond the tick limit");
+    horizon_ = until;
+    std::uint64_t since_gvt = 0;
+    for (;;) {
+      bool any = false;
+      for (int n = 0; n < c_.lps; ++n) {
+        deliver(false);
+        any = step(*lps_[c_.fuzz != 0 ? pick(c_.lps) : static_cast<std::size_t>(n)]) || any;
+      }
+      for (int n = 0; n < c_.lps && !any; ++n) any = step(*lps_[static_cast<std::size_t>(n)]);  // (a random order may miss one)
+      if (++since_gvt >= c_.gvt_every) {
+        since_gvt = 0;
+        gvt_commit();
+      }
+      if (!any && flight_.empty()) {
+        for (auto& lp : lps_)
+          if (lp->blocked) throw std::logic_error("parallel lattice engine: an LP waits for a rollback that no message brings (a bug)");
+        break;
+      }
+      if (!any) deliver(true);
+    }
+    gvt_commit();
+  }
+
+  /// The committed state at the last run_until's tick, by particle id (each particle from its
+  /// owner; the rare log and the groups the union of the LPs').
+  Snapshot snapshot() const {
+    Snapshot s = lps_.front()->eng.snapshot();
+    const std::size_t n = s.x.size();
+    s.clock = horizon_;
+    s.bits.clear();
+    std::vector<int> from(n, -1);
+    std::vector<std::vector<std::uint64_t>> words(n);
+    for (const auto& lp : lps_)
+      for (std::size_t id = 0; id < n; ++id) {
+        const int i = static_cast<int>(id);
+        if (!lp->eng.held(i) || owner_[static_cast<std::size_t>(lp->eng.region(i))] != lp->me) continue;
+        if (from[id] >= 0) throw std::logic_error("parallel lattice engine: a particle owned by two LPs (a bug)");
+        from[id] = lp->me;
+        const Record r = lp->eng.record(i);
+        s.x[id] = at(r, horizon_, s.units);
+        s.v[id] = r.v;
+        s.streams[id] = r.ctr;
+        s.particle_collisions[id] = r.pc;
+        const auto w = r.X.words();
+        words[id].assign(w.begin(), w.end());
+      }
+    for (std::size_t id = 0; id < n; ++id) {
+      if (from[id] < 0) throw std::logic_error("parallel lattice engine: a particle no LP owns (a bug)");
+      s.bits.insert(s.bits.end(), words[id].begin(), words[id].end());
+      s.bits_size[id] = words[id].size();
+    }
+    std::map<std::pair<std::uint32_t, std::uint64_t>, LogEntry> log;
+    std::map<std::pair<int, std::uint64_t>, GroupEntryN<D>> groups;
+    for (const auto& lp : lps_) {
+      const Snapshot t = lp->eng.snapshot();
+      for (const LogEntry& e : t.log) merge(log, std::make_pair(e.particle, e.count), e);
+      for (const GroupEntryN<D>& g : t.groups) merge(groups, std::make_pair(g.drawer, g.counts[index_of(g.members, g.drawer)]), g);
+    }
+    s.log.clear();
+    for (const auto& [k, e] : log) s.log.push_back(e);
+    s.groups.clear();
+    for (const auto& [k, g] : groups) s.groups.push_back(g);
+    // the collision count: every pair adds one to two counts, a group of m to m
+    std::uint64_t sum = 0;
+    for (std::uint64_t pc : s.particle_collisions) sum += pc;
+    for (const auto& g : s.groups) sum -= g.members.size() - 2;
+    s.collisions = sum / 2;
+    s.counters = Counters{};
+    return s;
+  }
+
+  const TimeWarpStats& stats() const noexcept { return stats_; }  ///< the counts so far
+  Engine& engine(int m) { return lps_.at(static_cast<std::size_t>(m))->eng; }  ///< LP m's engine (tests)
+  int lps() const noexcept { return c_.lps; }                      ///< K
+  std::int64_t band() const noexcept { return W_; }                ///< W, lattice units
+
+ private:
+  struct Message {
+    EventKey key;
+    int id = 0;  // the particle
+    int to = 0;
+    std::uint64_t serial = 0;
+    bool anti = false;
+    Record rec;
+  };
+  using MKey = std::pair<EventKey, std::uint64_t>;  // (key, serial): messages in key order
+  struct Lp {
+    explicit Lp(const Snapshot& s) : eng(s, operator_for(s.units, s.law)) {}
+    int me = 0;
+    Engine eng;
+    LpNotes notes;
+    EventKey last;                                    // the last key processed
+    std::map<MKey, Message> pending, taken;           // input not yet processed; processed (written or confirming)
+    std::map<std::pair<EventKey, int>, Record> guesses;  // (key, particle): a guessed post state, unconfirmed
+    std::map<MKey, Message> sent;                     // sent since GVT (for anti-messages)
+    std::map<EventKey, std::string> refused;          // events whose reach the LP's view cannot vouch for
+    std::vector<std::uint64_t> annihilate;            // anti-messages that overtook their message
+    bool blocked = false;
+    EventKey block_key;
+  };
+
+  // ---- the regions ----
+  void build_regions(int k) {
+    std::vector<std::int64_t> slab(static_cast<std::size_t>(k));
+    for (int m = 0; m < k; ++m) slab[static_cast<std::size_t>(m)] = static_cast<std::int64_t>(static_cast<__int128>(L_) * m / k);
+    slab_ = slab;
+    std::vector<std::int64_t> f;
+    for (int m = 0; m < k; ++m)
+      for (std::int64_t d : {std::int64_t{0}, -W_, W_}) {
+        std::int64_t y = slab[static_cast<std::size_t>(m)] + d;
+        if (wall_) {
+          if (y > 0 && y < L_) f.push_back(y);
+        } else {
+          f.push_back(((y % L_) + L_) % L_);
+        }
+      }
+    f.push_back(0);
+    std::sort(f.begin(), f.end());
+    f.erase(std::unique(f.begin(), f.end()), f.end());
+    fine_ = f;
+    for (std::int64_t g : f) {
+      owner_.push_back(slab_of(g));
+      std::uint64_t mask = 0;
+      for (int m = 0; m < k; ++m)
+        if (in_band(m, g)) mask |= std::uint64_t{1} << m;
+      views_.push_back(mask);
+    }
+  }
+  int slab_of(std::int64_t x) const {
+    int r = 0;
+    for (int m = 0; m < c_.lps; ++m)
+      if (x >= slab_[static_cast<std::size_t>(m)]) r = m;
+    return r;
+  }
+  bool in_band(int m, std::int64_t x) const {
+    const std::int64_t lo = slab_[static_cast<std::size_t>(m)] - W_;
+    const std::int64_t hi = (m + 1 < c_.lps ? slab_[static_cast<std::size_t>(m + 1)] : L_) + W_;
+    if (wall_ || hi - lo >= L_) return (x >= lo && x < hi) || hi - lo >= L_;
+    const std::int64_t d = ((x - lo) % L_ + L_) % L_;
+    return d < hi - lo;
+  }
+  bool in_view(int m, int region) const { return (views_[static_cast<std::size_t>(region)] >> m & 1u) != 0; }
+  int owner(int region) const { return owner_[static_cast<std::size_t>(region)]; }
+  // a centre's distance along the axis outside slab m (0 inside)
+  std::int64_t outside(int m, std::int64_t x) const {
+    const std::int64_t lo = slab_[static_cast<std::size_t>(m)];
+    const std::int64_t hi = m + 1 < c_.lps ? slab_[static_cast<std::size_t>(m + 1)] : L_;
+    if (x >= lo && x < hi) return 0;
+    if (wall_) return x < lo ? lo - x : x - hi + 1;
+    const std::int64_t below = ((lo - x) % L_ + L_) % L_, above = ((x - hi) % L_ + L_) % L_ + 1;
+    return std::min(below, above);
+  }
+
+  // ---- one LP step ----
+  // Processes the LP's next key (its messages at that key, or else its engine's next event),
+  // if any at or before the horizon. False: nothing to do.
+  bool step(Lp& lp) {
+    if (lp.blocked) return false;
+    EventKey ke;
+    const bool has_e = lp.eng.lp_next(ke) && ke.t <= horizon_;
+    const bool has_m = !lp.pending.empty() && lp.pending.begin()->first.first.t <= horizon_;
+    if (!has_e && !has_m) return false;
+    if (has_m && (!has_e || !(ke < lp.pending.begin()->first.first))) {
+      take_messages(lp);
+      return true;
+    }
+    lp.notes.migrations.clear();
+    try {
+      lp.eng.lp_step();
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string("parallel lattice engine: logical process ") + std::to_string(lp.me) +
+                               " met an engine error (the parallel engine cannot yet roll back across one): " + e.what());
+    }
+    lp.last = lp.notes.key;
+    if (lp.notes.type == LpNotes::none) {
+      ++stats_.stale;
+      return true;
+    }
+    ++stats_.events;
+    ++stats_.lp_events[static_cast<std::size_t>(lp.me)];
+    after_event(lp);
+    return true;
+  }
+
+  // the messages at the least pending key, written into the view
+  void take_messages(Lp& lp) {
+    const EventKey k = lp.pending.begin()->first.first;
+    std::vector<int> ids;
+    while (!lp.pending.empty() && lp.pending.begin()->first.first == k) {
+      auto node = lp.pending.extract(lp.pending.begin());
+      const Message& m = node.mapped();
+      ++stats_.written;
+      lp.eng.lp_write(m.id, m.rec, k);
+      ids.push_back(m.id);
+      lp.taken.insert(std::move(node));
+    }
+    lp.last = k;
+    // a view that cannot hold what it was told waits for the rollback that must come
+    for (int id : ids)
+      if (!lp.blocked && !lp.eng.lp_clear(id, k)) {
+        lp.blocked = true;
+        lp.block_key = k;
+        ++stats_.blocked;
+      }
+    park_leavers(lp, k, ids);  // a particle written outside the band leaves the view at the key
+    lp.notes.migrations.clear();
+  }
+
+  // the particles `ids` (or, none given, those whose region the last event changed) that are
+  // outside the band now: parked at the key
+  void park_leavers(Lp& lp, const EventKey& k, std::vector<int> ids = {}) {
+    if (ids.empty()) ids = moved(lp);
+    for (int id : ids)
+      if (lp.eng.held(id) && !in_view(lp.me, lp.eng.region(id))) lp.eng.lp_park(id, k);
+  }
+  // the particles whose region the last event changed, each once
+  std::vector<int> moved(const Lp& lp) const {
+    std::vector<int> ids;
+    for (const auto& mg : lp.notes.migrations)
+      if (std::find(ids.begin(), ids.end(), static_cast<int>(mg[1])) == ids.end()) ids.push_back(static_cast<int>(mg[1]));
+    return ids;
+  }
+
+  // a particle's region before the last event (its first migration's `from`, else its region)
+  int region_before(const Lp& lp, int id) const {
+    for (const auto& mg : lp.notes.migrations)
+      if (mg[1] == id) return static_cast<int>(mg[2]);
+    return lp.eng.region(id);
+  }
+
+  void after_event(Lp& lp) {
+    const EventKey k = lp.notes.key;
+    if (lp.notes.type == LpNotes::coll) {
+      const int key_owner = owner(region_before(lp, k.id));
+      if (key_owner == lp.me) {
+        check_reach(lp, k);
+        for (int id : lp.notes.ids) {
+          const std::uint64_t to = (views_[static_cast<std::size_t>(region_before(lp, id))] |
+                                    views_[static_cast<std::size_t>(lp.eng.region(id))]) & ~(std::uint64_t{1} << lp.me);
+          if (to != 0) send(lp, k, id, to);
+        }
+      } else {
+        for (int id : lp.notes.ids) lp.guesses[{k, id}] = lp.eng.record(id);
+      }
+    } else {
+      // a crossing or a wall: an owned particle entering another band is sent there
+      for (int id : moved(lp)) {
+        if (owner(region_before(lp, id)) != lp.me) continue;
+        const std::uint64_t to = views_[static_cast<std::size_t>(lp.eng.region(id))] &
+                                 ~views_[static_cast<std::size_t>(region_before(lp, id))] & ~(std::uint64_t{1} << lp.me);
+        if (to != 0) send(lp, k, id, to);
+      }
+    }
+    park_leavers(lp, k);
+  }
+
+  // a collision this LP is the authority of: every member must be far enough inside its band
+  // that all the bodies the event read are held
+  void check_reach(Lp& lp, const EventKey& k) {
+    if (lp.notes.ids.size() <= 2) return;  // a pair of an owned key particle: within reach by W
+    const auto& u = lp.eng.units();
+    for (int id : lp.notes.ids) {
+      const std::int64_t x = at(lp.eng.record(id), k.t, u)[static_cast<std::size_t>(c_.axis)];
+      if (outside(lp.me, x) > W_ - reach_)
+        lp.refused[k] = "a group collision of " + std::to_string(lp.notes.ids.size()) + " particles at tick " + std::to_string(k.t) +
+                        " reaches beyond logical process " + std::to_string(lp.me) + "'s band (use fewer logical processes)";
+    }
+  }
+
+  void send(Lp& lp, const EventKey& k, int id, std::uint64_t to) {
+    const Record r = lp.eng.record(id);
+    for (int y = 0; y < c_.lps; ++y) {
+      if ((to >> y & 1u) == 0) continue;
+      Message m{k, id, y, ++serial_, false, r};
+      lp.sent.emplace(MKey{k, m.serial}, m);
+      ++stats_.messages;
+      post(std::move(m));
+    }
+  }
+
+  // ---- the transport ----
+  // (never delivered at once: a receiver's rollback sends anti-messages, and their receiver may
+  // be the sender, in the middle of an event)
+  void post(Message m) {
+    const std::uint64_t wait = c_.fuzz == 0 || c_.max_delay == 0 ? 0 : rng_() % static_cast<std::uint64_t>(c_.max_delay + 1);
+    flight_.push_back({clock_ + wait, std::move(m)});
+  }
+  // delivers the messages whose delay has passed (all: every one in flight)
+  void deliver(bool all) {
+    ++clock_;
+    std::deque<std::pair<std::uint64_t, Message>> now, keep;
+    for (auto& item : flight_) (all || item.first <= clock_ ? now : keep).push_back(std::move(item));
+    flight_ = std::move(keep);
+    for (auto& item : now) receive(*lps_[static_cast<std::size_t>(item.second.to)], std::move(item.second));
+  }
+
+  void receive(Lp& lp, Message m) {
+    const MKey mk{m.key, m.serial};
+    if (m.anti) {
+      if (lp.pending.erase(mk) != 0) return;
+      if (lp.taken.count(mk) != 0) {
+        rollback(lp, m.key);
+        lp.pending.erase(mk);
+        return;
+      }
+      lp.annihilate.push_back(m.serial);  // it overtook its message
+      return;
+    }
+    if (const auto a = std::find(lp.annihilate.begin(), lp.annihilate.end(), m.serial); a != lp.annihilate.end()) {
+      lp.annihilate.erase(a);
+      return;
+    }
+    if (lp.last < m.key) {
+      lp.pending.emplace(mk, std::move(m));
+      return;
+    }
+    const auto g = lp.guesses.find({m.key, m.id});
+    if (g != lp.guesses.end() && g->second == m.rec) {  // the guess was right
+      lp.guesses.erase(g);
+      ++stats_.confirmed;
+      lp.taken.emplace(mk, std::move(m));
+      return;
+    }
+    rollback(lp, m.key);
+    lp.pending.emplace(mk, std::move(m));
+  }
+
+  // ---- rollback ----
+  void rollback(Lp& lp, const EventKey& k) {
+    const std::size_t before = lp.eng.journal_size();
+    lp.eng.rollback_before(k.t, k.kind, k.id);
+    ++stats_.rollbacks;
+    stats_.undone += before - lp.eng.journal_size();
+    lp.last = lp.eng.last_key();
+    // the messages taken in at or after k go back to the input; guesses from then are gone
+    for (auto it = lp.taken.lower_bound(MKey{k, 0}); it != lp.taken.end();) lp.pending.insert(lp.taken.extract(it++));
+    lp.guesses.erase(lp.guesses.lower_bound({k, std::numeric_limits<int>::min()}), lp.guesses.end());
+    lp.refused.erase(lp.refused.lower_bound(k), lp.refused.end());
+    if (lp.blocked && !(lp.block_key < k)) lp.blocked = false;
+    // what it sent from then is cancelled
+    for (auto it = lp.sent.lower_bound(MKey{k, 0}); it != lp.sent.end();) {
+      Message a = it->second;
+      a.anti = true;
+      ++stats_.anti;
+      it = lp.sent.erase(it);
+      post(std::move(a));
+    }
+  }
+
+  // ---- GVT ----
+  void gvt_commit() {
+    ++stats_.gvts;
+    EventKey g{std::numeric_limits<std::int64_t>::max(), 0, 0};
+    for (const auto& item : flight_) g = std::min(g, item.second.key);
+    for (auto& lp : lps_) {
+      EventKey k;
+      if (lp->blocked) g = std::min(g, lp->block_key);
+      if (!lp->pending.empty()) g = std::min(g, lp->pending.begin()->first.first);
+      if (lp->eng.lp_next(k)) g = std::min(g, k);
+    }
+    // (a run that reached its horizon: everything up to it is committed)
+    for (auto& lp : lps_) {
+      const EventKey until = std::min(g, lp->last.next());
+      if (!lp->refused.empty() && lp->refused.begin()->first < until) throw std::runtime_error("parallel lattice engine: " + lp->refused.begin()->second);
+      if (!lp->guesses.empty() && lp->guesses.begin()->first.first < until)
+        throw std::logic_error("parallel lattice engine: a guess of logical process " + std::to_string(lp->me) + " at tick " +
+                               std::to_string(lp->guesses.begin()->first.first.t) + " was never confirmed (a bug)");
+      lp->eng.commit_before(until);
+      lp->taken.erase(lp->taken.begin(), lp->taken.lower_bound(MKey{until, 0}));
+      lp->sent.erase(lp->sent.begin(), lp->sent.lower_bound(MKey{until, 0}));
+    }
+  }
+
+  // ---- helpers ----
+  std::size_t pick(int k) { return static_cast<std::size_t>(rng_() % static_cast<std::uint64_t>(k)); }
+  static Vec at(const Record& r, std::int64_t t, const UnitsN<D>& u) {
+    Vec x;
+    for (std::size_t k = 0; k < D; ++k) {
+      const __int128 y = static_cast<__int128>(r.x[k]) + static_cast<__int128>(r.v[k]) * (t - r.ta);
+      x[k] = u.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u.L[k]);
+    }
+    return x;
+  }
+  template <class M, class K, class V>
+  static void merge(M& map, const K& key, const V& value) {
+    const auto [it, fresh] = map.emplace(key, value);
+    if (!fresh && !(it->second == value)) throw std::logic_error("parallel lattice engine: two LPs disagree on a rare-log entry (a bug)");
+  }
+  static std::size_t index_of(const std::vector<int>& v, int x) {
+    return static_cast<std::size_t>(std::find(v.begin(), v.end(), x) - v.begin());
+  }
+
+  Config c_;
+  std::mt19937_64 rng_;
+  std::int64_t L_ = 0, W_ = 0, reach_ = 0, horizon_ = 0;
+  bool wall_ = false;
+  std::vector<std::int64_t> slab_, fine_;
+  std::vector<int> owner_;
+  std::vector<std::uint64_t> views_;
+  std::vector<std::unique_ptr<Lp>> lps_;
+  std::deque<std::pair<std::uint64_t, Message>> flight_;
+  std::uint64_t clock_ = 0, serial_ = 0;
+  TimeWarpStats stats_;
+};
+
+}  // namespace revcol::lattice

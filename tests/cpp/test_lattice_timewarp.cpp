@@ -1,0 +1,117 @@
+// The parallel lattice engine (timewarp.hpp): K logical processes on slabs, optimistic, rolled
+// back by reverse computation, commit the sequential engine's state bit for bit at every tick it
+// is asked to stop at, for K = 1 to 8, 2D and 3D, walls and periodic, in a round-robin schedule
+// and in random schedules with random message delays; a state that no schedule may change.
+#include <cstdio>
+#include <cstdlib>
+#include <set>
+#include <vector>
+
+#include "check.hpp"
+#include "lattice_gas_util.hpp"
+#include "revcol/lattice/engine.hpp"
+#include "revcol/lattice/timewarp.hpp"
+
+using namespace revcol::lattice;
+namespace en = revcol::engine;
+using revcol::Mode;
+
+namespace {
+
+using lattice_test::EngineOf;
+
+// collisions per stop, from the environment for longer runs
+std::uint64_t scaled(std::uint64_t n) {
+  const char* s = std::getenv("REVCOL_TIMEWARP_SCALE");
+  return s == nullptr ? n : n * std::strtoull(s, nullptr, 10);
+}
+
+template <std::size_t D>
+void check_parallel(EngineOf<D> e, int axis, const std::vector<int>& ks, const std::vector<std::uint64_t>& fuzz,
+                    std::uint64_t per_stop, const char* what) {
+  e.run(e.size(), tick_limit - 1);
+  const SnapshotN<D> s0 = e.snapshot();
+  // the sequential engine's state at three stops (every event at or before each stop's tick)
+  EngineOf<D> ref(s0, operator_for(s0.units, s0.law));
+  std::vector<std::array<std::int64_t, 3>> rtrace;
+  ref.trace = &rtrace;
+  std::vector<SnapshotN<D>> want;
+  for (int k = 0; k < 3; ++k) {
+    ref.run(per_stop, tick_limit - 1);
+    ref.run(~std::uint64_t{0}, ref.clock());
+    want.push_back(ref.snapshot());
+  }
+  for (int K : ks)
+    for (std::uint64_t f : fuzz) {
+      typename TimeWarp<EngineOf<D>>::Config c;
+      c.lps = K;
+      c.axis = axis;
+      c.fuzz = f;
+      if (const char* d = std::getenv("TW_DELAY")) c.max_delay = std::atoi(d);
+      if (const char* d = std::getenv("TW_GVT")) c.gvt_every = std::strtoull(d, nullptr, 10);
+      TimeWarp<EngineOf<D>> tw(s0, c);
+      std::vector<std::vector<std::array<std::int64_t, 3>>> traces(static_cast<std::size_t>(K));
+      for (int m = 0; m < K; ++m) tw.engine(m).trace = &traces[static_cast<std::size_t>(m)];
+      bool same = true;
+      for (const auto& w : want) {
+        tw.run_until(w.clock);
+        const bool eq = same_state(tw.snapshot(), w);
+        if (!eq) {
+          const SnapshotN<D> g = tw.snapshot();
+          std::printf("    differs at tick %lld: collisions %llu / %llu, log %zu / %zu, groups %zu / %zu\n", static_cast<long long>(w.clock),
+                      (unsigned long long)g.collisions, (unsigned long long)w.collisions, g.log.size(), w.log.size(), g.groups.size(), w.groups.size());
+          std::set<std::array<std::int64_t, 3>> have;
+          for (const auto& t : traces) have.insert(t.begin(), t.end());
+          int miss = 0;
+          for (const auto& t : rtrace)
+            if (t[0] <= w.clock && !have.count(t) && miss++ < 5) {
+              std::printf("      missing collision tick %lld (%lld, %lld); in LPs:", (long long)t[0], (long long)t[1], (long long)t[2]);
+              for (int m = 0; m < K; ++m) std::printf(" LP%d holds %d/%d region %d/%d", m, (int)tw.engine(m).held((int)t[1]), (int)tw.engine(m).held((int)t[2]),
+                                                      tw.engine(m).region((int)t[1]), tw.engine(m).region((int)t[2]));
+              std::printf("\n");
+            }
+          int shown = 0;
+          for (std::size_t p = 0; p < g.x.size() && shown < 5; ++p)
+            if (g.x[p] != w.x[p] || g.v[p] != w.v[p] || g.streams[p] != w.streams[p] || g.particle_collisions[p] != w.particle_collisions[p]) {
+              ++shown;
+              std::printf("      particle %zu: x %lld/%lld v %lld/%lld ctr %llu/%llu pc %llu/%llu\n", p, (long long)g.x[p][0], (long long)w.x[p][0],
+                          (long long)g.v[p][0], (long long)w.v[p][0], (unsigned long long)g.streams[p], (unsigned long long)w.streams[p],
+                          (unsigned long long)g.particle_collisions[p], (unsigned long long)w.particle_collisions[p]);
+            }
+        }
+        same = same && eq;
+      }
+      const TimeWarpStats& st = tw.stats();
+      std::printf("  %s, K = %d, %s: %llu collisions; events %llu, rollbacks %llu (%llu undone), messages %llu, anti %llu, "
+                  "confirmed %llu, written %llu, blocked %llu: same as sequential: %s\n",
+                  what, K, f == 0 ? "round robin" : "fuzzed", static_cast<unsigned long long>(want.back().collisions - s0.collisions),
+                  static_cast<unsigned long long>(st.events), static_cast<unsigned long long>(st.rollbacks),
+                  static_cast<unsigned long long>(st.undone), static_cast<unsigned long long>(st.messages),
+                  static_cast<unsigned long long>(st.anti), static_cast<unsigned long long>(st.confirmed),
+                  static_cast<unsigned long long>(st.written), static_cast<unsigned long long>(st.blocked), same ? "yes" : "NO");
+      CHECK(same);
+    }
+}
+
+}  // namespace
+
+const std::vector<int> kAll{1, 2, 3, 4, 8};
+
+TEST_CASE("the parallel engine commits the sequential state bit for bit (2D)") {
+  using B = en::Boundary;
+  check_parallel<2>(lattice_test::make_gas<2>(400, 0.4, B::periodic, 71, 16), 0, kAll, {0, 5, 6}, scaled(2000), "2D 0.4 periodic");
+  check_parallel<2>(lattice_test::make_gas<2>(2000, 0.5, B::periodic, 72, 16), 1, kAll, {0, 7}, scaled(11000), "2D 0.5 periodic N 2000");
+  check_parallel<2>(lattice_test::make_gas<2>(2000, 0.6, B::wall, 73, 16), 0, kAll, {0, 8}, scaled(11000), "2D 0.6 walls N 2000");
+  check_parallel<2>(lattice_test::make_gas<2>(1000, 0.4, B::periodic, 74, 16, Mode::specular), 0, {2, 4, 8}, {0, 9}, scaled(4000),
+                    "2D 0.4 periodic specular");
+}
+
+TEST_CASE("the parallel engine commits the sequential state bit for bit (3D)") {
+  using B = en::Boundary;
+  check_parallel<3>(lattice_test::make_gas<3>(2000, 0.3, B::periodic, 75, 16), 2, kAll, {0, 10}, scaled(11000), "3D 0.3 periodic N 2000");
+  check_parallel<3>(lattice_test::make_gas<3>(2000, 0.35, B::bounce, 76, 16), 0, kAll, {0, 11}, scaled(11000), "3D 0.35 bounce walls N 2000");
+  check_parallel<3>(lattice_test::make_gas<3>(1000, 0.25, B::wall, 77, 16, Mode::specular), 1, {2, 3}, {0, 12}, scaled(4000),
+                    "3D 0.25 walls specular");
+}
+
+int main() { return check::run_all(); }
