@@ -30,24 +30,36 @@
 // process or any message in flight carries; everything before it is committed: the journals and
 // message histories are forgotten there, and a guess not yet confirmed there is a protocol bug.
 //
-// Transport. This version runs the LPs on one thread, one step at a time, round robin or (fuzz)
-// in a random order with random message delays: the bits must not depend on either.
+// Transport. workers = 1: the LPs on the calling thread, one step at a time, round robin or
+// (fuzz) in a random order with random message delays. workers > 1: that many threads (the
+// calling one among them), each running its share of the LPs a batch of steps at a time; a
+// message goes into its receiver's inbox (a mutex each); GVT is computed with every worker
+// stopped at a barrier (every gvt_every steps of a worker, or when one finds nothing to do),
+// which is also where the run ends, the calling thread polls for Ctrl-C, and an LP's error is
+// raised. Neither the schedule nor the delays may change a bit.
 #pragma once
 #include <algorithm>
+#include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <exception>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include "revcol/error.hpp"
 #include "revcol/lattice/engine.hpp"
 #include "revcol/lattice/lp.hpp"
+#include "revcol/lattice/slab_views.hpp"
 #include "revcol/lattice/state.hpp"
 
 namespace revcol::lattice {
@@ -63,8 +75,13 @@ struct TimeWarpStats {
   std::uint64_t confirmed = 0;  ///< messages that confirmed a guess
   std::uint64_t written = 0;    ///< messages written into a view
   std::uint64_t blocked = 0;    ///< writes that left a view inconsistent (the LP waited for a rollback)
+  std::uint64_t reused = 0;     ///< messages a re-execution sent again as they were (lazy cancellation)
   std::uint64_t gvts = 0;       ///< GVT computations
   std::vector<std::uint64_t> lp_events;  ///< per LP: events processed
+  void add(const TimeWarpStats& o) {
+    events += o.events, stale += o.stale, rollbacks += o.rollbacks, undone += o.undone, messages += o.messages;
+    anti += o.anti, confirmed += o.confirmed, written += o.written, blocked += o.blocked, reused += o.reused;
+  }
 };
 
 template <class Engine>
@@ -80,65 +97,54 @@ class TimeWarp {
     int axis = 0;                   ///< the slabs' axis
     std::uint64_t fuzz = 0;         ///< 0: round robin, messages delivered at once; else the seed of a random order and delays
     int max_delay = 16;             ///< fuzz: a message waits up to this many scheduler steps
-    std::uint64_t gvt_every = 512;  ///< scheduler steps between GVT computations
+    std::uint64_t gvt_every = 512;  ///< scheduler steps (threads: a worker's steps) between GVT computations
+    int workers = 1;                ///< threads (the calling one among them), at most the LPs
+    int batch = 64;                 ///< threads: an LP's steps per turn
+    Rollback how = Rollback::reverse;  ///< how an LP rolls back: reverse computation, or state saving (SS1, SS2)
+    bool lazy = true;               ///< lazy cancellation (else aggressive: anti-messages at once)
+    std::int64_t window = 0;        ///< optimism: no event more than this many ticks past GVT (0: none)
   };
 
   /// K LPs on the state s (validated: bad input throws InvalidArgument, nothing is built).
   TimeWarp(const Snapshot& s, const Config& c) : c_(c), rng_(c.fuzz) {
-    require(c.lps >= 1 && c.lps <= 64, "parallel lattice engine: 1 to 64 logical processes");
     require(c.axis >= 0 && c.axis < static_cast<int>(D), "parallel lattice engine: the slabs' axis must be 0, 1 or (3D) 2");
-    require(c.max_delay >= 0 && c.gvt_every >= 1, "parallel lattice engine: max_delay >= 0 and gvt_every >= 1");
+    require(c.max_delay >= 0 && c.gvt_every >= 1 && c.batch >= 1, "parallel lattice engine: max_delay >= 0, gvt_every >= 1, batch >= 1");
+    require(c.workers >= 1 && c.workers <= c.lps, "parallel lattice engine: 1 to K (the logical processes) workers");
+    require(c.workers == 1 || c.fuzz == 0, "parallel lattice engine: the fuzzed schedule runs on one worker");
     const auto& u = s.units;
     const std::size_t ax = static_cast<std::size_t>(c.axis);
-    L_ = u.L[ax];
-    wall_ = u.wall[ax];
-    W_ = 3 * u.sigma + 8 * u.vmax;
     reach_ = u.sigma + 4 * u.vmax;
-    // (a slab thinner than the band is fine: a band may then hold most of the box, or all of it)
-    require(L_ / c.lps >= 1, "parallel lattice engine: more logical processes than lattice units along the slabs' axis");
-    build_regions(c.lps);
+    sv_ = SlabViews(c.lps, u.L[ax], u.wall[ax], 3 * u.sigma + 8 * u.vmax);
     horizon_ = s.clock;
     for (int m = 0; m < c.lps; ++m) {
       lps_.push_back(std::make_unique<Lp>(s));
       Lp& lp = *lps_.back();
       lp.me = m;
       lp.eng.set_list_shell(0.0);
-      lp.eng.set_regions(c.axis, fine_);
+      lp.eng.set_regions(c.axis, sv_.faces());
       std::vector<std::uint8_t> held(s.x.size());
-      for (std::size_t id = 0; id < held.size(); ++id) held[id] = in_view(m, lp.eng.region(static_cast<int>(id)));
+      for (std::size_t id = 0; id < held.size(); ++id) held[id] = sv_.in_view(m, lp.eng.region(static_cast<int>(id)));
       lp.eng.migrations = &lp.notes.migrations;
+      lp.eng.keep_journal(true, c.how);
       lp.eng.lp_begin(held, &lp.notes);
       lp.last = lp.eng.last_key();
     }
-    stats_.lp_events.assign(static_cast<std::size_t>(c.lps), 0);
   }
 
   /// Runs every LP to tick `until` (no event after it), then commits: the state is the
   /// sequential engine's run(until) bit for bit (snapshot()).
-  void run_until(std::int64_t until) {
+  /// Ctrl-C (poll() false, asked by the calling thread): every LP goes back to the last tick GVT
+  /// has passed, and the run ends there, as run(until = that tick) would. Returns false then.
+  bool run_until(std::int64_t until, const std::function<bool()>& poll = {}) {
     require(until >= horizon_, "parallel lattice engine: the end tick is before the clock");
     require(until < tick_limit, "parallel lattice engine: the end tick is beyond the tick limit");
+    start_ = horizon_;
+    gvt_t_ = std::max(gvt_t_, start_);
     horizon_ = until;
-    std::uint64_t since_gvt = 0;
-    for (;;) {
-      bool any = false;
-      for (int n = 0; n < c_.lps; ++n) {
-        deliver(false);
-        any = step(*lps_[c_.fuzz != 0 ? pick(c_.lps) : static_cast<std::size_t>(n)]) || any;
-      }
-      for (int n = 0; n < c_.lps && !any; ++n) any = step(*lps_[static_cast<std::size_t>(n)]);  // (a random order may miss one)
-      if (++since_gvt >= c_.gvt_every) {
-        since_gvt = 0;
-        gvt_commit();
-      }
-      if (!any && flight_.empty()) {
-        for (auto& lp : lps_)
-          if (lp->blocked) throw std::logic_error("parallel lattice engine: an LP waits for a rollback that no message brings (a bug)");
-        break;
-      }
-      if (!any) deliver(true);
-    }
-    gvt_commit();
+    stopped_ = false;
+    if (c_.workers > 1) run_threads(poll);
+    else run_one(poll);
+    return !stopped_;
   }
 
   /// The committed state at the last run_until's tick, by particle id (each particle from its
@@ -153,7 +159,7 @@ class TimeWarp {
     for (const auto& lp : lps_)
       for (std::size_t id = 0; id < n; ++id) {
         const int i = static_cast<int>(id);
-        if (!lp->eng.held(i) || owner_[static_cast<std::size_t>(lp->eng.region(i))] != lp->me) continue;
+        if (!lp->eng.held(i) || sv_.owner(lp->eng.region(i)) != lp->me) continue;
         if (from[id] >= 0) throw std::logic_error("parallel lattice engine: a particle owned by two LPs (a bug)");
         from[id] = lp->me;
         const Record r = lp->eng.record(i);
@@ -189,10 +195,19 @@ class TimeWarp {
     return s;
   }
 
-  const TimeWarpStats& stats() const noexcept { return stats_; }  ///< the counts so far
+  /// The counts so far, all LPs.
+  TimeWarpStats stats() const {
+    TimeWarpStats t;
+    t.gvts = gvts_;
+    for (const auto& lp : lps_) {
+      t.add(lp->st);
+      t.lp_events.push_back(lp->st.events);
+    }
+    return t;
+  }
   Engine& engine(int m) { return lps_.at(static_cast<std::size_t>(m))->eng; }  ///< LP m's engine (tests)
   int lps() const noexcept { return c_.lps; }                      ///< K
-  std::int64_t band() const noexcept { return W_; }                ///< W, lattice units
+  std::int64_t band() const noexcept { return sv_.band(); }         ///< W, lattice units
 
  private:
   struct Message {
@@ -213,77 +228,36 @@ class TimeWarp {
     std::map<MKey, Message> pending, taken;           // input not yet processed; processed (written or confirming)
     std::map<std::pair<EventKey, int>, Record> guesses;  // (key, particle): a guessed post state, unconfirmed
     std::map<MKey, Message> sent;                     // sent since GVT (for anti-messages)
+    std::map<MKey, Message> lazy;                     // sent, then rolled back: cancelled unless sent again
     std::map<EventKey, std::string> refused;          // events whose reach the LP's view cannot vouch for
     std::vector<std::uint64_t> annihilate;            // anti-messages that overtook their message
     bool blocked = false;
     EventKey block_key;
+    TimeWarpStats st;
+    std::uint64_t nsent = 0;                          // (serials: (LP << 48) + its count)
+    std::mutex inbox_mx;                              // threads: messages posted to it
+    std::vector<Message> inbox;
   };
-
-  // ---- the regions ----
-  void build_regions(int k) {
-    std::vector<std::int64_t> slab(static_cast<std::size_t>(k));
-    for (int m = 0; m < k; ++m) slab[static_cast<std::size_t>(m)] = static_cast<std::int64_t>(static_cast<__int128>(L_) * m / k);
-    slab_ = slab;
-    std::vector<std::int64_t> f;
-    for (int m = 0; m < k; ++m)
-      for (std::int64_t d : {std::int64_t{0}, -W_, W_}) {
-        std::int64_t y = slab[static_cast<std::size_t>(m)] + d;
-        if (wall_) {
-          if (y > 0 && y < L_) f.push_back(y);
-        } else {
-          f.push_back(((y % L_) + L_) % L_);
-        }
-      }
-    f.push_back(0);
-    std::sort(f.begin(), f.end());
-    f.erase(std::unique(f.begin(), f.end()), f.end());
-    fine_ = f;
-    for (std::int64_t g : f) {
-      owner_.push_back(slab_of(g));
-      std::uint64_t mask = 0;
-      for (int m = 0; m < k; ++m)
-        if (in_band(m, g)) mask |= std::uint64_t{1} << m;
-      views_.push_back(mask);
-    }
-  }
-  int slab_of(std::int64_t x) const {
-    int r = 0;
-    for (int m = 0; m < c_.lps; ++m)
-      if (x >= slab_[static_cast<std::size_t>(m)]) r = m;
-    return r;
-  }
-  bool in_band(int m, std::int64_t x) const {
-    const std::int64_t lo = slab_[static_cast<std::size_t>(m)] - W_;
-    const std::int64_t hi = (m + 1 < c_.lps ? slab_[static_cast<std::size_t>(m + 1)] : L_) + W_;
-    if (wall_ || hi - lo >= L_) return (x >= lo && x < hi) || hi - lo >= L_;
-    const std::int64_t d = ((x - lo) % L_ + L_) % L_;
-    return d < hi - lo;
-  }
-  bool in_view(int m, int region) const { return (views_[static_cast<std::size_t>(region)] >> m & 1u) != 0; }
-  int owner(int region) const { return owner_[static_cast<std::size_t>(region)]; }
-  // a centre's distance along the axis outside slab m (0 inside)
-  std::int64_t outside(int m, std::int64_t x) const {
-    const std::int64_t lo = slab_[static_cast<std::size_t>(m)];
-    const std::int64_t hi = m + 1 < c_.lps ? slab_[static_cast<std::size_t>(m + 1)] : L_;
-    if (x >= lo && x < hi) return 0;
-    if (wall_) return x < lo ? lo - x : x - hi + 1;
-    const std::int64_t below = ((lo - x) % L_ + L_) % L_, above = ((x - hi) % L_ + L_) % L_ + 1;
-    return std::min(below, above);
-  }
 
   // ---- one LP step ----
   // Processes the LP's next key (its messages at that key, or else its engine's next event),
   // if any at or before the horizon. False: nothing to do.
   bool step(Lp& lp) {
     if (lp.blocked) return false;
+    const std::int64_t limit = c_.window > 0 ? std::min(horizon_, gvt_t_ + c_.window) : horizon_;
     EventKey ke;
-    const bool has_e = lp.eng.lp_next(ke) && ke.t <= horizon_;
-    const bool has_m = !lp.pending.empty() && lp.pending.begin()->first.first.t <= horizon_;
-    if (!has_e && !has_m) return false;
+    const bool has_e = lp.eng.lp_next(ke) && ke.t <= limit;
+    const bool has_m = !lp.pending.empty() && lp.pending.begin()->first.first.t <= limit;
+    if (!has_e && !has_m) {
+      flush(lp, EventKey{limit + 1, std::numeric_limits<std::int32_t>::min(), 0});  // nothing up to it will send them again
+      return false;
+    }
     if (has_m && (!has_e || !(ke < lp.pending.begin()->first.first))) {
+      flush(lp, lp.pending.begin()->first.first);
       take_messages(lp);
       return true;
     }
+    flush(lp, ke);
     lp.notes.migrations.clear();
     try {
       lp.eng.lp_step();
@@ -293,13 +267,25 @@ class TimeWarp {
     }
     lp.last = lp.notes.key;
     if (lp.notes.type == LpNotes::none) {
-      ++stats_.stale;
+      ++lp.st.stale;
       return true;
     }
-    ++stats_.events;
-    ++stats_.lp_events[static_cast<std::size_t>(lp.me)];
+    ++lp.st.events;
     after_event(lp);
+    flush(lp, ke.next());
     return true;
+  }
+
+  // lazy cancellation: the messages sent before a rollback, at keys before k, that the
+  // re-execution did not send again: cancelled now
+  void flush(Lp& lp, const EventKey& k) {
+    while (!lp.lazy.empty() && lp.lazy.begin()->first.first < k) {
+      Message a = std::move(lp.lazy.begin()->second);
+      lp.lazy.erase(lp.lazy.begin());
+      a.anti = true;
+      ++lp.st.anti;
+      post(std::move(a));
+    }
   }
 
   // the messages at the least pending key, written into the view
@@ -309,7 +295,7 @@ class TimeWarp {
     while (!lp.pending.empty() && lp.pending.begin()->first.first == k) {
       auto node = lp.pending.extract(lp.pending.begin());
       const Message& m = node.mapped();
-      ++stats_.written;
+      ++lp.st.written;
       lp.eng.lp_write(m.id, m.rec, k);
       ids.push_back(m.id);
       lp.taken.insert(std::move(node));
@@ -320,7 +306,7 @@ class TimeWarp {
       if (!lp.blocked && !lp.eng.lp_clear(id, k)) {
         lp.blocked = true;
         lp.block_key = k;
-        ++stats_.blocked;
+        ++lp.st.blocked;
       }
     park_leavers(lp, k, ids);  // a particle written outside the band leaves the view at the key
     lp.notes.migrations.clear();
@@ -331,7 +317,7 @@ class TimeWarp {
   void park_leavers(Lp& lp, const EventKey& k, std::vector<int> ids = {}) {
     if (ids.empty()) ids = moved(lp);
     for (int id : ids)
-      if (lp.eng.held(id) && !in_view(lp.me, lp.eng.region(id))) lp.eng.lp_park(id, k);
+      if (lp.eng.held(id) && !sv_.in_view(lp.me, lp.eng.region(id))) lp.eng.lp_park(id, k);
   }
   // the particles whose region the last event changed, each once
   std::vector<int> moved(const Lp& lp) const {
@@ -351,12 +337,11 @@ class TimeWarp {
   void after_event(Lp& lp) {
     const EventKey k = lp.notes.key;
     if (lp.notes.type == LpNotes::coll) {
-      const int key_owner = owner(region_before(lp, k.id));
+      const int key_owner = sv_.owner(region_before(lp, k.id));
       if (key_owner == lp.me) {
         check_reach(lp, k);
         for (int id : lp.notes.ids) {
-          const std::uint64_t to = (views_[static_cast<std::size_t>(region_before(lp, id))] |
-                                    views_[static_cast<std::size_t>(lp.eng.region(id))]) & ~(std::uint64_t{1} << lp.me);
+          const std::uint64_t to = (sv_.views(region_before(lp, id)) | sv_.views(lp.eng.region(id))) & ~(std::uint64_t{1} << lp.me);
           if (to != 0) send(lp, k, id, to);
         }
       } else {
@@ -365,9 +350,8 @@ class TimeWarp {
     } else {
       // a crossing or a wall: an owned particle entering another band is sent there
       for (int id : moved(lp)) {
-        if (owner(region_before(lp, id)) != lp.me) continue;
-        const std::uint64_t to = views_[static_cast<std::size_t>(lp.eng.region(id))] &
-                                 ~views_[static_cast<std::size_t>(region_before(lp, id))] & ~(std::uint64_t{1} << lp.me);
+        if (sv_.owner(region_before(lp, id)) != lp.me) continue;
+        const std::uint64_t to = sv_.views(lp.eng.region(id)) & ~sv_.views(region_before(lp, id)) & ~(std::uint64_t{1} << lp.me);
         if (to != 0) send(lp, k, id, to);
       }
     }
@@ -381,7 +365,7 @@ class TimeWarp {
     const auto& u = lp.eng.units();
     for (int id : lp.notes.ids) {
       const std::int64_t x = at(lp.eng.record(id), k.t, u)[static_cast<std::size_t>(c_.axis)];
-      if (outside(lp.me, x) > W_ - reach_)
+      if (sv_.outside(lp.me, x) > sv_.band() - reach_)
         lp.refused[k] = "a group collision of " + std::to_string(lp.notes.ids.size()) + " particles at tick " + std::to_string(k.t) +
                         " reaches beyond logical process " + std::to_string(lp.me) + "'s band (use fewer logical processes)";
     }
@@ -391,9 +375,17 @@ class TimeWarp {
     const Record r = lp.eng.record(id);
     for (int y = 0; y < c_.lps; ++y) {
       if ((to >> y & 1u) == 0) continue;
-      Message m{k, id, y, ++serial_, false, r};
+      // lazy cancellation: the same message sent before the rollback stands
+      auto it = lp.lazy.lower_bound(MKey{k, 0});
+      while (it != lp.lazy.end() && it->first.first == k && !(it->second.id == id && it->second.to == y && it->second.rec == r)) ++it;
+      if (it != lp.lazy.end() && it->first.first == k) {
+        ++lp.st.reused;
+        lp.sent.insert(lp.lazy.extract(it));
+        continue;
+      }
+      Message m{k, id, y, (static_cast<std::uint64_t>(lp.me) << 48) + ++lp.nsent, false, r};
       lp.sent.emplace(MKey{k, m.serial}, m);
-      ++stats_.messages;
+      ++lp.st.messages;
       post(std::move(m));
     }
   }
@@ -402,16 +394,170 @@ class TimeWarp {
   // (never delivered at once: a receiver's rollback sends anti-messages, and their receiver may
   // be the sender, in the middle of an event)
   void post(Message m) {
+    if (threaded_) {
+      Lp& to = *lps_[static_cast<std::size_t>(m.to)];
+      const std::lock_guard<std::mutex> hold(to.inbox_mx);
+      to.inbox.push_back(std::move(m));
+      return;
+    }
     const std::uint64_t wait = c_.fuzz == 0 || c_.max_delay == 0 ? 0 : rng_() % static_cast<std::uint64_t>(c_.max_delay + 1);
-    flight_.push_back({clock_ + wait, std::move(m)});
+    flight_.push_back({tick_ + wait, std::move(m)});
   }
-  // delivers the messages whose delay has passed (all: every one in flight)
+  // one worker: delivers the messages whose delay has passed (all: every one in flight)
   void deliver(bool all) {
-    ++clock_;
+    ++tick_;
     std::deque<std::pair<std::uint64_t, Message>> now, keep;
-    for (auto& item : flight_) (all || item.first <= clock_ ? now : keep).push_back(std::move(item));
+    for (auto& item : flight_) (all || item.first <= tick_ ? now : keep).push_back(std::move(item));
     flight_ = std::move(keep);
     for (auto& item : now) receive(*lps_[static_cast<std::size_t>(item.second.to)], std::move(item.second));
+  }
+  // threads: the messages in an LP's inbox, taken in; true if there were any
+  bool drain(Lp& lp) {
+    std::vector<Message> got;
+    {
+      const std::lock_guard<std::mutex> hold(lp.inbox_mx);
+      got.swap(lp.inbox);
+    }
+    for (Message& m : got) receive(lp, std::move(m));
+    return !got.empty();
+  }
+
+  // one worker: round robin, or (fuzz) a random order with random delays
+  void run_one(const std::function<bool()>& poll) {
+    threaded_ = false;
+    std::uint64_t since_gvt = 0;
+    for (;;) {
+      bool any = false;
+      for (int n = 0; n < c_.lps; ++n) {
+        deliver(false);
+        any = step(*lps_[c_.fuzz != 0 ? pick(c_.lps) : static_cast<std::size_t>(n)]) || any;
+      }
+      for (int n = 0; n < c_.lps && !any; ++n) any = step(*lps_[static_cast<std::size_t>(n)]);  // (a random order may miss one)
+      if (!any && !flight_.empty()) {
+        deliver(true);
+        continue;
+      }
+      if (++since_gvt >= c_.gvt_every || !any) {
+        since_gvt = 0;
+        if (settle(poll, !any)) return;
+      }
+    }
+  }
+
+  // threads: each worker runs its LPs (a contiguous share) a batch of steps at a time; every
+  // GVT, the end and a Ctrl-C are decided with all of them stopped at a barrier
+  void run_threads(const std::function<bool()>& poll) {
+    threaded_ = true;
+    const int w = c_.workers;
+    std::mutex mx;
+    std::condition_variable cv;
+    int arrived = 0;
+    std::uint64_t generation = 0;
+    std::atomic<bool> want{false};
+    std::atomic<int> idle{0};
+    bool done = false;
+    std::exception_ptr err;
+    auto barrier = [&] {
+      std::unique_lock<std::mutex> hold(mx);
+      const std::uint64_t gen = generation;
+      if (++arrived == w) {
+        arrived = 0;
+        ++generation;
+        cv.notify_all();
+      } else {
+        cv.wait(hold, [&] { return generation != gen; });
+      }
+    };
+    auto work = [&](int me) {
+      const int lo = me * c_.lps / w, hi = (me + 1) * c_.lps / w;
+      std::uint64_t since = 0;
+      bool was_idle = false;
+      for (;;) {
+        if (want.load(std::memory_order_acquire)) {
+          barrier();
+          if (me == 0) {
+            try {
+              for (bool more = true; more;) {  // every inbox empty (a rollback posts anti-messages)
+                more = false;
+                for (auto& lp : lps_) more = drain(*lp) || more;
+              }
+              done = err != nullptr || settle(poll, idle.load() == w);
+            } catch (...) {
+              if (!err) err = std::current_exception();
+              done = true;
+            }
+            want.store(false, std::memory_order_release);
+          }
+          barrier();
+          if (done) return;
+          since = 0;
+          continue;
+        }
+        bool any = false;
+        try {
+          for (int m = lo; m < hi; ++m) {
+            Lp& lp = *lps_[static_cast<std::size_t>(m)];
+            any = drain(lp) || any;
+            for (int b = 0; b < c_.batch && step(lp); ++b) any = true, ++since;
+          }
+        } catch (...) {
+          {
+            const std::lock_guard<std::mutex> hold(mx);
+            if (!err) err = std::current_exception();
+          }
+          want.store(true, std::memory_order_release);
+          continue;
+        }
+        if (any == was_idle) idle.fetch_add(any ? -1 : 1);
+        was_idle = !any;
+        if (since >= c_.gvt_every || idle.load() == w) want.store(true, std::memory_order_release);
+        if (!any) std::this_thread::yield();
+      }
+    };
+    std::vector<std::thread> threads;
+    for (int i = 1; i < w; ++i) threads.emplace_back(work, i);
+    work(0);
+    for (auto& t : threads) t.join();
+    if (err) std::rethrow_exception(err);
+  }
+
+  // With nothing in flight: GVT and commit; then, when `idle` and no LP has anything left up to
+  // the horizon, the run is done (true); a Ctrl-C ends it at the last tick GVT has passed.
+  bool settle(const std::function<bool()>& poll, bool idle) {
+    const EventKey g = gvt_commit();
+    if (poll && !poll() && g.t - 1 >= start_) {
+      stop_at(g.t - 1);
+      return true;
+    }
+    if (!idle) return false;
+    for (auto& lp : lps_) {
+      EventKey k;
+      if (lp->blocked) throw std::logic_error("parallel lattice engine: an LP waits for a rollback that no message brings (a bug)");
+      if ((lp->eng.lp_next(k) && k.t <= horizon_) || (!lp->pending.empty() && lp->pending.begin()->first.first.t <= horizon_) ||
+          !lp->lazy.empty() || !lp->inbox.empty())
+        return false;
+    }
+    return true;
+  }
+
+  // every LP back to the state after tick t (nothing after it processed), every message after
+  // it cancelled: the state run(until = t) has
+  void stop_at(std::int64_t t) {
+    const EventKey k{t + 1, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()};
+    for (auto& lp : lps_) {
+      if (!(lp->last < k)) rollback(*lp, k);
+      flush(*lp, EventKey{std::numeric_limits<std::int64_t>::max(), 0, 0});
+    }
+    for (bool more = true; more;) {  // the anti-messages, each to its message
+      more = !flight_.empty();
+      deliver(true);
+      for (auto& lp : lps_) more = drain(*lp) || more;
+    }
+    for (auto& lp : lps_)
+      if (!lp->pending.empty() && !(lp->pending.begin()->first.first < k))
+        lp->pending.erase(lp->pending.lower_bound(MKey{k, 0}), lp->pending.end());
+    horizon_ = t;
+    stopped_ = true;
   }
 
   void receive(Lp& lp, Message m) {
@@ -437,7 +583,7 @@ class TimeWarp {
     const auto g = lp.guesses.find({m.key, m.id});
     if (g != lp.guesses.end() && g->second == m.rec) {  // the guess was right
       lp.guesses.erase(g);
-      ++stats_.confirmed;
+      ++lp.st.confirmed;
       lp.taken.emplace(mk, std::move(m));
       return;
     }
@@ -449,38 +595,38 @@ class TimeWarp {
   void rollback(Lp& lp, const EventKey& k) {
     const std::size_t before = lp.eng.journal_size();
     lp.eng.rollback_before(k.t, k.kind, k.id);
-    ++stats_.rollbacks;
-    stats_.undone += before - lp.eng.journal_size();
+    ++lp.st.rollbacks;
+    lp.st.undone += before - lp.eng.journal_size();
     lp.last = lp.eng.last_key();
     // the messages taken in at or after k go back to the input; guesses from then are gone
     for (auto it = lp.taken.lower_bound(MKey{k, 0}); it != lp.taken.end();) lp.pending.insert(lp.taken.extract(it++));
     lp.guesses.erase(lp.guesses.lower_bound({k, std::numeric_limits<int>::min()}), lp.guesses.end());
     lp.refused.erase(lp.refused.lower_bound(k), lp.refused.end());
     if (lp.blocked && !(lp.block_key < k)) lp.blocked = false;
-    // what it sent from then is cancelled
-    for (auto it = lp.sent.lower_bound(MKey{k, 0}); it != lp.sent.end();) {
-      Message a = it->second;
-      a.anti = true;
-      ++stats_.anti;
-      it = lp.sent.erase(it);
-      post(std::move(a));
-    }
+    // what it sent from then is cancelled: now (aggressive), or when the re-execution passes its
+    // key without sending it again (lazy)
+    for (auto it = lp.sent.lower_bound(MKey{k, 0}); it != lp.sent.end();) lp.lazy.insert(lp.sent.extract(it++));
+    if (!c_.lazy) flush(lp, EventKey{std::numeric_limits<std::int64_t>::max(), 0, 0});
   }
 
   // ---- GVT ----
-  void gvt_commit() {
-    ++stats_.gvts;
+  // GVT: the least key an LP could still process or a message in flight carries; everything
+  // before its tick is committed (whole ticks: a Ctrl-C can stop on the tick before it)
+  EventKey gvt_commit() {
+    ++gvts_;
     EventKey g{std::numeric_limits<std::int64_t>::max(), 0, 0};
     for (const auto& item : flight_) g = std::min(g, item.second.key);
     for (auto& lp : lps_) {
       EventKey k;
       if (lp->blocked) g = std::min(g, lp->block_key);
+      if (!lp->lazy.empty()) g = std::min(g, lp->lazy.begin()->first.first);  // (an anti-message it may still send)
       if (!lp->pending.empty()) g = std::min(g, lp->pending.begin()->first.first);
       if (lp->eng.lp_next(k)) g = std::min(g, k);
     }
     // (a run that reached its horizon: everything up to it is committed)
+    const EventKey whole{g.t, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()};
     for (auto& lp : lps_) {
-      const EventKey until = std::min(g, lp->last.next());
+      const EventKey until = std::min(whole, lp->last.next());
       if (!lp->refused.empty() && lp->refused.begin()->first < until) throw std::runtime_error("parallel lattice engine: " + lp->refused.begin()->second);
       if (!lp->guesses.empty() && lp->guesses.begin()->first.first < until)
         throw std::logic_error("parallel lattice engine: a guess of logical process " + std::to_string(lp->me) + " at tick " +
@@ -489,6 +635,8 @@ class TimeWarp {
       lp->taken.erase(lp->taken.begin(), lp->taken.lower_bound(MKey{until, 0}));
       lp->sent.erase(lp->sent.begin(), lp->sent.lower_bound(MKey{until, 0}));
     }
+    if (g.t != std::numeric_limits<std::int64_t>::max()) gvt_t_ = g.t;
+    return g;
   }
 
   // ---- helpers ----
@@ -512,15 +660,13 @@ class TimeWarp {
 
   Config c_;
   std::mt19937_64 rng_;
-  std::int64_t L_ = 0, W_ = 0, reach_ = 0, horizon_ = 0;
-  bool wall_ = false;
-  std::vector<std::int64_t> slab_, fine_;
-  std::vector<int> owner_;
-  std::vector<std::uint64_t> views_;
+  SlabViews sv_;
+  std::int64_t reach_ = 0, horizon_ = 0, start_ = 0;
   std::vector<std::unique_ptr<Lp>> lps_;
-  std::deque<std::pair<std::uint64_t, Message>> flight_;
-  std::uint64_t clock_ = 0, serial_ = 0;
-  TimeWarpStats stats_;
+  std::deque<std::pair<std::uint64_t, Message>> flight_;  // one worker: (delivery step, message)
+  std::uint64_t tick_ = 0, gvts_ = 0;                     // one worker: scheduler steps
+  std::int64_t gvt_t_ = 0;                                // the last GVT's tick (the window)
+  bool threaded_ = false, stopped_ = false;
 };
 
 }  // namespace revcol::lattice
