@@ -40,6 +40,7 @@ void add_lattice_op3_benches(std::vector<Bench>& out); ///< lattice_op3_bench.cp
 void add_lattice_benches(std::vector<Bench>& out);     ///< lattice_engine_bench.cpp: the 2D lattice engine
 void add_rollback_benches(std::vector<Bench>& out);    ///< lattice_rollback_bench.cpp: the lattice engine's journal and rollback
 void add_slabs_benches(std::vector<Bench>& out);       ///< lattice_slabs_bench.cpp: what K slabs would ask of a parallel run
+void add_parallel_benches(std::vector<Bench>& out);    ///< lattice_parallel_bench.cpp: the parallel lattice engine against the sequential one
 void add_tradeoff_benches(std::vector<Bench>& out);    ///< tradeoff_bench.cpp: run time against error per operator and knob
 
 /// Seconds of the steady clock since t0.

@@ -102,6 +102,7 @@ std::vector<Bench> all_benches() {
   revcol::bench::add_lattice_benches(out);
   revcol::bench::add_rollback_benches(out);
   revcol::bench::add_slabs_benches(out);
+  revcol::bench::add_parallel_benches(out);
   revcol::bench::add_tradeoff_benches(out);
   return out;
 }

@@ -53,9 +53,19 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
   std::uint64_t done = 0;
   std::uint32_t since_poll = 0;
   for (;;) {
-    if (lp_ != nullptr && lp_stepped_) [[unlikely]] {  // a logical process's step: one queue pop
-      clock_ = lp_->key.t;
-      return done;
+    if (lp_ != nullptr) [[unlikely]] {  // a logical process's run (lp_run): its hook, its stop
+      if (lp_stepped_) {
+        lp_stepped_ = false;
+        clock_ = lp_->key.t;
+        ++lp_->done;
+        lp_->in_after = true;
+        lp_->after(lp_->ctx);
+        lp_->in_after = false;
+      }
+      const int q = queue_.top();
+      if (q < 0 || lp_->done >= lp_->max || !(EventKey{queue_.time(q), queue_.kind(q), gid(q)} < lp_->stop)) return done;
+      begin_undo();  // (an engine error in the event undoes it: lp_run)
+      lp_->marks = {jdone_.size(), jwall_.size(), jss1_.size(), jss2_.size(), jss2x_.size(), jlp_.size()};
     }
     const int p = queue_.top();
     if (poll && ++since_poll == kPollEvents && p >= 0) {

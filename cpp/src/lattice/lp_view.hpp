@@ -114,14 +114,40 @@ bool BasicEngine<Op, Bits, Queue>::lp_next(EventKey& k) {
   return true;
 }
 
+// The engine's loop, in an LP: the events before `stop` (and at most max), notes->after called
+// after each (it may write or park particles: the loop reads the queue afresh). An engine error
+// in an event (a speculative state can hold what no sequential state does) undoes that event and
+// stops the run there, its message in notes->error: the LP waits for a rollback (timewarp.hpp).
 template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::lp_step() {
-  EventKey k;
-  require(lp_ != nullptr && lp_next(k), "lattice LP: no event to process");
+std::size_t BasicEngine<Op, Bits, Queue>::lp_run(const EventKey& stop, std::size_t max) {
+  require(lp_ != nullptr, "lattice LP: lp_run before lp_begin");
+  lp_->stop = stop;
+  lp_->max = max;
+  lp_->done = 0;
   lp_->ids.clear();
   lp_stepped_ = false;
-  // (the loop stops after one queue pop when lp_ is set; an engine error undoes it)
-  run(std::numeric_limits<std::uint64_t>::max(), k.t);
+  try {
+    loop(std::numeric_limits<std::uint64_t>::max(), tick_limit - 1, false, 0, {});
+  } catch (const std::exception& e) {
+    if (lp_->in_after) {  // not the engine's: the LP's own
+      lp_->in_after = false;
+      throw;
+    }
+    // the event under way, undone: its journal entries go, its particles come back as they
+    // were and are predicted again (its slot will come up again, as it was)
+    auto cut = [](auto& q, std::size_t m) { q.erase(q.begin() + static_cast<std::ptrdiff_t>(m), q.end()); };
+    cut(jdone_, lp_->marks[0]);
+    cut(jwall_, lp_->marks[1]);
+    cut(jss1_, lp_->marks[2]);
+    cut(jss2_, lp_->marks[3]);
+    cut(jss2x_, lp_->marks[4]);
+    cut(jlp_, lp_->marks[5]);
+    undo(false);
+    last_key_ = jdone_.empty() ? j_key0_ : std::make_pair(jdone_.back().t, jdone_.back().kind);
+    lp_stepped_ = false;
+    lp_->error = e.what();
+  }
+  return lp_->done;
 }
 
 template <class Op, class Bits, class Queue>

@@ -398,8 +398,10 @@ void BasicEngine<Op, Bits, Queue>::begin_undo() {
 }
 
 template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::undo() {
+void BasicEngine<Op, Bits, Queue>::undo(bool whole) {
+  std::vector<int> changed;
   for (const Saved& sv : undo_) {
+    changed.push_back(sv.p);
     ln_[sv.p] = sv.line;
     pre_wall_[sv.p] = sv.pre_wall;
     own_[sv.p].X = sv.X;
@@ -420,6 +422,14 @@ void BasicEngine<Op, Bits, Queue>::undo() {
   undo_log_.clear();
   undo_groups_.clear();
   ncoll_ = undo_ncoll_;
+  if (!whole) {  // one event of an LP's run (lp_view.hpp): the rest of the queue is as it was
+    for (int p : changed) {
+      reanchor(p, clock_);
+      sync(p);
+    }
+    for (int p : changed) predict(p, clock_);
+    return;
+  }
   rebuild();
   resort_at_ = next_resort();  // (the counters went back with the run)
 }

@@ -162,7 +162,7 @@ class BasicEngine {
   bool lp_clear(int id, const EventKey& k) const;
   void lp_park(int id, const EventKey& k);  ///< particle id leaves the view at key k (journaled)
   bool lp_next(EventKey& k);                ///< the next queue pop's key; false: none
-  void lp_step();                           ///< processes the next queue pop, one event
+  std::size_t lp_run(const EventKey& stop, std::size_t max);  ///< queue pops before `stop`, at most max; notes->after after each
   void commit_before(const EventKey& k);    ///< forgets the journal's entries before key k
   EventKey last_key() const noexcept;       ///< the key of the journal's last entry (or its start)
   Snapshot snapshot() const;  ///< The state (forward frame, positions at the clock).
@@ -481,7 +481,7 @@ class BasicEngine {
     undo_epoch_[p] = epoch_;
     undo_.push_back(Saved{p, ln_[p], pre_wall_[p], wall_tick_[p], own_[p].X, own_[p].ctr, own_[p].pc});
   }
-  void undo();
+  void undo(bool whole = true);  // whole: rebuild; else (an LP's event) predict the particles again
   // one particle's event bookkeeping, together in memory (the loop reads it per event, and the
   // partner's version): its version (bumped at every change of its line), its scheduled event's
   // type and partner, and the versions both had when it was scheduled (stale if either moved on)

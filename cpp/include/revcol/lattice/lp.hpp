@@ -6,6 +6,7 @@
 #include <array>
 #include <compare>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "revcol/lattice/geometry.hpp"
@@ -39,13 +40,20 @@ struct ParticleRecordN {
   friend bool operator==(const ParticleRecordN&, const ParticleRecordN&) = default;
 };
 
-/// What the engine noted about the one event an LP's step processed.
+/// What the engine noted about the event an LP's run has just processed, and how that run stops.
 struct LpNotes {
   enum Type : std::uint8_t { none = 0, cross = 1, wall = 2, coll = 3 };
   EventKey key;
   Type type = none;                                   ///< none: a stale slot recomputed
   std::vector<int> ids;                               ///< a collision's particles by id (a group's members)
   std::vector<std::array<std::int64_t, 4>> migrations;  ///< (tick, id, from, to) region changes in the event
+  void (*after)(void*) = nullptr;  ///< called after each event (the notes filled), between two events
+  void* ctx = nullptr;             ///< after's argument
+  EventKey stop;                   ///< lp_run: stop before this key
+  std::size_t max = 1, done = 0;   ///< lp_run: stop after max events; the events done
+  std::string error;               ///< lp_run: an engine error at `key` (the event undone, the run stopped there)
+  std::array<std::size_t, 6> marks{};  ///< (the engine's journal sizes before the event under way)
+  bool in_after = false;           ///< (after is running: its exceptions are not the engine's)
 };
 
 }  // namespace revcol::lattice

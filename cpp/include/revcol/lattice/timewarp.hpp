@@ -39,11 +39,8 @@
 // raised. Neither the schedule nor the delays may change a bit.
 #pragma once
 #include <algorithm>
-#include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
-#include <exception>
 #include <functional>
 #include <limits>
 #include <map>
@@ -52,7 +49,6 @@
 #include <random>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -60,6 +56,8 @@
 #include "revcol/lattice/engine.hpp"
 #include "revcol/lattice/lp.hpp"
 #include "revcol/lattice/slab_views.hpp"
+#include "revcol/lattice/timewarp_state.hpp"
+#include "revcol/lattice/workers.hpp"
 #include "revcol/lattice/state.hpp"
 
 namespace revcol::lattice {
@@ -106,6 +104,8 @@ class TimeWarp {
   };
 
   /// K LPs on the state s (validated: bad input throws InvalidArgument, nothing is built).
+  TimeWarp(const TimeWarp&) = delete;  // (its LPs' engines call back into it)
+  TimeWarp& operator=(const TimeWarp&) = delete;
   TimeWarp(const Snapshot& s, const Config& c) : c_(c), rng_(c.fuzz) {
     require(c.axis >= 0 && c.axis < static_cast<int>(D), "parallel lattice engine: the slabs' axis must be 0, 1 or (3D) 2");
     require(c.max_delay >= 0 && c.gvt_every >= 1 && c.batch >= 1, "parallel lattice engine: max_delay >= 0, gvt_every >= 1, batch >= 1");
@@ -125,6 +125,9 @@ class TimeWarp {
       std::vector<std::uint8_t> held(s.x.size());
       for (std::size_t id = 0; id < held.size(); ++id) held[id] = sv_.in_view(m, lp.eng.region(static_cast<int>(id)));
       lp.eng.migrations = &lp.notes.migrations;
+      lp.hook = {this, &lp};
+      lp.notes.after = &TimeWarp::after_hook;
+      lp.notes.ctx = &lp.hook;
       lp.eng.keep_journal(true, c.how);
       lp.eng.lp_begin(held, &lp.notes);
       lp.last = lp.eng.last_key();
@@ -148,51 +151,11 @@ class TimeWarp {
   }
 
   /// The committed state at the last run_until's tick, by particle id (each particle from its
-  /// owner; the rare log and the groups the union of the LPs').
+  /// owner; the rare log and the groups the union of the LPs'; timewarp_state.hpp).
   Snapshot snapshot() const {
-    Snapshot s = lps_.front()->eng.snapshot();
-    const std::size_t n = s.x.size();
-    s.clock = horizon_;
-    s.bits.clear();
-    std::vector<int> from(n, -1);
-    std::vector<std::vector<std::uint64_t>> words(n);
-    for (const auto& lp : lps_)
-      for (std::size_t id = 0; id < n; ++id) {
-        const int i = static_cast<int>(id);
-        if (!lp->eng.held(i) || sv_.owner(lp->eng.region(i)) != lp->me) continue;
-        if (from[id] >= 0) throw std::logic_error("parallel lattice engine: a particle owned by two LPs (a bug)");
-        from[id] = lp->me;
-        const Record r = lp->eng.record(i);
-        s.x[id] = at(r, horizon_, s.units);
-        s.v[id] = r.v;
-        s.streams[id] = r.ctr;
-        s.particle_collisions[id] = r.pc;
-        const auto w = r.X.words();
-        words[id].assign(w.begin(), w.end());
-      }
-    for (std::size_t id = 0; id < n; ++id) {
-      if (from[id] < 0) throw std::logic_error("parallel lattice engine: a particle no LP owns (a bug)");
-      s.bits.insert(s.bits.end(), words[id].begin(), words[id].end());
-      s.bits_size[id] = words[id].size();
-    }
-    std::map<std::pair<std::uint32_t, std::uint64_t>, LogEntry> log;
-    std::map<std::pair<int, std::uint64_t>, GroupEntryN<D>> groups;
-    for (const auto& lp : lps_) {
-      const Snapshot t = lp->eng.snapshot();
-      for (const LogEntry& e : t.log) merge(log, std::make_pair(e.particle, e.count), e);
-      for (const GroupEntryN<D>& g : t.groups) merge(groups, std::make_pair(g.drawer, g.counts[index_of(g.members, g.drawer)]), g);
-    }
-    s.log.clear();
-    for (const auto& [k, e] : log) s.log.push_back(e);
-    s.groups.clear();
-    for (const auto& [k, g] : groups) s.groups.push_back(g);
-    // the collision count: every pair adds one to two counts, a group of m to m
-    std::uint64_t sum = 0;
-    for (std::uint64_t pc : s.particle_collisions) sum += pc;
-    for (const auto& g : s.groups) sum -= g.members.size() - 2;
-    s.collisions = sum / 2;
-    s.counters = Counters{};
-    return s;
+    std::vector<const Engine*> engines;
+    for (const auto& lp : lps_) engines.push_back(&lp->eng);
+    return committed_state(engines, sv_, horizon_);
   }
 
   /// The counts so far, all LPs.
@@ -233,23 +196,27 @@ class TimeWarp {
     std::vector<std::uint64_t> annihilate;            // anti-messages that overtook their message
     bool blocked = false;
     EventKey block_key;
+    std::string block_error;                          // blocked by an engine error (else by a write)
     TimeWarpStats st;
     std::uint64_t nsent = 0;                          // (serials: (LP << 48) + its count)
+    std::pair<TimeWarp*, Lp*> hook;                   // the engine's after-event hook's argument
     std::mutex inbox_mx;                              // threads: messages posted to it
     std::vector<Message> inbox;
   };
 
   // ---- one LP step ----
-  // Processes the LP's next key (its messages at that key, or else its engine's next event),
-  // if any at or before the horizon. False: nothing to do.
+  // Processes the LP's next keys: its messages at the least pending key, or else its engine's
+  // events before that key (at most `batch`), if any at or before the horizon (and the window).
+  // False: nothing to do.
   bool step(Lp& lp) {
     if (lp.blocked) return false;
     const std::int64_t limit = c_.window > 0 ? std::min(horizon_, gvt_t_ + c_.window) : horizon_;
+    const EventKey end{limit + 1, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()};
     EventKey ke;
-    const bool has_e = lp.eng.lp_next(ke) && ke.t <= limit;
-    const bool has_m = !lp.pending.empty() && lp.pending.begin()->first.first.t <= limit;
+    const bool has_e = lp.eng.lp_next(ke) && ke < end;
+    const bool has_m = !lp.pending.empty() && lp.pending.begin()->first.first < end;
     if (!has_e && !has_m) {
-      flush(lp, EventKey{limit + 1, std::numeric_limits<std::int32_t>::min(), 0});  // nothing up to it will send them again
+      flush(lp, end);  // nothing up to it will send them again
       return false;
     }
     if (has_m && (!has_e || !(ke < lp.pending.begin()->first.first))) {
@@ -259,21 +226,30 @@ class TimeWarp {
     }
     flush(lp, ke);
     lp.notes.migrations.clear();
-    try {
-      lp.eng.lp_step();
-    } catch (const std::exception& e) {
-      throw std::runtime_error(std::string("parallel lattice engine: logical process ") + std::to_string(lp.me) +
-                               " met an engine error (the parallel engine cannot yet roll back across one): " + e.what());
+    lp.eng.lp_run(has_m ? lp.pending.begin()->first.first : end, static_cast<std::size_t>(c_.workers > 1 ? c_.batch : 1));
+    if (!lp.notes.error.empty()) {  // an engine error: real only if no rollback comes before GVT passes it
+      lp.blocked = true;
+      lp.block_key = lp.notes.key;
+      lp.block_error = "parallel lattice engine: logical process " + std::to_string(lp.me) + ": " + lp.notes.error;
+      lp.notes.error.clear();
+      ++lp.st.blocked;
     }
+    return true;
+  }
+
+  // the engine's hook after each event of an LP's run (LpNotes::after)
+  static void after_hook(void* ctx) {
+    auto* h = static_cast<std::pair<TimeWarp*, Lp*>*>(ctx);
+    Lp& lp = *h->second;
     lp.last = lp.notes.key;
     if (lp.notes.type == LpNotes::none) {
       ++lp.st.stale;
-      return true;
+    } else {
+      ++lp.st.events;
+      h->first->after_event(lp);
+      h->first->flush(lp, lp.last.next());
     }
-    ++lp.st.events;
-    after_event(lp);
-    flush(lp, ke.next());
-    return true;
+    lp.notes.migrations.clear();
   }
 
   // lazy cancellation: the messages sent before a rollback, at keys before k, that the
@@ -301,11 +277,21 @@ class TimeWarp {
       lp.taken.insert(std::move(node));
     }
     lp.last = k;
-    // a view that cannot hold what it was told waits for the rollback that must come
+    // a view that cannot hold what it was told waits for the rollback that must come; so does
+    // one told part of an event it would compute itself (the key particle's message, which must
+    // come, makes its own computation stale; the messages still to come roll it back)
+    EventKey ke;
+    if (!lp.blocked && lp.eng.lp_next(ke) && ke == k && lp.eng.held(k.id) && std::find(ids.begin(), ids.end(), k.id) == ids.end()) {
+      lp.blocked = true;
+      lp.block_key = k;
+      lp.block_error.clear();
+      ++lp.st.blocked;
+    }
     for (int id : ids)
       if (!lp.blocked && !lp.eng.lp_clear(id, k)) {
         lp.blocked = true;
         lp.block_key = k;
+        lp.block_error.clear();
         ++lp.st.blocked;
       }
     park_leavers(lp, k, ids);  // a particle written outside the band leaves the view at the key
@@ -364,7 +350,7 @@ class TimeWarp {
     if (lp.notes.ids.size() <= 2) return;  // a pair of an owned key particle: within reach by W
     const auto& u = lp.eng.units();
     for (int id : lp.notes.ids) {
-      const std::int64_t x = at(lp.eng.record(id), k.t, u)[static_cast<std::size_t>(c_.axis)];
+      const std::int64_t x = record_at(lp.eng.record(id), k.t, u)[static_cast<std::size_t>(c_.axis)];
       if (sv_.outside(lp.me, x) > sv_.band() - reach_)
         lp.refused[k] = "a group collision of " + std::to_string(lp.notes.ids.size()) + " particles at tick " + std::to_string(k.t) +
                         " reaches beyond logical process " + std::to_string(lp.me) + "'s band (use fewer logical processes)";
@@ -444,81 +430,24 @@ class TimeWarp {
     }
   }
 
-  // threads: each worker runs its LPs (a contiguous share) a batch of steps at a time; every
-  // GVT, the end and a Ctrl-C are decided with all of them stopped at a barrier
+  // threads (workers.hpp): a turn of an LP takes in its inbox and runs a batch of its events;
+  // at the barrier, every inbox is emptied first (a rollback posts anti-messages)
   void run_threads(const std::function<bool()>& poll) {
     threaded_ = true;
-    const int w = c_.workers;
-    std::mutex mx;
-    std::condition_variable cv;
-    int arrived = 0;
-    std::uint64_t generation = 0;
-    std::atomic<bool> want{false};
-    std::atomic<int> idle{0};
-    bool done = false;
-    std::exception_ptr err;
-    auto barrier = [&] {
-      std::unique_lock<std::mutex> hold(mx);
-      const std::uint64_t gen = generation;
-      if (++arrived == w) {
-        arrived = 0;
-        ++generation;
-        cv.notify_all();
-      } else {
-        cv.wait(hold, [&] { return generation != gen; });
-      }
-    };
-    auto work = [&](int me) {
-      const int lo = me * c_.lps / w, hi = (me + 1) * c_.lps / w;
-      std::uint64_t since = 0;
-      bool was_idle = false;
-      for (;;) {
-        if (want.load(std::memory_order_acquire)) {
-          barrier();
-          if (me == 0) {
-            try {
-              for (bool more = true; more;) {  // every inbox empty (a rollback posts anti-messages)
-                more = false;
-                for (auto& lp : lps_) more = drain(*lp) || more;
-              }
-              done = err != nullptr || settle(poll, idle.load() == w);
-            } catch (...) {
-              if (!err) err = std::current_exception();
-              done = true;
-            }
-            want.store(false, std::memory_order_release);
+    run_workers(
+        c_.workers, c_.lps, c_.gvt_every,
+        [&](int m) {
+          Lp& lp = *lps_[static_cast<std::size_t>(m)];
+          const bool got = drain(lp);
+          return step(lp) || got;
+        },
+        [&](bool idle) {
+          for (bool more = true; more;) {
+            more = false;
+            for (auto& lp : lps_) more = drain(*lp) || more;
           }
-          barrier();
-          if (done) return;
-          since = 0;
-          continue;
-        }
-        bool any = false;
-        try {
-          for (int m = lo; m < hi; ++m) {
-            Lp& lp = *lps_[static_cast<std::size_t>(m)];
-            any = drain(lp) || any;
-            for (int b = 0; b < c_.batch && step(lp); ++b) any = true, ++since;
-          }
-        } catch (...) {
-          {
-            const std::lock_guard<std::mutex> hold(mx);
-            if (!err) err = std::current_exception();
-          }
-          want.store(true, std::memory_order_release);
-          continue;
-        }
-        if (any == was_idle) idle.fetch_add(any ? -1 : 1);
-        was_idle = !any;
-        if (since >= c_.gvt_every || idle.load() == w) want.store(true, std::memory_order_release);
-        if (!any) std::this_thread::yield();
-      }
-    };
-    std::vector<std::thread> threads;
-    for (int i = 1; i < w; ++i) threads.emplace_back(work, i);
-    work(0);
-    for (auto& t : threads) t.join();
-    if (err) std::rethrow_exception(err);
+          return settle(poll, idle);
+        });
   }
 
   // With nothing in flight: GVT and commit; then, when `idle` and no LP has anything left up to
@@ -530,12 +459,16 @@ class TimeWarp {
       return true;
     }
     if (!idle) return false;
-    for (auto& lp : lps_) {
+    for (auto& lp : lps_) {  // (a blocked LP has nothing to do, but another may still roll it back)
       EventKey k;
-      if (lp->blocked) throw std::logic_error("parallel lattice engine: an LP waits for a rollback that no message brings (a bug)");
+      if (lp->blocked) continue;
       if ((lp->eng.lp_next(k) && k.t <= horizon_) || (!lp->pending.empty() && lp->pending.begin()->first.first.t <= horizon_) ||
-          !lp->lazy.empty() || !lp->inbox.empty())
+          !lp->lazy.empty() || !lp->inbox.empty() || !flight_.empty())
         return false;
+    }
+    for (auto& lp : lps_) {  // nothing can take a blocked LP back now
+      if (lp->blocked && !lp->block_error.empty()) throw std::runtime_error(lp->block_error);
+      if (lp->blocked) throw std::logic_error("parallel lattice engine: an LP waits for a rollback that no message brings (a bug)");
     }
     return true;
   }
@@ -602,7 +535,10 @@ class TimeWarp {
     for (auto it = lp.taken.lower_bound(MKey{k, 0}); it != lp.taken.end();) lp.pending.insert(lp.taken.extract(it++));
     lp.guesses.erase(lp.guesses.lower_bound({k, std::numeric_limits<int>::min()}), lp.guesses.end());
     lp.refused.erase(lp.refused.lower_bound(k), lp.refused.end());
-    if (lp.blocked && !(lp.block_key < k)) lp.blocked = false;
+    if (lp.blocked && !(lp.block_key < k)) {
+      lp.blocked = false;
+      lp.block_error.clear();
+    }
     // what it sent from then is cancelled: now (aggressive), or when the re-execution passes its
     // key without sending it again (lazy)
     for (auto it = lp.sent.lower_bound(MKey{k, 0}); it != lp.sent.end();) lp.lazy.insert(lp.sent.extract(it++));
@@ -641,23 +577,6 @@ class TimeWarp {
 
   // ---- helpers ----
   std::size_t pick(int k) { return static_cast<std::size_t>(rng_() % static_cast<std::uint64_t>(k)); }
-  static Vec at(const Record& r, std::int64_t t, const UnitsN<D>& u) {
-    Vec x;
-    for (std::size_t k = 0; k < D; ++k) {
-      const __int128 y = static_cast<__int128>(r.x[k]) + static_cast<__int128>(r.v[k]) * (t - r.ta);
-      x[k] = u.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u.L[k]);
-    }
-    return x;
-  }
-  template <class M, class K, class V>
-  static void merge(M& map, const K& key, const V& value) {
-    const auto [it, fresh] = map.emplace(key, value);
-    if (!fresh && !(it->second == value)) throw std::logic_error("parallel lattice engine: two LPs disagree on a rare-log entry (a bug)");
-  }
-  static std::size_t index_of(const std::vector<int>& v, int x) {
-    return static_cast<std::size_t>(std::find(v.begin(), v.end(), x) - v.begin());
-  }
-
   Config c_;
   std::mt19937_64 rng_;
   SlabViews sv_;

@@ -1,0 +1,166 @@
+// The parallel family of revcol-bench: the parallel lattice engine (timewarp.hpp) against the
+// sequential engine on the same collisions, from one warmed-up state (a collision per
+// particle): every variant runs to the tick of the n-th collision of the sequential run and must
+// end on its state bit for bit (same_<variant> = 1). The variants run interleaved, `rounds`
+// times (REVCOL_PARALLEL=rounds=R), each timed from a fresh engine:
+//   seq             the sequential engine, its default search (lists in 3D);
+//   seq_cells       the sequential engine on the cell grid (what every LP uses);
+//   K<k>_w<w>       k logical processes on w worker threads (lazy cancellation, no window);
+// reported as medians with their ranges: <variant>_per_s (collisions per second), speedup_<v>
+// (over seq, the same round), and from the last round events_per_collision_<v> (events processed
+// per collision), rollbacks_per_1k_<v>, undone_per_collision_<v>, messages_per_collision_<v>.
+// Settings: REVCOL_PARALLEL=rounds=3,lps=2:4,workers=1:2,window=0,gvt=512,batch=64,lazy=1
+// (lps and workers: colon-separated lists; every pair with workers <= lps is a variant).
+//
+//   revcol-bench --bench parallel/d2/n1000000/phi0.5 --collisions 2000000
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "bench.hpp"
+#include "revcol/lattice/engine.hpp"
+#include "revcol/lattice/timewarp.hpp"
+
+namespace revcol::bench {
+namespace {
+
+namespace la = revcol::lattice;
+
+template <std::size_t D>
+using EngineOf = std::conditional_t<D == 2, la::LatticeEngine, la::LatticeEngine3D>;
+
+struct ParCase {
+  std::size_t n;
+  double phi;
+};
+
+std::vector<int> int_list(const std::string& v) {
+  std::vector<int> out;
+  std::size_t at = 0;
+  while (at <= v.size()) {
+    const std::size_t end = std::min(v.find(':', at), v.size());
+    out.push_back(std::stoi(v.substr(at, end - at)));
+    at = end + 1;
+  }
+  return out;
+}
+
+template <std::size_t D>
+std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
+  int rounds = 3, gvt = 512, batch = 64, lazy = 1;
+  std::int64_t window = 0;
+  std::vector<int> lps{2, 4}, workers{1, 2};
+  apply_settings("REVCOL_PARALLEL", "rounds, lps, workers, window, gvt, batch, lazy", [&](const std::string& k, const std::string& v) {
+    if (k == "rounds") rounds = std::stoi(v);
+    else if (k == "lps") lps = int_list(v);
+    else if (k == "workers") workers = int_list(v);
+    else if (k == "window") window = std::stoll(v);
+    else if (k == "gvt") gvt = std::stoi(v);
+    else if (k == "batch") batch = std::stoi(v);
+    else if (k == "lazy") lazy = std::stoi(v);
+    else return false;
+    return true;
+  });
+  la::LatticeConfigN<D> cfg;
+  cfg.seed = 1;
+  const la::LatticeStartN<D> st = la::random_start(cfg, c.n, c.phi, 1, D == 2 && c.phi > 0.35 ? "crystal" : "auto");
+  EngineOf<D> e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
+  e.run(c.n, la::tick_limit - 1);  // warm up
+  const la::SnapshotN<D> s0 = e.snapshot();
+  e.run(nc, la::tick_limit - 1);
+  const std::int64_t until = e.clock();
+  e.run(~std::uint64_t{0}, until);
+  const la::SnapshotN<D> want = e.snapshot();
+  using clock = std::chrono::steady_clock;
+
+  struct Variant {
+    Variant(std::string s, int k_, int w_) : name(std::move(s)), k(k_), w(w_) {}
+    std::string name;
+    int k = 0, w = 0;  // k = 0: sequential (w = 1: cells)
+    std::vector<double> rate{}, speedup{};
+    bool same = true;
+    la::TimeWarpStats st{};
+  };
+  std::vector<Variant> vs{{"seq", 0, 0}, {"seq_cells", 0, 1}};
+  for (int k : lps)
+    for (int w : workers)
+      if (w <= k) vs.push_back({"K" + std::to_string(k) + "_w" + std::to_string(w), k, w});
+  for (int r = 0; r < rounds; ++r) {
+    double base = 0.0;
+    for (Variant& v : vs) {
+      double seconds = 0.0;
+      if (v.k == 0) {
+        EngineOf<D> s(s0, la::operator_for(s0.units, s0.law));
+        if (v.w == 1) s.set_list_shell(0.0);
+        const auto t0 = clock::now();
+        s.run(~std::uint64_t{0}, until);
+        seconds = seconds_since(t0);
+        v.same = v.same && la::same_state(s.snapshot(), want);
+      } else {
+        typename la::TimeWarp<EngineOf<D>>::Config tc;
+        tc.lps = v.k;
+        tc.workers = v.w;
+        tc.window = window;
+        tc.gvt_every = static_cast<std::uint64_t>(gvt);
+        tc.batch = batch;
+        tc.lazy = lazy != 0;
+        la::TimeWarp<EngineOf<D>> tw(s0, tc);
+        const auto t0 = clock::now();
+        tw.run_until(until);
+        seconds = seconds_since(t0);
+        v.same = v.same && la::same_state(tw.snapshot(), want);
+        v.st = tw.stats();
+      }
+      const double rate = static_cast<double>(want.collisions - s0.collisions) / seconds;
+      if (v.name == "seq") base = rate;
+      v.rate.push_back(rate);
+      v.speedup.push_back(rate / base);
+    }
+  }
+  std::vector<Metric> out;
+  const double coll = static_cast<double>(want.collisions - s0.collisions);
+  for (const Variant& v : vs) {
+    out.push_back({v.name + "_per_s", median(v.rate)});
+    out.push_back({v.name + "_per_s_min", *std::min_element(v.rate.begin(), v.rate.end())});
+    out.push_back({v.name + "_per_s_max", *std::max_element(v.rate.begin(), v.rate.end())});
+    out.push_back({"speedup_" + v.name, median(v.speedup)});
+    out.push_back({"speedup_" + v.name + "_min", *std::min_element(v.speedup.begin(), v.speedup.end())});
+    out.push_back({"speedup_" + v.name + "_max", *std::max_element(v.speedup.begin(), v.speedup.end())});
+    out.push_back({"same_" + v.name, v.same ? 1.0 : 0.0});
+    if (v.k == 0) continue;
+    out.push_back({"events_per_collision_" + v.name, static_cast<double>(v.st.events) / coll});
+    out.push_back({"rollbacks_per_1k_" + v.name, 1000.0 * static_cast<double>(v.st.rollbacks) / coll});
+    out.push_back({"undone_per_collision_" + v.name, static_cast<double>(v.st.undone) / coll});
+    out.push_back({"messages_per_collision_" + v.name, static_cast<double>(v.st.messages) / coll});
+    out.push_back({"anti_per_collision_" + v.name, static_cast<double>(v.st.anti) / coll});
+  }
+  out.push_back({"n", static_cast<double>(c.n)});
+  out.push_back({"phi", c.phi});
+  out.push_back({"collisions", coll});
+  out.push_back({"rounds", static_cast<double>(rounds)});
+  return out;
+}
+
+}  // namespace
+
+void add_parallel_benches(std::vector<Bench>& out) {
+  struct Named {
+    const char* name;
+    int dim;
+    ParCase c;
+  };
+  static const Named named[] = {{"parallel/d2/n10000/phi0.5", 2, {10000, 0.5}},   {"parallel/d2/n100000/phi0.5", 2, {100000, 0.5}},
+                                {"parallel/d2/n1000000/phi0.5", 2, {1000000, 0.5}}, {"parallel/d3/n10000/phi0.3", 3, {10000, 0.3}},
+                                {"parallel/d3/n100000/phi0.3", 3, {100000, 0.3}},   {"parallel/d3/n1000000/phi0.3", 3, {1000000, 0.3}}};
+  for (const Named& m : named) {
+    const ParCase c = m.c;
+    const int dim = m.dim;
+    out.push_back({m.name, "collisions/s", [c, dim](std::uint64_t k) { return dim == 3 ? run_parallel<3>(c, k) : run_parallel<2>(c, k); }});
+  }
+}
+
+}  // namespace revcol::bench

@@ -1,0 +1,89 @@
+// The committed state of a parallel lattice run (timewarp.hpp), assembled from its logical
+// processes' engines as the sequential engine's snapshot: each particle from the LP that owns it,
+// the rare log and the group entries the union of the LPs' (an entry two LPs hold must be the
+// same), the collision count from the particles' counts.
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <map>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "revcol/lattice/geometry.hpp"
+#include "revcol/lattice/slab_views.hpp"
+#include "revcol/lattice/state.hpp"
+
+namespace revcol::lattice {
+
+/// A particle record's point at tick t (wrapped on periodic axes).
+template <class Record, std::size_t D>
+VecN<D> record_at(const Record& r, std::int64_t t, const UnitsN<D>& u) {
+  VecN<D> x;
+  for (std::size_t k = 0; k < D; ++k) {
+    const __int128 y = static_cast<__int128>(r.x[k]) + static_cast<__int128>(r.v[k]) * (t - r.ta);
+    x[k] = u.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u.L[k]);
+  }
+  return x;
+}
+
+/// The state at tick `clock` of LPs (their engines, LP m's at m) that have processed every event
+/// up to it and none after, by particle id.
+template <class Engine>
+auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv, std::int64_t clock) {
+  using Snapshot = typename Engine::Snapshot;
+  constexpr std::size_t D = Engine::D;
+  Snapshot s = lps.front()->snapshot();
+  const std::size_t n = s.x.size();
+  s.clock = clock;
+  s.bits.clear();
+  std::vector<int> from(n, -1);
+  std::vector<std::vector<std::uint64_t>> words(n);
+  for (std::size_t m = 0; m < lps.size(); ++m)
+    for (std::size_t id = 0; id < n; ++id) {
+      const Engine& e = *lps[m];
+      const int i = static_cast<int>(id);
+      if (!e.held(i) || sv.owner(e.region(i)) != static_cast<int>(m)) continue;
+      if (from[id] >= 0) throw std::logic_error("parallel lattice engine: a particle owned by two LPs (a bug)");
+      from[id] = static_cast<int>(m);
+      const auto r = e.record(i);
+      s.x[id] = record_at(r, clock, s.units);
+      s.v[id] = r.v;
+      s.streams[id] = r.ctr;
+      s.particle_collisions[id] = r.pc;
+      const auto w = r.X.words();
+      words[id].assign(w.begin(), w.end());
+    }
+  for (std::size_t id = 0; id < n; ++id) {
+    if (from[id] < 0) throw std::logic_error("parallel lattice engine: a particle no LP owns (a bug)");
+    s.bits.insert(s.bits.end(), words[id].begin(), words[id].end());
+    s.bits_size[id] = words[id].size();
+  }
+  std::map<std::pair<std::uint32_t, std::uint64_t>, LogEntry> log;
+  std::map<std::pair<int, std::uint64_t>, GroupEntryN<D>> groups;
+  auto merge = [](auto& map, const auto& key, const auto& value) {
+    const auto [it, fresh] = map.emplace(key, value);
+    if (!fresh && !(it->second == value)) throw std::logic_error("parallel lattice engine: two LPs disagree on a rare-log entry (a bug)");
+  };
+  for (const Engine* e : lps) {
+    const Snapshot t = e->snapshot();
+    for (const LogEntry& x : t.log) merge(log, std::make_pair(x.particle, x.count), x);
+    for (const GroupEntryN<D>& g : t.groups) {
+      const auto at = std::find(g.members.begin(), g.members.end(), g.drawer) - g.members.begin();
+      merge(groups, std::make_pair(g.drawer, g.counts[static_cast<std::size_t>(at)]), g);
+    }
+  }
+  s.log.clear();
+  for (const auto& [k, x] : log) s.log.push_back(x);
+  s.groups.clear();
+  for (const auto& [k, g] : groups) s.groups.push_back(g);
+  // the collision count: every pair adds one to two counts, a group of m to m
+  std::uint64_t sum = 0;
+  for (std::uint64_t pc : s.particle_collisions) sum += pc;
+  for (const auto& g : s.groups) sum -= g.members.size() - 2;
+  s.collisions = sum / 2;
+  s.counters = Counters{};
+  return s;
+}
+
+}  // namespace revcol::lattice
