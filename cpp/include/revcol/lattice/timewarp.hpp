@@ -228,13 +228,20 @@ class TimeWarp {
     lp.notes.migrations.clear();
     lp.eng.lp_run(has_m ? lp.pending.begin()->first.first : end, static_cast<std::size_t>(c_.workers > 1 ? c_.batch : 1));
     if (!lp.notes.error.empty()) {  // an engine error: real only if no rollback comes before GVT passes it
-      lp.blocked = true;
-      lp.block_key = lp.notes.key;
-      lp.block_error = "parallel lattice engine: logical process " + std::to_string(lp.me) + ": " + lp.notes.error;
+      block(lp, lp.notes.key, "parallel lattice engine: logical process " + std::to_string(lp.me) + ": " + lp.notes.error);
       lp.notes.error.clear();
-      ++lp.st.blocked;
     }
     return true;
+  }
+
+  // the LP waits at key k for a rollback (why: an engine error's message, else a view that
+  // cannot hold what it was told)
+  void block(Lp& lp, const EventKey& k, std::string why = {}) {
+    if (lp.blocked) return;
+    lp.blocked = true;
+    lp.block_key = k;
+    lp.block_error = std::move(why);
+    ++lp.st.blocked;
   }
 
   // the engine's hook after each event of an LP's run (LpNotes::after)
@@ -281,19 +288,9 @@ class TimeWarp {
     // one told part of an event it would compute itself (the key particle's message, which must
     // come, makes its own computation stale; the messages still to come roll it back)
     EventKey ke;
-    if (!lp.blocked && lp.eng.lp_next(ke) && ke == k && lp.eng.held(k.id) && std::find(ids.begin(), ids.end(), k.id) == ids.end()) {
-      lp.blocked = true;
-      lp.block_key = k;
-      lp.block_error.clear();
-      ++lp.st.blocked;
-    }
+    if (lp.eng.lp_next(ke) && ke == k && lp.eng.held(k.id) && std::find(ids.begin(), ids.end(), k.id) == ids.end()) block(lp, k);
     for (int id : ids)
-      if (!lp.blocked && !lp.eng.lp_clear(id, k)) {
-        lp.blocked = true;
-        lp.block_key = k;
-        lp.block_error.clear();
-        ++lp.st.blocked;
-      }
+      if (!lp.blocked && !lp.eng.lp_clear(id, k)) block(lp, k);
     park_leavers(lp, k, ids);  // a particle written outside the band leaves the view at the key
     lp.notes.migrations.clear();
   }
