@@ -21,6 +21,7 @@
 
 #include "args.hpp"
 #include "bindings.hpp"
+#include "lattice_parallel.hpp"
 #include "observe.hpp"
 #include "revcol/error.hpp"
 #include "revcol/lattice/engine.hpp"
@@ -410,6 +411,7 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
   py::class_<P> cls(m, name, doc);
   // observation: the float engine's observer (revcol/engine/observe.hpp)
   def_observe(cls, [](P& p) -> Engine& { return p.engine(); });
+  def_parallel<Engine, P>(cls);
   cls
       .def(py::init([](const py::dict& units, const IArray& x, const IArray& v, PyInt seed_arg, const std::string& law,
                        PyInt clock_arg, const std::string& mode) {

@@ -129,13 +129,15 @@ class LatticeSimulation(SimulationBase):
 
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
-                 tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto", _engine=None,
-                 _quantization: Optional[dict] = None):
+                 tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
+                 workers: int = 1, lps: Optional[int] = None, _engine=None, _quantization: Optional[dict] = None):
         if _engine is not None:
             self._e = _engine
             self._q = dict(_quantization or {})
             self._search = -1.0
+            self.set_parallel(workers, lps=lps)
             return
+        self.set_parallel(workers, lps=lps)  # (checked before anything is built)
         mode = _mode(mode, law)
         shell = _shell(search)
         x = real_array(positions, "positions")
@@ -169,7 +171,7 @@ class LatticeSimulation(SimulationBase):
     def random(cls, n: int, dim: Optional[int] = None, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
                diameter: float = 1.0, seed: int = 1, init: str = "auto", mode: str = "exact", law: str = "flux",
                tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
-               packing_fraction: Optional[float] = None) -> "LatticeSimulation":
+               packing_fraction: Optional[float] = None, workers: int = 1, lps: Optional[int] = None) -> "LatticeSimulation":
         """n disks (spheres for LatticeSimulation3D) at area (volume) fraction ``phi`` (or
         ``packing_fraction=``; default 0.3) in a square (cubic) box (the float engine's
         ``random_state``: ``init`` ``"rsa"``, random sequential addition, or ``"crystal"``, a
@@ -194,6 +196,7 @@ class LatticeSimulation(SimulationBase):
         start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, init,
                                                    _tick(tick_bits), cell_bits)
         sim = cls.__new__(cls)
+        sim.set_parallel(workers, lps=lps)
         sim._init_from_start(start, law, seed, dim, shell, mode)
         return sim
 
@@ -215,21 +218,34 @@ class LatticeSimulation(SimulationBase):
         until = None if time is None else self._tick(time)
         n = None if collisions is None else integer(collisions, "collisions", 0)
         attached = self._attachments()
+        self._report = None
         if not attached:
-            done = int(self._e.run(n, until))
+            done = self._advance(n, until)
         else:  # in segments that end at the attached actions' triggers
             done, net = 0, int(self._e.collisions)
             while n is None or done < n:
                 seg = self._to_next_trigger(attached, net)
                 if n is not None:
                     seg = min(seg, n - done)
-                did = int(self._e.run(seg, until))
+                did = self._advance(seg, until)
                 done, net = done + did, net + did
                 if did:
                     self._fire(attached, net)
                 if did < seg:  # the clock reached time
                     break
-        return {"collisions": done, "clock": self.clock, "time": self.time}
+        out = {"collisions": done, "clock": self.clock, "time": self.time}
+        if self._report is not None:
+            out["parallel"] = dict(self._report)
+        return out
+
+    def _advance(self, n: Optional[int], until: Optional[int]) -> int:
+        """One run of the engine: sequential, or (set_parallel) on the parallel engine, whose
+        reports add up in ``self._report``."""
+        if self._par["lps"] == 1:
+            return int(self._e.run(n, until))
+        r = dict(self._e.run_parallel(n, until, **self._par))
+        self._report = add_reports(self._report, r)
+        return int(r["collisions"])
 
     def run_back(self, collisions: Optional[int] = None, time: Optional[float] = None,
                  to_collision: Optional[int] = None) -> dict:
@@ -248,6 +264,53 @@ class LatticeSimulation(SimulationBase):
         before = self._e.collisions
         self._e.run_back(target, tick)
         return {"collisions": int(before - self._e.collisions), "clock": self.clock, "time": self.time}
+
+    # --- the parallel engine ------------------------------------------------------------------
+
+    def set_parallel(self, workers: int = 1, *, lps: Optional[int] = None, axis: int = 0, rollback: str = "reverse",
+                     lazy: bool = True, window: int = 0) -> None:
+        """Runs forward on the parallel engine (docs/parallel.md): the box cut into ``lps``
+        slabs along ``axis`` (default: one per worker), each a logical process of Time Warp,
+        run by ``workers`` threads without the GIL; a straggler is rolled back by the engine's
+        own reverse computation (``rollback="reverse"``) or, for the comparison, by state saving
+        (``"save_all"``, SS1, or ``"save_changes"``, SS2). ``lazy``: lazy cancellation (else
+        anti-messages at once); ``window``: no event more than that many ticks past GVT (0:
+        none). ``run`` then reaches the state the sequential engine reaches, bit for bit, and
+        returns the run's ``"parallel"`` report (also :attr:`parallel_report`): collisions
+        committed by the parallel engine and by the sequential one (a stop at a collision count
+        is reached by a short sequential probe and tail, and runs of at most max(4096, n/4)
+        collisions stay sequential), events processed, rollbacks, undone events, messages,
+        anti-messages, per-LP events. ``run_back``, checkpoints and the rest are the sequential
+        engine's (the state is its own). ``workers=1`` with ``lps`` None is the sequential
+        engine. An observation cannot run on the parallel engine yet (a ValueError)."""
+        workers = integer(workers, "workers", 1, 64)
+        k = workers if lps is None else integer(lps, "lps", 1, 64)
+        if workers > k:
+            raise ValueError(f"workers must be at most lps (the logical processes), got workers={workers} > lps={k}")
+        axis = integer(axis, "axis", 0, self._DIM - 1)
+        rollback = name(rollback, "rollback")
+        if rollback not in ("reverse", "save_all", "save_changes"):
+            raise ValueError(f"rollback must be 'reverse', 'save_all' (SS1) or 'save_changes' (SS2), not {rollback!r}")
+        if not isinstance(lazy, (bool, np.bool_)):
+            raise ValueError(f"lazy must be True or False, got {lazy!r}")
+        window = integer(window, "window", 0)
+        self._par = {"lps": k, "workers": workers, "axis": axis, "rollback": rollback, "lazy": bool(lazy), "window": window}
+        self._report = None
+
+    @property
+    def parallel(self) -> dict:
+        """The parallel engine's settings (:meth:`set_parallel`; ``lps`` 1: the sequential engine)."""
+        return dict(self._par)
+
+    @property
+    def workers(self) -> int:
+        """The worker threads of a run (1: the sequential engine, unless ``lps`` > 1)."""
+        return int(self._par["workers"])
+
+    @property
+    def parallel_report(self) -> Optional[dict]:
+        """The last run's report on the parallel engine (None after a sequential run)."""
+        return None if self._report is None else dict(self._report)
 
     # --- rollback: the journal of processed events ------------------------------------------
 
@@ -455,6 +518,23 @@ class LatticeSimulation(SimulationBase):
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n={self.n}, collisions={self.collisions}, clock={self.clock})"
+
+
+def add_reports(a: Optional[dict], b: Optional[dict]) -> Optional[dict]:
+    """Two parallel runs' reports (``run()["parallel"]``) as one: the counts summed, per LP
+    too (runs on other K: the later's per-LP counts), ``stopped`` the later's."""
+    if a is None or b is None:
+        return dict(b if a is None else a) if (a, b) != (None, None) else None
+    out = dict(a)
+    for k, val in b.items():
+        if k == "lp_events":
+            mine, theirs = list(a[k]), list(val)
+            out[k] = [x + y for x, y in zip(mine, theirs)] if len(mine) == len(theirs) else (theirs or mine)
+        elif k == "stopped":
+            out[k] = val
+        else:
+            out[k] = a[k] + val
+    return out
 
 
 def _read_state(path: Union[str, os.PathLike]) -> dict:

@@ -34,7 +34,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import _core
-from .lattice import LatticeSimulation, LatticeSimulation3D
+from .lattice import LatticeSimulation, LatticeSimulation3D, add_reports
 from .progress import Bar, Interrupt, peak_rss
 from ._version import __version__
 from .roundtrip import BAR, round_trip_errors
@@ -87,6 +87,18 @@ def build_lattice(scene: Scene, seed: int | None = None) -> LatticeSimulation:
     return _make(scene, "[system] box" if scene.packing_fraction is None else "[system] kinetic_energy", make)
 
 
+def check_parallel(scene: Scene, trajectory) -> None:
+    """A lattice scene on the parallel engine (``workers`` > 1) that would observe its run
+    ([observe], or a trajectory's image flags): refused, a SceneError (the parallel engine does
+    not observe its committed events yet)."""
+    if scene.engine != "lattice" or scene.workers == 1:
+        return
+    if scene.observe is not None or observes_frames(scene, trajectory):
+        why = "[observe]" if scene.observe is not None else "a trajectory with image flags (periodic axes)"
+        raise SceneError(f"{scene.source}: [collisions] workers = {scene.workers}: the parallel engine does not observe "
+                         f"a run yet, and {why} needs it; run with one worker")
+
+
 def _make(scene: Scene, where: str, make: Callable[[], LatticeSimulation]) -> LatticeSimulation:
     try:
         return make()
@@ -120,6 +132,7 @@ class _LatticeRun:
 
     def __init__(self, scene: Scene, plot, trajectory, progress: bool, checkpoints: bool):
         self.scene, self.plot, self.progress = scene, plot, progress
+        check_parallel(scene, trajectory)
         self.sim = sim = build_lattice(scene)
         # [observe]: the forward run itself is observed (run_back ends the observation)
         self.observation = None
@@ -133,6 +146,9 @@ class _LatticeRun:
         self.nc = scene.collisions
         self.tick_end = None if scene.time is None else int(round(scene.time / sim.units["tick"]))
         self.every = max(1, min(10_000, (self.nc // 200) if self.nc is not None else 10 * self.n))
+        if sim.parallel["lps"] > 1:  # the parallel engine: calls long enough to pay for its K views
+            self.every = max(self.every, 2 * self.n, (self.nc or 0) // 20, 16_384)
+        self.parallel: dict | None = None  # the forward run's report on the parallel engine
         self.ckpt_every = scene.checkpoint_interval if checkpoints else 0
         self.traj_every = scene.trajectory_every if trajectory is not None else 0
         self.trajectory, self.writer = trajectory, None
@@ -197,6 +213,7 @@ class _LatticeRun:
                     self.forward_s += _time.perf_counter() - tick
                     self.cpu["forward"] += _time.process_time() - cpu
                 self.done += int(r["collisions"])
+                self.parallel = add_reports(self.parallel, r.get("parallel"))
                 self.sample(self.done)
                 bar.to(self.done if self.nc is not None else sim.clock)
                 if stop.presses:
@@ -298,6 +315,8 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
                   "tick_bits": units["tick_bits"], "cell_bits": units["cell_bits"],
                   "length_unit": units["length_unit"], "L": list(units["L"])},
         "search": sim.search,  # the neighbour search in use: "cells" or the lists' shell in diameters
+        # the forward run on the parallel engine: its settings and report (None: sequential)
+        "parallel": None if run.parallel is None else {**sim.parallel, **run.parallel},
         "mode": sim.mode,
         "quantization": sim.quantization,
         "collisions_forward": done, "collisions_back": run.back, "per_particle": 2.0 * done / n,

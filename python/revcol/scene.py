@@ -61,6 +61,8 @@ file and the replacement.
     cell_bits = 16                # engine = "lattice" only: 12..20, 2^cell_bits direction cells per turn
     search = "auto"               # engine = "lattice" only: "auto" | "cells" | a neighbour-list shell in
                                   # diameters, 0.02..2 (the speed only: the run is the same bit for bit)
+    workers = 1                   # engine = "lattice" only: 1..64 threads of the parallel engine, one
+                                  # slab each (the speed only: the run is the same bit for bit)
 
     [rng]
     generator = "clcg4"           # "clcg4" | "philox"
@@ -154,6 +156,7 @@ class Scene:
     tick_bits: int | None = None  # the lattice engine's options (None: automatic)
     cell_bits: int = 16
     search: str | float = "auto"
+    workers: int = 1
     generator: str = "clcg4"
     streams: str = "per_particle"
     seed: int = 0
@@ -339,7 +342,7 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
     for key in LATTICE_FIELDS:  # the lattice's own options: an error on the float engine, not ignored
         if engine != "lattice" and ("collisions", key) in values:
             raise _fail(source, f"[collisions] {key}", "applies to engine = 'lattice' only (the float engine has no "
-                        "ticks, direction cells or list shells)")
+                        "ticks, direction cells, list shells or parallel engine)")
 
     _check_mode(source, "[collisions] mode", "gas", engine, d, mode)
 
@@ -368,6 +371,7 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         kinetic_energy=get("system", "kinetic_energy"), initial_state=initial_path,
         mode=mode, law=law, bits=get("collisions", "bits", 40), tick_bits=get("collisions", "tick_bits"),
         cell_bits=get("collisions", "cell_bits", 16), search=get("collisions", "search", "auto"),
+        workers=get("collisions", "workers", 1),
         streams=get("rng", "streams", "per_particle"), collisions=nc, time=t_end,
         checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
         json=out("json"), plot=out("plot"), trajectory=trajectory,
@@ -413,7 +417,7 @@ def with_engine(scene: Scene, engine: str) -> Scene:
     ``[collisions] engine = ...`` would be: a scene that names no generator gets the engine's
     default one (Philox on the lattice); a lattice scene moved to the float engine keeps its
     Philox streams, gets the float engine's default chart bits, 40, and drops the lattice's own
-    options (tick_bits, cell_bits, search)."""
+    options (tick_bits, cell_bits, search, workers)."""
     if engine not in ENGINES:
         raise SceneError(f"{scene.source}: --engine must be one of {', '.join(map(repr, ENGINES))}, got {engine!r}")
     if scene.kind != "gas":
@@ -421,7 +425,7 @@ def with_engine(scene: Scene, engine: str) -> Scene:
     fields = scene.extra.get("fields", ())
     out = dataclasses.replace(scene, engine=engine)
     if engine == "float":
-        out = dataclasses.replace(out, tick_bits=None, cell_bits=16, search="auto")
+        out = dataclasses.replace(out, tick_bits=None, cell_bits=16, search="auto", workers=1)
     if engine == "lattice":
         if "rng.generator" not in fields:  # the lattice's default generator, as in a scene file
             out = dataclasses.replace(out, generator="philox")
@@ -525,15 +529,16 @@ def engine_options(scene: Scene) -> dict[str, Any]:
 def lattice_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.lattice.LatticeSimulation` that a gas scene sets."""
     return dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
-                seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search)
+                seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search,
+                workers=scene.workers)
 
 
 def with_lattice_options(scene: Scene, *, tick_bits: int | None = None, cell_bits: int | None = None,
-                         search: str | float | None = None) -> Scene:
+                         search: str | float | None = None, workers: int | None = None) -> Scene:
     """``scene`` with the lattice engine's options that are not None replaced (``revcol run`` and
-    ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``), each checked as its
+    ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``, ``--workers``), each checked as its
     ``[collisions]`` field; a scene that does not run the lattice engine refuses them."""
-    given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search)) if v is not None}
+    given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search, workers)) if v is not None}
     flags = {k: "--" + k.replace("_", "-") for k in given}
     if given and (scene.kind != "gas" or scene.engine != "lattice"):
         runs = "the float engine (add --engine lattice)" if scene.kind == "gas" else f"no gas (kind = {scene.kind!r})"

@@ -38,7 +38,7 @@ DEPRECATED: dict[tuple[str, str], dict[str, str]] = {
 }
 
 #: the [collisions] fields of the lattice engine alone (LatticeSimulation's options)
-LATTICE_FIELDS = ("tick_bits", "cell_bits", "search")
+LATTICE_FIELDS = ("tick_bits", "cell_bits", "search", "workers")
 
 # the schema: table -> field -> (type check name, allowed values or range)
 SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
@@ -64,6 +64,7 @@ SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "tick_bits": ("int", (16, 26)),
         "cell_bits": ("int", (12, 20)),
         "search": ("search", (0.02, 2.0)),
+        "workers": ("int", (1, 64)),  # the parallel engine's threads (timewarp.hpp): the speed only
     },
     "rng": {
         "generator": ("str", tuple(sorted(LIMITS["generators"]))),

@@ -250,7 +250,11 @@ TEST_CASE("an observed run is the unobserved run, and reverses bit for bit; run_
   // a forward run after run_back adds nothing to the stopped observation
   a.run(100, tick_limit - 1);
   CHECK(a.observer()->results().pair_collisions == o.pair_collisions);
-  // restore replaces the state: the observation is gone
+  // restore replaces the state: a stopped observation stays readable, a running one is gone
+  a.restore(s0);
+  CHECK(a.observer() != nullptr && !a.observing());
+  a.run(100, tick_limit - 1);  // (not fed by the restored state's run)
+  CHECK(a.observer()->results().pair_collisions == o.pair_collisions);
   a.observe(en::ObserveConfig{});
   a.restore(s0);
   CHECK(!a.observing());

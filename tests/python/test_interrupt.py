@@ -15,7 +15,9 @@ import pytest
 CHILD = r"""
 import sys, numpy as np, revcol
 engine, direction = sys.argv[1], sys.argv[2]
-s = revcol.Simulation.random(2000, 2, 0.3, seed=1, engine=engine, boundary="wall")
+workers = {"lattice-parallel": {"workers": 2}}.get(engine, {})  # (the parallel lattice engine, two threads)
+engine = engine.split("-")[0]
+s = revcol.Simulation.random(2000, 2, 0.3, seed=1, engine=engine, boundary="wall", **workers)
 x0, v0 = s.positions.copy(), s.velocities.copy()
 if direction == "back":  # a run_back of seconds, so that the SIGINT 0.3 s in surely lands inside it
     s.run(collisions=2000000)
@@ -66,6 +68,13 @@ def _interrupt(tmp_path, code, args, ready_s=120, after_s=0.3, wait_s=60):
 @pytest.mark.parametrize("engine", ["float", "lattice"])
 def test_ctrl_c_stops_a_run_at_a_valid_point(engine, direction, tmp_path):
     rc, text = _interrupt(tmp_path, CHILD, [engine, direction])
+    assert rc == 0 and "interrupted" in text and "usable" in text, text
+
+
+def test_ctrl_c_stops_a_parallel_lattice_run_at_a_whole_tick(tmp_path):
+    # the worker threads stop at the next GVT; the state is the run's at a whole tick, from which
+    # the simulation goes on and comes back to its start bit for bit
+    rc, text = _interrupt(tmp_path, CHILD, ["lattice-parallel", "fwd"])
     assert rc == 0 and "interrupted" in text and "usable" in text, text
 
 

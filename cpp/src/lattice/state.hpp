@@ -103,8 +103,10 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<
   // a large gas is stored in space order from the start (resort), unless an order is given
   const bool sort = order.empty() && s.observer.empty() && resort_every_for(s.x.size()) > 0;
   load(s, sort ? space_order(s.units, s.x) : order);
-  observer_ = std::move(resumed);  // none: an observation of the old state ends
-  obs_ = observer_.get();
+  // none: a running observation of the old state ends; a stopped one stays readable (not fed)
+  const bool running = resumed != nullptr;
+  if (running || obs_) observer_ = std::move(resumed);
+  obs_ = running ? observer_.get() : nullptr;
 }
 
 template <class Op, class Bits, class Queue>

@@ -2,12 +2,12 @@
 
     revcol run [SCENE.toml] [--json FILE] [--plot DIR] [--trajectory FILE.xyz|.gsd] [--collisions N] [--seed S]
                [--engine float|lattice] [--mode exact|paper|specular] [--max-output SIZE]
-               [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]
+               [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL] [--workers K]
     revcol run [SCENE.toml] --horizon [--seeds K] [--max-collisions N] [--engine float] [--json FILE] [--plot DIR]
     revcol simulate [SCENE] [--collisions N | --time T] [--trajectory FILE --every K|--every-time T] [--checkpoint DIR
                --checkpoint-every K] [--resume CHECKPOINT] [--species Ar] [--json FILE]   (forward only)
                [--engine float|lattice] [--mode exact|paper|specular] [--max-output SIZE]
-               [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL]   (lattice engine)
+               [--tick-bits T] [--cell-bits C] [--search auto|cells|SHELL] [--workers K]   (lattice engine)
     revcol verify pair2d --collisions 1000000 --mode exact --law flux --rng clcg4 --seed 0 --json
     revcol bench statesave --n 1000 10000 100000 1000000 --collisions 1000 [--lazy] --json out.json --plot out.png
     revcol bench tradeoff [--reduced] [--repeats 3] --json bench/results/tradeoff.json --plot docs/figures/tradeoff
@@ -96,6 +96,8 @@ def _lattice_flags(p: argparse.ArgumentParser) -> None:
     g.add_argument("--cell-bits", type=int, metavar="C", help="2^C direction cells per turn, 12..20 (default 16)")
     g.add_argument("--search", type=_search, metavar="S", help="neighbour search: 'auto' (lists in 3D, cells in 2D), "
                    "'cells', or lists with a shell of S diameters, 0.02..2; the run is the same bit for bit")
+    g.add_argument("--workers", type=int, metavar="K", help="run forward on the parallel engine, K threads and "
+                   "slabs, 1..64 (docs/parallel.md); the run is the same bit for bit")
 
 
 #: the collision modes --mode takes (a scene's [collisions] mode; the engine's own are checked with the scene)
@@ -284,7 +286,8 @@ def _simulate(args: argparse.Namespace) -> int:
             report = simulate(scene, collisions=args.collisions, time=args.time, trajectory=args.trajectory,
                               every=args.every, checkpoints=args.checkpoint, checkpoint_every=args.checkpoint_every,
                               resume=args.resume, seed=args.seed, engine=args.engine, species=args.species,
-                              tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search, mode=args.mode,
+                              tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search,
+                              workers=args.workers, mode=args.mode,
                               json_path=None if to_stdout else args.json, max_output=args.max_output,
                               progress=False if args.no_progress else None, every_time=args.every_time)
     except (SceneError, OSError) as e:

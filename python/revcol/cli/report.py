@@ -99,6 +99,18 @@ def _per(x: dict) -> str:
     return f" ({x['start'] / n:.4g} per particle)" if n else ""
 
 
+def parallel_line(p: dict | None) -> list[str]:
+    """The parallel engine's line of a lattice report (none for a sequential run)."""
+    if p is None:
+        return []
+    events, par = max(int(p["events"]), 1), int(p["parallel_collisions"])
+    return [f"  parallel         {p['lps']} logical processes on {p['workers']} worker thread(s), rollback by "
+            f"{p['rollback']}{', lazy cancellation' if p['lazy'] else ''}: {par:,} collisions committed in parallel, "
+            f"{int(p['sequential_collisions']):,} sequential (probe and tail); {int(p['events']):,} events processed "
+            f"(efficiency {par / events:.3g}), {int(p['rollbacks']):,} rollbacks undoing {int(p['undone']):,}, "
+            f"{int(p['messages']):,} messages, {int(p['anti_messages']):,} anti-messages"]
+
+
 def _lattice_lines(r: dict) -> list[str]:
     """A lattice-engine round trip: what came back bit for bit, X's size, the rare log,
     redraws (specular mode: refusals) and backscatters, multi-body ticks, drifts, rates and memory."""
@@ -116,6 +128,7 @@ def _lattice_lines(r: dict) -> list[str]:
         f"units (a typical particle moves 2^-{u['tick_bits']} sigma per tick), 2^{u['cell_bits']} direction cells",
         f"  settings         mode {r.get('mode', 'exact')}, tick_bits {u['tick_bits']}, cell_bits {u['cell_bits']}, "
         f"search {_search(r.get('search'))}",
+        *parallel_line(r.get("parallel")),
         f"  start            quantized once: positions within {_err(q['max_position_error'], 'diameters')}, "
         f"velocities within {_err(q['max_velocity_error'], 'v_rms')}; exact from there on",
         f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:,.4g} per particle) to "

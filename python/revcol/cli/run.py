@@ -32,7 +32,7 @@ def run_command(args: argparse.Namespace) -> int:
             warnings.simplefilter("always", DeprecationWarning)
             warnings.showwarning = _warn_line
             scene, engine = args.scene, args.engine
-            lattice = dict(tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search)
+            lattice = dict(tick_bits=args.tick_bits, cell_bits=args.cell_bits, search=args.search, workers=args.workers)
             if args.mode is not None or any(v is not None for v in lattice.values()):
                 # on the engine the scene runs on (--engine too), in the mode it runs (--mode too)
                 scene = load_scene(scene)

@@ -52,8 +52,9 @@ from .._output_size import (checkpoints_size, production_checkpoints, production
                             trajectory_size)
 from .._outputs import Output, check_outputs, checkpoint_names, estimates, output_limit, run_inputs
 from ..gas import build_simulation, check_memory
-from ..lattice import LatticeSimulation
-from ..lattice_gas import geometry as lattice_geometry
+from ..lattice import LatticeSimulation, add_reports
+from ..lattice_gas import check_parallel, geometry as lattice_geometry
+from .report import parallel_line
 from ..observe import report_lines
 from ..progress import Bar, Interrupt, peak_rss
 from ..roundtrip import geometry
@@ -153,6 +154,7 @@ class _Production:
                  species: str, precise: bool, every_time: float | None = None, resumed: bool = False):
         self.scene, self.sim, self.resumed = scene, sim, resumed
         self.lattice = scene.engine == "lattice"
+        self.parallel: dict | None = None  # the run's report on the parallel engine (lattice, workers > 1)
         self.start = self.done = _net(sim)
         self.target = None if collisions is None else self.start + int(collisions)
         self.t_start = sim.time
@@ -225,9 +227,13 @@ class _Production:
         sim, more = self.sim, None if stop_c is None else stop_c - self.done
         until = self.stop_time()
         if self.lattice:
-            more = LATTICE_CHUNK if more is None else min(more, LATTICE_CHUNK)
+            # (the parallel engine: calls long enough to pay for its K views; Ctrl-C is polled inside)
+            chunk = LATTICE_CHUNK if sim.parallel["lps"] == 1 else max(5 * LATTICE_CHUNK, 2 * sim.n)
+            more = chunk if more is None else min(more, chunk)
             try:
-                return int(sim.run(collisions=more, time=until)["collisions"])
+                r = sim.run(collisions=more, time=until)
+                self.parallel = add_reports(self.parallel, r.get("parallel"))
+                return int(r["collisions"])
             except RuntimeError as e:  # a collision the lattice engine cannot resolve: stop here
                 self.engine_error = str(e)
                 return _net(sim) - self.done
@@ -294,6 +300,8 @@ class _Production:
             "engine": scene.engine, "mode": scene.mode, "particles": sim.n, "dimension": sim.dim,
             "lattice": {"tick_bits": sim.units["tick_bits"], "cell_bits": sim.units["cell_bits"],
                         "search": sim.search} if self.lattice else None,
+            # the run on the parallel engine: its settings and report (None: sequential)
+            "parallel": None if self.parallel is None else {**sim.parallel, **self.parallel},
             # the lattice's specular pairs turned back in place (specular.hpp); None on the float engine
             "backscatters": int(d["backscatters"]) if self.lattice else None,
             "resumed_from": None if resume is None else os.fspath(resume),
@@ -320,13 +328,13 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
              species: str = "Ar", precise: bool = False, json_path: str | os.PathLike | None = None,
              progress: bool | None = None, every_time: float | None = None, tick_bits: int | None = None,
              cell_bits: int | None = None, search: str | float | None = None, mode: str | None = None,
-             max_output: int | str | None = None) -> dict:
+             max_output: int | str | None = None, workers: int | None = None) -> dict:
     """Runs a gas scene forward only (see the module's docstring) and returns the report; with
     ``json_path`` also writes it (atomically). ``species`` names the trajectory's element,
     ``precise`` adds float64 positions to a GSD trajectory; ``every_time`` writes frames at the
     multiples of that time instead of every ``every`` collisions. ``tick_bits``, ``cell_bits``,
-    ``search``: the lattice engine's options instead of the scene's (a resumed run keeps its
-    checkpoint's units, tick and cells, and takes a new search). ``mode``: the collision mode
+    ``search``, ``workers``: the lattice engine's options instead of the scene's (a resumed run keeps its
+    checkpoint's units, tick and cells, and takes a new search and workers). ``mode``: the collision mode
     instead of the scene's ``[collisions] mode`` (``"exact"``, ``"paper"``: float engine, 1D and
     2D, or ``"specular"``; a resumed run must be in its checkpoint's). ``max_output``: the outputs'
     limit in bytes (``"20G"``; 0 or ``"none"``: none) instead of the scene's ``[output] max_output``
@@ -338,7 +346,7 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
         scene = with_mode(scene, mode, engine)
     elif engine is not None:
         scene = with_engine(scene, engine)
-    scene = with_lattice_options(scene, tick_bits=tick_bits, cell_bits=cell_bits, search=search)
+    scene = with_lattice_options(scene, tick_bits=tick_bits, cell_bits=cell_bits, search=search, workers=workers)
     if resume is not None and (tick_bits, cell_bits) != (None, None):
         raise SceneError(f"{scene.source}: --tick-bits, --cell-bits: a resumed run keeps its checkpoint's units")
     if seed is not None:
@@ -353,6 +361,7 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
         raise SceneError(f"{scene.source}: --species: {e}") from None
     limit = output_limit(scene.source, max_output, scene.max_output)
     check_memory(scene)
+    check_parallel(scene, trajectory)
     # the checkpoint resumed from is read first: its count numbers the checkpoints the run may write
     sim = _build(scene, resume) if resume is not None else None
     start = 0 if sim is None else _net(sim)
@@ -367,6 +376,8 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
         sim = _build(scene, None)
     if resume is not None and search is not None:  # the checkpoint holds its own; a new one is the same run
         sim.search = scene.search
+    if scene.engine == "lattice":  # (a checkpoint holds no workers: a parallel run resumes on any)
+        sim.set_parallel(scene.workers)
     run = _Production(scene, sim, collisions, time, trajectory, every, checkpoints, checkpoint_every,
                       species, precise, every_time, resumed=resume is not None)
     run.go(sys.stdout.isatty() if progress is None else progress)
@@ -409,6 +420,7 @@ def format_simulate(r: dict) -> str:
              + (f"  (resumed from {r['resumed_from']})" if r["resumed_from"] else "")
              + (f"  (tick_bits {r['lattice']['tick_bits']}, cell_bits {r['lattice']['cell_bits']}, search "
                 f"{r['lattice']['search']})" if r.get("lattice") else ""),
+             *parallel_line(r.get("parallel")),
              f"  collisions       {r['collisions']:,} ({r['collisions_per_particle']:.3g} per particle; "
              f"net count now {r['net_collisions']:,})",
              f"  time             {r['time_start']:.6g} -> {r['time_end']:.6g}",

@@ -171,7 +171,7 @@ class BasicEngine {
   /// with the exact state converted once to float units (x length_unit, ticks x tick), the
   /// positions the engine gives (its *_at hooks: a lattice event moves centres by up to a
   /// tick's travel). Observation is forward only: run_back ends it; a snapshot keeps a running
-  /// one and restore resumes it (or ends the observation of the old state).
+  /// one and restore resumes it (or ends a running one of the old state; a stopped one stays).
   void observe(const engine::ObserveConfig& c);
   /// The running or last observation (null before observe()).
   const engine::Observer* observer() const noexcept { return observer_.get(); }
@@ -574,7 +574,7 @@ class BasicEngine {
   std::deque<std::pair<std::uint8_t, Record>> jlp_;  // per LP write or park: parked before, state before
   std::vector<std::uint8_t> parked_;  // an LP's particles outside its view (empty: none)
   LpNotes* lp_ = nullptr;
-  bool lp_stepped_ = false;  // lp_step: one event processed
+  bool lp_stepped_ = false;  // lp_run: an event was popped (its after-hook is due)
   EventKey done_key(const Done& d) const noexcept {
     return {d.t, d.kind, d.type >= lpw ? d.q : gid(d.unreflected & 4u ? d.q : d.p)};
   }

@@ -17,8 +17,8 @@ namespace revcol::lattice {
 /// Runs w workers (the calling thread is worker 0), worker m calling turn(i) for each item i of
 /// its share [m k / w, (m + 1) k / w) over and over (turn: whether it did anything). When a
 /// worker has done `every` turns with work since the last barrier, or when every worker found
-/// nothing to do, all of them stop at a barrier and worker 0 calls settle(idle) (idle: every
-/// worker had found nothing) with the others waiting; true ends the run. An exception in a turn
+/// nothing to do since the last barrier, all of them stop at a barrier and worker 0 calls
+/// settle(idle) (idle: every worker had found nothing) with the others waiting; true ends the run. An exception in a turn
 /// or in settle ends the run at the next barrier and is rethrown here.
 inline void run_workers(int w, int k, std::uint64_t every, const std::function<bool(int)>& turn, const std::function<bool(bool)>& settle) {
   std::mutex mx;
@@ -54,11 +54,13 @@ inline void run_workers(int w, int k, std::uint64_t every, const std::function<b
             if (!err) err = std::current_exception();
             done = true;
           }
+          idle.store(0);  // (idle again only once every worker has found nothing since)
           want.store(false, std::memory_order_release);
         }
         barrier();
         if (done) return;
         since = 0;
+        was_idle = false;
         continue;
       }
       bool any = false;

@@ -1,0 +1,84 @@
+// Binding of the parallel lattice run (revcol/lattice/parallel_run.hpp): LatticeEngine's and
+// LatticeEngine3D's run_parallel, the GIL released for the run (the worker threads never take
+// it; the calling thread takes it back for the Ctrl-C poll at GVT), the report as a dict.
+// Included by lattice.cpp (P: its PyLattice).
+#pragma once
+#include <pybind11/pybind11.h>
+
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "args.hpp"
+#include "revcol/error.hpp"
+#include "revcol/lattice/parallel_run.hpp"
+
+namespace revcol::bind {
+
+/// The report of a parallel run: collisions by engine, the Time Warp counts, per-LP events.
+inline pybind11::dict parallel_report_dict(const lattice::ParallelReport& r) {
+  pybind11::dict d;
+  const lattice::TimeWarpStats& s = r.stats;
+  d["collisions"] = r.collisions;
+  d["parallel_collisions"] = r.parallel;
+  d["sequential_collisions"] = r.sequential;
+  d["overshoot"] = r.overshoot;
+  d["chunks"] = r.chunks;
+  d["stopped"] = r.stopped;
+  d["events"] = s.events;
+  d["stale"] = s.stale;
+  d["rollbacks"] = s.rollbacks;
+  d["undone"] = s.undone;
+  d["messages"] = s.messages;
+  d["anti_messages"] = s.anti;
+  d["confirmed"] = s.confirmed;
+  d["written"] = s.written;
+  d["blocked"] = s.blocked;
+  d["reused"] = s.reused;
+  d["gvts"] = s.gvts;
+  d["lp_events"] = s.lp_events;
+  return d;
+}
+
+/// LatticeEngine(3D).run_parallel(collisions, until, lps, workers, ...) on the binding's class.
+template <class Engine, class P, class Cls>
+void def_parallel(Cls& cls) {
+  namespace py = pybind11;
+  namespace la = revcol::lattice;
+  cls.def(
+      "run_parallel",
+      [](P& p, std::optional<PyInt> collisions_arg, std::optional<PyInt> until_arg, PyInt lps, PyInt workers, PyInt axis,
+         const std::string& by, bool lazy, PyInt window, PyInt gvt_every, PyInt batch, PyInt fuzz, PyInt small) {
+        typename la::TimeWarp<Engine>::Config c;
+        c.lps = to_int<int>(lps, "lps", 1, 64);
+        c.workers = to_int<int>(workers, "workers", 1, 64);
+        require(c.workers <= c.lps, "workers must be at most lps (the logical processes), got workers=" +
+                                        std::to_string(c.workers) + " > lps=" + std::to_string(c.lps));
+        c.axis = to_int<int>(axis, "axis", 0, static_cast<int>(Engine::D) - 1);
+        if (by == "save_all") c.how = la::Rollback::save_all;
+        else if (by == "save_changes") c.how = la::Rollback::save_changes;
+        else require(by == "reverse", "rollback must be 'reverse', 'save_all' (SS1) or 'save_changes' (SS2), not '" + by + "'");
+        c.lazy = lazy;
+        c.window = to_int<std::int64_t>(window, "window", 0);
+        c.gvt_every = to_int<std::uint64_t>(gvt_every, "gvt_every", 1);
+        c.batch = to_int<int>(batch, "batch", 1);
+        c.fuzz = to_int<std::uint64_t>(fuzz, "fuzz", 0);
+        require(c.workers == 1 || c.fuzz == 0, "fuzz (a random schedule) runs on one worker");
+        const auto t = to_int<std::uint64_t>(small, "small", 0);
+        const auto collisions = to_int<std::uint64_t>(collisions_arg, "collisions");
+        const auto until = to_int<std::int64_t>(until_arg, "until");
+        const la::ParallelReport r = p.run_released([&](Engine& e, const auto& poll) {
+          return la::run_parallel(e, collisions.value_or(std::numeric_limits<std::uint64_t>::max()),
+                                  until.value_or(la::tick_limit - 1), c, poll, t);
+        });
+        if (PyErr_Occurred()) throw py::error_already_set();  // Ctrl-C: stopped at a whole tick
+        return parallel_report_dict(r);
+      },
+      py::arg("collisions") = py::none(), py::arg("until") = py::none(), py::arg("lps") = 2, py::arg("workers") = 2,
+      py::arg("axis") = 0, py::arg("rollback") = "reverse", py::arg("lazy") = true, py::arg("window") = 0,
+      py::arg("gvt_every") = 512, py::arg("batch") = 64, py::arg("fuzz") = 0, py::arg("small") = 0,
+      "Forward on `lps` logical processes and `workers` threads (the parallel engine, Time Warp): the state "
+      "run(collisions, until) reaches, bit for bit. Returns the run's report.");
+}
+
+}  // namespace revcol::bind

@@ -1,0 +1,124 @@
+// A run of a sequential lattice engine's state on the parallel engine (timewarp.hpp): what
+// LatticeSimulation(workers=K).run and `revcol run --workers K` call. The engine ends in the
+// state its own run(collisions, until) would reach, bit for bit.
+//
+// Time Warp runs to a tick; a stop at a collision count is reached in three steps: a probe of a
+// few thousand collisions on the sequential engine measures ticks per collision, the parallel
+// engine runs to a tick estimated to fall just short of the count (a second, nearer tick from
+// the rate the first chunk measured), and the sequential engine runs the last few thousand
+// collisions, or back the few a chunk ran past the count (its run_back is exact). Short runs (at
+// most `small` collisions, default max(4096, N/4): building K views costs more than they save)
+// stay sequential, and the report says how many collisions each engine ran.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+
+#include "revcol/error.hpp"
+#include "revcol/lattice/timewarp.hpp"
+
+namespace revcol::lattice {
+
+/// What run_parallel did.
+struct ParallelReport {
+  std::uint64_t collisions = 0;  ///< collisions done (committed) in all
+  std::uint64_t parallel = 0;    ///< of them, committed by the parallel engine
+  std::uint64_t sequential = 0;  ///< of them, run by the sequential engine (probe and tail)
+  std::uint64_t overshoot = 0;   ///< collisions a chunk ran past the stop, run back sequentially
+  int chunks = 0;                ///< parallel runs to a tick
+  bool stopped = false;          ///< Ctrl-C: the state is the run's at a whole tick before the stop
+  TimeWarpStats stats{};         ///< the parallel engine's counts
+};
+
+/// Runs engine e forward, as e.run(collisions, until) does (bit for bit the same state), on K
+/// logical processes (config c). An engine error leaves e's state as it was; Ctrl-C (poll()
+/// false) leaves it at a whole tick the run passed. A running observation is refused (the
+/// parallel engine does not observe its committed events yet). `small`: runs of at most that many
+/// collisions stay sequential (0: max(4096, N/4)); `bias` (tests): scales the chunks' ticks (> 1
+/// runs past the count, which the sequential engine then runs back).
+template <class Engine>
+ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t until, const typename TimeWarp<Engine>::Config& c,
+                            const std::function<bool()>& poll = {}, std::uint64_t small = 0, double bias = 1.0) {
+  require(!e.observing(),
+          "parallel lattice run: an observation is running (the parallel engine does not observe yet): stop_observing() "
+          "first, or run with one worker");
+  require(until >= e.clock(), "lattice run: the end tick is before the clock");
+  require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
+  constexpr std::uint64_t all = std::numeric_limits<std::uint64_t>::max();
+  if (small == 0) small = std::max<std::uint64_t>(4096, e.size() / 4);
+  constexpr std::uint64_t probe = 4096, tail = 4096;
+  ParallelReport r;
+  if (collisions == 0) return r;
+  const std::uint64_t c0 = e.collisions();
+  const std::uint64_t target = collisions >= all - c0 ? all : c0 + collisions;
+  const bool by_count = target != all;
+  const auto sequential = [&](std::uint64_t n) {
+    const std::uint64_t did = e.run(n, until, poll);
+    r.sequential += did;
+    r.collisions += did;
+    r.stopped = did < n && e.clock() < until;  // (a run short of n ends at until, or at a Ctrl-C)
+    return did;
+  };
+  if (by_count && collisions <= small) {
+    sequential(collisions);
+    return r;
+  }
+  const typename Engine::Snapshot start = e.snapshot();
+  try {
+    double per = 0.0;  // ticks per collision
+    if (by_count) {
+      const std::int64_t t0 = e.clock();
+      const std::uint64_t did = sequential(probe);
+      if (did < probe) return r;  // the run reached until (or a Ctrl-C)
+      per = static_cast<double>(e.clock() - t0) / static_cast<double>(did);
+    }
+    auto tw = std::make_unique<TimeWarp<Engine>>(e.snapshot(), c);
+    typename Engine::Snapshot s;
+    for (std::int64_t clock = e.clock(); r.chunks < 3;) {
+      const std::uint64_t had = e.collisions() + r.parallel;
+      std::int64_t t = until;
+      if (by_count) {
+        if (had + tail >= target) break;  // (at or past the count: the tail, or back)
+        const double left = static_cast<double>(target - had);
+        // short of the count: the probe's rate is good to 1/64 in a steady state, but a gas still
+        // relaxing (a fresh start) changes its rate by several per cent over a run, so the first
+        // chunk aims at 85%; the next, at the rate the chunk measured, four standard errors short
+        const double aim = r.chunks == 0 ? 0.85 * left : left - 4.0 * std::sqrt(left);
+        const double ticks = std::max(1.0, std::floor(aim * per * bias));
+        if (ticks < static_cast<double>(until - clock)) t = clock + static_cast<std::int64_t>(ticks);
+      }
+      const bool whole = tw->run_until(t, poll);
+      s = tw->snapshot();
+      ++r.chunks;
+      const std::uint64_t did = s.collisions - had;
+      r.parallel += did;
+      if (did > 0) per = static_cast<double>(s.clock - clock) / static_cast<double>(did);
+      clock = s.clock;
+      if (!whole) r.stopped = true;
+      if (!whole || t == until || !by_count) break;
+    }
+    r.stats = tw->stats();
+    tw.reset();  // (its K views' memory, before the engine rebuilds its own)
+    if (r.chunks > 0) e.restore(s);
+    r.collisions += r.parallel;
+    if (r.stopped || !by_count) return r;
+    if (e.collisions() > target) {  // the chunk ran past the count: back, exactly, to right after it
+      r.overshoot = e.collisions() - target;
+      r.collisions -= r.overshoot;
+      r.parallel -= r.overshoot;
+      e.run_back(target, e.origin(), poll);
+      r.stopped = e.collisions() > target;
+    } else if (e.collisions() < target && e.clock() < until) {
+      sequential(target - e.collisions());
+    }
+    return r;
+  } catch (...) {
+    e.restore(start);
+    throw;
+  }
+}
+
+}  // namespace revcol::lattice
