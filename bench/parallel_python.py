@@ -6,7 +6,7 @@ probe and the tail a stop at a collision count costs, building the K views, and 
 committed state into the simulation.
 
     PYTHONPATH=build-dev/pkg python bench/parallel_python.py --dim 2 --n 1000000 --phi 0.5 \\
-        --collisions 2000000 --rounds 3 --json bench/results/lattice_parallel_python.json
+        --collisions 2000000 10000000 --rounds 3 --json bench/results/lattice_parallel_python.json
 """
 from __future__ import annotations
 
@@ -30,14 +30,45 @@ def _same(a: dict, b: dict) -> bool:
     return all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in STATE)
 
 
+def measure(cls, s0: dict, collisions: int, rounds: int, workers: list[int]) -> dict:
+    """One call of run(collisions) per variant and round, interleaved, from the state s0."""
+    names = ["seq"] + [f"K{w}_w{w}" for w in workers]
+    rates: dict[str, list[float]] = {k: [] for k in names}
+    same: dict[str, bool] = {k: True for k in names}
+    report: dict[str, dict] = {}
+    want = None
+    for r in range(rounds):
+        for name in names:
+            s = cls.from_snapshot(s0)
+            if name != "seq":
+                w = int(name.split("_w")[1])
+                s.set_parallel(w, lps=w)
+            t0 = time.perf_counter()
+            out = s.run(collisions=collisions)
+            rates[name].append(collisions / (time.perf_counter() - t0))
+            end = s.snapshot()
+            if want is None:
+                want = end
+            same[name] = same[name] and _same(end, want)
+            if "parallel" in out:
+                report[name] = out["parallel"]
+            print(f"{collisions} round {r} {name}: {rates[name][-1]:,.0f} collisions/s, same {same[name]}",
+                  file=sys.stderr, flush=True)
+    base = float(np.median(rates["seq"]))
+    return {k: {"per_s": float(np.median(v)), "per_s_min": float(min(v)), "per_s_max": float(max(v)),
+                "speedup": float(np.median(v)) / base, "speedup_min": float(min(v)) / base,
+                "speedup_max": float(max(v)) / base, "same_as_sequential": same[k], "report": report.get(k)}
+            for k, v in rates.items()}
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--dim", type=int, choices=(2, 3), default=2)
     p.add_argument("--n", type=int, default=1_000_000)
     p.add_argument("--phi", type=float, default=0.5)
-    p.add_argument("--collisions", type=int, default=2_000_000)
+    p.add_argument("--collisions", type=int, nargs="+", default=[2_000_000], help="collisions per run() call")
     p.add_argument("--rounds", type=int, default=3)
-    p.add_argument("--workers", type=int, nargs="+", default=[1, 2], help="parallel variants (K = workers LPs)")
+    p.add_argument("--workers", type=int, nargs="+", default=[2], help="parallel variants, 2 or more (K = workers LPs)")
     p.add_argument("--json", required=True)
     a = p.parse_args(argv)
     cls = LatticeSimulation3D if a.dim == 3 else LatticeSimulation
@@ -45,47 +76,24 @@ def main(argv=None) -> int:
     sim = cls.random(a.n, phi=a.phi, seed=1)
     sim.run(collisions=a.n)  # warmed: the start's relaxation behind it
     s0 = sim.snapshot()
-    names = ["seq"] + [f"K{w}_w{w}" for w in a.workers]
-    rates: dict[str, list[float]] = {k: [] for k in names}
-    same: dict[str, bool] = {k: True for k in names}
-    report: dict[str, dict] = {}
-    want = None
-    for r in range(a.rounds):
-        for name in names:
-            s = cls.from_snapshot(s0)
-            if name != "seq":
-                w = int(name.split("_w")[1])
-                s.set_parallel(w, lps=w)
-            t0 = time.perf_counter()
-            out = s.run(collisions=a.collisions)
-            rates[name].append(a.collisions / (time.perf_counter() - t0))
-            end = s.snapshot()
-            if want is None:
-                want = end
-            same[name] = same[name] and _same(end, want)
-            if "parallel" in out:
-                report[name] = out["parallel"]
-            print(f"round {r} {name}: {rates[name][-1]:,.0f} collisions/s, same {same[name]}", file=sys.stderr, flush=True)
-    base = float(np.median(rates["seq"]))
+    runs = {c: measure(cls, s0, c, a.rounds, a.workers) for c in a.collisions}
     result = {
         "what": "LatticeSimulation.run(collisions=C) on the parallel engine against the sequential engine, end to end",
         "command": " ".join(["python", "bench/parallel_python.py", *(argv if argv is not None else sys.argv[1:])]),
         "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip(),
         "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "load_before": load0, "load_after": os.getloadavg()[0],
-        "cores": os.cpu_count(), "dim": a.dim, "n": a.n, "phi": a.phi, "collisions": a.collisions, "rounds": a.rounds,
-        "variants": {k: {"per_s": float(np.median(v)), "per_s_min": float(min(v)), "per_s_max": float(max(v)),
-                         "speedup": float(np.median(v)) / base, "speedup_min": float(min(v)) / base,
-                         "speedup_max": float(max(v)) / base, "same_as_sequential": same[k],
-                         "report": report.get(k)} for k, v in rates.items()},
+        "cores": os.cpu_count(), "dim": a.dim, "n": a.n, "phi": a.phi, "rounds": a.rounds,
+        "runs": {str(c): v for c, v in runs.items()},
     }
     d = os.path.dirname(os.path.abspath(a.json))
     with tempfile.NamedTemporaryFile("w", dir=d, delete=False, suffix=".tmp") as f:
         json.dump(result, f, indent=1)
     os.replace(f.name, a.json)
-    for k, v in result["variants"].items():
-        print(f"{k}: {v['per_s']:,.0f} collisions/s ({v['speedup']:.2f}x, {v['speedup_min']:.2f}-{v['speedup_max']:.2f}), "
-              f"same {v['same_as_sequential']}")
-    return 0 if all(same.values()) else 1
+    for c, variants in runs.items():
+        for k, v in variants.items():
+            print(f"{c} collisions per call, {k}: {v['per_s']:,.0f} collisions/s ({v['speedup']:.2f}x, "
+                  f"{v['speedup_min']:.2f}-{v['speedup_max']:.2f}), same {v['same_as_sequential']}")
+    return 0 if all(v["same_as_sequential"] for r in runs.values() for v in r.values()) else 1
 
 
 if __name__ == "__main__":

@@ -37,6 +37,10 @@ inline pybind11::dict parallel_report_dict(const lattice::ParallelReport& r) {
   d["reused"] = s.reused;
   d["gvts"] = s.gvts;
   d["lp_events"] = s.lp_events;
+  d["build_s"] = r.build_s;
+  d["parallel_s"] = r.parallel_s;
+  d["assemble_s"] = r.assemble_s;
+  d["sequential_s"] = r.sequential_s;
   return d;
 }
 

@@ -281,8 +281,11 @@ class LatticeSimulation(SimulationBase):
         is reached by a short sequential probe and tail, and runs of at most max(4096, n/4)
         collisions stay sequential), events processed, rollbacks, undone events, messages,
         anti-messages, per-LP events. ``run_back``, checkpoints and the rest are the sequential
-        engine's (the state is its own). ``workers=1`` with ``lps`` None is the sequential
-        engine. An observation cannot run on the parallel engine yet (a ValueError)."""
+        engine's (the state is its own). The settings are not part of the state: a snapshot,
+        checkpoint or pickle holds none, and a simulation rebuilt from one runs on the
+        sequential engine until ``set_parallel`` (any K: the bits are the same). ``workers=1``
+        with ``lps`` None is the sequential engine. An observation cannot run on the parallel
+        engine yet (a ValueError)."""
         workers = integer(workers, "workers", 1, 64)
         k = workers if lps is None else integer(lps, "lps", 1, 64)
         if workers > k:

@@ -73,16 +73,13 @@ namespace revcol::lattice {
 
 /// The dimension of a pair operator: that of the vectors its pair_forward takes.
 template <class R, class O, std::size_t D, class... A>
-constexpr std::size_t pair_dim(R (O::*)(const VecN<D>&, A...) const) noexcept {
-  return D;
-}
+constexpr std::size_t pair_dim(R (O::*)(const VecN<D>&, A...) const) noexcept { return D; }
 /// The dimension an engine over Op runs in (2 or 3).
 template <class Op>
 inline constexpr std::size_t op_dim = pair_dim(&Op::pair_forward);
 
 /// The lattice engine's event machinery over a pair operator Op (pair_forward / pair_reverse as
-/// LatticePair2D or LatticePair3D; the dimension is the operator's) and a bits-back integer Bits
-/// (BitsBack).
+/// LatticePair2D or LatticePair3D; the dimension is the operator's) and a bits-back integer Bits.
 template <class Op, class Bits, class Queue = engine::EventQueue<std::int64_t>>
 class BasicEngine {
  public:
@@ -93,9 +90,8 @@ class BasicEngine {
   using Snapshot = SnapshotN<D>;    ///< the state
   using GroupEntry = GroupEntryN<D>;  ///< a group collision in the rare log
 
-  /// An engine on a validated integer state at tick clock, each X from initial_bits(p, seed); mode
-  /// exact (the operator Op, randomized) or specular (the deterministic map of specular.hpp: no
-  /// draws, X never changes).
+  /// An engine on a validated integer state at tick clock, each X from initial_bits(p, seed); mode exact
+  /// (the operator Op, randomized) or specular (the map of specular.hpp: no draws, X never changes).
   BasicEngine(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, Op op,
               std::int64_t clock = 0, Mode mode = Mode::exact)
       : op_(std::move(op)) {
@@ -103,9 +99,13 @@ class BasicEngine {
   }
   BasicEngine(const Snapshot& s, Op op) : op_(std::move(op)) { restore(s); }  ///< An engine resuming a snapshot bit for bit.
   /// The same, its particles stored in another order: local index p holds particle order[p] (a
-  /// permutation of [0, N)). Every key, draw, tie and output is by particle id, so the run is
-  /// the same bit for bit (the parallel engine's logical processes hold their particles so).
+  /// permutation of [0, N)); every key, draw, tie and output is by particle id (the same bits).
   BasicEngine(const Snapshot& s, Op op, const std::vector<std::uint32_t>& order) : op_(std::move(op)) { restore(s, order); }
+  /// A logical process's (timewarp.hpp): the cell grid and the regions (set_regions) set before its one build.
+  BasicEngine(const Snapshot& s, Op op, int axis, std::vector<std::int64_t> faces) : op_(std::move(op)) {
+    list_shell_ = 0.0, rax_ = axis, faces_ = std::move(faces);
+    restore(s);
+  }
 
   /// Replaces the state by a snapshot (validated first: on bad input nothing changes); `order`
   /// (optional): the particle each local index holds, a permutation of [0, N).
@@ -510,8 +510,8 @@ class BasicEngine {
   std::array<std::int64_t, 2 * D> momentum0_{};
   Counters cnt_;
   bool reversed_ = false;
-  // the neighbour search (set_list_shell): the cell grid of the particles, or neighbour lists
-  static constexpr double kShellBase = 0.545, kShellSlope = 1.0, kShellMin = 0.6, kShellMax = 1.2;  // measured: docs/lattice.md
+  // the neighbour search (set_list_shell): the cell grid, or neighbour lists (measured: docs/lattice.md)
+  static constexpr double kShellBase = 0.545, kShellSlope = 1.0, kShellMin = 0.6, kShellMax = 1.2;
   double list_shell_ = -1.0;
   // the periodic re-sort (state.hpp, resort; docs/lattice.md "The storage order")
   static constexpr std::size_t kResortMinN = 32768;

@@ -4,13 +4,14 @@
 //
 // Time Warp runs to a tick; a stop at a collision count is reached in three steps: a probe of a
 // few thousand collisions on the sequential engine measures ticks per collision, the parallel
-// engine runs to a tick estimated to fall just short of the count (a second, nearer tick from
-// the rate the first chunk measured), and the sequential engine runs the last few thousand
+// engine runs to a tick estimated to fall just short of the count (up to two more, nearer ticks
+// from the rate the last chunk measured), and the sequential engine runs the last few thousand
 // collisions, or back the few a chunk ran past the count (its run_back is exact). Short runs (at
 // most `small` collisions, default max(4096, N/4): building K views costs more than they save)
 // stay sequential, and the report says how many collisions each engine ran.
 #pragma once
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -31,6 +32,10 @@ struct ParallelReport {
   int chunks = 0;                ///< parallel runs to a tick
   bool stopped = false;          ///< Ctrl-C: the state is the run's at a whole tick before the stop
   TimeWarpStats stats{};         ///< the parallel engine's counts
+  double build_s = 0.0;          ///< seconds: building the K views
+  double parallel_s = 0.0;       ///< seconds: the parallel engine's runs
+  double assemble_s = 0.0;       ///< seconds: assembling the committed state and restoring the engine
+  double sequential_s = 0.0;     ///< seconds: the sequential probe, tail or run back
 };
 
 /// Runs engine e forward, as e.run(collisions, until) does (bit for bit the same state), on K
@@ -55,8 +60,12 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
   const std::uint64_t c0 = e.collisions();
   const std::uint64_t target = collisions >= all - c0 ? all : c0 + collisions;
   const bool by_count = target != all;
+  using clock_type = std::chrono::steady_clock;
+  const auto since = [](clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); };
   const auto sequential = [&](std::uint64_t n) {
+    const auto t0 = clock_type::now();
     const std::uint64_t did = e.run(n, until, poll);
+    r.sequential_s += since(t0);
     r.sequential += did;
     r.collisions += did;
     r.stopped = did < n && e.clock() < until;  // (a run short of n ends at until, or at a Ctrl-C)
@@ -75,7 +84,9 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
       if (did < probe) return r;  // the run reached until (or a Ctrl-C)
       per = static_cast<double>(e.clock() - t0) / static_cast<double>(did);
     }
+    auto t0 = clock_type::now();
     auto tw = std::make_unique<TimeWarp<Engine>>(e.snapshot(), c);
+    r.build_s = since(t0);
     typename Engine::Snapshot s;
     for (std::int64_t clock = e.clock(); r.chunks < 3;) {
       const std::uint64_t had = e.collisions() + r.parallel;
@@ -83,15 +94,20 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
       if (by_count) {
         if (had + tail >= target) break;  // (at or past the count: the tail, or back)
         const double left = static_cast<double>(target - had);
-        // short of the count: the probe's rate is good to 1/64 in a steady state, but a gas still
-        // relaxing (a fresh start) changes its rate by several per cent over a run, so the first
-        // chunk aims at 85%; the next, at the rate the chunk measured, four standard errors short
-        const double aim = r.chunks == 0 ? 0.85 * left : left - 4.0 * std::sqrt(left);
+        // short of the count (running past it costs a run back, two rebuilds of the search; short
+        // of it, a cheap further chunk or tail): the probe's rate is good to 1/64 in a steady
+        // state, but a gas still relaxing changes its rate by several per cent over a run, so the
+        // first chunk aims at 85%, the next at 97% of the rest at the rate the last chunk measured
+        const double aim = r.chunks == 0 ? 0.85 * left : 0.97 * left - 4.0 * std::sqrt(left);
         const double ticks = std::max(1.0, std::floor(aim * per * bias));
         if (ticks < static_cast<double>(until - clock)) t = clock + static_cast<std::int64_t>(ticks);
       }
+      t0 = clock_type::now();
       const bool whole = tw->run_until(t, poll);
+      r.parallel_s += since(t0);
+      t0 = clock_type::now();
       s = tw->snapshot();
+      r.assemble_s += since(t0);
       ++r.chunks;
       const std::uint64_t did = s.collisions - had;
       r.parallel += did;
@@ -101,15 +117,19 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
       if (!whole || t == until || !by_count) break;
     }
     r.stats = tw->stats();
+    t0 = clock_type::now();
     tw.reset();  // (its K views' memory, before the engine rebuilds its own)
     if (r.chunks > 0) e.restore(s);
+    r.assemble_s += since(t0);
     r.collisions += r.parallel;
     if (r.stopped || !by_count) return r;
     if (e.collisions() > target) {  // the chunk ran past the count: back, exactly, to right after it
       r.overshoot = e.collisions() - target;
       r.collisions -= r.overshoot;
       r.parallel -= r.overshoot;
+      t0 = clock_type::now();
       e.run_back(target, e.origin(), poll);
+      r.sequential_s += since(t0);
       r.stopped = e.collisions() > target;
     } else if (e.collisions() < target && e.clock() < until) {
       sequential(target - e.collisions());

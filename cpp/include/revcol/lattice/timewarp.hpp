@@ -116,12 +116,12 @@ class TimeWarp {
     reach_ = u.sigma + 4 * u.vmax;
     sv_ = SlabViews(c.lps, u.L[ax], u.wall[ax], 3 * u.sigma + 8 * u.vmax);
     horizon_ = s.clock;
+    // the LPs' engines (cells and regions: one build each), built by the workers side by side
+    lps_.resize(static_cast<std::size_t>(c.lps));
+    build_in_workers(c.workers, c.lps, [&](int m) { lps_[static_cast<std::size_t>(m)] = std::make_unique<Lp>(s, c.axis, sv_.faces()); });
     for (int m = 0; m < c.lps; ++m) {
-      lps_.push_back(std::make_unique<Lp>(s));
-      Lp& lp = *lps_.back();
+      Lp& lp = *lps_[static_cast<std::size_t>(m)];
       lp.me = m;
-      lp.eng.set_list_shell(0.0);
-      lp.eng.set_regions(c.axis, sv_.faces());
       std::vector<std::uint8_t> held(s.x.size());
       for (std::size_t id = 0; id < held.size(); ++id) held[id] = sv_.in_view(m, lp.eng.region(static_cast<int>(id)));
       lp.eng.migrations = &lp.notes.migrations;
@@ -183,7 +183,7 @@ class TimeWarp {
   };
   using MKey = std::pair<EventKey, std::uint64_t>;  // (key, serial): messages in key order
   struct Lp {
-    explicit Lp(const Snapshot& s) : eng(s, operator_for(s.units, s.law)) {}
+    Lp(const Snapshot& s, int axis, std::vector<std::int64_t> faces) : eng(s, operator_for(s.units, s.law), axis, std::move(faces)) {}
     int me = 0;
     Engine eng;
     LpNotes notes;

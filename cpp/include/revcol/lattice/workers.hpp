@@ -88,4 +88,23 @@ inline void run_workers(int w, int k, std::uint64_t every, const std::function<b
   if (err) std::rethrow_exception(err);
 }
 
+/// Calls make(i) for every i in [0, k) on w threads (the calling one among them), each its share
+/// of the items; the first exception is rethrown here once every thread has finished.
+inline void build_in_workers(int w, int k, const std::function<void(int)>& make) {
+  std::vector<std::exception_ptr> err(static_cast<std::size_t>(w));
+  auto share = [&](int me) {
+    try {
+      for (int i = me * k / w; i < (me + 1) * k / w; ++i) make(i);
+    } catch (...) {
+      err[static_cast<std::size_t>(me)] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int i = 1; i < w; ++i) threads.emplace_back(share, i);
+  share(0);
+  for (auto& t : threads) t.join();
+  for (const auto& e : err)
+    if (e) std::rethrow_exception(e);
+}
+
 }  // namespace revcol::lattice
