@@ -5,17 +5,22 @@
 // times (REVCOL_PARALLEL=rounds=R), each timed from a fresh engine:
 //   seq             the sequential engine, its default search (lists in 3D);
 //   seq_cells       the sequential engine on the cell grid (what every LP uses);
-//   K<k>_w<w>       k logical processes on w worker threads (lazy cancellation, no window);
+//   K<k>_w<w>       k logical processes on w worker threads (lazy cancellation, no window),
+//                   rolled back by reverse computation; K<k>_w<w>_ss1 / _ss2 the same rolled back
+//                   by state saving (how=rc:ss1:ss2: SS1 the touched particles' whole records,
+//                   SS2 the lines and X an event changes; the paper's comparison);
 // reported as medians with their ranges: <variant>_per_s (collisions per second), speedup_<v>
 // (over seq, the same round), and from the last round events_per_collision_<v> (events processed
-// per collision), rollbacks_per_1k_<v>, undone_per_collision_<v>, messages_per_collision_<v>.
-// Settings: REVCOL_PARALLEL=rounds=3,lps=2:4,workers=1:2,window=0,gvt=512,batch=64,lazy=1
+// per collision), rollbacks_per_1k_<v>, undone_per_collision_<v>, messages_per_collision_<v>,
+// collisions_per_event_<v> (committed collisions over the LPs' events processed, crossings too).
+// Settings: REVCOL_PARALLEL=rounds=3,lps=2:4,workers=1:2,window=0,gvt=512,batch=64,lazy=1,how=rc
 // (lps and workers: colon-separated lists; every pair with workers <= lps is a variant).
 //
 //   revcol-bench --bench parallel/d2/n1000000/phi0.5 --collisions 2000000
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -38,14 +43,27 @@ struct ParCase {
   double phi;
 };
 
-std::vector<int> int_list(const std::string& v) {
-  std::vector<int> out;
+std::vector<std::string> split_list(const std::string& v) {
+  std::vector<std::string> out;
   std::size_t at = 0;
   while (at <= v.size()) {
     const std::size_t end = std::min(v.find(':', at), v.size());
-    out.push_back(std::stoi(v.substr(at, end - at)));
+    out.push_back(v.substr(at, end - at));
     at = end + 1;
   }
+  return out;
+}
+
+la::Rollback rollback_of(const std::string& h) {
+  if (h == "ss1") return la::Rollback::save_all;
+  if (h == "ss2") return la::Rollback::save_changes;
+  if (h != "rc") throw std::invalid_argument("REVCOL_PARALLEL how: rc, ss1 or ss2, not '" + h + "'");
+  return la::Rollback::reverse;
+}
+
+std::vector<int> int_list(const std::string& v) {
+  std::vector<int> out;
+  for (const std::string& x : split_list(v)) out.push_back(std::stoi(x));
   return out;
 }
 
@@ -54,7 +72,8 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
   int rounds = 3, gvt = 512, batch = 64, lazy = 1;
   std::int64_t window = 0;
   std::vector<int> lps{2, 4}, workers{1, 2};
-  apply_settings("REVCOL_PARALLEL", "rounds, lps, workers, window, gvt, batch, lazy", [&](const std::string& k, const std::string& v) {
+  std::vector<std::string> hows{"rc"};
+  apply_settings("REVCOL_PARALLEL", "rounds, lps, workers, window, gvt, batch, lazy, how", [&](const std::string& k, const std::string& v) {
     if (k == "rounds") rounds = std::stoi(v);
     else if (k == "lps") lps = int_list(v);
     else if (k == "workers") workers = int_list(v);
@@ -62,6 +81,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     else if (k == "gvt") gvt = std::stoi(v);
     else if (k == "batch") batch = std::stoi(v);
     else if (k == "lazy") lazy = std::stoi(v);
+    else if (k == "how") hows = split_list(v);
     else return false;
     return true;
   });
@@ -78,9 +98,10 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
   using clock = std::chrono::steady_clock;
 
   struct Variant {
-    Variant(std::string s, int k_, int w_) : name(std::move(s)), k(k_), w(w_) {}
+    Variant(std::string s, int k_, int w_, la::Rollback h = la::Rollback::reverse) : name(std::move(s)), k(k_), w(w_), how(h) {}
     std::string name;
     int k = 0, w = 0;  // k = 0: sequential (w = 1: cells)
+    la::Rollback how = la::Rollback::reverse;
     std::vector<double> rate{}, speedup{};
     bool same = true;
     la::TimeWarpStats st{};
@@ -88,7 +109,8 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
   std::vector<Variant> vs{{"seq", 0, 0}, {"seq_cells", 0, 1}};
   for (int k : lps)
     for (int w : workers)
-      if (w <= k) vs.push_back({"K" + std::to_string(k) + "_w" + std::to_string(w), k, w});
+      for (const std::string& h : hows)
+        if (w <= k) vs.push_back({"K" + std::to_string(k) + "_w" + std::to_string(w) + (h == "rc" ? "" : "_" + h), k, w, rollback_of(h)});
   for (int r = 0; r < rounds; ++r) {
     double base = 0.0;
     for (Variant& v : vs) {
@@ -108,6 +130,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
         tc.gvt_every = static_cast<std::uint64_t>(gvt);
         tc.batch = batch;
         tc.lazy = lazy != 0;
+        tc.how = v.how;
         la::TimeWarp<EngineOf<D>> tw(s0, tc);
         const auto t0 = clock::now();
         tw.run_until(until);
@@ -137,6 +160,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     out.push_back({"undone_per_collision_" + v.name, static_cast<double>(v.st.undone) / coll});
     out.push_back({"messages_per_collision_" + v.name, static_cast<double>(v.st.messages) / coll});
     out.push_back({"anti_per_collision_" + v.name, static_cast<double>(v.st.anti) / coll});
+    out.push_back({"collisions_per_event_" + v.name, coll / static_cast<double>(v.st.events)});
   }
   out.push_back({"n", static_cast<double>(c.n)});
   out.push_back({"phi", c.phi});

@@ -278,7 +278,7 @@ class LatticeSimulation(SimulationBase):
         none). ``run`` then reaches the state the sequential engine reaches, bit for bit, and
         returns the run's ``"parallel"`` report (also :attr:`parallel_report`): collisions
         committed by the parallel engine and by the sequential one (a stop at a collision count
-        is reached by a short sequential probe and tail, and runs of at most max(4096, n/4)
+        is reached by a short sequential probe and tail, and runs of at most max(8192, n/4)
         collisions stay sequential), events processed, rollbacks, undone events, messages,
         anti-messages, per-LP events. ``run_back``, checkpoints and the rest are the sequential
         engine's (the state is its own). The settings are not part of the state: a snapshot,

@@ -70,7 +70,7 @@ def test_the_rollback_by_state_saving_and_aggressive_cancellation_give_the_same_
 
 def test_short_runs_stay_sequential_and_the_report_says_so():
     seq, sim = _pair(LatticeSimulation, 600, 0.3, "periodic", 2, workers=2)
-    r = sim.run(collisions=3000)  # at most max(4096, N/4): building K views would cost more
+    r = sim.run(collisions=3000)  # at most max(8192, N/4): building K views would cost more
     assert r["parallel"]["sequential_collisions"] == 3000 and r["parallel"]["parallel_collisions"] == 0
     seq.run(collisions=3000)
     assert _same(seq.snapshot(), sim.snapshot())

@@ -7,7 +7,7 @@
 // engine runs to a tick estimated to fall just short of the count (up to two more, nearer ticks
 // from the rate the last chunk measured), and the sequential engine runs the last few thousand
 // collisions, or back the few a chunk ran past the count (its run_back is exact). Short runs (at
-// most `small` collisions, default max(4096, N/4): building K views costs more than they save)
+// most `small` collisions, default max(8192, N/4): building K views costs more than they save)
 // stay sequential, and the report says how many collisions each engine ran.
 #pragma once
 #include <algorithm>
@@ -42,7 +42,7 @@ struct ParallelReport {
 /// logical processes (config c). An engine error leaves e's state as it was; Ctrl-C (poll()
 /// false) leaves it at a whole tick the run passed. A running observation is refused (the
 /// parallel engine does not observe its committed events yet). `small`: runs of at most that many
-/// collisions stay sequential (0: max(4096, N/4)); `bias` (tests): scales the chunks' ticks (> 1
+/// collisions stay sequential (0: max(8192, N/4)); `bias` (tests): scales the chunks' ticks (> 1
 /// runs past the count, which the sequential engine then runs back).
 template <class Engine>
 ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t until, const typename TimeWarp<Engine>::Config& c,
@@ -53,8 +53,8 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
   require(until >= e.clock(), "lattice run: the end tick is before the clock");
   require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
   constexpr std::uint64_t all = std::numeric_limits<std::uint64_t>::max();
-  if (small == 0) small = std::max<std::uint64_t>(4096, e.size() / 4);
   constexpr std::uint64_t probe = 4096, tail = 4096;
+  if (small == 0) small = std::max<std::uint64_t>(probe + tail, e.size() / 4);
   ParallelReport r;
   if (collisions == 0) return r;
   const std::uint64_t c0 = e.collisions();
