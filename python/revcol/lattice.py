@@ -120,8 +120,9 @@ class LatticeSimulation(SimulationBase):
     ``"auto"`` (default: neighbour lists in 3D, the cell grid in 2D), ``"cells"`` (the cell
     grid) or neighbour lists with a shell of that many diameters (a float in [0.02, 2]); it
     changes the speed only, never which collisions happen (the state is the same bit for bit),
-    and it is kept in snapshots and checkpoints. Bad input raises ``ValueError`` naming the
-    problem.
+    and it is kept in snapshots and checkpoints. ``workers`` (1..64) and ``lps``: run forward on
+    the parallel engine, K threads and slabs, the same bits (:meth:`set_parallel`,
+    docs/parallel.md). Bad input raises ``ValueError`` naming the problem.
     """
 
     _DIM = 2  # LatticeSimulation3D: 3

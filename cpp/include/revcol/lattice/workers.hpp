@@ -18,8 +18,8 @@ namespace revcol::lattice {
 /// its share [m k / w, (m + 1) k / w) over and over (turn: whether it did anything). When a
 /// worker has done `every` turns with work since the last barrier, or when every worker found
 /// nothing to do since the last barrier, all of them stop at a barrier and worker 0 calls
-/// settle(idle) (idle: every worker had found nothing) with the others waiting; true ends the run. An exception in a turn
-/// or in settle ends the run at the next barrier and is rethrown here.
+/// settle(idle) (idle: every worker had found nothing) with the others waiting; true ends the
+/// run. An exception in a turn or in settle ends the run at the next barrier and is rethrown here.
 inline void run_workers(int w, int k, std::uint64_t every, const std::function<bool(int)>& turn, const std::function<bool(bool)>& settle) {
   std::mutex mx;
   std::condition_variable cv;
