@@ -40,7 +40,9 @@ import numpy as np
 from . import _core
 from ._args import integer, name, names, placement, real, real_array
 from ._args import packing_fraction as _packing_fraction
-from ._io import read_checkpoint, write_checkpoint
+from ._io import write_checkpoint
+from ._lattice_state import add_reports, read_state as _read_state
+from ._lattice_state import snapshot_shell as _snapshot_shell
 from .simulation import SimulationBase, register_engine
 
 __all__ = ["LatticeSimulation", "LatticeSimulation3D", "MODES", "restart_from_legacy"]
@@ -524,38 +526,6 @@ class LatticeSimulation(SimulationBase):
         return f"{type(self).__name__}(n={self.n}, collisions={self.collisions}, clock={self.clock})"
 
 
-def add_reports(a: Optional[dict], b: Optional[dict]) -> Optional[dict]:
-    """Two parallel runs' reports (``run()["parallel"]``) as one: the counts summed, per LP
-    too (runs on other K: the later's per-LP counts), ``stopped`` the later's."""
-    if a is None or b is None:
-        return dict(b if a is None else a) if (a, b) != (None, None) else None
-    out = dict(a)
-    for k, val in b.items():
-        if k == "lp_events":
-            mine, theirs = list(a[k]), list(val)
-            out[k] = [x + y for x, y in zip(mine, theirs)] if len(mine) == len(theirs) else (theirs or mine)
-        elif k == "stopped":
-            out[k] = val
-        else:
-            out[k] = a[k] + val
-    return out
-
-
-def _read_state(path: Union[str, os.PathLike]) -> dict:
-    """A checkpoint written by ``save`` as a snapshot dict (nested ``a.b`` keys rebuilt)."""
-    st: dict = {}
-    for k, a in read_checkpoint(path, "lattice").items():
-        val = a.item() if a.ndim == 0 else a
-        if "." in k:
-            outer, inner = k.split(".", 1)
-            if isinstance(val, np.ndarray) and outer == "units":
-                val = tuple(val.tolist())
-            st.setdefault(outer, {})[inner] = val
-        else:
-            st[k] = val
-    return st
-
-
 #: what a checkpoint of an older revcol kept whole: its physical state and settings
 _LEGACY_KEPT = ("engine", "dim", "units", "law", "mode", "seed", "clock", "x", "v", "streams", "energy0", "momentum0",
                 "quantization", "search")
@@ -586,20 +556,6 @@ def restart_from_legacy(source: Union[str, os.PathLike, dict]) -> "LatticeSimula
                group_size=empty_i, group_members=empty_i, group_counts=empty_u, group_kind=empty_i,
                group_v=np.zeros((0, dim), dtype=np.int64))
     return LatticeSimulation.from_snapshot(new)
-
-
-def _snapshot_shell(value) -> float:
-    """A snapshot's ``search`` entry, checked: -1 (automatic; any negative), 0 (the cell grid)
-    or a shell in [0.02, 2] diameters."""
-    try:
-        shell = float(np.asarray(value))
-    except (TypeError, ValueError):
-        raise ValueError(f"snapshot: search must be a number (the list shell), got {value!r:.40}") from None
-    if shell < 0.0:
-        return -1.0
-    if not (shell == 0.0 or 0.02 <= shell <= 2.0):
-        raise ValueError(f"snapshot: search = {shell!r} must be -1 (automatic), 0 (cells) or in [0.02, 2]")
-    return shell
 
 
 class LatticeSimulation3D(LatticeSimulation):

@@ -123,7 +123,7 @@ from .engine import Simulation
 from .lattice import LatticeSimulation
 from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINE_MODES,  # noqa: F401 (__all__)
                            ENGINES, KINDS, LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES,
-                           SceneError, _check, _check_mode, _fail, _modernize)
+                           SceneError, _check, _check_mode, _fail, _modernize, with_lattice_options)
 from .statesave import variants as statesave_variants
 from .verify import verify_cases
 
@@ -531,24 +531,6 @@ def lattice_options(scene: Scene) -> dict[str, Any]:
     return dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
                 seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search,
                 workers=scene.workers)
-
-
-def with_lattice_options(scene: Scene, *, tick_bits: int | None = None, cell_bits: int | None = None,
-                         search: str | float | None = None, workers: int | None = None) -> Scene:
-    """``scene`` with the lattice engine's options that are not None replaced (``revcol run`` and
-    ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``, ``--workers``), each checked as its
-    ``[collisions]`` field; a scene that does not run the lattice engine refuses them."""
-    given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search, workers)) if v is not None}
-    flags = {k: "--" + k.replace("_", "-") for k in given}
-    if given and (scene.kind != "gas" or scene.engine != "lattice"):
-        runs = "the float engine (add --engine lattice)" if scene.kind == "gas" else f"no gas (kind = {scene.kind!r})"
-        raise SceneError(f"{scene.source}: {', '.join(flags.values())}: the lattice engine's options; this scene runs {runs}")
-    for k, v in given.items():
-        try:
-            given[k] = _check(scene.source, "collisions", k, v, *SCHEMA["collisions"][k])
-        except SceneError as e:
-            raise SceneError(str(e).replace(f"[collisions] {k}", flags[k])) from None
-    return dataclasses.replace(scene, **given)
 
 
 def scene_dirs() -> list[Path]:

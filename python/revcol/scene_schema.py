@@ -5,6 +5,7 @@ reads a scene with them (and re-exports the public names).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from typing import Any
@@ -13,7 +14,7 @@ from . import _core
 from ._args import size
 
 __all__ = ["KINDS", "ENGINES", "ENGINE_MODES", "LIMITS", "DEFAULT_SCENE", "SCHEMA", "USES", "DEPRECATED",
-           "LATTICE_FIELDS", "SceneError"]
+           "LATTICE_FIELDS", "SceneError", "with_lattice_options"]
 
 #: the kinds of scene
 KINDS = ("gas", "reversal", "statesave")
@@ -223,3 +224,21 @@ def _modernize(source: str, table: str, key: str, value: Any) -> Any:
     warnings.warn(f"{source}: [{table}] {key}: {said}", DeprecationWarning, stacklevel=4)
     new = [old_new.get(v, v) if isinstance(v, str) else v for v in items]
     return new if isinstance(value, list) else new[0]
+
+
+def with_lattice_options(scene, *, tick_bits: int | None = None, cell_bits: int | None = None,
+                         search: str | float | None = None, workers: int | None = None):
+    """``scene`` with the lattice engine's options that are not None replaced (``revcol run`` and
+    ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``, ``--workers``), each checked as its
+    ``[collisions]`` field; a scene that does not run the lattice engine refuses them."""
+    given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search, workers)) if v is not None}
+    flags = {k: "--" + k.replace("_", "-") for k in given}
+    if given and (scene.kind != "gas" or scene.engine != "lattice"):
+        runs = "the float engine (add --engine lattice)" if scene.kind == "gas" else f"no gas (kind = {scene.kind!r})"
+        raise SceneError(f"{scene.source}: {', '.join(flags.values())}: the lattice engine's options; this scene runs {runs}")
+    for k, v in given.items():
+        try:
+            given[k] = _check(scene.source, "collisions", k, v, *SCHEMA["collisions"][k])
+        except SceneError as e:
+            raise SceneError(str(e).replace(f"[collisions] {k}", flags[k])) from None
+    return dataclasses.replace(scene, **given)
