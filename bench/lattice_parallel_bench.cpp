@@ -12,7 +12,11 @@
 // reported as medians with their ranges: <variant>_per_s (collisions per second), speedup_<v>
 // (over seq, the same round), and from the last round events_per_collision_<v> (events processed
 // per collision), rollbacks_per_1k_<v>, undone_per_collision_<v>, messages_per_collision_<v>,
-// collisions_per_event_<v> (committed collisions over the LPs' events processed, crossings too).
+// collisions_per_event_<v> (committed collisions over the LPs' events processed, crossings too),
+// stale_per_collision_<v>, gvts_<v> (GVT computations), worker_imbalance_<v> (the busiest
+// worker's events over the mean: LPs [m k / w, (m + 1) k / w) on worker m) and seconds_<v> (the
+// median run time); band_over_L (the band W over the slabs' axis) and ticks, for the
+// performance model (bench/parallel_model.py).
 // Settings: REVCOL_PARALLEL=rounds=3,lps=2:4,workers=1:2,window=0,gvt=512,batch=64,lazy=1,how=rc
 // (lps and workers: colon-separated lists; every pair with workers <= lps is a variant).
 //
@@ -105,8 +109,10 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     std::vector<double> rate{}, speedup{};
     bool same = true;
     la::TimeWarpStats st{};
+    std::vector<double> seconds{};
   };
   std::vector<Variant> vs{{"seq", 0, 0}, {"seq_cells", 0, 1}};
+  double band = 0.0;
   for (int k : lps)
     for (int w : workers)
       for (const std::string& h : hows)
@@ -137,7 +143,9 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
         seconds = seconds_since(t0);
         v.same = v.same && la::same_state(tw.snapshot(), want);
         v.st = tw.stats();
+        band = static_cast<double>(tw.band());
       }
+      v.seconds.push_back(seconds);
       const double rate = static_cast<double>(want.collisions - s0.collisions) / seconds;
       if (v.name == "seq") base = rate;
       v.rate.push_back(rate);
@@ -154,6 +162,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     out.push_back({"speedup_" + v.name + "_min", *std::min_element(v.speedup.begin(), v.speedup.end())});
     out.push_back({"speedup_" + v.name + "_max", *std::max_element(v.speedup.begin(), v.speedup.end())});
     out.push_back({"same_" + v.name, v.same ? 1.0 : 0.0});
+    out.push_back({"seconds_" + v.name, median(v.seconds)});
     if (v.k == 0) continue;
     out.push_back({"events_per_collision_" + v.name, static_cast<double>(v.st.events) / coll});
     out.push_back({"rollbacks_per_1k_" + v.name, 1000.0 * static_cast<double>(v.st.rollbacks) / coll});
@@ -161,7 +170,17 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     out.push_back({"messages_per_collision_" + v.name, static_cast<double>(v.st.messages) / coll});
     out.push_back({"anti_per_collision_" + v.name, static_cast<double>(v.st.anti) / coll});
     out.push_back({"collisions_per_event_" + v.name, coll / static_cast<double>(v.st.events)});
+    out.push_back({"stale_per_collision_" + v.name, static_cast<double>(v.st.stale) / coll});
+    out.push_back({"gvts_" + v.name, static_cast<double>(v.st.gvts)});
+    std::vector<double> per_worker(static_cast<std::size_t>(v.w), 0.0);
+    for (int m = 0; m < v.k; ++m)
+      for (int q = 0; q < v.w; ++q)
+        if (m >= q * v.k / v.w && m < (q + 1) * v.k / v.w) per_worker[static_cast<std::size_t>(q)] += static_cast<double>(v.st.lp_events[static_cast<std::size_t>(m)]);
+    const double busiest = *std::max_element(per_worker.begin(), per_worker.end());
+    out.push_back({"worker_imbalance_" + v.name, busiest * v.w / static_cast<double>(v.st.events)});
   }
+  out.push_back({"band_over_L", band / static_cast<double>(s0.units.L[0])});
+  out.push_back({"ticks", static_cast<double>(until - s0.clock)});
   out.push_back({"n", static_cast<double>(c.n)});
   out.push_back({"phi", c.phi});
   out.push_back({"collisions", coll});
