@@ -13,7 +13,8 @@
 // (over seq, the same round), and from the last round events_per_collision_<v> (events processed
 // per collision), rollbacks_per_1k_<v>, undone_per_collision_<v>, messages_per_collision_<v>,
 // collisions_per_event_<v> (committed collisions over the LPs' events processed, crossings too),
-// stale_per_collision_<v>, gvts_<v> (GVT computations), worker_imbalance_<v> (the busiest
+// stale_per_collision_<v>, gvts_<v> (GVT computations), gvt_s_per_collision_<v> (seconds in
+// the GVT step, worker 0 alone, from the last round), worker_imbalance_<v> (the busiest
 // worker's events over the mean: LPs [m k / w, (m + 1) k / w) on worker m) and seconds_<v> (the
 // median run time); band_over_L (the band W over the slabs' axis) and ticks, for the
 // performance model (bench/parallel_model.py).
@@ -172,6 +173,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     out.push_back({"collisions_per_event_" + v.name, coll / static_cast<double>(v.st.events)});
     out.push_back({"stale_per_collision_" + v.name, static_cast<double>(v.st.stale) / coll});
     out.push_back({"gvts_" + v.name, static_cast<double>(v.st.gvts)});
+    out.push_back({"gvt_s_per_collision_" + v.name, v.st.gvt_seconds / coll});
     std::vector<double> per_worker(static_cast<std::size_t>(v.w), 0.0);
     for (int m = 0; m < v.k; ++m)
       for (int q = 0; q < v.w; ++q)

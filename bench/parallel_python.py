@@ -7,6 +7,11 @@ committed state into the simulation.
 
     PYTHONPATH=build-dev/pkg python bench/parallel_python.py --dim 2 --n 1000000 --phi 0.5 \\
         --collisions 2000000 10000000 --rounds 3 --json bench/results/lattice_parallel_python.json
+
+With ``--memory``, each variant runs alone in a fresh process instead (a random start, one
+collision per particle of warm-up, then one run(collisions=C)), and the file gives each
+process's peak resident set (ru_maxrss) against the sequential one's, per C: the memory a
+parallel run costs.
 """
 from __future__ import annotations
 
@@ -61,6 +66,43 @@ def measure(cls, s0: dict, collisions: int, rounds: int, workers: list[int]) -> 
             for k, v in rates.items()}
 
 
+def _child(a) -> None:
+    """One variant alone: prints the process's peak resident set (KiB) after its run."""
+    import resource
+    cls = LatticeSimulation3D if a.dim == 3 else LatticeSimulation
+    sim = cls.random(a.n, phi=a.phi, seed=1)
+    sim.run(collisions=a.n)
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    if a.child > 1:
+        sim.set_parallel(a.child, lps=a.child)
+    sim.run(collisions=a.collisions[0])
+    print(json.dumps({"rss_before_kib": before, "rss_peak_kib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}))
+
+
+def memory(a, argv) -> dict:
+    """Peak RSS per variant and collision count, each in a fresh process, interleaved."""
+    out: dict[str, dict] = {}
+    for c in a.collisions:
+        for w in [1] + a.workers:
+            cmd = [sys.executable, os.path.abspath(__file__), "--dim", str(a.dim), "--n", str(a.n), "--phi", str(a.phi),
+                   "--collisions", str(c), "--child", str(w), "--json", "-"]
+            r = json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout.strip().splitlines()[-1])
+            out.setdefault(str(c), {})["seq" if w == 1 else f"K{w}_w{w}"] = r
+            print(f"{c} collisions, workers {w}: peak {r['rss_peak_kib'] / 1024:.0f} MiB (before the run {r['rss_before_kib'] / 1024:.0f})",
+                  file=sys.stderr, flush=True)
+        seq = out[str(c)]["seq"]["rss_peak_kib"]
+        for v in out[str(c)].values():
+            v["over_sequential"] = v["rss_peak_kib"] / seq
+    return out
+
+
+def _write(result: dict, path: str) -> None:
+    d = os.path.dirname(os.path.abspath(path))
+    with tempfile.NamedTemporaryFile("w", dir=d, delete=False, suffix=".tmp") as f:
+        json.dump(result, f, indent=1)
+    os.replace(f.name, path)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--dim", type=int, choices=(2, 3), default=2)
@@ -69,10 +111,24 @@ def main(argv=None) -> int:
     p.add_argument("--collisions", type=int, nargs="+", default=[2_000_000], help="collisions per run() call")
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--workers", type=int, nargs="+", default=[2], help="parallel variants, 2 or more (K = workers LPs)")
+    p.add_argument("--memory", action="store_true", help="peak RSS per variant, each in a fresh process")
+    p.add_argument("--child", type=int, default=0, help=argparse.SUPPRESS)
     p.add_argument("--json", required=True)
     a = p.parse_args(argv)
+    if a.child:
+        _child(a)
+        return 0
     cls = LatticeSimulation3D if a.dim == 3 else LatticeSimulation
     load0 = os.getloadavg()[0]
+    if a.memory:
+        result = {"what": "peak RSS of LatticeSimulation.run(collisions=C), sequential and parallel, each variant in a fresh process",
+                  "command": " ".join(["python", "bench/parallel_python.py", *(argv if argv is not None else sys.argv[1:])]),
+                  "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip(),
+                  "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "load_before": load0,
+                  "dim": a.dim, "n": a.n, "phi": a.phi, "runs": memory(a, argv)}
+        result["load_after"] = os.getloadavg()[0]
+        _write(result, a.json)
+        return 0
     sim = cls.random(a.n, phi=a.phi, seed=1)
     sim.run(collisions=a.n)  # warmed: the start's relaxation behind it
     s0 = sim.snapshot()
@@ -85,10 +141,7 @@ def main(argv=None) -> int:
         "cores": os.cpu_count(), "dim": a.dim, "n": a.n, "phi": a.phi, "rounds": a.rounds,
         "runs": {str(c): v for c, v in runs.items()},
     }
-    d = os.path.dirname(os.path.abspath(a.json))
-    with tempfile.NamedTemporaryFile("w", dir=d, delete=False, suffix=".tmp") as f:
-        json.dump(result, f, indent=1)
-    os.replace(f.name, a.json)
+    _write(result, a.json)
     for c, variants in runs.items():
         for k, v in variants.items():
             print(f"{c} collisions per call, {k}: {v['per_s']:,.0f} collisions/s ({v['speedup']:.2f}x, "

@@ -36,6 +36,7 @@ inline pybind11::dict parallel_report_dict(const lattice::ParallelReport& r) {
   d["blocked"] = s.blocked;
   d["reused"] = s.reused;
   d["gvts"] = s.gvts;
+  d["gvt_s"] = s.gvt_seconds;  // seconds in the GVT step (worker 0 alone)
   d["lp_events"] = s.lp_events;
   d["build_s"] = r.build_s;
   d["parallel_s"] = r.parallel_s;

@@ -39,6 +39,7 @@
 // raised. Neither the schedule nor the delays may change a bit.
 #pragma once
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -75,6 +76,7 @@ struct TimeWarpStats {
   std::uint64_t blocked = 0;    ///< writes that left a view inconsistent (the LP waited for a rollback)
   std::uint64_t reused = 0;     ///< messages a re-execution sent again as they were (lazy cancellation)
   std::uint64_t gvts = 0;       ///< GVT computations
+  double gvt_seconds = 0.0;     ///< seconds in the GVT step (worker 0 alone, the others at the barrier)
   std::vector<std::uint64_t> lp_events;  ///< per LP: events processed
   void add(const TimeWarpStats& o) {
     events += o.events, stale += o.stale, rollbacks += o.rollbacks, undone += o.undone, messages += o.messages;
@@ -162,6 +164,7 @@ class TimeWarp {
   TimeWarpStats stats() const {
     TimeWarpStats t;
     t.gvts = gvts_;
+    t.gvt_seconds = gvt_s_;
     for (const auto& lp : lps_) {
       t.add(lp->st);
       t.lp_events.push_back(lp->st.events);
@@ -422,7 +425,10 @@ class TimeWarp {
       }
       if (++since_gvt >= c_.gvt_every || !any) {
         since_gvt = 0;
-        if (settle(poll, !any)) return;
+        const auto t0 = std::chrono::steady_clock::now();
+        const bool end = settle(poll, !any);
+        gvt_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (end) return;
       }
     }
   }
@@ -439,11 +445,14 @@ class TimeWarp {
           return step(lp) || got;
         },
         [&](bool idle) {
+          const auto t0 = std::chrono::steady_clock::now();
           for (bool more = true; more;) {
             more = false;
             for (auto& lp : lps_) more = drain(*lp) || more;
           }
-          return settle(poll, idle);
+          const bool end = settle(poll, idle);
+          gvt_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          return end;
         });
   }
 
@@ -582,6 +591,7 @@ class TimeWarp {
   std::deque<std::pair<std::uint64_t, Message>> flight_;  // one worker: (delivery step, message)
   std::uint64_t tick_ = 0, gvts_ = 0;                     // one worker: scheduler steps
   std::int64_t gvt_t_ = 0;                                // the last GVT's tick (the window)
+  double gvt_s_ = 0.0;                                    // seconds in the GVT step
   bool threaded_ = false, stopped_ = false;
 };
 
