@@ -47,6 +47,7 @@ def test_a_parallel_run_is_the_sequential_run_bit_for_bit(cls, n, phi, boundary,
         assert p["parallel_collisions"] > collisions // 2  # most of the run is the parallel engine's
         assert p["parallel_collisions"] + p["sequential_collisions"] == collisions
         assert p["events"] >= p["parallel_collisions"] and len(p["lp_events"]) == sim.parallel["lps"]
+        assert p["gvts"] >= 1 and 0.0 < p["gvt_s"] < p["parallel_s"]  # the GVT step, timed, is part of the parallel phase
         assert _same(seq.snapshot(), sim.snapshot())
     t = sim.time * (1.0 + 40_000 / sim.collisions)  # a stop at a time, some 40 000 collisions on
     a, b = seq.run(time=t), sim.run(time=t)
