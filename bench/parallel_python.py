@@ -80,7 +80,7 @@ def _child(a) -> None:
 
 
 def memory(a, argv) -> dict:
-    """Peak RSS per variant and collision count, each in a fresh process, interleaved."""
+    """Peak RSS per variant and collision count, each in a fresh process (sequential, then K = 2, 4, ... per count)."""
     out: dict[str, dict] = {}
     for c in a.collisions:
         for w in [1] + a.workers:
