@@ -4,11 +4,12 @@
 // end on its state bit for bit (same_<variant> = 1). The variants run interleaved, `rounds`
 // times (REVCOL_PARALLEL=rounds=R), each timed from a fresh engine:
 //   seq             the sequential engine, its default search (lists in 3D);
-//   seq_cells       the sequential engine on the cell grid (what every LP uses);
+//   seq_cells       the sequential engine on the cell grid;
 //   K<k>_w<w>       k logical processes on w worker threads (lazy cancellation, no window),
 //                   rolled back by reverse computation; K<k>_w<w>_ss1 / _ss2 the same rolled back
 //                   by state saving (how=rc:ss1:ss2: SS1 the touched particles' whole records,
-//                   SS2 the lines and X an event changes; the paper's comparison);
+//                   SS2 the lines and X an event changes; the paper's comparison); the LPs search as
+//                   seq does (lists in 3D), or (search=auto:cells) _cells: on the cell grid;
 // reported as medians with their ranges: <variant>_per_s (collisions per second), speedup_<v>
 // (over seq, the same round), and from the last round events_per_collision_<v> (events processed
 // per collision), rollbacks_per_1k_<v>, undone_per_collision_<v>, messages_per_collision_<v>,
@@ -18,8 +19,10 @@
 // worker's events over the mean: LPs [m k / w, (m + 1) k / w) on worker m) and seconds_<v> (the
 // median run time); band_over_L (the band W over the slabs' axis) and ticks, for the
 // performance model (bench/parallel_model.py).
-// Settings: REVCOL_PARALLEL=rounds=3,lps=2:4,workers=1:2,window=0,gvt=512,batch=64,lazy=1,how=rc
-// (lps and workers: colon-separated lists; every pair with workers <= lps is a variant).
+// Settings: REVCOL_PARALLEL=rounds=3,lps=2:4,workers=1:2,window=0,gvt=512,batch=64,lazy=1,how=rc,
+// search=auto,observe=0 (lps, workers, how, search: colon-separated lists; every pair with
+// workers <= lps is a variant); observe=1: every variant observes the run (an observer started at
+// the warmed state; its end checked bit for bit too).
 //
 //   revcol-bench --bench parallel/d2/n1000000/phi0.5 --collisions 2000000
 #include <algorithm>
@@ -74,11 +77,11 @@ std::vector<int> int_list(const std::string& v) {
 
 template <std::size_t D>
 std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
-  int rounds = 3, gvt = 512, batch = 64, lazy = 1;
+  int rounds = 3, gvt = 512, batch = 64, lazy = 1, observe = 0;
   std::int64_t window = 0;
   std::vector<int> lps{2, 4}, workers{1, 2};
-  std::vector<std::string> hows{"rc"};
-  apply_settings("REVCOL_PARALLEL", "rounds, lps, workers, window, gvt, batch, lazy, how", [&](const std::string& k, const std::string& v) {
+  std::vector<std::string> hows{"rc"}, searches{"auto"};
+  apply_settings("REVCOL_PARALLEL", "rounds, lps, workers, window, gvt, batch, lazy, how, search, observe", [&](const std::string& k, const std::string& v) {
     if (k == "rounds") rounds = std::stoi(v);
     else if (k == "lps") lps = int_list(v);
     else if (k == "workers") workers = int_list(v);
@@ -87,6 +90,8 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     else if (k == "batch") batch = std::stoi(v);
     else if (k == "lazy") lazy = std::stoi(v);
     else if (k == "how") hows = split_list(v);
+    else if (k == "search") searches = split_list(v);
+    else if (k == "observe") observe = std::stoi(v);
     else return false;
     return true;
   });
@@ -95,6 +100,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
   const la::LatticeStartN<D> st = la::random_start(cfg, c.n, c.phi, 1, D == 2 && c.phi > 0.35 ? "crystal" : "auto");
   EngineOf<D> e(st.units, st.x, st.v, cfg.seed, la::operator_for(st.units));
   e.run(c.n, la::tick_limit - 1);  // warm up
+  if (observe != 0) e.observe(revcol::engine::ObserveConfig{});  // every variant observes (committed events, in parallel)
   const la::SnapshotN<D> s0 = e.snapshot();
   e.run(nc, la::tick_limit - 1);
   const std::int64_t until = e.clock();
@@ -103,10 +109,12 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
   using clock = std::chrono::steady_clock;
 
   struct Variant {
-    Variant(std::string s, int k_, int w_, la::Rollback h = la::Rollback::reverse) : name(std::move(s)), k(k_), w(w_), how(h) {}
+    Variant(std::string s, int k_, int w_, la::Rollback h = la::Rollback::reverse, double sh = -1.0)
+        : name(std::move(s)), k(k_), w(w_), how(h), shell(sh) {}
     std::string name;
     int k = 0, w = 0;  // k = 0: sequential (w = 1: cells)
     la::Rollback how = la::Rollback::reverse;
+    double shell = -1.0;  // the LPs' search: -1 the sequential engine's (automatic), 0 cells
     std::vector<double> rate{}, speedup{};
     bool same = true;
     la::TimeWarpStats st{};
@@ -117,7 +125,12 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
   for (int k : lps)
     for (int w : workers)
       for (const std::string& h : hows)
-        if (w <= k) vs.push_back({"K" + std::to_string(k) + "_w" + std::to_string(w) + (h == "rc" ? "" : "_" + h), k, w, rollback_of(h)});
+        for (const std::string& sr : searches) {
+          if (sr != "auto" && sr != "cells") throw std::invalid_argument("REVCOL_PARALLEL search: auto or cells, not '" + sr + "'");
+          if (w <= k)
+            vs.push_back({"K" + std::to_string(k) + "_w" + std::to_string(w) + (h == "rc" ? "" : "_" + h) + (sr == "auto" ? "" : "_cells"), k, w,
+                          rollback_of(h), sr == "auto" ? -1.0 : 0.0});
+        }
   for (int r = 0; r < rounds; ++r) {
     double base = 0.0;
     for (Variant& v : vs) {
@@ -128,7 +141,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
         const auto t0 = clock::now();
         s.run(~std::uint64_t{0}, until);
         seconds = seconds_since(t0);
-        v.same = v.same && la::same_state(s.snapshot(), want);
+        v.same = v.same && la::same_state(s.snapshot(), want) && s.snapshot().observer == want.observer;
       } else {
         typename la::TimeWarp<EngineOf<D>>::Config tc;
         tc.lps = v.k;
@@ -138,11 +151,15 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
         tc.batch = batch;
         tc.lazy = lazy != 0;
         tc.how = v.how;
+        tc.shell = v.shell;
         la::TimeWarp<EngineOf<D>> tw(s0, tc);
         const auto t0 = clock::now();
         tw.run_until(until);
         seconds = seconds_since(t0);
-        v.same = v.same && la::same_state(tw.snapshot(), want);
+        const la::SnapshotN<D> got = tw.snapshot();
+        EngineOf<D> synced(got, la::operator_for(got.units, got.law));  // (as run_parallel: the observation synced at the end)
+        synced.sync_observation();
+        v.same = v.same && la::same_state(got, want) && synced.snapshot().observer == want.observer;
         v.st = tw.stats();
         band = static_cast<double>(tw.band());
       }
@@ -187,6 +204,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
   out.push_back({"phi", c.phi});
   out.push_back({"collisions", coll});
   out.push_back({"rounds", static_cast<double>(rounds)});
+  out.push_back({"observed", static_cast<double>(observe)});
   return out;
 }
 

@@ -287,8 +287,8 @@ class LatticeSimulation(SimulationBase):
         engine's (the state is its own). The settings are not part of the state: a snapshot,
         checkpoint or pickle holds none, and a simulation rebuilt from one runs on the
         sequential engine until ``set_parallel`` (any K: the bits are the same). ``workers=1``
-        with ``lps`` None is the sequential engine. An observation cannot run on the parallel
-        engine yet (a ValueError)."""
+        with ``lps`` None is the sequential engine. A running observation (:meth:`observe`)
+        sees the committed events and is the sequential run's bit for bit."""
         workers = integer(workers, "workers", 1, 64)
         k = workers if lps is None else integer(lps, "lps", 1, 64)
         if workers > k:

@@ -87,18 +87,6 @@ def build_lattice(scene: Scene, seed: int | None = None) -> LatticeSimulation:
     return _make(scene, "[system] box" if scene.packing_fraction is None else "[system] kinetic_energy", make)
 
 
-def check_parallel(scene: Scene, trajectory) -> None:
-    """A lattice scene on the parallel engine (``workers`` > 1) that would observe its run
-    ([observe], or a trajectory's image flags): refused, a SceneError (the parallel engine does
-    not observe its committed events yet)."""
-    if scene.engine != "lattice" or scene.workers == 1:
-        return
-    if scene.observe is not None or observes_frames(scene, trajectory):
-        why = "[observe]" if scene.observe is not None else "a trajectory with image flags (periodic axes)"
-        raise SceneError(f"{scene.source}: [collisions] workers = {scene.workers}: the parallel engine does not observe "
-                         f"a run yet, and {why} needs it; run with one worker")
-
-
 def _make(scene: Scene, where: str, make: Callable[[], LatticeSimulation]) -> LatticeSimulation:
     try:
         return make()
@@ -132,7 +120,6 @@ class _LatticeRun:
 
     def __init__(self, scene: Scene, plot, trajectory, progress: bool, checkpoints: bool):
         self.scene, self.plot, self.progress = scene, plot, progress
-        check_parallel(scene, trajectory)
         self.sim = sim = build_lattice(scene)
         # [observe]: the forward run itself is observed (run_back ends the observation)
         self.observation = None

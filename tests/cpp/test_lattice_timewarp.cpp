@@ -1,7 +1,8 @@
 // The parallel lattice engine (timewarp.hpp): K logical processes on slabs, optimistic, rolled
 // back by reverse computation, commit the sequential engine's state bit for bit at every tick it
 // is asked to stop at, for K = 1 to 8, 2D and 3D, walls and periodic, in a round-robin schedule
-// and in random schedules with random message delays; a state that no schedule may change.
+// and in random schedules with random message delays; a state that no schedule may change; an
+// observation running through the parallel run is the sequential run's bit for bit.
 #include <cstdio>
 #include <algorithm>
 #include <cstdlib>
@@ -31,11 +32,19 @@ std::uint64_t scaled(std::uint64_t n) {
 
 template <std::size_t D>
 void check_parallel(EngineOf<D> e, int axis, const std::vector<int>& ks, const std::vector<std::uint64_t>& fuzz,
-                    std::uint64_t per_stop, const char* what) {
+                    std::uint64_t per_stop, const char* what, double shell = -1.0, bool observe = false) {
   e.run(e.size(), tick_limit - 1);
+  if (observe) {  // a running observation: the parallel engine's, fed its committed events, is the sequential one's
+    en::ObserveConfig oc;
+    oc.slabs = 4;
+    oc.speed_bins = 16;
+    oc.collision_record = true;
+    e.observe(oc);
+  }
   const SnapshotN<D> s0 = e.snapshot();
   // the sequential engine's state at three stops (every event at or before each stop's tick)
   EngineOf<D> ref(s0, operator_for(s0.units, s0.law));
+  ref.sync_after_run = false;  // (the parallel engine's observation is not synced at a stop)
   std::vector<std::array<std::int64_t, 3>> rtrace;
   ref.trace = &rtrace;
   std::vector<SnapshotN<D>> want;
@@ -53,18 +62,22 @@ void check_parallel(EngineOf<D> e, int axis, const std::vector<int>& ks, const s
       c.workers = f == kThreads ? std::min(K, 2) : 1;
       c.lazy = f < 1000;  // (a fuzz seed from 1000 up: aggressive cancellation)
       c.batch = 8;
+      c.shell = shell;  // the LPs' search: -1 the sequential engine's automatic one (3D lists, 2D cells)
       if (f == kThreads && K == 1) continue;
       if (const char* d = std::getenv("TW_DELAY")) c.max_delay = std::atoi(d);
       if (const char* d = std::getenv("TW_GVT")) c.gvt_every = std::strtoull(d, nullptr, 10);
       TimeWarp<EngineOf<D>> tw(s0, c);
+      CHECK((tw.engine(0).neighbour_search() == 0) == (shell == 0.0 || (shell < 0.0 && D == 2)));
       std::vector<std::vector<std::array<std::int64_t, 3>>> traces(static_cast<std::size_t>(K));
       for (int m = 0; m < K; ++m) tw.engine(m).trace = &traces[static_cast<std::size_t>(m)];
       bool same = true;
       for (const auto& w : want) {
         tw.run_until(w.clock);
-        const bool eq = same_state(tw.snapshot(), w);
+        const SnapshotN<D> got = tw.snapshot();
+        const bool eq = same_state(got, w) && got.observer == w.observer && got.observer_counts == w.observer_counts;
+        CHECK(!observe || got.observer.size() > 100);
         if (!eq) {
-          const SnapshotN<D> g = tw.snapshot();
+          const SnapshotN<D>& g = got;
           std::printf("    differs at tick %lld: collisions %llu / %llu, log %zu / %zu, groups %zu / %zu\n", static_cast<long long>(w.clock),
                       (unsigned long long)g.collisions, (unsigned long long)w.collisions, g.log.size(), w.log.size(), g.groups.size(), w.groups.size());
           std::set<std::array<std::int64_t, 3>> have;
@@ -89,9 +102,9 @@ void check_parallel(EngineOf<D> e, int axis, const std::vector<int>& ks, const s
         same = same && eq;
       }
       const TimeWarpStats& st = tw.stats();
-      std::printf("  %s, K = %d, %s: %llu collisions; events %llu, rollbacks %llu (%llu undone), messages %llu, anti %llu, "
+      std::printf("  %s (%s), K = %d, %s: %llu collisions; events %llu, rollbacks %llu (%llu undone), messages %llu, anti %llu, "
                   "confirmed %llu, written %llu, blocked %llu: same as sequential: %s\n",
-                  what, K, f == kThreads ? "2 threads" : f == 0 ? "round robin" : f < 1000 ? "fuzzed" : "fuzzed, aggressive", static_cast<unsigned long long>(want.back().collisions - s0.collisions),
+                  what, tw.engine(0).neighbour_search() == 0 ? "cells" : "lists", K, f == kThreads ? "2 threads" : f == 0 ? "round robin" : f < 1000 ? "fuzzed" : "fuzzed, aggressive", static_cast<unsigned long long>(want.back().collisions - s0.collisions),
                   static_cast<unsigned long long>(st.events), static_cast<unsigned long long>(st.rollbacks),
                   static_cast<unsigned long long>(st.undone), static_cast<unsigned long long>(st.messages),
                   static_cast<unsigned long long>(st.anti), static_cast<unsigned long long>(st.confirmed),
@@ -107,16 +120,25 @@ TEST_CASE("the parallel engine commits the sequential state bit for bit (2D)") {
   using B = en::Boundary;
   check_parallel<2>(lattice_test::make_gas<2>(400, 0.4, B::periodic, 71, 16), 0, {1, 2, 3, 4, 8}, {0, 5, 1006, kThreads}, scaled(2000),
                     "2D 0.4 periodic");
+  check_parallel<2>(lattice_test::make_gas<2>(400, 0.4, B::periodic, 71, 16), 0, {1, 3, 8}, {5, 1006, kThreads}, scaled(2000),
+                    "2D 0.4 periodic, observed", -1.0, true);
   check_parallel<2>(lattice_test::make_gas<2>(1000, 0.6, B::wall, 73, 16), 1, {2, 3, 8}, {0, 8, kThreads}, scaled(3000), "2D 0.6 walls");
+  check_parallel<2>(lattice_test::make_gas<2>(1000, 0.6, B::wall, 73, 16), 1, {3}, {8, kThreads}, scaled(3000), "2D 0.6 walls, observed", -1.0,
+                    true);
   check_parallel<2>(lattice_test::make_gas<2>(600, 0.4, B::periodic, 74, 16, Mode::specular), 0, {2, 4}, {0, 9}, scaled(2000),
                     "2D 0.4 periodic specular");
+  check_parallel<2>(lattice_test::make_gas<2>(1000, 0.5, B::periodic, 78, 16), 0, {2, 4}, {0, 13, kThreads}, scaled(2000), "2D 0.5 periodic",
+                    0.6);
 }
 
 TEST_CASE("the parallel engine commits the sequential state bit for bit (3D)") {
   using B = en::Boundary;
   check_parallel<3>(lattice_test::make_gas<3>(1000, 0.3, B::periodic, 75, 16), 2, {1, 2, 4, 8}, {0, 1010, kThreads}, scaled(3000),
                     "3D 0.3 periodic");
+  check_parallel<3>(lattice_test::make_gas<3>(1000, 0.3, B::periodic, 75, 16), 2, {2, 3}, {14, kThreads}, scaled(3000), "3D 0.3 periodic", 0.0);
   check_parallel<3>(lattice_test::make_gas<3>(1000, 0.35, B::bounce, 76, 16), 0, {2, 3}, {11, kThreads}, scaled(3000), "3D 0.35 bounce walls");
+  check_parallel<3>(lattice_test::make_gas<3>(1000, 0.35, B::bounce, 76, 16), 0, {3}, {11, kThreads}, scaled(3000), "3D 0.35 bounce walls, observed",
+                    -1.0, true);
   check_parallel<3>(lattice_test::make_gas<3>(600, 0.25, B::wall, 77, 16, Mode::specular), 1, {2}, {12}, scaled(2000), "3D 0.25 walls specular");
 }
 

@@ -2,8 +2,9 @@
 set_parallel / workers= runs forward on Time Warp and reaches the sequential engine's state bit
 for bit, at a collision count or a time, 2D and 3D, periodic and walls, on more logical
 processes than cores; run_back, checkpoints (resumed on another K) and attached actions work on
-the state it leaves; bad settings are named and leave the state as it was; an observation is
-refused, a stopped one kept; scenes and `revcol run/simulate --workers` report the run."""
+the state it leaves; bad settings are named and leave the state as it was; an observation
+running through it is the sequential run's bit for bit (so are a trajectory's image flags), a
+stopped one is kept; scenes and `revcol run/simulate --workers` report the run."""
 import json
 
 import numpy as np
@@ -152,20 +153,30 @@ def test_the_binding_names_bad_settings_and_keeps_the_state():
     assert _same(seq.snapshot(), sim.snapshot())
 
 
-def test_an_observation_is_refused_and_a_stopped_one_kept():
+@pytest.mark.parametrize("cls, boundary, lps", [(LatticeSimulation, "periodic", 3), (LatticeSimulation3D, "wall", 2)])
+def test_an_observation_through_a_parallel_run_is_the_sequential_one(cls, boundary, lps):
+    seen = {}
+    for workers in (1, 2):
+        sim = cls.random(2000, phi=0.3, boundary=boundary, seed=3)
+        sim.set_parallel(workers, lps=lps if workers > 1 else None)
+        sim.run(collisions=2000)
+        sim.observe(slabs=4, speed_bins=8)
+        r = sim.run(collisions=40_000)
+        assert workers == 1 or r["parallel"]["parallel_collisions"] > 20_000
+        sim.run(time=sim.time + 0.5)
+        seen[workers] = sim.observation().to_dict()
+        assert sim.observing
+    assert seen[1] == seen[2] and seen[1]["pair_collisions"] > 40_000 and len(seen[1]["msd"]) > 0
+
+
+def test_a_stopped_observation_is_kept_through_a_parallel_run():
     sim = LatticeSimulation.random(2000, phi=0.3, seed=3, workers=2)
     sim.observe()
-    s0 = sim.snapshot()
-    with pytest.raises(ValueError, match="an observation is running"):
-        sim.run(collisions=20_000)
-    assert _same(sim.snapshot(), s0) and sim.observing
-    sim.set_parallel(1)
     sim.run(collisions=5000)
     sim.stop_observing()
     seen = sim.observation().to_dict()
-    sim.set_parallel(2)
     sim.run(collisions=20_000)
-    assert sim.observation().to_dict() == seen  # still readable after the parallel run's restore
+    assert sim.observation().to_dict() == seen and not sim.observing  # still readable, not fed
 
 
 def test_the_simulation_front_door_takes_workers():
@@ -222,6 +233,10 @@ def test_revcol_simulate_with_workers_is_the_sequential_run(tmp_path, capsys):
         assert (r["parallel"] is None) == (workers == "1")
         ends.append(LatticeSimulation.load(r["checkpoints"][-1]).snapshot())
     assert _same(*ends)
-    # an observed run (a periodic trajectory's image flags) is refused on the parallel engine
-    assert cli_main(["simulate", s, "--workers", "2", "--trajectory", str(tmp_path / "t.xyz"), "--no-progress"]) == 2
-    assert "the parallel engine does not observe a run yet" in capsys.readouterr().err
+    # an observed run (a periodic trajectory's image flags) on the parallel engine: the same frames
+    frames = []
+    for workers in ("1", "2"):
+        t = tmp_path / f"t{workers}.xyz"
+        assert cli_main(["simulate", s, "--workers", workers, "--trajectory", str(t), "--no-progress"]) == 0
+        frames.append(t.read_text())
+    assert frames[0] == frames[1] and len(frames[0]) > 1000

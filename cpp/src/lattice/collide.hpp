@@ -150,7 +150,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   ++own_[j].pc;
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, gid(i), gid(j)});
-  if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
+  if (obs_ || events || seen_) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
   apply(i, j, xi2, xj2, vi2, vj2, a);
   return true;
 }
@@ -228,7 +228,7 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
   ++own_[j].pc;
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, gid(i), gid(j)});
-  if (obs_ || events) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
+  if (obs_ || events || seen_) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
   apply(i, j, xi2, xj2, vi2, vj2, a);
 }
 

@@ -240,7 +240,7 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
       ++cnt_.wall_groups;
     }
   if (trace != nullptr) trace->push_back({a, gid(i), gid(j)});
-  if (obs_ || events) [[unlikely]] note_group(a, g, post, vel);
+  if (obs_ || events || seen_) [[unlikely]] note_group(a, g, post, vel);
   for (std::size_t m = 0; m < g.size(); ++m) {
     ln_[g[m]] = Line{post[m], vel[m], a};
     sync(g[m]);

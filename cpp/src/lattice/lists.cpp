@@ -201,6 +201,25 @@ void NeighbourListsN<Dim>::renew(int p, const Vec& c) {
 }
 
 template <std::size_t Dim>
+void NeighbourListsN<Dim>::remove(int p) {
+  const std::size_t base = static_cast<std::size_t>(p) * cap_;
+  for (std::int32_t e = 0, ne = count_[static_cast<std::size_t>(p)]; e < ne; ++e) drop(ids_[base + e], p);
+  count_[static_cast<std::size_t>(p)] = 0;
+  if (node_[static_cast<std::size_t>(p)].cell >= 0) unlink(p);
+}
+
+template <std::size_t Dim>
+void NeighbourListsN<Dim>::insert(int p, const Vec& c) {
+  require(node_[static_cast<std::size_t>(p)].cell < 0, "lattice neighbour lists: the particle is already listed");
+  node_[static_cast<std::size_t>(p)].c = c;
+  link(p, grid_.cell_id(c));
+  scan(p, [&](int q, std::uint8_t code) {
+    add(p, q, code);
+    add(q, p, mirror(code));
+  });
+}
+
+template <std::size_t Dim>
 void NeighbourListsN<Dim>::link(int p, int cell) {
   Node& n = node_[static_cast<std::size_t>(p)];
   n.cell = cell;

@@ -21,7 +21,7 @@ auto BasicEngine<Op, Bits, Queue>::run(std::uint64_t collisions, std::int64_t un
   begin_undo();
   try {
     const std::uint64_t done = loop(collisions, until, false, 0, poll);
-    if (obs_) obs_->sync(time_of(clock_));
+    if (obs_ && sync_after_run) obs_->sync(time_of(clock_));
     return done;
   } catch (...) {
     undo();
@@ -183,7 +183,7 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
     }
     if (overlap(old_line_at_a, pos(q, a))) ++cnt_.wall_body;
   });
-  if (!reversed_ && (obs_ || events)) [[unlikely]] note_wall(a, p, x, v, axes);
+  if (!reversed_ && (obs_ || events || seen_)) [[unlikely]] note_wall(a, p, x, v, axes);
   pre_wall_[p] = Line{pos(p, a - 1), ln_[p].v, a - 1};  // a group collision at a may take it back
   ln_[p].x = x;
   ln_[p].v = v;

@@ -35,15 +35,27 @@ void BasicEngine<Op, Bits, Queue>::lp_set(int p, const Record& r) {
   sync(p);
 }
 
+// p into the view's search (its cell, or lists about its anchor: a prediction renews them when
+// the line has left the ball by then) and out of it
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::lp_unpark(int p) {
   parked_[static_cast<std::size_t>(p)] = 0;
-  grid_.insert(p, grid_.cell_id(ln_[p].x));
+  if (lists_) {
+    nl_.insert(p, ln_[p].x);
+    sync(p);  // (the anchor unwrapped about the new centre)
+  } else {
+    grid_.insert(p, grid_.cell_id(ln_[p].x));
+  }
+}
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::lp_unplace(int p) {
+  if (lists_) nl_.remove(p);
+  else grid_.remove(p);
 }
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::lp_begin(const std::vector<std::uint8_t>& held, LpNotes* notes) {
-  require(!lists_, "lattice LP: a logical process's view needs the cell grid (set_list_shell(0) first)");
   require(held.size() == ln_.size(), "lattice LP: the view must say, for every particle, whether it is held");
   require(notes != nullptr, "lattice LP: the engine needs somewhere to leave its notes");
   parked_.assign(ln_.size(), 0);
@@ -51,11 +63,15 @@ void BasicEngine<Op, Bits, Queue>::lp_begin(const std::vector<std::uint8_t>& hel
     if (held[id] != 0) continue;
     const int p = static_cast<int>(local(static_cast<int>(id)));
     parked_[static_cast<std::size_t>(p)] = 1;
-    grid_.remove(p);
+    lp_unplace(p);
     schedule(p, none, 0, 0, -1);
     ++slot_[static_cast<std::size_t>(p)].ver;  // a held particle's slot naming it is stale
   }
   lp_ = notes;
+  observer_.reset();  // an LP never observes itself: an observed one keeps the observer's calls
+  obs_ = nullptr;
+  seen_ = notes->seen;
+  if (seen_ != nullptr) seen_->dim = static_cast<int>(D);
   keep_journal(true, jhow_);
 }
 
@@ -84,7 +100,7 @@ bool BasicEngine<Op, Bits, Queue>::lp_clear(int id, const EventKey& k) const {
   if (!parked_.empty() && parked_[static_cast<std::size_t>(p)] != 0) return true;
   const Vec x = pos(p, k.t), x0 = pos(p, k.t - 1);
   bool clear = true;
-  grid_.for_neighbours(grid_.cell_of_particle(p), [&](int q) {
+  near(p, [&](int q) {
     if (q == p || !overlap(x, pos(q, k.t))) return;
     const EventKey pair{k.t, coll_kind(p, q), std::min(gid(p), gid(q))};
     if (!(k < pair) || overlap(x0, pos(q, k.t - 1))) clear = false;
@@ -100,7 +116,7 @@ void BasicEngine<Op, Bits, Queue>::lp_park(int id, const EventKey& k) {
   jlp_.emplace_back(0, record(id));
   jdone_.push_back(Done{k.t, k.kind, p, k.id, lpp, 0, 0});
   parked_[static_cast<std::size_t>(p)] = 1;
-  grid_.remove(p);
+  lp_unplace(p);
   schedule(p, none, 0, 0, -1);
   ++slot_[static_cast<std::size_t>(p)].ver;
   last_key_ = {k.t, k.kind};
@@ -144,6 +160,7 @@ std::size_t BasicEngine<Op, Bits, Queue>::lp_run(const EventKey& stop, std::size
     cut(jlp_, lp_->marks[5]);
     undo(false);
     last_key_ = jdone_.empty() ? j_key0_ : std::make_pair(jdone_.back().t, jdone_.back().kind);
+    if (seen_ != nullptr) seen_->drop_after(last_key());  // (the event's observer calls)
     lp_stepped_ = false;
     lp_->error = e.what();
   }

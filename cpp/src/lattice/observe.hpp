@@ -20,7 +20,7 @@ void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::make_observer(const Units& u, const std::vector<Vec>& x, const std::vector<Vec>& v,
                                                  std::int64_t clock, const engine::ObserveConfig* c,
-                                                 const Snapshot* s) const -> std::unique_ptr<engine::Observer> {
+                                                 const Snapshot* s) -> std::unique_ptr<engine::Observer> {
   const double len = u.length_unit, speed = u.length_unit / u.tick;
   const std::size_t n = x.size();
   std::vector<double> xf(n * D), vf(n * D);
@@ -65,7 +65,7 @@ void BasicEngine<Op, Bits, Queue>::record(int kind, std::int64_t a, const std::v
 template <class Op, class Bits, class Queue>
 [[gnu::noinline, gnu::cold]] void BasicEngine<Op, Bits, Queue>::note_pair(std::int64_t a, int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj) {
   if (events != nullptr) record(EventRecordN<D>::pair, a, {i, j}, {xi, xj}, {vi, vj}, 0);
-  if (!obs_) return;
+  if (!obs_ && !seen_) return;
   double x[2 * D], v[2 * D];
   for (std::size_t k = 0; k < D; ++k) {
     x[k] = to_length(xi[k]);
@@ -73,25 +73,32 @@ template <class Op, class Bits, class Queue>
     v[k] = to_speed(vi[k]);
     v[D + k] = to_speed(vj[k]);
   }
+  if (seen_) {  // an LP's: kept, the committed ones replayed (lp_seen.hpp)
+    const int ids[2] = {gid(i), gid(j)};
+    seen_->add(lp_->key, LpSeen::pair, time_of(a), 0, 2, ids, x, v);
+    return;
+  }
   obs_->pair_at(time_of(a), gid(i), gid(j), x, x + D, v, v + D);
 }
 
 template <class Op, class Bits, class Queue>
 [[gnu::noinline, gnu::cold]] void BasicEngine<Op, Bits, Queue>::note_wall(std::int64_t a, int p, const Vec& xp, const Vec& vp, unsigned axes) {
   if (events != nullptr) record(EventRecordN<D>::wall, a, {p}, {xp}, {vp}, axes);
-  if (!obs_) return;
+  if (!obs_ && !seen_) return;
   double x[D], v[D];
   for (std::size_t k = 0; k < D; ++k) {
     x[k] = to_length(xp[k]);
     v[k] = to_speed(vp[k]);
   }
-  obs_->wall_at(time_of(a), gid(p), x, v, axes);
+  const int id = gid(p);
+  if (seen_) seen_->add(lp_->key, LpSeen::wall, time_of(a), axes, 1, &id, x, v);
+  else obs_->wall_at(time_of(a), id, x, v, axes);
 }
 
 template <class Op, class Bits, class Queue>
 [[gnu::noinline, gnu::cold]] void BasicEngine<Op, Bits, Queue>::note_group(std::int64_t a, const std::vector<int>& g, const std::vector<Vec>& xg, const std::vector<Vec>& vg) {
   if (events != nullptr) record(EventRecordN<D>::group, a, g, xg, vg, 0);
-  if (!obs_) return;
+  if (!obs_ && !seen_) return;
   const std::size_t n = g.size();
   std::vector<double> x(n * D), v(n * D);
   std::vector<int> ids(n);
@@ -102,7 +109,8 @@ template <class Op, class Bits, class Queue>
       x[m * D + k] = to_length(m > 0 ? xg[0][k] + diff(xg[m], xg[0])[k] : xg[m][k]);
       v[m * D + k] = to_speed(vg[m][k]);
     }
-  obs_->group_at(time_of(a), static_cast<int>(n), ids.data(), x.data(), v.data());
+  if (seen_) seen_->add(lp_->key, LpSeen::group, time_of(a), 0, n, ids.data(), x.data(), v.data());
+  else obs_->group_at(time_of(a), static_cast<int>(n), ids.data(), x.data(), v.data());
 }
 
 }  // namespace revcol::lattice

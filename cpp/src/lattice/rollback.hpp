@@ -232,7 +232,7 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
       if (parked && was_parked == 0) lp_unpark(d.p);
       if (!parked && was_parked != 0) {
         parked_[static_cast<std::size_t>(d.p)] = 1;
-        grid_.remove(d.p);
+        lp_unplace(d.p);
         schedule(d.p, none, 0, 0, -1);
       }
       continue;
@@ -279,6 +279,7 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
   unwinding_ = true;
   for (int p : jtouched_) predict(p, clock_);
   unwinding_ = false;
+  if (seen_ != nullptr) seen_->drop_after(last_key());  // an LP's: the undone events' observer calls
 }
 
 template <class Op, class Bits, class Queue>

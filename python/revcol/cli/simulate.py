@@ -53,7 +53,7 @@ from .._output_size import (checkpoints_size, production_checkpoints, production
 from .._outputs import Output, check_outputs, checkpoint_names, estimates, output_limit, run_inputs
 from ..gas import build_simulation, check_memory
 from ..lattice import LatticeSimulation, add_reports
-from ..lattice_gas import check_parallel, geometry as lattice_geometry
+from ..lattice_gas import geometry as lattice_geometry
 from .report import parallel_line
 from ..observe import report_lines
 from ..progress import Bar, Interrupt, peak_rss
@@ -361,7 +361,6 @@ def simulate(scene: Scene | str | os.PathLike | None = None, *, collisions: int 
         raise SceneError(f"{scene.source}: --species: {e}") from None
     limit = output_limit(scene.source, max_output, scene.max_output)
     check_memory(scene)
-    check_parallel(scene, trajectory)
     # the checkpoint resumed from is read first: its count numbers the checkpoints the run may write
     sim = _build(scene, resume) if resume is not None else None
     start = 0 if sim is None else _net(sim)

@@ -27,7 +27,6 @@
 //
 // Neighbour search (set_list_shell): cells or neighbour lists, behind a double filter; neither
 // changes which collisions happen (predict.hpp; docs/lattice.md "Finding the next event").
-
 // Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
 // collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
 // lo descending (kind 1 + (N - 1 - lo)), then walls (kind N + 1). So the reverse undoes each tick's
@@ -63,6 +62,7 @@
 #include "revcol/lattice/cell_grid.hpp"
 #include "revcol/lattice/geometry.hpp"
 #include "revcol/lattice/lp.hpp"
+#include "revcol/lattice/lp_seen.hpp"
 #include "revcol/lattice/state.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
 #include "revcol/lattice/specular.hpp"
@@ -101,9 +101,10 @@ class BasicEngine {
   /// The same, its particles stored in another order: local index p holds particle order[p] (a
   /// permutation of [0, N)); every key, draw, tie and output is by particle id (the same bits).
   BasicEngine(const Snapshot& s, Op op, const std::vector<std::uint32_t>& order) : op_(std::move(op)) { restore(s, order); }
-  /// A logical process's (timewarp.hpp): the cell grid and the regions (set_regions) set before its one build.
-  BasicEngine(const Snapshot& s, Op op, int axis, std::vector<std::int64_t> faces) : op_(std::move(op)) {
-    list_shell_ = 0.0, rax_ = axis, faces_ = std::move(faces);
+  /// A logical process's (timewarp.hpp): its search (`shell` as set_list_shell's: 0 the cell grid,
+  /// -1 automatic) and the regions (set_regions) set before its one build.
+  BasicEngine(const Snapshot& s, Op op, int axis, std::vector<std::int64_t> faces, double shell = 0.0) : op_(std::move(op)) {
+    list_shell_ = shell, rax_ = axis, faces_ = std::move(faces);
     restore(s);
   }
 
@@ -153,7 +154,7 @@ class BasicEngine {
   using Record = ParticleRecordN<D, Bits>;  ///< one particle's whole state
   Record record(int id) const;              ///< particle id's state (its line as anchored)
   /// Makes this engine an LP's: the particles not `held[id]` parked (in no cell, no event), every
-  /// event noted in `notes`, the journal kept. Cells only (set_list_shell(0) first).
+  /// event noted in `notes`, the journal kept. Cells or lists (a parked particle is on no list).
   void lp_begin(const std::vector<std::uint8_t>& held, LpNotes* notes);
   bool held(int id) const { return parked_.empty() || parked_[local(id)] == 0; }  ///< in the view
   /// Particle id takes state r at key k (a message), held from then on; journaled, a rollback
@@ -177,11 +178,16 @@ class BasicEngine {
   const engine::Observer* observer() const noexcept { return observer_.get(); }
   bool observing() const noexcept { return obs_ != nullptr; }  ///< Whether an observation is running.
   void stop_observing();  ///< Ends the observation at the clock; observer() still reads it.
-  /// A tick as float time (the observer's clock).
-  double time_of(std::int64_t tick) const noexcept { return static_cast<double>(tick) * u_.tick; }
+  /// run() brings a running observation to its end tick (Observer::sync: every particle's segment
+  /// closed there); false leaves that to sync_observation() (a run in parts observed as one run).
+  bool sync_after_run = true;
+  void sync_observation() { if (obs_) obs_->sync(time_of(clock_)); }  ///< The observation brought to the clock.
+  /// An observer of state x, v at tick `clock` in units u: a new one (config c) or s's (resumed).
+  static std::unique_ptr<engine::Observer> make_observer(const Units& u, const std::vector<Vec>& x, const std::vector<Vec>& v,
+                                                         std::int64_t clock, const engine::ObserveConfig* c, const Snapshot* s);
+  double time_of(std::int64_t tick) const noexcept { return static_cast<double>(tick) * u_.tick; }  ///< A tick as float time (the observer's clock).
   double to_length(std::int64_t x) const noexcept { return static_cast<double>(x) * u_.length_unit; }  ///< Lattice units as a float length.
-  /// Lattice units per tick as a float speed.
-  double to_speed(std::int64_t v) const noexcept { return static_cast<double>(v) * (u_.length_unit / u_.tick); }
+  double to_speed(std::int64_t v) const noexcept { return static_cast<double>(v) * (u_.length_unit / u_.tick); }  ///< Lattice units per tick as a float speed.
 
   std::vector<Vec> positions() const;  ///< Positions at the clock, wrapped, by particle id.
   std::vector<Vec> velocities() const;  ///< Velocities by particle id (a copy).
@@ -287,7 +293,6 @@ class BasicEngine {
       if (std::tie(t2, k2, gq2) < std::tie(t, k, gq) || type == none) t = t2, k = k2, type = ty, q = q2, gq = gq2;
     }
   };
-
   void load(const Snapshot& s, const std::vector<std::uint32_t>& order = {});
   Snapshot fresh(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, std::int64_t clock, Mode mode) const;
   void check_log(const Snapshot& s) const;  // the rare log against the per-particle counts
@@ -342,7 +347,6 @@ class BasicEngine {
   }
   void check_order(std::int64_t t, std::int32_t k);
   std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target, const std::function<bool()>& poll);
-
   void reflect(int p, std::int64_t a);
   // a state the reverse cannot take back (a loaded state no run wrote): an error naming it, the
   // collision and the pair; run_back restores the state it began with
@@ -378,17 +382,12 @@ class BasicEngine {
   bool collide_drawn(int i, int j, std::int64_t a, bool fallback);
   void collide_specular(int i, int j, std::int64_t a);
   void back_specular(int i, int j, std::int64_t a);
-
   std::vector<int> group_of(int i, int j, std::int64_t a) const;
   std::vector<Vec> resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const;
   bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec>& post, std::vector<Vec>& vel) const;
   // false when it can neither resolve nor bounce (nothing changed) and !must; must: throws then
   bool group_collide(int i, int j, std::int64_t a, std::uint64_t ctr0, const std::array<std::uint64_t, 8>& reasons, bool must = true);
   void group_back(int i, int j, std::int64_t a, Group& entry);
-
-  std::unique_ptr<engine::Observer> make_observer(const Units& u, const std::vector<Vec>& x, const std::vector<Vec>& v,
-                                                 std::int64_t clock, const engine::ObserveConfig* c,
-                                                 const Snapshot* s) const;
   void record(int kind, std::int64_t a, const std::vector<int>& ids, const std::vector<Vec>& x, const std::vector<Vec>& v, unsigned axes);
   [[gnu::noinline, gnu::cold]] void note_pair(std::int64_t a, int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj);
   [[gnu::noinline, gnu::cold]] void note_wall(std::int64_t a, int p, const Vec& xp, const Vec& vp, unsigned axes);
@@ -574,12 +573,13 @@ class BasicEngine {
   std::deque<std::pair<std::uint8_t, Record>> jlp_;  // per LP write or park: parked before, state before
   std::vector<std::uint8_t> parked_;  // an LP's particles outside its view (empty: none)
   LpNotes* lp_ = nullptr;
+  LpSeen* seen_ = nullptr;  // an observed LP's: the observer's calls kept (lp_seen.hpp)
   bool lp_stepped_ = false;  // lp_run: an event was popped (its after-hook is due)
   EventKey done_key(const Done& d) const noexcept {
     return {d.t, d.kind, d.type >= lpw ? d.q : gid(d.unreflected & 4u ? d.q : d.p)};
   }
   void lp_set(int p, const Record& r);
-  void lp_unpark(int p);
+  void lp_unpark(int p), lp_unplace(int p);  // into the view's search (cells or lists), out of it
   void lp_note(int i, int j);  // the collision's particles into lp_'s notes
   std::uint64_t j_ncoll0_ = 0;
   std::int64_t j_clock0_ = 0;

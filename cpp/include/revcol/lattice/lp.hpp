@@ -1,7 +1,7 @@
 // What a logical process (LP) of the parallel lattice engine and its engine say to each other
 // (ARCHITECTURE.md "The parallel engine"; timewarp.hpp runs the LPs): an event's key, one
 // particle's whole state as a message carries it, and the notes the engine leaves on each event
-// it processes for an LP.
+// it processes for an LP; the counts of a parallel run.
 #pragma once
 #include <array>
 #include <compare>
@@ -12,6 +12,8 @@
 #include "revcol/lattice/geometry.hpp"
 
 namespace revcol::lattice {
+
+struct LpSeen;
 
 /// An event's key in the engine's total order (forward): its tick, its queue kind (0 crossings,
 /// 1 walls, 2 + lo a collision of the pair whose lower id is lo) and the id of the particle whose
@@ -54,6 +56,28 @@ struct LpNotes {
   std::string error;               ///< lp_run: an engine error at `key` (the event undone, the run stopped there)
   std::array<std::size_t, 6> marks{};  ///< (the engine's journal sizes before the event under way)
   bool in_after = false;           ///< (after is running: its exceptions are not the engine's)
+  LpSeen* seen = nullptr;          ///< an observed run: where the engine keeps its observer calls (lp_seen.hpp)
+};
+
+/// The counts of a parallel run (all LPs).
+struct TimeWarpStats {
+  std::uint64_t events = 0;     ///< queue pops that changed a state (rolled back ones too)
+  std::uint64_t stale = 0;      ///< queue pops of stale slots
+  std::uint64_t rollbacks = 0;  ///< rollbacks (stragglers and cancellations)
+  std::uint64_t undone = 0;     ///< journal entries they undid
+  std::uint64_t messages = 0;   ///< messages sent
+  std::uint64_t anti = 0;       ///< anti-messages sent
+  std::uint64_t confirmed = 0;  ///< messages that confirmed a guess
+  std::uint64_t written = 0;    ///< messages written into a view
+  std::uint64_t blocked = 0;    ///< writes that left a view inconsistent (the LP waited for a rollback)
+  std::uint64_t reused = 0;     ///< messages a re-execution sent again as they were (lazy cancellation)
+  std::uint64_t gvts = 0;       ///< GVT computations
+  double gvt_seconds = 0.0;     ///< seconds in the GVT step (worker 0 alone, the others at the barrier)
+  std::vector<std::uint64_t> lp_events;  ///< per LP: events processed
+  void add(const TimeWarpStats& o) {
+    events += o.events, stale += o.stale, rollbacks += o.rollbacks, undone += o.undone, messages += o.messages;
+    anti += o.anti, confirmed += o.confirmed, written += o.written, blocked += o.blocked, reused += o.reused;
+  }
 };
 
 }  // namespace revcol::lattice

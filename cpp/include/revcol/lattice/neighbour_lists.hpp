@@ -56,6 +56,10 @@ class NeighbourListsN {
   void build(const UnitsN<Dim>& u, std::int64_t h, const std::vector<Vec>& centres);
   /// Moves p's centre to c (a wrapped position) and renews p's list and its neighbours' entries.
   void renew(int p, const Vec& c);
+  /// Takes p out: off every list and out of the centres' grid (a logical process parks it).
+  void remove(int p);
+  /// Puts a removed p back with centre c (a wrapped position): its list and its neighbours'.
+  void insert(int p, const Vec& c);
   /// True when x (a wrapped position) is within h of p's centre, exactly.
   bool inside(int p, const Vec& x) const noexcept;
   /// Ticks tau >= 1 such that the line x + v t stays within h of p's centre for t in [0, tau - 1]

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -28,7 +29,7 @@ struct ParallelReport {
   std::uint64_t collisions = 0;  ///< collisions done (committed) in all
   std::uint64_t parallel = 0;    ///< of them, committed by the parallel engine
   std::uint64_t sequential = 0;  ///< of them, run by the sequential engine (probe and tail)
-  std::uint64_t overshoot = 0;   ///< collisions a chunk ran past the stop, run back sequentially
+  std::uint64_t overshoot = 0;   ///< collisions a chunk ran past the stop: run back sequentially (observed: the chunk discarded, run again sequentially)
   int chunks = 0;                ///< parallel runs to a tick
   bool stopped = false;          ///< Ctrl-C: the state is the run's at a whole tick before the stop
   TimeWarpStats stats{};         ///< the parallel engine's counts
@@ -40,16 +41,15 @@ struct ParallelReport {
 
 /// Runs engine e forward, as e.run(collisions, until) does (bit for bit the same state), on K
 /// logical processes (config c). An engine error leaves e's state as it was; Ctrl-C (poll()
-/// false) leaves it at a whole tick the run passed. A running observation is refused (the
-/// parallel engine does not observe its committed events yet). `small`: runs of at most that many
+/// false) leaves it at a whole tick the run passed. A running observation sees the committed
+/// events (lp_seen.hpp) and is synced once, at the end: the observation is e.run's bit for bit
+/// (a chunk that ran past the count is then discarded and its rest run sequentially, since an
+/// observation cannot run back). `small`: runs of at most that many
 /// collisions stay sequential (0: max(8192, N/4)); `bias` (tests): scales the chunks' ticks (> 1
 /// runs past the count, which the sequential engine then runs back).
 template <class Engine>
 ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t until, const typename TimeWarp<Engine>::Config& c,
                             const std::function<bool()>& poll = {}, std::uint64_t small = 0, double bias = 1.0) {
-  require(!e.observing(),
-          "parallel lattice run: an observation is running (the parallel engine does not observe yet): stop_observing() "
-          "first, or run with one worker");
   require(until >= e.clock(), "lattice run: the end tick is before the clock");
   require(until < tick_limit, "lattice run: the end tick is beyond the tick limit 2^61");
   constexpr std::uint64_t all = std::numeric_limits<std::uint64_t>::max();
@@ -57,6 +57,16 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
   if (small == 0) small = std::max<std::uint64_t>(probe + tail, e.size() / 4);
   ParallelReport r;
   if (collisions == 0) return r;
+  struct Synced {  // the run's parts observed as one run: its observation synced once, at its end
+    Engine& e;
+    bool was;
+    ~Synced() {
+      e.sync_after_run = was;
+      if (was && std::uncaught_exceptions() == 0) e.sync_observation();
+    }
+  } synced{e, e.sync_after_run};
+  e.sync_after_run = false;
+  const bool observed = e.observing();
   const std::uint64_t c0 = e.collisions();
   const std::uint64_t target = collisions >= all - c0 ? all : c0 + collisions;
   const bool by_count = target != all;
@@ -85,9 +95,11 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
       per = static_cast<double>(e.clock() - t0) / static_cast<double>(did);
     }
     auto t0 = clock_type::now();
-    auto tw = std::make_unique<TimeWarp<Engine>>(e.snapshot(), c);
+    typename TimeWarp<Engine>::Config cs = c;
+    if (cs.shell < 0.0) cs.shell = e.list_shell();  // the LPs search as e does (cells or its lists)
+    auto tw = std::make_unique<TimeWarp<Engine>>(e.snapshot(), cs);
     r.build_s = since(t0);
-    typename Engine::Snapshot s;
+    typename Engine::Snapshot s, before;  // before: the state before the chunk (an observed run's)
     for (std::int64_t clock = e.clock(); r.chunks < 3;) {
       const std::uint64_t had = e.collisions() + r.parallel;
       std::int64_t t = until;
@@ -102,6 +114,7 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
         const double ticks = std::max(1.0, std::floor(aim * per * bias));
         if (ticks < static_cast<double>(until - clock)) t = clock + static_cast<std::int64_t>(ticks);
       }
+      if (observed) before = r.chunks == 0 ? e.snapshot() : s;
       t0 = clock_type::now();
       const bool whole = tw->run_until(t, poll);
       r.parallel_s += since(t0);
@@ -114,6 +127,12 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
       if (did > 0) per = static_cast<double>(s.clock - clock) / static_cast<double>(did);
       clock = s.clock;
       if (!whole) r.stopped = true;
+      if (observed && by_count && s.collisions > target) {  // past the count: discarded (see above)
+        r.overshoot = s.collisions - target;
+        r.parallel -= did;
+        s = std::move(before);
+        break;
+      }
       if (!whole || t == until || !by_count) break;
     }
     r.stats = tw->stats();

@@ -56,33 +56,13 @@
 #include "revcol/error.hpp"
 #include "revcol/lattice/engine.hpp"
 #include "revcol/lattice/lp.hpp"
+#include "revcol/lattice/lp_seen.hpp"
 #include "revcol/lattice/slab_views.hpp"
 #include "revcol/lattice/timewarp_state.hpp"
 #include "revcol/lattice/workers.hpp"
 #include "revcol/lattice/state.hpp"
 
 namespace revcol::lattice {
-
-/// The counts of a parallel run (all LPs).
-struct TimeWarpStats {
-  std::uint64_t events = 0;     ///< queue pops that changed a state (rolled back ones too)
-  std::uint64_t stale = 0;      ///< queue pops of stale slots
-  std::uint64_t rollbacks = 0;  ///< rollbacks (stragglers and cancellations)
-  std::uint64_t undone = 0;     ///< journal entries they undid
-  std::uint64_t messages = 0;   ///< messages sent
-  std::uint64_t anti = 0;       ///< anti-messages sent
-  std::uint64_t confirmed = 0;  ///< messages that confirmed a guess
-  std::uint64_t written = 0;    ///< messages written into a view
-  std::uint64_t blocked = 0;    ///< writes that left a view inconsistent (the LP waited for a rollback)
-  std::uint64_t reused = 0;     ///< messages a re-execution sent again as they were (lazy cancellation)
-  std::uint64_t gvts = 0;       ///< GVT computations
-  double gvt_seconds = 0.0;     ///< seconds in the GVT step (worker 0 alone, the others at the barrier)
-  std::vector<std::uint64_t> lp_events;  ///< per LP: events processed
-  void add(const TimeWarpStats& o) {
-    events += o.events, stale += o.stale, rollbacks += o.rollbacks, undone += o.undone, messages += o.messages;
-    anti += o.anti, confirmed += o.confirmed, written += o.written, blocked += o.blocked, reused += o.reused;
-  }
-};
 
 template <class Engine>
 class TimeWarp {
@@ -103,6 +83,7 @@ class TimeWarp {
     Rollback how = Rollback::reverse;  ///< how an LP rolls back: reverse computation, or state saving (SS1, SS2)
     bool lazy = true;               ///< lazy cancellation (else aggressive: anti-messages at once)
     std::int64_t window = 0;        ///< optimism: no event more than this many ticks past GVT (0: none)
+    double shell = -1.0;            ///< the LPs' search, as set_list_shell's: -1 the sequential engine's automatic one, 0 cells
   };
 
   /// K LPs on the state s (validated: bad input throws InvalidArgument, nothing is built).
@@ -113,14 +94,16 @@ class TimeWarp {
     require(c.max_delay >= 0 && c.gvt_every >= 1 && c.batch >= 1, "parallel lattice engine: max_delay >= 0, gvt_every >= 1, batch >= 1");
     require(c.workers >= 1 && c.workers <= c.lps, "parallel lattice engine: 1 to K (the logical processes) workers");
     require(c.workers == 1 || c.fuzz == 0, "parallel lattice engine: the fuzzed schedule runs on one worker");
+    require(!(c.shell > 2.0) && (c.shell <= 0.0 || c.shell >= 0.02), "parallel lattice engine: the LPs' list shell must be 0 (cells), < 0 (automatic) or in [0.02, 2]");
     const auto& u = s.units;
     const std::size_t ax = static_cast<std::size_t>(c.axis);
     reach_ = u.sigma + 4 * u.vmax;
     sv_ = SlabViews(c.lps, u.L[ax], u.wall[ax], 3 * u.sigma + 8 * u.vmax);
     horizon_ = s.clock;
-    // the LPs' engines (cells and regions: one build each), built by the workers side by side
+    // the LPs' engines (their search and regions: one build each), built by the workers side by side
     lps_.resize(static_cast<std::size_t>(c.lps));
-    build_in_workers(c.workers, c.lps, [&](int m) { lps_[static_cast<std::size_t>(m)] = std::make_unique<Lp>(s, c.axis, sv_.faces()); });
+    build_in_workers(c.workers, c.lps, [&](int m) { lps_[static_cast<std::size_t>(m)] = std::make_unique<Lp>(s, c.axis, sv_.faces(), c.shell); });
+    if (!s.observer.empty()) obs_ = Engine::make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);  // a running observation goes on (lp_seen.hpp)
     for (int m = 0; m < c.lps; ++m) {
       Lp& lp = *lps_[static_cast<std::size_t>(m)];
       lp.me = m;
@@ -130,6 +113,7 @@ class TimeWarp {
       lp.hook = {this, &lp};
       lp.notes.after = &TimeWarp::after_hook;
       lp.notes.ctx = &lp.hook;
+      if (obs_) lp.notes.seen = &lp.seen;
       lp.eng.keep_journal(true, c.how);
       lp.eng.lp_begin(held, &lp.notes);
       lp.last = lp.eng.last_key();
@@ -157,7 +141,9 @@ class TimeWarp {
   Snapshot snapshot() const {
     std::vector<const Engine*> engines;
     for (const auto& lp : lps_) engines.push_back(&lp->eng);
-    return committed_state(engines, sv_, horizon_);
+    Snapshot s = committed_state(engines, sv_, horizon_);
+    if (obs_) obs_->save(s.observer, s.observer_counts);  // (not synced: run_parallel syncs the whole run's once)
+    return s;
   }
 
   /// The counts so far, all LPs.
@@ -186,10 +172,11 @@ class TimeWarp {
   };
   using MKey = std::pair<EventKey, std::uint64_t>;  // (key, serial): messages in key order
   struct Lp {
-    Lp(const Snapshot& s, int axis, std::vector<std::int64_t> faces) : eng(s, operator_for(s.units, s.law), axis, std::move(faces)) {}
+    Lp(const Snapshot& s, int axis, std::vector<std::int64_t> faces, double shell) : eng(s, operator_for(s.units, s.law), axis, std::move(faces), shell) {}
     int me = 0;
     Engine eng;
     LpNotes notes;
+    LpSeen seen;                                      // an observed run: the observer's calls of its events
     EventKey last;                                    // the last key processed
     std::map<MKey, Message> pending, taken;           // input not yet processed; processed (written or confirming)
     std::map<std::pair<EventKey, int>, Record> guesses;  // (key, particle): a guessed post state, unconfirmed
@@ -322,6 +309,7 @@ class TimeWarp {
 
   void after_event(Lp& lp) {
     const EventKey k = lp.notes.key;
+    if (obs_ && sv_.owner(region_before(lp, k.id)) != lp.me) lp.seen.drop_event(k);  // only the authority's calls count
     if (lp.notes.type == LpNotes::coll) {
       const int key_owner = sv_.owner(region_before(lp, k.id));
       if (key_owner == lp.me) {
@@ -577,6 +565,11 @@ class TimeWarp {
       lp->taken.erase(lp->taken.begin(), lp->taken.lower_bound(MKey{until, 0}));
       lp->sent.erase(lp->sent.begin(), lp->sent.lower_bound(MKey{until, 0}));
     }
+    if (obs_) {  // the committed events' observer calls, in key order
+      std::vector<LpSeen*> seen;
+      for (auto& lp : lps_) seen.push_back(&lp->seen);
+      feed_committed(seen, whole, *obs_);
+    }
     if (g.t != std::numeric_limits<std::int64_t>::max()) gvt_t_ = g.t;
     return g;
   }
@@ -592,6 +585,7 @@ class TimeWarp {
   std::uint64_t tick_ = 0, gvts_ = 0;                     // one worker: scheduler steps
   std::int64_t gvt_t_ = 0;                                // the last GVT's tick (the window)
   double gvt_s_ = 0.0;                                    // seconds in the GVT step
+  std::unique_ptr<engine::Observer> obs_;                 // a running observation: fed the committed events
   bool threaded_ = false, stopped_ = false;
 };
 
