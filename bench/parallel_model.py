@@ -11,7 +11,7 @@ events over the mean), plus the GVT step, measured (``gvt_s``: worker 0 drains t
 computes GVT and commits every LP while the others wait at the barrier), plus ``c_b`` per GVT
 on more than one worker (the barrier itself). The unit costs are fitted per case (dimension,
 N) by non-negative least squares in relative error on all its runs (1 and 2 workers, K = 1 to
-32), and each run is predicted again with itself left out.
+16), and each run is predicted again with itself left out.
 
 Counts. Each LP processes every event of the particles in its band (its slab widened by W on
 both sides), so the LPs process ``rho = 1 + 2 K W / L`` times the events of one engine (slabs;
