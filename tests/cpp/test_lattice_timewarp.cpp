@@ -2,7 +2,8 @@
 // back by reverse computation, commit the sequential engine's state bit for bit at every tick it
 // is asked to stop at, for K = 1 to 8, 2D and 3D, walls and periodic, in a round-robin schedule
 // and in random schedules with random message delays; a state that no schedule may change; an
-// observation running through the parallel run is the sequential run's bit for bit.
+// observation running through the parallel run is the sequential run's bit for bit (threads: with
+// more LPs than threads too, where LPs sharing a thread run in key order among themselves).
 #include <cstdio>
 #include <algorithm>
 #include <cstdlib>
@@ -140,6 +141,27 @@ TEST_CASE("the parallel engine commits the sequential state bit for bit (3D)") {
   check_parallel<3>(lattice_test::make_gas<3>(1000, 0.35, B::bounce, 76, 16), 0, {3}, {11, kThreads}, scaled(3000), "3D 0.35 bounce walls, observed",
                     -1.0, true);
   check_parallel<3>(lattice_test::make_gas<3>(600, 0.25, B::wall, 77, 16, Mode::specular), 1, {2}, {12}, scaled(2000), "3D 0.25 walls specular");
+}
+
+// the threaded schedule caps a turn by the other LPs on its worker: share_of must name the
+// very items run_workers gives that worker
+TEST_CASE("share_of gives each item the share of the worker that runs it") {
+  for (int w = 1; w <= 4; ++w)
+    for (int k = w; k <= 9; ++k) {
+      std::vector<int> seen(static_cast<std::size_t>(k), 0);
+      std::vector<std::pair<int, int>> shares;
+      for (int me = 0; me < w; ++me) shares.push_back({me * k / w, (me + 1) * k / w});  // run_workers' shares
+      for (int i = 0; i < k; ++i) {
+        const std::pair<int, int> s = share_of(i, w, k);
+        CHECK(s.first <= i && i < s.second);
+        CHECK(std::find(shares.begin(), shares.end(), s) != shares.end());
+        for (int j = s.first; j < s.second; ++j) ++seen[static_cast<std::size_t>(j)];
+      }
+      for (int i = 0; i < k; ++i) {  // every item in one share, counted once per member of it
+        const std::pair<int, int> s = share_of(i, w, k);
+        CHECK(seen[static_cast<std::size_t>(i)] == s.second - s.first);
+      }
+    }
 }
 
 int main() { return check::run_all(); }

@@ -33,12 +33,15 @@
 // Transport. workers = 1: the LPs on the calling thread, one step at a time, round robin or
 // (fuzz) in a random order with random message delays. workers > 1: that many threads (the
 // calling one among them), each running its share of the LPs a batch of steps at a time; a
-// message goes into its receiver's inbox (a mutex each); GVT is computed with every worker
-// stopped at a barrier (every gvt_every steps of a worker, or when one finds nothing to do),
-// which is also where the run ends, the calling thread polls for Ctrl-C, and an LP's error is
-// raised. Neither the schedule nor the delays may change a bit.
+// message goes into its receiver's inbox (a mutex each), and mail ends the receiver's turn
+// after its event under way (a straggler then undoes fewer events); LPs that share a thread run
+// in key order among themselves (a turn stops at the others' least next key). GVT is computed
+// with every worker stopped at a barrier (every gvt_every steps of a worker, or when one finds
+// nothing to do), which is also where the run ends, the calling thread polls for Ctrl-C, and an
+// LP's error is raised. Neither the schedule nor the delays may change a bit.
 #pragma once
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -192,16 +195,17 @@ class TimeWarp {
     std::pair<TimeWarp*, Lp*> hook;                   // the engine's after-event hook's argument
     std::mutex inbox_mx;                              // threads: messages posted to it
     std::vector<Message> inbox;
+    std::atomic<bool> mail{false};                    // threads: the inbox holds some (set and cleared under inbox_mx)
   };
 
   // ---- one LP step ----
   // Processes the LP's next keys: its messages at the least pending key, or else its engine's
-  // events before that key (at most `batch`), if any at or before the horizon (and the window).
-  // False: nothing to do.
-  bool step(Lp& lp) {
+  // events before that key (at most `batch`), if any at or before the horizon (and the window)
+  // and before `cap`. False: nothing to do.
+  bool step(Lp& lp, const EventKey& cap = EventKey{std::numeric_limits<std::int64_t>::max(), 0, 0}) {
     if (lp.blocked) return false;
     const std::int64_t limit = c_.window > 0 ? std::min(horizon_, gvt_t_ + c_.window) : horizon_;
-    const EventKey end{limit + 1, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()};
+    const EventKey end = std::min(cap, EventKey{limit + 1, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()});
     EventKey ke;
     const bool has_e = lp.eng.lp_next(ke) && ke < end;
     const bool has_m = !lp.pending.empty() && lp.pending.begin()->first.first < end;
@@ -247,6 +251,8 @@ class TimeWarp {
       h->first->flush(lp, lp.last.next());
     }
     lp.notes.migrations.clear();
+    // threads: mail ends the turn, so that a straggler rolls back as few events as it can
+    if (lp.mail.load(std::memory_order_relaxed)) lp.notes.max = lp.notes.done;
   }
 
   // lazy cancellation: the messages sent before a rollback, at keys before k, that the
@@ -307,62 +313,10 @@ class TimeWarp {
     return lp.eng.region(id);
   }
 
-  void after_event(Lp& lp) {
-    const EventKey k = lp.notes.key;
-    if (obs_ && sv_.owner(region_before(lp, k.id)) != lp.me) lp.seen.drop_event(k);  // only the authority's calls count
-    if (lp.notes.type == LpNotes::coll) {
-      const int key_owner = sv_.owner(region_before(lp, k.id));
-      if (key_owner == lp.me) {
-        check_reach(lp, k);
-        for (int id : lp.notes.ids) {
-          const std::uint64_t to = (sv_.views(region_before(lp, id)) | sv_.views(lp.eng.region(id))) & ~(std::uint64_t{1} << lp.me);
-          if (to != 0) send(lp, k, id, to);
-        }
-      } else {
-        for (int id : lp.notes.ids) lp.guesses[{k, id}] = lp.eng.record(id);
-      }
-    } else {
-      // a crossing or a wall: an owned particle entering another band is sent there
-      for (int id : moved(lp)) {
-        if (sv_.owner(region_before(lp, id)) != lp.me) continue;
-        const std::uint64_t to = sv_.views(lp.eng.region(id)) & ~sv_.views(region_before(lp, id)) & ~(std::uint64_t{1} << lp.me);
-        if (to != 0) send(lp, k, id, to);
-      }
-    }
-    park_leavers(lp, k);
-  }
-
-  // a collision this LP is the authority of: every member must be far enough inside its band
-  // that all the bodies the event read are held
-  void check_reach(Lp& lp, const EventKey& k) {
-    if (lp.notes.ids.size() <= 2) return;  // a pair of an owned key particle: within reach by W
-    const auto& u = lp.eng.units();
-    for (int id : lp.notes.ids) {
-      const std::int64_t x = record_at(lp.eng.record(id), k.t, u)[static_cast<std::size_t>(c_.axis)];
-      if (sv_.outside(lp.me, x) > sv_.band() - reach_)
-        lp.refused[k] = "a group collision of " + std::to_string(lp.notes.ids.size()) + " particles at tick " + std::to_string(k.t) +
-                        " reaches beyond logical process " + std::to_string(lp.me) + "'s band (use fewer logical processes)";
-    }
-  }
-
-  void send(Lp& lp, const EventKey& k, int id, std::uint64_t to) {
-    const Record r = lp.eng.record(id);
-    for (int y = 0; y < c_.lps; ++y) {
-      if ((to >> y & 1u) == 0) continue;
-      // lazy cancellation: the same message sent before the rollback stands
-      auto it = lp.lazy.lower_bound(MKey{k, 0});
-      while (it != lp.lazy.end() && it->first.first == k && !(it->second.id == id && it->second.to == y && it->second.rec == r)) ++it;
-      if (it != lp.lazy.end() && it->first.first == k) {
-        ++lp.st.reused;
-        lp.sent.insert(lp.lazy.extract(it));
-        continue;
-      }
-      Message m{k, id, y, (static_cast<std::uint64_t>(lp.me) << 48) + ++lp.nsent, false, r};
-      lp.sent.emplace(MKey{k, m.serial}, m);
-      ++lp.st.messages;
-      post(std::move(m));
-    }
-  }
+  // the authority's messages after an event (timewarp_messages.hpp)
+  void after_event(Lp& lp);
+  void check_reach(Lp& lp, const EventKey& k);
+  void send(Lp& lp, const EventKey& k, int id, std::uint64_t to);
 
   // ---- the transport ----
   // (never delivered at once: a receiver's rollback sends anti-messages, and their receiver may
@@ -372,6 +326,7 @@ class TimeWarp {
       Lp& to = *lps_[static_cast<std::size_t>(m.to)];
       const std::lock_guard<std::mutex> hold(to.inbox_mx);
       to.inbox.push_back(std::move(m));
+      to.mail.store(true, std::memory_order_relaxed);
       return;
     }
     const std::uint64_t wait = c_.fuzz == 0 || c_.max_delay == 0 ? 0 : rng_() % static_cast<std::uint64_t>(c_.max_delay + 1);
@@ -387,10 +342,12 @@ class TimeWarp {
   }
   // threads: the messages in an LP's inbox, taken in; true if there were any
   bool drain(Lp& lp) {
+    if (!lp.mail.load(std::memory_order_relaxed)) return false;  // (a post after this: the next turn's)
     std::vector<Message> got;
     {
       const std::lock_guard<std::mutex> hold(lp.inbox_mx);
       got.swap(lp.inbox);
+      lp.mail.store(false, std::memory_order_relaxed);
     }
     for (Message& m : got) receive(lp, std::move(m));
     return !got.empty();
@@ -430,7 +387,7 @@ class TimeWarp {
         [&](int m) {
           Lp& lp = *lps_[static_cast<std::size_t>(m)];
           const bool got = drain(lp);
-          return step(lp) || got;
+          return step(lp, shared_cap(m)) || got;
         },
         [&](bool idle) {
           const auto t0 = std::chrono::steady_clock::now();
@@ -442,6 +399,21 @@ class TimeWarp {
           gvt_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
           return end;
         });
+  }
+
+  // threads: LP m's turn ends after the least next key of the other LPs on its worker (blocked
+  // ones aside), so that LPs sharing a thread run in key order among themselves and roll back
+  // only for the other workers' messages
+  EventKey shared_cap(int m) {
+    EventKey cap{std::numeric_limits<std::int64_t>::max(), 0, 0}, k;
+    const auto [lo, hi] = share_of(m, c_.workers, c_.lps);
+    for (int j = lo; j < hi; ++j) {
+      Lp& o = *lps_[static_cast<std::size_t>(j)];
+      if (j == m || o.blocked) continue;
+      if (o.eng.lp_next(k) && k < cap) cap = k;
+      if (!o.pending.empty() && o.pending.begin()->first.first < cap) cap = o.pending.begin()->first.first;
+    }
+    return cap.t == std::numeric_limits<std::int64_t>::max() ? cap : cap.next();
   }
 
   // With nothing in flight: GVT and commit; then, when `idle` and no LP has anything left up to
@@ -590,3 +562,5 @@ class TimeWarp {
 };
 
 }  // namespace revcol::lattice
+
+#include "revcol/lattice/timewarp_messages.hpp"  // (TimeWarp's after_event, check_reach, send)

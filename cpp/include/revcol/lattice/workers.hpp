@@ -10,6 +10,7 @@
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace revcol::lattice {
@@ -86,6 +87,13 @@ inline void run_workers(int w, int k, std::uint64_t every, const std::function<b
   work(0);
   for (auto& t : threads) t.join();
   if (err) std::rethrow_exception(err);
+}
+
+/// The items [lo, hi) of the worker that run_workers(w, k, ...) gives item i.
+inline std::pair<int, int> share_of(int i, int w, int k) {
+  int me = 0;
+  while ((me + 1) * k / w <= i) ++me;
+  return {me * k / w, (me + 1) * k / w};
 }
 
 /// Calls make(i) for every i in [0, k) on w threads (the calling one among them), each its share
