@@ -23,10 +23,7 @@ import sys
 import tempfile
 import time
 
-
-def _load() -> float:
-    with open("/proc/loadavg") as f:
-        return float(f.read().split()[0])
+from ab_compare import _load  # (bench/ is the script's directory)
 
 
 def _run(build: str, bench: str, k: int, w: int, collisions: int) -> dict:

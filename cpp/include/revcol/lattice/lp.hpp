@@ -6,6 +6,7 @@
 #include <array>
 #include <compare>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,13 @@ struct EventKey {
   friend auto operator<=>(const EventKey&, const EventKey&) = default;
   /// The least key after this one.
   EventKey next() const noexcept { return EventKey{t, kind, id + 1}; }
+  /// The least key of tick t (before every event at t).
+  static constexpr EventKey tick_start(std::int64_t t) noexcept {
+    return EventKey{t, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()};
+  }
+  /// A key after every event's ("none").
+  static constexpr EventKey never() noexcept { return EventKey{std::numeric_limits<std::int64_t>::max(), 0, 0}; }
+  bool is_never() const noexcept { return t == std::numeric_limits<std::int64_t>::max(); }
 };
 
 /// One particle's whole state: its line (anchor point, velocity, anchor tick), the one-tick cache

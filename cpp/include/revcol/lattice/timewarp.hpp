@@ -202,10 +202,10 @@ class TimeWarp {
   // Processes the LP's next keys: its messages at the least pending key, or else its engine's
   // events before that key (at most `batch`), if any at or before the horizon (and the window)
   // and before `cap`. False: nothing to do.
-  bool step(Lp& lp, const EventKey& cap = EventKey{std::numeric_limits<std::int64_t>::max(), 0, 0}) {
+  bool step(Lp& lp, const EventKey& cap = EventKey::never()) {
     if (lp.blocked) return false;
     const std::int64_t limit = c_.window > 0 ? std::min(horizon_, gvt_t_ + c_.window) : horizon_;
-    const EventKey end = std::min(cap, EventKey{limit + 1, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()});
+    const EventKey end = std::min(cap, EventKey::tick_start(limit + 1));
     EventKey ke;
     const bool has_e = lp.eng.lp_next(ke) && ke < end;
     const bool has_m = !lp.pending.empty() && lp.pending.begin()->first.first < end;
@@ -405,7 +405,8 @@ class TimeWarp {
   // ones aside), so that LPs sharing a thread run in key order among themselves and roll back
   // only for the other workers' messages
   EventKey shared_cap(int m) {
-    EventKey cap{std::numeric_limits<std::int64_t>::max(), 0, 0}, k;
+    EventKey cap = EventKey::never(), k;
+    if (c_.lps <= c_.workers) return cap;  // (an LP to each thread)
     const auto [lo, hi] = share_of(m, c_.workers, c_.lps);
     for (int j = lo; j < hi; ++j) {
       Lp& o = *lps_[static_cast<std::size_t>(j)];
@@ -413,7 +414,7 @@ class TimeWarp {
       if (o.eng.lp_next(k) && k < cap) cap = k;
       if (!o.pending.empty() && o.pending.begin()->first.first < cap) cap = o.pending.begin()->first.first;
     }
-    return cap.t == std::numeric_limits<std::int64_t>::max() ? cap : cap.next();
+    return cap.is_never() ? cap : cap.next();
   }
 
   // With nothing in flight: GVT and commit; then, when `idle` and no LP has anything left up to
@@ -442,10 +443,10 @@ class TimeWarp {
   // every LP back to the state after tick t (nothing after it processed), every message after
   // it cancelled: the state run(until = t) has
   void stop_at(std::int64_t t) {
-    const EventKey k{t + 1, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()};
+    const EventKey k = EventKey::tick_start(t + 1);
     for (auto& lp : lps_) {
       if (!(lp->last < k)) rollback(*lp, k);
-      flush(*lp, EventKey{std::numeric_limits<std::int64_t>::max(), 0, 0});
+      flush(*lp, EventKey::never());
     }
     for (bool more = true; more;) {  // the anti-messages, each to its message
       more = !flight_.empty();
@@ -508,7 +509,7 @@ class TimeWarp {
     // what it sent from then is cancelled: now (aggressive), or when the re-execution passes its
     // key without sending it again (lazy)
     for (auto it = lp.sent.lower_bound(MKey{k, 0}); it != lp.sent.end();) lp.lazy.insert(lp.sent.extract(it++));
-    if (!c_.lazy) flush(lp, EventKey{std::numeric_limits<std::int64_t>::max(), 0, 0});
+    if (!c_.lazy) flush(lp, EventKey::never());
   }
 
   // ---- GVT ----
@@ -516,7 +517,7 @@ class TimeWarp {
   // before its tick is committed (whole ticks: a Ctrl-C can stop on the tick before it)
   EventKey gvt_commit() {
     ++gvts_;
-    EventKey g{std::numeric_limits<std::int64_t>::max(), 0, 0};
+    EventKey g = EventKey::never();
     for (const auto& item : flight_) g = std::min(g, item.second.key);
     for (auto& lp : lps_) {
       EventKey k;
@@ -526,7 +527,7 @@ class TimeWarp {
       if (lp->eng.lp_next(k)) g = std::min(g, k);
     }
     // (a run that reached its horizon: everything up to it is committed)
-    const EventKey whole{g.t, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min()};
+    const EventKey whole = EventKey::tick_start(g.t);
     for (auto& lp : lps_) {
       const EventKey until = std::min(whole, lp->last.next());
       if (!lp->refused.empty() && lp->refused.begin()->first < until) throw std::runtime_error("parallel lattice engine: " + lp->refused.begin()->second);
@@ -542,7 +543,7 @@ class TimeWarp {
       for (auto& lp : lps_) seen.push_back(&lp->seen);
       feed_committed(seen, whole, *obs_);
     }
-    if (g.t != std::numeric_limits<std::int64_t>::max()) gvt_t_ = g.t;
+    if (!g.is_never()) gvt_t_ = g.t;
     return g;
   }
 
