@@ -19,8 +19,8 @@ blocks of side l: ``(1 + 2 W / l)^d``). Undone entries and messages per collisio
 proportional to the redundant part, ``e1 (rho - 1)``, with factors measured at one LP per core
 (K = 2 on 2 workers) and, as the pessimistic bound, the largest factor measured with more LPs
 than cores. W is fixed in diameters, so W / L falls as N^(-1/d); undone entries per collision
-at K = 2 fall more slowly (a power law N^alpha fitted through the 2D cases), so the factor per
-redundant event grows as N^(alpha + 1/d).
+at K = 2 fall more slowly (a power law N^alpha fitted per dimension through its sizes), so the
+factor per redundant event grows as N^(alpha + 1/d).
 
     python bench/parallel_model.py --runs bench/results/lattice_parallel_scaling.json \\
         --json bench/results/lattice_parallel_model.json
@@ -130,15 +130,17 @@ def case_model(name: str, m: dict[str, float]) -> dict:
             "measured_speedup": {r["name"]: [r["speedup"], r["speedup_min"], r["speedup_max"]] for r in runs}}
 
 
-def undone_slope(models: list[dict]) -> float:
-    """How undone entries per collision at K = 2 on 2 workers fall with N (the exponent of a
-    power law through the 2D cases): they fall more slowly than the bands (N^(-1/2) in 2D)."""
-    pts = [(math.log(cm["n"]), math.log(cm["undone_per_redundant"] * cm["events_per_collision_K1"] * 4 * cm["band_over_L"]))
-           for cm in models if cm["d"] == 2]
-    if len(pts) < 2:
-        return -0.5
-    x, y = np.array(pts).T
-    return float(np.polyfit(x, y, 1)[0])
+def undone_slope(models: list[dict], d: int) -> float:
+    """How undone entries per collision at K = 2 on 2 workers fall with N: the exponent of a
+    power law through the cases of dimension d (two sizes or more; else through the 2D cases;
+    else the bands', -1/d)."""
+    for dim in (d, 2):
+        pts = [(math.log(cm["n"]), math.log(cm["undone_per_redundant"] * cm["events_per_collision_K1"] * 4 * cm["band_over_L"]))
+               for cm in models if cm["d"] == dim and cm["undone_per_redundant"] > 0]
+        if len({x for x, _ in pts}) >= 2:
+            x, y = np.array(pts).T
+            return float(np.polyfit(x, y, 1)[0])
+    return -1.0 / d
 
 
 def predict(cm: dict, n: float, p: int, blocks: bool, worst: bool, alpha: float = 0.0) -> dict:
@@ -185,13 +187,14 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  {x['run']:>8}: rho {x['rho']:.3f} events {x['events_measured']:.3f} geometry {x['events_geometry']:.3f} (+undone {x['events_geometry_plus_undone']:.3f})"
                   f" undone/red {x['undone_per_redundant'] if x['undone_per_redundant'] is None else round(x['undone_per_redundant'], 3)}")
     # the model of a smaller gas predicting a larger one's two-worker run (what the predictions do)
-    alpha = undone_slope(models)
-    print(f"undone entries per collision at K = 2 on 2 workers scale as N^{alpha:.2f} (2D cases)")
+    alpha = {d: undone_slope(models, d) for d in sorted({cm["d"] for cm in models})}
+    for d, a_d in alpha.items():
+        print(f"{d}D: undone entries per collision at K = 2 on 2 workers scale as N^{a_d:.2f}")
     cross = []
     for a_ in models:
         for b_ in models:
             if a_["d"] == b_["d"] and a_["n"] < b_["n"]:
-                q = predict(a_, b_["n"], 2, False, False, alpha)
+                q = predict(a_, b_["n"], 2, False, False, alpha[a_["d"]])
                 got = b_["measured_speedup"]["K2_w2"]
                 cross.append({"from": a_["case"], "to": b_["case"], "predicted_K2_speedup": q["speedup"],
                               "measured": got[0], "measured_min": got[1], "measured_max": got[2]})
@@ -203,8 +206,8 @@ def main(argv: list[str] | None = None) -> int:
         for n in a.n:
             for blocks in (False, True):
                 for p in a.cores:
-                    lo = predict(cm, n, p, blocks, True, alpha)
-                    hi = predict(cm, n, p, blocks, False, alpha)
+                    lo = predict(cm, n, p, blocks, True, alpha[d])
+                    hi = predict(cm, n, p, blocks, False, alpha[d])
                     preds.append({"d": d, "phi": cm["phi"], "from_case": cm["case"], "n": n, "cores": p,
                                   "decomposition": "blocks" if blocks else "slabs", "rho": hi["rho"],
                                   "speedup": hi["speedup"], "speedup_pessimistic": lo["speedup"],
@@ -224,7 +227,7 @@ def main(argv: list[str] | None = None) -> int:
     if a.json:
         commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
         out = {"what": "performance model of the parallel lattice engine (bench/parallel_model.py)", "commit": commit,
-               "runs": a.runs, "cases": models, "undone_exponent": alpha, "cross_validation": cross, "predictions": preds}
+               "runs": a.runs, "cases": models, "undone_exponent": {str(d): a_d for d, a_d in alpha.items()}, "cross_validation": cross, "predictions": preds}
         fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(a.json)) or ".", suffix=".tmp")
         with os.fdopen(fd, "w") as f:
             json.dump(out, f, indent=1)

@@ -83,3 +83,18 @@ def test_the_committed_runs_give_the_committed_model(tmp_path):
     assert len(got["predictions"]) == len(want["predictions"]) == 2 * 3 * 2 * 6
     for a, b in zip(got["predictions"], want["predictions"]):
         assert a["speedup"] == pytest.approx(b["speedup"], rel=1e-9) and a["decomposition"] == b["decomposition"]
+
+
+def test_the_undone_slope_is_fitted_per_dimension():
+    mod = _module()
+
+    def case(d, n, undone_per_collision):  # undone per collision at K = 2 = u_red * e1 * 4 * beta
+        return {"d": d, "n": n, "events_per_collision_K1": 1.0, "band_over_L": 0.25,
+                "undone_per_redundant": undone_per_collision}
+
+    two = [case(2, 1e4, 1.0), case(2, 1e6, 0.01)]           # N^-1
+    three = [case(3, 1e5, 1.0), case(3, 1e6, 10 ** -0.5)]   # N^-0.5
+    assert mod.undone_slope(two + three, 2) == pytest.approx(-1.0)
+    assert mod.undone_slope(two + three, 3) == pytest.approx(-0.5)
+    assert mod.undone_slope(two + three[:1], 3) == pytest.approx(-1.0)  # one 3D size: the 2D slope
+    assert mod.undone_slope(three[:1], 3) == pytest.approx(-1.0 / 3)    # nothing to fit: the bands'
