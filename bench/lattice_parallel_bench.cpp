@@ -15,7 +15,9 @@
 // per collision), rollbacks_per_1k_<v>, undone_per_collision_<v>, messages_per_collision_<v>,
 // collisions_per_event_<v> (committed collisions over the LPs' events processed, crossings too),
 // stale_per_collision_<v>, gvts_<v> (GVT computations), gvt_s_per_collision_<v> (seconds in
-// the GVT step, worker 0 alone, from the last round), worker_imbalance_<v> (the busiest
+// the GVT step, worker 0 alone, from the last round), journal_peak_bytes_<v> and
+// journal_bytes_per_entry_<v> (the LPs' journals as the GVTs found them: the most bytes, and bytes
+// per entry held, state saving's saved states included), worker_imbalance_<v> (the busiest
 // worker's events over the mean: LPs [m k / w, (m + 1) k / w) on worker m) and seconds_<v> (the
 // median run time); band_over_L (the band W over the slabs' axis) and ticks, for the
 // performance model (bench/parallel_model.py).
@@ -191,6 +193,8 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     out.push_back({"stale_per_collision_" + v.name, static_cast<double>(v.st.stale) / coll});
     out.push_back({"gvts_" + v.name, static_cast<double>(v.st.gvts)});
     out.push_back({"gvt_s_per_collision_" + v.name, v.st.gvt_seconds / coll});
+    out.push_back({"journal_peak_bytes_" + v.name, static_cast<double>(v.st.journal_peak_bytes)});
+    out.push_back({"journal_bytes_per_entry_" + v.name, v.st.journal_entries_at_gvts == 0 ? 0.0 : static_cast<double>(v.st.journal_bytes_at_gvts) / static_cast<double>(v.st.journal_entries_at_gvts)});
     std::vector<double> per_worker(static_cast<std::size_t>(v.w), 0.0);
     for (int m = 0; m < v.k; ++m)
       for (int q = 0; q < v.w; ++q)

@@ -37,6 +37,8 @@ inline pybind11::dict parallel_report_dict(const lattice::ParallelReport& r) {
   d["reused"] = s.reused;
   d["gvts"] = s.gvts;
   d["gvt_s"] = s.gvt_seconds;  // seconds in the GVT step (worker 0 alone)
+  d["journal_peak_bytes"] = s.journal_peak_bytes;  // the LPs' journals together, at their largest a GVT found
+  d["journal_bytes_per_entry"] = s.journal_entries_at_gvts == 0 ? 0.0 : static_cast<double>(s.journal_bytes_at_gvts) / static_cast<double>(s.journal_entries_at_gvts);
   d["lp_events"] = s.lp_events;
   d["build_s"] = r.build_s;
   d["parallel_s"] = r.parallel_s;

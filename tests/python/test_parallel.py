@@ -63,11 +63,17 @@ def test_a_parallel_run_is_the_sequential_run_bit_for_bit(cls, n, phi, boundary,
 def test_the_rollback_by_state_saving_and_aggressive_cancellation_give_the_same_bits():
     seq = LatticeSimulation.random(1500, phi=0.45, seed=9)
     seq.run(collisions=25_000)
-    for how, lazy in (("save_all", True), ("save_changes", False)):
+    per_entry = {}
+    for how, lazy in (("reverse", True), ("save_all", True), ("save_changes", False)):
         sim = LatticeSimulation.random(1500, phi=0.45, seed=9, workers=2, lps=3)
         sim.set_parallel(2, lps=3, rollback=how, lazy=lazy, window=2000)
-        sim.run(collisions=25_000)
+        p = sim.run(collisions=25_000)["parallel"]
         assert _same(seq.snapshot(), sim.snapshot()), how
+        # the journals' memory as the GVTs found them: an entry (a queue pop, 24 bytes) and, state
+        # saving, the states saved with it (SS1 whole records, SS2 lines and X only)
+        assert p["journal_peak_bytes"] >= 24 and p["journal_bytes_per_entry"] >= 24.0, how
+        per_entry[how] = p["journal_bytes_per_entry"]
+    assert per_entry["reverse"] < per_entry["save_changes"] < per_entry["save_all"]
 
 
 def test_short_runs_stay_sequential_and_the_report_says_so():

@@ -81,6 +81,10 @@ struct TimeWarpStats {
   std::uint64_t reused = 0;     ///< messages a re-execution sent again as they were (lazy cancellation)
   std::uint64_t gvts = 0;       ///< GVT computations
   double gvt_seconds = 0.0;     ///< seconds in the GVT step (worker 0 alone, the others at the barrier)
+  /// The LPs' journals together as each GVT found them, before it freed what it committed: the
+  /// most bytes, and the sums of bytes and of entries over the GVTs (bytes per entry held: the
+  /// memory an event costs until it is committed, state saving's saved states included).
+  std::uint64_t journal_peak_bytes = 0, journal_bytes_at_gvts = 0, journal_entries_at_gvts = 0;
   std::vector<std::uint64_t> lp_events;  ///< per LP: events processed
   void add(const TimeWarpStats& o) {
     events += o.events, stale += o.stale, rollbacks += o.rollbacks, undone += o.undone, messages += o.messages;

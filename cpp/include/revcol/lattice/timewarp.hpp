@@ -154,6 +154,9 @@ class TimeWarp {
     TimeWarpStats t;
     t.gvts = gvts_;
     t.gvt_seconds = gvt_s_;
+    t.journal_peak_bytes = jpeak_;
+    t.journal_bytes_at_gvts = jbytes_;
+    t.journal_entries_at_gvts = jentries_;
     for (const auto& lp : lps_) {
       t.add(lp->st);
       t.lp_events.push_back(lp->st.events);
@@ -528,6 +531,10 @@ class TimeWarp {
     }
     // (a run that reached its horizon: everything up to it is committed)
     const EventKey whole = EventKey::tick_start(g.t);
+    std::uint64_t bytes = 0;  // the journals' memory, before the commit frees some
+    for (auto& lp : lps_) bytes += lp->eng.journal_bytes(), jentries_ += lp->eng.journal_size();
+    jbytes_ += bytes;
+    jpeak_ = std::max(jpeak_, bytes);
     for (auto& lp : lps_) {
       const EventKey until = std::min(whole, lp->last.next());
       if (!lp->refused.empty() && lp->refused.begin()->first < until) throw std::runtime_error("parallel lattice engine: " + lp->refused.begin()->second);
@@ -558,6 +565,7 @@ class TimeWarp {
   std::uint64_t tick_ = 0, gvts_ = 0;                     // one worker: scheduler steps
   std::int64_t gvt_t_ = 0;                                // the last GVT's tick (the window)
   double gvt_s_ = 0.0;                                    // seconds in the GVT step
+  std::uint64_t jpeak_ = 0, jbytes_ = 0, jentries_ = 0;   // the journals at the GVTs (TimeWarpStats)
   std::unique_ptr<engine::Observer> obs_;                 // a running observation: fed the committed events
   bool threaded_ = false, stopped_ = false;
 };
