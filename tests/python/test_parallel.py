@@ -225,7 +225,10 @@ def test_revcol_run_with_workers_comes_back_bit_for_bit(tmp_path, capsys):
     assert r["bit_for_bit"] and r["collisions_forward"] == 40_000
     p = r["parallel"]
     assert (p["workers"], p["lps"]) == (2, 2) and p["parallel_collisions"] > 20_000
-    assert "2 logical processes on 2 worker thread(s)" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "2 logical processes on 2 worker thread(s)" in text
+    assert f"journals at most {p['journal_peak_bytes']:,} bytes ({p['journal_bytes_per_entry']:.0f} per entry)" in text
+    assert p["journal_peak_bytes"] > 0 and p["journal_bytes_per_entry"] >= 24.0  # at least the pops (24 bytes each)
 
 
 def test_revcol_simulate_with_workers_is_the_sequential_run(tmp_path, capsys):

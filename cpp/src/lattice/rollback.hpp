@@ -45,9 +45,11 @@ void BasicEngine<Op, Bits, Queue>::keep_journal(bool on, Rollback how) {
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::journal_bytes() const noexcept -> std::size_t {
   std::size_t b = jdone_.size() * sizeof(Done) + jwall_.size() * sizeof(WallDone) + jss1_.size() * sizeof(Saved) +
-                  jss2_.size() * sizeof(std::pair<int, Line>) + jss2x_.size() * sizeof(Bits);
+                  jss2_.size() * sizeof(std::pair<int, Line>) + jss2x_.size() * sizeof(Bits) +
+                  jlp_.size() * sizeof(std::pair<std::uint8_t, Record>);  // (an LP's: the states messages replaced)
   for (const Saved& s : jss1_) b += s.X.heap_bytes();
   for (const Bits& x : jss2x_) b += x.heap_bytes();
+  for (const auto& w : jlp_) b += w.second.X.heap_bytes();
   return b;
 }
 

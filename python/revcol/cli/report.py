@@ -108,7 +108,8 @@ def parallel_line(p: dict | None) -> list[str]:
             f"{p['rollback']}{', lazy cancellation' if p['lazy'] else ''}: {par:,} collisions committed in parallel, "
             f"{int(p['sequential_collisions']):,} sequential (probe and tail); {int(p['events']):,} events processed "
             f"(efficiency {par / events:.3g}), {int(p['rollbacks']):,} rollbacks undoing {int(p['undone']):,}, "
-            f"{int(p['messages']):,} messages, {int(p['anti_messages']):,} anti-messages"]
+            f"{int(p['messages']):,} messages, {int(p['anti_messages']):,} anti-messages; journals at most "
+            f"{int(p['journal_peak_bytes']):,} bytes ({float(p['journal_bytes_per_entry']):.0f} per entry)"]
 
 
 def _lattice_lines(r: dict) -> list[str]:

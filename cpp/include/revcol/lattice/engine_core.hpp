@@ -129,7 +129,7 @@ class BasicEngine {
   void keep_journal(bool on, Rollback how = Rollback::reverse);
   bool journaling() const noexcept { return jon_; }  ///< Whether the journal is kept.
   Rollback rollback_by() const noexcept { return jhow_; }  ///< how a rollback restores the state
-  std::size_t journal_bytes() const noexcept;  ///< Bytes the journal holds (its entries and, state saving, the saved states).
+  std::size_t journal_bytes() const noexcept;  ///< Bytes the journal holds (its entries and, state saving, the saved states; an LP's, the states its messages replaced).
   /// Rolls back to the state right after collision `collisions` (clock = its tick; the journal's
   /// start when that is where the count is), bit for bit the forward run's state there; a run on
   /// processes the same events. journal_start() <= collisions <= collisions(); ends observation.
