@@ -31,7 +31,7 @@ BitsBack::BitsBack(const std::vector<std::uint64_t>& words) {
   trim();
 }
 
-BitsBack::BitsBack(const BitsBack& o) {
+void BitsBack::copy_words(const BitsBack& o) {
   const std::uint64_t* w = o.data();
   for (std::uint32_t k = 0; k < o.n_; ++k) push_word(w[k]);
 }
@@ -48,14 +48,6 @@ void BitsBack::steal(BitsBack& o) noexcept {  // (this holds no heap words)
   } else {
     std::copy(o.inl_, o.inl_ + o.n_, inl_);
   }
-}
-
-BitsBack& BitsBack::operator=(const BitsBack& o) {
-  if (this == &o) return *this;
-  n_ = 0;
-  const std::uint64_t* w = o.data();
-  for (std::uint32_t k = 0; k < o.n_; ++k) push_word(w[k]);
-  return *this;
 }
 
 BitsBack& BitsBack::operator=(BitsBack&& o) noexcept {

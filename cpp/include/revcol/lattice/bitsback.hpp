@@ -35,9 +35,30 @@ class BitsBack {
   BitsBack() noexcept {}
   /// X from words (least significant first); leading zero words are dropped.
   explicit BitsBack(const std::vector<std::uint64_t>& words);
-  BitsBack(const BitsBack& o);
+  BitsBack(const BitsBack& o) {  // (inline: the journals copy an X per particle and event)
+    if (o.n_ <= kInline) {
+      n_ = o.n_;
+      const std::uint64_t* w = o.data();
+      for (std::uint32_t k = 0; k < n_; ++k) inl_[k] = w[k];
+    } else {
+      copy_words(o);
+    }
+  }
   BitsBack(BitsBack&& o) noexcept;
-  BitsBack& operator=(const BitsBack& o);
+  BitsBack& operator=(const BitsBack& o) {
+    if (this != &o) {
+      if (o.n_ <= cap_) {
+        n_ = o.n_;
+        std::uint64_t* d = data();
+        const std::uint64_t* w = o.data();
+        for (std::uint32_t k = 0; k < n_; ++k) d[k] = w[k];
+      } else {
+        n_ = 0;
+        copy_words(o);
+      }
+    }
+    return *this;
+  }
   BitsBack& operator=(BitsBack&& o) noexcept;
   ~BitsBack() { release(); }
   /// X from a hexadecimal string ("0x" prefix optional, "0" or "" for zero); throws on a bad digit.
@@ -72,6 +93,7 @@ class BitsBack {
   std::uint64_t* data() noexcept { return cap_ > kInline ? heap_ : inl_; }
   const std::uint64_t* data() const noexcept { return cap_ > kInline ? heap_ : inl_; }
   void push_word(std::uint64_t w);                   // append a most significant word
+  void copy_words(const BitsBack& o);                // append o's words (this holds none)
   void release() noexcept;                           // free the heap words (if any)
   void steal(BitsBack& o) noexcept;                  // take o's words (o left zero)
   void trim() noexcept;                              // drop leading zero words
