@@ -69,8 +69,9 @@ def test_the_rollback_by_state_saving_and_aggressive_cancellation_give_the_same_
         sim.set_parallel(2, lps=3, rollback=how, lazy=lazy, window=2000)
         p = sim.run(collisions=25_000)["parallel"]
         assert _same(seq.snapshot(), sim.snapshot()), how
-        # the journals' memory as the GVTs found them: an entry (a queue pop, 24 bytes) and, state
-        # saving, the states saved with it (SS1 whole records, SS2 lines and X only)
+        # the journals' memory as the GVTs found them: an entry (a queue pop, 24 bytes), the states
+        # messages replaced and, state saving, the states saved with it (SS1 whole records, SS2
+        # lines and X only)
         assert p["journal_peak_bytes"] >= 24 and p["journal_bytes_per_entry"] >= 24.0, how
         per_entry[how] = p["journal_bytes_per_entry"]
     assert per_entry["reverse"] < per_entry["save_changes"] < per_entry["save_all"]
