@@ -47,6 +47,14 @@ CASES = ["engine/d3/n10000/phi0.3", "engine/d3/n10000/phi0.45", "engine/d3/n1000
          "engine/d3/n100000/phi0.45", "engine/d2/n10000/phi0.5"]
 
 
+def write_json(doc: dict, path: str) -> None:
+    """doc as JSON at path, atomically (a temporary file renamed over it)."""
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(doc, f, indent=1)
+    os.replace(tmp, path)
+
+
 def _load() -> float:
     with open("/proc/loadavg") as f:
         return float(f.read().split()[0])
@@ -233,10 +241,7 @@ def main() -> None:
                   old=os.path.abspath(args.old), new=os.path.abspath(args.new))
     os.makedirs(RESULTS, exist_ok=True)
     path = args.json or os.path.join(RESULTS, f"ab_{args.what}.json")
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        json.dump(report, f, indent=1)
-    os.replace(tmp, path)
+    write_json(report, path)
     print(f"wrote {os.path.relpath(path)}")
 
 

@@ -23,7 +23,7 @@ import sys
 import tempfile
 import time
 
-from ab_compare import _load  # (bench/ is the script's directory)
+from ab_compare import _load, write_json  # (bench/ is the script's directory)
 
 
 def _run(build: str, bench: str, k: int, w: int, collisions: int) -> dict:
@@ -103,10 +103,7 @@ def main() -> None:
                       f"{row['undone']:.3f}, events {row['events']:.3f}, same {row['same']}", flush=True)
     doc = dict(bundle="the parallel lattice engine, two builds interleaved (bench/parallel_ab.py)", commits=commits,
                command=" ".join(sys.argv), collisions=args.collisions, summary=summarize(rows, commits), rows=rows, runs=runs)
-    tmp = args.json + ".tmp"
-    with open(tmp, "w") as f:
-        json.dump(doc, f, indent=1)
-    os.replace(tmp, args.json)
+    write_json(doc, args.json)
     print(f"wrote {args.json}")
 
 
