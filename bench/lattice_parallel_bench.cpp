@@ -18,17 +18,25 @@
 // the GVT step, worker 0 alone, from the last round), journal_peak_bytes_<v> and
 // journal_bytes_per_entry_<v> (the LPs' journals as the GVTs found them: the most bytes, and bytes
 // per entry held, state saving's saved states included), worker_imbalance_<v> (the busiest
-// worker's events over the mean: LPs [m k / w, (m + 1) k / w) on worker m) and seconds_<v> (the
+// worker's events over the mean: its LPs as workers.hpp's share_of gives them) and seconds_<v> (the
 // median run time); band_over_L (the band W over the slabs' axis) and ticks, for the
 // performance model (bench/parallel_model.py).
+// back=1: every variant also runs back, from the forward run's end to its start tick (seq:
+// run_back, which flips its frame and rebuilds its search twice; K<k>_w<w>: the parallel engine in
+// run_back's frame, Config::back), right after its forward run, and must end on seq's state bit
+// for bit (same_back_<v>): <v>_back_per_s, speedup_back_<v> (over seq's run_back, the same round),
+// speedup_back_net_<v> (over seq's run_back less its two rebuilds, seconds_seq_flips, timed on a
+// run back of no collision), seconds_back_<v>, events_back_per_collision_<v>,
+// rollbacks_back_per_1k_<v>, undone_back_per_collision_<v>.
 // Settings: REVCOL_PARALLEL=rounds=3,lps=2:4,workers=1:2,window=0,gvt=512,batch=64,lazy=1,how=rc,
-// search=auto,observe=0 (lps, workers, how, search: colon-separated lists; every pair with
+// search=auto,observe=0,back=0 (lps, workers, how, search: colon-separated lists; every pair with
 // workers <= lps is a variant); observe=1: every variant observes the run (an observer started at
 // the warmed state; its end checked bit for bit too).
 //
 //   revcol-bench --bench parallel/d2/n1000000/phi0.5 --collisions 2000000
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -79,11 +87,11 @@ std::vector<int> int_list(const std::string& v) {
 
 template <std::size_t D>
 std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
-  int rounds = 3, gvt = 512, batch = 64, lazy = 1, observe = 0;
+  int rounds = 3, gvt = 512, batch = 64, lazy = 1, observe = 0, back = 0;
   std::int64_t window = 0;
   std::vector<int> lps{2, 4}, workers{1, 2};
   std::vector<std::string> hows{"rc"}, searches{"auto"};
-  apply_settings("REVCOL_PARALLEL", "rounds, lps, workers, window, gvt, batch, lazy, how, search, observe", [&](const std::string& k, const std::string& v) {
+  apply_settings("REVCOL_PARALLEL", "rounds, lps, workers, window, gvt, batch, lazy, how, search, observe, back", [&](const std::string& k, const std::string& v) {
     if (k == "rounds") rounds = std::stoi(v);
     else if (k == "lps") lps = int_list(v);
     else if (k == "workers") workers = int_list(v);
@@ -94,6 +102,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     else if (k == "how") hows = split_list(v);
     else if (k == "search") searches = split_list(v);
     else if (k == "observe") observe = std::stoi(v);
+    else if (k == "back") back = std::stoi(v);
     else return false;
     return true;
   });
@@ -121,7 +130,13 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     bool same = true;
     la::TimeWarpStats st{};
     std::vector<double> seconds{};
+    std::vector<double> back_rate{}, back_speedup{}, back_net{}, back_seconds{};  // back=1
+    bool back_same = true;
+    la::TimeWarpStats back_st{};
   };
+  la::SnapshotN<D> want_back;  // seq's run back (back=1)
+  bool have_back = false;
+  std::vector<double> flips;  // seq: a run back of no collision (its two rebuilds), seconds
   std::vector<Variant> vs{{"seq", 0, 0}, {"seq_cells", 0, 1}};
   double band = 0.0;
   for (int k : lps)
@@ -133,8 +148,21 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
             vs.push_back({"K" + std::to_string(k) + "_w" + std::to_string(w) + (h == "rc" ? "" : "_" + h) + (sr == "auto" ? "" : "_cells"), k, w,
                           rollback_of(h), sr == "auto" ? -1.0 : 0.0});
         }
+  const auto config = [&](const Variant& v, bool back_run) {
+    typename la::TimeWarp<EngineOf<D>>::Config tc;
+    tc.lps = v.k;
+    tc.workers = v.w;
+    tc.window = window;
+    tc.gvt_every = static_cast<std::uint64_t>(gvt);
+    tc.batch = batch;
+    tc.lazy = lazy != 0;
+    tc.how = back_run ? la::Rollback::reverse : v.how;  // (a run back rolls back by reverse computation)
+    tc.shell = v.shell;
+    tc.back = back_run;
+    return tc;
+  };
   for (int r = 0; r < rounds; ++r) {
-    double base = 0.0;
+    double base = 0.0, base_back = 0.0, base_net = 0.0;
     for (Variant& v : vs) {
       double seconds = 0.0;
       if (v.k == 0) {
@@ -145,16 +173,7 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
         seconds = seconds_since(t0);
         v.same = v.same && la::same_state(s.snapshot(), want) && s.snapshot().observer == want.observer;
       } else {
-        typename la::TimeWarp<EngineOf<D>>::Config tc;
-        tc.lps = v.k;
-        tc.workers = v.w;
-        tc.window = window;
-        tc.gvt_every = static_cast<std::uint64_t>(gvt);
-        tc.batch = batch;
-        tc.lazy = lazy != 0;
-        tc.how = v.how;
-        tc.shell = v.shell;
-        la::TimeWarp<EngineOf<D>> tw(s0, tc);
+        la::TimeWarp<EngineOf<D>> tw(s0, config(v, false));
         const auto t0 = clock::now();
         tw.run_until(until);
         seconds = seconds_since(t0);
@@ -170,6 +189,38 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
       if (v.name == "seq") base = rate;
       v.rate.push_back(rate);
       v.speedup.push_back(rate / base);
+      if (back == 0) continue;
+      // back, from the forward run's end to its start tick
+      la::SnapshotN<D> got;
+      if (v.k == 0) {
+        EngineOf<D> s(want, la::operator_for(want.units, want.law));
+        if (v.w == 1) s.set_list_shell(0.0);
+        auto t0 = clock::now();
+        s.run_back(0, s0.clock);
+        seconds = seconds_since(t0);
+        got = s.snapshot();
+        if (v.name == "seq") {
+          EngineOf<D> f(want, la::operator_for(want.units, want.law));
+          t0 = clock::now();
+          f.run_back(0, want.clock);  // (no collision: the two flips, each a rebuild of the search)
+          flips.push_back(seconds_since(t0));
+        }
+      } else {
+        la::TimeWarp<EngineOf<D>> tw(want, config(v, true));
+        const auto t0 = clock::now();
+        tw.run_until(-s0.clock);
+        seconds = seconds_since(t0);
+        got = tw.snapshot();
+        v.back_st = tw.stats();
+      }
+      if (!have_back) want_back = got, have_back = true;
+      v.back_same = v.back_same && la::same_state(got, want_back);
+      v.back_seconds.push_back(seconds);
+      const double brate = static_cast<double>(want.collisions - got.collisions) / seconds;
+      if (v.name == "seq") base_back = brate, base_net = static_cast<double>(want.collisions - got.collisions) / (seconds - flips.back());
+      v.back_rate.push_back(brate);
+      v.back_speedup.push_back(brate / base_back);
+      v.back_net.push_back(brate / base_net);
     }
   }
   std::vector<Metric> out;
@@ -195,12 +246,36 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     out.push_back({"gvt_s_per_collision_" + v.name, v.st.gvt_seconds / coll});
     out.push_back({"journal_peak_bytes_" + v.name, static_cast<double>(v.st.journal_peak_bytes)});
     out.push_back({"journal_bytes_per_entry_" + v.name, v.st.journal_entries_at_gvts == 0 ? 0.0 : static_cast<double>(v.st.journal_bytes_at_gvts) / static_cast<double>(v.st.journal_entries_at_gvts)});
-    std::vector<double> per_worker(static_cast<std::size_t>(v.w), 0.0);
-    for (int m = 0; m < v.k; ++m)
-      for (int q = 0; q < v.w; ++q)
-        if (m >= q * v.k / v.w && m < (q + 1) * v.k / v.w) per_worker[static_cast<std::size_t>(q)] += static_cast<double>(v.st.lp_events[static_cast<std::size_t>(m)]);
-    const double busiest = *std::max_element(per_worker.begin(), per_worker.end());
+    std::map<int, double> per_worker;  // by the first LP of the worker's share
+    for (int m = 0; m < v.k; ++m) per_worker[la::share_of(m, v.w, v.k).first] += static_cast<double>(v.st.lp_events[static_cast<std::size_t>(m)]);
+    double busiest = 0.0;
+    for (const auto& [first, events] : per_worker) busiest = std::max(busiest, events);
     out.push_back({"worker_imbalance_" + v.name, busiest * v.w / static_cast<double>(v.st.events)});
+  }
+  const double coll_back = have_back ? static_cast<double>(want.collisions - want_back.collisions) : 0.0;
+  for (const Variant& v : vs) {
+    if (back == 0) break;
+    const auto lo = [](const std::vector<double>& x) { return *std::min_element(x.begin(), x.end()); };
+    const auto hi = [](const std::vector<double>& x) { return *std::max_element(x.begin(), x.end()); };
+    out.push_back({v.name + "_back_per_s", median(v.back_rate)});
+    out.push_back({v.name + "_back_per_s_min", lo(v.back_rate)});
+    out.push_back({v.name + "_back_per_s_max", hi(v.back_rate)});
+    out.push_back({"speedup_back_" + v.name, median(v.back_speedup)});
+    out.push_back({"speedup_back_" + v.name + "_min", lo(v.back_speedup)});
+    out.push_back({"speedup_back_" + v.name + "_max", hi(v.back_speedup)});
+    out.push_back({"speedup_back_net_" + v.name, median(v.back_net)});
+    out.push_back({"speedup_back_net_" + v.name + "_min", lo(v.back_net)});
+    out.push_back({"speedup_back_net_" + v.name + "_max", hi(v.back_net)});
+    out.push_back({"same_back_" + v.name, v.back_same ? 1.0 : 0.0});
+    out.push_back({"seconds_back_" + v.name, median(v.back_seconds)});
+    if (v.k == 0) continue;
+    out.push_back({"events_back_per_collision_" + v.name, static_cast<double>(v.back_st.events) / coll_back});
+    out.push_back({"rollbacks_back_per_1k_" + v.name, 1000.0 * static_cast<double>(v.back_st.rollbacks) / coll_back});
+    out.push_back({"undone_back_per_collision_" + v.name, static_cast<double>(v.back_st.undone) / coll_back});
+  }
+  if (back != 0) {
+    out.push_back({"seconds_seq_flips", median(flips)});
+    out.push_back({"collisions_back", coll_back});
   }
   out.push_back({"band_over_L", band / static_cast<double>(s0.units.L[0])});
   out.push_back({"ticks", static_cast<double>(until - s0.clock)});

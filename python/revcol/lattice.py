@@ -265,8 +265,12 @@ class LatticeSimulation(SimulationBase):
             target = to_collision if target is None else max(target, to_collision)
         tick = None if time is None else self._tick(time)
         before = self._e.collisions
-        self._e.run_back(target, tick)
-        return {"collisions": int(before - self._e.collisions), "clock": self.clock, "time": self.time}
+        out: dict = {}
+        if self._par["lps"] == 1:
+            self._e.run_back(target, tick)
+        else:  # the parallel engine, in run_back's reversed frame
+            out["parallel"] = self._report = dict(self._e.run_back_parallel(target, tick, **self._par))
+        return {"collisions": int(before - self._e.collisions), "clock": self.clock, "time": self.time, **out}
 
     # --- the parallel engine ------------------------------------------------------------------
 
@@ -283,8 +287,11 @@ class LatticeSimulation(SimulationBase):
         committed by the parallel engine and by the sequential one (a stop at a collision count
         is reached by a short sequential probe and tail, and runs of at most max(8192, n/4)
         collisions stay sequential), events processed, rollbacks, undone events, messages,
-        anti-messages, per-LP events. ``run_back``, checkpoints and the rest are the sequential
-        engine's (the state is its own). The settings are not part of the state: a snapshot,
+        anti-messages, per-LP events. ``run_back`` runs on the parallel engine too, in the
+        reversed frame (rolled back by reverse computation whatever ``rollback`` says: an undone
+        back step is its forward collision computed again), and reaches the sequential
+        ``run_back``'s state bit for bit; its report is the ``"parallel"`` entry of what it
+        returns. Checkpoints and the rest are the sequential engine's (the state is its own). The settings are not part of the state: a snapshot,
         checkpoint or pickle holds none, and a simulation rebuilt from one runs on the
         sequential engine until ``set_parallel`` (any K: the bits are the same). ``workers=1``
         with ``lps`` None is the sequential engine. A running observation (:meth:`observe`)

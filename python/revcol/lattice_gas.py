@@ -136,6 +136,7 @@ class _LatticeRun:
         if sim.parallel["lps"] > 1:  # the parallel engine: calls long enough to pay for its K views
             self.every = max(self.every, 2 * self.n, (self.nc or 0) // 20, 16_384)
         self.parallel: dict | None = None  # the forward run's report on the parallel engine
+        self.parallel_back: dict | None = None  # the run back's
         self.ckpt_every = scene.checkpoint_interval if checkpoints else 0
         self.traj_every = scene.trajectory_every if trajectory is not None else 0
         self.trajectory, self.writer = trajectory, None
@@ -249,10 +250,8 @@ class _LatticeRun:
                     break
                 tick, cpu = _time.perf_counter(), _time.process_time()
                 try:
-                    if target > 0:
-                        sim.run_back(to_collision=target)
-                    else:
-                        sim.run_back()
+                    r = sim.run_back(to_collision=target) if target > 0 else sim.run_back()
+                    self.parallel_back = add_reports(self.parallel_back, r.get("parallel"))
                 except (RuntimeError, ValueError) as e:
                     self.engine_error = (self.engine_error + "; " if self.engine_error else "") + f"reverse: {e}"
                     break
@@ -304,6 +303,7 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "search": sim.search,  # the neighbour search in use: "cells" or the lists' shell in diameters
         # the forward run on the parallel engine: its settings and report (None: sequential)
         "parallel": None if run.parallel is None else {**sim.parallel, **run.parallel},
+        "parallel_back": None if run.parallel_back is None else {**sim.parallel, **run.parallel_back},
         "mode": sim.mode,
         "quantization": sim.quantization,
         "collisions_forward": done, "collisions_back": run.back, "per_particle": 2.0 * done / n,

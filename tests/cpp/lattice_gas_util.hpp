@@ -1,6 +1,7 @@
 // A lattice gas for the engine tests (test_lattice_local.cpp, test_lattice_specular_engine.cpp,
 // test_lattice_rollback.cpp): the engine of a dimension, a random start with one boundary kind on
-// every axis, and a check that a call is refused with a given message.
+// every axis, and a check that a call is refused with a given message; run_config, the parallel
+// engine's settings for a run_parallel(_back) (test_lattice_parallel_run.cpp, _back.cpp).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -31,6 +32,16 @@ EngineOf<D> make_gas(std::size_t n, double phi, revcol::engine::Boundary kind, s
   c.seed = seed;
   const la::LatticeStartN<D> s = la::random_start(c, n, phi, seed);
   return {s.units, s.x, s.v, seed, la::operator_for(s.units), 0, mode};
+}
+
+/// The parallel engine's settings (TimeWarp<E>::Config) for a run on k LPs and w workers, short batches.
+template <class Config>
+Config run_config(int k, int w) {
+  Config c;
+  c.lps = k;
+  c.workers = w;
+  c.batch = 16;
+  return c;
 }
 
 /// True when f() throws an exception whose message contains `what` (another message is printed).

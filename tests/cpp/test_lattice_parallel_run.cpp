@@ -24,11 +24,7 @@ using lattice_test::EngineOf;
 
 template <std::size_t D>
 typename TimeWarp<EngineOf<D>>::Config config(int k, int w) {
-  typename TimeWarp<EngineOf<D>>::Config c;
-  c.lps = k;
-  c.workers = w;
-  c.batch = 16;
-  return c;
+  return lattice_test::run_config<typename TimeWarp<EngineOf<D>>::Config>(k, w);
 }
 
 template <std::size_t D>

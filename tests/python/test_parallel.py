@@ -1,8 +1,8 @@
 """The parallel lattice engine from Python and the CLI (issue 55): LatticeSimulation's
-set_parallel / workers= runs forward on Time Warp and reaches the sequential engine's state bit
-for bit, at a collision count or a time, 2D and 3D, periodic and walls, on more logical
-processes than cores; run_back, checkpoints (resumed on another K) and attached actions work on
-the state it leaves; bad settings are named and leave the state as it was; an observation
+set_parallel / workers= runs forward and back on Time Warp and reaches the sequential engine's
+state bit for bit, at a collision count or a time, 2D and 3D, periodic and walls, on more logical
+processes than cores, and back to the start exactly; checkpoints (resumed on another K) and
+attached actions work on the state it leaves; bad settings are named and leave the state as it was; an observation
 running through it is the sequential run's bit for bit (so are a trajectory's image flags), a
 stopped one is kept; scenes and `revcol run/simulate --workers` report the run."""
 import json
@@ -55,7 +55,16 @@ def test_a_parallel_run_is_the_sequential_run_bit_for_bit(cls, n, phi, boundary,
     assert (a["collisions"], a["clock"]) == (b["collisions"], b["clock"]) and a["collisions"] > 20_000
     assert b["parallel"]["sequential_collisions"] == 0 and _same(seq.snapshot(), sim.snapshot())
     assert sim.parallel_report == b["parallel"]
-    # back to the start, exactly, on the state the parallel engine left
+    # back on the parallel engine too (run_back's reversed frame): part way, to a collision count
+    # and to a time, then to the start, which is the first state bit for bit
+    a, b = seq.run_back(collisions=50_000), sim.run_back(collisions=50_000)
+    assert a["collisions"] == b["collisions"] == 50_000 and _same(seq.snapshot(), sim.snapshot())
+    p = b["parallel"]
+    assert p["parallel_collisions"] > 25_000 and p["parallel_collisions"] + p["sequential_collisions"] == 50_000
+    t = sim.time / 2
+    a, b = seq.run_back(time=t), sim.run_back(time=t)
+    assert (a["collisions"], a["clock"]) == (b["collisions"], b["clock"]) and b["parallel"]["sequential_collisions"] == 0
+    assert _same(seq.snapshot(), sim.snapshot())
     sim.run_back()
     assert _same(sim.snapshot(), s0)
 
@@ -152,6 +161,16 @@ def test_the_binding_names_bad_settings_and_keeps_the_state():
         sim._e.run_parallel(50_000, None, lps=2, workers=2, fuzz=3)
     with pytest.raises(ValueError, match="the end tick is before the clock"):
         sim._e.run_parallel(None, -1)
+    sim.run(collisions=20_000)
+    s1 = sim.snapshot()
+    with pytest.raises(ValueError, match="the target collision count is ahead of the state"):
+        sim._e.run_back_parallel(30_000, None, lps=2, workers=2)
+    with pytest.raises(ValueError, match=r"the target tick must be in \[origin, clock\]"):
+        sim._e.run_back_parallel(None, sim.clock + 1, lps=2, workers=2)
+    with pytest.raises(ValueError, match="workers must be at most lps"):
+        sim._e.run_back_parallel(None, None, lps=2, workers=3)
+    assert _same(sim.snapshot(), s1)
+    sim.run_back()
     assert _same(sim.snapshot(), s0)
     # a fuzzed schedule (random order and message delays) on one worker: the same bits
     seq = LatticeSimulation.random(2000, phi=0.3, seed=1)
@@ -230,6 +249,9 @@ def test_revcol_run_with_workers_comes_back_bit_for_bit(tmp_path, capsys):
     assert "2 logical processes on 2 worker thread(s)" in text
     assert f"journals at most {p['journal_peak_bytes']:,} bytes ({p['journal_bytes_per_entry']:.0f} per entry)" in text
     assert p["journal_peak_bytes"] > 0 and p["journal_bytes_per_entry"] >= 24.0  # at least the pops (24 bytes each)
+    b = r["parallel_back"]  # the run back, on the parallel engine too
+    assert b["parallel_collisions"] > 20_000 and b["parallel_collisions"] + b["sequential_collisions"] == 40_000
+    assert f"parallel back    {b['parallel_collisions']:,} collisions taken back in parallel" in text
 
 
 def test_revcol_simulate_with_workers_is_the_sequential_run(tmp_path, capsys):

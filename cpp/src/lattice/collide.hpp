@@ -16,10 +16,18 @@
 #pragma once
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 #include "revcol/lattice/engine_core.hpp"
 
 namespace revcol::lattice {
+
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::inconsistent(const std::string& what, int i, int j) const {
+  throw std::logic_error("lattice engine: inconsistent state (a damaged or edited checkpoint, or a bug): " + what +
+                         ", undoing collision " + std::to_string(ncoll_) + " of particles " + std::to_string(gid(i)) +
+                         " and " + std::to_string(gid(j)));
+}
 
 // why the candidate post state (positions at a, velocities) of i, j must be redrawn; 0 if none.
 // The same scan flags `multi` when a pre line (pre_a: i's and j's pre lines at tick a) overlaps

@@ -65,7 +65,7 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
       const int q = queue_.top();
       if (q < 0 || lp_->done >= lp_->max || !(EventKey{queue_.time(q), queue_.kind(q), gid(q)} < lp_->stop)) return done;
       begin_undo();  // (an engine error in the event undoes it: lp_run)
-      lp_->marks = {jdone_.size(), jwall_.size(), jss1_.size(), jss2_.size(), jss2x_.size(), jlp_.size()};
+      lp_->marks = {jdone_.size(), jwall_.size(), jss1_.size(), jss2_.size(), jss2x_.size(), jlp_.size(), jback_.size()};
     }
     const int p = queue_.top();
     if (poll && ++since_poll == kPollEvents && p >= 0) {
@@ -84,7 +84,7 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
       continue;
     }
     ++cnt_.events;
-    const bool journal = jon_ && !back;
+    const bool journal = jon_ && (!back || lp_ != nullptr);  // (an LP running back journals its back steps)
     if (lp_ != nullptr) [[unlikely]] {
       lp_stepped_ = true;
       lp_->key = EventKey{t, queue_.kind(p), gid(p)};
@@ -122,11 +122,17 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
     if (throw_at_collision != 0 && (back ? ncoll_ : ncoll_ + 1) == throw_at_collision)
       throw std::runtime_error("lattice engine: test hook at collision " + std::to_string(throw_at_collision));
     if (back) {
-      if (ncoll_ == target) {
+      if (ncoll_ == target && lp_ == nullptr) {
         clock_ = t - 1;
         return done;
       }
+      std::uint8_t side = 0;
+      if (lp_ != nullptr) [[unlikely]] {
+        lp_note(i, j);  // (before: a group's entry goes with its back step)
+        if (journal) side = note_back(i);
+      }
       collide_back(i, j, t);
+      if (journal) jdone_.push_back(Done{t, kind, i, j, coll, static_cast<std::uint8_t>(side | (p == j ? 4u : 0u)), 0});
     } else {
       unreflected_ = 0;
       jkept_ = 0;

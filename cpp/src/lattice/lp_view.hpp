@@ -75,6 +75,17 @@ void BasicEngine<Op, Bits, Queue>::lp_begin(const std::vector<std::uint8_t>& hel
   keep_journal(true, jhow_);
 }
 
+// An LP of a run back: every LP flips its frame once, as run_back does, and runs the back steps
+// as events (the loop's back branch). Its journal holds them; a rollback undoes each by computing
+// its forward collision again (rollback.hpp, redo_collision).
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::lp_reverse() {
+  require(lp_ == nullptr && !reversed_, "lattice LP: lp_reverse before lp_begin, once");
+  require(jhow_ == Rollback::reverse, "lattice LP: a run back rolls back by reverse computation");
+  stop_observing();  // observation is forward only
+  flip();
+}
+
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::lp_write(int id, const Record& r, const EventKey& k) {
   require(lp_ != nullptr, "lattice LP: lp_write before lp_begin");
@@ -143,7 +154,7 @@ std::size_t BasicEngine<Op, Bits, Queue>::lp_run(const EventKey& stop, std::size
   lp_->ids.clear();
   lp_stepped_ = false;
   try {
-    loop(std::numeric_limits<std::uint64_t>::max(), tick_limit - 1, false, 0, {});
+    loop(std::numeric_limits<std::uint64_t>::max(), tick_limit - 1, reversed_, 0, {});
   } catch (const std::exception& e) {
     if (lp_->in_after) {  // not the engine's: the LP's own
       lp_->in_after = false;
@@ -158,6 +169,7 @@ std::size_t BasicEngine<Op, Bits, Queue>::lp_run(const EventKey& stop, std::size
     cut(jss2_, lp_->marks[3]);
     cut(jss2x_, lp_->marks[4]);
     cut(jlp_, lp_->marks[5]);
+    cut(jback_, lp_->marks[6]);
     undo(false);
     last_key_ = jdone_.empty() ? j_key0_ : std::make_pair(jdone_.back().t, jdone_.back().kind);
     if (seen_ != nullptr) seen_->drop_after(last_key());  // (the event's observer calls)
@@ -181,10 +193,11 @@ void BasicEngine<Op, Bits, Queue>::lp_note(int i, int j) {
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::commit_before(const EventKey& k) {
-  std::size_t n = 0, walls = 0, kept = 0, xs = 0, lps = 0;
+  std::size_t n = 0, walls = 0, kept = 0, xs = 0, lps = 0, backs = 0;
   while (n < jdone_.size() && done_key(jdone_[n]) < k) {
     const Done& d = jdone_[n++];
     kept += d.kept;
+    backs += d.type == coll && (d.unreflected & 8u) != 0;
     walls += d.type == wall;
     xs += d.type == coll;
     lps += d.type == lpw || d.type == lpp;
@@ -195,12 +208,13 @@ void BasicEngine<Op, Bits, Queue>::commit_before(const EventKey& k) {
   cut(jdone_, n);
   cut(jwall_, walls);
   cut(jlp_, lps);
+  cut(jback_, backs);
   if (jhow_ == Rollback::save_all) cut(jss1_, kept);
   if (jhow_ == Rollback::save_changes) {
     cut(jss2_, kept);
     cut(jss2x_, xs);
   }
-  j_ncoll0_ += xs;
+  j_ncoll0_ = reversed_ ? j_ncoll0_ - xs : j_ncoll0_ + xs;
 }
 
 template <class Op, class Bits, class Queue>

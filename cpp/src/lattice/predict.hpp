@@ -104,7 +104,7 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
     if (dr > 0) b.offer(lo + dr, 0, cross, -1, -1);
     const int r = region_of(ln_[p].x);
     if (r != region_[static_cast<std::size_t>(p)]) {
-      if (migrations != nullptr && !reversed_ && !unwinding_) migrations->push_back({lo, gid(p), region_[static_cast<std::size_t>(p)], r});
+      if (migrations != nullptr && !unwinding_) migrations->push_back({lo, gid(p), region_[static_cast<std::size_t>(p)], r});
       region_[static_cast<std::size_t>(p)] = r;
     }
   }

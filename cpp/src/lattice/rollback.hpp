@@ -50,6 +50,7 @@ auto BasicEngine<Op, Bits, Queue>::journal_bytes() const noexcept -> std::size_t
   for (const Saved& s : jss1_) b += s.X.heap_bytes();
   for (const Bits& x : jss2x_) b += x.heap_bytes();
   for (const auto& w : jlp_) b += w.second.X.heap_bytes();
+  for (const BackDone& x : jback_) b += sizeof(BackDone) + x.lines.size() * sizeof(Line);
   return b;
 }
 
@@ -135,6 +136,7 @@ void BasicEngine<Op, Bits, Queue>::restart_journal() {
   jss2_.clear();
   jss2x_.clear();
   jlp_.clear();
+  jback_.clear();
   j_ncoll0_ = ncoll_;
   j_clock0_ = clock_;
   j_key0_ = last_key_;
@@ -255,6 +257,9 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
     if (d.type == wall) {
       undo_wall(d.p, d.t, jwall_.back());
       jwall_.pop_back();
+    } else if (d.type == coll && reversed_) {  // an LP running back: its back step undone
+      touch(d.q);
+      redo_collision(d);
     } else if (d.type == coll) {
       touch(d.q);
       undo_collision(d.p, d.q, d.t, d.unreflected);
@@ -326,6 +331,83 @@ void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, 
   --ncoll_;
   ln_[i] = Line{shifted(xj, xi0), vi0, a - 1};
   ln_[j] = Line{shifted(xj, xj0), vj0, a - 1};
+  sync(i);
+  sync(j);
+  ++cnt_.collisions;
+}
+
+// An LP running back (lp_reverse): a back step about to take back the collision drawn by i that
+// read the rare log keeps what its undo needs and the log no longer holds: the redraws (the
+// forward's accepted draw is the one after them, so no acceptance test runs again), or the
+// group and its members' lines. Returns Done's bit 3 when it kept an entry.
+template <class Op, class Bits, class Queue>
+std::uint8_t BasicEngine<Op, Bits, Queue>::note_back(int i) {
+  const LogKey key{static_cast<std::uint32_t>(gid(i)), own_[i].pc};
+  if (const auto it = groups_.empty() ? groups_.end() : groups_.find(key); it != groups_.end()) {
+    BackDone b;
+    b.group = it->second;
+    for (int q : b.group->members) b.lines.push_back(ln_[local(q)]);
+    jback_.push_back(std::move(b));
+    return 8;
+  }
+  const auto logged = log_.empty() ? log_.end() : log_.find(key);
+  if (logged == log_.end()) return 0;
+  jback_.push_back(BackDone{logged->second, nullptr, {}});
+  return 8;
+}
+
+// The undo of a back step (an LP running back, in the reversed frame): the forward collision it
+// took back, computed again. The back step left the pair's lines at their forward pre points
+// (at tick a here) with the negated pre velocities; the forward map of those, with the draw the
+// forward accepted (after the logged redraws) and the drawer's X, gives the post points (at
+// a - 1 here) and velocities and X before the back step, bit for bit (pair_forward is a
+// function of its inputs; pair_reverse its inverse). Specular mode: the deterministic map. A
+// group: its members' lines come back from the entry note_back kept.
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::redo_collision(const Done& d) {
+  const int i = d.p, j = d.q;
+  const std::int64_t a = d.t;
+  BackDone side;
+  if ((d.unreflected & 8u) != 0) {
+    side = std::move(jback_.back());
+    jback_.pop_back();
+  }
+  if (side.group) {
+    const std::shared_ptr<Group> g = side.group;
+    for (std::size_t m = 0; m < g->members.size(); ++m) {
+      const int q = static_cast<int>(local(g->members[m]));
+      ln_[q] = side.lines[m];
+      touch(q);
+      ++own_[q].pc;
+      groups_.emplace(LogKey{static_cast<std::uint32_t>(g->members[m]), own_[q].pc}, g);
+      sync(q);
+    }
+    own_[local(g->drawer)].ctr += g->draws;
+    ++ngroups_;
+    ++ncoll_;
+    ++cnt_.collisions;
+    return;
+  }
+  const Vec xj = pos(j, a), xi = diff(pos(i, a), xj), zero{};
+  Vec xi2, xj2, vi2, vj2;
+  const bool logged = (d.unreflected & 8u) != 0;
+  if (mode_ == Mode::specular && !logged) {
+    if (spec_.pair_map(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi2, xj2, vi2, vj2, nullptr) != Refusal::none)
+      throw std::logic_error("lattice rollback: the specular map refused a collision a back step took back (a bug)");
+  } else {
+    const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr + side.redraws);
+    Bits out;
+    if (op_.pair_forward(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi2, xj2, vi2, vj2, out) != Refusal::none)
+      throw std::logic_error("lattice rollback: the operator refused the draw a back step took back (a bug)");
+    own_[i].X = std::move(out);
+    own_[i].ctr += 1 + static_cast<std::uint64_t>(side.redraws);
+    if (logged) log_.emplace(LogKey{static_cast<std::uint32_t>(gid(i)), own_[i].pc + 1}, side.redraws);
+  }
+  ++own_[i].pc;
+  ++own_[j].pc;
+  ++ncoll_;
+  ln_[i] = Line{shifted(xj, xi2), neg(vi2), a - 1};
+  ln_[j] = Line{shifted(xj, xj2), neg(vj2), a - 1};
   sync(i);
   sync(j);
   ++cnt_.collisions;

@@ -308,6 +308,19 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
 }
 
 template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::check_operator(const Units& u) const {
+  require(op_.sigma() == u.sigma, "lattice: the operator's sigma differs from the units'");
+  if constexpr (requires { op_.cell_bits(); })
+    require(op_.cell_bits() == u.cell_bits, "lattice: the operator's cell_bits differ from the units'");
+}
+
+template <class Op, class Bits, class Queue>
+std::uint64_t BasicEngine<Op, Bits, Queue>::next_resort() const noexcept {
+  const int k = resort_every();
+  return k > 0 ? cnt_.crossings + static_cast<std::uint64_t>(k) * ln_.size() : 0;
+}
+
+template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::flip() {
   for (Line& l : ln_) {
     l.v = neg(l.v);

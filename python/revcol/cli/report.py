@@ -99,11 +99,16 @@ def _per(x: dict) -> str:
     return f" ({x['start'] / n:.4g} per particle)" if n else ""
 
 
-def parallel_line(p: dict | None) -> list[str]:
-    """The parallel engine's line of a lattice report (none for a sequential run)."""
+def parallel_line(p: dict | None, back: bool = False) -> list[str]:
+    """The parallel engine's line of a lattice report (none for a sequential run); ``back``: the run back's."""
     if p is None:
         return []
     events, par = max(int(p["events"]), 1), int(p["parallel_collisions"])
+    if back:
+        return [f"  parallel back    {par:,} collisions taken back in parallel, {int(p['sequential_collisions']):,} "
+                f"sequential (tail); {int(p['events']):,} events processed (efficiency {par / events:.3g}), "
+                f"{int(p['rollbacks']):,} rollbacks undoing {int(p['undone']):,}, {int(p['messages']):,} messages; "
+                f"journals at most {int(p['journal_peak_bytes']):,} bytes ({float(p['journal_bytes_per_entry']):.0f} per entry)"]
     return [f"  parallel         {p['lps']} logical processes on {p['workers']} worker thread(s), rollback by "
             f"{p['rollback']}{', lazy cancellation' if p['lazy'] else ''}: {par:,} collisions committed in parallel, "
             f"{int(p['sequential_collisions']):,} sequential (probe and tail); {int(p['events']):,} events processed "
@@ -130,6 +135,7 @@ def _lattice_lines(r: dict) -> list[str]:
         f"  settings         mode {r.get('mode', 'exact')}, tick_bits {u['tick_bits']}, cell_bits {u['cell_bits']}, "
         f"search {_search(r.get('search'))}",
         *parallel_line(r.get("parallel")),
+        *parallel_line(r.get("parallel_back"), back=True),
         f"  start            quantized once: positions within {_err(q['max_position_error'], 'diameters')}, "
         f"velocities within {_err(q['max_velocity_error'], 'v_rms')}; exact from there on",
         f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:,.4g} per particle) to "

@@ -156,6 +156,9 @@ class BasicEngine {
   /// Makes this engine an LP's: the particles not `held[id]` parked (in no cell, no event), every
   /// event noted in `notes`, the journal kept. Cells or lists (a parked particle is on no list).
   void lp_begin(const std::vector<std::uint8_t>& held, LpNotes* notes);
+  /// Makes this engine an LP that runs back (before lp_begin): the frame flipped, as run_back's,
+  /// its events the back steps, each undone by computing its forward collision again.
+  void lp_reverse();
   bool held(int id) const { return parked_.empty() || parked_[local(id)] == 0; }  ///< in the view
   /// Particle id takes state r at key k (a message), held from then on; journaled, a rollback
   /// to before k takes it back. lp_clear: false when it overlaps a body it may not (lp_view.hpp).
@@ -350,11 +353,7 @@ class BasicEngine {
   void reflect(int p, std::int64_t a);
   // a state the reverse cannot take back (a loaded state no run wrote): an error naming it, the
   // collision and the pair; run_back restores the state it began with
-  [[noreturn, gnu::cold]] void inconsistent(const std::string& what, int i, int j) const {
-    throw std::logic_error("lattice engine: inconsistent state (a damaged or edited checkpoint, or a bug): " + what +
-                           ", undoing collision " + std::to_string(ncoll_) + " of particles " + std::to_string(gid(i)) +
-                           " and " + std::to_string(gid(j)));
-  }
+  [[noreturn, gnu::cold]] void inconsistent(const std::string& what, int i, int j) const;  // (collide.hpp)
   // the reflection map of a line whose tick-(a-1) point is x with velocity v (beyond the walls of
   // the returned axes at a): x becomes its point at a, v its velocity after (loop.hpp)
   unsigned reflection(Vec& x, Vec& v) const noexcept;
@@ -397,11 +396,7 @@ class BasicEngine {
 
   // The operator must work in the units' lattice: the same sigma and (an operator with
   // direction cells) the same cell resolution.
-  void check_operator(const Units& u) const {
-    require(op_.sigma() == u.sigma, "lattice: the operator's sigma differs from the units'");
-    if constexpr (requires { op_.cell_bits(); })
-      require(op_.cell_bits() == u.cell_bits, "lattice: the operator's cell_bits differ from the units'");
-  }
+  void check_operator(const Units& u) const;  // (state.hpp)
   Op op_;
   // specular mode: the deterministic map (built by load for the units' sigma)
   using Specular = std::conditional_t<D == 2, LatticeSpecular2D, LatticeSpecular3D>;
@@ -518,10 +513,7 @@ class BasicEngine {
   int resort_every_ = -1;
   std::uint64_t resort_at_ = 0, resorts_ = 0;  // the crossing count of the next re-sort (0: none)
   int resort_every_for(std::size_t n) const noexcept { return resort_every_ >= 0 ? resort_every_ : (n >= kResortMinN ? kResortEvery : 0); }
-  std::uint64_t next_resort() const noexcept {
-    const int k = resort_every();
-    return k > 0 ? cnt_.crossings + static_cast<std::uint64_t>(k) * ln_.size() : 0;
-  }
+  std::uint64_t next_resort() const noexcept;  // (state.hpp)
   [[gnu::noinline, gnu::cold]] void resort(std::int64_t t);
   static std::vector<std::uint32_t> space_order(const Units& u, const std::vector<Vec>& x);
   bool lists_ = false, direct_ = false;
@@ -553,7 +545,7 @@ class BasicEngine {
     std::int32_t kind;  // its queue kind
     int p, q;          // the particle popped; a collision: its drawer (the smaller id) and partner
     Type type;         // none: a stale event recomputed
-    std::uint8_t unreflected;  // a group: bit 0 (p), bit 1 (q) took in their reflection at t; bit 2: q was popped
+    std::uint8_t unreflected;  // a group: bit 0 (p), bit 1 (q) took in their reflection at t; bit 2: q was popped; bit 3: a jback_ entry
     std::uint8_t kept;         // state saving: the particle states saved before it
   };
   struct WallDone {  // a reflection's replaced one-tick cache
@@ -571,6 +563,14 @@ class BasicEngine {
   void restore_kept(const Done& d);
   std::deque<WallDone> jwall_;  // one per wall entry of jdone_, in order
   std::deque<std::pair<std::uint8_t, Record>> jlp_;  // per LP write or park: parked before, state before
+  struct BackDone {  // a back step that read the rare log: its redraws, or its group and the members' lines before
+    std::uint32_t redraws = 0;
+    std::shared_ptr<Group> group;
+    std::vector<Line> lines;
+  };
+  std::deque<BackDone> jback_;  // per back step that erased a log entry or a group (an LP running back)
+  std::uint8_t note_back(int i);  // its jback_ entry (bit 3 of Done::unreflected) or 0
+  void redo_collision(const Done& d);    // the undo of a back step
   std::vector<std::uint8_t> parked_;  // an LP's particles outside its view (empty: none)
   LpNotes* lp_ = nullptr;
   LpSeen* seen_ = nullptr;  // an observed LP's: the observer's calls kept (lp_seen.hpp)

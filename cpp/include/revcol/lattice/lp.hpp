@@ -62,7 +62,7 @@ struct LpNotes {
   EventKey stop;                   ///< lp_run: stop before this key
   std::size_t max = 1, done = 0;   ///< lp_run: stop after max events; the events done
   std::string error;               ///< lp_run: an engine error at `key` (the event undone, the run stopped there)
-  std::array<std::size_t, 6> marks{};  ///< (the engine's journal sizes before the event under way)
+  std::array<std::size_t, 7> marks{};  ///< (the engine's journal sizes before the event under way)
   bool in_after = false;           ///< (after is running: its exceptions are not the engine's)
   LpSeen* seen = nullptr;          ///< an observed run: where the engine keeps its observer calls (lp_seen.hpp)
 };

@@ -160,4 +160,97 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
   }
 }
 
+/// Runs engine e back, as e.run_back(to_collisions, to_tick) does (bit for bit the same state),
+/// on K logical processes in run_back's reversed frame (TimeWarp's Config::back; a straggler is
+/// rolled back by computing the back steps' forward collisions again, whatever c.how). The
+/// parallel engine runs back to a tick: chunks to ticks estimated from the run's mean ticks per
+/// collision (the first at 85% of the collisions to undo, the next at 97% of the rest at the
+/// rate the last chunk measured), then the sequential engine runs back the last few thousand,
+/// or forward again, exactly, the few a chunk took back past the count. Runs back of at most
+/// `small` collisions (0: max(8192, N/4)) stay sequential. An engine error leaves e's state as
+/// it was; Ctrl-C leaves it at a whole tick the run passed. Ends a running observation (as
+/// run_back does). `bias` (tests): scales the chunks' ticks (> 1 runs past the count).
+template <class Engine>
+ParallelReport run_parallel_back(Engine& e, std::uint64_t to_collisions, std::int64_t to_tick, const typename TimeWarp<Engine>::Config& c,
+                                 const std::function<bool()>& poll = {}, std::uint64_t small = 0, double bias = 1.0) {
+  require(to_collisions <= e.collisions(), "lattice run_back: the target collision count is ahead of the state");
+  require(to_tick >= e.origin() && to_tick <= e.clock(), "lattice run_back: the target tick must be in [origin, clock]");
+  constexpr std::uint64_t tail = 4096;
+  if (small == 0) small = std::max<std::uint64_t>(8192, e.size() / 4);
+  ParallelReport r;
+  e.stop_observing();  // observation is forward only
+  using clock_type = std::chrono::steady_clock;
+  const auto since = [](clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); };
+  const auto sequential = [&] {
+    const auto t0 = clock_type::now();
+    const std::uint64_t had = e.collisions();
+    e.run_back(to_collisions, to_tick, poll);
+    r.sequential_s += since(t0);
+    r.sequential += had - e.collisions();
+    r.collisions += had - e.collisions();
+    r.stopped = e.collisions() > to_collisions && e.clock() > to_tick;
+  };
+  const std::uint64_t c0 = e.collisions();
+  if (c0 - to_collisions <= small || e.clock() == to_tick) {
+    sequential();
+    return r;
+  }
+  const typename Engine::Snapshot start = e.snapshot();
+  try {
+    // ticks per collision: the run's mean since its origin (then the last chunk's)
+    double per = static_cast<double>(e.clock() - e.origin()) / static_cast<double>(c0);
+    auto t0 = clock_type::now();
+    typename TimeWarp<Engine>::Config cs = c;
+    if (cs.shell < 0.0) cs.shell = e.list_shell();
+    cs.back = true;
+    cs.how = Rollback::reverse;
+    auto tw = std::make_unique<TimeWarp<Engine>>(start, cs);
+    r.build_s = since(t0);
+    typename Engine::Snapshot s;
+    for (std::int64_t clock = e.clock(); r.chunks < 3;) {
+      const std::uint64_t had = c0 - r.parallel;
+      if (had <= to_collisions + tail) break;  // (the tail)
+      const double left = static_cast<double>(had - to_collisions);
+      const double aim = r.chunks == 0 ? 0.85 * left : 0.97 * left - 4.0 * std::sqrt(left);
+      const double ticks = std::max(1.0, std::floor(aim * per * bias));
+      const std::int64_t to = ticks < static_cast<double>(clock - to_tick) ? clock - static_cast<std::int64_t>(ticks) : to_tick;
+      t0 = clock_type::now();
+      const bool whole = tw->run_until(-to, poll);  // (the reversed frame's tick)
+      r.parallel_s += since(t0);
+      t0 = clock_type::now();
+      s = tw->snapshot();
+      r.assemble_s += since(t0);
+      ++r.chunks;
+      const std::uint64_t did = had - s.collisions;
+      r.parallel += did;
+      if (did > 0) per = static_cast<double>(clock - s.clock) / static_cast<double>(did);
+      clock = s.clock;
+      if (!whole) r.stopped = true;
+      if (!whole || to == to_tick) break;
+    }
+    r.stats = tw->stats();
+    t0 = clock_type::now();
+    tw.reset();
+    if (r.chunks > 0) e.restore(s);
+    r.assemble_s += since(t0);
+    r.collisions += r.parallel;
+    if (r.stopped) return r;
+    if (e.collisions() < to_collisions) {  // a chunk ran back past the count: forward, exactly, to right after it
+      r.overshoot = to_collisions - e.collisions();
+      r.collisions -= r.overshoot;
+      r.parallel -= r.overshoot;
+      t0 = clock_type::now();
+      e.run(r.overshoot, start.clock, poll);
+      r.sequential_s += since(t0);
+      r.stopped = e.collisions() < to_collisions;
+    } else if (e.collisions() > to_collisions && e.clock() > to_tick) {
+      sequential();
+    }
+    return r;
+  } catch (...) {
+    e.restore(start);
+    throw;
+  }
+}
+
 }  // namespace revcol::lattice

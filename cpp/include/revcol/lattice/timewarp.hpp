@@ -87,6 +87,7 @@ class TimeWarp {
     bool lazy = true;               ///< lazy cancellation (else aggressive: anti-messages at once)
     std::int64_t window = 0;        ///< optimism: no event more than this many ticks past GVT (0: none)
     double shell = -1.0;            ///< the LPs' search, as set_list_shell's: -1 the sequential engine's automatic one, 0 cells
+    bool back = false;              ///< a run back: the LPs in run_back's reversed frame (ticks and keys too); rollback by reverse computation
   };
 
   /// K LPs on the state s (validated: bad input throws InvalidArgument, nothing is built).
@@ -102,11 +103,15 @@ class TimeWarp {
     const std::size_t ax = static_cast<std::size_t>(c.axis);
     reach_ = u.sigma + 4 * u.vmax;
     sv_ = SlabViews(c.lps, u.L[ax], u.wall[ax], 3 * u.sigma + 8 * u.vmax);
-    horizon_ = s.clock;
+    require(!c.back || c.how == Rollback::reverse, "parallel lattice engine: a run back rolls back by reverse computation");
+    horizon_ = c.back ? -s.clock : s.clock;
     // the LPs' engines (their search and regions: one build each), built by the workers side by side
     lps_.resize(static_cast<std::size_t>(c.lps));
-    build_in_workers(c.workers, c.lps, [&](int m) { lps_[static_cast<std::size_t>(m)] = std::make_unique<Lp>(s, c.axis, sv_.faces(), c.shell); });
-    if (!s.observer.empty()) obs_ = Engine::make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);  // a running observation goes on (lp_seen.hpp)
+    build_in_workers(c.workers, c.lps, [&](int m) {
+      lps_[static_cast<std::size_t>(m)] = std::make_unique<Lp>(s, c.axis, sv_.faces(), c.shell);
+      if (c.back) lps_[static_cast<std::size_t>(m)]->eng.lp_reverse();
+    });
+    if (!s.observer.empty() && !c.back) obs_ = Engine::make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);  // a running observation goes on (lp_seen.hpp)
     for (int m = 0; m < c.lps; ++m) {
       Lp& lp = *lps_[static_cast<std::size_t>(m)];
       lp.me = m;
@@ -124,7 +129,8 @@ class TimeWarp {
   }
 
   /// Runs every LP to tick `until` (no event after it), then commits: the state is the
-  /// sequential engine's run(until) bit for bit (snapshot()).
+  /// sequential engine's run(until) bit for bit (snapshot()). A run back: `until` in the reversed
+  /// frame (-T), the state run_back(to_tick = T) reaches.
   /// Ctrl-C (poll() false, asked by the calling thread): every LP goes back to the last tick GVT
   /// has passed, and the run ends there, as run(until = that tick) would. Returns false then.
   bool run_until(std::int64_t until, const std::function<bool()>& poll = {}) {
@@ -144,7 +150,7 @@ class TimeWarp {
   Snapshot snapshot() const {
     std::vector<const Engine*> engines;
     for (const auto& lp : lps_) engines.push_back(&lp->eng);
-    Snapshot s = committed_state(engines, sv_, horizon_);
+    Snapshot s = committed_state(engines, sv_, horizon_, c_.back);
     if (obs_) obs_->save(s.observer, s.observer_counts);  // (not synced: run_parallel syncs the whole run's once)
     return s;
   }

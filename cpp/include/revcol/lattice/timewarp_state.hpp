@@ -1,7 +1,10 @@
 // The committed state of a parallel lattice run (timewarp.hpp), assembled from its logical
 // processes' engines as the sequential engine's snapshot: each particle from the LP that owns it,
 // the rare log and the group entries the union of the LPs' (an entry two LPs hold must be the
-// same), the collision count from the particles' counts.
+// same), the collision count from the particles' counts. A run back's LPs (the reversed frame,
+// lp_reverse): each record read in the forward frame, and the log and group entries of collisions
+// the run took back (keyed by counts above their particles' counts: an LP that did not hold the
+// particles then still has them) left out.
 #pragma once
 #include <algorithm>
 #include <cstdint>
@@ -28,14 +31,14 @@ VecN<D> record_at(const Record& r, std::int64_t t, const UnitsN<D>& u) {
 }
 
 /// The state at tick `clock` of LPs (their engines, LP m's at m) that have processed every event
-/// up to it and none after, by particle id.
+/// up to it and none after, by particle id; `back`: LPs of a run back (clock in their frame).
 template <class Engine>
-auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv, std::int64_t clock) {
+auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv, std::int64_t clock, bool back = false) {
   using Snapshot = typename Engine::Snapshot;
   constexpr std::size_t D = Engine::D;
   Snapshot s = lps.front()->snapshot();
   const std::size_t n = s.x.size();
-  s.clock = clock;
+  s.clock = back ? -clock : clock;
   s.bits.clear();
   std::vector<int> from(n, -1);
   std::vector<std::vector<std::uint64_t>> words(n);
@@ -48,7 +51,7 @@ auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv,
       from[id] = static_cast<int>(m);
       const auto r = e.record(i);
       s.x[id] = record_at(r, clock, s.units);
-      s.v[id] = r.v;
+      s.v[id] = back ? neg(r.v) : r.v;
       s.streams[id] = r.ctr;
       s.particle_collisions[id] = r.pc;
       const auto w = r.X.words();
@@ -67,10 +70,11 @@ auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv,
   };
   for (const Engine* e : lps) {
     const Snapshot t = e->snapshot();
-    for (const LogEntry& x : t.log) merge(log, std::make_pair(x.particle, x.count), x);
+    for (const LogEntry& x : t.log)
+      if (x.count <= s.particle_collisions[x.particle]) merge(log, std::make_pair(x.particle, x.count), x);
     for (const GroupEntryN<D>& g : t.groups) {
-      const auto at = std::find(g.members.begin(), g.members.end(), g.drawer) - g.members.begin();
-      merge(groups, std::make_pair(g.drawer, g.counts[static_cast<std::size_t>(at)]), g);
+      const auto at = static_cast<std::size_t>(std::find(g.members.begin(), g.members.end(), g.drawer) - g.members.begin());
+      if (g.counts[at] <= s.particle_collisions[static_cast<std::size_t>(g.drawer)]) merge(groups, std::make_pair(g.drawer, g.counts[at]), g);
     }
   }
   s.log.clear();
