@@ -1,9 +1,12 @@
 """The parallel lattice engine end to end from Python: ``LatticeSimulation.run(collisions=C)``
-with ``set_parallel(workers)`` against the sequential engine, interleaved (seq, K1, K2, seq,
-K1, K2, ...), from one warmed state; each run's end state compared with the sequential one bit
-for bit. What it measures beyond ``revcol-bench --bench parallel/...`` (the engine alone): the
-probe and the tail a stop at a collision count costs, building the K views, and restoring the
-committed state into the simulation.
+with ``set_parallel(workers)`` against the sequential engine, then ``run_back(collisions=C)``
+(the parallel engine in run_back's reversed frame, or the sequential run_back), interleaved
+(seq, K2, seq, K2, ...), from one warmed state; each run's end state compared with the
+sequential one bit for bit, and each run back's with the warmed state it started from. What it
+measures beyond ``revcol-bench --bench parallel/...`` (the engine alone): the probe and the tail
+a stop at a collision count costs, building the K views (a run back: flipped), and restoring the
+committed state into the simulation; the sequential run_back's two rebuilds of its search (its
+frame flipped and back).
 
     PYTHONPATH=build-dev/pkg python bench/parallel_python.py --dim 2 --n 1000000 --phi 0.5 \\
         --collisions 2000000 10000000 --rounds 3 --json bench/results/lattice_parallel_python.json
@@ -39,8 +42,10 @@ def measure(cls, s0: dict, collisions: int, rounds: int, workers: list[int]) -> 
     """One call of run(collisions) per variant and round, interleaved, from the state s0."""
     names = ["seq"] + [f"K{w}_w{w}" for w in workers]
     rates: dict[str, list[float]] = {k: [] for k in names}
+    back: dict[str, list[float]] = {k: [] for k in names}
     same: dict[str, bool] = {k: True for k in names}
     report: dict[str, dict] = {}
+    back_report: dict[str, dict] = {}
     want = None
     for r in range(rounds):
         for name in names:
@@ -57,12 +62,21 @@ def measure(cls, s0: dict, collisions: int, rounds: int, workers: list[int]) -> 
             same[name] = same[name] and _same(end, want)
             if "parallel" in out:
                 report[name] = out["parallel"]
-            print(f"{collisions} round {r} {name}: {rates[name][-1]:,.0f} collisions/s, same {same[name]}",
-                  file=sys.stderr, flush=True)
-    base = float(np.median(rates["seq"]))
-    return {k: {"per_s": float(np.median(v)), "per_s_min": float(min(v)), "per_s_max": float(max(v)),
-                "speedup": float(np.median(v)) / base, "speedup_min": float(min(v)) / base,
-                "speedup_max": float(max(v)) / base, "same_as_sequential": same[k], "report": report.get(k)}
+            t0 = time.perf_counter()
+            out = s.run_back(collisions=collisions)  # back to the warmed state, exactly
+            back[name].append(collisions / (time.perf_counter() - t0))
+            same[name] = same[name] and _same(s.snapshot(), s0)
+            if "parallel" in out:
+                back_report[name] = out["parallel"]
+            print(f"{collisions} round {r} {name}: {rates[name][-1]:,.0f} collisions/s, back {back[name][-1]:,.0f}, "
+                  f"same {same[name]}", file=sys.stderr, flush=True)
+    base, base_back = float(np.median(rates["seq"])), float(np.median(back["seq"]))
+
+    def stats(v: list[float], b: float) -> dict:
+        return {"per_s": float(np.median(v)), "per_s_min": float(min(v)), "per_s_max": float(max(v)),
+                "speedup": float(np.median(v)) / b, "speedup_min": float(min(v)) / b, "speedup_max": float(max(v)) / b}
+    return {k: {**stats(v, base), "back": {**stats(back[k], base_back), "report": back_report.get(k)},
+                "same_as_sequential": same[k], "report": report.get(k)}
             for k, v in rates.items()}
 
 
@@ -134,7 +148,8 @@ def main(argv=None) -> int:
     s0 = sim.snapshot()
     runs = {c: measure(cls, s0, c, a.rounds, a.workers) for c in a.collisions}
     result = {
-        "what": "LatticeSimulation.run(collisions=C) on the parallel engine against the sequential engine, end to end",
+        "what": "LatticeSimulation.run(collisions=C), then run_back(collisions=C), on the parallel engine against the "
+                "sequential engine, end to end",
         "command": " ".join(["python", "bench/parallel_python.py", *(argv if argv is not None else sys.argv[1:])]),
         "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip(),
         "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "load_before": load0, "load_after": os.getloadavg()[0],
@@ -144,8 +159,10 @@ def main(argv=None) -> int:
     _write(result, a.json)
     for c, variants in runs.items():
         for k, v in variants.items():
+            b = v["back"]
             print(f"{c} collisions per call, {k}: {v['per_s']:,.0f} collisions/s ({v['speedup']:.2f}x, "
-                  f"{v['speedup_min']:.2f}-{v['speedup_max']:.2f}), same {v['same_as_sequential']}")
+                  f"{v['speedup_min']:.2f}-{v['speedup_max']:.2f}), back {b['per_s']:,.0f} ({b['speedup']:.2f}x, "
+                  f"{b['speedup_min']:.2f}-{b['speedup_max']:.2f}), same {v['same_as_sequential']}")
     return 0 if all(v["same_as_sequential"] for r in runs.values() for v in r.values()) else 1
 
 

@@ -322,7 +322,7 @@ class LatticeSimulation(SimulationBase):
 
     @property
     def parallel_report(self) -> Optional[dict]:
-        """The last run's report on the parallel engine (None after a sequential run)."""
+        """The last run's (or run back's) report on the parallel engine (None after a sequential run)."""
         return None if self._report is None else dict(self._report)
 
     # --- rollback: the journal of processed events ------------------------------------------

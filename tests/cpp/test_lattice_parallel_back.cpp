@@ -44,8 +44,7 @@ void check_undo(EngineOf<D> e, std::uint64_t forward, int max_redraws, const cha
   e.max_redraws = max_redraws;  // (-1: every collision a group)
   e.run(forward, tick_limit - 1);
   const SnapshotN<D> end = e.snapshot();
-  EngineOf<D> lp(end, operator_for(end.units, end.law), 0, {0}, -1.0);
-  lp.lp_reverse();
+  EngineOf<D> lp(end, operator_for(end.units, end.law), 0, {0}, -1.0, true);  // (an LP of a run back)
   LpNotes notes;
   notes.after = [](void*) {};
   lp.lp_begin(std::vector<std::uint8_t>(end.x.size(), 1), &notes);
@@ -131,6 +130,11 @@ void check_counts(EngineOf<D> e, int k, int w, double bias, const char* what) {
   const SnapshotN<D> s0 = e.snapshot();
   e.run(90000, tick_limit - 1);
   const SnapshotN<D> end = e.snapshot();
+  {  // the whole way back in one call: the start (a chunk past a count of 0 goes to the start's tick)
+    EngineOf<D> whole(end, operator_for(end.units, end.law));
+    const ParallelReport r = run_parallel_back(whole, 0, whole.origin(), config<D>(k, w), {}, 0, bias);
+    CHECK(same_state(whole.snapshot(), s0) && r.collisions == end.collisions && r.sequential == 0);
+  }
   EngineOf<D> ref(end, operator_for(end.units, end.law));
   std::uint64_t parallel = 0, overshoot = 0;
   for (const std::uint64_t to : {std::uint64_t{60000}, std::uint64_t{57000}, std::uint64_t{20000}}) {

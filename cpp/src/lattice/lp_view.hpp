@@ -67,23 +67,13 @@ void BasicEngine<Op, Bits, Queue>::lp_begin(const std::vector<std::uint8_t>& hel
     schedule(p, none, 0, 0, -1);
     ++slot_[static_cast<std::size_t>(p)].ver;  // a held particle's slot naming it is stale
   }
+  require(!reversed_ || jhow_ == Rollback::reverse, "lattice LP: a run back rolls back by reverse computation");
   lp_ = notes;
   observer_.reset();  // an LP never observes itself: an observed one keeps the observer's calls
   obs_ = nullptr;
   seen_ = notes->seen;
   if (seen_ != nullptr) seen_->dim = static_cast<int>(D);
   keep_journal(true, jhow_);
-}
-
-// An LP of a run back: every LP flips its frame once, as run_back does, and runs the back steps
-// as events (the loop's back branch). Its journal holds them; a rollback undoes each by computing
-// its forward collision again (rollback.hpp, redo_collision).
-template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::lp_reverse() {
-  require(lp_ == nullptr && !reversed_, "lattice LP: lp_reverse before lp_begin, once");
-  require(jhow_ == Rollback::reverse, "lattice LP: a run back rolls back by reverse computation");
-  stop_observing();  // observation is forward only
-  flip();
 }
 
 template <class Op, class Bits, class Queue>

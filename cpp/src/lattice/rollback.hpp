@@ -336,7 +336,7 @@ void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, 
   ++cnt_.collisions;
 }
 
-// An LP running back (lp_reverse): a back step about to take back the collision drawn by i that
+// An LP running back (built in the reversed frame): a back step about to take back the collision drawn by i that
 // read the rare log keeps what its undo needs and the log no longer holds: the redraws (the
 // forward's accepted draw is the one after them, so no acceptance test runs again), or the
 // group and its members' lines. Returns Done's bit 3 when it kept an entry.

@@ -240,6 +240,11 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s, const std::vector<std
   wall_tick_.assign(n, std::numeric_limits<std::int64_t>::min());
   pre_wall_.assign(n, Line{});
   reversed_ = false;
+  if (load_back_) {  // an LP of a run back: the frame flipped as flip() does, before the one build
+    for (Line& l : ln_) l.v = neg(l.v), l.ta = -l.ta;
+    clock_ = -clock_;
+    reversed_ = true;
+  }
   sigma2_ = static_cast<u128>(u_.sigma) * static_cast<u128>(u_.sigma);
   sigma2d_ = static_cast<double>(sigma2_);
   const double far = static_cast<double>(u_.sigma) + 4.0 * static_cast<double>(u_.vmax);

@@ -102,10 +102,12 @@ class BasicEngine {
   /// permutation of [0, N)); every key, draw, tie and output is by particle id (the same bits).
   BasicEngine(const Snapshot& s, Op op, const std::vector<std::uint32_t>& order) : op_(std::move(op)) { restore(s, order); }
   /// A logical process's (timewarp.hpp): its search (`shell` as set_list_shell's: 0 the cell grid,
-  /// -1 automatic) and the regions (set_regions) set before its one build.
-  BasicEngine(const Snapshot& s, Op op, int axis, std::vector<std::int64_t> faces, double shell = 0.0) : op_(std::move(op)) {
-    list_shell_ = shell, rax_ = axis, faces_ = std::move(faces);
+  /// -1 automatic) and the regions (set_regions) set before its one build; `back`: an LP of a run
+  /// back, built in run_back's reversed frame (its events the back steps; Config::back).
+  BasicEngine(const Snapshot& s, Op op, int axis, std::vector<std::int64_t> faces, double shell = 0.0, bool back = false) : op_(std::move(op)) {
+    list_shell_ = shell, rax_ = axis, faces_ = std::move(faces), load_back_ = back;
     restore(s);
+    load_back_ = false;
   }
 
   /// Replaces the state by a snapshot (validated first: on bad input nothing changes); `order`
@@ -156,9 +158,6 @@ class BasicEngine {
   /// Makes this engine an LP's: the particles not `held[id]` parked (in no cell, no event), every
   /// event noted in `notes`, the journal kept. Cells or lists (a parked particle is on no list).
   void lp_begin(const std::vector<std::uint8_t>& held, LpNotes* notes);
-  /// Makes this engine an LP that runs back (before lp_begin): the frame flipped, as run_back's,
-  /// its events the back steps, each undone by computing its forward collision again.
-  void lp_reverse();
   bool held(int id) const { return parked_.empty() || parked_[local(id)] == 0; }  ///< in the view
   /// Particle id takes state r at key k (a message), held from then on; journaled, a rollback
   /// to before k takes it back. lp_clear: false when it overlaps a body it may not (lp_view.hpp).
@@ -503,7 +502,7 @@ class BasicEngine {
   std::array<std::uint64_t, 2> energy0_{};
   std::array<std::int64_t, 2 * D> momentum0_{};
   Counters cnt_;
-  bool reversed_ = false;
+  bool reversed_ = false, load_back_ = false;  // load_back_: load into the reversed frame (an LP running back)
   // the neighbour search (set_list_shell): the cell grid, or neighbour lists (measured: docs/lattice.md)
   static constexpr double kShellBase = 0.545, kShellSlope = 1.0, kShellMin = 0.6, kShellMax = 1.2;
   double list_shell_ = -1.0;

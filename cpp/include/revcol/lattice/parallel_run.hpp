@@ -8,7 +8,8 @@
 // from the rate the last chunk measured), and the sequential engine runs the last few thousand
 // collisions, or back the few a chunk ran past the count (its run_back is exact). Short runs (at
 // most `small` collisions, default max(8192, N/4): building K views costs more than they save)
-// stay sequential, and the report says how many collisions each engine ran.
+// stay sequential, and the report says how many collisions each engine ran. run_parallel_back is
+// the same for a run back (the LPs in run_back's reversed frame).
 #pragma once
 #include <algorithm>
 #include <chrono>
@@ -24,19 +25,19 @@
 
 namespace revcol::lattice {
 
-/// What run_parallel did.
+/// What run_parallel (or run_parallel_back) did.
 struct ParallelReport {
   std::uint64_t collisions = 0;  ///< collisions done (committed) in all
   std::uint64_t parallel = 0;    ///< of them, committed by the parallel engine
   std::uint64_t sequential = 0;  ///< of them, run by the sequential engine (probe and tail)
-  std::uint64_t overshoot = 0;   ///< collisions a chunk ran past the stop: run back sequentially (observed: the chunk discarded, run again sequentially)
+  std::uint64_t overshoot = 0;   ///< collisions a chunk ran past the stop: run back sequentially (observed: the chunk discarded, run again sequentially; a run back: forward again)
   int chunks = 0;                ///< parallel runs to a tick
   bool stopped = false;          ///< Ctrl-C: the state is the run's at a whole tick before the stop
   TimeWarpStats stats{};         ///< the parallel engine's counts
   double build_s = 0.0;          ///< seconds: building the K views
   double parallel_s = 0.0;       ///< seconds: the parallel engine's runs
   double assemble_s = 0.0;       ///< seconds: assembling the committed state and restoring the engine
-  double sequential_s = 0.0;     ///< seconds: the sequential probe, tail or run back
+  double sequential_s = 0.0;     ///< seconds: the sequential probe, tail or run back (a run back: its tail, or forward again)
 };
 
 /// Runs engine e forward, as e.run(collisions, until) does (bit for bit the same state), on K
@@ -127,7 +128,7 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
       if (did > 0) per = static_cast<double>(s.clock - clock) / static_cast<double>(did);
       clock = s.clock;
       if (!whole) r.stopped = true;
-      if (observed && by_count && s.collisions > target) {  // past the count: discarded (see above)
+      if (observed && by_count && s.collisions >= target) {  // at or past the count: discarded (see above)
         r.overshoot = s.collisions - target;
         r.parallel -= did;
         s = std::move(before);
@@ -142,7 +143,9 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
     r.assemble_s += since(t0);
     r.collisions += r.parallel;
     if (r.stopped || !by_count) return r;
-    if (e.collisions() > target) {  // the chunk ran past the count: back, exactly, to right after it
+    // the chunk ran past the count, or reached it on a tick after its collision's: back, exactly,
+    // to right after it (run_back stops before the collision it would take back next)
+    if (e.collisions() > target || (e.collisions() == target && r.chunks > 0 && r.parallel > 0)) {
       r.overshoot = e.collisions() - target;
       r.collisions -= r.overshoot;
       r.parallel -= r.overshoot;
@@ -164,9 +167,11 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
 /// on K logical processes in run_back's reversed frame (TimeWarp's Config::back; a straggler is
 /// rolled back by computing the back steps' forward collisions again, whatever c.how). The
 /// parallel engine runs back to a tick: chunks to ticks estimated from the run's mean ticks per
-/// collision (the first at 85% of the collisions to undo, the next at 97% of the rest at the
-/// rate the last chunk measured), then the sequential engine runs back the last few thousand,
-/// or forward again, exactly, the few a chunk took back past the count. Runs back of at most
+/// collision, the first at 85% of the collisions to undo, the next just past the count (by 3% of
+/// the rest and four standard errors, at the rate the last chunk measured); then the sequential
+/// engine runs forward again, exactly, the few a chunk took back past the count (a sequential
+/// tail back would cost two rebuilds of the search, its frame flipped and back; it runs only
+/// when three chunks fell short). Runs back of at most
 /// `small` collisions (0: max(8192, N/4)) stay sequential. An engine error leaves e's state as
 /// it was; Ctrl-C leaves it at a whole tick the run passed. Ends a running observation (as
 /// run_back does). `bias` (tests): scales the chunks' ticks (> 1 runs past the count).
@@ -175,7 +180,6 @@ ParallelReport run_parallel_back(Engine& e, std::uint64_t to_collisions, std::in
                                  const std::function<bool()>& poll = {}, std::uint64_t small = 0, double bias = 1.0) {
   require(to_collisions <= e.collisions(), "lattice run_back: the target collision count is ahead of the state");
   require(to_tick >= e.origin() && to_tick <= e.clock(), "lattice run_back: the target tick must be in [origin, clock]");
-  constexpr std::uint64_t tail = 4096;
   if (small == 0) small = std::max<std::uint64_t>(8192, e.size() / 4);
   ParallelReport r;
   e.stop_observing();  // observation is forward only
@@ -209,11 +213,13 @@ ParallelReport run_parallel_back(Engine& e, std::uint64_t to_collisions, std::in
     typename Engine::Snapshot s;
     for (std::int64_t clock = e.clock(); r.chunks < 3;) {
       const std::uint64_t had = c0 - r.parallel;
-      if (had <= to_collisions + tail) break;  // (the tail)
+      if (had <= to_collisions) break;  // (at or past the count)
       const double left = static_cast<double>(had - to_collisions);
-      const double aim = r.chunks == 0 ? 0.85 * left : 0.97 * left - 4.0 * std::sqrt(left);
+      const double aim = r.chunks == 0 ? 0.85 * left : 1.03 * left + 4.0 * std::sqrt(left) + 16.0;
       const double ticks = std::max(1.0, std::floor(aim * per * bias));
-      const std::int64_t to = ticks < static_cast<double>(clock - to_tick) ? clock - static_cast<std::int64_t>(ticks) : to_tick;
+      // (past a count of 0 is the start: to_tick, where run_back ends with no collision left)
+      const bool start = r.chunks > 0 && to_collisions == 0;
+      const std::int64_t to = ticks < static_cast<double>(clock - to_tick) && !start ? clock - static_cast<std::int64_t>(ticks) : to_tick;
       t0 = clock_type::now();
       const bool whole = tw->run_until(-to, poll);  // (the reversed frame's tick)
       r.parallel_s += since(t0);
@@ -243,7 +249,9 @@ ParallelReport run_parallel_back(Engine& e, std::uint64_t to_collisions, std::in
       e.run(r.overshoot, start.clock, poll);
       r.sequential_s += since(t0);
       r.stopped = e.collisions() < to_collisions;
-    } else if (e.collisions() > to_collisions && e.clock() > to_tick) {
+    } else if (e.collisions() >= to_collisions && e.clock() > to_tick) {
+      // (at the count but on a later tick than its collision's, or short of it: run_back goes on
+      // to the next collision it would take back, or to the tick)
       sequential();
     }
     return r;

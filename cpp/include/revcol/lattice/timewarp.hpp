@@ -39,6 +39,10 @@
 // with every worker stopped at a barrier (every gvt_every steps of a worker, or when one finds
 // nothing to do), which is also where the run ends, the calling thread polls for Ctrl-C, and an
 // LP's error is raised. Neither the schedule nor the delays may change a bit.
+//
+// Running back (Config::back). Every LP is built in run_back's reversed frame (one build), and
+// the same protocol runs on the back steps, keyed by the reversed frame's order; a rollback
+// undoes a back step by computing its forward collision again (rollback.hpp, redo_collision).
 #pragma once
 #include <algorithm>
 #include <atomic>
@@ -108,8 +112,7 @@ class TimeWarp {
     // the LPs' engines (their search and regions: one build each), built by the workers side by side
     lps_.resize(static_cast<std::size_t>(c.lps));
     build_in_workers(c.workers, c.lps, [&](int m) {
-      lps_[static_cast<std::size_t>(m)] = std::make_unique<Lp>(s, c.axis, sv_.faces(), c.shell);
-      if (c.back) lps_[static_cast<std::size_t>(m)]->eng.lp_reverse();
+      lps_[static_cast<std::size_t>(m)] = std::make_unique<Lp>(s, c.axis, sv_.faces(), c.shell, c.back);
     });
     if (!s.observer.empty() && !c.back) obs_ = Engine::make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);  // a running observation goes on (lp_seen.hpp)
     for (int m = 0; m < c.lps; ++m) {
@@ -184,7 +187,8 @@ class TimeWarp {
   };
   using MKey = std::pair<EventKey, std::uint64_t>;  // (key, serial): messages in key order
   struct Lp {
-    Lp(const Snapshot& s, int axis, std::vector<std::int64_t> faces, double shell) : eng(s, operator_for(s.units, s.law), axis, std::move(faces), shell) {}
+    Lp(const Snapshot& s, int axis, std::vector<std::int64_t> faces, double shell, bool back)
+        : eng(s, operator_for(s.units, s.law), axis, std::move(faces), shell, back) {}
     int me = 0;
     Engine eng;
     LpNotes notes;

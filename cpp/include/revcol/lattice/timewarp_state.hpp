@@ -2,7 +2,7 @@
 // processes' engines as the sequential engine's snapshot: each particle from the LP that owns it,
 // the rare log and the group entries the union of the LPs' (an entry two LPs hold must be the
 // same), the collision count from the particles' counts. A run back's LPs (the reversed frame,
-// lp_reverse): each record read in the forward frame, and the log and group entries of collisions
+// Config::back): each record read in the forward frame, and the log and group entries of collisions
 // the run took back (keyed by counts above their particles' counts: an LP that did not hold the
 // particles then still has them) left out.
 #pragma once
