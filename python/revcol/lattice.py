@@ -291,7 +291,8 @@ class LatticeSimulation(SimulationBase):
         reversed frame (rolled back by reverse computation whatever ``rollback`` says: an undone
         back step is its forward collision computed again), and reaches the sequential
         ``run_back``'s state bit for bit; its report is the ``"parallel"`` entry of what it
-        returns. Checkpoints and the rest are the sequential engine's (the state is its own). The settings are not part of the state: a snapshot,
+        returns. Checkpoints and the rest are the sequential engine's (the state is its own).
+        The settings are not part of the state: a snapshot,
         checkpoint or pickle holds none, and a simulation rebuilt from one runs on the
         sequential engine until ``set_parallel`` (any K: the bits are the same). ``workers=1``
         with ``lps`` None is the sequential engine. A running observation (:meth:`observe`)

@@ -16,7 +16,9 @@
 //   wall      the reflection map on the time-reversed post line (its point at a, -v): the
 //             mirror is its own inverse (cell_grid.hpp), so it gives the point at a-1 and -v;
 //             the one-tick cache it replaced (wall tick, pre-wall line) comes back from the entry;
-//   neutral   (crossings, list renewals, stale recomputes) nothing physical.
+//   neutral   (crossings, list renewals, stale recomputes) nothing physical;
+//   back step (an LP running back, in the reversed frame) its forward collision computed again
+//             (redo_collision).
 // Then every particle the undone span touched (popped, partners, group members) is anchored
 // at the new clock and predicted again, its version bumped so that any slot naming its
 // undone line is stale: the queue is again one whose least event is the next one (the argument
@@ -336,10 +338,10 @@ void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, 
   ++cnt_.collisions;
 }
 
-// An LP running back (built in the reversed frame): a back step about to take back the collision drawn by i that
-// read the rare log keeps what its undo needs and the log no longer holds: the redraws (the
-// forward's accepted draw is the one after them, so no acceptance test runs again), or the
-// group and its members' lines. Returns Done's bit 3 when it kept an entry.
+// An LP running back (built in the reversed frame): a back step about to take back a collision
+// drawn by i that read the rare log keeps what its undo needs and the log no longer holds: the
+// redraws (the forward's accepted draw is the one after them, so no acceptance test runs again),
+// or the group and its members' lines. Returns Done's bit 3 when it kept an entry.
 template <class Op, class Bits, class Queue>
 std::uint8_t BasicEngine<Op, Bits, Queue>::note_back(int i) {
   const LogKey key{static_cast<std::uint32_t>(gid(i)), own_[i].pc};

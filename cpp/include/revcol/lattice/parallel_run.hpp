@@ -171,10 +171,11 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
 /// the rest and four standard errors, at the rate the last chunk measured); then the sequential
 /// engine runs forward again, exactly, the few a chunk took back past the count (a sequential
 /// tail back would cost two rebuilds of the search, its frame flipped and back; it runs only
-/// when three chunks fell short). Runs back of at most
-/// `small` collisions (0: max(8192, N/4)) stay sequential. An engine error leaves e's state as
-/// it was; Ctrl-C leaves it at a whole tick the run passed. Ends a running observation (as
-/// run_back does). `bias` (tests): scales the chunks' ticks (> 1 runs past the count).
+/// when three chunks fell short, or one landed on the count on a later tick than its collision's).
+/// Runs back of at most `small` collisions (0: max(8192, N/4)) stay sequential. An engine error
+/// leaves e's state as it was; Ctrl-C leaves it at a whole tick the run passed. Ends a running
+/// observation (as run_back does). `bias` (tests): scales the chunks' ticks (> 1 runs past the
+/// count).
 template <class Engine>
 ParallelReport run_parallel_back(Engine& e, std::uint64_t to_collisions, std::int64_t to_tick, const typename TimeWarp<Engine>::Config& c,
                                  const std::function<bool()>& poll = {}, std::uint64_t small = 0, double bias = 1.0) {
