@@ -313,6 +313,17 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
 }
 
 template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::release() {
+  const auto drop = [](auto& v) { std::remove_reference_t<decltype(v)>().swap(v); };
+  drop(ln_), drop(lnd_), drop(wall_tick_), drop(pre_wall_), drop(own_), drop(slot_), drop(gid_), drop(lid_);
+  drop(region_), drop(parked_), drop(undo_), drop(undo_epoch_), drop(jmark_), drop(jtouched_);
+  drop(jdone_), drop(jss1_), drop(jss2_), drop(jss2x_), drop(jwall_), drop(jlp_), drop(jback_);
+  grid_ = CellGridN<D>{};
+  nl_ = NeighbourListsN<D>{};
+  queue_ = Queue{};
+}
+
+template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::check_operator(const Units& u) const {
   require(op_.sigma() == u.sigma, "lattice: the operator's sigma differs from the units'");
   if constexpr (requires { op_.cell_bits(); })

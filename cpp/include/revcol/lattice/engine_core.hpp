@@ -113,6 +113,9 @@ class BasicEngine {
   /// Replaces the state by a snapshot (validated first: on bad input nothing changes); `order`
   /// (optional): the particle each local index holds, a permutation of [0, N).
   void restore(const Snapshot& s, const std::vector<std::uint32_t>& order = {});
+  /// Frees the particles, the search, the queue and the journals (a parallel run holds the state
+  /// in its LPs meanwhile, parallel_run.hpp): the clock and counts stay; restore() must follow.
+  void release();
 
   /// Runs forward until `collisions` more collisions (clock = the last one's tick) or up to tick
   /// `until` (clock = until), whichever comes first. Returns the collisions done.
@@ -547,10 +550,7 @@ class BasicEngine {
     std::uint8_t unreflected;  // a group: bit 0 (p), bit 1 (q) took in their reflection at t; bit 2: q was popped; bit 3: a jback_ entry
     std::uint8_t kept;         // state saving: the particle states saved before it
   };
-  struct WallDone {  // a reflection's replaced one-tick cache
-    std::int64_t wall_tick;
-    Line pre_wall;
-  };
+  struct WallDone { std::int64_t wall_tick; Line pre_wall; };  // a reflection's replaced one-tick cache
   bool jon_ = false;
   Rollback jhow_ = Rollback::reverse;
   std::deque<Done> jdone_;

@@ -98,9 +98,11 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
     auto t0 = clock_type::now();
     typename TimeWarp<Engine>::Config cs = c;
     if (cs.shell < 0.0) cs.shell = e.list_shell();  // the LPs search as e does (cells or its lists)
-    auto tw = std::make_unique<TimeWarp<Engine>>(e.snapshot(), cs);
+    typename Engine::Snapshot s, before = e.snapshot();  // before: the state before the chunk (an observed run's)
+    e.release();  // (the state is the LPs' until the run ends: the engine's memory meanwhile)
+    auto tw = std::make_unique<TimeWarp<Engine>>(before, cs);
+    if (!observed) before = {};
     r.build_s = since(t0);
-    typename Engine::Snapshot s, before;  // before: the state before the chunk (an observed run's)
     for (std::int64_t clock = e.clock(); r.chunks < 3;) {
       const std::uint64_t had = e.collisions() + r.parallel;
       std::int64_t t = until;
@@ -115,7 +117,7 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
         const double ticks = std::max(1.0, std::floor(aim * per * bias));
         if (ticks < static_cast<double>(until - clock)) t = clock + static_cast<std::int64_t>(ticks);
       }
-      if (observed) before = r.chunks == 0 ? e.snapshot() : s;
+      if (observed && r.chunks > 0) before = s;
       t0 = clock_type::now();
       const bool whole = tw->run_until(t, poll);
       r.parallel_s += since(t0);
@@ -138,8 +140,9 @@ ParallelReport run_parallel(Engine& e, std::uint64_t collisions, std::int64_t un
     }
     r.stats = tw->stats();
     t0 = clock_type::now();
+    if (r.chunks == 0) s = tw->snapshot();  // (no chunk ran: the state it was built from)
     tw.reset();  // (its K views' memory, before the engine rebuilds its own)
-    if (r.chunks > 0) e.restore(s);
+    e.restore(s);
     r.assemble_s += since(t0);
     r.collisions += r.parallel;
     if (r.stopped || !by_count) return r;
@@ -209,6 +212,7 @@ ParallelReport run_parallel_back(Engine& e, std::uint64_t to_collisions, std::in
     if (cs.shell < 0.0) cs.shell = e.list_shell();
     cs.back = true;
     cs.how = Rollback::reverse;
+    e.release();  // (the state is the LPs' until the run ends: the engine's memory meanwhile)
     auto tw = std::make_unique<TimeWarp<Engine>>(start, cs);
     r.build_s = since(t0);
     typename Engine::Snapshot s;
@@ -238,7 +242,7 @@ ParallelReport run_parallel_back(Engine& e, std::uint64_t to_collisions, std::in
     r.stats = tw->stats();
     t0 = clock_type::now();
     tw.reset();
-    if (r.chunks > 0) e.restore(s);
+    e.restore(r.chunks > 0 ? s : start);
     r.assemble_s += since(t0);
     r.collisions += r.parallel;
     if (r.stopped) return r;
