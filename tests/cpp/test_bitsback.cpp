@@ -93,6 +93,33 @@ TEST_CASE("isqrt: edges (0, perfect squares, k^2 - 1, near 2^127 and 2^128)") {
   CHECK(isqrt_ceil(0) == 0);
 }
 
+TEST_CASE("to_double: the bits of static_cast<double> for every word pattern") {
+  // one word zero (the fast paths: sigma^2 = 2^(2S) for S = 20..60), both words set (the library
+  // call), halfway cases that round to even, and a run of random values
+  std::vector<u128> xs = {0, 1, ~u128{0}, u128{1} << 64, u128{1} << 127, (u128{1} << 64) - 1};
+  for (int s = 20; s <= 60; ++s) xs.push_back(u128{1} << (2 * s));
+  for (int k = 0; k < 64; ++k) {
+    xs.push_back((u128{1} << (64 + k)) | (u128{1} << k));    // both words set
+    xs.push_back((u128{(1ULL << 53) + 1}) << (k + 11));      // a halfway case above 2^64
+    xs.push_back(u128{(1ULL << 53) + 1} << 11 | 1);          // just above halfway, one word
+  }
+  std::uint64_t z = 0x9e3779b97f4a7c15ULL;
+  auto next = [&z] {  // splitmix64
+    std::uint64_t x = (z += 0x9e3779b97f4a7c15ULL);
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+    return x ^ (x >> 31);
+  };
+  for (int k = 0; k < 20000; ++k) {
+    const u64 hi = next(), lo = next();
+    const int shape = k % 4;  // both words, high only, low only, high with few bits
+    xs.push_back(shape == 0 ? (u128{hi} << 64 | lo) : shape == 1 ? u128{hi} << 64 : shape == 2 ? u128{lo} : u128{hi >> (k % 64)} << 64);
+  }
+  int bad = 0;
+  for (u128 x : xs) bad += to_double(x) != static_cast<double>(x);
+  CHECK(bad == 0);
+}
+
 TEST_CASE("floor_div, floor_mod, >>: Python's semantics on negatives") {
   const auto rows = read_rows("floor.txt");
   REQUIRE(rows.size() >= 300);

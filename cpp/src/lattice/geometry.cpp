@@ -58,7 +58,7 @@ std::int64_t guessed_tick(const VecN<D>& r, const VecN<D>& w, u128 sigma2, doubl
     // |w_k t| and m = sum a_k^2: each y_k = r_k + w_k t is within ~4u a_k, so f = |y|^2 is
     // within ~12u m of the exact value; the band is 1e-12 (m + sigma^2), ~800 times that. A
     // component beyond overlap_at's 2^61 range gives f >> sigma^2: "no overlap" either way.
-    const double s2 = static_cast<double>(sigma2);  // 2^(2S): exact
+    const double s2 = to_double(sigma2);  // 2^(2S): exact
     auto at = [&](std::int64_t tau) {
       const double td = static_cast<double>(tau);
       double f = 0.0, m = 0.0;
@@ -87,7 +87,7 @@ std::int64_t first_overlap_d(const VecN<D>& r, const VecN<D>& w, u128 sigma2) no
   {
     // the common case, decided by two exact predicates: the double entry root's ceiling t with
     // f(t) < 0 <= f(t - 1) is the answer (f convex and f(0) >= 0: nothing before t - 1 is inside)
-    const double c0 = ddot(r, r) - static_cast<double>(sigma2);
+    const double c0 = ddot(r, r) - to_double(sigma2);
     const double g = c0 / (std::sqrt(std::max(0.0, b * b - a * c0)) - b);
     if (g > 0.0) {
       const std::int64_t t = guessed_tick(r, w, sigma2, g);

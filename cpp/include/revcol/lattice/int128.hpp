@@ -23,6 +23,14 @@ using u128 = unsigned __int128;        ///< squares up to 2^128 - 1
 inline double approx_double(u128 n) {
   return static_cast<double>(static_cast<u64>(n >> 64)) * 0x1p64 + static_cast<double>(static_cast<u64>(n));
 }
+/// static_cast<double>(n), the same bits, without the library call (~40 instructions) when one
+/// word of n is zero, as for sigma^2 = 2^(2S): a power-of-two scaling commutes with the rounding.
+inline double to_double(u128 n) {
+  const u64 hi = static_cast<u64>(n >> 64), lo = static_cast<u64>(n);
+  if (hi == 0) return static_cast<double>(lo);
+  if (lo == 0) return static_cast<double>(hi) * 0x1p64;
+  return static_cast<double>(n);
+}
 /// An approximation of a signed n as a double (only ever a first guess).
 inline double approx_double(i128 n) {
   return static_cast<double>(static_cast<std::int64_t>(n >> 64)) * 0x1p64 + static_cast<double>(static_cast<u64>(n));
