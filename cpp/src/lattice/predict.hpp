@@ -135,7 +135,7 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
 
 // p's candidate partners (its list, or its 3^D cells) into b.
 template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) {
+inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) {
   // The candidates. A double-precision filter drops the pairs that cannot collide, or not
   // before the best event so far; the others get the exact search (measure before changing).
   // Rounding: a position is within 2^10 lattice units of its double (|x| < 2^63; an unwrapped
