@@ -224,14 +224,15 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
     }
   }
   std::vector<Metric> out;
+  const auto add_spread = [&out](const std::string& name, const std::vector<double>& x) {  // median, _min, _max
+    out.push_back({name, median(x)});
+    out.push_back({name + "_min", *std::min_element(x.begin(), x.end())});
+    out.push_back({name + "_max", *std::max_element(x.begin(), x.end())});
+  };
   const double coll = static_cast<double>(want.collisions - s0.collisions);
   for (const Variant& v : vs) {
-    out.push_back({v.name + "_per_s", median(v.rate)});
-    out.push_back({v.name + "_per_s_min", *std::min_element(v.rate.begin(), v.rate.end())});
-    out.push_back({v.name + "_per_s_max", *std::max_element(v.rate.begin(), v.rate.end())});
-    out.push_back({"speedup_" + v.name, median(v.speedup)});
-    out.push_back({"speedup_" + v.name + "_min", *std::min_element(v.speedup.begin(), v.speedup.end())});
-    out.push_back({"speedup_" + v.name + "_max", *std::max_element(v.speedup.begin(), v.speedup.end())});
+    add_spread(v.name + "_per_s", v.rate);
+    add_spread("speedup_" + v.name, v.speedup);
     out.push_back({"same_" + v.name, v.same ? 1.0 : 0.0});
     out.push_back({"seconds_" + v.name, median(v.seconds)});
     if (v.k == 0) continue;
@@ -255,17 +256,9 @@ std::vector<Metric> run_parallel(const ParCase& c, std::uint64_t nc) {
   const double coll_back = have_back ? static_cast<double>(want.collisions - want_back.collisions) : 0.0;
   for (const Variant& v : vs) {
     if (back == 0) break;
-    const auto lo = [](const std::vector<double>& x) { return *std::min_element(x.begin(), x.end()); };
-    const auto hi = [](const std::vector<double>& x) { return *std::max_element(x.begin(), x.end()); };
-    out.push_back({v.name + "_back_per_s", median(v.back_rate)});
-    out.push_back({v.name + "_back_per_s_min", lo(v.back_rate)});
-    out.push_back({v.name + "_back_per_s_max", hi(v.back_rate)});
-    out.push_back({"speedup_back_" + v.name, median(v.back_speedup)});
-    out.push_back({"speedup_back_" + v.name + "_min", lo(v.back_speedup)});
-    out.push_back({"speedup_back_" + v.name + "_max", hi(v.back_speedup)});
-    out.push_back({"speedup_back_net_" + v.name, median(v.back_net)});
-    out.push_back({"speedup_back_net_" + v.name + "_min", lo(v.back_net)});
-    out.push_back({"speedup_back_net_" + v.name + "_max", hi(v.back_net)});
+    add_spread(v.name + "_back_per_s", v.back_rate);
+    add_spread("speedup_back_" + v.name, v.back_speedup);
+    add_spread("speedup_back_net_" + v.name, v.back_net);
     out.push_back({"same_back_" + v.name, v.back_same ? 1.0 : 0.0});
     out.push_back({"seconds_back_" + v.name, median(v.back_seconds)});
     if (v.k == 0) continue;
