@@ -4,6 +4,8 @@ Writes bench/results/peer_profile.json (``--json``).
 
     python bench/peers/profile.py [--n 10976] [--phi 0.30 0.45] [--collisions 1e6] [--cpu 1]
         [--lattice] [--src bench/peers/src/EDMD] [--json bench/results/peer_profile.json]
+    python bench/peers/profile.py --callgrind lattice3d/periodic/n10000/phi0.45 [CASE ...]
+        [--bin build-dev/revcol-bench] [--counts 100000 200000] [--json FILE]
 
 The codes run on the same equilibrated fluid as in ``fs_edmd.py`` (its state, its patched peer,
 its revcol children: 2e5 untimed collisions, then 1e6 timed; revcol also runs them back), each a
@@ -39,6 +41,13 @@ rare log's lookups), **operator + bits-back** (the pair operator, its direction 
 rotations, the bits-back integer, the draws), **renewal** (the neighbour lists and the
 re-anchoring), **queue** (``EventQueue`` and ``schedule``), **bookkeeping** (the loop, the
 collision's frame, ``apply``, walls), **other**.
+
+``--callgrind CASE ...`` needs no peer and no perf: instructions per collision of revcol-bench's
+cases (forward and back), part by part, which the host's load does not change. Each case runs
+under callgrind at two collision counts; a function's own instructions (inlined helpers count
+with the function they are inlined into) at the larger count less the smaller, over the
+difference of the counts, go to the part of the function's name (the rules above: lattice
+cases ``lattice...``, the float engine's otherwise). Needs valgrind.
 
 Needs ``perf`` (Debian: linux-perf) and binutils. Line-level attribution needs debug
 information, which changes no machine code: the peer is compiled here with its own flags plus
@@ -315,6 +324,67 @@ def profile_workload(n: int, phi: float, args, src: str, tmp: str) -> dict:
     return out
 
 
+_ANNOTATE = re.compile(r"^\s*([\d,]+) \(\s*[\d.]+%\)\s+(\S*?):(.+?)(?: \[[^\]]*\])?\s*$")
+
+
+def parse_annotate(out: str) -> dict:
+    """``callgrind_annotate --inclusive=no`` output -> {function: its own instructions} (a name
+    in several files or objects summed; the PROGRAM TOTALS line left out)."""
+    own: dict = {}
+    for line in out.splitlines():
+        m = _ANNOTATE.match(line)
+        if m:
+            name = m.group(3).strip()
+            own[name] = own.get(name, 0) + int(m.group(1).replace(",", ""))
+    return own
+
+
+def parts_of_counts(small: dict, large: dict, collisions: int, code: str) -> dict:
+    """Instructions per collision by part: each function's own count at the larger run less the
+    smaller, over the collisions between them, in the part of its name (setup cancels)."""
+    parts = {p: 0.0 for p in (LATTICE_PARTS if code == "lattice" else PARTS)}
+    for name in set(small) | set(large):
+        parts[part_of([name], code)] += (large.get(name, 0) - small.get(name, 0)) / collisions
+    return parts
+
+
+def callgrind_case(binary: str, case: str, counts: list, tmp: str) -> dict:
+    """One revcol-bench case under callgrind at the two counts: instructions per collision
+    (forward and back), in all and by part."""
+    own = []
+    for c in counts:
+        out = os.path.join(tmp, "callgrind.out")
+        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", binary, "--repeats", "1",
+                        "--bench", case, "--collisions", str(c)], capture_output=True, text=True, check=True)
+        ann = subprocess.run(["callgrind_annotate", "--inclusive=no", "--threshold=100", out],
+                             capture_output=True, text=True, check=True).stdout
+        own.append(parse_annotate(ann))
+    code = "lattice" if case.startswith("lattice") else "revcol"
+    parts = parts_of_counts(own[0], own[1], counts[1] - counts[0], code)
+    return {"case": case, "counts": counts, "instructions_per_collision": sum(parts.values()), "parts": parts}
+
+
+def main_callgrind(args) -> int:
+    for tool in ("valgrind", "callgrind_annotate"):
+        if shutil.which(tool) is None:
+            print(f"profile.py --callgrind needs `{tool}` (Debian: valgrind); measured nothing")
+            return 0
+    if len(args.counts) != 2 or not 0 < args.counts[0] < args.counts[1]:
+        raise SystemExit("profile.py: --counts takes two collision counts, the smaller first")
+    head = subprocess.run(["git", "-C", HERE, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    res = {"command": " ".join(sys.argv), "binary": os.path.abspath(args.bin), "commit": head or None, "cases": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for case in args.callgrind:
+            r = callgrind_case(args.bin, case, args.counts, tmp)
+            res["cases"].append(r)
+            print(f"{case}: {r['instructions_per_collision']:.0f} instructions per collision (forward and back)")
+            for p, v in r["parts"].items():
+                print(f"  {p:26s} {v:8.0f}")
+    fs_edmd._write_json(args.json, res)
+    print(f"wrote {args.json}")
+    return 0
+
+
 def main(argv: Optional[list] = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--src", default=fs_edmd.DEFAULT_SRC, help="the peer's checkout (FSmallenburg/EDMD)")
@@ -329,8 +399,16 @@ def main(argv: Optional[list] = None) -> int:
     ap.add_argument("--lattice", action="store_true",
                     help="also profile revcol's lattice engine (3D, integer state) in the same rounds")
     ap.add_argument("--revcol-pkg", default="", help="a staged revcol package built with -g (default: the one imported)")
-    ap.add_argument("--json", default=os.path.join(fs_edmd.RESULTS, "peer_profile.json"))
+    ap.add_argument("--json", default=None, help="default: bench/results/peer_profile.json (--callgrind: lattice_instructions.json)")
+    ap.add_argument("--callgrind", nargs="+", default=None, metavar="CASE",
+                    help="instructions per collision of these revcol-bench cases by part (callgrind; no peer)")
+    ap.add_argument("--bin", default="build-dev/revcol-bench", help="--callgrind: the revcol-bench binary")
+    ap.add_argument("--counts", type=int, nargs="+", default=[100000, 200000], help="--callgrind: the two collision counts")
     args = ap.parse_args(argv)
+    if args.callgrind:
+        args.json = args.json or os.path.join(fs_edmd.RESULTS, "lattice_instructions.json")
+        return main_callgrind(args)
+    args.json = args.json or os.path.join(fs_edmd.RESULTS, "peer_profile.json")
     src = os.path.abspath(args.src)
     if not os.path.isfile(os.path.join(src, "Single", "mdSingle.c")):
         print(fs_edmd.where_to_put(src))

@@ -251,6 +251,28 @@ def test_profile_turns_shares_into_ns_per_collision():
     assert prof.ns_per_part({"prediction": 0}, 800.0) == {"prediction": 0.0}
 
 
+def test_profile_reads_callgrind_annotate_and_puts_instructions_per_collision_in_parts():
+    ann = "\n".join([
+        "--------------------------------------------------------------------------------",
+        "6,716,013,181 (100.0%)  PROGRAM TOTALS",
+        "Ir                      file:function",
+        f"1,441,492,207 (21.46%)  ???:{LATTICE}predict(int, long) [/w/build-dev/revcol-bench]",
+        "  342,833,214 ( 5.10%)  ???:revcol::lattice::boundary(long) [/w/build-dev/revcol-bench]",
+        "   25,848,923 ( 0.38%)  ./math/../sysdeps/ieee754/dbl-64/e_asin.c:__ieee754_asin_fma [/usr/lib/libm.so.6]",
+        "   10,000,000 ( 0.10%)  ???:revcol::lattice::boundary(long) [/w/other.so]",
+    ])
+    own = prof.parse_annotate(ann)
+    assert own == {LATTICE + "predict(int, long)": 1441492207, "revcol::lattice::boundary(long)": 352833214,
+                   "__ieee754_asin_fma": 25848923}
+    small = {LATTICE + "predict(int, long)": 1000, "revcol::lattice::boundary(long)": 500, "setup_only": 7000}
+    large = {LATTICE + "predict(int, long)": 3000, "revcol::lattice::boundary(long)": 1500, "setup_only": 7000,
+             "__ieee754_asin_fma": 100}
+    parts = prof.parts_of_counts(small, large, 10, "lattice")
+    assert parts["prediction: filter"] == 200.0 and parts["operator + bits-back"] == 100.0
+    assert parts["other"] == 10.0 and sum(parts.values()) == 310.0  # the setup cancels
+    assert set(parts) == set(prof.LATTICE_PARTS)
+
+
 def test_profile_without_the_peer_says_where_it_goes_and_measures_nothing(tmp_path, capsys):
     out = tmp_path / "profile.json"
     assert prof.main(["--src", str(tmp_path / "nowhere"), "--json", str(out)]) == 0
