@@ -369,10 +369,10 @@ def main_callgrind(args) -> int:
         if shutil.which(tool) is None:
             print(f"profile.py --callgrind needs `{tool}` (Debian: valgrind); measured nothing")
             return 0
-    if len(args.counts) != 2 or not 0 < args.counts[0] < args.counts[1]:
+    if not 0 < args.counts[0] < args.counts[1]:
         raise SystemExit("profile.py: --counts takes two collision counts, the smaller first")
-    head = subprocess.run(["git", "-C", HERE, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-    res = {"command": " ".join(sys.argv), "binary": os.path.abspath(args.bin), "commit": head or None, "cases": []}
+    res = {"command": " ".join(sys.argv), "binary": os.path.abspath(args.bin), "commit": fs_edmd.peer_commit(fs_edmd.ROOT),
+           "cases": []}
     with tempfile.TemporaryDirectory() as tmp:
         for case in args.callgrind:
             r = callgrind_case(args.bin, case, args.counts, tmp)
@@ -403,7 +403,7 @@ def main(argv: Optional[list] = None) -> int:
     ap.add_argument("--callgrind", nargs="+", default=None, metavar="CASE",
                     help="instructions per collision of these revcol-bench cases by part (callgrind; no peer)")
     ap.add_argument("--bin", default="build-dev/revcol-bench", help="--callgrind: the revcol-bench binary")
-    ap.add_argument("--counts", type=int, nargs="+", default=[100000, 200000], help="--callgrind: the two collision counts")
+    ap.add_argument("--counts", type=int, nargs=2, default=[100000, 200000], help="--callgrind: the two collision counts")
     args = ap.parse_args(argv)
     if args.callgrind:
         args.json = args.json or os.path.join(fs_edmd.RESULTS, "lattice_instructions.json")
