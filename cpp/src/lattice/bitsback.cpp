@@ -63,15 +63,13 @@ void BitsBack::release() noexcept {
   n_ = 0;
 }
 
-void BitsBack::push_word(std::uint64_t w) {
-  if (n_ == cap_) {
-    const std::uint32_t cap = 2 * cap_;
-    auto* h = new std::uint64_t[cap];
-    std::copy(data(), data() + n_, h);
-    if (cap_ > kInline) delete[] heap_;
-    heap_ = h;
-    cap_ = cap;
-  }
+void BitsBack::grow_push(std::uint64_t w) {
+  const std::uint32_t cap = 2 * cap_;
+  auto* h = new std::uint64_t[cap];
+  std::copy(data(), data() + n_, h);
+  if (cap_ > kInline) delete[] heap_;
+  heap_ = h;
+  cap_ = cap;
   data()[n_++] = w;
 }
 
@@ -106,11 +104,6 @@ std::string BitsBack::to_hex() const {
   return "0x" + s.substr(first);
 }
 
-void BitsBack::trim() noexcept {
-  const std::uint64_t* w = data();
-  while (n_ > 0 && w[n_ - 1] == 0) --n_;
-}
-
 void BitsBack::mul_add(std::uint64_t m, std::uint64_t a) {
   u64 carry = a;
   u64* w = data();
@@ -119,8 +112,9 @@ void BitsBack::mul_add(std::uint64_t m, std::uint64_t a) {
     w[k] = static_cast<u64>(t);
     carry = static_cast<u64>(t >> 64);
   }
+  // no trim: a canonical X (no leading zero word) times m >= 1 plus a is at least X, so its top
+  // word is not zero; every caller passes m >= 1
   if (carry != 0) push_word(carry);
-  trim();
 }
 
 std::uint64_t BitsBack::divmod(std::uint64_t d) noexcept {
@@ -157,15 +151,19 @@ void BitsBack::push_rans(std::uint64_t c, std::uint64_t f) {
 void BitsBack::pop_rans(std::uint64_t c, std::uint64_t f) {
   const u64 s = low48();
   require(f >= 1 && c <= s && s - c < f, "BitsBack::pop_rans: the low 48 bits are not in [c, c+f)");
-  // X = f * (X >> 48) + s - c
-  const std::size_t n = n_;
+  // X = f * (X >> 48) + s - c, in one pass: word k of X >> 48 is read (from words k and k + 1)
+  // before word k is written
+  const std::uint32_t n = n_;
   u64* w = data();
-  for (std::size_t k = 0; k < n; ++k) {
+  u64 carry = s - c;
+  for (std::uint32_t k = 0; k < n; ++k) {
     const u64 hi = (k + 1 < n) ? w[k + 1] : 0;
-    w[k] = (w[k] >> 48) | (hi << 16);
+    const u128 t = static_cast<u128>((w[k] >> 48) | (hi << 16)) * f + carry;
+    w[k] = static_cast<u64>(t);
+    carry = static_cast<u64>(t >> 64);
   }
+  if (carry != 0) push_word(carry);
   trim();
-  mul_add(f, s - c);
 }
 
 void BitsBack::add_low48(std::uint64_t g) {

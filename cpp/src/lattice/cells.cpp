@@ -1,6 +1,7 @@
 // Direction cells, the flux-law table and the lifting rotation (revcol/lattice/cells.hpp).
-// Everything that decides a cell is integer arithmetic on compile-time tables; libm values
-// (atan2, acos, asin) are only first guesses that an exact comparison corrects.
+// Everything that decides a cell is integer arithmetic on compile-time tables; angles in double
+// (atan2_guess, cells.hpp) are only first guesses that an exact comparison corrects.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -15,12 +16,11 @@ constexpr i128 kOne = static_cast<i128>(1) << kFixBits;   // 1.0 in 62-bit fixed
 constexpr i128 kHalf = static_cast<i128>(1) << (kFixBits - 1);
 // round(2*pi * 2^100) (tests/reference/lattice_cells.py recomputes it with Machin's formula).
 constexpr i128 kTwoPiFx100 = (static_cast<i128>(0x6487ed5110ULL) << 64) | static_cast<i128>(0xb4611a62633145c0ULL);
-constexpr std::int64_t kOctant = 1LL << 18;    // pi/4 at half-cell resolution (2^21 per turn)
-constexpr std::int64_t kQuadrant = 1LL << 19;  // pi/2 at half-cell resolution
-constexpr std::int64_t kHalfMask = (1LL << 21) - 1;
-constexpr int kFineBits = 9;                   // fine table: 2^9 half-cells
-constexpr std::int64_t kFine = 1LL << kFineBits;
-constexpr std::int64_t kCoarse = kOctant / kFine;  // 512 coarse steps (+1 entry for pi/4)
+using detail::kCoarse;
+using detail::kFine;
+using detail::kFineBits;
+using detail::kOctant;
+using detail::kQuadrant;
 
 // 2*pi*h/2^21 in 62-bit fixed point, rounded (h <= 2^18).
 constexpr i128 angle_fx(std::int64_t h) {
@@ -53,13 +53,8 @@ constexpr u128 isqrt_newton(u128 n) {
   return x;
 }
 
-struct Tables {
-  std::array<IVec, kCoarse + 1> coarse{};  // angle i * 2^9 half-cells, i = 0..512
-  std::array<IVec, kFine> fine{};          // angle j half-cells, j = 0..511
-};
-
-constexpr Tables make_tables() {
-  Tables t;
+constexpr detail::CellTables make_tables() {
+  detail::CellTables t;
   for (std::int64_t i = 0; i < kCoarse; ++i) t.coarse[i] = sincos_fx(angle_fx(i * kFine));
   const i64 diag = static_cast<i64>(isqrt_newton(static_cast<u128>(1) << (2 * kFixBits - 1)));
   t.coarse[kCoarse] = {diag, diag};  // exactly on the diagonal: the octant symmetry is exact
@@ -67,18 +62,7 @@ constexpr Tables make_tables() {
   return t;
 }
 
-constexpr Tables kTables = make_tables();
-
-// B(h) for 0 <= h <= 2^18: coarse (x) fine, a complex product rounded to nearest.
-inline IVec boundary_octant(std::int64_t h) {
-  const IVec& a = kTables.coarse[h >> kFineBits];
-  const std::int64_t j = h & (kFine - 1);
-  if (j == 0) return a;
-  const IVec& b = kTables.fine[j];
-  const i128 x = static_cast<i128>(a.x) * b.x - static_cast<i128>(a.y) * b.y;
-  const i128 y = static_cast<i128>(a.y) * b.x + static_cast<i128>(a.x) * b.y;
-  return {static_cast<i64>((x + kHalf) >> kFixBits), static_cast<i64>((y + kHalf) >> kFixBits)};
-}
+constexpr detail::CellTables kTables = make_tables();
 
 // n / d for a quotient below 2^64 (n >> 64 < d): one divq on x86-64.
 inline std::uint64_t div_word(u128 n, std::uint64_t d) {
@@ -99,75 +83,8 @@ inline i128 cross(const IVec& b, i64 wx, i64 wy) {
 
 }  // namespace
 
-IVec boundary(std::int64_t h) {
-  h &= kHalfMask;
-  const std::int64_t r = h & (kQuadrant - 1);
-  IVec b;
-  if (r <= kOctant) {
-    b = boundary_octant(r);
-  } else {
-    const IVec m = boundary_octant(kQuadrant - r);
-    b = {m.y, m.x};
-  }
-  return rot90(b, static_cast<int>(h >> 19));
-}
-
-namespace {
-
-// Component `y` (false: x) of the octant vector, as boundary_octant computes it (2 products).
-inline i64 octant_component(std::int64_t h, bool y) {
-  const IVec& a = kTables.coarse[h >> kFineBits];
-  const std::int64_t j = h & (kFine - 1);
-  if (j == 0) return y ? a.y : a.x;
-  const IVec& b = kTables.fine[j];
-  const i128 v = y ? static_cast<i128>(a.y) * b.x + static_cast<i128>(a.x) * b.y
-                   : static_cast<i128>(a.x) * b.x - static_cast<i128>(a.y) * b.y;
-  return static_cast<i64>((v + kHalf) >> kFixBits);
-}
-
-// One component of B(h), the same bits as boundary(h) (half the products).
-inline i64 boundary_component(std::int64_t h, bool y) {
-  h &= kHalfMask;
-  const int q = static_cast<int>(h >> 19);
-  const std::int64_t r = h & (kQuadrant - 1);
-  // rot90 by q: x <- (x, -y, -x, y)[q], y <- (y, x, -y, -x)[q] of the quadrant vector
-  const bool take_y = y ? (q & 1) == 0 : (q & 1) == 1;
-  const bool negate = y ? q >= 2 : (q == 1 || q == 2);
-  const i64 c = r <= kOctant ? octant_component(r, take_y) : octant_component(kQuadrant - r, !take_y);
-  return negate ? -c : c;
-}
-
-}  // namespace
-
-i64 boundary_x(std::int64_t h) { return boundary_component(h, false); }
-i64 boundary_y(std::int64_t h) { return boundary_component(h, true); }
-
-namespace {
-
-// atan2(y, x) within 2.5e-7 rad for (x, y) != 0: an odd polynomial of degree 13 in t = min / max
-// on [0, 1] (fitted for this purpose, max error 2.5e-7), then the octant. A cell is 6e-6 rad, so
-// the guess is within a cell; it is only a guess, which the exact comparisons correct (any
-// rounding of it changes the number of correction steps, never the cell). About a fifth of the
-// instructions of libm's atan2f.
-inline double atan2_guess(double y, double x) {
-  const double ax = std::fabs(x), ay = std::fabs(y);
-  const bool steep = ay > ax;
-  const double t = steep ? ax / ay : ay / ax;
-  const double t2 = t * t;
-  double p = 0.0068117926046103588;
-  p = p * t2 - 0.03360421913636702;
-  p = p * t2 + 0.079623671866918211;
-  p = p * t2 - 0.13233342169370219;
-  p = p * t2 + 0.19807815630014494;
-  p = p * t2 - 0.33317368071638948;
-  p = p * t2 + 0.99999611156190982;
-  double a = t * p;
-  if (steep) a = std::numbers::pi / 2 - a;
-  if (x < 0) a = std::numbers::pi - a;
-  return y < 0 ? -a : a;
-}
-
-}  // namespace
+// the tables of boundary() (cells.hpp), computed at compile time above; constant-initialized
+constinit const detail::CellTables detail::kCellTables = kTables;
 
 std::int64_t dir_cell(i64 wx, i64 wy) {
   require(wx != 0 || wy != 0, "dir_cell: the zero vector has no direction");
@@ -222,8 +139,10 @@ std::int64_t normal_cell(i64 xc, i64 sigma) { return normal_cell(xc, sigma, 0); 
 std::int64_t normal_cell(i64 xc, i64 sigma, int shift) {
   require(sigma >= 1 && xc > -sigma && xc < sigma, "normal_cell: needs |xc| < sigma");
   require(shift >= 0 && shift <= kCellBits - 4, "normal_cell: shift must be in [0, 16]");
-  const double phi = std::acos(static_cast<float>(static_cast<double>(xc) / static_cast<double>(sigma)));
-  std::int64_t k = std::llround(phi * kCellsPerRadian * (1.0 / static_cast<double>(1LL << shift)));
+  // the guess: acos(u) = atan2(sqrt(1 - u^2), u) in [0, pi], rounded (any guess gives the same k)
+  const double u = static_cast<double>(xc) / static_cast<double>(sigma);
+  const double phi = atan2_guess(std::sqrt(std::max(0.0, 1.0 - u * u)), u);
+  std::int64_t k = static_cast<std::int64_t>(phi * kCellsPerRadian * (1.0 / static_cast<double>(1LL << shift)) + 0.5);
   const i128 lhs = static_cast<i128>(xc) << kFixBits;
   // the coarse half-cell point h is the fine half-cell point h 2^shift
   auto bound = [&](std::int64_t h) { return static_cast<i128>(sigma) * boundary_x(h << shift); };
@@ -246,22 +165,6 @@ RotCoef rot_coef(std::int64_t k) {
   return {static_cast<int>(qt & 3), b.y >= 0 ? -mag : mag, b.y};
 }
 
-IVec rotate(IVec w, const RotCoef& c) {
-  IVec v = rot90(w, c.qt);
-  v.x += static_cast<i64>((static_cast<i128>(c.p) * v.y + kHalf) >> kFixBits);
-  v.y += static_cast<i64>((static_cast<i128>(c.s) * v.x + kHalf) >> kFixBits);
-  v.x += static_cast<i64>((static_cast<i128>(c.p) * v.y + kHalf) >> kFixBits);
-  return v;
-}
-
-IVec rotate_inv(IVec w, const RotCoef& c) {
-  IVec v = w;
-  v.x -= static_cast<i64>((static_cast<i128>(c.p) * v.y + kHalf) >> kFixBits);
-  v.y -= static_cast<i64>((static_cast<i128>(c.s) * v.x + kHalf) >> kFixBits);
-  v.x -= static_cast<i64>((static_cast<i128>(c.p) * v.y + kHalf) >> kFixBits);
-  return rot90(v, -c.qt);
-}
-
 std::uint64_t flux_cum(std::int64_t a) {
   const i64 y = boundary_y(2 * (a - kQuarterTurn));
   return static_cast<std::uint64_t>((1LL << 47) + ((y + (1LL << 14)) >> 15));
@@ -270,7 +173,8 @@ std::uint64_t flux_cum(std::int64_t a) {
 std::int64_t flux_decode(std::uint64_t s, std::uint64_t& cum, std::uint64_t& freq) {
   constexpr std::int64_t n = kHalfTurn;  // relative cells 0..2^19-1
   const double u = static_cast<double>(s) / static_cast<double>(1ULL << 47) - 1.0;
-  const double th = std::asin(u < -1.0 ? -1.0 : (u > 1.0 ? 1.0 : u));
+  const double uc = u < -1.0 ? -1.0 : (u > 1.0 ? 1.0 : u);
+  const double th = atan2_guess(uc, std::sqrt(1.0 - uc * uc));  // asin(u), a guess
   std::int64_t b = static_cast<std::int64_t>(std::floor(th * kCellsPerRadian)) + kQuarterTurn;
   b = b < 0 ? 0 : (b >= n ? n - 1 : b);
   std::uint64_t lo = flux_cum(b);

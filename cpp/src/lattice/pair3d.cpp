@@ -258,7 +258,9 @@ std::uint64_t LatticePair3D::cum(std::int64_t b) const {
 
 std::int64_t LatticePair3D::decode(std::uint64_t s, std::uint64_t& c, std::uint64_t& f) const {
   const double u = static_cast<double>(s) / static_cast<double>(kThetaTotal);
-  const double th = law_ == Law::flux ? std::asin(std::sqrt(u)) : std::acos(1.0 - u);
+  // the guess: asin(sqrt(u)) (flux) or acos(1 - u) (uniform) as atan2 of the two legs
+  const double th = law_ == Law::flux ? atan2_guess(std::sqrt(u), std::sqrt(1.0 - u))
+                                      : atan2_guess(std::sqrt(std::max(0.0, u * (2.0 - u))), 1.0 - u);
   std::int64_t b = static_cast<std::int64_t>(th / (std::numbers::pi / 2) * static_cast<double>(quarter_) + 0.5);
   b = std::clamp<std::int64_t>(b, 0, quarter_);
   std::uint64_t lo = cum(b);

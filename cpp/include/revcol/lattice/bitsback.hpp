@@ -92,12 +92,19 @@ class BitsBack {
   static constexpr std::uint32_t kInline = 4;
   std::uint64_t* data() noexcept { return cap_ > kInline ? heap_ : inl_; }
   const std::uint64_t* data() const noexcept { return cap_ > kInline ? heap_ : inl_; }
-  void push_word(std::uint64_t w);                   // append a most significant word
+  void push_word(std::uint64_t w) {                  // append a most significant word
+    if (n_ < cap_) data()[n_++] = w;
+    else grow_push(w);
+  }
+  void grow_push(std::uint64_t w);                   // push_word when the storage is full
   void copy_words(const BitsBack& o);                // append o's words (this holds none)
   void release() noexcept;                           // free the heap words (if any)
   void steal(BitsBack& o) noexcept;                  // take o's words (o left zero)
-  void trim() noexcept;                              // drop leading zero words
-  void mul_add(std::uint64_t m, std::uint64_t a);    // X = X*m + a
+  void trim() noexcept {                             // drop leading zero words
+    const std::uint64_t* w = data();
+    while (n_ > 0 && w[n_ - 1] == 0) --n_;
+  }
+  void mul_add(std::uint64_t m, std::uint64_t a);    // X = X*m + a (m >= 1: stays canonical)
   std::uint64_t divmod(std::uint64_t d) noexcept;    // X = X div d, returns X mod d (d >= 1)
   void set_low48(std::uint64_t s);                   // replace the low 48 bits by s < 2^48
   std::uint32_t n_ = 0, cap_ = kInline;              // words held; capacity (kInline: inline)

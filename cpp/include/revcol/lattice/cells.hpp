@@ -36,7 +36,10 @@
 // undone exactly by subtracting the same rounded term, so rotate_inv(rotate(w, k), k) == w
 // for every w (the rotation is a bijection of Z^2, close to the true rotation within ~1 unit).
 #pragma once
+#include <cmath>
+#include <array>
 #include <cstdint>
+#include <numbers>
 
 #include "revcol/lattice/int128.hpp"
 
@@ -66,12 +69,94 @@ inline IVec rot90(IVec v, int k) {
   }
 }
 
-/// The boundary vector B(h) at half-cell resolution (h taken mod 2^21), |B| ~= 2^62.
-IVec boundary(std::int64_t h);
+/// atan2(y, x) within 2.5e-7 rad for (x, y) != 0, a first guess only (a cell is 6e-6 rad): an odd
+/// polynomial of degree 13 in t = min / max on [0, 1] (fitted for this purpose), then the octant.
+/// The exact comparisons that follow it correct any guess (its rounding changes the number of
+/// correction steps, never a cell), so no libm value decides anything; about a fifth of the
+/// instructions of libm's atan2f, and it stands in for acos and asin too (atan2 of the two legs).
+inline double atan2_guess(double y, double x) {
+  const double ax = std::fabs(x), ay = std::fabs(y);
+  const bool steep = ay > ax;
+  const double t = steep ? ax / ay : ay / ax;
+  const double t2 = t * t;
+  double p = 0.0068117926046103588;
+  p = p * t2 - 0.03360421913636702;
+  p = p * t2 + 0.079623671866918211;
+  p = p * t2 - 0.13233342169370219;
+  p = p * t2 + 0.19807815630014494;
+  p = p * t2 - 0.33317368071638948;
+  p = p * t2 + 0.99999611156190982;
+  double a = t * p;
+  if (steep) a = std::numbers::pi / 2 - a;
+  if (x < 0) a = std::numbers::pi - a;
+  return y < 0 ? -a : a;
+}
+
+namespace detail {
+inline constexpr std::int64_t kOctant = 1LL << 18;    // pi/4 at half-cell resolution (2^21 per turn)
+inline constexpr std::int64_t kQuadrant = 1LL << 19;  // pi/2 at half-cell resolution
+inline constexpr std::int64_t kHalfMask = (1LL << 21) - 1;
+inline constexpr int kFineBits = 9;                   // fine table: 2^9 half-cells
+inline constexpr std::int64_t kFine = 1LL << kFineBits;
+inline constexpr std::int64_t kCoarse = kOctant / kFine;  // 512 coarse steps (+1 entry for pi/4)
+inline constexpr i128 kRound = static_cast<i128>(1) << (kFixBits - 1);  // 1/2 in 62-bit fixed point
+/// The two tables of B on the first octant (computed at compile time in cells.cpp, 16 KB).
+struct CellTables {
+  std::array<IVec, kCoarse + 1> coarse{};  ///< angle i * 2^9 half-cells, i = 0..512
+  std::array<IVec, kFine> fine{};          ///< angle j half-cells, j = 0..511
+};
+extern const CellTables kCellTables;
+// B(h) for 0 <= h <= 2^18: coarse (x) fine, a complex product rounded to nearest.
+inline IVec boundary_octant(std::int64_t h) {
+  const IVec& a = kCellTables.coarse[static_cast<std::size_t>(h >> kFineBits)];
+  const std::int64_t j = h & (kFine - 1);
+  if (j == 0) return a;
+  const IVec& b = kCellTables.fine[static_cast<std::size_t>(j)];
+  const i128 x = static_cast<i128>(a.x) * b.x - static_cast<i128>(a.y) * b.y;
+  const i128 y = static_cast<i128>(a.y) * b.x + static_cast<i128>(a.x) * b.y;
+  return {static_cast<i64>((x + kRound) >> kFixBits), static_cast<i64>((y + kRound) >> kFixBits)};
+}
+// Component `y` (false: x) of the octant vector, as boundary_octant computes it (2 products).
+inline i64 octant_component(std::int64_t h, bool y) {
+  const IVec& a = kCellTables.coarse[static_cast<std::size_t>(h >> kFineBits)];
+  const std::int64_t j = h & (kFine - 1);
+  if (j == 0) return y ? a.y : a.x;
+  const IVec& b = kCellTables.fine[static_cast<std::size_t>(j)];
+  const i128 v = y ? static_cast<i128>(a.y) * b.x + static_cast<i128>(a.x) * b.y
+                   : static_cast<i128>(a.x) * b.x - static_cast<i128>(a.y) * b.y;
+  return static_cast<i64>((v + kRound) >> kFixBits);
+}
+// One component of B(h), the same bits as boundary(h) (half the products).
+inline i64 boundary_component(std::int64_t h, bool y) {
+  h &= kHalfMask;
+  const int q = static_cast<int>(h >> 19);
+  const std::int64_t r = h & (kQuadrant - 1);
+  // rot90 by q: x <- (x, -y, -x, y)[q], y <- (y, x, -y, -x)[q] of the quadrant vector
+  const bool take_y = y ? (q & 1) == 0 : (q & 1) == 1;
+  const bool negate = y ? q >= 2 : (q == 1 || q == 2);
+  const i64 c = r <= kOctant ? octant_component(r, take_y) : octant_component(kQuadrant - r, !take_y);
+  return negate ? -c : c;
+}
+}  // namespace detail
+
+/// The boundary vector B(h) at half-cell resolution (h taken mod 2^21), |B| ~= 2^62. (Inline:
+/// the pair operators evaluate about a dozen per collision; the call cost ~15% of each.)
+inline IVec boundary(std::int64_t h) {
+  h &= detail::kHalfMask;
+  const std::int64_t r = h & (detail::kQuadrant - 1);
+  IVec b;
+  if (r <= detail::kOctant) {
+    b = detail::boundary_octant(r);
+  } else {
+    const IVec m = detail::boundary_octant(detail::kQuadrant - r);
+    b = {m.y, m.x};
+  }
+  return rot90(b, static_cast<int>(h >> 19));
+}
 /// B(h).x with half the work (the same bits).
-i64 boundary_x(std::int64_t h);
+inline i64 boundary_x(std::int64_t h) { return detail::boundary_component(h, false); }
 /// B(h).y with half the work (the same bits).
-i64 boundary_y(std::int64_t h);
+inline i64 boundary_y(std::int64_t h) { return detail::boundary_component(h, true); }
 /// The direction cell in [0, ND) of w != 0 (exact; see above).
 std::int64_t dir_cell(i64 wx, i64 wy);
 /// The half-cell h in [0, 2^21) of w != 0: cross(B(h), w) >= 0 > cross(B(h + 1), w), i.e.
@@ -101,9 +186,21 @@ struct RotCoef {
 /// The coefficients for k cells (k taken mod ND).
 RotCoef rot_coef(std::int64_t k);
 /// The lifting rotation with given coefficients (exact bijection of Z^2 for |x|,|y| < 2^62).
-IVec rotate(IVec w, const RotCoef& c);
+inline IVec rotate(IVec w, const RotCoef& c) {
+  IVec v = rot90(w, c.qt);
+  v.x += static_cast<i64>((static_cast<i128>(c.p) * v.y + detail::kRound) >> kFixBits);
+  v.y += static_cast<i64>((static_cast<i128>(c.s) * v.x + detail::kRound) >> kFixBits);
+  v.x += static_cast<i64>((static_cast<i128>(c.p) * v.y + detail::kRound) >> kFixBits);
+  return v;
+}
 /// Its exact inverse.
-IVec rotate_inv(IVec w, const RotCoef& c);
+inline IVec rotate_inv(IVec w, const RotCoef& c) {
+  IVec v = w;
+  v.x -= static_cast<i64>((static_cast<i128>(c.p) * v.y + detail::kRound) >> kFixBits);
+  v.y -= static_cast<i64>((static_cast<i128>(c.s) * v.x + detail::kRound) >> kFixBits);
+  v.x -= static_cast<i64>((static_cast<i128>(c.p) * v.y + detail::kRound) >> kFixBits);
+  return rot90(v, -c.qt);
+}
 
 /// The flux-law cumulative frequency cum(a), 0 <= a <= 2^19 (cum(2^19) = 2^48).
 std::uint64_t flux_cum(std::int64_t a);
