@@ -16,11 +16,12 @@ constexpr i128 kOne = static_cast<i128>(1) << kFixBits;   // 1.0 in 62-bit fixed
 constexpr i128 kHalf = static_cast<i128>(1) << (kFixBits - 1);
 // round(2*pi * 2^100) (tests/reference/lattice_cells.py recomputes it with Machin's formula).
 constexpr i128 kTwoPiFx100 = (static_cast<i128>(0x6487ed5110ULL) << 64) | static_cast<i128>(0xb4611a62633145c0ULL);
-using detail::kCoarse;
-using detail::kFine;
-using detail::kFineBits;
-using detail::kOctant;
-using detail::kQuadrant;
+constexpr std::int64_t kOctant = 1LL << 18;    // pi/4 at half-cell resolution (2^21 per turn)
+constexpr std::int64_t kQuadrant = 1LL << 19;  // pi/2 at half-cell resolution
+constexpr std::int64_t kHalfMask = (1LL << 21) - 1;
+constexpr int kFineBits = 9;                   // fine table: 2^9 half-cells
+constexpr std::int64_t kFine = 1LL << kFineBits;
+constexpr std::int64_t kCoarse = kOctant / kFine;  // 512 coarse steps (+1 entry for pi/4)
 
 // 2*pi*h/2^21 in 62-bit fixed point, rounded (h <= 2^18).
 constexpr i128 angle_fx(std::int64_t h) {
@@ -53,8 +54,13 @@ constexpr u128 isqrt_newton(u128 n) {
   return x;
 }
 
-constexpr detail::CellTables make_tables() {
-  detail::CellTables t;
+struct Tables {
+  std::array<IVec, kCoarse + 1> coarse{};  // angle i * 2^9 half-cells, i = 0..512
+  std::array<IVec, kFine> fine{};          // angle j half-cells, j = 0..511
+};
+
+constexpr Tables make_tables() {
+  Tables t;
   for (std::int64_t i = 0; i < kCoarse; ++i) t.coarse[i] = sincos_fx(angle_fx(i * kFine));
   const i64 diag = static_cast<i64>(isqrt_newton(static_cast<u128>(1) << (2 * kFixBits - 1)));
   t.coarse[kCoarse] = {diag, diag};  // exactly on the diagonal: the octant symmetry is exact
@@ -62,7 +68,18 @@ constexpr detail::CellTables make_tables() {
   return t;
 }
 
-constexpr detail::CellTables kTables = make_tables();
+constexpr Tables kTables = make_tables();
+
+// B(h) for 0 <= h <= 2^18: coarse (x) fine, a complex product rounded to nearest.
+inline IVec boundary_octant(std::int64_t h) {
+  const IVec& a = kTables.coarse[h >> kFineBits];
+  const std::int64_t j = h & (kFine - 1);
+  if (j == 0) return a;
+  const IVec& b = kTables.fine[j];
+  const i128 x = static_cast<i128>(a.x) * b.x - static_cast<i128>(a.y) * b.y;
+  const i128 y = static_cast<i128>(a.y) * b.x + static_cast<i128>(a.x) * b.y;
+  return {static_cast<i64>((x + kHalf) >> kFixBits), static_cast<i64>((y + kHalf) >> kFixBits)};
+}
 
 // n / d for a quotient below 2^64 (n >> 64 < d): one divq on x86-64.
 inline std::uint64_t div_word(u128 n, std::uint64_t d) {
@@ -83,8 +100,49 @@ inline i128 cross(const IVec& b, i64 wx, i64 wy) {
 
 }  // namespace
 
-// the tables of boundary() (cells.hpp), computed at compile time above; constant-initialized
-constinit const detail::CellTables detail::kCellTables = kTables;
+IVec boundary(std::int64_t h) {
+  h &= kHalfMask;
+  const std::int64_t r = h & (kQuadrant - 1);
+  IVec b;
+  if (r <= kOctant) {
+    b = boundary_octant(r);
+  } else {
+    const IVec m = boundary_octant(kQuadrant - r);
+    b = {m.y, m.x};
+  }
+  return rot90(b, static_cast<int>(h >> 19));
+}
+
+namespace {
+
+// Component `y` (false: x) of the octant vector, as boundary_octant computes it (2 products).
+inline i64 octant_component(std::int64_t h, bool y) {
+  const IVec& a = kTables.coarse[h >> kFineBits];
+  const std::int64_t j = h & (kFine - 1);
+  if (j == 0) return y ? a.y : a.x;
+  const IVec& b = kTables.fine[j];
+  const i128 v = y ? static_cast<i128>(a.y) * b.x + static_cast<i128>(a.x) * b.y
+                   : static_cast<i128>(a.x) * b.x - static_cast<i128>(a.y) * b.y;
+  return static_cast<i64>((v + kHalf) >> kFixBits);
+}
+
+// One component of B(h), the same bits as boundary(h) (half the products).
+inline i64 boundary_component(std::int64_t h, bool y) {
+  h &= kHalfMask;
+  const int q = static_cast<int>(h >> 19);
+  const std::int64_t r = h & (kQuadrant - 1);
+  // rot90 by q: x <- (x, -y, -x, y)[q], y <- (y, x, -y, -x)[q] of the quadrant vector
+  const bool take_y = y ? (q & 1) == 0 : (q & 1) == 1;
+  const bool negate = y ? q >= 2 : (q == 1 || q == 2);
+  const i64 c = r <= kOctant ? octant_component(r, take_y) : octant_component(kQuadrant - r, !take_y);
+  return negate ? -c : c;
+}
+
+}  // namespace
+
+i64 boundary_x(std::int64_t h) { return boundary_component(h, false); }
+i64 boundary_y(std::int64_t h) { return boundary_component(h, true); }
+
 
 std::int64_t dir_cell(i64 wx, i64 wy) {
   require(wx != 0 || wy != 0, "dir_cell: the zero vector has no direction");
