@@ -143,7 +143,6 @@ inline i64 boundary_component(std::int64_t h, bool y) {
 i64 boundary_x(std::int64_t h) { return boundary_component(h, false); }
 i64 boundary_y(std::int64_t h) { return boundary_component(h, true); }
 
-
 std::int64_t dir_cell(i64 wx, i64 wy) {
   require(wx != 0 || wy != 0, "dir_cell: the zero vector has no direction");
   constexpr std::int64_t mask = kCells - 1;
