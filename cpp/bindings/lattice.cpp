@@ -138,6 +138,7 @@ py::dict start_dict(const la::LatticeStartN<D>& s) {
   d["units"] = units_dict(s.units);
   d["x"] = vec_array(s.x);
   d["v"] = vec_array(s.v);
+  d["radius"] = flat_array(s.radius.data(), s.radius.size());  // (empty: one diameter)
   d["max_position_error"] = s.max_position_error;
   d["max_velocity_error"] = s.max_velocity_error;
   return d;
@@ -160,6 +161,10 @@ template <class T, std::size_t K>
 void put(py::dict& d, const char* key, const std::array<T, K>& a) { d[key] = flat_array(a.data(), K); }
 void put(py::dict& d, const char* key, const std::vector<std::uint64_t>& v) { d[key] = flat_array(v.data(), v.size()); }
 void put(py::dict& d, const char* key, const std::vector<double>& v) { d[key] = flat_array(v.data(), v.size()); }
+// a mixture's radii (lattice units, by particle id): no entry for a gas of one diameter
+void put(py::dict& d, const char* key, const std::vector<std::int64_t>& v) {
+  if (!v.empty()) d[key] = flat_array(v.data(), v.size());
+}
 // the rare log as three arrays: log_particle (the drawer), log_count (its collision count
 // after the collision) and log_redraws
 void put(py::dict& d, const char*, const std::vector<la::LogEntry>& log) {
@@ -221,6 +226,9 @@ void take(const py::dict& d, const char* key, std::vector<la::VecN<D>>& v) {
 }
 void take(const py::dict& d, const char* key, std::vector<std::uint64_t>& v) { v = get_flat<std::uint64_t>(d, key); }
 void take(const py::dict& d, const char* key, std::vector<double>& v) { v = get_flat<double>(d, key); }
+void take(const py::dict& d, const char* key, std::vector<std::int64_t>& v) {
+  if (d.contains(key)) v = get_flat<std::int64_t>(d, key);  // absent: one diameter (and every older checkpoint)
+}
 
 // a running observation's entries: written only while one runs, absent in older checkpoints
 bool observer_entry(const char* key) { return std::strcmp(key, "observer") == 0 || std::strcmp(key, "observer_counts") == 0; }
@@ -369,7 +377,7 @@ void set_boundaries(la::LatticeConfigN<D>& c, const std::vector<std::string>& bo
 // lattice_random_start (2D) and lattice3d_random_start
 template <std::size_t D>
 py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<std::string> boundary, PyReal diameter_arg, PyInt seed_arg,
-                        const std::string& init, PyInt tick_bits_arg, PyInt cell_bits_arg) {
+                        const std::string& init, PyInt tick_bits_arg, PyInt cell_bits_arg, std::vector<double> diameters) {
   const auto n = to_int<std::size_t>(n_arg, "n");
   const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
   const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
@@ -380,13 +388,14 @@ py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<std::string> bo
   c.seed = static_cast<std::uint32_t>(seed);
   c.tick_bits = tick_bits;
   c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
+  c.diameters = std::move(diameters);
   return start_dict(la::random_start(c, n, phi, seed, init));
 }
 
 // lattice_quantize (2D) and lattice3d_quantize
 template <std::size_t D>
 py::dict quantize_d(const FArray& x, const FArray& v, std::vector<double> box, std::vector<std::string> boundary, PyReal diameter_arg,
-                    PyInt tick_bits_arg, PyInt cell_bits_arg) {
+                    PyInt tick_bits_arg, PyInt cell_bits_arg, std::vector<double> diameters) {
   const double diameter = to_real(diameter_arg, "diameter");
   const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
   require(box.size() == D, D == 2 ? "lattice: box needs two lengths (2D)" : "lattice: box needs three lengths (3D)");
@@ -399,6 +408,7 @@ py::dict quantize_d(const FArray& x, const FArray& v, std::vector<double> box, s
   c.diameter = diameter;
   c.tick_bits = tick_bits;
   c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
+  c.diameters = std::move(diameters);
   return start_dict(la::quantize_start(c, std::vector<double>(x.data(), x.data() + x.size()),
                                        std::vector<double>(v.data(), v.data() + v.size())));
 }
@@ -414,16 +424,19 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
   def_parallel<Engine, P>(cls);
   cls
       .def(py::init([](const py::dict& units, const IArray& x, const IArray& v, PyInt seed_arg, const std::string& law,
-                       PyInt clock_arg, const std::string& mode) {
+                       PyInt clock_arg, const std::string& mode, const std::optional<IArray>& radius) {
              const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
              const auto clock = to_int<std::int64_t>(clock_arg, "clock");
              const la::UnitsN<D> u = units_from<D>(units);
              const revcol::Law lw = parse_law(law);
              const revcol::Mode md = parse_lattice_mode(mode);
-             return P{Engine(u, vecs<D>(x, "x"), vecs<D>(v, "v"), static_cast<std::uint32_t>(seed), la::operator_for(u, lw), clock, md)};
+             if (!radius || radius->size() == 0)  // one diameter
+               return P{Engine(u, vecs<D>(x, "x"), vecs<D>(v, "v"), static_cast<std::uint32_t>(seed), la::operator_for(u, lw), clock, md)};
+             return P{Engine(u, vecs<D>(x, "x"), vecs<D>(v, "v"), std::vector<std::int64_t>(radius->data(), radius->data() + radius->size()),
+                             static_cast<std::uint32_t>(seed), la::operator_for(u, lw), clock, md)};
            }),
            py::arg("units"), py::arg("x"), py::arg("v"), py::arg("seed"), py::arg("law"), py::arg("clock") = 0,
-           py::arg("mode") = "exact")
+           py::arg("mode") = "exact", py::arg("radius") = py::none())
       .def_static(
           "from_snapshot",
           [](const py::dict& d) {
@@ -500,6 +513,10 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
       .def_property_readonly("collisions", [](const P& p) { return p.engine().collisions(); })
       .def_property_readonly("units", [](const P& p) { return units_dict(p.engine().units()); })
       .def_property_readonly("n", [](const P& p) { return p.engine().size(); })
+      .def_property_readonly("radius", [](const P& p) {
+        const auto r = p.engine().radii();
+        return flat_array(r.data(), r.size());
+      }, "A mixture's radii in lattice units, by particle id (empty: one diameter, units['sigma']).")
       .def_property_readonly("law", [](const P& p) { return std::string(to_string(p.engine().law())); })
       .def_property_readonly("mode", [](const P& p) { return std::string(to_string(p.engine().mode())); })
       // ---- the neighbour search (BasicEngine::set_list_shell): never changes which collisions happen ----
@@ -534,15 +551,19 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
 void register_lattice(py::module_& m) {
   m.def("lattice_random_start", &random_start_d<2>, py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"),
         py::arg("seed"), py::arg("init"), py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
+        py::arg("diameters") = std::vector<double>{},
         "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
   m.def("lattice3d_random_start", &random_start_d<3>, py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"),
         py::arg("seed"), py::arg("init"), py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
+        py::arg("diameters") = std::vector<double>{},
         "A random 3D start (spheres) as engine_random_state, quantized once: {units, x, v, errors}.");
   m.def("lattice_quantize", &quantize_d<2>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
         py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
+        py::arg("diameters") = std::vector<double>{},
         "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
   m.def("lattice3d_quantize", &quantize_d<3>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
         py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
+        py::arg("diameters") = std::vector<double>{},
         "3D units from the box and rms speed, and one quantization of (n, 3) arrays: {units, x, v, errors}.");
   m.def(
       "lattice_initial_bits",

@@ -120,3 +120,17 @@ def size(x, what: str) -> int:
         raise ValueError(f"{what} must be a size: bytes, or a number with K, M, G or T (powers of 1024; e.g. "
                          f"'20G'), or 0 or 'none' for no limit; got {x!r}")
     return int(round(v * SIZE_UNITS[unit]))
+
+
+def diameters_arg(diameters, n: int, diameter: float) -> list:
+    """The per-particle diameters as the binding takes them ([] for one diameter)."""
+    if diameters is None:
+        return []
+    if diameter != 1.0:
+        raise ValueError("give diameter (one for all) or diameters (one per particle), not both")
+    d = real_array(diameters, "diameters")
+    if d.ndim != 1 or d.size != n:
+        raise ValueError(f"diameters must have one entry per particle ({n}), got shape {d.shape}")
+    if not (np.isfinite(d).all() and (d > 0).all()):
+        raise ValueError("diameters must be finite and > 0")
+    return [float(a) for a in d]

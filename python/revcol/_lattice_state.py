@@ -8,9 +8,10 @@ from typing import Optional, Union
 
 import numpy as np
 
+from . import _core
 from ._io import read_checkpoint
 
-__all__ = ["add_reports", "read_state", "snapshot_shell"]
+__all__ = ["add_reports", "read_state", "snapshot_shell", "legacy_snapshot"]
 
 
 def add_reports(a: Optional[dict], b: Optional[dict]) -> Optional[dict]:
@@ -57,3 +58,28 @@ def snapshot_shell(value) -> float:
     if not (shell == 0.0 or 0.02 <= shell <= 2.0):
         raise ValueError(f"snapshot: search = {shell!r} must be -1 (automatic), 0 (cells) or in [0.02, 2]")
     return shell
+
+
+#: what a checkpoint of an older revcol kept whole: its physical state and settings
+_LEGACY_KEPT = ("engine", "dim", "units", "law", "mode", "seed", "clock", "x", "v", "streams", "energy0", "momentum0",
+                "quantization", "search")
+
+
+def legacy_snapshot(source: Union[str, os.PathLike, dict]) -> dict:
+    """The snapshot revcol.lattice.restart_from_legacy starts from (see there)."""
+    st = dict(source) if isinstance(source, dict) else read_state(source)
+    if "log_index" not in st:
+        raise ValueError("restart_from_legacy: this checkpoint is of the current layout: load it with LatticeSimulation.load")
+    missing = [k for k in ("units", "x", "v", "clock", "seed", "streams", "energy0", "momentum0") if k not in st]
+    if missing:
+        raise ValueError(f"restart_from_legacy: the checkpoint lacks {', '.join(missing)}")
+    new = {k: st[k] for k in _LEGACY_KEPT if k in st}
+    n, dim = len(np.asarray(st["x"])), int(np.asarray(st.get("dim", 2)))
+    new.update(_core.lattice_initial_bits(n, int(np.asarray(st["seed"]))))
+    new["origin"], new["collisions"] = new["clock"], 0
+    new["particle_collisions"] = np.zeros(n, dtype=np.uint64)
+    empty_u, empty_i = np.zeros(0, dtype=np.uint64), np.zeros(0, dtype=np.int64)
+    new.update(log_particle=empty_u, log_count=empty_u, log_redraws=empty_u, group_drawer=empty_i, group_draws=empty_u,
+               group_size=empty_i, group_members=empty_i, group_counts=empty_u, group_kind=empty_i,
+               group_v=np.zeros((0, dim), dtype=np.int64))
+    return new

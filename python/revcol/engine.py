@@ -88,10 +88,13 @@ class Simulation(SimulationBase):
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  bits: int = 40, groups: bool = True, group_tol: float = 1e-9,
                  time: float = 0.0, generator: str = "philox", streams: str = "per-particle",
-                 _engine=None):
+                 diameters=None, _engine=None):
         if _engine is not None:
             self._e = _engine
             return
+        if diameters is not None:
+            raise ValueError("diameters (a mixture) run on the lattice engine so far: engine='lattice' "
+                             "(the float engine has one diameter)")
         x = real_array(positions, "positions")
         v = real_array(velocities, "velocities")
         if x.ndim == 1:

@@ -38,11 +38,11 @@ from typing import Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._args import integer, name, names, placement, real, real_array
+from ._args import diameters_arg, integer, name, names, placement, real, real_array
 from ._args import packing_fraction as _packing_fraction
 from ._io import write_checkpoint
-from ._lattice_state import add_reports, read_state as _read_state
-from ._lattice_state import snapshot_shell as _snapshot_shell
+from ._lattice_state import (add_reports, legacy_snapshot as _legacy_snapshot, read_state as _read_state,
+                             snapshot_shell as _snapshot_shell)
 from .simulation import SimulationBase, register_engine
 
 __all__ = ["LatticeSimulation", "LatticeSimulation3D", "MODES", "restart_from_legacy"]
@@ -124,7 +124,10 @@ class LatticeSimulation(SimulationBase):
     changes the speed only, never which collisions happen (the state is the same bit for bit),
     and it is kept in snapshots and checkpoints. ``workers`` (1..64) and ``lps``: run forward on
     the parallel engine, K threads and slabs, the same bits (:meth:`set_parallel`,
-    docs/parallel.md). Bad input raises ``ValueError`` naming the problem.
+    docs/parallel.md). ``diameters`` (one per particle; instead of ``diameter``): a mixture of
+    equal masses, binary, ternary or polydisperse (a pair meets at the sum of its radii; the
+    largest diameter is the lattice's sigma and the others, within a ratio of 16, are quantized to
+    even lattice lengths; docs/mixtures.md). Bad input raises ``ValueError`` naming the problem.
     """
 
     _DIM = 2  # LatticeSimulation3D: 3
@@ -133,7 +136,8 @@ class LatticeSimulation(SimulationBase):
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
-                 workers: int = 1, lps: Optional[int] = None, _engine=None, _quantization: Optional[dict] = None):
+                 workers: int = 1, lps: Optional[int] = None, diameters=None, _engine=None,
+                 _quantization: Optional[dict] = None):
         if _engine is not None:
             self._e = _engine
             self._q = dict(_quantization or {})
@@ -151,14 +155,16 @@ class LatticeSimulation(SimulationBase):
             raise ValueError(f"box must be one length or two (2D), got shape {box.shape}")
         if dim == 3 and (box.ndim > 1 or box.size not in (1, 3)):
             raise ValueError(f"box must be one length or three (3D), got shape {box.shape}")
+        sizes = diameters_arg(diameters, x.shape[0] if x.ndim == 2 else -1, diameter)
         start = getattr(_core, _QUANTIZE[dim])(x, v, [float(b) for b in np.broadcast_to(box, (dim,))],
-                                               _boundary(boundary), diameter, _tick(tick_bits), cell_bits)
+                                               _boundary(boundary), diameter, _tick(tick_bits), cell_bits, sizes)
         self._init_from_start(start, law, seed, dim, shell, mode)
 
     def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2, shell: float = -1.0,
                          mode: str = "exact") -> None:
         engine = getattr(_core, _ENGINE[dim])
-        self._e = engine(start["units"], start["x"], start["v"], seed, name(law, "law"), mode=mode)
+        self._e = engine(start["units"], start["x"], start["v"], seed, name(law, "law"), mode=mode,
+                         radius=start["radius"])
         self._q = {"max_position_error": start["max_position_error"],
                    "max_velocity_error": start["max_velocity_error"]}
         self._search = -1.0
@@ -174,7 +180,8 @@ class LatticeSimulation(SimulationBase):
     def random(cls, n: int, dim: Optional[int] = None, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
                diameter: float = 1.0, seed: int = 1, init: str = "auto", mode: str = "exact", law: str = "flux",
                tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
-               packing_fraction: Optional[float] = None, workers: int = 1, lps: Optional[int] = None) -> "LatticeSimulation":
+               packing_fraction: Optional[float] = None, workers: int = 1, lps: Optional[int] = None,
+               diameters=None) -> "LatticeSimulation":
         """n disks (spheres for LatticeSimulation3D) at area (volume) fraction ``phi`` (or
         ``packing_fraction=``; default 0.3) in a square (cubic) box (the float engine's
         ``random_state``: ``init`` ``"rsa"``, random sequential addition, or ``"crystal"``, a
@@ -182,7 +189,10 @@ class LatticeSimulation(SimulationBase):
         name ``"lattice"`` still works, with a DeprecationWarning; Gaussian velocities with zero
         momentum, kT = 1), quantized once. The same ``seed`` keys the streams. ``dim`` (default:
         the class's, 2 or 3) must be the class's; the other keywords (``mode``, ``law``, ...) as
-        the constructor's."""
+        the constructor's. ``diameters`` (one per particle): a mixture at packing fraction
+        ``phi`` (the particles' own volumes), placed as spheres of the largest diameter (so a
+        mixture's ``phi`` is bounded by the crystal of the largest: about 0.74 of its volume
+        fraction in a periodic cube, less in walls)."""
         n = integer(n, "n", 1)  # not a bool or a float (a named error)
         if dim is not None:
             dim = integer(dim, "dim", 1, 3)
@@ -196,8 +206,9 @@ class LatticeSimulation(SimulationBase):
                 raise ValueError(f"LatticeSimulation is the 2D class, got dim={dim} (spheres: LatticeSimulation3D, or "
                                  "Simulation.random(dim=3, engine='lattice'))")
             raise ValueError(f"LatticeSimulation3D is 3D, got dim={dim}")
+        sizes = diameters_arg(diameters, n, diameter)
         start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, init,
-                                                   _tick(tick_bits), cell_bits)
+                                                   _tick(tick_bits), cell_bits, sizes)
         sim = cls.__new__(cls)
         sim.set_parallel(workers, lps=lps)
         sim._init_from_start(start, law, seed, dim, shell, mode)
@@ -436,6 +447,20 @@ class LatticeSimulation(SimulationBase):
         return dict(self._e.units)
 
     @property
+    def radii(self) -> np.ndarray:
+        """Each particle's radius in lattice units (int64, by id; a pair meets at the sum of two)."""
+        r = np.asarray(self._e.radius, dtype=np.int64)
+        return r if r.size else np.full(self.n, int(self._e.units["sigma"]) // 2, dtype=np.int64)
+
+    @property
+    def diameters(self) -> np.ndarray:
+        """Each particle's diameter in float units (2 radii x length_unit), shape (n,)."""
+        return 2.0 * self.radii.astype(float) * float(self._e.units["length_unit"])
+
+    mixture = property(lambda self: bool(np.asarray(self._e.radius).size),
+                       doc="True for a mixture (built with ``diameters``; sizes kept per particle).")
+
+    @property
     def search(self) -> Union[str, float]:
         """The neighbour search in use: ``"cells"`` (the cell grid) or the neighbour lists' shell
         in diameters (a float, the asked one on the lattice's integer radius); ``"auto"`` has
@@ -534,36 +559,15 @@ class LatticeSimulation(SimulationBase):
         return f"{type(self).__name__}(n={self.n}, collisions={self.collisions}, clock={self.clock})"
 
 
-#: what a checkpoint of an older revcol kept whole: its physical state and settings
-_LEGACY_KEPT = ("engine", "dim", "units", "law", "mode", "seed", "clock", "x", "v", "streams", "energy0", "momentum0",
-                "quantization", "search")
-
-
 def restart_from_legacy(source: Union[str, os.PathLike, dict]) -> "LatticeSimulation":
-    """A new run from a checkpoint (path or snapshot dict) written by a revcol that kept one
-    bits-back integer for the whole gas and keyed its rare log by the global collision index.
-    Such a state cannot resume bit for bit here (its draws and its reverse's keys are those of
-    the old layout), so this keeps its physical state (positions, velocities, clock, stream
-    counters, units, mode, seed) and starts afresh at its clock: origin = clock, no collisions,
-    every particle's X its initial bits (:func:`revcol._core.lattice_initial_bits`), an empty rare
-    log. The run cannot go back before that point (the old run's history is not in the new
-    layout). A checkpoint of this version raises ``ValueError`` (load it with ``load``)."""
-    st = dict(source) if isinstance(source, dict) else _read_state(source)
-    if "log_index" not in st:
-        raise ValueError("restart_from_legacy: this checkpoint is of the current layout: load it with LatticeSimulation.load")
-    missing = [k for k in ("units", "x", "v", "clock", "seed", "streams", "energy0", "momentum0") if k not in st]
-    if missing:
-        raise ValueError(f"restart_from_legacy: the checkpoint lacks {', '.join(missing)}")
-    new = {k: st[k] for k in _LEGACY_KEPT if k in st}
-    n, dim = len(np.asarray(st["x"])), int(np.asarray(st.get("dim", 2)))
-    new.update(_core.lattice_initial_bits(n, int(np.asarray(st["seed"]))))
-    new["origin"], new["collisions"] = new["clock"], 0
-    new["particle_collisions"] = np.zeros(n, dtype=np.uint64)
-    empty_u, empty_i = np.zeros(0, dtype=np.uint64), np.zeros(0, dtype=np.int64)
-    new.update(log_particle=empty_u, log_count=empty_u, log_redraws=empty_u, group_drawer=empty_i, group_draws=empty_u,
-               group_size=empty_i, group_members=empty_i, group_counts=empty_u, group_kind=empty_i,
-               group_v=np.zeros((0, dim), dtype=np.int64))
-    return LatticeSimulation.from_snapshot(new)
+    """A new run from a checkpoint (path or snapshot dict) of a revcol that kept one bits-back
+    integer for the whole gas and keyed its rare log by the global collision index. Such a state
+    cannot resume bit for bit here (its draws and its reverse's keys are the old layout's), so this
+    keeps its physical state (positions, velocities, clock, stream counters, units, mode, seed)
+    and starts afresh at its clock: origin = clock, no collisions, every X its initial bits
+    (:func:`revcol._core.lattice_initial_bits`), an empty rare log; the run cannot go back before
+    it. A checkpoint of this version raises ``ValueError`` (load it with ``load``)."""
+    return LatticeSimulation.from_snapshot(_legacy_snapshot(source))
 
 
 class LatticeSimulation3D(LatticeSimulation):

@@ -4,6 +4,7 @@ bench/results/lattice_validation_*.json.
 
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py matrix [--collisions 1e7]
         [--n 1000 10000] [--phi 0.1 0.3 0.5 0.7] [--boundary wall periodic bounce] [--mode exact|specular] [--out matrix]
+        [--sizes one|binary|gauss]
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py equilibrium [--n 1000] [--phi 0.5]
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py failures [--phi 0.5 0.7] [--seeds 4] [--collisions 2e6] --out failures
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py gas --n 1000 --phi 0.3 --boundary wall --collisions 1e5
@@ -27,6 +28,11 @@ running back from the failed state works, and checks bit for bit from the latest
 the failure (taken every C/100 collisions) back to an earlier one and to 0. Rows are written
 after each gas (atomically: a temporary file renamed), with the commit of the build and the load
 average before and after.
+
+--sizes (matrix, gas): one diameter (default), a binary mixture of equal numbers with size ratio
+1.4 (``binary``), or a polydisperse gas (``gauss``: diameters 1 + 0.1 z, z a standard normal
+truncated at +-2, so the start's crystal of the largest holds area fraction 0.5 and volume
+fraction 0.4), the packing fraction counting each particle's own size.
 
 probe: forward only, one gas per (N, area fraction, boundary) for each tick (--ticks) and cell
 resolution (--cells): the rare log's entries, the group entries and the redraws by reason, the
@@ -232,8 +238,21 @@ def _after_failure(sim, f: dict):
     return LatticeSimulation.from_snapshot(f["last"][1])
 
 
+def sizes_of(sizes: str, n: int, seed: int):
+    """The diameters of --sizes (None: one diameter)."""
+    if sizes == "one":
+        return None
+    if sizes == "binary":
+        d = np.ones(n)
+        d[1::2] = 1.0 / 1.4
+        return d
+    rng = np.random.default_rng(seed)
+    z = rng.standard_normal(4 * n)
+    return 1.0 + 0.1 * z[np.abs(z) <= 2.0][:n]
+
+
 def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, samples: int = 100,
-            law: str = "flux", tick_bits: int = 0, cell_bits: int = 16, mode: str = "exact") -> dict:
+            law: str = "flux", tick_bits: int = 0, cell_bits: int = 16, mode: str = "exact", sizes: str = "one") -> dict:
     """One gas: C collisions forward (snapshot at C/2), back to C/2 (compared), back to 0
     (compared). Returns the row (see the module doc). If the engine fails on the way forward, the
     row says so (``completed`` false, ``forward_error``) and the checks run on the collisions done,
@@ -241,7 +260,8 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     LatticeSimulation = _sim_cls()
     load0 = os.getloadavg()
     sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi), law=law,
-                                   tick_bits=tick_bits or None, cell_bits=cell_bits, mode=mode)
+                                   tick_bits=tick_bits or None, cell_bits=cell_bits, mode=mode,
+                                   diameters=sizes_of(sizes, n, seed))
     s0 = sim.snapshot()
     units = sim.units
     wall = [bool(w) for w in units["wall"]]
@@ -266,7 +286,7 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     log_held = d_end["log_entries"]  # every entry, group bounces included (they are keyed in the same log)
     cc = max(c, 1)
     row = {
-        "dim": DIM, "n": n, "phi": phi, "boundary": boundary, "mode": mode, "law": law, "seed": seed,
+        "dim": DIM, "n": n, "phi": phi, "boundary": boundary, "mode": mode, "law": law, "seed": seed, "sizes": sizes,
         "collisions_asked": int(collisions), "backscatters": d_end.get("backscatters"),
         "collisions": c, "completed": f["error"] is None, "forward_error": f["error"],
         "run_back_from_failure": f.get("run_back_from_failure"), "collisions_checked_back": checked,
@@ -301,17 +321,18 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
 
 def _child(args) -> int:
     row = run_gas(args.n, args.phi, args.boundary, int(float(args.collisions)), args.seed,
-                  tick_bits=args.tick_bits, cell_bits=args.cell_bits, mode=args.mode)
+                  tick_bits=args.tick_bits, cell_bits=args.cell_bits, mode=args.mode, sizes=args.sizes)
     print("ROW " + json.dumps(row), flush=True)
     return 0
 
 
 def run_child(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, tick_bits: int = 0,
-              cell_bits: int = 16, mode: str = "exact") -> dict:
+              cell_bits: int = 16, mode: str = "exact", sizes: str = "one") -> dict:
     """``run_gas`` in a fresh subprocess; adds the child's ru_maxrss (wait4) and exit status."""
     cmd = [sys.executable, os.path.abspath(__file__), "gas", "--n", str(n), "--phi", str(phi),
            "--boundary", boundary, "--collisions", str(int(collisions)), "--seed", str(seed),
-           "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits), "--dim", str(DIM), "--mode", mode]
+           "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits), "--dim", str(DIM), "--mode", mode,
+           "--sizes", sizes]
     t0 = time.time()
     with tempfile.TemporaryFile(mode="w+") as ferr:
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=ferr, text=True)
@@ -337,15 +358,14 @@ def matrix(args) -> dict:
            "build": _build_info(), "dim": DIM, "collisions": c, "mode": args.mode, "law": "flux", "seed": args.seed,
            "tick_bits": args.tick_bits,
            "cell_bits": args.cell_bits, "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "rows": []}
-    for phi in args.phi:  # in the order given: a run cut short still covers both N
-        for n in args.n:
-            for b in args.boundary:
-                row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits, args.mode)
-                res["rows"].append(row)
-                res["updated_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
-                _write_atomic(path, res)
-                print(json.dumps({k: row.get(k) for k in ("n", "phi", "boundary", "collisions", "completed", "bit_for_bit",
-                                                          "log_entries", "child_wall_s")}), flush=True)
+    for phi, n, b, sizes in ((phi, n, b, sizes) for phi in args.phi for n in args.n for b in args.boundary
+                             for sizes in args.sizes):  # in the order given: a run cut short still covers both N
+        row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits, args.mode, sizes)
+        res["rows"].append(row)
+        res["updated_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
+        _write_atomic(path, res)
+        print(json.dumps({k: row.get(k) for k in ("n", "phi", "boundary", "sizes", "collisions", "completed", "bit_for_bit",
+                                                  "log_entries", "child_wall_s")}), flush=True)
     res["finished_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
     _write_atomic(path, res)
     print("wrote", path)
@@ -650,6 +670,8 @@ def main(argv=None) -> int:
     ap.add_argument("--batch", type=float, default=20.0, help="equilibrium: collisions per particle per batch")
     ap.add_argument("--batches", type=int, default=10)
     ap.add_argument("--dim", type=int, default=2, choices=[2, 3], help="2: disks (area fraction); 3: spheres (volume fraction)")
+    ap.add_argument("--sizes", nargs="+", default=["one"], choices=["one", "binary", "gauss"],
+                    help="matrix, gas: a mixture (see the doc)")
     a = ap.parse_args(argv)
     global DIM
     DIM = a.dim
@@ -658,7 +680,7 @@ def main(argv=None) -> int:
     if a.phi is None:
         a.phi = [0.5] if a.what == "equilibrium" else [0.1, 0.3, 0.5, 0.7]
     if a.what == "gas":
-        a.n, a.phi, a.boundary = a.n[0], a.phi[0], a.boundary[0]
+        a.n, a.phi, a.boundary, a.sizes = a.n[0], a.phi[0], a.boundary[0], a.sizes[0]
         return _child(a)
     os.makedirs(RESULTS, exist_ok=True)
     if a.what == "matrix":

@@ -38,14 +38,15 @@ auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, cons
     for (const Vec* vv : {&vi, &vj})
       if ((*vv)[k] > u_.vmax || (*vv)[k] < -u_.vmax) return redraw_outside;
     if (!u_.wall[k]) continue;
-    for (const Vec* xx : {&xi, &xj})
-      if ((*xx)[k] < hlo_ || (*xx)[k] > hhi(static_cast<int>(k))) return redraw_outside;
+    if (xi[k] < lo_of(i) || xi[k] > hi_of(i, static_cast<int>(k))) return redraw_outside;
+    if (xj[k] < lo_of(j) || xj[k] > hi_of(j, static_cast<int>(k))) return redraw_outside;
   }
   int why = 0;
   multi = false;
   for (int s = 0; s < 2 && why == 0; ++s) {
     const Vec& x = s == 0 ? xi : xj;
     const Vec& v = s == 0 ? vi : vj;
+    const int o = s == 0 ? i : j;  // whose post point
     const Vec ghost = wrapped(sub(x, v));
     auto third = [&](int q) {
       if (why != 0 || q == i || q == j) return;
@@ -56,12 +57,11 @@ auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, cons
       double dd = static_cast<double>(d[0]) * d[0];
       for (std::size_t k = 1; k < D; ++k) dd += static_cast<double>(d[k]) * d[k];
       if (dd > far2_) return;
-      if (overlap(x, qa)) why = redraw_overlap_after;
-      else if (overlap(ghost, wrapped(sub(qa, ln_[q].v)))) why = redraw_ghost_tie;
-      if (overlap(pre_a[s], qa)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
+      if (overlap(x, qa, o, q)) why = redraw_overlap_after;
+      else if (overlap(ghost, wrapped(sub(qa, ln_[q].v)), o, q)) why = redraw_ghost_tie;
+      if (overlap(pre_a[s], qa, o, q)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
     };
     if (direct_) {  // the owner's list (x is within 2 vmax of its line), far ones dropped in double
-      const int o = s == 0 ? i : j;
       const std::array<double, D> ax = unwrapped_about(o, x);
       const int* ids = nl_.ids(o);
       const std::uint8_t* codes = nl_.codes(o);
@@ -129,11 +129,13 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
   Vec xi2, xj2, vi2, vj2;
   Bits out;
+  std::optional<Op> opm;
+  const Op& op = op_of(i, j, opm);
   std::uint32_t redraws = 0;
   for (;;) {
     if (static_cast<std::int64_t>(redraws) > max_redraws) return group_collide(i, j, a, ctr0, reasons, !fallback);
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr++);
-    const auto rf = op_.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi2, xj2, vi2, vj2, out);
+    const auto rf = op.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi2, xj2, vi2, vj2, out);
     int why = static_cast<int>(rf);
     if (why == 0) {
       xi2 = shifted(xj, xi2);
@@ -185,7 +187,8 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr - 1);
   Vec xi0, xj0, vi0, vj0;
   if (own_[i].pc == 0 || own_[j].pc == 0) inconsistent("a collision count would step back past 0", i, j);
-  op_.pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi0, xj0, vi0, vj0);
+  std::optional<Op> opm;
+  op_of(i, j, opm).pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi0, xj0, vi0, vj0);
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
   own_[i].ctr -= 1 + redraws;
@@ -213,7 +216,8 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
   Vec xi2, xj2, vi2, vj2;
   SpecularTrace tr;
   bool multi = false;
-  int why = static_cast<int>(spec_.pair_map(xi, zero, ln_[i].v, ln_[j].v, xi2, xj2, vi2, vj2, &tr));
+  std::optional<Specular> spm;
+  int why = static_cast<int>(spec_of(i, j, spm).pair_map(xi, zero, ln_[i].v, ln_[j].v, xi2, xj2, vi2, vj2, &tr));
   if (why == 0) {
     xi2 = shifted(xj, xi2);
     xj2 = shifted(xj, xj2);
@@ -245,7 +249,8 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::back_specular(int i, int j, std::int64_t a) {
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
   Vec xi0, xj0, vi0, vj0;
-  if (spec_.pair_unmap(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi0, xj0, vi0, vj0) != Refusal::none)
+  std::optional<Specular> spm;
+  if (spec_of(i, j, spm).pair_unmap(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi0, xj0, vi0, vj0) != Refusal::none)
     inconsistent("the specular map refuses the post state it is to take back", i, j);
   if (own_[i].pc == 0 || own_[j].pc == 0) inconsistent("a collision count would step back past 0", i, j);
   xi0 = shifted(xj, xi0);

@@ -29,11 +29,31 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
   double s2 = 0.0;
   for (double a : v) s2 += a * a;
   const double v_rms = std::sqrt(s2 / static_cast<double>(x.size() / D));
+  const std::size_t n = x.size() / D;
+  double dmax = c.diameter;
+  if (!c.diameters.empty()) {
+    require(c.diameters.size() == n, [&] {
+      return "lattice: diameters must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(c.diameters.size());
+    });
+    dmax = 0.0;
+    for (double d : c.diameters) {
+      require(std::isfinite(d) && d > 0.0, "lattice: every diameter must be finite and > 0");
+      dmax = std::max(dmax, d);
+    }
+  }
   LatticeStartN<D> s;
-  s.units = choose_units_d<D>(c.box, c.diameter, v_rms, c.wall, c.tick_bits, c.cell_bits, x.size() / D);
+  s.units = choose_units_d<D>(c.box, dmax, v_rms, c.wall, c.tick_bits, c.cell_bits, n);
   s.units.bounce = c.bounce;
   validate(s.units);
-  QuantizedN<D> q = quantize(s.units, x, v);
+  if (!c.diameters.empty()) {
+    s.radius.resize(n);
+    for (std::size_t p = 0; p < n; ++p) {  // the largest exactly sigma / 2
+      const double r = c.diameters[p] == dmax ? static_cast<double>(s.units.sigma / 2) : std::round(0.5 * c.diameters[p] / s.units.length_unit);
+      s.radius[p] = static_cast<std::int64_t>(std::min(r, static_cast<double>(s.units.sigma / 2)));
+    }
+    validate_radii(s.units, s.radius, n);
+  }
+  QuantizedN<D> q = quantize(s.units, x, v, s.radius);
   s.x = std::move(q.x);
   s.v = std::move(q.v);
   s.max_position_error = q.max_position_error;
@@ -49,7 +69,28 @@ LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double 
   fc.diameter = c.diameter;
   for (std::size_t k = 0; k < D; ++k)
     fc.boundary[k] = !c.wall[k] ? engine::Boundary::periodic : c.bounce[k] ? engine::Boundary::bounce : engine::Boundary::wall;
-  const engine::InitialState st = engine::random_state(fc, n, phi, seed, 0.0, init);
+  engine::InitialState st;
+  if (c.diameters.empty()) {
+    st = engine::random_state(fc, n, phi, seed, 0.0, init);
+  } else {
+    // a mixture: the cube whose packing fraction (the particles' own volumes) is phi, the
+    // particles placed as spheres of the largest diameter (every pair then at least that far
+    // apart), particle p taking diameters[p]
+    require(c.diameters.size() == n, [&] {
+      return "lattice: diameters must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(c.diameters.size());
+    });
+    require(std::isfinite(phi) && phi > 0.0, "lattice: the packing fraction must be > 0");
+    double vol = 0.0, dmax = 0.0;
+    for (double d : c.diameters) {
+      require(std::isfinite(d) && d > 0.0, "lattice: every diameter must be finite and > 0");
+      vol += engine::particle_volume(static_cast<int>(D), d);
+      dmax = std::max(dmax, d);
+    }
+    fc.diameter = dmax;
+    const double L = std::pow(vol / phi, 1.0 / static_cast<double>(D));
+    for (std::size_t k = 0; k < D; ++k) fc.box[k] = L;
+    st = engine::random_start(fc, n, seed, 0.0, init);
+  }
   LatticeConfigN<D> lc = c;
   for (std::size_t k = 0; k < D; ++k) lc.box[k] = st.config.box[k];
   return quantize_start(lc, st.x, st.v);

@@ -218,10 +218,12 @@ namespace {
 // arithmetic: a collision of keys only adds candidates, every pair is decided exactly). With
 // velocities (v non-null), a pair that overlaps at the clock but did not one tick earlier is a
 // collision pending at this tick (a snapshot taken between two collisions of one tick), not an
-// overlap.
+// overlap. A mixture (radius non-empty): a pair's contact distance is the sum of its radii
+// (at most sigma, the cells' width).
 template <std::size_t Dim>
-void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>* v) {
-  const u128 s2 = static_cast<u128>(u.sigma) * static_cast<u128>(u.sigma);
+void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>* v,
+                    const std::vector<std::int64_t>& radius) {
+  const u128 sigma2 = static_cast<u128>(u.sigma) * static_cast<u128>(u.sigma);
   std::array<std::int64_t, Dim> nc{};
   for (std::size_t k = 0; k < Dim; ++k) nc[k] = std::max<std::int64_t>(1, u.L[k] / u.sigma);
   using Cell = std::array<std::int64_t, Dim>;
@@ -257,6 +259,7 @@ void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
       if (it == grid.end()) continue;
       for (int j : it->second) {
         if (j <= static_cast<int>(i)) continue;
+        const u128 s2 = radius.empty() ? sigma2 : contact2(radius[i] + radius[static_cast<std::size_t>(j)]);
         VecN<Dim> r;
         for (std::size_t k = 0; k < Dim; ++k) {
           const std::int64_t d = x[i][k] - x[j][k];
@@ -280,13 +283,14 @@ void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
 
 template <std::size_t Dim>
 void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v,
-                    bool pending) {
+                    bool pending, const std::vector<std::int64_t>& radius) {
   validate(u);
   require(x.size() == v.size(), "lattice: x (positions) and v (velocities) differ in length");
   require(!x.empty(), "lattice: no particles");
   require(x.size() < (std::size_t{1} << 30), "lattice: at most 2^30 particles");
-  const std::int64_t h = u.sigma / 2;
+  validate_radii(u, radius, x.size());
   for (std::size_t i = 0; i < x.size(); ++i) {
+    const std::int64_t h = radius.empty() ? u.sigma / 2 : radius[i];
     for (std::size_t k = 0; k < Dim; ++k) {
       require(x[i][k] >= 0 && x[i][k] < u.L[k], [&] {
         return "lattice: particle " + std::to_string(i) + " is outside the box [0, L)";
@@ -304,11 +308,27 @@ void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
   const u128 e = kinetic2(v);
   require(e <= static_cast<u128>(u.vmax) * static_cast<u128>(u.vmax),
           "lattice: the total kinetic energy allows a speed beyond vmax (too many particles for the velocity scale)");
-  check_overlaps(u, x, pending ? &v : nullptr);
+  check_overlaps(u, x, pending ? &v : nullptr, radius);
 }
 
 template <std::size_t Dim>
-QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, const std::vector<double>& v) {
+void validate_radii(const UnitsN<Dim>& u, const std::vector<std::int64_t>& radius, std::size_t n) {
+  if (radius.empty()) return;
+  require(radius.size() == n, [&] {
+    return "lattice: radius must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(radius.size());
+  });
+  const std::int64_t lo = min_radius(u);
+  for (std::size_t i = 0; i < n; ++i)
+    require(radius[i] >= lo && 2 * radius[i] <= u.sigma, [&] {
+      return "lattice: particle " + std::to_string(i) + "'s radius " + std::to_string(radius[i]) +
+             " is outside [sigma / 32, sigma / 2] = [" + std::to_string(lo) + ", " + std::to_string(u.sigma / 2) +
+             "] lattice units (sigma, the largest diameter; diameters within a ratio of 16)";
+    });
+}
+
+template <std::size_t Dim>
+QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, const std::vector<double>& v,
+                         const std::vector<std::int64_t>& radius) {
   validate(u);
   require(x.size() == v.size() && x.size() % Dim == 0,
           Dim == 2 ? "lattice: positions and velocities must both be n x 2" : "lattice: positions and velocities must both be n x 3");
@@ -340,7 +360,7 @@ QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, con
       }
     }
   }
-  validate_state(u, q.x, q.v);
+  validate_state(u, q.x, q.v, false, radius);
   return q;
 }
 
@@ -477,10 +497,12 @@ template UnitsN<3> choose_units_d<3>(const std::array<double, 3>&, double, doubl
                                      std::size_t);
 template u128 kinetic2(const std::vector<VecN<2>>&) noexcept;
 template u128 kinetic2(const std::vector<VecN<3>>&) noexcept;
-template void validate_state(const UnitsN<2>&, const std::vector<VecN<2>>&, const std::vector<VecN<2>>&, bool);
-template void validate_state(const UnitsN<3>&, const std::vector<VecN<3>>&, const std::vector<VecN<3>>&, bool);
-template QuantizedN<2> quantize(const UnitsN<2>&, const std::vector<double>&, const std::vector<double>&);
-template QuantizedN<3> quantize(const UnitsN<3>&, const std::vector<double>&, const std::vector<double>&);
+template void validate_state(const UnitsN<2>&, const std::vector<VecN<2>>&, const std::vector<VecN<2>>&, bool, const std::vector<std::int64_t>&);
+template void validate_state(const UnitsN<3>&, const std::vector<VecN<3>>&, const std::vector<VecN<3>>&, bool, const std::vector<std::int64_t>&);
+template void validate_radii(const UnitsN<2>&, const std::vector<std::int64_t>&, std::size_t);
+template void validate_radii(const UnitsN<3>&, const std::vector<std::int64_t>&, std::size_t);
+template QuantizedN<2> quantize(const UnitsN<2>&, const std::vector<double>&, const std::vector<double>&, const std::vector<std::int64_t>&);
+template QuantizedN<3> quantize(const UnitsN<3>&, const std::vector<double>&, const std::vector<double>&, const std::vector<std::int64_t>&);
 template class CellGridN<2>;
 template class CellGridN<3>;
 

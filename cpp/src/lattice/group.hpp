@@ -37,7 +37,7 @@ auto BasicEngine<Op, Bits, Queue>::group_of(int i, int j, std::int64_t a) const 
   for (std::size_t m = 0; m < g.size(); ++m) {
     const Vec xa = pos(g[m], a);
     near(g[m], [&](int q) {
-      if (!member(q) && overlap(xa, pos(q, a))) g.push_back(q);
+      if (!member(q) && overlap(xa, pos(q, a), g[m], q)) g.push_back(q);
     });
   }
   return g;
@@ -73,8 +73,8 @@ auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g,
       }
       const double len = std::sqrt(ddot(rd, rd));
       // touching: the pre lines overlap at a, or the pair is within one tick's relative travel at a-1
-      const bool near = len < static_cast<double>(u_.sigma) + std::sqrt(ddot(w, w));
-      if (len > 0.0 && (near || overlap(pos(g[p], a), pos(g[q], a)))) {
+      const bool near = len < static_cast<double>(rad(g[p]) + rad(g[q])) + std::sqrt(ddot(w, w));
+      if (len > 0.0 && (near || overlap(pos(g[p], a), pos(g[q], a), g[p], g[q]))) {
         for (std::size_t k = 0; k < D; ++k) rd[k] /= len;
         touch.push_back({p, q, rd});
       }
@@ -84,7 +84,7 @@ auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g,
   for (std::size_t m = 0; m < n; ++m) {
     const Vec xa = pos(g[m], a);
     for (std::size_t k = 0; k < D; ++k)
-      if (u_.wall[k]) wall[m][k] = xa[k] < hlo_ ? -1 : xa[k] > hhi(static_cast<int>(k)) ? 1 : 0;
+      if (u_.wall[k]) wall[m][k] = xa[k] < lo_of(g[m]) ? -1 : xa[k] > hi_of(g[m], static_cast<int>(k)) ? 1 : 0;
   }
   const double eps = 1e-12 * static_cast<double>(u_.vmax);
   for (int sweep = 0; sweep < 64; ++sweep) {
@@ -149,12 +149,12 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
     for (std::size_t m = 0; m < g.size() && !grew; ++m) {
       for (std::size_t k = 0; k < D; ++k) {
         if (vel[m][k] > u_.vmax || vel[m][k] < -u_.vmax) return false;
-        if (u_.wall[k] && (post[m][k] < hlo_ || post[m][k] > hhi(static_cast<int>(k)))) return false;
+        if (u_.wall[k] && (post[m][k] < lo_of(g[m]) || post[m][k] > hi_of(g[m], static_cast<int>(k)))) return false;
       }
       const Vec ghost = wrapped(sub(post[m], vel[m]));  // the new line at a-1
       near(g[m], [&](int q) {
         if (grew || member(q)) return;
-        if (overlap(post[m], pos(q, a)) || overlap(ghost, pos(q, a - 1))) {
+        if (overlap(post[m], pos(q, a), g[m], q) || overlap(ghost, pos(q, a - 1), g[m], q)) {
           g.push_back(q);
           grew = true;
         }
@@ -168,7 +168,7 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
       for (std::size_t q = p + 1; q < g.size(); ++q) {
         const Vec gp = wrapped(sub(post[p], vel[p]));
         const Vec gq = wrapped(sub(post[q], vel[q]));
-        if (overlap(gp, gq)) return true;  // the reverse meets this pair at a-1
+        if (overlap(gp, gq, g[p], g[q])) return true;  // the reverse meets this pair at a-1
       }
     return false;
   }

@@ -2,6 +2,26 @@
 // reflection (a mirror on the transition into the first tick beyond the wall).
 // Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
 // design); included by engine_impl.hpp, which the instantiating sources include.
+//
+// Event rule. Invariant: no pair overlaps at any integer tick, and every centre is inside [h, H] on
+// wall axes (a mixture: [r_p, L - r_p], sizes.hpp). A pair collides on the transition a-1 -> a
+// where a is the first tick at which its incoming lines overlap; a wall reflects on the transition into the first tick beyond it
+// (cell_grid.hpp; a line anchored beyond a wall, by a neutral event of the reflection's tick or,
+// in the reverse, by the undo of a collision that came right after a reflection on the same
+// tick, reflects on that tick); a cell crossing is neutral. One event per particle in the queue (its earliest:
+// crossing, wall, or collision with a neighbour); a collision found by p with q is also written into
+// q's slot when it is earlier there, so a pair's collision sits in both slots; an event whose versions
+// are stale is recomputed when it comes up.
+//
+// Neighbour search (set_list_shell): cells or neighbour lists, behind a double filter; neither
+// changes which collisions happen (predict.hpp; docs/lattice.md "Finding the next event").
+// Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
+// collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
+// lo descending (kind 1 + (N - 1 - lo)), then walls (kind N + 1). So the reverse undoes each tick's
+// state changes in exactly the opposite order: the bits-back X and the streams are stacks.
+//
+// Reverse (the prototype's engine.py): negate velocities, anchor ticks and the clock, run the same
+// search, apply v -> -reverse(-v) at each collision with the streams stepping back, negate again.
 #pragma once
 #include <algorithm>
 #include <stdexcept>
@@ -176,18 +196,18 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   journal(p);
   Vec x = pos(p, a - 1), v = ln_[p].v;
   const Vec old_line_at_a = pos(p, a);
-  const unsigned axes = reflection(x, v);
+  const unsigned axes = reflection(p, x, v);
   const Vec ghost = wrapped(sub(x, v));
   near(p, [&](int q) {
     if (q == p) return;
     // the forward's guard (its reverse would meet q first); the reverse replays the forward, and
     // its ghost is the forward's pre-wall line at a, beyond the wall (right after a collision
     // undone on this tick, a body may well overlap it there)
-    if (!reversed_ && overlap(ghost, pos(q, a - 1))) {
+    if (!reversed_ && overlap(ghost, pos(q, a - 1), p, q)) {
       throw std::runtime_error("lattice engine: a wall and a body within one tick that the rule cannot resolve (particle " +
                                std::to_string(p) + ", tick " + std::to_string(a) + "); not supported yet");
     }
-    if (overlap(old_line_at_a, pos(q, a))) ++cnt_.wall_body;
+    if (overlap(old_line_at_a, pos(q, a), p, q)) ++cnt_.wall_body;
   });
   if (!reversed_ && (obs_ || events || seen_)) [[unlikely]] note_wall(a, p, x, v, axes);
   pre_wall_[p] = Line{pos(p, a - 1), ln_[p].v, a - 1};  // a group collision at a may take it back
@@ -202,17 +222,17 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
 }
 
 template <class Op, class Bits, class Queue>
-unsigned BasicEngine<Op, Bits, Queue>::reflection(Vec& x, Vec& v) const noexcept {
+unsigned BasicEngine<Op, Bits, Queue>::reflection(int p, Vec& x, Vec& v) const noexcept {
   unsigned axes = 0;  // the walls it meets
   bool whole = false;  // one of them bounces back
   for (std::size_t k = 0; k < D; ++k)
-    if (u_.wall[k] && (x[k] + v[k] < hlo_ || x[k] + v[k] > hhi(static_cast<int>(k)))) {
+    if (u_.wall[k] && (x[k] + v[k] < lo_of(p) || x[k] + v[k] > hi_of(p, static_cast<int>(k)))) {
       axes |= 1u << k;
       whole = whole || u_.bounce[k];
     }
   const Vec v0 = v;
   for (std::size_t k = 0; k < D; ++k) {
-    if (axes >> k & 1u) wall_mirror(x[k], v[k], hlo_, hhi(static_cast<int>(k)));
+    if (axes >> k & 1u) wall_mirror(x[k], v[k], lo_of(p), hi_of(p, static_cast<int>(k)));
     else if (!whole) x[k] += v[k];  // a bounce back: the other axes stall at their a-1 point
     if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
   }

@@ -102,9 +102,9 @@ bool BasicEngine<Op, Bits, Queue>::lp_clear(int id, const EventKey& k) const {
   const Vec x = pos(p, k.t), x0 = pos(p, k.t - 1);
   bool clear = true;
   near(p, [&](int q) {
-    if (q == p || !overlap(x, pos(q, k.t))) return;
+    if (q == p || !overlap(x, pos(q, k.t), p, q)) return;
     const EventKey pair{k.t, coll_kind(p, q), std::min(gid(p), gid(q))};
-    if (!(k < pair) || overlap(x0, pos(q, k.t - 1))) clear = false;
+    if (!(k < pair) || overlap(x0, pos(q, k.t - 1), p, q)) clear = false;
   });
   return clear;
 }

@@ -114,11 +114,12 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
       if (dt > 0) b.offer(lo + dt, 0, cross, -1, -1);
     }
     if (u_.wall[k]) {
-      const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], hlo_, hhi(static_cast<int>(k)));
+      const std::int64_t dw = wall_ticks(ln_[p].x[k], ln_[p].v[k], lo_of(p), hi_of(p, static_cast<int>(k)));
       if (dw >= 0) b.offer(lo + dw, wall_kind(), wall, -1, -1);
     }
   }
-  scan(p, lo, b);
+  if (sz_.mixed()) scan<true>(p, lo, b);
+  else scan<false>(p, lo, b);
   schedule(p, b.type, b.t, b.k, b.q);
   if (b.type == coll) {  // write it into the partner's slot when before the event there
     // in offer's order (tick, kind, other particle): with (tick, kind) alone, a tie (two pairs of
@@ -135,6 +136,7 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
 
 // p's candidate partners (its list, or its 3^D cells) into b.
 template <class Op, class Bits, class Queue>
+template <bool Mixed>
 inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) {
   // The candidates. A double-precision filter drops the pairs that cannot collide, or not
   // before the best event so far; the others get the exact search (measure before changing).
@@ -151,25 +153,38 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
     const Vec r = diff(lp.x, pos(q, lo));
     std::int64_t tau;
     if constexpr (D == 3) {
-      tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_, guess);
+      tau = first_overlap(r, sub(lp.v, ln_[q].v), Mixed ? sig2(p, q) : sigma2_, guess);
     } else {
       (void)guess;
-      tau = first_overlap(r, sub(lp.v, ln_[q].v), sigma2_);
+      tau = first_overlap(r, sub(lp.v, ln_[q].v), Mixed ? sig2(p, q) : sigma2_);
     }
     if (tau >= 0) {
       b.offer(lo + tau, coll_kind(p, q), coll, q, gid(q));
       tb = static_cast<double>(b.t - lo);
     }
   };
-  // the filter's tests on r, w (doubles): true when the pair surely has no overlap tick <= t
-  auto beyond = [&](double rr, double bb, double aa, double t) {
+  // the filter's tests on r, w (doubles) for the contact distance s2 (squared): true when the
+  // pair surely has no overlap tick <= t
+  auto beyond = [&](double rr, double bb, double aa, double t, double s2) {
     // never inside: the smallest |r + w t|^2 over t >= 0 (rr - bb^2 / aa when approaching, here
     // times aa: no division on the loop's path; its rounding, ~4u rr aa by Cauchy-Schwarz, is far
     // inside the margin) is beyond sigma^2
-    const double lim = sigma2d_ + 1e-6 * (rr + sigma2d_);
+    const double lim = s2 + 1e-6 * (rr + s2);
     if (bb >= 0.0 ? rr > lim : rr * aa - bb * bb > lim * aa) return true;
     // not up to t: f(t) = |r + w t|^2 is still falling at t and outside there
-    return t != never && -bb >= aa * t && rr + t * (2.0 * bb + aa * t) > sigma2d_ + 1e-6 * (rr + aa * t * t + sigma2d_);
+    return t != never && -bb >= aa * t && rr + t * (2.0 * bb + aa * t) > s2 + 1e-6 * (rr + aa * t * t + s2);
+  };
+  // a mixture's contact distance squared, in double (the radii are the lines' doubles; within
+  // the filter's margin of the exact sum); one diameter: sigma^2
+  const double rp = Mixed ? lnd_[static_cast<std::size_t>(p)].r : 0.0;
+  auto s2d = [&](int q) {
+    if constexpr (!Mixed) {
+      (void)q;
+      return sigma2d_;
+    } else {
+      const double s = rp + lnd_[static_cast<std::size_t>(q)].r;
+      return s * s;
+    }
   };
   if (direct_ && !exhaustive_search) {
     // lists on a box wide enough: r = (a_p - a_q - s) - v_q (lo - t_q), with a the anchors
@@ -194,10 +209,11 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
         bb += r * w;
         aa += w * w;
       }
-      if (beyond(rr, bb, aa, tb)) continue;
+      const double s2 = s2d(q);
+      if (beyond(rr, bb, aa, tb, s2)) continue;
       // the entry root of aa t^2 + 2 bb t + rr - sigma^2 from these doubles: first_overlap's
       // first guess (its exact predicates decide; any guess gives the same answer)
-      const double c0 = rr - sigma2d_;
+      const double c0 = rr - s2;
       exact(q, c0 / (std::sqrt(std::max(0.0, bb * bb - aa * c0)) - bb));
     }
   } else if (!lists_ && shifted_ && !exhaustive_search) {
@@ -218,7 +234,7 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
         bb += r * w;
         aa += w * w;
       }
-      if (!beyond(rr, bb, aa, tb)) exact(q, std::numeric_limits<double>::quiet_NaN());
+      if (!beyond(rr, bb, aa, tb, s2d(q))) exact(q, std::numeric_limits<double>::quiet_NaN());
     });
   } else {
     std::array<double, D> xp{};
@@ -242,7 +258,7 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
           bb += r * w;
           aa += w * w;
         }
-        if (!edge && beyond(rr, bb, aa, tb)) return;
+        if (!edge && beyond(rr, bb, aa, tb, s2d(q))) return;
       }
       exact(q, std::numeric_limits<double>::quiet_NaN());
     });

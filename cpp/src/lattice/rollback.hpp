@@ -294,7 +294,7 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::undo_wall(int p, std::int64_t a, const WallDone& w) {
   Vec x = pos(p, a), v = neg(ln_[p].v);
-  if (reflection(x, v) == 0) throw std::logic_error("lattice rollback: a reflection's post line meets no wall (a bug)");
+  if (reflection(p, x, v) == 0) throw std::logic_error("lattice rollback: a reflection's post line meets no wall (a bug)");
   ln_[p] = Line{x, neg(v), a - 1};
   pre_wall_[p] = w.pre_wall;
   wall_tick_[p] = w.wall_tick;
@@ -318,13 +318,15 @@ void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, 
   const Vec xj = pos(j, a), xi = diff(pos(i, a), xj), zero{};
   Vec xi0, xj0, vi0, vj0;
   if (mode_ == Mode::specular && logged == log_.end()) {  // (a log entry: a drawn fallback)
-    if (spec_.pair_unmap(xi, zero, ln_[i].v, ln_[j].v, xi0, xj0, vi0, vj0) != Refusal::none)
+    std::optional<Specular> spm;
+    if (spec_of(i, j, spm).pair_unmap(xi, zero, ln_[i].v, ln_[j].v, xi0, xj0, vi0, vj0) != Refusal::none)
       throw std::logic_error("lattice rollback: the specular map refused a post state it wrote (a bug)");
   } else {
     const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
     if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice rollback: a stream would step back past draw 0 (a bug)");
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr - 1);
-    op_.pair_reverse(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi0, xj0, vi0, vj0);
+    std::optional<Op> opm;
+    op_of(i, j, opm).pair_reverse(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi0, xj0, vi0, vj0);
     own_[i].ctr -= 1 + redraws;
     if (logged != log_.end()) log_.erase(logged);
   }
@@ -394,12 +396,14 @@ void BasicEngine<Op, Bits, Queue>::redo_collision(const Done& d) {
   Vec xi2, xj2, vi2, vj2;
   const bool logged = (d.unreflected & 8u) != 0;
   if (mode_ == Mode::specular && !logged) {
-    if (spec_.pair_map(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi2, xj2, vi2, vj2, nullptr) != Refusal::none)
+    std::optional<Specular> spm;
+    if (spec_of(i, j, spm).pair_map(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi2, xj2, vi2, vj2, nullptr) != Refusal::none)
       throw std::logic_error("lattice rollback: the specular map refused a collision a back step took back (a bug)");
   } else {
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr + side.redraws);
     Bits out;
-    if (op_.pair_forward(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi2, xj2, vi2, vj2, out) != Refusal::none)
+    std::optional<Op> opm;
+    if (op_of(i, j, opm).pair_forward(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi2, xj2, vi2, vj2, out) != Refusal::none)
       throw std::logic_error("lattice rollback: the operator refused the draw a back step took back (a bug)");
     own_[i].X = std::move(out);
     own_[i].ctr += 1 + static_cast<std::uint64_t>(side.redraws);
@@ -445,7 +449,7 @@ void BasicEngine<Op, Bits, Queue>::undo_group(std::int64_t a, const Group& entry
     const int m = s == 0 ? i : j;
     pre_wall_[m] = ln_[m];
     Vec x = pos(m, a - 1), v = ln_[m].v;
-    if (reflection(x, v) == 0) throw std::logic_error("lattice rollback: a group member's reflection meets no wall (a bug)");
+    if (reflection(m, x, v) == 0) throw std::logic_error("lattice rollback: a group member's reflection meets no wall (a bug)");
     ln_[m] = Line{x, v, a};
     wall_tick_[m] = a;
   }

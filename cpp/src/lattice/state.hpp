@@ -3,6 +3,18 @@
 // forward run's undo journal (an engine error mid-run restores the state).
 // Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
 // design); included by engine_impl.hpp, which the instantiating sources include.
+//
+// State: per particle an anchor position (integer, wrapped into the box) at an anchor tick, an
+// integer velocity, a line version (bumped when the line changes), a Philox stream counter, a
+// bits-back integer X (about 128 bits) and a collision count; the clock; the rare log; the
+// collision count. Free flight is exact: x(t) = x_a + v (t - t_a), wrapped on periodic axes.
+// Every collision reads and writes only its particles' state: the pair operator runs on the
+// drawing particle's X (the lower index i of the pair), and the rare log and the group entries
+// are keyed by (particle, that particle's collision count after the collision), never by a global
+// index. So collisions in different places commute, and a state cut into regions is the same
+// state (ARCHITECTURE.md, "Per-particle state"); the global collision count is the sum.
+// A mixture adds each particle's radius (sizes.hpp), fixed for the run.
+//
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -71,7 +83,8 @@ void BasicEngine<Op, Bits, Queue>::check_log(const Snapshot& s) const {
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<std::uint32_t>& order) {
-  validate_state(s.units, s.x, s.v, true);  // collisions may be pending at the clock (rebuild finds them)
+  validate_state(s.units, s.x, s.v, true, s.radius);  // collisions may be pending at the clock (rebuild finds them)
+  if (!s.radius.empty()) Sizes::require_resizable<Op>();
   if (!order.empty()) {
     require(order.size() == s.x.size(), "lattice: an order must name every particle once (a permutation of [0, N))");
     std::vector<char> seen(order.size(), 0);
@@ -137,6 +150,7 @@ auto BasicEngine<Op, Bits, Queue>::snapshot() const -> Snapshot {
   s.energy0 = energy0_;
   s.momentum0 = momentum0_;
   s.counters = cnt_;
+  s.radius = radii();
   if (obs_) obs_->save(s.observer, s.observer_counts);  // a running observation resumes (observe.hpp)
   return s;
 }
@@ -165,10 +179,11 @@ auto BasicEngine<Op, Bits, Queue>::streams() const -> std::vector<std::uint64_t>
 // A new state: the particles' streams at 0, their X from initial_bits, energy and momentum recorded.
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::fresh(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed,
-                                         std::int64_t clock, Mode mode) const -> Snapshot {
+                                         std::int64_t clock, Mode mode, std::vector<std::int64_t> radius) const -> Snapshot {
   check_operator(u);
   require(mode == Mode::exact || mode == Mode::specular, "lattice: mode must be 'exact' or 'specular'");
-  validate_state(u, x, v);
+  validate_state(u, x, v, false, radius);
+  if (!radius.empty()) Sizes::require_resizable<Op>();
   require(clock > -tick_limit / 2 && clock < tick_limit / 2, "lattice: the start tick must be within +-2^60");
   Snapshot s;
   s.units = u;
@@ -178,6 +193,7 @@ auto BasicEngine<Op, Bits, Queue>::fresh(const Units& u, std::vector<Vec> x, std
   s.clock = s.origin = clock;
   s.x = std::move(x);
   s.v = std::move(v);
+  s.radius = std::move(radius);
   s.streams.assign(s.x.size(), 0);
   s.particle_collisions.assign(s.x.size(), 0);
   for (std::size_t p = 0; p < s.x.size(); ++p) {
@@ -215,6 +231,7 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s, const std::vector<std
   ln_.resize(n);
   slot_.assign(n, Slot{});
   own_.assign(n, Own{});
+  sz_.set(u_.sigma, s.radius, [this](int p) { return gid(p); });
   for (std::size_t p = 0; p < n; ++p) {
     const auto q = static_cast<std::size_t>(gid(static_cast<int>(p)));
     ln_[p] = Line{s.x[q], s.v[q], s.clock};
@@ -297,7 +314,10 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
     shifted_ = grid_.shifted();
   }
   lnd_.resize(n);
-  for (std::size_t p = 0; p < n; ++p) sync(static_cast<int>(p));
+  for (std::size_t p = 0; p < n; ++p) {
+    sync(static_cast<int>(p));
+    lnd_[p].r = static_cast<double>(rad(static_cast<int>(p)));
+  }
   // first bucket width: ~2^tick_bits ticks per mean free time per particle, over N particles
   // (the queue adapts it; a speed setting only)
   queue_.reset(n, clock_, std::max<std::int64_t>(1, (std::int64_t{1} << u_.tick_bits) / static_cast<std::int64_t>(n)), !gid_.empty());
@@ -321,11 +341,12 @@ void BasicEngine<Op, Bits, Queue>::release() {
   grid_ = CellGridN<D>{};
   nl_ = NeighbourListsN<D>{};
   queue_ = Queue{};
+  sz_.clear();
 }
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::check_operator(const Units& u) const {
-  require(op_.sigma() == u.sigma, "lattice: the operator's sigma differs from the units'");
+  require(op_.sigma() == u.sigma, "lattice: the operator's sigma differs from the units' (the largest diameter)");
   if constexpr (requires { op_.cell_bits(); })
     require(op_.cell_bits() == u.cell_bits, "lattice: the operator's cell_bits differ from the units'");
 }
@@ -405,6 +426,7 @@ void BasicEngine<Op, Bits, Queue>::resort(std::int64_t t) {
   permute(wall_tick_);
   permute(pre_wall_);
   permute(undo_epoch_);
+  permute(sz_.data());
   for (Saved& sv : undo_) sv.p = to[static_cast<std::size_t>(sv.p)];
   gid_.assign(order.begin(), order.end());
   lid_.assign(n, 0);

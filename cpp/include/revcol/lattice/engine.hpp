@@ -52,6 +52,10 @@ struct LatticeConfigN {
   std::uint32_t seed = 1;                  ///< stream seed (Philox key {particle, seed}) and X's first bits
   int tick_bits = default_tick_bits;       ///< a particle of rms speed moves 2^-tick_bits D per tick (units.hpp)
   int cell_bits = default_cell_bits;       ///< the pair operator's 2^cell_bits direction (2D) or polar (3D) cells per turn
+  /// A mixture (equal masses): per particle its diameter in float units (empty: every one
+  /// `diameter`). The largest is the units' sigma (`diameter` is then ignored); the others are
+  /// quantized to even lattice lengths, radius = round(d / (2 length_unit)), within a ratio of 16.
+  std::vector<double> diameters;
 };
 /// The 2D configuration.
 using LatticeConfig = LatticeConfigN<2>;
@@ -66,6 +70,7 @@ struct LatticeStartN {
   std::vector<VecN<D>> v;           ///< integer velocities
   double max_position_error = 0.0;  ///< max |x_float - x_lattice| / D
   double max_velocity_error = 0.0;  ///< max |v_float - v_lattice| / v_rms
+  std::vector<std::int64_t> radius;  ///< a mixture: per particle its radius in lattice units (empty: one diameter)
 };
 /// A quantized 2D start.
 using LatticeStart = LatticeStartN<2>;

@@ -5,36 +5,11 @@
 // acceptance test, the redraws, the rare log, the group collisions, the counters and the
 // snapshots are one code for both (per-axis loops over D; a wall is a flat plane per axis).
 //
-// State: per particle an anchor position (integer, wrapped into the box) at an anchor tick, an
-// integer velocity, a line version (bumped when the line changes), a Philox stream counter, a
-// bits-back integer X (about 128 bits) and a collision count; the clock; the rare log; the
-// collision count. Free flight is exact: x(t) = x_a + v (t - t_a), wrapped on periodic axes.
-// Every collision reads and writes only its particles' state: the pair operator runs on the
-// drawing particle's X (the lower index i of the pair), and the rare log and the group entries
-// are keyed by (particle, that particle's collision count after the collision), never by a global
-// index. So collisions in different places commute, and a state cut into regions is the same
-// state (ARCHITECTURE.md, "Per-particle state"); the global collision count is the sum.
+// State (per particle, each collision touching only its particles'): state.hpp.
 //
-// Event rule. Invariant: no pair overlaps at any integer tick, and every centre is inside [h, H] on
-// wall axes. A pair collides on the transition a-1 -> a where a is the first tick at which its
-// incoming lines overlap; a wall reflects on the transition into the first tick beyond it
-// (cell_grid.hpp; a line anchored beyond a wall, by a neutral event of the reflection's tick or,
-// in the reverse, by the undo of a collision that came right after a reflection on the same
-// tick, reflects on that tick); a cell crossing is neutral. One event per particle in the queue (its earliest:
-// crossing, wall, or collision with a neighbour); a collision found by p with q is also written into
-// q's slot when it is earlier there, so a pair's collision sits in both slots; an event whose versions
-// are stale is recomputed when it comes up.
-//
-// Neighbour search (set_list_shell): cells or neighbour lists, behind a double filter; neither
-// changes which collisions happen (predict.hpp; docs/lattice.md "Finding the next event").
-// Order within a tick (queue key (tick, kind, id)): forward, crossings (kind 0), walls (1), then
-// collisions by pair index lo = min(i, j) ascending (kind 2 + lo); reverse, crossings, collisions by
-// lo descending (kind 1 + (N - 1 - lo)), then walls (kind N + 1). So the reverse undoes each tick's
-// state changes in exactly the opposite order: the bits-back X and the streams are stacks.
-//
-// Reverse (the prototype's engine.py): negate velocities, anchor ticks and the clock, run the same
-// search, apply v -> -reverse(-v) at each collision with the streams stepping back, negate again.
-// Acceptance, redraws, the rare log: collide.hpp. A logical process's view: lp_view.hpp.
+// The event rule, the order within a tick, the reverse and the neighbour search: loop.hpp.
+// Acceptance, redraws, the rare log: collide.hpp. Sizes (a mixture): sizes.hpp. A logical
+// process's view: lp_view.hpp.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -45,6 +20,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -65,6 +41,7 @@
 #include "revcol/lattice/lp_seen.hpp"
 #include "revcol/lattice/state.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
+#include "revcol/lattice/sizes.hpp"
 #include "revcol/lattice/specular.hpp"
 #include "revcol/lattice/streams.hpp"
 #include "revcol/lattice/units.hpp"
@@ -96,6 +73,15 @@ class BasicEngine {
               std::int64_t clock = 0, Mode mode = Mode::exact)
       : op_(std::move(op)) {
     load(fresh(u, std::move(x), std::move(v), seed, clock, mode));
+  }
+  /// A mixture (equal masses): particle p of radius radius[p] lattice units, in [sigma / 32,
+  /// sigma / 2] (validate_radii; sigma = u.sigma, the largest diameter, the operator's), a
+  /// pair's contact distance the sum of its radii; otherwise as above.
+  BasicEngine(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::vector<std::int64_t> radius, std::uint32_t seed,
+              Op op, std::int64_t clock = 0, Mode mode = Mode::exact)
+      : op_(std::move(op)) {
+    require(!radius.empty(), "lattice: a mixture needs one radius per particle");
+    load(fresh(u, std::move(x), std::move(v), seed, clock, mode, std::move(radius)));
   }
   BasicEngine(const Snapshot& s, Op op) : op_(std::move(op)) { restore(s); }  ///< An engine resuming a snapshot bit for bit.
   /// The same, its particles stored in another order: local index p holds particle order[p] (a
@@ -172,6 +158,8 @@ class BasicEngine {
   void commit_before(const EventKey& k);    ///< forgets the journal's entries before key k
   EventKey last_key() const noexcept;       ///< the key of the journal's last entry (or its start)
   Snapshot snapshot() const;  ///< The state (forward frame, positions at the clock).
+  /// A mixture's radii in lattice units, by particle id (empty: every diameter units().sigma).
+  std::vector<std::int64_t> radii() const { return sz_.by_id([this](int q) { return local(q); }); }
   /// Starts observing the forward run from the clock (replacing any earlier observation):
   /// the float engine's observer (revcol/engine/observe.hpp) fed at every velocity change
   /// with the exact state converted once to float units (x length_unit, ticks x tick), the
@@ -293,13 +281,16 @@ class BasicEngine {
     std::int32_t k = 0;
     Type type = none;
     int q = -1, gq = -1;
-    void offer(std::int64_t t2, std::int32_t k2, Type ty, int q2, int gq2) noexcept {
+    // (always inline: out of line, as GCC chose once predict held two scans, it cost 70
+    // instructions per collision in 2D)
+    [[gnu::always_inline]] void offer(std::int64_t t2, std::int32_t k2, Type ty, int q2, int gq2) noexcept {
       if (t2 >= tick_limit) return;
       if (std::tie(t2, k2, gq2) < std::tie(t, k, gq) || type == none) t = t2, k = k2, type = ty, q = q2, gq = gq2;
     }
   };
   void load(const Snapshot& s, const std::vector<std::uint32_t>& order = {});
-  Snapshot fresh(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, std::int64_t clock, Mode mode) const;
+  Snapshot fresh(const Units& u, std::vector<Vec> x, std::vector<Vec> v, std::uint32_t seed, std::int64_t clock, Mode mode,
+                 std::vector<std::int64_t> radius = {}) const;
   void check_log(const Snapshot& s) const;  // the rare log against the per-particle counts
 
   // ---- geometry of the lines ----
@@ -310,11 +301,12 @@ class BasicEngine {
     for (std::size_t k = 0; k < D; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
     return r;
   }
-  bool overlap(const Vec& a, const Vec& b) const noexcept {
-    const Vec r = diff(a, b);
-    return norm2(r) < sigma2_;
-  }
-  std::int64_t hhi(int k) const noexcept { return u_.L[k] - hlo_; }
+  // ---- the sizes (sizes.hpp): a pair's contact distance, a centre's range on a wall axis ----
+  std::int64_t rad(int p) const noexcept { return sz_.rad(p); }
+  u128 sig2(int p, int q) const noexcept { return sz_.sig2(p, q); }
+  bool overlap(const Vec& a, const Vec& b, int p, int q) const noexcept { return norm2(diff(a, b)) < sig2(p, q); }
+  std::int64_t lo_of(int p) const noexcept { return rad(p); }
+  std::int64_t hi_of(int p, int k) const noexcept { return u_.L[k] - rad(p); }
   // f(q) for every q that may be near p: p's neighbour list, or the particles of its 3^D cells
   template <class F>
   void near(int p, F&& f) const {
@@ -340,6 +332,7 @@ class BasicEngine {
   void reanchor(int p, std::int64_t t);
   void schedule(int p, Type type, std::int64_t t, std::int32_t kind, int partner);
   void predict(int p, std::int64_t lo);
+  template <bool Mixed>  // a mixture's contact distances (a one-size gas's scan reads no radius)
   [[gnu::always_inline]] void scan(int p, std::int64_t lo, Best& b);
   void rebuild();
   void flip();
@@ -358,7 +351,7 @@ class BasicEngine {
   [[noreturn, gnu::cold]] void inconsistent(const std::string& what, int i, int j) const;  // (collide.hpp)
   // the reflection map of a line whose tick-(a-1) point is x with velocity v (beyond the walls of
   // the returned axes at a): x becomes its point at a, v its velocity after (loop.hpp)
-  unsigned reflection(Vec& x, Vec& v) const noexcept;
+  unsigned reflection(int p, Vec& x, Vec& v) const noexcept;  // p's wall range
 
   // ---- collisions ----
   // origin + d, wrapped on periodic axes (128-bit sum: no overflow whatever the box)
@@ -404,6 +397,9 @@ class BasicEngine {
   using Specular = std::conditional_t<D == 2, LatticeSpecular2D, LatticeSpecular3D>;
   Mode mode_ = Mode::exact;
   Specular spec_{2};
+  // the pair's operator and specular map: the units' own, or made for r_i + r_j (a mixture)
+  const Op& op_of(int i, int j, std::optional<Op>& tmp) const { return sz_.pair_op(op_, i, j, tmp); }
+  const Specular& spec_of(int i, int j, std::optional<Specular>& tmp) const { return sz_.pair_op(spec_, i, j, tmp); }
   Units u_;
   std::uint32_t seed_ = 1;
   // one particle's line, together in memory (the prediction loop reads all three)
@@ -419,6 +415,7 @@ class BasicEngine {
     std::array<double, D> a;  // c_p + min_image(x_p - c_p) (x_p on wall axes); x_p with the cell grid
     std::array<double, D> v;  // velocity
     std::int64_t ta;          // anchor tick
+    double r;                 // a mixture: the radius (set by rebuild; the filter's contact distance)
   };
   std::vector<LineD> lnd_;
   // a position x (wrapped) unwrapped about p's list centre: c_p + min_image(x - c_p), in
@@ -433,7 +430,7 @@ class BasicEngine {
                         : static_cast<double>(c[k]) + static_cast<double>(min_image(x[k] - c[k], u_.L[k]));
     return a;
   }
-  void sync(int p) noexcept {
+  [[gnu::always_inline]] void sync(int p) noexcept {
     LineD& d = lnd_[static_cast<std::size_t>(p)];
     const Line& l = ln_[static_cast<std::size_t>(p)];
     if (lists_) {
@@ -526,6 +523,7 @@ class BasicEngine {
   bool shifted_ = false;  // cells whose images are known (CellGridN::shifted)
   std::array<std::array<double, D>, 1u << (2 * D)> shift_{};  // a list entry's image shift by code (neighbour_lists.hpp)
   std::int64_t hlo_ = 0;
+  Sizes sz_;
   CellGridN<D> grid_;
   Queue queue_;
   std::pair<std::int64_t, std::int32_t> last_key_{};

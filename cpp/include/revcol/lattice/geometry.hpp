@@ -54,6 +54,9 @@ inline std::int64_t min_image(std::int64_t d, std::int64_t L) noexcept {
   return d >= hu ? d - L : d < hu - L ? d + L : d;
 }
 
+/// s^2 in 128 bits for a contact distance s >= 0 (a mixture's pair: the sum of two radii).
+inline u128 contact2(std::int64_t s) noexcept { return static_cast<u128>(s) * static_cast<u128>(s); }
+
 /// |r|^2 in 128 bits (|r_k| < 2^62).
 inline u128 norm2(std::int64_t rx, std::int64_t ry) noexcept {
   const u128 ax = static_cast<u128>(rx < 0 ? -static_cast<i128>(rx) : static_cast<i128>(rx));

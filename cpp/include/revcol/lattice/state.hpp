@@ -128,6 +128,9 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
   Counters counters;                           ///< statistics (not compared by same_state)
   std::vector<double> observer;                ///< a running observation (engine::Observer::save; empty: none)
   std::vector<std::uint64_t> observer_counts;  ///< its counts per block (not compared by same_state)
+  /// Per particle (by id): its radius in lattice units, a pair's contact distance being the sum
+  /// of its two radii (a mixture; equal masses). Empty: every particle of diameter units.sigma.
+  std::vector<std::int64_t> radius;
 
   /// Calls f(name, field) for every field but `counters`, in the checkpoint format's order and
   /// with its names (log and groups are each written as several arrays by the binding).
@@ -152,6 +155,7 @@ struct SnapshotN : Visitable<SnapshotN<D>> {
     f("momentum0", s.momentum0);
     f("observer", s.observer);
     f("observer_counts", s.observer_counts);
+    f("radius", s.radius);
   }
 };
 /// A 2D snapshot.
@@ -169,7 +173,7 @@ bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.particle_collisions == b.particle_collisions &&
          a.bits == b.bits && a.bits_size == b.bits_size && a.log == b.log &&
          a.groups == b.groups &&
-         a.energy0 == b.energy0 && a.momentum0 == b.momentum0;
+         a.energy0 == b.energy0 && a.momentum0 == b.momentum0 && a.radius == b.radius;
 }
 
 /// Particle by particle, the words of each X in a snapshot (bits split by bits_size).

@@ -125,18 +125,32 @@ struct QuantizedN {
 using Quantized = QuantizedN<2>;
 
 /// Quantizes n x Dim float positions and velocities (row-major) once. Refuses (InvalidArgument) a
-/// speed beyond vmax, a position outside the walls, or a pair overlapping after quantization.
+/// speed beyond vmax, a position outside the walls, or a pair overlapping after quantization
+/// (a mixture: with the given radii, validate_state).
 template <std::size_t Dim>
-QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, const std::vector<double>& v);
+QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, const std::vector<double>& v,
+                         const std::vector<std::int64_t>& radius = {});
 
 /// Checks an integer state: positions inside [0, L) (and inside the walls), |v| <= vmax per axis,
 /// sqrt(sum |v|^2) <= vmax, and no pair overlapping (|r|^2 < sigma^2); throws InvalidArgument
 /// naming the first problem. O(N) with a hash grid. `pending` (a snapshot's state): a pair that
 /// overlaps but was apart one tick earlier (x - v) is a collision pending at the clock (a run
 /// stops after a collision, other collisions of that tick still to come) and is accepted.
+/// `radius` (a mixture, validate_radii): per particle its radius, a pair overlapping when
+/// |r| < r_i + r_j and a particle its radius from a wall; empty: every diameter sigma.
 template <std::size_t Dim>
 void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v,
-                    bool pending = false);
+                    bool pending = false, const std::vector<std::int64_t>& radius = {});
+
+/// The smallest radius a mixture may hold: sigma / 32 (sigma = 2^S, the largest diameter), so
+/// diameters are within a ratio of 16 and a relative move per tick (below sigma / 128 per axis)
+/// stays well inside the smallest contact distance.
+template <std::size_t Dim>
+constexpr std::int64_t min_radius(const UnitsN<Dim>& u) noexcept { return u.sigma / 32; }
+/// Checks a mixture's radii (empty: one diameter, nothing to check): one per particle, each in
+/// [min_radius, sigma / 2]; throws InvalidArgument naming the first problem.
+template <std::size_t Dim>
+void validate_radii(const UnitsN<Dim>& u, const std::vector<std::int64_t>& radius, std::size_t n);
 
 /// Kinetic energy sum |v|^2 in 128 bits (lattice units).
 template <std::size_t Dim>
