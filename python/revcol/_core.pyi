@@ -358,6 +358,8 @@ class _LatticeEngineMethods(_ObserveMethods):
     def n(self) -> int: ...
     @property
     def radius(self) -> _I64: ...  # a mixture's radii by id (empty: one diameter)
+    def set_trace(self, on: bool) -> None: ...  # keep the forward collisions (tick, i, j)
+    def take_trace(self) -> _I64: ...  # (k, 3): the kept collisions, then cleared
     @property
     def law(self) -> str: ...
     @property

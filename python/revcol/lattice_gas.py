@@ -147,7 +147,10 @@ class _LatticeRun:
 
             if observes_frames(scene, trajectory):
                 sim.observe()  # the observer's unwrapped positions give the frames' image flags (not reported)
-            self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter)
+            sp = scene.species  # a mixture: each particle's diameter and species (ids in blocks)
+            kinds = dict(diameters=sim.diameters, types=[s.name for s in sp],
+                         typeid=np.repeat(np.arange(len(sp)), [s.count for s in sp])) if sp else {}
+            self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter, **kinds)
             self.frame(0, "forward")
         self.energy_series: list[tuple[int, float]] = [(0, 0.0)]
         self.bits_series: list[tuple[int, int]] = [(0, self.bits0)]

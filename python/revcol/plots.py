@@ -192,7 +192,8 @@ def _energy_figure(r: dict, out: Path, plt, title: str, fmt: str, exact: bool) -
 def _snapshots_figure(r: dict, out: Path, plt, title: str, start, turn, end, fmt: str) -> str:
     d, box = r["dimension"], np.asarray(r["box"], float)
     periodic = list(r.get("periodic", [False] * d))
-    sigma = r["scene"]["diameter"]
+    species = r["scene"].get("species") or []  # a mixture: (name, diameter, count), ids in blocks
+    sigma = np.concatenate([np.full(int(c), float(s)) for _, s, c in species]) if species else r["scene"]["diameter"]
     shots = [("start", *start), (f"after {r['collisions_forward']:,} collisions forward", *turn),
              ("after reversal", *end)]
     vmax = max(float(np.max(np.linalg.norm(np.asarray(v, float).reshape(len(v), -1), axis=1), initial=0.0))
@@ -227,7 +228,7 @@ def _snapshots_figure(r: dict, out: Path, plt, title: str, start, turn, end, fmt
 
 def _slice_count(x, box, sigma) -> int:
     z = np.asarray(x, float)[:, 2]
-    return int(np.count_nonzero(np.abs(z - 0.5 * box[2]) < 0.5 * sigma))
+    return int(np.count_nonzero(np.abs(z - 0.5 * box[2]) < 0.5 * np.asarray(sigma, float)))
 
 
 def _edges(ax, box, periodic) -> None:
@@ -245,12 +246,13 @@ def _disks(ax, x, v, box, periodic, sigma, vmax, d):
     from matplotlib.collections import EllipseCollection  # optional (the plot extra)
 
     speed = np.linalg.norm(v, axis=1)
-    diam = np.full(len(x), float(sigma))
+    diam = np.broadcast_to(np.asarray(sigma, float), (len(x),)).copy()  # one per particle (a mixture)
+    sigma = float(np.max(diam, initial=0.0))
     if d == 3:
         dz = x[:, 2] - 0.5 * box[2]
-        keep = np.abs(dz) < 0.5 * sigma
+        keep = np.abs(dz) < 0.5 * diam
         x, speed = x[keep], speed[keep]
-        diam = 2.0 * np.sqrt(np.maximum(0.25 * sigma * sigma - dz[keep] ** 2, 0.0))
+        diam = 2.0 * np.sqrt(np.maximum(0.25 * diam[keep] ** 2 - dz[keep] ** 2, 0.0))
     xy = x[:, :2]
     # periodic images of particles that cross a periodic edge, so the picture wraps as the box does
     imgs, cols, ds = [xy], [speed], [diam]

@@ -98,6 +98,11 @@ file and the replacement.
     block_time = 1.0              # the first blocks' length (default D / v_rms); min_blocks = 16
     pair_bins = 100               # pair distances over [0, pair_rmax] (2-64 particles, walls on every axis)
 
+    [[species]]                   # gas, engine = "lattice", random start: a mixture of equal masses, one
+    name = "A"                    # table per species (no [system] diameter then); diameter > 0; count,
+    diameter = 1.0                # or fraction of [system] particles (the fractions add up to 1)
+    fraction = 0.5
+
 **Scenes by name.** The example scenes ship with the package (``revcol/scenes``, the repository's
 ``scenes/``): ``load_scene("spheres-3d")`` (``revcol run spheres-3d``) reads the scene of that
 name when no file of that name exists (:func:`scene_names` lists them). Its initial-state files
@@ -123,7 +128,8 @@ from .engine import Simulation
 from .lattice import LatticeSimulation
 from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINE_MODES,  # noqa: F401 (__all__)
                            ENGINES, KINDS, LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES,
-                           SceneError, _check, _check_mode, _fail, _modernize, with_lattice_options)
+                           SceneError, _check, _check_lattice, _check_mode, _fail, _modernize, with_lattice_options)
+from ._species import parse_species, species_diameters, species_volume
 from .statesave import variants as statesave_variants
 from .verify import verify_cases
 
@@ -176,6 +182,7 @@ class Scene:
     checkpoints: Path | None = None
     max_output: int | None = None  # [output] max_output in bytes, 0: no limit (None: revcol._outputs' default)
     observe: dict[str, Any] | None = None  # [observe]: Simulation.observe's arguments (None: no table)
+    species: tuple = ()  # [[species]] (revcol._species.Species): a mixture, lattice engine; () one diameter
     name: str = "scene"
     description: str = ""
     source: str = "<built-in>"
@@ -196,7 +203,9 @@ class Scene:
         box = " x ".join(f"{b:g}" for b in self.box)
         end = length or (f"{self.collisions:,} collisions" if self.collisions is not None else f"t = {self.time:g}")
         engine = "lattice engine, " if self.engine == "lattice" else ""
-        return (f"{self.name}: {self.particles} particles in {self.dimension}D, sigma = {self.diameter:g}, "
+        sizes = (", ".join(f"{s.count} {s.name} (d = {s.diameter:g})" for s in self.species) if self.species
+                 else f"sigma = {self.diameter:g}")
+        return (f"{self.name}: {self.particles} particles in {self.dimension}D, {sizes}, "
                 f"box {box} ({', '.join(self.boundaries)}), {engine}{self.mode}{law}, {self.generator} "
                 f"{self.streams} seed {self.seed}, {end}")
 
@@ -222,6 +231,8 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         raise SceneError(f"{source}: a scene is a TOML document of tables")
     values: dict[tuple[str, str], Any] = {}
     for table, fields in doc.items():
+        if table == "species":  # an array of tables ([[species]]): _gas reads it (revcol._species)
+            continue
         if table not in SCHEMA:
             raise _fail(source, f"[{table}]", f"unknown table; allowed: {', '.join(SCHEMA)}")
         if not isinstance(fields, dict):
@@ -237,6 +248,8 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
     # fields the kind does not use are errors, not silently ignored
     kind = values.get(("scene", "kind"), "gas")
     uses = USES[kind]
+    if "species" in doc and kind != "gas":
+        raise _fail(source, "[[species]]", f"does not apply to kind = {kind!r} (used by: 'gas')")
     if "observe" in doc and "observe" not in uses:
         raise _fail(source, "[observe]", f"does not apply to kind = {kind!r} (used by: 'gas')")
     for table, key in values:
@@ -273,10 +286,10 @@ def scene_from_dict(doc: dict[str, Any], source: str = "<dict>", base: Path | No
         return _reversal(source, get, common, mode, law, out)
     if kind == "statesave":
         return _statesave(source, get, common, mode, law, out)
-    return _gas(source, get, values, base, common, mode, law, out)
+    return _gas(source, get, values, base, common, mode, law, out, doc.get("species"))
 
 
-def _gas(source, get, values, base, common, mode, law, out) -> Scene:
+def _gas(source, get, values, base, common, mode, law, out, species_doc=None) -> Scene:
     """A gas scene from its checked fields (``values``; ``get`` reads one with a default)."""
     name = common["name"]
     d = get("system", "dimension")
@@ -294,6 +307,8 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         if n is not None and n != arrays[0].shape[0]:
             raise _fail(source, "[system] particles", f"is {n} but initial_state holds {arrays[0].shape[0]} particles")
         n = int(arrays[0].shape[0])
+    species = parse_species(source, species_doc, n) if species_doc else ()
+    n = sum(sp.count for sp in species) if species else n
     if n is None:
         raise _fail(source, "[system] particles", "is required (a positive integer) unless initial_state gives it")
     top_n = LIMITS["max_particles"][d]
@@ -301,6 +316,13 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         raise _fail(source, "[system] particles", f"must be at most {top_n:,} in {d}D for the float engine "
                     f"(a neighbour-list entry packs an id and its image in 32 bits), got {n:,}")
     sigma = get("system", "diameter", 1.0)
+    if species:
+        if ("system", "diameter") in values:
+            raise _fail(source, "[system] diameter", "give [system] diameter (one size) or [[species]] diameters, not both")
+        if get("collisions", "engine", "float") != "lattice" or arrays is not None:
+            raise _fail(source, "[[species]]", "runs on engine = 'lattice' from a random start (the float engine has "
+                        "one diameter)")
+        sigma = max(sp.diameter for sp in species)
 
     box = get("system", "box")
     phi = get("system", "packing_fraction")
@@ -312,7 +334,8 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         top = LIMITS["max_fraction"][d]
         if phi > top:
             raise _fail(source, "[system] packing_fraction", f"must be at most {top} in {d}D, got {phi}")
-        side = (n * _core.engine_particle_volume(d, sigma) / phi) ** (1.0 / d)
+        vol = species_volume(species, d) if species else n * _core.engine_particle_volume(d, sigma)
+        side = (vol / phi) ** (1.0 / d)
         box = (side,) * d
     if len(box) != d:
         raise _fail(source, "[system] box", f"needs {d} lengths for dimension {d}, got {len(box)}")
@@ -376,7 +399,7 @@ def _gas(source, get, values, base, common, mode, law, out) -> Scene:
         checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
         json=out("json"), plot=out("plot"), trajectory=trajectory,
         trajectory_every=get("output", "trajectory_every", 100), max_output=get("output", "max_output"),
-        observe=observe, **common)
+        observe=observe, species=species, **common)
     if arrays is not None:
         _check_initial(source, scene, *arrays)
     return scene
@@ -393,23 +416,6 @@ def _observe(source: str, values: dict, d: int, n: int, bounds, engine: str) -> 
         if not 2 <= n <= 64 or "periodic" in bounds:
             raise _fail(source, "[observe] pair_bins", "pair distances need 2 to 64 particles and walls on every axis")
     return obs
-
-
-def _check_lattice(source: str, d: int, mode: str, generator: str, streams: str, bits_given: bool) -> None:
-    """The combinations the lattice engine runs: 2D and 3D, exact mode (flux or uniform law) or
-    specular mode, Philox per-particle streams, no chart bits; anything else is a SceneError
-    naming the field."""
-    why = "engine = 'lattice'"
-    if d not in (2, 3):
-        raise _fail(source, "[system] dimension", f"{why} runs 2D and 3D gases, got dimension {d}")
-    _check_mode(source, "[collisions] mode", "gas", "lattice", d, mode)
-    if generator != "philox":
-        raise _fail(source, "[rng] generator", f"{why} draws from Philox per-particle streams, got {generator!r}")
-    if streams != "per_particle":
-        raise _fail(source, "[rng] streams", f"{why} draws from one Philox stream per particle, got {streams!r}")
-    if bits_given:
-        raise _fail(source, "[collisions] bits", f"does not apply to {why} (its collisions are exact integer "
-                    "bijections, no K-bit chart)")
 
 
 def with_engine(scene: Scene, engine: str) -> Scene:
@@ -528,9 +534,13 @@ def engine_options(scene: Scene) -> dict[str, Any]:
 
 def lattice_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.lattice.LatticeSimulation` that a gas scene sets."""
-    return dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
+    opts = dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
                 seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search,
                 workers=scene.workers)
+    if scene.species:  # a mixture: one diameter per particle instead
+        del opts["diameter"]
+        opts["diameters"] = species_diameters(scene.species)
+    return opts
 
 
 def scene_dirs() -> list[Path]:

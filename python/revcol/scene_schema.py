@@ -162,6 +162,23 @@ def _check_mode(source: str, where: str, kind: str, engine: str, d: int, mode: s
                     f"only (it has no invertible {d}D pair operator), got dimension {d}")
 
 
+def _check_lattice(source: str, d: int, mode: str, generator: str, streams: str, bits_given: bool) -> None:
+    """The combinations the lattice engine runs: 2D and 3D, exact mode (flux or uniform law) or
+    specular mode, Philox per-particle streams, no chart bits; anything else is a SceneError
+    naming the field."""
+    why = "engine = 'lattice'"
+    if d not in (2, 3):
+        raise _fail(source, "[system] dimension", f"{why} runs 2D and 3D gases, got dimension {d}")
+    _check_mode(source, "[collisions] mode", "gas", "lattice", d, mode)
+    if generator != "philox":
+        raise _fail(source, "[rng] generator", f"{why} draws from Philox per-particle streams, got {generator!r}")
+    if streams != "per_particle":
+        raise _fail(source, "[rng] streams", f"{why} draws from one Philox stream per particle, got {streams!r}")
+    if bits_given:
+        raise _fail(source, "[collisions] bits", f"does not apply to {why} (its collisions are exact integer "
+                    "bijections, no K-bit chart)")
+
+
 def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: Any) -> Any:
     where = f"[{table}] {key}"
     if kind == "int":

@@ -182,12 +182,12 @@ class XYZWriter(_Writer):
     """Extended XYZ frames, appended to one text file."""
 
     def __init__(self, path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],
-                 diameter: float, *, species: str = "Ar"):
+                 diameter: float, *, species: str = "Ar", diameters=None):
         self.path = Path(path)
         self.dim = len(box)
         self.species = _species(species)
         self._head = _xyz_head(box, periodic, diameter)
-        self._radius = 0.5 * diameter
+        self._radius = 0.5 * (diameter if diameters is None else np.asarray(diameters, dtype=float))  # a mixture: per particle
         per = np.zeros(3, dtype=bool)
         per[: self.dim] = [bool(p) for p in periodic]
         lengths3 = np.ones(3)
@@ -325,8 +325,14 @@ class GSDWriter(_Writer):
     """GSD frames through the ``gsd`` package (HOOMD-blue's schema)."""
 
     def __init__(self, path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],
-                 diameter: float, *, species: str = "Ar", precise: bool = False):
+                 diameter: float, *, species: str = "Ar", precise: bool = False, diameters=None, types=None,
+                 typeid=None):
         import gsd.hoomd  # checked by open_trajectory
+
+        # a mixture: per particle its diameter and its species (types[typeid]); else one of each
+        self._diameters = None if diameters is None else np.asarray(diameters, dtype=np.float32)
+        self._types = None if types is None else [str(t) for t in types]
+        self._typeid = None if typeid is None else np.asarray(typeid, dtype=np.uint32)
 
         self._hoomd = gsd.hoomd
         self.path = Path(path)
@@ -382,12 +388,12 @@ class GSDWriter(_Writer):
         if self._dimensions == 3:
             x[:, 2] -= 0.5 * lz
         f.particles.N = n
-        f.particles.types = [self.species]
-        f.particles.typeid = np.zeros(n, dtype=np.uint32)
+        f.particles.types = [self.species] if self._types is None else self._types
+        f.particles.typeid = np.zeros(n, dtype=np.uint32) if self._typeid is None else self._typeid
         f.particles.position = x.astype(np.float32)
         f.particles.image = image.astype(np.int32)
         f.particles.velocity = _pad3(velocities).astype(np.float32)
-        f.particles.diameter = np.full(n, self._diameter, dtype=np.float32)
+        f.particles.diameter = np.full(n, self._diameter, dtype=np.float32) if self._diameters is None else self._diameters
         if self.precise:
             f.log["particles/revcol/position"] = x
         f.log["revcol/time"] = np.array([time], dtype=np.float64)
@@ -468,17 +474,21 @@ def _publish(tmp: str, path: Path) -> None:
 
 
 def open_trajectory(path: str | os.PathLike, box: Sequence[float], periodic: Sequence[bool],
-                    diameter: float, *, species: str = "Ar", precise: bool = False) -> XYZWriter | GSDWriter:
+                    diameter: float, *, species: str = "Ar", precise: bool = False, diameters=None, types=None,
+                    typeid=None) -> XYZWriter | GSDWriter:
     """A writer for ``path``: ``.xyz`` (extended XYZ) or ``.gsd`` (needs ``gsd``; ``precise``
-    adds the float64 positions). Raises ValueError for another suffix, for ``.gsd`` when ``gsd``
-    is not installed, or for a ``species`` that is not an element symbol."""
+    adds the float64 positions). A mixture: ``diameters`` per particle (XYZ's radius column,
+    GSD's particles.diameter) and, GSD, the species' names ``types`` with each particle's
+    ``typeid``. Raises ValueError for another suffix, for ``.gsd`` when ``gsd`` is not
+    installed, or for a ``species`` that is not an element symbol."""
     suffix = Path(path).suffix.lower()
     _species(species)
     if suffix == ".xyz":
-        return XYZWriter(path, box, periodic, diameter, species=species)
+        return XYZWriter(path, box, periodic, diameter, species=species, diameters=diameters)
     if suffix == ".gsd":
         check_format(path)
-        return GSDWriter(path, box, periodic, diameter, species=species, precise=precise)
+        return GSDWriter(path, box, periodic, diameter, species=species, precise=precise, diameters=diameters,
+                         types=types, typeid=typeid)
     raise ValueError(f"trajectory {str(path)!r}: the suffix must be .xyz (extended XYZ) or .gsd")
 
 

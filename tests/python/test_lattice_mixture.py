@@ -97,3 +97,73 @@ def test_equation_of_state_reduced(dim, phi):
     assert r["back_to_start"]
     assert r["blocks"] >= 16
     assert abs(r["deviation_sd"]) < 3.0, r
+
+
+def _mixture_scene(extra: str = "", system: str = "particles = 400\n") -> dict:
+    import tomllib
+    text = ("[system]\ndimension = 2\npacking_fraction = 0.35\nboundaries = \"periodic\"\n" + system +
+            "[collisions]\nengine = \"lattice\"\n[run]\ncollisions = 3000\n"
+            "[[species]]\nname = \"big\"\ndiameter = 1.0\nfraction = 0.25\n"
+            "[[species]]\nname = \"small\"\ndiameter = 0.8\nfraction = 0.75\n" + extra)
+    return tomllib.loads(text)
+
+
+def test_scene_species_table_builds_the_mixture(tmp_path):
+    from revcol.lattice_gas import build_lattice
+    from revcol.scene import SceneError, lattice_options, scene_from_dict
+    scene = scene_from_dict(_mixture_scene(), "mix.toml")
+    assert [(s.name, s.count) for s in scene.species] == [("big", 100), ("small", 300)]
+    assert "100 big (d = 1), 300 small (d = 0.8)" in scene.summary()
+    # the box from the species' own areas at the packing fraction
+    area = 100 * np.pi / 4 + 300 * np.pi / 4 * 0.64
+    assert scene.box[0] == pytest.approx(np.sqrt(area / 0.35), rel=1e-12)
+    sim = build_lattice(scene)
+    assert sim.mixture and np.allclose(np.sort(np.unique(sim.diameters)), [0.8, 1.0], atol=2.0 ** -40)
+    assert np.allclose(sim.box, scene.box, rtol=1e-12)
+    assert "diameters" in lattice_options(scene)
+    # counts instead of fractions, and the errors, each naming its field
+    counted = _mixture_scene(system="").copy()
+    counted["species"] = [{"name": "a", "diameter": 1.0, "count": 7}, {"name": "b", "diameter": 0.8, "count": 5}]
+    assert scene_from_dict(counted, "c.toml").particles == 12
+    bad = [({"system": {"diameter": 1.0}}, "not both"), ({"collisions": {"engine": "float"}}, "engine = 'lattice'"),
+           ({"species": [{"name": "a", "diameter": 1.0, "fraction": 0.5}]}, "add up to 1"),
+           ({"species": [{"name": "a", "diameter": 1.0, "count": 3, "mass": 2.0}]}, "unknown field"),
+           ({"species": [{"name": "a", "diameter": -1.0, "count": 3}]}, "diameter"),
+           ({"species": [{"name": "a", "diameter": 1.0, "count": 3}, {"name": "a", "diameter": 0.5, "count": 3}]},
+            "unique")]
+    for change, what in bad:
+        doc = _mixture_scene()
+        for table, fields in change.items():
+            doc[table] = fields if table == "species" else {**doc.get(table, {}), **fields}
+        with pytest.raises(SceneError, match=what):
+            scene_from_dict(doc, "bad.toml")
+
+
+def test_mixture_trajectory_carries_types_and_diameters(tmp_path):
+    gsd_hoomd = pytest.importorskip("gsd.hoomd")
+    from revcol.gas import run_gas
+    from revcol.scene import scene_from_dict
+    scene = scene_from_dict(_mixture_scene("[output]\ntrajectory_every = 1000\n"), str(tmp_path / "mix.toml"))
+    run_gas(scene, trajectory=tmp_path / "mix.gsd", progress=False, checkpoints=False)
+    with gsd_hoomd.open(str(tmp_path / "mix.gsd")) as t:
+        f = t[0]
+        assert f.particles.types == ["big", "small"]
+        assert np.bincount(f.particles.typeid).tolist() == [100, 300]
+        assert np.allclose(np.unique(f.particles.diameter), [0.8, 1.0], atol=1e-6)
+
+
+def test_partial_structure_and_contact_values_from_rates():
+    # the study's frames path at N = 1000: the partial g of one species equals the g of the gas;
+    # the contact values from the collision rates, through the virial route, give the collision
+    # virial's Z within 3 of its block errors (two estimators of the same collisions)
+    from revcol.observe import radial_distribution
+    from revcol.observe_species import partial_radial_distribution
+    r = measure(3, 1000, 0.4, 1.4, equilibrate=40, collisions=150, seed=2, frames=10)
+    assert abs(r["z_from_contact"] - r["z"]) < 3.0 * r["z_error"], r
+    assert len(r["contact"]) == 3 and all(c["collisions"] > 1000 for c in r["contact"])
+    assert abs(r["temperatures"][0] - r["temperatures"][1]) < 0.05
+    rng = np.random.default_rng(4)
+    frames = rng.uniform(0.0, 6.0, size=(3, 200, 3))
+    r1, g1 = radial_distribution(frames, [6.0] * 3, bins=30, r_max=3.0, use_freud=False)
+    r2, g2 = partial_radial_distribution(frames, [6.0] * 3, np.zeros(200, dtype=int), bins=30, r_max=3.0)
+    assert np.allclose(r1, r2) and np.allclose(g1, g2[0, 0], rtol=1e-12, atol=1e-12)

@@ -26,7 +26,11 @@ PNG = b"\x89PNG\r\n\x1a\n"
 def reduced_doc(doc: dict, particles: int = 200, collisions: int = 20_000) -> dict:
     """A lattice scene's document in its CI form: fewer particles and collisions, no outputs."""
     doc = copy.deepcopy(doc)
-    doc["system"]["particles"] = particles
+    # (a mixture starts on a crystal of its largest size: 256 spheres fill whole face-centred cells)
+    doc["system"]["particles"] = 256 if doc.get("species") and doc["system"]["dimension"] == 3 else particles
+    counts = [sp.pop("count") for sp in doc.get("species", []) if "count" in sp]
+    for sp, c in zip(doc.get("species", []), counts):  # a mixture: its species' shares of the fewer particles
+        sp["fraction"] = c / sum(counts)
     doc["run"] = {"collisions": collisions}
     doc.pop("output", None)
     return doc
@@ -87,7 +91,10 @@ def _toml(doc: dict) -> str:
         if isinstance(v, list):
             return "[" + ", ".join(val(x) for x in v) + "]"
         return repr(v)
-    return "".join(f"[{t}]\n" + "".join(f"{k} = {val(v)}\n" for k, v in f.items()) for t, f in doc.items())
+    def table(head: str, f: dict) -> str:
+        return head + "".join(f"{k} = {val(v)}\n" for k, v in f.items())
+    return "".join("".join(table(f"[[{t}]]\n", e) for e in f) if isinstance(f, list) else table(f"[{t}]\n", f)
+                   for t, f in doc.items())
 
 
 def test_chunked_run_is_the_one_call_run(tmp_path):

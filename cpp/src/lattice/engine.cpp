@@ -89,7 +89,14 @@ LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double 
     fc.diameter = dmax;
     const double L = std::pow(vol / phi, 1.0 / static_cast<double>(D));
     for (std::size_t k = 0; k < D; ++k) fc.box[k] = L;
-    st = engine::random_start(fc, n, seed, 0.0, init);
+    try {
+      st = engine::random_start(fc, n, seed, 0.0, init);
+    } catch (const InvalidArgument& e) {
+      const double as_largest = static_cast<double>(n) * engine::particle_volume(static_cast<int>(D), dmax) / vol * phi;
+      throw InvalidArgument("lattice: a mixture's random start places every particle as one of the largest (diameter " +
+                            std::to_string(dmax) + "), which at packing fraction " + std::to_string(phi) +
+                            " would fill " + std::to_string(as_largest) + " of the box: " + e.what());
+    }
   }
   LatticeConfigN<D> lc = c;
   for (std::size_t k = 0; k < D; ++k) lc.box[k] = st.config.box[k];
