@@ -39,7 +39,7 @@ template <class Engine>
 struct PyLattice {
   Engine e;
   std::optional<std::thread::id> runner{};  ///< the thread whose run/run_back is under way (GIL held to touch)
-  std::vector<std::array<std::int64_t, 3>> trace;  ///< set_trace(True): the forward collisions (tick, i, j) since take_trace
+  std::vector<std::array<std::int64_t, 3>> trace{};  ///< set_trace(True): the forward collisions (tick, i, j) since take_trace
 
   /// The engine; a RuntimeError when a run is under way (its loop runs without the GIL).
   Engine& engine() {

@@ -22,6 +22,21 @@ std::vector<std::uint64_t> initial_bits(std::uint32_t p, std::uint32_t seed) {
   return w;
 }
 
+namespace {
+// A mixture's diameters checked (one per particle, each finite and > 0); the largest.
+double largest_diameter(const std::vector<double>& diameters, std::size_t n) {
+  require(diameters.size() == n, [&] {
+    return "lattice: diameters must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(diameters.size());
+  });
+  double dmax = 0.0;
+  for (double d : diameters) {
+    require(std::isfinite(d) && d > 0.0, "lattice: every diameter must be finite and > 0");
+    dmax = std::max(dmax, d);
+  }
+  return dmax;
+}
+}  // namespace
+
 template <std::size_t D>
 LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<double>& x, const std::vector<double>& v) {
   require(x.size() == v.size() && x.size() % D == 0 && !x.empty(),
@@ -30,17 +45,7 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
   for (double a : v) s2 += a * a;
   const double v_rms = std::sqrt(s2 / static_cast<double>(x.size() / D));
   const std::size_t n = x.size() / D;
-  double dmax = c.diameter;
-  if (!c.diameters.empty()) {
-    require(c.diameters.size() == n, [&] {
-      return "lattice: diameters must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(c.diameters.size());
-    });
-    dmax = 0.0;
-    for (double d : c.diameters) {
-      require(std::isfinite(d) && d > 0.0, "lattice: every diameter must be finite and > 0");
-      dmax = std::max(dmax, d);
-    }
-  }
+  const double dmax = c.diameters.empty() ? c.diameter : largest_diameter(c.diameters, n);
   LatticeStartN<D> s;
   s.units = choose_units_d<D>(c.box, dmax, v_rms, c.wall, c.tick_bits, c.cell_bits, n);
   s.units.bounce = c.bounce;
@@ -76,16 +81,10 @@ LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double 
     // a mixture: the cube whose packing fraction (the particles' own volumes) is phi, the
     // particles placed as spheres of the largest diameter (every pair then at least that far
     // apart), particle p taking diameters[p]
-    require(c.diameters.size() == n, [&] {
-      return "lattice: diameters must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(c.diameters.size());
-    });
+    const double dmax = largest_diameter(c.diameters, n);
     require(std::isfinite(phi) && phi > 0.0, "lattice: the packing fraction must be > 0");
-    double vol = 0.0, dmax = 0.0;
-    for (double d : c.diameters) {
-      require(std::isfinite(d) && d > 0.0, "lattice: every diameter must be finite and > 0");
-      vol += engine::particle_volume(static_cast<int>(D), d);
-      dmax = std::max(dmax, d);
-    }
+    double vol = 0.0;
+    for (double d : c.diameters) vol += engine::particle_volume(static_cast<int>(D), d);
     fc.diameter = dmax;
     const double L = std::pow(vol / phi, 1.0 / static_cast<double>(D));
     for (std::size_t k = 0; k < D; ++k) fc.box[k] = L;

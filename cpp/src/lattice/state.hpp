@@ -276,7 +276,6 @@ void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s, const std::vector<std
       const unsigned ck = (code >> (2 * k)) & 3u;
       shift_[code][k] = ck == 1 ? Ld_[k] : ck == 2 ? -Ld_[k] : 0.0;
     }
-  hlo_ = u_.sigma / 2;
   rebuild();
 }
 

@@ -522,7 +522,6 @@ class BasicEngine {
   std::array<double, D> Ld_{}, invL_{}, edge_{};  // the prediction's filter: L, 1 / L, L / 2 less rounding
   bool shifted_ = false;  // cells whose images are known (CellGridN::shifted)
   std::array<std::array<double, D>, 1u << (2 * D)> shift_{};  // a list entry's image shift by code (neighbour_lists.hpp)
-  std::int64_t hlo_ = 0;
   Sizes sz_;
   CellGridN<D> grid_;
   Queue queue_;
