@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "args.hpp"
@@ -39,7 +40,7 @@ void register_ecmc(py::module_& m) {
                          "Event-chain Monte Carlo of hard spheres in a periodic box (revcol/studies/ecmc.hpp): "
                          "an independent sampler of the equilibrium configurations and their pressure.")
       .def(py::init([](const std::vector<double>& box, const py::array_t<double, py::array::c_style | py::array::forcecast>& x,
-                       PyReal diameter, PyInt seed) {
+                       const std::optional<PyReal>& diameter, PyInt seed, const py::object& diameters) {
              const auto d = static_cast<py::ssize_t>(box.size());
              require(x.ndim() == 2 && x.shape(1) == d, [&] {
                std::string shape;
@@ -47,10 +48,21 @@ void register_ecmc(py::module_& m) {
                return "positions must be an (n, " + std::to_string(d) + ") array, got shape (" + shape + ")";
              });
              std::vector<double> xs(x.data(), x.data() + x.size());
-             return EventChain(box, std::move(xs), to_real(diameter, "diameter"),
-                               to_int<std::uint64_t>(seed, "seed"));
+             const auto sd = to_int<std::uint64_t>(seed, "seed");
+             if (!diameters.is_none()) {
+               require(!diameter, "give diameter (one size) or diameters (one per sphere), not both");
+               const auto ds = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(diameters);
+               require(ds && ds.ndim() == 1 && ds.shape(0) == x.shape(0), [&] {
+                 return "diameters must be a 1-d array of one diameter per sphere (" + std::to_string(x.shape(0)) +
+                        ")";
+               });
+               return EventChain(box, std::move(xs), std::vector<double>(ds.data(), ds.data() + ds.size()), sd);
+             }
+             const double one = to_real(diameter, "diameter").value_or(1.0);
+             return EventChain(box, std::move(xs), one, sd);
            }),
-           py::arg("box"), py::arg("positions"), py::kw_only(), py::arg("diameter") = 1.0, py::arg("seed") = 1)
+           py::arg("box"), py::arg("positions"), py::kw_only(), py::arg("diameter") = py::none(), py::arg("seed") = 1,
+           py::arg("diameters") = py::none())
       .def(
           "run",
           [](EventChain& s, PyInt chains, PyReal ell) {
@@ -79,12 +91,22 @@ void register_ecmc(py::module_& m) {
       .def_property_readonly("box", [](const EventChain& s) { return py::array(py::cast(s.box())); }, "Box lengths.")
       .def_property_readonly("dim", &EventChain::dim, "Dimension d.")
       .def_property_readonly("n", &EventChain::size, "Number of spheres.")
-      .def_property_readonly("diameter", &EventChain::diameter, "Diameter D.")
-      .def_property_readonly("packing_fraction", &EventChain::packing_fraction, "N v_D / V.")
+      .def_property_readonly("diameter", &EventChain::diameter, "Diameter D (a mixture's largest).")
+      .def_property_readonly(
+          "diameters",
+          [](const EventChain& s) -> py::object {
+            if (s.radii().empty()) return py::none();
+            py::array_t<double> out(static_cast<py::ssize_t>(s.radii().size()));
+            for (std::size_t i = 0; i < s.radii().size(); ++i) out.mutable_data()[i] = 2.0 * s.radii()[i];
+            return out;
+          },
+          "A mixture's diameters by sphere; None for one diameter.")
+      .def_property_readonly("packing_fraction", &EventChain::packing_fraction, "The spheres' volumes over V.")
       .def_property_readonly("totals", [](const EventChain& s) { return sums_dict(s.totals()); },
                              "The sums over every run so far, as run() returns them.")
       .def("min_distance", &EventChain::min_distance,
-           "The smallest centre distance over all pairs (nearest image), in diameters; inf for n < 2.");
+           "The smallest centre distance (nearest image) in contact distances (diameters for one size) over the "
+           "pairs in neighbouring cells, which hold every pair closer than the largest diameter; inf when none.");
 }
 
 }  // namespace revcol::bind

@@ -61,6 +61,31 @@ def test_bad_input_names_the_problem_and_changes_nothing():
         ecmc.sample(2, 0.3, n=50, blocks=1)
 
 
+def test_mixture_sampler_from_python():
+    # every other sphere of an engine start shrunk: the pair's own contact distance counts
+    s0 = ecmc.start(2, 0.5, 200, seed=3)
+    d = np.where(np.arange(200) % 2, 1 / 1.4, 1.0)
+    s = ecmc.EventChain(list(s0.box), s0.positions, diameters=d, seed=3)
+    assert s.diameter == 1.0 and np.array_equal(s.diameters, d) and s0.diameters is None
+    assert s.packing_fraction == pytest.approx(0.5 * (1 + 1 / 1.4 ** 2) / 2, rel=1e-12)
+    s.run(2000, 5.0)
+    assert s.min_distance() >= 1.0 - 1e-9
+    # equal diameters given one by one: the one-size chain, bit for bit
+    a = ecmc.EventChain(list(s0.box), s0.positions, seed=4)
+    b = ecmc.EventChain(list(s0.box), s0.positions, diameters=np.ones(200), seed=4)
+    assert a.run(500, 4.0) == b.run(500, 4.0) and np.array_equal(a.positions, b.positions)
+    box, x = [4.0, 4.0], [[0.5, 0.5], [1.3, 0.5]]
+    with pytest.raises(ValueError, match="not both"):
+        ecmc.EventChain(box, x, diameter=1.0, diameters=[1.0, 0.5])
+    with pytest.raises(ValueError, match="one diameter per sphere"):
+        ecmc.EventChain(box, x, diameters=[1.0])
+    with pytest.raises(ValueError, match="overlap"):  # 0.8 apart, contact at 0.85
+        ecmc.EventChain(box, x, diameters=[1.0, 0.7])
+    with pytest.raises(ValueError, match="16 times smaller"):
+        ecmc.EventChain(box, x, diameters=[1.0, 0.05])
+    assert ecmc.EventChain(box, x, diameters=[0.8, 0.7]).min_distance() == pytest.approx(0.8 / 0.75)
+
+
 def test_rods_give_tonks_in_the_engine_convention():
     # 1D: the chains' Z_mc is Tonks' finite-N value, and md_equivalent turns it into 1 / (1 - phi)
     r = ecmc.sample(1, 0.5, n=50, seed=1, per_particle=500, blocks=16, warmup=20)

@@ -17,12 +17,43 @@ namespace {
 constexpr double kCellMargin = 1e-9;
 /// A pair closer than D (1 - kOverlapTol) is refused as an overlap.
 constexpr double kOverlapTol = 1e-9;
+/// A mixture's diameters lie within this ratio of the largest (the lattice engine's bound).
+constexpr double kMaxSizeRatio = 16.0;
 /// Philox key word of the chains' stream (the engine's start uses 0xFFFFFF00 and 0xFFFFFF01).
 constexpr std::uint32_t kStreamWord = 0xFFFFFF10u;
 }  // namespace
 
 EventChain::EventChain(std::vector<double> box, std::vector<double> x, double diameter, std::uint64_t seed)
     : dim_(static_cast<int>(box.size())), n_(0), diameter_(diameter), rng_({kStreamWord, 0}) {
+  init(std::move(box), std::move(x), {}, seed);
+}
+
+EventChain::EventChain(std::vector<double> box, std::vector<double> x, const std::vector<double>& diameters,
+                       std::uint64_t seed)
+    : dim_(static_cast<int>(box.size())), n_(0), diameter_(0.0), rng_({kStreamWord, 0}) {
+  for (std::size_t i = 0; i < diameters.size(); ++i) {
+    const double d = diameters[i];
+    require(std::isfinite(d) && d > 0, [&] {
+      return "diameters must be positive and finite: diameter " + std::to_string(i) + " is " + num(d);
+    });
+    diameter_ = std::max(diameter_, d);
+  }
+  for (std::size_t i = 0; i < diameters.size(); ++i)
+    require(diameters[i] * kMaxSizeRatio >= diameter_, [&] {
+      return "diameter " + std::to_string(i) + " = " + num(diameters[i]) + " is more than " +
+             std::to_string(static_cast<int>(kMaxSizeRatio)) + " times smaller than the largest, " + num(diameter_);
+    });
+  require(dim_ == 0 || x.size() == diameters.size() * box.size(), [&] {
+    return "diameters must give one diameter per sphere: " + std::to_string(diameters.size()) + " for " +
+           std::to_string(x.size() / box.size()) + " spheres";
+  });
+  if (diameters.empty()) diameter_ = 1.0;  // no spheres: nothing to size (the checks below still run)
+  init(std::move(box), std::move(x), diameters, seed);
+}
+
+void EventChain::init(std::vector<double> box, std::vector<double> x, const std::vector<double>& diameters,
+                      std::uint64_t seed) {
+  const double diameter = diameter_;
   require(dim_ >= 1 && dim_ <= 3, [&] { return "box must have 1, 2 or 3 lengths, got " + std::to_string(dim_); });
   require(std::isfinite(diameter) && diameter > 0, [&] { return "diameter must be positive and finite, got " + num(diameter); });
   require(seed <= 0xFFFFFFFFull, [&] { return "seed must be below 2^32, got " + std::to_string(seed); });
@@ -57,13 +88,18 @@ EventChain::EventChain(std::vector<double> box, std::vector<double> x, double di
       cell_[i][k] = std::min(static_cast<int>(v / w_[k]), m_[k] - 1);
     }
   x_ = std::move(x);
+  radius_.clear();
+  for (const double d : diameters) radius_.push_back(0.5 * d);
   count_.assign(cells, 0);
   cap_ = dim_ == 1 ? 2 : dim_ == 2 ? 4 : 8;
   members_.assign(cells * static_cast<std::size_t>(cap_), -1);
   slot_.resize(n_);
   for (std::size_t i = 0; i < n_; ++i) insert(static_cast<int>(i), cell_index(cell_[i]));
   const double md = min_distance();
-  require(md >= 1.0 - kOverlapTol, [&] { return "two spheres overlap: the closest pair is " + num(md) + " D apart"; });
+  require(md >= 1.0 - kOverlapTol, [&] {
+    return "two spheres overlap: the closest pair is " + num(md) + (radius_.empty() ? " D" : " contact distances") +
+           " apart";
+  });
   rng_ = rng::Philox({kStreamWord, static_cast<std::uint32_t>(seed)});
 }
 
@@ -74,7 +110,10 @@ std::size_t EventChain::cell_index(const std::array<int, 3>& c) const {
 double EventChain::packing_fraction() const {
   double vol = 1.0;
   for (int k = 0; k < dim_; ++k) vol *= box_[k];
-  return static_cast<double>(n_) * engine::limits::particle_volume(dim_, diameter_) / vol;
+  if (radius_.empty()) return static_cast<double>(n_) * engine::limits::particle_volume(dim_, diameter_) / vol;
+  double v = 0.0;
+  for (const double r : radius_) v += engine::limits::particle_volume(dim_, 2.0 * r);
+  return v / vol;
 }
 
 template <int Dim, class F>
@@ -135,7 +174,7 @@ double EventChain::min_distance_d() const {
         const double r = x_[j * Dim + k] + shift[k] - x_[i * Dim + k];
         r2 += r * r;
       }
-      best = std::min(best, std::sqrt(r2) / diameter_);
+      best = std::min(best, std::sqrt(r2) / (radius_.empty() ? diameter_ : radius_[i] + radius_[j]));
     });
   return best;
 }
@@ -153,15 +192,20 @@ ChainSums EventChain::run(std::uint64_t chains, double ell, const InterruptCheck
   InterruptPoll poll(check, 256);
   for (std::uint64_t c = 0; c < chains && n_ > 0; ++c) {
     poll.tick();  // between chains: totals() always counts whole chains
-    const ChainSums one = dim_ == 1 ? run_chain<1>(ell) : dim_ == 2 ? run_chain<2>(ell) : run_chain<3>(ell);
+    const ChainSums one = radius_.empty()
+                              ? (dim_ == 1 ? run_chain<1, false>(ell) : dim_ == 2 ? run_chain<2, false>(ell)
+                                                                      : run_chain<3, false>(ell))
+                              : (dim_ == 1 ? run_chain<1, true>(ell) : dim_ == 2 ? run_chain<2, true>(ell)
+                                                                     : run_chain<3, true>(ell));
     sums += one;
     totals_ += one;
   }
   return sums;
 }
 
-// One chain along axis axis_ % d: measure before changing (this loop is the whole cost).
-template <int Dim>
+// One chain along axis axis_ % d: measure before changing (this loop is the whole cost). Mixed:
+// each pair's contact distance is r_i + r_j (a one-size chain reads no radius).
+template <int Dim, bool Mixed>
 ChainSums EventChain::run_chain(double ell) {
   const int k = static_cast<int>(axis_ % Dim);
   int i = std::min(static_cast<int>(rng_.next() * static_cast<double>(n_)), static_cast<int>(n_) - 1);
@@ -184,15 +228,21 @@ ChainSums EventChain::run_chain(double ell) {
       if (j == i) return;
       const double* xj = &x_[static_cast<std::size_t>(j) * Dim];
       const double rk = xj[k] + shift[k] - xi[k];
-      if (rk <= 0.0 || (j == prev && rk < half)) return;
+      double sig2 = D2, sig_half = half;
+      if constexpr (Mixed) {
+        const double sig = radius_[i] + radius_[j];
+        sig2 = sig * sig;
+        sig_half = 0.5 * sig;
+      }
+      if (rk <= 0.0 || (j == prev && rk < sig_half)) return;
       double b2 = 0.0;
       for (int a = 0; a < Dim; ++a) {
         if (a == k) continue;
         const double r = xj[a] + shift[a] - xi[a];
         b2 += r * r;
       }
-      if (b2 >= D2) return;
-      const double step = std::max(rk - std::sqrt(D2 - b2), 0.0);
+      if (b2 >= sig2) return;
+      const double step = std::max(rk - std::sqrt(sig2 - b2), 0.0);
       if (step < best) {
         best = step;
         hit = j;

@@ -22,7 +22,8 @@ the same N, phi and seed (ratio 1, the mixture code path with equal radii): BMCS
 Carnahan-Starling, which is 0.2-0.3% low for the pure sphere fluid at 0.3-0.45 (docs/physics.md),
 so beside Z against BMCSL it reports the pure gas against Liu's and CS's equations and the
 ratio Z_mixture / Z_pure against BMCSL / CS (SLHY / Liu in 2D), which the pure fluid's
-equation and the O(1/N) terms both cancel from. ``python -m revcol.studies.mixture_eos --json F``
+equation and the O(1/N) terms both cancel from; and each beside the project's event-chain Monte
+Carlo of the same mixture at the same N (``ecmc``), which needs no theory at all. ``python -m revcol.studies.mixture_eos --json F``
 writes the 2D (area fraction 0.5) and 3D (0.4) points beside the theories.
 
     >>> round(bmcsl_z(0.3, [1.0]), 6) == round((1 + 0.3 + 0.09 - 0.027) / 0.7**3, 6)
@@ -35,6 +36,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 import time
 from typing import Sequence
 
@@ -97,15 +99,19 @@ def binary_diameters(n: int, ratio: float) -> np.ndarray:
 
 
 def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 100.0, collisions: float = 400.0,
-            seed: int = 1, blocks: int = 32, frames: int = 0) -> dict:
+            seed: int = 1, blocks: int = 32, frames: int = 0, ecmc: float = 0.0) -> dict:
     """One run (see the module docstring): Z with its block error, the theory, and the checks;
     ``frames`` > 0: that many frames at evenly spaced times (not at collisions) give the partial
-    contact values g_ab(sigma_ab+) against the theory's and each species' temperature."""
+    contact values g_ab(sigma_ab+) against the theory's and each species' temperature; ``ecmc``
+    > 0: the event-chain sampler (:mod:`revcol.studies.ecmc`, a different algorithm sharing no
+    code with the engine) from the same start, box and quantized diameters, that many largest
+    diameters of chain displacement per sphere, its Z as the engine's (md_equivalent) beside."""
     from ..lattice import LatticeSimulation, LatticeSimulation3D
     cls = LatticeSimulation3D if dim == 3 else LatticeSimulation
     d = binary_diameters(n, ratio)
     sim = cls.random(n, phi=phi, diameters=d, seed=seed)
     x0 = sim.lattice_positions.copy()
+    chains = _ecmc(dim, phi, sim, seed, ecmc) if ecmc > 0 else None
     t0 = time.perf_counter()
     sim.run(collisions=int(equilibrate * n))
     # blocks of equal time: the rate from the equilibration
@@ -135,10 +141,24 @@ def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 
            "back_to_start": bool((sim.lattice_positions == x0).all()), "seconds": seconds}
     if dim == 2:
         out["z_slhy_henderson"] = slhy_z(phi, sim.diameters, henderson)
+    if chains is not None:
+        (zc, zce) = chains["z_md"]
+        out["ecmc"] = chains
+        out["ecmc_deviation_sd"] = (z - zc) / math.hypot(ze, zce)
     if frames:
         out.update(_structure(dim, phi, sim, np.asarray(xs), np.asarray(vs), trace, t_obs,
                               obs.temperature.value))
     return out
+
+
+def _ecmc(dim: int, phi: float, sim, seed: int, per_particle: float) -> dict:
+    """The event-chain run of ``measure``: chains from the lattice gas's start (its float
+    positions, box and diameters), 200 diameters per sphere of warm-up, 32 blocks."""
+    from .ecmc import EventChain, sample
+    chain = EventChain(list(sim.box), sim.positions, diameters=sim.diameters, seed=seed)
+    r = sample(dim, phi, n=sim.n, seed=seed, per_particle=per_particle, sampler=chain)
+    return {k: r[k] for k in ("z_mc", "z_md", "per_particle", "warmup", "chain_length", "lifts", "cpu_s",
+                              "min_distance")}
 
 
 def _structure(dim: int, phi: float, sim, xs: np.ndarray, vs: np.ndarray, trace, duration: float, kt: float) -> dict:
@@ -248,6 +268,14 @@ def table(runs: list) -> str:
                  ("Z, one size", [c["pure"]["z"] for c in cs], cs[0]["z_pure_theory"], cs[0]["pure_theory"]),
                  ("Z mixture / Z one size", [c["ratio"] for c in cs], cs[0]["ratio_theory"],
                   "BMCSL / CS" if dim == 3 else "SLHY / Liu")]
+        if "ecmc" in m0:
+            items.append(("Z, mixture: lattice - ECMC (same N)", [c["mixture"]["z"] - c["mixture"]["ecmc"]["z_md"][0]
+                                                              for c in cs], 0.0, "0"))
+            items.append(("Z, mixture, ECMC (same N)", [c["mixture"]["ecmc"]["z_md"][0] for c in cs], m0["z_theory"],
+                          m0["theory"]))
+            if "ecmc" in cs[0]["pure"]:
+                items.append(("Z, one size: lattice - ECMC (same N)", [c["pure"]["z"] - c["pure"]["ecmc"]["z_md"][0]
+                                                                    for c in cs], 0.0, "0"))
         if "z_from_contact" in m0:
             items.append(("Z from the contact values (rates)", [c["mixture"]["z_from_contact"] for c in cs],
                           float(np.mean([c["mixture"]["z"] for c in cs])), "Z (collision virial)"))
@@ -261,17 +289,21 @@ def table(runs: list) -> str:
             items.append(("T small / T large", list(t[:, 0] / t[:, 1]), 1.0, "equipartition"))
         for name, vals, th, thname in items:
             mean, se = pooled(vals)
+            pct = f" ({100 * (mean / th - 1):+.2f}%)" if th else ""
             rows.append(f"| {dim} | {m0['phi']:g} | {name} | {mean:.5g} +- {se:.2g} ({k}) | {th:.5g} ({thname}) | "
-                        f"{(mean - th) / se:+.1f} ({100 * (mean / th - 1):+.2f}%) |")
+                        f"{(mean - th) / se:+.1f}{pct} |")
     return "\n".join(rows)
 
 
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--n", type=int, default=4000)
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     p.add_argument("--collisions", type=float, default=400.0, help="observed collisions per particle")
     p.add_argument("--frames", type=int, default=100, help="frames for the partial contact values (0: none)")
+    p.add_argument("--ecmc", type=float, default=2000.0, help="event-chain displacement per sphere, in largest "
+                   "diameters, for the cross-check at the same N (0: none)")
     p.add_argument("--json", default=None)
     p.add_argument("--figure", default=None, help="the partial g_ab(r) of the first seed's runs (PNG); with --from, "
                    "from that JSON alone")
@@ -288,7 +320,7 @@ def main(argv=None) -> int:
     runs = []
     for seed in a.seeds:
         for dim, phi in ((2, 0.5), (3, 0.4)):
-            c = compare(dim, a.n, phi, 1.4, collisions=a.collisions, seed=seed, frames=a.frames)
+            c = compare(dim, a.n, phi, 1.4, collisions=a.collisions, seed=seed, frames=a.frames, ecmc=a.ecmc)
             r, q = c["mixture"], c["pure"]
             print(f"{dim}D phi {phi} seed {seed}: Z = {r['z']:.4f} +- {r['z_error']:.4f}, {r['theory']} "
                   f"{r['z_theory']:.4f} ({r['deviation_sd']:+.1f} sd); one size {q['z']:.4f} +- {q['z_error']:.4f}, "
@@ -296,6 +328,11 @@ def main(argv=None) -> int:
                   f"{c['ratio']:.5f} +- {c['ratio_error']:.5f} against {c['ratio_theory']:.5f} "
                   f"({c['ratio_deviation_sd']:+.1f} sd); back to start {r['back_to_start'] and q['back_to_start']}",
                   flush=True)
+            for name, run in (("mixture", r), ("one size", q)):
+                if "ecmc" in run:
+                    e = run["ecmc"]["z_md"]
+                    print(f"    {name}: ECMC at the same N {e[0]:.4f} +- {e[1]:.4f}, lattice - ECMC "
+                          f"{run['z'] - e[0]:+.4f} ({run['ecmc_deviation_sd']:+.1f} sd)", flush=True)
             if "z_from_contact" in r:
                 print(f"    Z from the rates' contact values (virial route) {r['z_from_contact']:.4f}; temperatures "
                       + ", ".join(f"{t:.4f}" for t in r["temperatures"]), flush=True)

@@ -2,6 +2,10 @@
 // 056704, 2009): an independent sampler of the equilibrium that the engine's dynamics should
 // keep, and the pressure of that equilibrium at the engine's own N and box.
 //
+// Mixtures. Each sphere may have its own diameter d_i (a pair touches at (d_i + d_j) / 2; the
+// largest, D, sizes the cells): the uniform measure, the chains and the pressure estimator are
+// the same, dx being the contact's projection for the pair's own contact distance.
+//
 // What it samples. N spheres of diameter D in a periodic box (d = 1, 2, 3, side L_k >= 3 D on
 // every axis): the uniform measure over non-overlapping configurations, which is the
 // configurational equilibrium of hard spheres at any temperature (the velocities of an
@@ -86,6 +90,11 @@ class EventChain {
   /// closer than D (1 - 1e-9), a seed of 2^32 or more, more than 2^22 cells (floor(L_k / D)
   /// per axis).
   EventChain(std::vector<double> box, std::vector<double> x, double diameter, std::uint64_t seed);
+  /// A mixture: sphere i has diameter diameters[i] (one per sphere, positive, finite, within a
+  /// ratio of 16 of the largest, D, which sizes the cells and the box's minimum of 3 D); a pair
+  /// touches at (d_i + d_j) / 2. Throws as the one-size constructor does, and on a bad diameter.
+  EventChain(std::vector<double> box, std::vector<double> x, const std::vector<double>& diameters,
+             std::uint64_t seed);
 
   /// Runs `chains` chains of mean length `ell` (> 0, finite, at most 1e6 L_max) and returns their
   /// sums (also added to totals()). The check is polled between chains; Interrupted leaves
@@ -99,20 +108,25 @@ class EventChain {
   std::size_t size() const { return n_; }
   /// Box lengths (d of them).
   std::vector<double> box() const { return {box_.begin(), box_.begin() + dim_}; }
-  /// Diameter D.
+  /// Diameter D (a mixture's largest).
   double diameter() const { return diameter_; }
+  /// A mixture's radii, d_i / 2 by sphere; empty for one diameter.
+  const std::vector<double>& radii() const { return radius_; }
   /// Positions, n x d row-major, each in [0, L_k).
   const std::vector<double>& positions() const { return x_; }
   /// Sums over every run so far.
   const ChainSums& totals() const { return totals_; }
-  /// Packing fraction N v_D / V.
+  /// Packing fraction: the spheres' volumes over V (N v_D / V for one diameter).
   double packing_fraction() const;
-  /// The smallest centre distance over all pairs (nearest periodic image) divided by D;
-  /// infinity for N < 2. O(N) through the cells.
+  /// The smallest centre distance (nearest periodic image) divided by the pair's contact
+  /// distance (D, or (d_i + d_j) / 2 in a mixture), over the pairs in neighbouring cells, which
+  /// hold every pair closer than D; infinity when no pair is that near. O(N) through the cells.
   double min_distance() const;
 
  private:
-  template <int Dim> ChainSums run_chain(double ell);  ///< one chain along axis axis_ % d
+  /// The checks and the cells, for both constructors (diameter_ already the largest diameter).
+  void init(std::vector<double> box, std::vector<double> x, const std::vector<double>& diameters, std::uint64_t seed);
+  template <int Dim, bool Mixed> ChainSums run_chain(double ell);  ///< one chain along axis axis_ % d
   std::size_t cell_index(const std::array<int, 3>& c) const;
   /// Calls f(j, shift) for every sphere j of the 3^Dim cells around cell c (x fastest, then y,
   /// z; each cell's members in order), shift the image shift of that cell's wrap.
@@ -126,6 +140,7 @@ class EventChain {
   std::array<int, 3> m_{1, 1, 1};           ///< cells per axis
   std::array<double, 3> w_{1.0, 1.0, 1.0};  ///< cell sides
   std::vector<double> x_;                   ///< n x dim
+  std::vector<double> radius_;              ///< a mixture's radii by sphere; empty for one diameter
   std::vector<std::array<int, 3>> cell_;    ///< each sphere's cell coordinates
   /// The spheres of cell c: members_[c cap_ .. c cap_ + count_[c]), in insertion order with
   /// removals filled from the back. cap_ starts at 2, 4, 8 (1D, 2D, 3D) and doubles for all
