@@ -86,6 +86,20 @@ py::dict observation_dict(const engine::Observation& o) {
   py::array_t<double> h({hc > 0 ? static_cast<py::ssize_t>(o.helfand.size()) / hc : 0, hc});
   if (!o.helfand.empty()) std::memcpy(h.mutable_data(), o.helfand.data(), o.helfand.size() * sizeof(double));
   d["helfand"] = h;
+  // a mixture's species (empty for one species): the estimates per species, the MSD (block ends, S)
+  d["species_diameter"] = array(o.species_diameter);
+  py::array_t<std::uint64_t> counts(static_cast<py::ssize_t>(o.species_count.size()));
+  for (std::size_t u = 0; u < o.species_count.size(); ++u) counts.mutable_data()[u] = o.species_count[u];
+  d["species_count"] = counts;
+  py::list temps, press;
+  for (const auto& e : o.species_temperature) temps.append(estimate(e));
+  for (const auto& e : o.species_pressure) press.append(estimate(e));
+  d["species_temperature"] = temps;
+  d["species_pressure"] = press;
+  const auto ns = static_cast<py::ssize_t>(o.species_count.size());
+  py::array_t<double> sm({ns > 0 ? static_cast<py::ssize_t>(o.species_msd.size()) / ns : 0, ns});
+  if (!o.species_msd.empty()) std::memcpy(sm.mutable_data(), o.species_msd.data(), o.species_msd.size() * sizeof(double));
+  d["species_msd"] = sm;
   return d;
 }
 

@@ -47,6 +47,7 @@ void Observer::Block::add(const Block& b) {
   sum(slab, b.slab);
   sum(speed, b.speed);
   sum(pair, b.pair);
+  sum(sp, b.sp);
 }
 
 // The config's checks (the constructor's and a snapshot's): n particles in dim dimensions.
@@ -134,6 +135,7 @@ Observer::Block Observer::empty_block(double t0) const {
   b.slab.assign(2 * static_cast<std::size_t>(cfg_.slabs), 0.0);
   b.speed.assign(cfg_.speed_bins + 1, 0.0);  // + the overflow bin (set_velocity)
   b.pair.assign(cfg_.pair_bins, 0.0);
+  b.sp.assign(2 * static_cast<std::size_t>(ns_), 0.0);
   return b;
 }
 
@@ -225,7 +227,6 @@ void Observer::pairs_to(int i, double t) {
   }
 }
 
-
 // The open block ends at te: the sums are integrated to te and the MSD is taken from every
 // particle's position then, without closing the segments (a segment's profile time goes
 // to the block in which it closes), except with pair distances (small systems, exact).
@@ -245,6 +246,7 @@ void Observer::end_block() {
     }
   msd_t_.push_back(te - t_start_);
   msd_.push_back(msd / static_cast<double>(n_));
+  if (ns_ > 0) species_msd(te);
   if (helf_kept_) helf_rec_.insert(helf_rec_.end(), helf_.begin(), helf_.begin() + hc_);  // integrated to te above
   if (!start_v_.empty()) {  // velocities are constant on segments: the segment's is the one at te
     double c = 0.0;
@@ -316,6 +318,7 @@ template <int Dim>
     w += r[k] * dp[k];
   }
   cur_.w += w;
+  if (ns_ > 0) [[unlikely]] species_pair_virial(a, b, w);
   helfand_add<Dim>(r, dp);
 }
 
@@ -337,13 +340,5 @@ void Observer::pair_general(double t, int a, int b, const double* va, const doub
 template void Observer::pair_d<1>(double, int, int, const double*, const double*);
 template void Observer::pair_d<2>(double, int, int, const double*, const double*);
 template void Observer::pair_d<3>(double, int, int, const double*, const double*);
-
-
-
-
-
-
-
-
 
 }  // namespace revcol::engine

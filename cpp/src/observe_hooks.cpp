@@ -26,11 +26,13 @@ void Observer::group(double t, int n, const int* ids, const double* x, const dou
 // A group member i at x (image-consistent) going to velocity v: x . Delta p to the virial,
 // x_a Delta p_b to the Helfand moment (their sums over members are the same for any image).
 void Observer::group_virial(int i, const double* x, const double* v) {
-  double dp[3];
+  double dp[3], own = 0.0;
   for (int k = 0; k < dim_; ++k) {
     dp[k] = v[k] - seg_[i].v[k];
     cur_.w += x[k] * dp[k];
+    own += x[k] * dp[k];
   }
+  if (ns_ > 0) cur_.sp[2 * static_cast<std::size_t>(label_[i]) + 1] += own;
   helfand_add<0>(x, dp);
 }
 
@@ -38,7 +40,7 @@ void Observer::wall(double t, int i, const double* v) {
   reach(t);
   close<3>(i, t);
   close_pairs(i, t);
-  const double r = 0.5 * diameter_, tol = 1e-6 * diameter_;
+  const double r = radius_of(i), tol = 1e-6 * diameter_;
   for (int k = 0; k < dim_; ++k) {
     const double dv = v[k] - seg_[i].v[k], xk = seg_[i].x[k];
     if (!walls_[k] || dv == 0.0) continue;
@@ -79,6 +81,7 @@ void Observer::pair_at(double t, int a, int b, const double* xa, const double* x
     w += r[k] * dp[k];
   }
   cur_.w += w;
+  if (ns_ > 0) species_pair_virial(a, b, w);
   helfand_add<0>(r, dp);
   place(a, xa);
   place(b, xb);
@@ -109,7 +112,7 @@ void Observer::wall_at(double t, int i, const double* x, const double* v, unsign
   reach(t);
   close<3>(i, t);
   close_pairs(i, t);
-  const double r = 0.5 * diameter_;
+  const double r = radius_of(i);
   for (int k = 0; k < dim_; ++k) {
     if (!(axes >> k & 1u) || !walls_[k]) continue;
     const double dv = v[k] - seg_[i].v[k];

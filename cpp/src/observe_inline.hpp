@@ -58,6 +58,7 @@ template <int K>
     v2 += v[k] * v[k];
   }
   const double speed = root(v2);
+  if (ns_ > 0) [[unlikely]] v2_sp_[static_cast<std::size_t>(label_[i])] += v2 - s.v2;  // per species
   v2_sum_ += v2 - s.v2;  // sum_i v_i^2 and sum_i |v_i| (their time integrals: accumulate)
   speed_sum_ += speed - s.speed;
   s.v2 = v2;
@@ -119,6 +120,7 @@ template <int K>
   cur_.k2 += v2_sum_ * dt;
   cur_.dist += speed_sum_ * dt;
   for (int c = 0; c < 3; ++c) helf_[c] += vv_off_[c] * dt;
+  for (int u = 0; u < ns_; ++u) cur_.sp[2 * static_cast<std::size_t>(u)] += v2_sp_[static_cast<std::size_t>(u)] * dt;
   t_now_ = t;
 }
 

@@ -46,6 +46,13 @@ void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& coun
     reals.insert(reals.end(), helf_.begin(), helf_.begin() + hc_);
     reals.insert(reals.end(), vv_off_.begin(), vv_off_.begin() + hc_);
     reals.insert(reals.end(), helf_rec_.begin(), helf_rec_.end());
+    if (ns_ > 0) {  // the species' sums (a mixture's; absent for one species and in older snapshots)
+      reals.push_back(static_cast<double>(ns_));
+      reals.insert(reals.end(), v2_sp_.begin(), v2_sp_.end());
+      for (const Block& b : blocks_) reals.insert(reals.end(), b.sp.begin(), b.sp.end());
+      reals.insert(reals.end(), cur_.sp.begin(), cur_.sp.end());
+      reals.insert(reals.end(), msd_sp_.begin(), msd_sp_.end());
+    }
   }
 }
 
@@ -90,9 +97,15 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   const std::size_t size = kHeader + n_ * per_particle + np + (nb + 1) * per_block + 2 * nm;
   hc_ = dim * (dim - 1) / 2;
   const std::size_t hc = static_cast<std::size_t>(hc_), vacf = size + n_ * d + nm, helf = vacf + hc * (2 + nm);
-  // with the VACF and the Helfand moment, with the VACF only, or neither (older snapshots)
-  require(reals.size() == helf || reals.size() == vacf || reals.size() == size,
-          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points)");
+  // with the VACF and the Helfand moment (and a mixture's species sums), with the VACF only, or
+  // neither (older snapshots)
+  std::size_t species = 0;
+  if (reals.size() > helf) {
+    ns_saved_ = static_cast<int>(whole(helf, 1, static_cast<double>(n_), "species count"));
+    species = static_cast<std::size_t>(ns_saved_) * (2 * (nb + 1) + nm + 1) + 1;
+  }
+  require(reals.size() == helf + species || reals.size() == vacf || reals.size() == size,
+          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points, species)");
   require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
   bin_scale_ = cfg_.speed_bins / speed_max_;
   bin_cap_ = cfg_.speed_bins;
@@ -153,13 +166,22 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
     take(start_v_, n_ * d);
     take(vacf_, nm);
   }
-  helf_kept_ = reals.size() == helf;  // the Helfand moment (a snapshot without it resumes none)
+  helf_kept_ = reals.size() >= helf;  // the Helfand moment (a snapshot without it resumes none)
   if (helf_kept_) {
     for (std::size_t c = 0; c < hc; ++c) helf_[c] = reals[u + c];
     for (std::size_t c = 0; c < hc; ++c) vv_off_[c] = reals[u + hc + c];  // the running sums as they were
     u += 2 * hc;
     take(helf_rec_, nm * hc);
   }
+  if (ns_saved_ > 0) {  // the species' sums: set_species turns them on
+    const auto ns = static_cast<std::size_t>(ns_saved_);
+    ++u;  // the count, read above
+    take(v2_sp_, ns);
+    for (Block& b : blocks_) take(b.sp, 2 * ns);
+    take(cur_.sp, 2 * ns);
+    take(msd_sp_, nm * ns);
+  }
+  resumed_ = true;
   v2_sum_ = reals[16];  // the running sums as they were (set_velocity above rebuilt them afresh)
   speed_sum_ = reals[17];
   set_fast_until();

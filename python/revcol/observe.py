@@ -111,7 +111,8 @@ _SCALARS = ("temperature", "pressure_virial", "compressibility", "collision_rate
 _PROFILES = ("slab_density", "slab_temperature", "speed", "pair_distance")
 _COUNTS = ("dim", "n", "t_start", "t_end", "blocks", "block_time", "pair_collisions", "group_collisions",
            "particle_collisions", "wall_reflections")
-_KNOWN = set(_SCALARS) | set(_PROFILES) | set(_COUNTS) | {"pressure_wall"}
+_SPECIES = ("species_temperature", "species_pressure")  # a mixture's estimates per species
+_KNOWN = set(_SCALARS) | set(_PROFILES) | set(_COUNTS) | set(_SPECIES) | {"pressure_wall"}
 
 
 class Observation:
@@ -129,7 +130,12 @@ class Observation:
     Helfand moment of the shear stress at the same times, an array (block ends, d (d - 1) / 2)
     of I_ab, a < b ((0, 1); (0, 1), (0, 2), (1, 2)), the integral of sum_i v_ia v_ib plus
     sum r_a Delta p_b over collisions (:func:`helfand_viscosity`). Both are empty for an
-    observation resumed from a snapshot written before they existed. Any other entry the C++
+    observation resumed from a snapshot written before they existed. A mixture (the lattice
+    engine with ``diameters``; all empty for one size), per species in ascending diameter:
+    ``species_diameter``, ``species_count``, ``species_temperature`` and ``species_pressure``
+    (lists of :class:`Estimate`: K2_s / (d N_s tau) and the partial pressure (K2_s + W_s) /
+    (d V tau), W_s half of each pair's virial to each member's species; their sum is
+    ``pressure_virial``), ``species_msd`` (block ends, S) at ``msd_time``. Any other entry the C++
     observer reports appears as an attribute of its own name. Counts: ``pair_collisions``,
     ``group_collisions``, ``particle_collisions``, ``wall_reflections``; ``t_start``, ``t_end``,
     ``blocks``, ``block_time``.
@@ -164,6 +170,8 @@ class Observation:
         for key in _SCALARS:
             setattr(self, key, Estimate(float(raw[key]["value"]), float(raw[key]["error"])))
         self.pressure_wall = [Estimate(float(e["value"]), float(e["error"])) for e in raw["pressure_wall"]]
+        for key in _SPECIES:
+            setattr(self, key, [Estimate(float(e["value"]), float(e["error"])) for e in raw.get(key, [])])
         for key in _PROFILES:
             p = raw[key]
             setattr(self, key, None if p is None else Profile(np.asarray(p["edges"]), np.asarray(p["value"]),
@@ -192,6 +200,8 @@ class Observation:
             e = getattr(self, key)
             out[key] = [e.value, e.error]
         out["pressure_wall"] = [[e.value, e.error] for e in self.pressure_wall]
+        for key in _SPECIES:
+            out[key] = [[e.value, e.error] for e in getattr(self, key)]
         for key in _PROFILES:
             p = getattr(self, key)
             out[key] = None if p is None else {"edges": p.edges.tolist(), "value": p.value.tolist(),
@@ -228,6 +238,12 @@ def report_lines(d: dict[str, Any]) -> list[str]:
             rows.append(f"  pressure_wall[{k}] {v:.5g}" + (f" +- {e:.2g}" if d["blocks"] >= 2 else ""))
     if d["msd"]:
         rows.append(f"  msd              {d['msd'][-1]:.5g} at t = {d['msd_time'][-1]:.5g} after the start")
+    pm = "+-" if d["blocks"] >= 2 else "~"
+    for u, diam in enumerate(d.get("species_diameter") or []):
+        (t, te), (p, pe) = d["species_temperature"][u], d["species_pressure"][u]
+        msd = f", msd {d['species_msd'][-1][u]:.5g}" if len(d.get("species_msd") or []) else ""
+        rows.append(f"  species d={diam:.4g} ({d['species_count'][u]}): T {t:.5g} {pm} {te:.2g}, partial pressure "
+                    f"{p:.5g} {pm} {pe:.2g}{msd}")
     return rows
 
 

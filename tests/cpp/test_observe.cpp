@@ -108,6 +108,54 @@ TEST_CASE("a rod between walls: wall pressure, slab occupancy, speeds") {
   CHECK_NEAR(o.virial_balance.value, 0.0, 1e-12);  // whole periods: K2 + W_wall = 0
 }
 
+TEST_CASE("species by hand: a head-on pair of two sizes, partial pressures, temperatures, MSD; resumed") {
+  // 1D, walls at 0 and 10; a (radius 1/4) at 1 moving +1, b (radius 1/2) at 3 moving -1: they
+  // touch at 2 - 2t = 3/4, t = 5/8, and swap velocities; r . dp_a = (-3/4)(-2) = 3/2, half to each
+  ObserveConfig oc;
+  oc.block_time = 0.5;
+  Observer o(oc, 1, {1.0, 3.0}, {1.0, -1.0}, 0.0, {10.0, 1.0, 1.0}, {true, false, false}, 1.0);
+  o.set_species({0, 1}, {0.25, 0.5});
+  const double xa = 1.625, xb = 2.375, va = -1.0, vb = 1.0;
+  o.pair_at(0.625, 0, 1, &xa, &xb, &va, &vb);
+  std::vector<double> reals;
+  std::vector<std::uint64_t> counts;
+  o.save(reals, counts);
+  o.sync(1.0);
+  const Observation r = o.results();
+  CHECK(r.species_count == (std::vector<std::size_t>{1, 1}));
+  CHECK(same(r.species_diameter, {0.5, 1.0}));
+  for (int s = 0; s < 2; ++s) {
+    CHECK_NEAR(r.species_temperature[s].value, 1.0, 1e-15);
+    CHECK_NEAR(r.species_pressure[s].value, (1.0 + 0.75) / 10.0, 1e-15);
+  }
+  CHECK_NEAR(r.pressure_virial.value, 0.35, 1e-15);
+  // block ends 0.5 (each moved 1/2) and 1 (each 1/4 from its start)
+  CHECK(same(r.species_msd, {0.25, 0.25, 0.0625, 0.0625}));
+  // resumed from the snapshot taken after the collision: the same results, bit for bit
+  Observer back(reals, counts, 1, {va, vb}, 0.625, {10.0, 1.0, 1.0}, {true, false, false}, 1.0);
+  back.set_species({0, 1}, {0.25, 0.5});
+  back.sync(1.0);
+  const Observation q = back.results();
+  CHECK(same(q, r));
+  CHECK(same(q.species_msd, r.species_msd));
+  for (int s = 0; s < 2; ++s)
+    CHECK(same(q.species_pressure[s], r.species_pressure[s]) && same(q.species_temperature[s], r.species_temperature[s]));
+  // bad species: named, and a snapshot's species count must match
+  Observer fresh(oc, 1, {1.0, 3.0}, {1.0, -1.0}, 0.0, {10.0, 1.0, 1.0}, {true, false, false}, 1.0);
+  CHECK_THROWS_AS(fresh.set_species({0}, {0.25}), InvalidArgument);
+  CHECK_THROWS_AS(fresh.set_species({0, 2}, {0.25, 0.5}), InvalidArgument);  // species 1 empty
+  CHECK_THROWS_AS(fresh.set_species({0, -1}, {0.25, 0.5}), InvalidArgument);
+  CHECK_THROWS_AS(fresh.set_species({0, 1}, {0.25, 0.6}), InvalidArgument);  // above D / 2
+  CHECK_THROWS_AS(fresh.set_species({0, 1}, {0.0, 0.5}), InvalidArgument);
+  Observer other(reals, counts, 1, {va, vb}, 0.625, {10.0, 1.0, 1.0}, {true, false, false}, 1.0);
+  CHECK_THROWS_AS(other.set_species({0, 0}, {0.5, 0.5}), InvalidArgument);  // one species, the snapshot kept two
+  CHECK_THROWS_AS(o.set_species({0, 1}, {0.25, 0.5}), InvalidArgument);     // after events
+  // one species keeps none of it
+  Observer one(oc, 1, {1.0, 3.0}, {1.0, -1.0}, 0.0, {10.0, 1.0, 1.0}, {true, false, false}, 1.0);
+  one.sync(1.0);
+  CHECK(one.results().species_count.empty() && one.results().species_msd.empty());
+}
+
 TEST_CASE("periodic free flight: unwrapped mean squared displacement, blocks of equal time") {
   Config c;
   c.dim = 2;

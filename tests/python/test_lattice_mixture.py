@@ -93,10 +93,14 @@ def test_mixture_theories_reduce_to_the_pure_fluid():
 def test_equation_of_state_reduced(dim, phi):
     # N = 1000, 300 collisions per particle observed: the full study (N = 4000, four seeds) is in
     # bench/results/mixture_eos.json. Within 3 block errors of the theory (stated there)
-    r = measure(dim, 1000, phi, 1.4, equilibrate=60, collisions=300, seed=1)
+    r = measure(dim, 1000, phi, 1.4, equilibrate=60, collisions=300, seed=1, ecmc=400)
     assert r["back_to_start"]
     assert r["blocks"] >= 16
     assert abs(r["deviation_sd"]) < 3.0, r
+    # the event-chain sampler of the same mixture at the same N (no theory): within 3 combined errors
+    assert r["ecmc"]["min_distance"] >= 1.0 - 1e-9
+    assert r["ecmc"]["z_md"][1] < 0.02
+    assert abs(r["ecmc_deviation_sd"]) < 3.0, r["ecmc"]
 
 
 def _mixture_scene(extra: str = "", system: str = "particles = 400\n") -> dict:
@@ -167,3 +171,70 @@ def test_partial_structure_and_contact_values_from_rates():
     r1, g1 = radial_distribution(frames, [6.0] * 3, bins=30, r_max=3.0, use_freud=False)
     r2, g2 = partial_radial_distribution(frames, [6.0] * 3, np.zeros(200, dtype=int), bins=30, r_max=3.0)
     assert np.allclose(r1, r2) and np.allclose(g1, g2[0, 0], rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("cls,boundary", [(LatticeSimulation, "periodic"), (LatticeSimulation3D, "wall")])
+def test_the_observer_reports_each_species(cls, boundary, tmp_path):
+    """Per species temperature, partial pressure and MSD (ascending diameter): they add up to
+    the gas's own (partial pressures to P_virial, count-weighted MSD and temperatures to the
+    whole's, to round-off); equipartition within 4 block errors; a snapshot resumes them bit
+    for bit; a one-size gas reports none."""
+    import pickle
+    d = binary_diameters(600, 1.4)
+    sim = cls.random(600, phi=0.35, diameters=d, seed=8, boundary=boundary)
+    sim.run(collisions=6000)
+    sim.observe(block_time=0.05)
+    sim.run(collisions=20000)
+    snap = sim.snapshot()
+    copy = pickle.loads(pickle.dumps(sim))
+    sim.save(tmp_path / "m.npz")
+    sim.run(collisions=30000)
+    o = sim.observation()
+    assert np.allclose(o.species_diameter, [1 / 1.4, 1.0], rtol=1e-9) and o.species_count.tolist() == [300, 300]
+    assert sum(e.value for e in o.species_pressure) == pytest.approx(o.pressure_virial.value, rel=1e-12)
+    assert o.species_msd.shape == (len(o.msd), 2)
+    assert np.allclose(o.species_msd @ o.species_count / 600, o.msd, rtol=1e-12)
+    assert o.species_msd[-1, 0] > o.species_msd[-1, 1]  # the small ones diffuse faster
+    t = [e.value for e in o.species_temperature]
+    assert np.dot(t, o.species_count) / 600 == pytest.approx(o.temperature.value, rel=1e-12)
+    for e in o.species_temperature:
+        assert abs(e.value - o.temperature.value) < 4 * e.error, o.species_temperature
+    assert any("species d=0.7143 (300)" in line for line in o.lines())
+    want = o.to_dict()
+    assert len(want["species_pressure"]) == 2
+    for resumed in (cls.from_snapshot(snap), cls.load(tmp_path / "m.npz"), copy):
+        resumed.run(collisions=30000)
+        assert resumed.observation().to_dict() == want
+    one = cls.random(200, phi=0.3, seed=2)
+    one.observe()
+    one.run(collisions=2000)
+    assert one.observation().species_temperature == [] and one.observation().species_msd.size == 0
+
+
+def test_the_wall_virial_takes_each_particle_its_own_radius():
+    """Two particles of diameters 1 and 1/2 flying along x between walls, never meeting: each
+    one's wall virial balances its kinetic term over whole flights only if its contact plane
+    is its own radius from the wall (with the larger one's, the small one's 1/4 offset leaves
+    (K2 + W_wall) / K2 at 0.06 here)."""
+    x = np.array([[2.0, 1.5], [2.5, 4.0]])
+    v = np.array([[1.0, 0.0], [0.7, 0.0]])
+    sim = LatticeSimulation(x, v, [6.0, 6.0], boundary="wall", diameters=[0.5, 1.0])
+    sim.observe(block_time=1.0)
+    sim.run(time=2000.0)
+    o = sim.observation()
+    assert o.wall_reflections > 500 and o.pair_collisions == 0
+    assert abs(o.virial_balance.value) < 2e-3, o.virial_balance
+
+
+def test_the_parallel_engine_observes_the_species_of_the_sequential_run():
+    """4 logical processes on 2 workers (oversubscribed): the committed observation, species
+    included, is the sequential one bit for bit."""
+    out = []
+    for workers, lps in ((1, 1), (2, 4)):
+        sim = LatticeSimulation3D.random(800, phi=0.35, diameters=binary_diameters(800, 1.4), seed=4, boundary="wall")
+        sim.set_parallel(workers, lps=lps)
+        sim.run(collisions=3000)
+        sim.observe(block_time=0.05)
+        sim.run(collisions=12000)
+        out.append(sim.observation().to_dict())
+    assert len(out[0]["species_pressure"]) == 2 and out[0] == out[1]

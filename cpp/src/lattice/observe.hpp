@@ -3,6 +3,7 @@
 // Part of BasicEngine (revcol/lattice/engine_core.hpp, which declares it and explains the
 // design); included by engine_impl.hpp, which the instantiating sources include.
 #pragma once
+#include <algorithm>
 #include <memory>
 
 #include "revcol/lattice/engine_core.hpp"
@@ -11,7 +12,7 @@ namespace revcol::lattice {
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
-  observer_ = make_observer(u_, positions(), velocities(), clock_, &c, nullptr);
+  observer_ = make_observer(u_, positions(), velocities(), clock_, &c, nullptr, radii());
   obs_ = observer_.get();
 }
 
@@ -20,7 +21,8 @@ void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::make_observer(const Units& u, const std::vector<Vec>& x, const std::vector<Vec>& v,
                                                  std::int64_t clock, const engine::ObserveConfig* c,
-                                                 const Snapshot* s) -> std::unique_ptr<engine::Observer> {
+                                                 const Snapshot* s, const std::vector<std::int64_t>& radius)
+    -> std::unique_ptr<engine::Observer> {
   const double len = u.length_unit, speed = u.length_unit / u.tick;
   const std::size_t n = x.size();
   std::vector<double> xf(n * D), vf(n * D);
@@ -36,10 +38,22 @@ auto BasicEngine<Op, Bits, Queue>::make_observer(const Units& u, const std::vect
     walls[k] = u.wall[k];
   }
   const double t = static_cast<double>(clock) * u.tick, diameter = static_cast<double>(u.sigma) * len;
-  if (s != nullptr)
-    return std::make_unique<engine::Observer>(s->observer, s->observer_counts, static_cast<int>(D), vf, t, box, walls,
-                                              diameter);
-  return std::make_unique<engine::Observer>(*c, static_cast<int>(D), xf, vf, t, box, walls, diameter);
+  auto o = s != nullptr ? std::make_unique<engine::Observer>(s->observer, s->observer_counts, static_cast<int>(D), vf,
+                                                             t, box, walls, diameter)
+                        : std::make_unique<engine::Observer>(*c, static_cast<int>(D), xf, vf, t, box, walls, diameter);
+  if (!radius.empty()) {  // a mixture: its species by radius, ascending (revcol.observe_species.species_labels)
+    std::vector<std::int64_t> sizes(radius);
+    std::sort(sizes.begin(), sizes.end());
+    sizes.erase(std::unique(sizes.begin(), sizes.end()), sizes.end());
+    std::vector<int> label(n);
+    std::vector<double> rf(n);
+    for (std::size_t q = 0; q < n; ++q) {
+      label[q] = static_cast<int>(std::lower_bound(sizes.begin(), sizes.end(), radius[q]) - sizes.begin());
+      rf[q] = static_cast<double>(radius[q]) * len;
+    }
+    o->set_species(label, rf);
+  }
+  return o;
 }
 
 template <class Op, class Bits, class Queue>

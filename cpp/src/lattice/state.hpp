@@ -112,7 +112,7 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<
   // a running observation resumes (built before anything changes: a spoiled one is an error)
   std::unique_ptr<engine::Observer> resumed;
   require(!s.observer.empty() || s.observer_counts.empty(), "lattice snapshot: observer_counts without observer");
-  if (!s.observer.empty()) resumed = make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);
+  if (!s.observer.empty()) resumed = make_observer(s.units, s.x, s.v, s.clock, nullptr, &s, s.radius);
   // a large gas is stored in space order from the start (resort), unless an order is given
   const bool sort = order.empty() && s.observer.empty() && resort_every_for(s.x.size()) > 0;
   load(s, sort ? space_order(s.units, s.x) : order);

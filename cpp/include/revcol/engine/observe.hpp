@@ -83,6 +83,14 @@
 // and stops it (its results stay readable, nothing more is added); a forward run after it
 // adds nothing until observe() starts a new observation.
 //
+// Species (mixtures: set_species). Per species s the kinetic sum K2_s (its particles' sum
+// of v^2, integrated like K2), the virial W_s (each pair's r . Delta p shared half and half
+// between its members' species; a group member's own x . Delta p) and the MSD: species
+// temperature T_s = K2_s / (d N_s tau), partial pressure P_s = (K2_s + W_s) / (d V tau), whose
+// sum is P_virial (to round-off), and the MSD per species. A wall's contact plane is the
+// particle's own radius from the wall. One species keeps none of this (one test per
+// velocity change and per collision's virial).
+//
 // Snapshots keep a running observation: its whole state (config, segments, start
 // positions, blocks, MSD) as reals and counts (save; the layout is in observe.cpp), from
 // which a restored simulation resumes it, so that its results are those of a run never
@@ -158,6 +166,12 @@ struct Observation {
   int helfand_components = 0;        ///< c = d (d - 1) / 2 off-diagonal pairs a < b: (0,1); (0,1), (0,2), (1,2)
   std::vector<double> helfand;       ///< the Helfand moment I_ab at each block end (msd_time), c per point (row-major);
                                      ///< empty for an observation resumed from a snapshot that did not keep it
+  // Species (Observer::set_species; all empty for one species): S species in ascending size.
+  std::vector<double> species_diameter;        ///< each species' diameter
+  std::vector<std::size_t> species_count;      ///< its particles N_s
+  std::vector<Estimate> species_temperature;   ///< K2_s / (d N_s tau)
+  std::vector<Estimate> species_pressure;      ///< partial pressure (K2_s + W_s) / (d V tau); their sum is pressure_virial
+  std::vector<double> species_msd;             ///< each species' MSD at each block end (msd_time), S per point (row-major)
 };
 
 /// The accumulator behind Simulation::observe (any d; the engine calls the hooks).
@@ -182,7 +196,10 @@ class Observer {
   /// snapshots written before the velocity autocorrelation existed (a resumed observation
   /// then reports none); then the Helfand moment's running values and running sums of v_a v_b
   /// (c each, c = d (d - 1) / 2) and its record (c per MSD point), absent in snapshots written
-  /// before it existed (a resumed observation then reports none). counts: per block (the same order) pairs, groups, parts, walls.
+  /// before it existed (a resumed observation then reports none); then, for a mixture whose
+  /// sums are kept (set_species), S, the running sums of v^2 per species (S), per block (the
+  /// same order) K2_s and W_s (2 S), and the species' MSD (S per MSD point).
+  /// counts: per block (the same order) pairs, groups, parts, walls.
   /// Integers among the reals are exact (all far below 2^53).
   void save(std::vector<double>& reals, std::vector<std::uint64_t>& counts) const;
 
@@ -208,6 +225,15 @@ class Observer {
   /// met a wall of axis k (the lower one if it now moves up, else the upper one), whose
   /// contact plane (D/2 or L - D/2) is the wall virial's position.
   void wall_at(double t, int i, const double* x, const double* v, unsigned axes);
+  /// A mixture (engines with one size per particle call it right after constructing or
+  /// resuming): label[i] in [0, S) each particle's species (every species non-empty),
+  /// radius[i] > 0 its radius (float units; the wall virial's contact plane). A fresh
+  /// observation (no event yet) then keeps per species the kinetic sum K2_s, the virial W_s
+  /// (half of each pair's r . Delta p to each member's species, a group member's own
+  /// x . Delta p) and the MSD; a resumed one takes them from its snapshot (one saved without
+  /// them keeps none). Throws InvalidArgument on a bad label or radius, or another number of
+  /// species than the snapshot's.
+  void set_species(const std::vector<int>& label, const std::vector<double>& radius);
   /// Every segment closed at t (the end of a run call); closes any block ended by then.
   void sync(double t);
   /// The results up to the last hook or sync.
@@ -242,6 +268,7 @@ class Observer {
     std::uint64_t pairs = 0, groups = 0, parts = 0, walls = 0;
     std::vector<double> slab;  // per slab its time, then its v^2 time (interleaved: one address)
     std::vector<double> speed, pair;
+    std::vector<double> sp;    // per species its K2, then its virial W (interleaved)
     void add(const Block& b);
   };
   void reach(double t);  // closes every block that ends at or before t
@@ -295,6 +322,20 @@ class Observer {
   std::array<double, 3> helf_{};           // the Helfand moment up to t_now_
   bool helf_kept_ = true;                  // false: resumed from a snapshot without it
   std::vector<double> helf_rec_;           // I_ab at each block end (hc_ per MSD point)
+  // species (set_species): all empty and ns_ = 0 for one species
+  std::vector<int> label_;                 // each particle's species
+  std::vector<double> radius_;             // each particle's radius (empty: diameter_ / 2)
+  int ns_ = 0;                             // species whose sums are kept (0: none)
+  std::vector<double> v2_sp_;              // per species the running sum of v^2
+  std::vector<double> msd_sp_;             // per species its MSD at each block end (ns_ per point)
+  bool resumed_ = false;                   // built from a snapshot
+  int ns_saved_ = 0;                       // the species the snapshot kept sums of (set_species turns them on)
+  void species_pair_virial(int a, int b, double w) {
+    cur_.sp[2 * static_cast<std::size_t>(label_[a]) + 1] += 0.5 * w;
+    cur_.sp[2 * static_cast<std::size_t>(label_[b]) + 1] += 0.5 * w;
+  }
+  double radius_of(int i) const { return radius_.empty() ? 0.5 * diameter_ : radius_[i]; }
+  void species_msd(double te);             // appends each species' MSD at the block end te
 
   // --- the collision record (see the header comment) ---
  public:

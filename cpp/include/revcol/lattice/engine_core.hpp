@@ -175,9 +175,11 @@ class BasicEngine {
   /// closed there); false leaves that to sync_observation() (a run in parts observed as one run).
   bool sync_after_run = true;
   void sync_observation() { if (obs_) obs_->sync(time_of(clock_)); }  ///< The observation brought to the clock.
-  /// An observer of state x, v at tick `clock` in units u: a new one (config c) or s's (resumed).
+  /// An observer of state x, v at tick `clock` in units u: a new one (config c) or s's (resumed);
+  /// a mixture's radii by id (empty for one size) make its species (ascending radius).
   static std::unique_ptr<engine::Observer> make_observer(const Units& u, const std::vector<Vec>& x, const std::vector<Vec>& v,
-                                                         std::int64_t clock, const engine::ObserveConfig* c, const Snapshot* s);
+                                                         std::int64_t clock, const engine::ObserveConfig* c, const Snapshot* s,
+                                                         const std::vector<std::int64_t>& radius);
   double time_of(std::int64_t tick) const noexcept { return static_cast<double>(tick) * u_.tick; }  ///< A tick as float time (the observer's clock).
   double to_length(std::int64_t x) const noexcept { return static_cast<double>(x) * u_.length_unit; }  ///< Lattice units as a float length.
   double to_speed(std::int64_t v) const noexcept { return static_cast<double>(v) * (u_.length_unit / u_.tick); }  ///< Lattice units per tick as a float speed.

@@ -114,7 +114,7 @@ class TimeWarp {
     build_in_workers(c.workers, c.lps, [&](int m) {
       lps_[static_cast<std::size_t>(m)] = std::make_unique<Lp>(s, c.axis, sv_.faces(), c.shell, c.back);
     });
-    if (!s.observer.empty() && !c.back) obs_ = Engine::make_observer(s.units, s.x, s.v, s.clock, nullptr, &s);  // a running observation goes on (lp_seen.hpp)
+    if (!s.observer.empty() && !c.back) obs_ = Engine::make_observer(s.units, s.x, s.v, s.clock, nullptr, &s, s.radius);  // a running observation goes on (lp_seen.hpp)
     for (int m = 0; m < c.lps; ++m) {
       Lp& lp = *lps_[static_cast<std::size_t>(m)];
       lp.me = m;

@@ -1,0 +1,69 @@
+// The observer's species (mixtures; the definitions are in revcol/engine/observe.hpp):
+// set_species and the species' MSD at a block end.
+#include <string>
+
+#include "observe_inline.hpp"
+#include "revcol/error.hpp"
+
+namespace revcol::engine {
+
+void Observer::set_species(const std::vector<int>& label, const std::vector<double>& radius) {
+  require(label.size() == n_ && radius.size() == n_, [&] {
+    return "observe: species need a label and a radius per particle (" + std::to_string(n_) + "), got " +
+           std::to_string(label.size()) + " and " + std::to_string(radius.size());
+  });
+  int ns = 0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    require(label[i] >= 0 && static_cast<std::size_t>(label[i]) < n_, [&] {
+      return "observe: particle " + std::to_string(i) + "'s species label " + std::to_string(label[i]) +
+             " is outside [0, n)";
+    });
+    require(std::isfinite(radius[i]) && radius[i] > 0.0 && radius[i] <= 0.5 * diameter_ * (1.0 + 1e-12), [&] {
+      return "observe: particle " + std::to_string(i) + "'s radius " + num(radius[i]) +
+             " must be positive and at most half the largest diameter";
+    });
+    ns = std::max(ns, label[i] + 1);
+  }
+  std::vector<std::size_t> count(static_cast<std::size_t>(ns), 0);
+  for (const int l : label) ++count[static_cast<std::size_t>(l)];
+  for (int u = 0; u < ns; ++u)
+    require(count[static_cast<std::size_t>(u)] > 0,
+            [&] { return "observe: species " + std::to_string(u) + " has no particle (labels must be 0..S-1)"; });
+  if (resumed_) {
+    // the sums come from the snapshot, or it kept none (then none are kept now)
+    require(ns_saved_ == 0 || ns_saved_ == ns, [&] {
+      return "snapshot: observer kept " + std::to_string(ns_saved_) + " species, the particles have " +
+             std::to_string(ns);
+    });
+    ns_ = ns_saved_;
+  } else {
+    require(blocks_.empty() && cur_.parts == 0 && cur_.walls == 0 && t_now_ == t_start_,
+            "observe: set_species must come before the first event");
+    ns_ = ns;
+    v2_sp_.assign(static_cast<std::size_t>(ns), 0.0);
+    for (std::size_t i = 0; i < n_; ++i) v2_sp_[static_cast<std::size_t>(label[i])] += seg_[i].v2;
+    cur_.sp.assign(2 * static_cast<std::size_t>(ns), 0.0);
+  }
+  label_ = label;
+  radius_ = radius;
+}
+
+// Each species' MSD at te (positions then, as end_block's MSD).
+void Observer::species_msd(double te) {
+  const std::size_t s0 = msd_sp_.size();
+  msd_sp_.resize(s0 + static_cast<std::size_t>(ns_), 0.0);
+  std::vector<double> count(static_cast<std::size_t>(ns_), 0.0);
+  for (std::size_t i = 0; i < n_; ++i) {
+    double m = 0.0;
+    for (int k = 0; k < dim_; ++k) {
+      const double d = pos(static_cast<int>(i), k, te) - start_[i * dim_ + k];
+      m += d * d;
+    }
+    const auto l = static_cast<std::size_t>(label_[i]);
+    msd_sp_[s0 + l] += m;
+    count[l] += 1.0;
+  }
+  for (std::size_t l = 0; l < count.size(); ++l) msd_sp_[s0 + l] /= count[l];
+}
+
+}  // namespace revcol::engine
