@@ -141,6 +141,9 @@ def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 
            "back_to_start": bool((sim.lattice_positions == x0).all()), "seconds": seconds}
     if dim == 2:
         out["z_slhy_henderson"] = slhy_z(phi, sim.diameters, henderson)
+    # the observer's species (ascending diameter): temperatures and partial pressures, exact time averages
+    out["species_temperature"] = [[e.value, e.error] for e in obs.species_temperature]
+    out["species_pressure"] = [[e.value, e.error] for e in obs.species_pressure]
     if chains is not None:
         (zc, zce) = chains["z_md"]
         out["ecmc"] = chains
@@ -286,12 +289,15 @@ def table(runs: list) -> str:
                 items.append((f"g({ct['a']:.3g}, {ct['b']:.3g}) at contact, frames", [c["mixture"]["contact"][j]["g_frames"] for c in cs],
                               ct["theory"], th))
             t = np.asarray([c["mixture"]["temperatures"] for c in cs])
-            items.append(("T small / T large", list(t[:, 0] / t[:, 1]), 1.0, "equipartition"))
+            items.append(("T small / T large (frames)", list(t[:, 0] / t[:, 1]), 1.0, "equipartition"))
+        if m0.get("species_temperature"):
+            t = np.asarray([[e[0] for e in c["mixture"]["species_temperature"]] for c in cs])
+            items.append(("T small / T large (observer)", list(t[:, 0] / t[:, 1]), 1.0, "equipartition"))
         for name, vals, th, thname in items:
             mean, se = pooled(vals)
             pct = f" ({100 * (mean / th - 1):+.2f}%)" if th else ""
             rows.append(f"| {dim} | {m0['phi']:g} | {name} | {mean:.5g} +- {se:.2g} ({k}) | {th:.5g} ({thname}) | "
-                        f"{(mean - th) / se:+.1f}{pct} |")
+                        f"{(mean - th) / se if se > 0 else float('nan'):+.1f}{pct} |")
     return "\n".join(rows)
 
 
@@ -335,7 +341,8 @@ def main(argv=None) -> int:
                           f"{run['z'] - e[0]:+.4f} ({run['ecmc_deviation_sd']:+.1f} sd)", flush=True)
             if "z_from_contact" in r:
                 print(f"    Z from the rates' contact values (virial route) {r['z_from_contact']:.4f}; temperatures "
-                      + ", ".join(f"{t:.4f}" for t in r["temperatures"]), flush=True)
+                      + ", ".join(f"{t:.4f}" for t in r["temperatures"]) + " (frames), "
+                      + ", ".join(f"{t:.4f} +- {e:.4f}" for t, e in r["species_temperature"]) + " (observer)", flush=True)
             for g in r.get("contact", []):
                 print(f"    g({g['a']:.3f}, {g['b']:.3f}) at contact: rates {g['g_rate']:.4f} +- {g['g_rate_error']:.4f}, "
                       f"theory {g['theory']:.4f} ({g['deviation_sd']:+.1f} sd); frames {g['g_frames']:.3f} +- "
