@@ -101,7 +101,7 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   // neither (older snapshots)
   std::size_t species = 0;
   if (reals.size() > helf) {
-    ns_saved_ = static_cast<int>(whole(helf, 1, static_cast<double>(n_), "species count"));
+    ns_saved_ = static_cast<int>(whole(helf, 1, kMaxSpecies, "species count"));
     species = static_cast<std::size_t>(ns_saved_) * (2 * (nb + 1) + nm + 1) + 1;
   }
   require(reals.size() == helf + species || reals.size() == vacf || reals.size() == size,

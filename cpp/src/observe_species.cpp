@@ -8,21 +8,26 @@
 namespace revcol::engine {
 
 void Observer::set_species(const std::vector<int>& label, const std::vector<double>& radius) {
-  require(label.size() == n_ && radius.size() == n_, [&] {
+  require((label.empty() || label.size() == n_) && radius.size() == n_, [&] {
     return "observe: species need a label and a radius per particle (" + std::to_string(n_) + "), got " +
            std::to_string(label.size()) + " and " + std::to_string(radius.size());
   });
   int ns = 0;
   for (std::size_t i = 0; i < n_; ++i) {
-    require(label[i] >= 0 && static_cast<std::size_t>(label[i]) < n_, [&] {
-      return "observe: particle " + std::to_string(i) + "'s species label " + std::to_string(label[i]) +
-             " is outside [0, n)";
-    });
     require(std::isfinite(radius[i]) && radius[i] > 0.0 && radius[i] <= 0.5 * diameter_ * (1.0 + 1e-12), [&] {
       return "observe: particle " + std::to_string(i) + "'s radius " + num(radius[i]) +
              " must be positive and at most half the largest diameter";
     });
+    if (label.empty()) continue;
+    require(label[i] >= 0 && label[i] < kMaxSpecies, [&] {
+      return "observe: particle " + std::to_string(i) + "'s species label " + std::to_string(label[i]) +
+             " is outside [0, " + std::to_string(kMaxSpecies) + ")";
+    });
     ns = std::max(ns, label[i] + 1);
+  }
+  if (label.empty()) {  // radii only (the walls' contact planes); a resumed observation's sums stay off
+    radius_ = radius;
+    return;
   }
   std::vector<std::size_t> count(static_cast<std::size_t>(ns), 0);
   for (const int l : label) ++count[static_cast<std::size_t>(l)];

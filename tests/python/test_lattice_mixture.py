@@ -209,6 +209,12 @@ def test_the_observer_reports_each_species(cls, boundary, tmp_path):
     one.observe()
     one.run(collisions=2000)
     assert one.observation().species_temperature == [] and one.observation().species_msd.size == 0
+    # a polydisperse sample (more than 16 sizes) has no species: its hooks keep no per-species sums
+    from revcol.studies.mixture_eos import gaussian_diameters
+    poly = cls.random(200, phi=0.3, diameters=gaussian_diameters(200, 3), seed=2, boundary=boundary)
+    poly.observe()
+    poly.run(collisions=2000)
+    assert poly.mixture and poly.observation().species_count.size == 0
 
 
 def test_the_wall_virial_takes_each_particle_its_own_radius():

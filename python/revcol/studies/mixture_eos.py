@@ -13,7 +13,8 @@ project's reference for the disk fluid); Henderson's, which the SLHY paper used 
 about 1.6% high at area fraction 0.5, is reported beside it.
 
 A run: ``measure(dim, n, phi, ratio, ...)`` starts a binary mixture (equal numbers, diameters 1
-and 1/ratio) at packing fraction phi, runs it ``equilibrate`` collisions per particle, then
+and 1/ratio; or, ``sizes="gauss"``, a polydisperse gas of diameters 1 + 0.1 z, z a standard
+normal truncated at +-2) at packing fraction phi, runs it ``equilibrate`` collisions per particle, then
 observes ``collisions`` per particle (the collision virial, Z = 1 + W / K2, with its block
 error), with ``frames`` the partial contact values g_ab(sigma_ab+) against Boublik-Grundke-
 Henderson-Lee-Levesque (spheres; the contact values behind BMCSL) or SLHY's (disks) and each
@@ -98,8 +99,15 @@ def binary_diameters(n: int, ratio: float) -> np.ndarray:
     return d
 
 
+def gaussian_diameters(n: int, seed: int, width: float = 0.1) -> np.ndarray:
+    """n diameters 1 + width z, z standard normal truncated at +-2 (numpy's generator keyed by
+    ``seed``; tests/long/lattice_validation.py's ``gauss`` sizes): a polydisperse sample."""
+    z = np.random.default_rng(seed).standard_normal(4 * n)
+    return 1.0 + width * z[np.abs(z) <= 2.0][:n]
+
+
 def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 100.0, collisions: float = 400.0,
-            seed: int = 1, blocks: int = 32, frames: int = 0, ecmc: float = 0.0) -> dict:
+            seed: int = 1, blocks: int = 32, frames: int = 0, ecmc: float = 0.0, sizes: str = "binary") -> dict:
     """One run (see the module docstring): Z with its block error, the theory, and the checks;
     ``frames`` > 0: that many frames at evenly spaced times (not at collisions) give the partial
     contact values g_ab(sigma_ab+) against the theory's and each species' temperature; ``ecmc``
@@ -108,7 +116,11 @@ def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 
     diameters of chain displacement per sphere, its Z as the engine's (md_equivalent) beside."""
     from ..lattice import LatticeSimulation, LatticeSimulation3D
     cls = LatticeSimulation3D if dim == 3 else LatticeSimulation
-    d = binary_diameters(n, ratio)
+    if sizes not in ("binary", "gauss"):
+        raise ValueError(f"sizes must be 'binary' or 'gauss', got {sizes!r}")
+    if sizes == "gauss" and frames:
+        raise ValueError("a polydisperse gas has no species for the partial contact values: frames=0")
+    d = binary_diameters(n, ratio) if sizes == "binary" else gaussian_diameters(n, seed)
     sim = cls.random(n, phi=phi, diameters=d, seed=seed)
     x0 = sim.lattice_positions.copy()
     chains = _ecmc(dim, phi, sim, seed, ecmc) if ecmc > 0 else None
@@ -134,7 +146,8 @@ def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 
     seconds = time.perf_counter() - t0
     z, ze = obs.compressibility.value, obs.compressibility.error
     theory = bmcsl_z(phi, sim.diameters) if dim == 3 else slhy_z(phi, sim.diameters)
-    out = {"dim": dim, "n": n, "phi": phi, "ratio": ratio, "seed": seed, "equilibrate_per_particle": equilibrate,
+    out = {"dim": dim, "n": n, "phi": phi, "sizes": sizes, "ratio": ratio if sizes == "binary" else None,
+           "seed": seed, "equilibrate_per_particle": equilibrate,
            "collisions_per_particle": collisions, "z": z, "z_error": ze, "blocks": obs.blocks,
            "theory": "BMCSL" if dim == 3 else "SLHY (Liu)", "z_theory": theory,
            "deviation_sd": (z - theory) / ze if ze > 0 else float("inf"),
@@ -211,11 +224,12 @@ def _structure(dim: int, phi: float, sim, xs: np.ndarray, vs: np.ndarray, trace,
     return out
 
 
-def compare(dim: int, n: int, phi: float, ratio: float, **kw) -> dict:
-    """The mixture (``measure``) and the one-size gas at the same N, phi and seed, and the
-    ratio of their Z against the theory's (module docstring)."""
+def compare(dim: int, n: int, phi: float, ratio: float, pure: dict | None = None, **kw) -> dict:
+    """The mixture (``measure``) and the one-size gas at the same N, phi and seed (``pure``: one
+    measured already), and the ratio of their Z against the theory's (module docstring)."""
     mix = measure(dim, n, phi, ratio, **kw)
-    pure = measure(dim, n, phi, 1.0, **kw)
+    if pure is None:
+        pure = measure(dim, n, phi, 1.0, **{k: v for k, v in kw.items() if k != "sizes"})
     pure_theory = liu_spheres(phi) if dim == 3 else liu_disks(phi)
     pure_base = carnahan_starling(phi) if dim == 3 else liu_disks(phi)  # what the mixture theory reduces to
     r = mix["z"] / pure["z"]
@@ -234,7 +248,8 @@ def figure(runs: list, path: str) -> None:
     plt = _pyplot()
     firsts = {}
     for c in runs:
-        firsts.setdefault(c["mixture"]["dim"], c["mixture"])
+        if "g_r" in c["mixture"]:  # the binary runs with frames
+            firsts.setdefault(c["mixture"]["dim"], c["mixture"])
     fig, axes = plt.subplots(1, len(firsts), figsize=(6 * len(firsts), 4.2), squeeze=False)
     for ax, (dim, m) in zip(axes[0], sorted(firsts.items())):
         r = np.asarray(m["g_r"]["r"])
@@ -264,9 +279,11 @@ def table(runs: list) -> str:
         return float(v.mean()), float(v.std(ddof=1) / math.sqrt(len(v))) if len(v) > 1 else float("nan")
     rows = ["| d | phi | quantity | measured (mean +- s.e., seeds) | theory | deviation (s.e.) |",
             "|---|---|---|---|---|---|"]
-    for dim in sorted({c["mixture"]["dim"] for c in runs}):
-        cs = [c for c in runs if c["mixture"]["dim"] == dim]
+    for kind, dim in sorted({(c["mixture"].get("sizes", "binary"), c["mixture"]["dim"]) for c in runs}):
+        cs = [c for c in runs if c["mixture"]["dim"] == dim and c["mixture"].get("sizes", "binary") == kind]
         m0, k = cs[0]["mixture"], len(cs)
+        if kind == "gauss":
+            rows.append(f"| {dim} | {m0['phi']:g} | (polydisperse: 10% Gaussian) | | | |")
         items = [("Z, mixture", [c["mixture"]["z"] for c in cs], m0["z_theory"], m0["theory"]),
                  ("Z, one size", [c["pure"]["z"] for c in cs], cs[0]["z_pure_theory"], cs[0]["pure_theory"]),
                  ("Z mixture / Z one size", [c["ratio"] for c in cs], cs[0]["ratio_theory"],
@@ -308,6 +325,8 @@ def main(argv=None) -> int:
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     p.add_argument("--collisions", type=float, default=400.0, help="observed collisions per particle")
     p.add_argument("--frames", type=int, default=100, help="frames for the partial contact values (0: none)")
+    p.add_argument("--sizes", nargs="+", default=["binary"], choices=["binary", "gauss"],
+                   help="the mixtures: 1:1 binary of ratio 1.4 (with partial contact values), 10%% Gaussian")
     p.add_argument("--ecmc", type=float, default=2000.0, help="event-chain displacement per sphere, in largest "
                    "diameters, for the cross-check at the same N (0: none)")
     p.add_argument("--json", default=None)
@@ -326,28 +345,32 @@ def main(argv=None) -> int:
     runs = []
     for seed in a.seeds:
         for dim, phi in ((2, 0.5), (3, 0.4)):
-            c = compare(dim, a.n, phi, 1.4, collisions=a.collisions, seed=seed, frames=a.frames, ecmc=a.ecmc)
-            r, q = c["mixture"], c["pure"]
-            print(f"{dim}D phi {phi} seed {seed}: Z = {r['z']:.4f} +- {r['z_error']:.4f}, {r['theory']} "
-                  f"{r['z_theory']:.4f} ({r['deviation_sd']:+.1f} sd); one size {q['z']:.4f} +- {q['z_error']:.4f}, "
-                  f"{c['pure_theory']} {c['z_pure_theory']:.4f} ({c['pure_deviation_sd']:+.1f} sd); ratio "
-                  f"{c['ratio']:.5f} +- {c['ratio_error']:.5f} against {c['ratio_theory']:.5f} "
-                  f"({c['ratio_deviation_sd']:+.1f} sd); back to start {r['back_to_start'] and q['back_to_start']}",
-                  flush=True)
-            for name, run in (("mixture", r), ("one size", q)):
-                if "ecmc" in run:
-                    e = run["ecmc"]["z_md"]
-                    print(f"    {name}: ECMC at the same N {e[0]:.4f} +- {e[1]:.4f}, lattice - ECMC "
-                          f"{run['z'] - e[0]:+.4f} ({run['ecmc_deviation_sd']:+.1f} sd)", flush=True)
-            if "z_from_contact" in r:
-                print(f"    Z from the rates' contact values (virial route) {r['z_from_contact']:.4f}; temperatures "
-                      + ", ".join(f"{t:.4f}" for t in r["temperatures"]) + " (frames), "
-                      + ", ".join(f"{t:.4f} +- {e:.4f}" for t, e in r["species_temperature"]) + " (observer)", flush=True)
-            for g in r.get("contact", []):
-                print(f"    g({g['a']:.3f}, {g['b']:.3f}) at contact: rates {g['g_rate']:.4f} +- {g['g_rate_error']:.4f}, "
-                      f"theory {g['theory']:.4f} ({g['deviation_sd']:+.1f} sd); frames {g['g_frames']:.3f} +- "
-                      f"{g['g_frames_error']:.3f}", flush=True)
-            runs.append(c)
+            pure = None
+            for kind in a.sizes:
+                c = compare(dim, a.n, phi, 1.4, pure=pure, collisions=a.collisions, seed=seed, ecmc=a.ecmc, sizes=kind,
+                            frames=a.frames if kind == "binary" else 0)
+                r, q = c["mixture"], c["pure"]
+                pure = q
+                print(f"{kind} {dim}D phi {phi} seed {seed}: Z = {r['z']:.4f} +- {r['z_error']:.4f}, {r['theory']} "
+                      f"{r['z_theory']:.4f} ({r['deviation_sd']:+.1f} sd); one size {q['z']:.4f} +- {q['z_error']:.4f}, "
+                      f"{c['pure_theory']} {c['z_pure_theory']:.4f} ({c['pure_deviation_sd']:+.1f} sd); ratio "
+                      f"{c['ratio']:.5f} +- {c['ratio_error']:.5f} against {c['ratio_theory']:.5f} "
+                      f"({c['ratio_deviation_sd']:+.1f} sd); back to start {r['back_to_start'] and q['back_to_start']}",
+                      flush=True)
+                for name, run in (("mixture", r), ("one size", q)):
+                    if "ecmc" in run:
+                        e = run["ecmc"]["z_md"]
+                        print(f"    {name}: ECMC at the same N {e[0]:.4f} +- {e[1]:.4f}, lattice - ECMC "
+                              f"{run['z'] - e[0]:+.4f} ({run['ecmc_deviation_sd']:+.1f} sd)", flush=True)
+                if "z_from_contact" in r:
+                    print(f"    Z from the rates' contact values (virial route) {r['z_from_contact']:.4f}; temperatures "
+                          + ", ".join(f"{t:.4f}" for t in r["temperatures"]) + " (frames), "
+                          + ", ".join(f"{t:.4f} +- {e:.4f}" for t, e in r["species_temperature"]) + " (observer)", flush=True)
+                for g in r.get("contact", []):
+                    print(f"    g({g['a']:.3f}, {g['b']:.3f}) at contact: rates {g['g_rate']:.4f} +- {g['g_rate_error']:.4f}, "
+                          f"theory {g['theory']:.4f} ({g['deviation_sd']:+.1f} sd); frames {g['g_frames']:.3f} +- "
+                          f"{g['g_frames_error']:.3f}", flush=True)
+                runs.append(c)
     if a.figure:
         figure(runs, a.figure)
     if a.json:

@@ -89,7 +89,8 @@
 // temperature T_s = K2_s / (d N_s tau), partial pressure P_s = (K2_s + W_s) / (d V tau), whose
 // sum is P_virial (to round-off), and the MSD per species. A wall's contact plane is the
 // particle's own radius from the wall. One species keeps none of this (one test per
-// velocity change and per collision's virial).
+// velocity change and per collision's virial), nor does a polydisperse sample of more than
+// kMaxSpecies sizes (each hook's time step integrates every species' sum: S multiply-adds).
 //
 // Snapshots keep a running observation: its whole state (config, segments, start
 // positions, blocks, MSD) as reals and counts (save; the layout is in observe.cpp), from
@@ -225,9 +226,12 @@ class Observer {
   /// met a wall of axis k (the lower one if it now moves up, else the upper one), whose
   /// contact plane (D/2 or L - D/2) is the wall virial's position.
   void wall_at(double t, int i, const double* x, const double* v, unsigned axes);
+  /// At most this many species keep sums (a polydisperse sample of more sizes keeps none).
+  static constexpr int kMaxSpecies = 16;
   /// A mixture (engines with one size per particle call it right after constructing or
-  /// resuming): label[i] in [0, S) each particle's species (every species non-empty),
-  /// radius[i] > 0 its radius (float units; the wall virial's contact plane). A fresh
+  /// resuming): label[i] in [0, S) each particle's species (every species non-empty, S <=
+  /// kMaxSpecies; empty: radii only, no species' sums), radius[i] > 0 its radius (float
+  /// units; the wall virial's contact plane). A fresh
   /// observation (no event yet) then keeps per species the kinetic sum K2_s, the virial W_s
   /// (half of each pair's r . Delta p to each member's species, a group member's own
   /// x . Delta p) and the MSD; a resumed one takes them from its snapshot (one saved without
