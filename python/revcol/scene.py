@@ -431,6 +431,9 @@ def with_engine(scene: Scene, engine: str) -> Scene:
     fields = scene.extra.get("fields", ())
     out = dataclasses.replace(scene, engine=engine)
     if engine == "float":
+        if scene.species:
+            raise SceneError(f"{scene.source}: [[species]] runs on engine = 'lattice' (the float engine has one "
+                             "diameter), not --engine float")
         out = dataclasses.replace(out, tick_bits=None, cell_bits=16, search="auto", workers=1)
     if engine == "lattice":
         if "rng.generator" not in fields:  # the lattice's default generator, as in a scene file

@@ -117,6 +117,9 @@ def test_scene_species_table_builds_the_mixture(tmp_path):
     from revcol.scene import SceneError, lattice_options, scene_from_dict
     scene = scene_from_dict(_mixture_scene(), "mix.toml")
     assert [(s.name, s.count) for s in scene.species] == [("big", 100), ("small", 300)]
+    from revcol.scene import with_engine
+    with pytest.raises(SceneError, match=r"\[\[species\]\] runs on engine = 'lattice'.*--engine float"):
+        with_engine(scene, "float")  # (revcol run --engine float): not a one-size gas of the largest
     assert "100 big (d = 1), 300 small (d = 0.8)" in scene.summary()
     # the box from the species' own areas at the packing fraction
     area = 100 * np.pi / 4 + 300 * np.pi / 4 * 0.64
