@@ -12,6 +12,7 @@ namespace revcol::engine {
 
 void Observer::group(double t, int n, const int* ids, const double* x, const double* v) {
   reach(t);
+  if (ns_ > 0) species_group_virial(n, ids, x, v);
   for (int u = 0; u < n; ++u) {
     const int i = ids[u];
     group_virial(i, x + u * dim_, v + u * dim_);
@@ -26,14 +27,29 @@ void Observer::group(double t, int n, const int* ids, const double* x, const dou
 // A group member i at x (image-consistent) going to velocity v: x . Delta p to the virial,
 // x_a Delta p_b to the Helfand moment (their sums over members are the same for any image).
 void Observer::group_virial(int i, const double* x, const double* v) {
-  double dp[3], own = 0.0;
+  double dp[3];
   for (int k = 0; k < dim_; ++k) {
     dp[k] = v[k] - seg_[i].v[k];
     cur_.w += x[k] * dp[k];
-    own += x[k] * dp[k];
   }
-  if (ns_ > 0) cur_.sp[2 * static_cast<std::size_t>(label_[i]) + 1] += own;
   helfand_add<0>(x, dp);
+}
+
+// A group's virial by species (before its velocities change): member u's (x_u - c) . Delta p_u
+// to its species, c the members' centroid. Their sum is the group's virial (sum Delta p_u = 0),
+// and each share, unlike x_u . Delta p_u, does not depend on where the origin or the image is
+// (for two members it is the pair's half and half).
+void Observer::species_group_virial(int n, const int* ids, const double* x, const double* v) {
+  double c[3] = {0.0, 0.0, 0.0};
+  for (int u = 0; u < n; ++u)
+    for (int k = 0; k < dim_; ++k) c[k] += x[u * dim_ + k];
+  for (int k = 0; k < dim_; ++k) c[k] /= n;
+  for (int u = 0; u < n; ++u) {
+    const int i = ids[u];
+    double share = 0.0;
+    for (int k = 0; k < dim_; ++k) share += (x[u * dim_ + k] - c[k]) * (v[u * dim_ + k] - seg_[i].v[k]);
+    cur_.sp[2 * static_cast<std::size_t>(label_[i]) + 1] += share;
+  }
 }
 
 void Observer::wall(double t, int i, const double* v) {
@@ -94,6 +110,7 @@ void Observer::pair_at(double t, int a, int b, const double* xa, const double* x
 
 void Observer::group_at(double t, int n, const int* ids, const double* x, const double* v) {
   reach(t);
+  if (ns_ > 0) species_group_virial(n, ids, x, v);
   for (int u = 0; u < n; ++u) {
     const int i = ids[u];
     close<3>(i, t);

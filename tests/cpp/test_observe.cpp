@@ -156,6 +156,27 @@ TEST_CASE("species by hand: a head-on pair of two sizes, partial pressures, temp
   CHECK(one.results().species_count.empty() && one.results().species_msd.empty());
 }
 
+TEST_CASE("species: a group's virial shares about its centroid, whatever the origin") {
+  // a 1D cradle of three (species 0, 1, 1) meets at t = 1 at x = 3, 4, 5 (or the same 10 to the
+  // right): velocities 1, 0, -1 -> -1, 0, 1. Shares (x_u - 4) . Delta p_u: 2 to species 0, 0 + 2
+  // to species 1 (their sum, 4, is the group's virial); K2 per species 2 over tau = 2, V = 10
+  for (const double shift : {0.0, 10.0}) {
+    ObserveConfig oc;
+    oc.block_time = 100.0;
+    Observer o(oc, 1, {2.0 + shift, 4.0 + shift, 6.0 + shift}, {1.0, 0.0, -1.0}, 0.0, {10.0, 1.0, 1.0},
+               {false, false, false}, 1.0);
+    o.set_species({0, 1, 1}, {0.5, 0.5, 0.5});
+    const int ids[3] = {0, 1, 2};
+    const double x[3] = {3.0 + shift, 4.0 + shift, 5.0 + shift}, v[3] = {-1.0, 0.0, 1.0};
+    o.group(1.0, 3, ids, x, v);
+    o.sync(2.0);
+    const Observation r = o.results();
+    CHECK_NEAR(r.species_pressure[0].value, (2.0 + 2.0) / 20.0, 1e-15);
+    CHECK_NEAR(r.species_pressure[1].value, (2.0 + 2.0) / 20.0, 1e-15);
+    CHECK_NEAR(r.pressure_virial.value, (4.0 + 4.0) / 20.0, 1e-15);
+  }
+}
+
 TEST_CASE("periodic free flight: unwrapped mean squared displacement, blocks of equal time") {
   Config c;
   c.dim = 2;

@@ -85,7 +85,8 @@
 //
 // Species (mixtures: set_species). Per species s the kinetic sum K2_s (its particles' sum
 // of v^2, integrated like K2), the virial W_s (each pair's r . Delta p shared half and half
-// between its members' species; a group member's own x . Delta p) and the MSD: species
+// between its members' species; a group member's (x_u - c) . Delta p_u, c the members'
+// centroid, which for two is the same half and half) and the MSD: species
 // temperature T_s = K2_s / (d N_s tau), partial pressure P_s = (K2_s + W_s) / (d V tau), whose
 // sum is P_virial (to round-off), and the MSD per species. A wall's contact plane is the
 // particle's own radius from the wall. One species keeps none of this (one test per
@@ -231,12 +232,12 @@ class Observer {
   /// A mixture (engines with one size per particle call it right after constructing or
   /// resuming): label[i] in [0, S) each particle's species (every species non-empty, S <=
   /// kMaxSpecies; empty: radii only, no species' sums), radius[i] > 0 its radius (float
-  /// units; the wall virial's contact plane). A fresh
-  /// observation (no event yet) then keeps per species the kinetic sum K2_s, the virial W_s
-  /// (half of each pair's r . Delta p to each member's species, a group member's own
-  /// x . Delta p) and the MSD; a resumed one takes them from its snapshot (one saved without
-  /// them keeps none). Throws InvalidArgument on a bad label or radius, or another number of
-  /// species than the snapshot's.
+  /// units; the wall virial's contact plane). A fresh observation (no event yet) then keeps
+  /// per species the kinetic sum K2_s, the virial W_s (half of each pair's r . Delta p to each
+  /// member's species, a group member's (x_u - c) . Delta p_u about the members' centroid c)
+  /// and the MSD; a resumed one takes them from its snapshot (one saved without them keeps
+  /// none). Throws InvalidArgument on a bad label or radius, or another number of species
+  /// than the snapshot's.
   void set_species(const std::vector<int>& label, const std::vector<double>& radius);
   /// Every segment closed at t (the end of a run call); closes any block ended by then.
   void sync(double t);
@@ -340,6 +341,7 @@ class Observer {
   }
   double radius_of(int i) const { return radius_.empty() ? 0.5 * diameter_ : radius_[i]; }
   void species_msd(double te);             // appends each species' MSD at the block end te
+  void species_group_virial(int n, const int* ids, const double* x, const double* v);  // observe_hooks.cpp
 
   // --- the collision record (see the header comment) ---
  public:
