@@ -239,14 +239,20 @@ void Observer::end_block() {
       close_pairs(static_cast<int>(i), te);
     }
   double msd = 0.0;
-  for (std::size_t i = 0; i < n_; ++i)
+  const std::size_t s0 = msd_sp_.size();  // a mixture: each species' MSD too (ns_ per point)
+  msd_sp_.resize(s0 + static_cast<std::size_t>(ns_), 0.0);
+  for (std::size_t i = 0; i < n_; ++i) {
+    double own = 0.0;
     for (int k = 0; k < dim_; ++k) {
       const double d = pos(static_cast<int>(i), k, te) - start_[i * dim_ + k];
       msd += d * d;
+      own += d * d;
     }
+    if (ns_ > 0) msd_sp_[s0 + static_cast<std::size_t>(label_[i])] += own;
+  }
   msd_t_.push_back(te - t_start_);
   msd_.push_back(msd / static_cast<double>(n_));
-  if (ns_ > 0) species_msd(te);
+  for (int u = 0; u < ns_; ++u) msd_sp_[s0 + static_cast<std::size_t>(u)] /= static_cast<double>(sp_count_[u]);
   if (helf_kept_) helf_rec_.insert(helf_rec_.end(), helf_.begin(), helf_.begin() + hc_);  // integrated to te above
   if (!start_v_.empty()) {  // velocities are constant on segments: the segment's is the one at te
     double c = 0.0;

@@ -106,12 +106,8 @@ Observation Observer::results() const {
   o.helfand = helf_rec_;
   if (ns_ > 0) {
     o.species_diameter.assign(static_cast<std::size_t>(ns_), 0.0);
-    o.species_count.assign(static_cast<std::size_t>(ns_), 0);
-    for (std::size_t i = 0; i < n_; ++i) {
-      const auto l = static_cast<std::size_t>(label_[i]);
-      o.species_diameter[l] = 2.0 * radius_[i];
-      ++o.species_count[l];
-    }
+    o.species_count = sp_count_;
+    for (std::size_t i = 0; i < n_; ++i) o.species_diameter[static_cast<std::size_t>(label_[i])] = 2.0 * radius_[i];
     for (std::size_t u = 0; u < static_cast<std::size_t>(ns_); ++u) {
       const double Ns = static_cast<double>(o.species_count[u]);
       o.species_temperature.push_back(est([&](const Block& b, double tau) { return b.sp[2 * u] / (d * Ns * tau); }));

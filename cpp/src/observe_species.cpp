@@ -1,5 +1,5 @@
 // The observer's species (mixtures; the definitions are in revcol/engine/observe.hpp):
-// set_species and the species' MSD at a block end.
+// set_species (the sums live in the hooks, end_block and results).
 #include <string>
 
 #include "observe_inline.hpp"
@@ -51,24 +51,7 @@ void Observer::set_species(const std::vector<int>& label, const std::vector<doub
   }
   label_ = label;
   radius_ = radius;
-}
-
-// Each species' MSD at te (positions then, as end_block's MSD).
-void Observer::species_msd(double te) {
-  const std::size_t s0 = msd_sp_.size();
-  msd_sp_.resize(s0 + static_cast<std::size_t>(ns_), 0.0);
-  std::vector<double> count(static_cast<std::size_t>(ns_), 0.0);
-  for (std::size_t i = 0; i < n_; ++i) {
-    double m = 0.0;
-    for (int k = 0; k < dim_; ++k) {
-      const double d = pos(static_cast<int>(i), k, te) - start_[i * dim_ + k];
-      m += d * d;
-    }
-    const auto l = static_cast<std::size_t>(label_[i]);
-    msd_sp_[s0 + l] += m;
-    count[l] += 1.0;
-  }
-  for (std::size_t l = 0; l < count.size(); ++l) msd_sp_[s0 + l] /= count[l];
+  sp_count_ = count;
 }
 
 }  // namespace revcol::engine

@@ -333,6 +333,7 @@ class Observer {
   int ns_ = 0;                             // species whose sums are kept (0: none)
   std::vector<double> v2_sp_;              // per species the running sum of v^2
   std::vector<double> msd_sp_;             // per species its MSD at each block end (ns_ per point)
+  std::vector<std::size_t> sp_count_;      // per species its particles (set_species)
   bool resumed_ = false;                   // built from a snapshot
   int ns_saved_ = 0;                       // the species the snapshot kept sums of (set_species turns them on)
   void species_pair_virial(int a, int b, double w) {
@@ -340,7 +341,6 @@ class Observer {
     cur_.sp[2 * static_cast<std::size_t>(label_[b]) + 1] += 0.5 * w;
   }
   double radius_of(int i) const { return radius_.empty() ? 0.5 * diameter_ : radius_[i]; }
-  void species_msd(double te);             // appends each species' MSD at the block end te
   void species_group_virial(int n, const int* ids, const double* x, const double* v);  // observe_hooks.cpp
 
   // --- the collision record (see the header comment) ---
