@@ -230,6 +230,7 @@ class PyEngine {
     for (int k = 0; k < c.dim; ++k) bnd.push_back(static_cast<std::int64_t>(c.boundary[k]));
     d["boundary"] = vec_array(bnd);
     d["diameter"] = c.diameter;
+    if (!c.diameters.empty()) d["diameters"] = vec_array(c.diameters);  // a mixture
     d["mode"] = std::string(to_string(c.mode));
     d["law"] = std::string(to_string(c.law));
     d["seed"] = c.seed;
@@ -275,6 +276,7 @@ class PyEngine {
       c.boundary[k] = en::boundary_from_value(per[k]);  // every kind of en::kBoundaries, by value
     }
     c.diameter = checkpoint_field<double>(get("diameter"), "diameter");
+    if (d.contains("diameters")) c.diameters = array_vec<double>(d, "diameters");  // a mixture
     c.mode = en::parse_engine_mode(checkpoint_field<std::string>(get("mode"), "mode"));
     c.law = parse_law(checkpoint_field<std::string>(get("law"), "law"));
     c.seed = checkpoint_field<std::uint32_t>(get("seed"), "seed");
@@ -338,7 +340,7 @@ void register_engine(py::module_& m) {
       .def(py::init([](const Array& x, const Array& v, const std::vector<double>& box,
                        const std::vector<std::string>& boundary, PyReal diameter_arg, PyStr mode_arg,
                        PyStr law_arg, PyInt seed_arg, PyInt bits_arg, bool groups, PyReal group_tol_arg,
-                       PyReal time_arg, PyStr generator_arg, PyStr streams_arg) {
+                       PyReal time_arg, PyStr generator_arg, PyStr streams_arg, std::vector<double> diameters) {
              const std::string mode = to_str(mode_arg, "mode"), law = to_str(law_arg, "law");
              const std::string generator = to_str(generator_arg, "generator"), streams = to_str(streams_arg, "streams");
              const double diameter = to_real(diameter_arg, "diameter"), group_tol = to_real(group_tol_arg, "group_tol");
@@ -349,14 +351,15 @@ void register_engine(py::module_& m) {
              auto xs = flat(x, "positions", n, d);
              auto vs = flat(v, "velocities", nv, dv);
              require(n == nv && d == dv, "positions and velocities must have the same shape");
-             const en::Config c = make_config(d, box, boundary, diameter, mode, law, seed, bits, groups, group_tol, generator,
-                                             streams);
+             en::Config c = make_config(d, box, boundary, diameter, mode, law, seed, bits, groups, group_tol, generator,
+                                       streams);
+             c.diameters = std::move(diameters);  // a mixture (validated with the state)
              return PyEngine(en::make_simulation(c, xs, vs, time));
            }),
            py::arg("positions"), py::arg("velocities"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
            py::arg("mode"), py::arg("law"), py::arg("seed"), py::arg("bits"), py::arg("groups"),
            py::arg("group_tol"), py::arg("time"), py::arg("generator") = "philox",
-           py::arg("streams") = "per_particle")
+           py::arg("streams") = "per_particle", py::arg("diameters") = std::vector<double>{})
       .def_static("from_snapshot", &PyEngine::from_snapshot, py::arg("snapshot"))
       .def("run", &PyEngine::run, py::arg("collisions") = py::none(), py::arg("time") = py::none(),
            py::arg("callback") = py::none(), py::arg("every") = 10000)
@@ -368,6 +371,10 @@ void register_engine(py::module_& m) {
       .def_property_readonly("time", [](const PyEngine& e) { return e.sim().time(); })
       .def_property_readonly("start_time", [](const PyEngine& e) { return e.sim().start_time(); })
       .def_property_readonly("n", [](const PyEngine& e) { return e.sim().size(); })
+      .def_property_readonly("diameter", [](const PyEngine& e) { return e.sim().config().diameter; })
+      .def_property_readonly(
+          "diameters", [](const PyEngine& e) { return e.sim().config().diameters; },
+          "A mixture's diameters, one per particle (empty: one size, `diameter`).")
       .def_property_readonly("dim", [](const PyEngine& e) { return e.sim().config().dim; })
       .def_property_readonly("box",
                              [](const PyEngine& e) {
@@ -400,7 +407,7 @@ void register_engine(py::module_& m) {
   m.def(
       "engine_random_state",
       [](PyInt dim_arg, PyInt n_arg, PyReal phi_arg, const std::vector<std::string>& boundary, PyReal diameter_arg,
-         PyInt seed_arg, PyReal energy_arg, PyStr init_arg, bool equal_speeds) {
+         PyInt seed_arg, PyReal energy_arg, PyStr init_arg, bool equal_speeds, std::vector<double> diameters) {
         const std::string init = to_str(init_arg, "init");
         const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
         const double energy = to_real(energy_arg, "energy");
@@ -414,12 +421,13 @@ void register_engine(py::module_& m) {
                 "boundary must be one name or one per axis");
         for (int k = 0; k < dim; ++k) c.boundary[k] = en::parse_boundary(boundary.size() == 1 ? boundary[0] : boundary[k]);
         c.diameter = diameter;
+        c.diameters = std::move(diameters);  // a mixture: random_state sets diameter to the largest
         const en::InitialState s = en::random_state(c, n, phi, seed, energy, init, equal_speeds);
         return py::make_tuple(to_array(s.x, n, dim), to_array(s.v, n, dim),
                               std::vector<double>(s.config.box.begin(), s.config.box.begin() + dim));
       },
       py::arg("dim"), py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"), py::arg("seed"),
-      py::arg("energy"), py::arg("init"), py::arg("equal_speeds"));
+      py::arg("energy"), py::arg("init"), py::arg("equal_speeds"), py::arg("diameters") = std::vector<double>{});
   // the counted Ctrl-C (revcol.progress.Interrupt) that both engines' polls read (args.hpp)
   m.def(
       "request_stop", [](bool on) { stop_requested() = on; }, py::arg("on"),

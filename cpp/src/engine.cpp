@@ -103,6 +103,32 @@ void validate_config(const Config& c) {
   }
 }
 
+// Particle i's radius: half its own diameter in a mixture, else D / 2.
+double radius_of(const Config& c, std::size_t i) { return 0.5 * (c.diameters.empty() ? c.diameter : c.diameters[i]); }
+
+// A mixture's sizes: one per particle, finite, > 0, the largest equal to `diameter` and the
+// smallest at least the largest / kMaxSizeRatio.
+void validate_sizes(const Config& c, std::size_t n) {
+  if (c.diameters.empty()) return;
+  require(c.diameters.size() == n, [&] {
+    return "diameters must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(c.diameters.size());
+  });
+  double hi = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = c.diameters[i];
+    require(std::isfinite(d) && d > 0.0, [&] { return "diameter of particle " + std::to_string(i) + " must be finite and > 0"; });
+    hi = std::max(hi, d);
+  }
+  require(hi == c.diameter, [&] {
+    return "diameter must be the largest of the diameters (" + num(hi) + "), got " + num(c.diameter);
+  });
+  for (std::size_t i = 0; i < n; ++i)
+    require(c.diameters[i] * limits::kMaxSizeRatio >= hi, [&] {
+      return "diameter of particle " + std::to_string(i) + ", " + num(c.diameters[i]) + ", is more than " +
+             std::to_string(static_cast<int>(limits::kMaxSizeRatio)) + " times smaller than the largest, " + num(hi);
+    });
+}
+
 // Throws InvalidArgument naming the first pair closer than D (1 - 1e-9): a cell grid of cells >= D,
 // the 3^d neighbouring cells, minimum images on periodic axes. x: n x d positions inside the box.
 void check_overlaps(const Config& c, const std::vector<double>& x, std::size_t n) {
@@ -128,6 +154,7 @@ void check_overlaps(const Config& c, const std::vector<double>& x, std::size_t n
     return id;
   };
   const double min2 = c.diameter * c.diameter * (1.0 - 1e-9) * (1.0 - 1e-9);
+  const bool mixed = !c.diameters.empty();  // then each pair's own contact distance
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < d; ++k) cc[i][k] = std::clamp(static_cast<int>(std::floor(x[i * d + k] / cw[k])), 0, nc[k] - 1);
     const int noff = d == 1 ? 3 : d == 2 ? 9 : 27;
@@ -152,9 +179,10 @@ void check_overlaps(const Config& c, const std::vector<double>& x, std::size_t n
           const double dx = x[i * d + k] - (x[j * d + k] + sh[k]);
           r2 += dx * dx;
         }
-        require(r2 >= min2, [&] {
+        const double sig = mixed ? radius_of(c, i) + radius_of(c, static_cast<std::size_t>(j)) : c.diameter;
+        require(r2 >= (mixed ? sig * sig * (1.0 - 1e-9) * (1.0 - 1e-9) : min2), [&] {
           return "particles " + std::to_string(j) + " and " + std::to_string(i) + " overlap: distance " +
-                 num(std::sqrt(r2)) + " < diameter " + num(c.diameter);
+                 num(std::sqrt(r2)) + " < " + (mixed ? "contact distance " : "diameter ") + num(sig);
         });
       }
     }
@@ -173,10 +201,11 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
   require(v.size() == x.size(), "velocities must have the same shape as positions");
   const std::size_t n = x.size() / d;
   require(n <= limits::max_particles(d), [&] { return limits::too_many_particles(d, n); });
-  const double r = 0.5 * c.diameter;
+  validate_sizes(c, n);
   double e = 0.0;
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < d; ++k) {
+      const double r = radius_of(c, i);
       const double xk = x[i * d + k], vk = v[i * d + k];
       require(std::isfinite(xk), [&] { return "position of particle " + std::to_string(i) + " is not finite"; });
       require(std::isfinite(vk), [&] { return "velocity of particle " + std::to_string(i) + " is not finite"; });
@@ -184,7 +213,7 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
         require(xk >= r && xk <= c.box[k] - r, [&] {
           return "particle " + std::to_string(i) + " is outside the box on axis " + std::to_string(k) + ": x = " +
                  num(xk) + ", allowed [" + num(r) + ", " + num(c.box[k] - r) +
-                 "] (walls at 0 and L, centre at least D/2 inside)";
+                 "] (walls at 0 and L, centre at least its radius inside)";
         });
       else
         require(xk >= 0.0 && xk < c.box[k], [&] {
@@ -276,6 +305,12 @@ void require_finite(const char* name, const std::vector<double>& a) {
 void check_snapshot_shapes(const Snapshot& s) {
   const std::size_t n = s.n, d = static_cast<std::size_t>(s.config.dim);
   require(n > 0, "snapshot: n must be > 0 (no particles)");
+  if (!s.config.diameters.empty()) require_size("diameters", s.config.diameters.size(), n, "n, or none");
+  try {
+    validate_sizes(s.config, n);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("snapshot: ") + e.what());
+  }
   require_size("x", s.x.size(), n * d, "n x dim");
   require_size("v", s.v.size(), n * d, "n x dim");
   require_size("cell", s.cell.size(), n * d, "n x dim");
@@ -340,10 +375,11 @@ void check_snapshot_positions(const Snapshot& s) {
   for (std::size_t i = 0; i < s.centre.size(); ++i)
     require(s.centre[i] >= 0.0 && s.centre[i] <= s.config.box[i % d], "snapshot: centre (a list centre) outside the box");
   const Config& c = s.config;
-  const double r = 0.5 * c.diameter, slack = 1e-9 * c.diameter;
+  const double slack = 1e-9 * c.diameter;
   std::vector<double> now(n * d);
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t k = 0; k < d; ++k) {
+      const double r = radius_of(c, i);
       double q = s.x[i * d + k] + s.v[i * d + k] * (s.time - s.t_local[i]);
       require(std::isfinite(q), "snapshot: x + v (time - t_local), a position at the clock, is not finite");
       if (has_walls(c.boundary[k])) {

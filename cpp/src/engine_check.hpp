@@ -52,7 +52,7 @@ std::string EngineImpl<Dim, Op>::schedule_fault() const {
     for (int k = 0; k < Dim && !rev_; ++k) {
       const double vk = pi.v[k];
       if (vk == 0.0 || !box_.walls(k)) continue;
-      if (before(std::max(Kin::plane_time(pi, k, box_.wall_at(k, vk > 0.0 ? 1 : 0)), clock_)))
+      if (before(std::max(Kin::plane_time(pi, k, box_.wall_at(k, vk > 0.0 ? 1 : 0, radius(i))), clock_)))
         return who(i) + " meets a wall on axis " + std::to_string(k) + " before its scheduled event";
     }
     const bool live = e.kind == kColl && p_[static_cast<std::size_t>(e.partner)].stamp == e.stamp;
@@ -63,7 +63,8 @@ std::string EngineImpl<Dim, Op>::schedule_fault() const {
         [&](int j, const Vec& sh) {
           double t;
           bool touching = false;
-          const bool hit = Kin::pair_time(pi, p_[static_cast<std::size_t>(j)], sh, sigma2_, contact_tol_, t, touching);
+          const double s2 = sigma2(i, j);
+          const bool hit = Kin::pair_time(pi, p_[static_cast<std::size_t>(j)], sh, s2, contact_tol(s2), t, touching);
           if (live && j == e.partner) {
             found = true;
             if (fault.empty() && !(hit && std::fabs(std::max(t, clock_) - e.t) <= slack(e.t)))
@@ -88,7 +89,6 @@ std::string EngineImpl<Dim, Op>::schedule_fault() const {
 // and no collision before that time is predicted (pair_time starts at the later local time).
 template <int Dim, PairOperator Op>
 std::string EngineImpl<Dim, Op>::first_overlap() const {
-  const double bar = sigma2_ * (1.0 - 1e-9) * (1.0 - 1e-9);
   const auto who = [&](int j) { return "particle " + std::to_string(bk_[static_cast<std::size_t>(j)].id); };
   std::string fault;
   for (int i = 0; i < static_cast<int>(n_) && fault.empty(); ++i)
@@ -101,9 +101,10 @@ std::string EngineImpl<Dim, Op>::first_overlap() const {
             const double rk = (pos_at(i, k, clock_) - pos_at(j, k, clock_)) - sh[k];
             r2 += rk * rk;
           }
-          if (r2 < bar)
-            fault = who(i) + " and " + who(j) + " overlap: distance " + std::to_string(std::sqrt(r2)) + " < diameter " +
-                    std::to_string(cfg_.diameter);
+          const double s2 = sigma2(i, j);
+          if (r2 < s2 * (1.0 - 1e-9) * (1.0 - 1e-9))
+            fault = who(i) + " and " + who(j) + " overlap: distance " + std::to_string(std::sqrt(r2)) +
+                    " < contact distance " + std::to_string(std::sqrt(s2));
         },
         [](int) {});
   return fault;

@@ -45,7 +45,8 @@ void EngineImpl<Dim, Op>::gather(int a, int b, const Vec& s, double t, Group& g)
         r[k] = pm[k] - (pos_at(j, k, t) + sh[k]);
         r2 += r[k] * r[k];
       }
-      if (!(r2 - sigma2_ <= contact_tol_)) return;
+      const double s2 = sigma2(im, j);
+      if (!(r2 - s2 <= contact_tol(s2))) return;
       for (int k = 0; k < Dim; ++k) rw += r[k] * (p_[im].v[k] - p_[j].v[k]);
       if (!(rw <= 0.0)) return;
       int q = -1;
@@ -126,7 +127,7 @@ Reflection EngineImpl<Dim, Op>::touch_walls(int i) {
     x[k] = p_[i].x[k];
     v[k] = p_[i].v[k];
   }
-  const Reflection mask = box_.reflect(x, v);
+  const Reflection mask = box_.reflect(x, v, radius(i));
   if (mask != 0) set_velocity(i, v, mask);
   return mask;
 }
@@ -155,7 +156,7 @@ Reflection EngineImpl<Dim, Op>::wall_mask(int i, int k, double t) const {
     x[j] = pos_at(i, j, t);
     v[j] = p_[i].v[j];
   }
-  return box_.reflect_at(k, x, v);
+  return box_.reflect_at(k, x, v, radius(i));
 }
 // Whether the W2 mask of wall-log member slot m holds every reflection of `mask`.
 template <int Dim, PairOperator Op>
@@ -166,7 +167,7 @@ bool EngineImpl<Dim, Op>::w2_covers(long m, Reflection mask) const {
 template <int Dim, PairOperator Op>
 bool EngineImpl<Dim, Op>::touches_wall(int i) const {
   for (int k = 0; k < Dim; ++k)
-    if (box_.touches(k, p_[i].x[k])) return true;
+    if (box_.touches(k, p_[i].x[k], radius(i))) return true;
   return false;
 }
 
@@ -518,6 +519,7 @@ void EngineImpl<Dim, Op>::observe(const ObserveConfig& c) {
   std::array<bool, 3> walls{};
   for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
   auto o = std::make_unique<Observer>(c, Dim, positions(), velocities(), clock_, cfg_.box, walls, cfg_.diameter);
+  if (!cfg_.diameters.empty()) o->set_sizes(radii());  // a mixture: species by size
   observer_ = std::move(o);
   obs_ = observer_.get();
 }
@@ -552,9 +554,10 @@ void EngineImpl<Dim, Op>::validate_collision(const int* slots, int n) const {
         const double d = pos_at(i, k, clock_) - (pos_at(j, k, clock_) + sh[k]);
         r2 += d * d;
       }
-      if (!(r2 >= sigma2_ * (1.0 - 1e-6)))
+      const double s2 = sigma2(i, j);
+      if (!(r2 >= s2 * (1.0 - 1e-6)))
         throw std::logic_error("REVCOL_VALIDATE: particles " + std::to_string(bk_[i].id) + " and " + std::to_string(bk_[j].id) +
-                               " overlap after a collision: |r| / D = " + std::to_string(std::sqrt(r2 / sigma2_)) +
+                               " overlap after a collision: |r| / D = " + std::to_string(std::sqrt(r2 / s2)) +
                                (rev_ ? " (reversed run)" : " (forward run)") + " at t = " + std::to_string(clock_));
     });
   }

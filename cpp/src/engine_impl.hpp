@@ -213,6 +213,7 @@ class EngineImpl final : public Simulation {
 
   std::size_t memory_bytes() const override {
     return n_ * (sizeof(Particle<Dim>) + sizeof(Book)) + slot_.capacity() * sizeof(std::int32_t) +
+           (rad_.capacity() + cfg_.diameters.capacity()) * sizeof(double) +
            nl_.memory_bytes() + queue_.memory_bytes() + log_.bytes() + pre_.bytes() + wlog_.bytes() + trace_.bytes() +
            clcg_.size() * sizeof(rng::CLCG4);
   }
@@ -228,21 +229,48 @@ class EngineImpl final : public Simulation {
   }
   static constexpr int kPrefetchNext = 6;  // the loop prefetches the Books of this many likely next tops
   static constexpr double kWrap = 0.25;  // 1D ring: a rod is wrapped kWrap D past the box's end
+                                         // (a mixture: kWrap times the smallest diameter, wrap_)
 
   // ---- prediction ---------------------------------------------------------------------
 
+  // ---- sizes (a mixture: rad_, each slot's radius; one size: rad_ empty) ----------------
+
+  // Slot i's radius for the walls (one size: Boundaries' own D / 2).
+  double radius(int i) const { return rad_.empty() ? Boundaries<Dim>::kOwn : rad_[static_cast<std::size_t>(i)]; }
+  // The squared contact distance of slots i and j, and the contact tolerance of a pair whose
+  // squared contact distance is s2 (r^2 - s2 <= 2 group_tol s2: |r| within group_tol of it).
+  double sigma2(int i, int j) const {
+    if (rad_.empty()) return sigma2_;
+    const double s = rad_[static_cast<std::size_t>(i)] + rad_[static_cast<std::size_t>(j)];
+    return s * s;
+  }
+  double contact_tol(double s2) const { return rad_.empty() ? contact_tol_ : 2.0 * cfg_.group_tol * s2; }
+  // A mixture's radii in id order (the observer's species).
+  std::vector<double> radii() const {
+    std::vector<double> r(cfg_.diameters.size());
+    for (std::size_t i = 0; i < r.size(); ++i) r[i] = 0.5 * cfg_.diameters[i];
+    return r;
+  }
+
   // i's earliest event: a wall, its list renewal (in 1D on a ring: its wrap), or a
   // collision with a listed particle; also its second earliest collision time and whether
-  // a neighbour touches it (the group gate).
+  // a neighbour touches it (the group gate). A mixture's scan reads each pair's contact
+  // distance; one size's reads no radius (a template: one branch per prediction).
   void predict(int i) {
+    if (rad_.empty()) predict_sized<false>(i);
+    else predict_sized<true>(i);
+  }
+  template <bool Mixed>
+  void predict_sized(int i) {
     Ev best;
     const double ti = p_[i].t;
+    const double r_own = Mixed ? rad_[static_cast<std::size_t>(i)] : Boundaries<Dim>::kOwn;  // the walls' radius
     for (int k = 0; k < (walled_ ? Dim : 0); ++k) {  // a periodic box: no wall to test
       const double vk = p_[i].v[k];
       if (vk == 0.0 || !box_.walls(k)) continue;
       const int up = vk > 0.0 ? 1 : 0;
       bool wall_ok = true;
-      if (rev_ && box_.touches_ahead(k, p_[i].x[k] + vk * (clock_ - ti), up)) {
+      if (rev_ && box_.touches_ahead(k, p_[i].x[k] + vk * (clock_ - ti), up, r_own)) {
         // touching and approaching in a reversed run at the instant of a logged collision
         // of i: a reflection of its W2 is undone now; any other touched wall waits for the
         // collision. With no such collision (m < 0) the wall is met on its own, as forward
@@ -251,7 +279,7 @@ class EngineImpl final : public Simulation {
         wall_ok = m < 0 || w2_covers(m, wall_mask(i, k, clock_));
       }
       if (wall_ok) {
-        double t = Kin::plane_time(p_[i], k, box_.wall_at(k, up));
+        double t = Kin::plane_time(p_[i], k, box_.wall_at(k, up, r_own));
         if (t < clock_) t = clock_;
         if (earlier(t, kWall, 2 * k + up, best)) best = Ev{t, kWall, 2 * k + up, 0};
       }
@@ -260,7 +288,7 @@ class EngineImpl final : public Simulation {
       // 1D: no renewal; on a periodic axis the wrap, kWrap D past either end of the box
       const double vk = p_[i].v[0];
       if (box_.periodic(0) && vk != 0.0) {
-        const double edge = vk > 0.0 ? box_.length(0) + kWrap * cfg_.diameter : -kWrap * cfg_.diameter;
+        const double edge = vk > 0.0 ? box_.length(0) + wrap_ : -wrap_;
         double t = Kin::plane_time(p_[i], 0, edge);
         if (t < clock_) t = clock_;
         if (earlier(t, kRenew, 0, best)) best = Ev{t, kRenew, 0, 0};
@@ -295,10 +323,29 @@ class EngineImpl final : public Simulation {
       touch = true;
       bk_[j].touching = 1;
     };
+    [[maybe_unused]] const double ri = r_own;
+    const double tol_scale = 2.0 * cfg_.group_tol;  // (a mixture's: contact_tol(s2) = tol_scale s2)
+    const auto s2_of = [&](int j) {
+      if constexpr (Mixed) {
+        const double s = ri + rad_[static_cast<std::size_t>(j)];
+        return s * s;
+      } else {
+        (void)j;
+        return sigma2_;
+      }
+    };
+    const auto tol_of = [&](double s2) {
+      if constexpr (Mixed) return tol_scale * s2;
+      else {
+        (void)s2;
+        return contact_tol_;
+      }
+    };
     const auto one = [&](int j, const Vec& sh) {
       double t;
       bool tj = false;
-      const bool hit = Kin::pair_time(pi, p_[j], sh, sigma2_, contact_tol_, t, tj, limit);
+      const double s2 = s2_of(j);
+      const bool hit = Kin::pair_time(pi, p_[j], sh, s2, tol_of(s2), t, tj, limit);
       if (tj) touched(j);
       if (hit) record(j, t);
     };
@@ -307,7 +354,8 @@ class EngineImpl final : public Simulation {
     // scan decides exactly as one entry at a time would
     const auto two = [&](int j0, const Vec& s0, int j1, const Vec& s1) {
       typename Kin::Pair2 q;
-      Kin::pair_test2(pi, p_[j0], p_[j1], s0, s1, sigma2_, contact_tol_, limit, q);
+      const double s20 = s2_of(j0), s21 = s2_of(j1);
+      Kin::pair_test2(pi, p_[j0], p_[j1], s0, s1, s20, s21, tol_of(s20), tol_of(s21), limit, q);
       if (q.touching[0]) touched(j0);
       if (q.hit[0]) record(j0, q.finish(0));
       if (q.touching[1]) touched(j1);
@@ -560,7 +608,9 @@ class EngineImpl final : public Simulation {
   Op op_;                                  // the pair operator, chosen once (make_engine)
   Boundaries<Dim> box_;
   bool walled_ = true;                     // box_.any_walls(): predict tests no wall without
-  double sigma2_ = 1.0, contact_tol_ = 0.0;
+  double sigma2_ = 1.0, contact_tol_ = 0.0;  // one size's squared contact distance and tolerance
+  std::vector<double> rad_;                // a mixture: each slot's radius (Config::diameters / 2); empty: one size
+  double wrap_ = 0.0;                      // 1D ring: kWrap times the smallest diameter (setup_geometry)
   double shell_ = 0.0, renew_h_ = 0.0, renew_h2_ = 0.0;  // the neighbour lists
   std::vector<Particle<Dim>> p_;
   NeighbourLists<Dim> nl_;

@@ -355,8 +355,48 @@ InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, do
   return start_in_box(c, n, seed, energy, rsa, how == Placement::automatic, equal_speeds);
 }
 
+namespace {
+
+// A mixture's start (random_state with diameters): the cube of the particles' own volumes at
+// phi, placed as spheres of the largest diameter.
+InitialState mixture_state(Config c, std::size_t n, double phi, std::uint64_t seed, double energy,
+                           const std::string& init, bool equal_speeds) {
+  require(c.diameters.size() == n, [&] {
+    return "diameters must have one entry per particle (" + std::to_string(n) + "), got " +
+           std::to_string(c.diameters.size());
+  });
+  double dmax = 0.0, vol = 0.0;
+  for (const double q : c.diameters) {
+    require(std::isfinite(q) && q > 0.0, "every diameter must be finite and > 0");
+    dmax = std::max(dmax, q);
+  }
+  // (the size ratio is the engine's to check: each engine names its own limit)
+  for (const double q : c.diameters) vol += limits::particle_volume(c.dim, q);
+  require(std::isfinite(phi) && phi > 0.0, "packing fraction must be finite and > 0");
+  c.diameter = dmax;
+  const double L = std::pow(vol / phi, 1.0 / static_cast<double>(c.dim));
+  require(std::isfinite(L) && L > 0.0 && limits::box_ratio_fits(L, dmax), [&] {
+    return "the box for this mixture at packing fraction " + num(phi) + " is not representable (length " + num(L) + ")";
+  });
+  for (int k = 0; k < 3; ++k) c.box[k] = k < c.dim ? L : 1.0;
+  try {
+    return random_start(c, n, seed, energy, init, equal_speeds);
+  } catch (const InvalidArgument& e) {
+    const double as_largest = static_cast<double>(n) * limits::particle_volume(c.dim, dmax) / vol * phi;
+    throw InvalidArgument("a mixture's random start places every particle as one of the largest (diameter " +
+                          num(dmax) + "), which at packing fraction " + num(phi) + " would fill " + num(as_largest) +
+                          " of the box: " + e.what());
+  }
+}
+
+}  // namespace
+
 InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t seed, double energy,
                           const std::string& init, bool equal_speeds) {
+  if (!c.diameters.empty()) {
+    check_common(c, n, seed);
+    return mixture_state(std::move(c), n, phi, seed, energy, init, equal_speeds);
+  }
   check_common(c, n, seed);
   check_energy(energy);
   require(std::isfinite(phi) && phi > 0.0, "packing fraction must be finite and > 0");

@@ -186,6 +186,7 @@ EngineImpl<Dim, Op>::EngineImpl(const Snapshot& s, Op op) : cfg_(s.config), n_(s
     for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
     observer_ = std::make_unique<Observer>(s.observer, s.observer_counts, Dim, s.v, clock_, cfg_.box, walls,
                                            cfg_.diameter);
+    if (!cfg_.diameters.empty()) observer_->set_sizes(radii());
     obs_ = observer_.get();
   }
 }
@@ -197,12 +198,26 @@ EngineImpl<Dim, Op>::EngineImpl(const Snapshot& s, Op op) : cfg_(s.config), n_(s
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::setup_geometry() {
   sigma2_ = cfg_.diameter * cfg_.diameter;
+  // 1D ring: stored positions stay within wrap_ of the box, so the rod beside a rod lies at
+  // least its contact distance >= the smallest diameter > 2 wrap_ away (NeighbourLists::right_code)
+  double smallest = cfg_.diameter;
+  for (const double d : cfg_.diameters) smallest = std::min(smallest, d);
+  wrap_ = kWrap * smallest;
   contact_tol_ = 2.0 * cfg_.group_tol * sigma2_;
   box_ = Boundaries<Dim>(cfg_);
   walled_ = box_.any_walls();
   double vol = 1.0;  // in diameters^d
   for (int k = 0; k < Dim; ++k) vol *= cfg_.box[k] / cfg_.diameter;
-  const double phi = static_cast<double>(n_) * particle_volume(Dim, 1.0) / vol;
+  // the particles' volume in largest ones' (a mixture: the sum of (D_i / D)^d, n when all are D)
+  double parts = static_cast<double>(n_);
+  if (!cfg_.diameters.empty()) {
+    parts = 0.0;
+    for (const double d : cfg_.diameters) {
+      const double q = d / cfg_.diameter;
+      parts += Dim == 1 ? q : Dim == 2 ? q * q : q * q * q;
+    }
+  }
+  const double phi = parts * particle_volume(Dim, 1.0) / vol;
   shell_ = (cfg_.shell > 0.0 ? cfg_.shell : auto_shell(Dim, phi)) * cfg_.diameter;
   for (int k = 0; k < Dim; ++k)
     if (box_.periodic(k)) shell_ = std::min(shell_, 0.9 * (0.5 * cfg_.box[k] - cfg_.diameter));
@@ -228,6 +243,8 @@ void EngineImpl<Dim, Op>::number_slots() {
     if (resort_every_ > 0) slot_[i] = static_cast<std::int32_t>(i);
     bk_[i].id = static_cast<std::int32_t>(i);
   }
+  rad_.clear();
+  for (const double d : cfg_.diameters) rad_.push_back(0.5 * d);  // a mixture: slot i holds id i
 }
 
 // Stores the particles in the order of their list centres' cells (the grid's row-major
@@ -251,6 +268,7 @@ void EngineImpl<Dim, Op>::sort_storage() {
   }
   permute_in_place(p_, to);
   permute_in_place(bk_, to);
+  if (!rad_.empty()) permute_in_place(rad_, to);
   for (std::size_t j = 0; j < n_; ++j) {
     Book& q = bk_[j];
     if (q.ev.kind == kColl) q.ev.partner = to[static_cast<std::size_t>(q.ev.partner)];

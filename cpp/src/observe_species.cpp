@@ -1,5 +1,6 @@
 // The observer's species (mixtures; the definitions are in revcol/engine/observe.hpp):
 // set_species (the sums live in the hooks, end_block and results).
+#include <algorithm>
 #include <string>
 
 #include "observe_inline.hpp"
@@ -52,6 +53,18 @@ void Observer::set_species(const std::vector<int>& label, const std::vector<doub
   label_ = label;
   radius_ = radius;
   sp_count_ = count;
+}
+
+void Observer::set_sizes(const std::vector<double>& radius) {
+  std::vector<double> sizes(radius);
+  std::sort(sizes.begin(), sizes.end());
+  sizes.erase(std::unique(sizes.begin(), sizes.end()), sizes.end());
+  const bool species = sizes.size() <= static_cast<std::size_t>(kMaxSpecies);
+  std::vector<int> label(species ? radius.size() : 0);
+  if (species)
+    for (std::size_t q = 0; q < radius.size(); ++q)
+      label[q] = static_cast<int>(std::lower_bound(sizes.begin(), sizes.end(), radius[q]) - sizes.begin());
+  set_species(label, radius);
 }
 
 }  // namespace revcol::engine

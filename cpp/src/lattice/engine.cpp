@@ -75,27 +75,16 @@ LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double 
   for (std::size_t k = 0; k < D; ++k)
     fc.boundary[k] = !c.wall[k] ? engine::Boundary::periodic : c.bounce[k] ? engine::Boundary::bounce : engine::Boundary::wall;
   engine::InitialState st;
-  if (c.diameters.empty()) {
+  if (!c.diameters.empty()) {
+    largest_diameter(c.diameters, n);  // one per particle, each finite and > 0 (named errors)
+    fc.diameters = c.diameters;        // a mixture: engine::random_state's cube of their own volumes
+    fc.diameter = 1.0;                 // (it sets the largest)
+  }
+  try {
     st = engine::random_state(fc, n, phi, seed, 0.0, init);
-  } else {
-    // a mixture: the cube whose packing fraction (the particles' own volumes) is phi, the
-    // particles placed as spheres of the largest diameter (every pair then at least that far
-    // apart), particle p taking diameters[p]
-    const double dmax = largest_diameter(c.diameters, n);
-    require(std::isfinite(phi) && phi > 0.0, "lattice: the packing fraction must be > 0");
-    double vol = 0.0;
-    for (double d : c.diameters) vol += engine::particle_volume(static_cast<int>(D), d);
-    fc.diameter = dmax;
-    const double L = std::pow(vol / phi, 1.0 / static_cast<double>(D));
-    for (std::size_t k = 0; k < D; ++k) fc.box[k] = L;
-    try {
-      st = engine::random_start(fc, n, seed, 0.0, init);
-    } catch (const InvalidArgument& e) {
-      const double as_largest = static_cast<double>(n) * engine::particle_volume(static_cast<int>(D), dmax) / vol * phi;
-      throw InvalidArgument("lattice: a mixture's random start places every particle as one of the largest (diameter " +
-                            std::to_string(dmax) + "), which at packing fraction " + std::to_string(phi) +
-                            " would fill " + std::to_string(as_largest) + " of the box: " + e.what());
-    }
+  } catch (const InvalidArgument& e) {
+    if (c.diameters.empty()) throw;
+    throw InvalidArgument(std::string("lattice: ") + e.what());
   }
   LatticeConfigN<D> lc = c;
   for (std::size_t k = 0; k < D; ++k) lc.box[k] = st.config.box[k];

@@ -41,19 +41,10 @@ auto BasicEngine<Op, Bits, Queue>::make_observer(const Units& u, const std::vect
   auto o = s != nullptr ? std::make_unique<engine::Observer>(s->observer, s->observer_counts, static_cast<int>(D), vf,
                                                              t, box, walls, diameter)
                         : std::make_unique<engine::Observer>(*c, static_cast<int>(D), xf, vf, t, box, walls, diameter);
-  if (!radius.empty()) {  // a mixture: its species by radius, ascending (revcol.observe_species.species_labels);
-                          // more sizes than the observer keeps species of (polydisperse): the radii only
-    std::vector<std::int64_t> sizes(radius);
-    std::sort(sizes.begin(), sizes.end());
-    sizes.erase(std::unique(sizes.begin(), sizes.end()), sizes.end());
-    const bool species = sizes.size() <= static_cast<std::size_t>(engine::Observer::kMaxSpecies);
-    std::vector<int> label(species ? n : 0);
+  if (!radius.empty()) {  // a mixture: its species by radius (engine::Observer::set_sizes)
     std::vector<double> rf(n);
-    for (std::size_t q = 0; q < n; ++q) {
-      if (species) label[q] = static_cast<int>(std::lower_bound(sizes.begin(), sizes.end(), radius[q]) - sizes.begin());
-      rf[q] = static_cast<double>(radius[q]) * len;
-    }
-    o->set_species(label, rf);
+    for (std::size_t q = 0; q < n; ++q) rf[q] = static_cast<double>(radius[q]) * len;  // distinct radii stay distinct (< 2^52)
+    o->set_sizes(rf);
   }
   return o;
 }

@@ -179,7 +179,7 @@ class Boundaries {
   }
   /// Calls f with an axis-type value of axis k's kind (the one switch over the kinds).
   template <class F>
-  decltype(auto) visit(int k, F&& f) const {
+  [[gnu::always_inline]] decltype(auto) visit(int k, F&& f) const {
     switch (kind_[k]) {
       case Boundary::wall: return f(WallAxis{});
       case Boundary::bounce: return f(BounceAxis{});
@@ -213,21 +213,25 @@ class Boundaries {
   double shift(int k, unsigned code) const { return code == 1 ? L_[k] : code == 2 ? -L_[k] : 0.0; }
   /// Moves a stored position x (line at c) by L when c has left a periodic axis.
   bool wrap(int k, double& x, double c) const { return periodic(k) && PeriodicAxis::wrap(x, c, L_[k]); }
+  // Every question about a particle's contact with a wall takes its radius r; kOwn (the
+  // default) is the configuration's D / 2 (a mixture passes each particle's own; the contact
+  // tolerance stays group_tol times the largest diameter).
+  static constexpr double kOwn = -1.0;
   /// The centre's position at axis k's wall ahead (walls only).
-  double wall_at(int k, int up) const {
-    return visit(k, [&](auto a) { return decltype(a)::wall_at(up, L_[k], radius_); });
+  [[gnu::always_inline]] double wall_at(int k, int up, double r = kOwn) const {
+    return visit(k, [&](auto a) { return decltype(a)::wall_at(up, L_[k], rad(r)); });
   }
   /// Whether the centre x touches axis k's wall ahead (walls only).
-  bool touches_ahead(int k, double x, int up) const {
-    return visit(k, [&](auto a) { return decltype(a)::touches_ahead(x, up, L_[k], radius_, tol_); });
+  [[gnu::always_inline]] bool touches_ahead(int k, double x, int up, double r = kOwn) const {
+    return visit(k, [&](auto a) { return decltype(a)::touches_ahead(x, up, L_[k], rad(r), tol_); });
   }
   /// Whether the centre x touches a wall of axis k.
-  bool touches(int k, double x) const {
-    return visit(k, [&](auto a) { return decltype(a)::touches(x, L_[k], radius_, tol_); });
+  [[gnu::always_inline]] bool touches(int k, double x, double r = kOwn) const {
+    return visit(k, [&](auto a) { return decltype(a)::touches(x, L_[k], rad(r), tol_); });
   }
   /// Whether the centre x meets the wall of axis k that the component vk approaches.
-  bool meets(int k, double x, double vk) const {
-    return visit(k, [&](auto a) { return decltype(a)::meets(x, vk, L_[k], radius_, tol_); });
+  [[gnu::always_inline]] bool meets(int k, double x, double vk, double r = kOwn) const {
+    return visit(k, [&](auto a) { return decltype(a)::meets(x, vk, L_[k], rad(r), tol_); });
   }
   /// Whether axis k's reflection acts on the whole velocity.
   bool whole(int k) const {
@@ -236,11 +240,11 @@ class Boundaries {
 
   /// The walls met by a particle at x with velocity v at one instant (a collision's): the
   /// corner rule above. Changes v; returns the mask applied (0: no wall met).
-  Reflection reflect(const Vec& x, Vec& v) const {
+  Reflection reflect(const Vec& x, Vec& v, double r = kOwn) const {
     unsigned met = 0;
     int first_whole = -1;
     for (int k = 0; k < Dim; ++k)
-      if (meets(k, x[k], v[k])) {
+      if (meets(k, x[k], v[k], r)) {
         met |= 1u << k;
         if (first_whole < 0 && whole(k)) first_whole = k;
       }
@@ -255,7 +259,7 @@ class Boundaries {
     if (!(applied & kReversed)) return applied;
     unsigned again = 0;  // touched walls that -v approaches: each flips its own component
     for (int k = 0; k < Dim; ++k)
-      if (meets(k, x[k], v[k])) {
+      if (meets(k, x[k], v[k], r)) {
         v[k] = -v[k];
         again |= 1u << k;
       }
@@ -266,12 +270,12 @@ class Boundaries {
   /// and now approaches flips its own component too: its event would come at this very
   /// instant, and at an exact corner two bounce walls would hand the particle back and forth
   /// forever. Changes v; returns the mask applied.
-  Reflection reflect_at(int k, const Vec& x, Vec& v) const {
+  Reflection reflect_at(int k, const Vec& x, Vec& v, double r = kOwn) const {
     const Reflection applied = axis_reflect(k, v);
     if (!(applied & kReversed)) return applied;
     unsigned again = 0;
     for (int j = 0; j < Dim; ++j)
-      if (j != k && v[j] != 0.0 && walls(j) && touches_ahead_within(j, x[j], v[j] > 0.0 ? 1 : 0, 0.0)) {
+      if (j != k && v[j] != 0.0 && walls(j) && touches_ahead_within(j, x[j], v[j] > 0.0 ? 1 : 0, 0.0, r)) {
         v[j] = -v[j];
         again |= 1u << j;
       }
@@ -279,9 +283,10 @@ class Boundaries {
   }
 
  private:
-  bool touches_ahead_within(int k, double x, int up, double tol) const {
-    return visit(k, [&](auto a) { return decltype(a)::touches_ahead(x, up, L_[k], radius_, tol); });
+  bool touches_ahead_within(int k, double x, int up, double tol, double r) const {
+    return visit(k, [&](auto a) { return decltype(a)::touches_ahead(x, up, L_[k], rad(r), tol); });
   }
+  double rad(double r) const { return r < 0.0 ? radius_ : r; }
   Reflection axis_reflect(int k, Vec& v) const {
     return visit(k, [&](auto a) { return decltype(a)::template reflect<Dim>(k, v); });
   }

@@ -129,7 +129,9 @@ struct Config {
   int dim = 2;                                   ///< d = 1, 2, 3
   std::array<double, 3> box{1.0, 1.0, 1.0};      ///< box lengths L_k: the box is [0, L_k] per axis
   std::array<Boundary, 3> boundary{Boundary::periodic, Boundary::periodic, Boundary::periodic};  ///< per axis
-  double diameter = 1.0;                         ///< D
+  double diameter = 1.0;                         ///< D (a mixture: the largest of `diameters`)
+  std::vector<double> diameters;                 ///< a mixture: one diameter per particle (id order),
+                                                 ///< the largest equal to `diameter`; empty: one size
   Mode mode = Mode::exact;                       ///< the pair operator: exact (default), paper, ... (engine_operators.hpp)
   Law law = Law::flux;                           ///< exact mode's target law
   std::uint32_t seed = 1;                        ///< the generator family (rng/streams.hpp)

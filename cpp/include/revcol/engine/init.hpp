@@ -46,7 +46,10 @@ struct InitialState {
 /// packing fraction = n particle_volume(d, D) / box volume.
 double particle_volume(int d, double D);
 
-/// See InitialState.
+/// See InitialState. A mixture (config.diameters, one per particle; config.diameter is then
+/// set to the largest): the cube whose packing fraction, from the particles' own volumes, is
+/// phi, every particle placed as one of the largest (so each pair starts at least the largest
+/// diameter apart, and phi is bounded by the largest ones' crystal).
 InitialState random_state(Config config, std::size_t n, double phi, std::uint64_t seed,
                           double energy = 0.0, const std::string& init = "auto",
                           bool equal_speeds = false);

@@ -8,7 +8,8 @@
 // which invalidates every prediction made with the old state.
 //
 // Pair contact. For a particle a and its listed b with image shift s (r = x_a - x_b - s),
-// from the later of the two local times t_r: with b = r.w (w = v_a - v_b), c = r^2 - D^2 and
+// from the later of the two local times t_r: with b = r.w (w = v_a - v_b), c = r^2 - D^2 (D the
+// pair's contact distance, (D_a + D_b) / 2 in a mixture) and
 // disc = b^2 - w^2 c, an approaching pair (b < 0) meets at
 //     t = t_r + c / (-b + sqrt(disc))
 // the cancellation-free root (the textbook (-b - sqrt(disc)) / w^2 loses digits when
@@ -119,6 +120,14 @@ struct FloatKinematics {
   [[gnu::always_inline]] static void pair_test2(const Particle<Dim>& a, const Particle<Dim>& b0,
                                                 const Particle<Dim>& b1, const Vec& s0, const Vec& s1,
                                                 double sigma2, double contact_tol, double limit, Pair2& out) {
+    pair_test2(a, b0, b1, s0, s1, sigma2, sigma2, contact_tol, contact_tol, limit, out);
+  }
+  /// The same with each lane's own contact distance and tolerance (a mixture): lane l's
+  /// sigma2_l, contact_tol_l.
+  [[gnu::always_inline]] static void pair_test2(const Particle<Dim>& a, const Particle<Dim>& b0,
+                                                const Particle<Dim>& b1, const Vec& s0, const Vec& s1,
+                                                double sigma2_0, double sigma2_1, double contact_tol_0,
+                                                double contact_tol_1, double limit, Pair2& out) {
     typedef double v2d __attribute__((vector_size(16)));
     typedef long long v2l __attribute__((vector_size(16)));
     const v2d ta = {a.t, a.t}, tb = {b0.t, b1.t};
@@ -137,7 +146,7 @@ struct FloatKinematics {
       r2 += r[k] * r[k];
       w2 += w[k] * w[k];
     }
-    const v2d sig = {sigma2, sigma2}, tol = {contact_tol, contact_tol}, lim = {limit, limit};
+    const v2d sig = {sigma2_0, sigma2_1}, tol = {contact_tol_0, contact_tol_1}, lim = {limit, limit};
     const v2d zero = {0.0, 0.0}, m2 = {-2.0, -2.0};
     const v2d c = r2 - sig;
     const v2d disc = bb * bb - w2 * c;
@@ -156,7 +165,7 @@ struct FloatKinematics {
   /// Time after p's local time at which p leaves the sphere of radius h (h2 = h^2) around
   /// the centre c; false when p is at rest. Outside and not entering (round-off at the
   /// surface): 0, renew now.
-  static bool renewal_time(const Particle<Dim>& p, const double* c, double h2, double& tau) {
+  [[gnu::always_inline]] static bool renewal_time(const Particle<Dim>& p, const double* c, double h2, double& tau) {
     double dd = 0.0, b = 0.0, vv = 0.0;
     for (int k = 0; k < Dim; ++k) {
       const double dk = p.x[k] - c[k], vk = p.v[k];

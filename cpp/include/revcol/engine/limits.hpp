@@ -39,6 +39,9 @@ inline constexpr int kMinDim = 1, kMaxDim = 3;
 inline constexpr int kMinPeriodicCells = 3;
 /// Smallest and largest K, exact mode's bits per chart coordinate (FixedPoint's).
 inline constexpr int kMinBits = FixedPoint::min_bits, kMaxBits = FixedPoint::max_bits;
+/// A mixture's sizes: the smallest diameter at least the largest / kMaxSizeRatio (the lists,
+/// sized by the largest, would list ratio^d small particles per small one).
+inline constexpr double kMaxSizeRatio = 16.0;
 /// group_tol must lie in [0, kMaxGroupTol).
 inline constexpr double kMaxGroupTol = 1e-3;
 /// Seeds (and generator keys) are 32-bit: seed <= kMaxSeed.

@@ -502,7 +502,8 @@ class NeighbourLists {
   }
   // The image of b, the rod to the right of a, seen from a: b itself (code 0) when it lies
   // to the right, else b + L (code 1). Unambiguous: stored positions are within a quarter
-  // diameter of the box, and b lies between D and L - 2 D to the right of a on the ring.
+  // of the smallest diameter of the box, and b lies between its contact distance (at least
+  // the smallest diameter) and L less two smallest diameters to the right of a on the ring.
   template <class Pos>
   unsigned right_code(int a, int b, Pos& pos) const {
     if (!box_.periodic(0)) return 0u;

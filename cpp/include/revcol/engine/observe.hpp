@@ -239,6 +239,9 @@ class Observer {
   /// none). Throws InvalidArgument on a bad label or radius, or another number of species
   /// than the snapshot's.
   void set_species(const std::vector<int>& label, const std::vector<double>& radius);
+  /// set_species from the radii alone: the species are the distinct radii in ascending order
+  /// (revcol.observe_species.species_labels); more than kMaxSpecies sizes, the radii only.
+  void set_sizes(const std::vector<double>& radius);
   /// Every segment closed at t (the end of a run call); closes any block ended by then.
   void sync(double t);
   /// The results up to the last hook or sync.
