@@ -18,7 +18,8 @@ minutes apart at most, so a slow phase of a shared host hits both), their median
 quartiles, which resolve a few per cent where the medians of either build swing by 10%.
 `--case` chooses named cases (default: all five below; `floor/pair2d` and `floor/pair3d`
 report the operator's ns per collision and its ratio to the floor instead of throughput);
-`--custom SPEC` adds an `engine/custom` case with REVCOL_ENGINE=SPEC (any number of each).
+`--custom SPEC` adds an `engine/custom` case with REVCOL_ENGINE=SPEC (any number of each; in
+callgrind too, run on both builds).
 Callgrind: instructions per collision, which a loaded host does not change: for each case and
 build, valgrind's Ir of the whole benchmark at two collision counts C1 < C2, and their
 difference over C2 - C1 (forward and back, the start and setup cancelling); `--setting
@@ -100,14 +101,16 @@ def _instructions(build: str, case: str, collisions: int) -> int:
 
 
 def callgrind(args) -> dict:
-    cases = (args.case or CALLGRIND_CASES) + (args.setting or [])
+    custom = [f"engine/custom:REVCOL_ENGINE={c}" for c in (args.custom or [])]
+    cases = (args.case or ([] if custom else CALLGRIND_CASES)) + (args.setting or []) + custom
     c1, c2 = args.c1, args.c2
     rows = []
     for case in cases:
         row = {"case": case}
         for label, build in (("old", args.old), ("new", args.new)):
-            # a setting runs on the new build only; the old one runs the case without it
-            run = case if label == "new" else case.partition(":")[0]
+            # a setting runs on the new build only; the old one runs the case without it (a
+            # --custom case runs on both: the same gas)
+            run = case if label == "new" or case in custom else case.partition(":")[0]
             a, b = _instructions(build, run, c1), _instructions(build, run, c2)
             row[label] = (b - a) / (c2 - c1)
         row["new_over_old"] = row["new"] / row["old"]
