@@ -15,7 +15,7 @@ from typing import Any, NamedTuple, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["Species", "parse_species", "species_diameters", "species_volume", "SPECIES_FIELDS"]
+__all__ = ["Species", "parse_species", "species_diameters", "species_volume", "trajectory_kinds", "SPECIES_FIELDS"]
 
 #: the fields of one ``[[species]]`` entry
 SPECIES_FIELDS = ("name", "diameter", "count", "fraction")
@@ -89,3 +89,12 @@ def species_volume(species: Sequence[Species], d: int) -> float:
     """The particles' own volume (area in 2D, length in 1D) summed over every species."""
     unit = {1: 1.0, 2: math.pi / 4.0, 3: math.pi / 6.0}[d]
     return sum(s.count * unit * s.diameter**d for s in species)
+
+
+def trajectory_kinds(species: Sequence[Species], diameters) -> dict:
+    """The trajectory writers' per-particle keywords for a mixture (each particle's diameter,
+    the species' names and each particle's species, ids in blocks); {} for one size."""
+    if not species:
+        return {}
+    return dict(diameters=diameters, types=[s.name for s in species],
+                typeid=np.repeat(np.arange(len(species)), [s.count for s in species]))

@@ -41,7 +41,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._args import integer, names, placement, real_array
+from ._args import diameters_arg, integer, names, placement, real_array
 from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, write_checkpoint
 from .roundtrip import divergence_text
@@ -92,20 +92,20 @@ class Simulation(SimulationBase):
         if _engine is not None:
             self._e = _engine
             return
-        if diameters is not None:
-            raise ValueError("diameters (a mixture) run on the lattice engine so far: engine='lattice' "
-                             "(the float engine has one diameter)")
         x = real_array(positions, "positions")
         v = real_array(velocities, "velocities")
         if x.ndim == 1:
             x = x[:, None]
         if v.ndim == 1:
             v = v[:, None]
+        sizes = diameters_arg(diameters, x.shape[0], diameter)
+        if sizes:  # a mixture: the engine's diameter is the largest (its lists' and cells' size)
+            diameter = max(sizes)
         box = np.atleast_1d(real_array(box, "box")).tolist()
         # scalars go through as given: the engine names a wrong type or range (issue 17)
         self._e = _core.Engine(x, v, box, _boundary_list(boundary), diameter, mode, law,
                                seed, bits, bool(groups), group_tol, time,
-                               generator, streams)
+                               generator, streams, sizes)
 
     @classmethod
     def random(cls, n: int, dim: int = 3, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
@@ -130,9 +130,13 @@ class Simulation(SimulationBase):
                 raise ValueError("engine='lattice' starts at kT = 1 with Gaussian velocities: energy and "
                                  "equal_speeds are not available")
             return lat.random(n, dim, phi, boundary=boundary, diameter=diameter, seed=seed, init=init, **kwargs)
+        diameters = kwargs.pop("diameters", None)
+        sizes = diameters_arg(diameters, n, diameter)
         x, v, box = _core.engine_random_state(dim, n, phi, _boundary_list(boundary), diameter, seed,
                                               energy if energy is not None else 0.0, init,
-                                              bool(equal_speeds))
+                                              bool(equal_speeds), sizes)
+        if sizes:
+            return cls(x, v, box, boundary=boundary, diameters=sizes, seed=seed, **kwargs)
         return cls(x, v, box, boundary=boundary, diameter=diameter, seed=seed, **kwargs)
 
     # --- running -------------------------------------------------------------------------
@@ -258,6 +262,15 @@ class Simulation(SimulationBase):
     def collisions(self) -> int:
         """Net collisions since the start (forward less undone)."""
         return int(self._e.diagnostics()["net_collisions"])
+
+    @property
+    def diameters(self) -> np.ndarray:
+        """Each particle's diameter, shape (n,) (one size: all ``diameter``)."""
+        d = np.asarray(self._e.diameters, dtype=float)
+        return d if d.size else np.full(self.n, float(self._e.diameter))
+
+    mixture = property(lambda self: bool(len(self._e.diameters)),
+                       doc="True for a mixture (built with ``diameters``; sizes kept per particle).")
 
     def diagnostics(self) -> dict:
         """Energy and momentum (and their drift from the start), rare-log bytes, collisions

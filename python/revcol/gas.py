@@ -27,6 +27,7 @@ import numpy as np
 
 from . import _core, plots
 from ._outputs import Input, Output, check_outputs
+from ._species import trajectory_kinds
 from .engine import Simulation
 from .lattice_gas import _LatticeRun, build_lattice
 from .progress import Bar, Interrupt, peak_rss
@@ -59,7 +60,7 @@ def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
             scene.particles, scene.dimension, scene.packing_fraction, init=init,
             energy=scene.kinetic_energy, **opts))
 
-    def make() -> Simulation:  # the engine's start in the scene's box (random_start)
+    def make() -> Simulation:  # the engine's start in the scene's box (random_start; a mixture's as its largest)
         x, v = _core.engine_random_start(scene.particles, list(scene.box), opts["boundary"], scene.diameter,
                                          opts["seed"], scene.kinetic_energy or 0.0, init, False)
         return Simulation(x, v, scene.box, **opts)
@@ -125,7 +126,8 @@ class _GasRun:
 
             if observes_frames(scene, trajectory):
                 sim.observe()  # the observer's unwrapped positions give the frames' image flags (not reported)
-            self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter)
+            kinds = trajectory_kinds(scene.species, sim.diameters if scene.species else None)
+            self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter, **kinds)
             self.forward_frame(0)
         self.curve: list[dict] = []
         self.energy_series: list[tuple[int, float]] = [(0, 0.0)] if plot is not None else []

@@ -36,6 +36,7 @@ import numpy as np
 from . import _core
 from .lattice import LatticeSimulation, LatticeSimulation3D, add_reports
 from .progress import Bar, Interrupt, peak_rss
+from ._species import trajectory_kinds
 from ._version import __version__
 from .roundtrip import BAR, round_trip_errors
 from .scene import Scene, SceneError, lattice_options, observes_frames, read_initial
@@ -147,9 +148,7 @@ class _LatticeRun:
 
             if observes_frames(scene, trajectory):
                 sim.observe()  # the observer's unwrapped positions give the frames' image flags (not reported)
-            sp = scene.species  # a mixture: each particle's diameter and species (ids in blocks)
-            kinds = dict(diameters=sim.diameters, types=[s.name for s in sp],
-                         typeid=np.repeat(np.arange(len(sp)), [s.count for s in sp])) if sp else {}
+            kinds = trajectory_kinds(scene.species, sim.diameters if scene.species else None)
             self.writer = open_trajectory(trajectory, self.box, self.periodic, scene.diameter, **kinds)
             self.frame(0, "forward")
         self.energy_series: list[tuple[int, float]] = [(0, 0.0)]

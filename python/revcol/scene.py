@@ -98,7 +98,7 @@ file and the replacement.
     block_time = 1.0              # the first blocks' length (default D / v_rms); min_blocks = 16
     pair_bins = 100               # pair distances over [0, pair_rmax] (2-64 particles, walls on every axis)
 
-    [[species]]                   # gas, engine = "lattice", random start: a mixture of equal masses, one
+    [[species]]                   # gas, either engine, random start: a mixture of equal masses, one
     name = "A"                    # table per species (no [system] diameter then); diameter > 0; count,
     diameter = 1.0                # or fraction of [system] particles (the fractions add up to 1)
     fraction = 0.5
@@ -182,7 +182,7 @@ class Scene:
     checkpoints: Path | None = None
     max_output: int | None = None  # [output] max_output in bytes, 0: no limit (None: revcol._outputs' default)
     observe: dict[str, Any] | None = None  # [observe]: Simulation.observe's arguments (None: no table)
-    species: tuple = ()  # [[species]] (revcol._species.Species): a mixture, lattice engine; () one diameter
+    species: tuple = ()  # [[species]] (revcol._species.Species): a mixture; () one diameter
     name: str = "scene"
     description: str = ""
     source: str = "<built-in>"
@@ -319,9 +319,9 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
     if species:
         if ("system", "diameter") in values:
             raise _fail(source, "[system] diameter", "give [system] diameter (one size) or [[species]] diameters, not both")
-        if get("collisions", "engine", "float") != "lattice" or arrays is not None:
-            raise _fail(source, "[[species]]", "runs on engine = 'lattice' from a random start (the float engine has "
-                        "one diameter)")
+        if arrays is not None:
+            raise _fail(source, "[[species]]", "takes a random start (each species' count in id order), not "
+                        "[system] initial_state")
         sigma = max(sp.diameter for sp in species)
 
     box = get("system", "box")
@@ -431,9 +431,6 @@ def with_engine(scene: Scene, engine: str) -> Scene:
     fields = scene.extra.get("fields", ())
     out = dataclasses.replace(scene, engine=engine)
     if engine == "float":
-        if scene.species:
-            raise SceneError(f"{scene.source}: [[species]] runs on engine = 'lattice' (the float engine has one "
-                             "diameter), not --engine float")
         out = dataclasses.replace(out, tick_bits=None, cell_bits=16, search="auto", workers=1)
     if engine == "lattice":
         if "rng.generator" not in fields:  # the lattice's default generator, as in a scene file
@@ -530,9 +527,8 @@ _read_initial = read_initial  # its name before it was public
 
 def engine_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.Simulation` that a gas scene sets."""
-    return dict(boundary=list(scene.boundaries),
-                diameter=scene.diameter, mode=scene.mode, law=scene.law, seed=scene.seed,
-                bits=scene.bits, generator=scene.generator, streams=scene.streams)
+    return _sized(scene, dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
+                              seed=scene.seed, bits=scene.bits, generator=scene.generator, streams=scene.streams))
 
 
 def lattice_options(scene: Scene) -> dict[str, Any]:
@@ -540,6 +536,10 @@ def lattice_options(scene: Scene) -> dict[str, Any]:
     opts = dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
                 seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search,
                 workers=scene.workers)
+    return _sized(scene, opts)
+
+
+def _sized(scene: Scene, opts: dict) -> dict:
     if scene.species:  # a mixture: one diameter per particle instead
         del opts["diameter"]
         opts["diameters"] = species_diameters(scene.species)

@@ -49,8 +49,9 @@ def test_polydisperse_and_the_facade(tmp_path):
     sim.run(collisions=2000)
     back.run(collisions=2000)
     assert np.array_equal(back.lattice_positions, sim.lattice_positions)
-    with pytest.raises(ValueError, match="lattice engine so far"):
-        Simulation.random(10, dim=2, phi=0.2, diameters=np.ones(10))
+    # the float engine takes the same diameters (tests/python/test_float_mixture.py)
+    f = Simulation.random(10, dim=2, phi=0.2, diameters=np.ones(10))
+    assert f.engine == "float" and f.mixture
 
 
 def test_arrays_that_fit_only_with_their_sizes():
@@ -93,7 +94,7 @@ def test_mixture_theories_reduce_to_the_pure_fluid():
 def test_equation_of_state_reduced(dim, phi):
     # N = 1000, 300 collisions per particle observed: the full study (N = 4000, four seeds) is in
     # bench/results/mixture_eos.json. Within 3 block errors of the theory (stated there)
-    r = measure(dim, 1000, phi, 1.4, equilibrate=60, collisions=300, seed=1, ecmc=400)
+    r = measure(dim, 1000, phi, 1.4, equilibrate=60, collisions=300, seed=1, ecmc=400, float_md=True)
     assert r["back_to_start"]
     assert r["blocks"] >= 16
     assert abs(r["deviation_sd"]) < 3.0, r
@@ -101,6 +102,12 @@ def test_equation_of_state_reduced(dim, phi):
     assert r["ecmc"]["min_distance"] >= 1.0 - 1e-9
     assert r["ecmc"]["z_md"][1] < 0.02
     assert abs(r["ecmc_deviation_sd"]) < 3.0, r["ecmc"]
+    # the float engine's run of the same particles from the same start: within 3 combined errors,
+    # and within 3 of its own errors of the theory
+    f = r["float"]
+    assert abs(r["float_deviation_sd"]) < 3.0, f
+    assert abs(f["z"] - r["z_theory"]) < 3.0 * f["z_error"], f
+    assert abs(f["energy_drift"]) < 1e-12
 
 
 def _mixture_scene(extra: str = "", system: str = "particles = 400\n") -> dict:
@@ -117,9 +124,10 @@ def test_scene_species_table_builds_the_mixture(tmp_path):
     from revcol.scene import SceneError, lattice_options, scene_from_dict
     scene = scene_from_dict(_mixture_scene(), "mix.toml")
     assert [(s.name, s.count) for s in scene.species] == [("big", 100), ("small", 300)]
+    from revcol.gas import build_simulation
     from revcol.scene import with_engine
-    with pytest.raises(SceneError, match=r"\[\[species\]\] runs on engine = 'lattice'.*--engine float"):
-        with_engine(scene, "float")  # (revcol run --engine float): not a one-size gas of the largest
+    flt = build_simulation(with_engine(scene, "float"))  # (revcol run --engine float): the same mixture
+    assert flt.engine == "float" and np.array_equal(np.unique(flt.diameters), [0.8, 1.0])
     assert "100 big (d = 1), 300 small (d = 0.8)" in scene.summary()
     # the box from the species' own areas at the packing fraction
     area = 100 * np.pi / 4 + 300 * np.pi / 4 * 0.64
@@ -132,7 +140,7 @@ def test_scene_species_table_builds_the_mixture(tmp_path):
     counted = _mixture_scene(system="").copy()
     counted["species"] = [{"name": "a", "diameter": 1.0, "count": 7}, {"name": "b", "diameter": 0.8, "count": 5}]
     assert scene_from_dict(counted, "c.toml").particles == 12
-    bad = [({"system": {"diameter": 1.0}}, "not both"), ({"collisions": {"engine": "float"}}, "engine = 'lattice'"),
+    bad = [({"system": {"diameter": 1.0}}, "not both"),
            ({"species": [{"name": "a", "diameter": 1.0, "fraction": 0.5}]}, "add up to 1"),
            ({"species": [{"name": "a", "diameter": 1.0, "count": 3, "mass": 2.0}]}, "unknown field"),
            ({"species": [{"name": "a", "diameter": -1.0, "count": 3}]}, "diameter"),
@@ -146,11 +154,14 @@ def test_scene_species_table_builds_the_mixture(tmp_path):
             scene_from_dict(doc, "bad.toml")
 
 
-def test_mixture_trajectory_carries_types_and_diameters(tmp_path):
+@pytest.mark.parametrize("engine", ["lattice", "float"])
+def test_mixture_trajectory_carries_types_and_diameters(tmp_path, engine):
     gsd_hoomd = pytest.importorskip("gsd.hoomd")
     from revcol.gas import run_gas
     from revcol.scene import scene_from_dict
-    scene = scene_from_dict(_mixture_scene("[output]\ntrajectory_every = 1000\n"), str(tmp_path / "mix.toml"))
+    doc = _mixture_scene("[output]\ntrajectory_every = 1000\n")
+    doc["collisions"]["engine"] = engine
+    scene = scene_from_dict(doc, str(tmp_path / "mix.toml"))
     run_gas(scene, trajectory=tmp_path / "mix.gsd", progress=False, checkpoints=False)
     with gsd_hoomd.open(str(tmp_path / "mix.gsd")) as t:
         f = t[0]

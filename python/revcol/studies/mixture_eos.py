@@ -107,13 +107,16 @@ def gaussian_diameters(n: int, seed: int, width: float = 0.1) -> np.ndarray:
 
 
 def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 100.0, collisions: float = 400.0,
-            seed: int = 1, blocks: int = 32, frames: int = 0, ecmc: float = 0.0, sizes: str = "binary") -> dict:
+            seed: int = 1, blocks: int = 32, frames: int = 0, ecmc: float = 0.0, sizes: str = "binary",
+            float_md: bool = False) -> dict:
     """One run (see the module docstring): Z with its block error, the theory, and the checks;
     ``frames`` > 0: that many frames at evenly spaced times (not at collisions) give the partial
     contact values g_ab(sigma_ab+) against the theory's and each species' temperature; ``ecmc``
     > 0: the event-chain sampler (:mod:`revcol.studies.ecmc`, a different algorithm sharing no
     code with the engine) from the same start, box and quantized diameters, that many largest
-    diameters of chain displacement per sphere, its Z as the engine's (md_equivalent) beside."""
+    diameters of chain displacement per sphere, its Z as the engine's (md_equivalent) beside;
+    ``float_md``: the float engine's run of the same particles from the same start (its own
+    dynamics, the same equilibration and observed collisions per particle)."""
     from ..lattice import LatticeSimulation, LatticeSimulation3D
     cls = LatticeSimulation3D if dim == 3 else LatticeSimulation
     if sizes not in ("binary", "gauss"):
@@ -124,6 +127,7 @@ def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 
     sim = cls.random(n, phi=phi, diameters=d, seed=seed)
     x0 = sim.lattice_positions.copy()
     chains = _ecmc(dim, phi, sim, seed, ecmc) if ecmc > 0 else None
+    flt = _float_md(sim, seed, equilibrate, collisions, blocks) if float_md else None
     t0 = time.perf_counter()
     sim.run(collisions=int(equilibrate * n))
     # blocks of equal time: the rate from the equilibration
@@ -161,6 +165,9 @@ def measure(dim: int, n: int, phi: float, ratio: float, *, equilibrate: float = 
         (zc, zce) = chains["z_md"]
         out["ecmc"] = chains
         out["ecmc_deviation_sd"] = (z - zc) / math.hypot(ze, zce)
+    if flt is not None:
+        out["float"] = flt
+        out["float_deviation_sd"] = (flt["z"] - z) / math.hypot(ze, flt["z_error"])
     if frames:
         out.update(_structure(dim, phi, sim, np.asarray(xs), np.asarray(vs), trace, t_obs,
                               obs.temperature.value))
@@ -175,6 +182,22 @@ def _ecmc(dim: int, phi: float, sim, seed: int, per_particle: float) -> dict:
     r = sample(dim, phi, n=sim.n, seed=seed, per_particle=per_particle, sampler=chain)
     return {k: r[k] for k in ("z_mc", "z_md", "per_particle", "warmup", "chain_length", "lifts", "cpu_s",
                               "min_distance")}
+
+
+def _float_md(sim, seed: int, equilibrate: float, collisions: float, blocks: int) -> dict:
+    """The float engine's run of ``measure``: the lattice gas's start (float positions,
+    velocities, box and diameters), blocks of equal time from its own collision rate."""
+    from ..engine import Simulation
+    f = Simulation(sim.positions, sim.velocities, sim.box, diameters=sim.diameters, seed=seed)
+    t0 = time.perf_counter()
+    f.run(collisions=int(equilibrate * f.n))
+    rate = f.collisions / max(f.time - f.start_time, 1e-300)
+    f.observe(block_time=collisions * f.n / rate / blocks)
+    f.run(collisions=int(collisions * f.n))
+    obs = f.observation()
+    return {"z": obs.compressibility.value, "z_error": obs.compressibility.error, "blocks": obs.blocks,
+            "species_temperature": [[e.value, e.error] for e in obs.species_temperature],
+            "energy_drift": f.diagnostics()["energy_drift"], "seconds": time.perf_counter() - t0}
 
 
 def _structure(dim: int, phi: float, sim, xs: np.ndarray, vs: np.ndarray, trace, duration: float, kt: float) -> dict:
@@ -296,6 +319,14 @@ def table(runs: list) -> str:
             if "ecmc" in cs[0]["pure"]:
                 items.append(("Z, one size: lattice - ECMC (same N)", [c["pure"]["z"] - c["pure"]["ecmc"]["z_md"][0]
                                                                     for c in cs], 0.0, "0"))
+        if "float" in m0:
+            items.append(("Z, mixture: float - lattice (same start)", [c["mixture"]["float"]["z"] - c["mixture"]["z"]
+                                                                      for c in cs], 0.0, "0"))
+            items.append(("Z, mixture, float engine", [c["mixture"]["float"]["z"] for c in cs], m0["z_theory"],
+                          m0["theory"]))
+            if "float" in cs[0]["pure"]:
+                items.append(("Z, one size: float - lattice (same start)", [c["pure"]["float"]["z"] - c["pure"]["z"]
+                                                                           for c in cs], 0.0, "0"))
         if "z_from_contact" in m0:
             items.append(("Z from the contact values (rates)", [c["mixture"]["z_from_contact"] for c in cs],
                           float(np.mean([c["mixture"]["z"] for c in cs])), "Z (collision virial)"))
@@ -329,6 +360,8 @@ def main(argv=None) -> int:
                    help="the mixtures: 1:1 binary of ratio 1.4 (with partial contact values), 10%% Gaussian")
     p.add_argument("--ecmc", type=float, default=2000.0, help="event-chain displacement per sphere, in largest "
                    "diameters, for the cross-check at the same N (0: none)")
+    p.add_argument("--float", dest="float_md", action="store_true", help="the float engine's run of the same "
+                   "particles from the same start beside each")
     p.add_argument("--json", default=None)
     p.add_argument("--figure", default=None, help="the partial g_ab(r) of the first seed's runs (PNG); with --from, "
                    "from that JSON alone")
@@ -348,7 +381,7 @@ def main(argv=None) -> int:
             pure = None
             for kind in a.sizes:
                 c = compare(dim, a.n, phi, 1.4, pure=pure, collisions=a.collisions, seed=seed, ecmc=a.ecmc, sizes=kind,
-                            frames=a.frames if kind == "binary" else 0)
+                            frames=a.frames if kind == "binary" else 0, float_md=a.float_md)
                 r, q = c["mixture"], c["pure"]
                 pure = q
                 print(f"{kind} {dim}D phi {phi} seed {seed}: Z = {r['z']:.4f} +- {r['z_error']:.4f}, {r['theory']} "
@@ -362,6 +395,11 @@ def main(argv=None) -> int:
                         e = run["ecmc"]["z_md"]
                         print(f"    {name}: ECMC at the same N {e[0]:.4f} +- {e[1]:.4f}, lattice - ECMC "
                               f"{run['z'] - e[0]:+.4f} ({run['ecmc_deviation_sd']:+.1f} sd)", flush=True)
+                for name, run in (("mixture", r), ("one size", q)):
+                    if "float" in run:
+                        f = run["float"]
+                        print(f"    {name}: float engine {f['z']:.4f} +- {f['z_error']:.4f}, float - lattice "
+                              f"{f['z'] - run['z']:+.4f} ({run['float_deviation_sd']:+.1f} sd)", flush=True)
                 if "z_from_contact" in r:
                     print(f"    Z from the rates' contact values (virial route) {r['z_from_contact']:.4f}; temperatures "
                           + ", ".join(f"{t:.4f}" for t in r["temperatures"]) + " (frames), "
