@@ -231,6 +231,7 @@ class PyEngine {
     d["boundary"] = vec_array(bnd);
     d["diameter"] = c.diameter;
     if (!c.diameters.empty()) d["diameters"] = vec_array(c.diameters);  // a mixture
+    if (!c.masses.empty()) d["masses"] = vec_array(c.masses);
     d["mode"] = std::string(to_string(c.mode));
     d["law"] = std::string(to_string(c.law));
     d["seed"] = c.seed;
@@ -277,6 +278,7 @@ class PyEngine {
     }
     c.diameter = checkpoint_field<double>(get("diameter"), "diameter");
     if (d.contains("diameters")) c.diameters = array_vec<double>(d, "diameters");  // a mixture
+    if (d.contains("masses")) c.masses = array_vec<double>(d, "masses");
     c.mode = en::parse_engine_mode(checkpoint_field<std::string>(get("mode"), "mode"));
     c.law = parse_law(checkpoint_field<std::string>(get("law"), "law"));
     c.seed = checkpoint_field<std::uint32_t>(get("seed"), "seed");
@@ -340,7 +342,8 @@ void register_engine(py::module_& m) {
       .def(py::init([](const Array& x, const Array& v, const std::vector<double>& box,
                        const std::vector<std::string>& boundary, PyReal diameter_arg, PyStr mode_arg,
                        PyStr law_arg, PyInt seed_arg, PyInt bits_arg, bool groups, PyReal group_tol_arg,
-                       PyReal time_arg, PyStr generator_arg, PyStr streams_arg, std::vector<double> diameters) {
+                       PyReal time_arg, PyStr generator_arg, PyStr streams_arg, std::vector<double> diameters,
+                       std::vector<double> masses) {
              const std::string mode = to_str(mode_arg, "mode"), law = to_str(law_arg, "law");
              const std::string generator = to_str(generator_arg, "generator"), streams = to_str(streams_arg, "streams");
              const double diameter = to_real(diameter_arg, "diameter"), group_tol = to_real(group_tol_arg, "group_tol");
@@ -354,12 +357,14 @@ void register_engine(py::module_& m) {
              en::Config c = make_config(d, box, boundary, diameter, mode, law, seed, bits, groups, group_tol, generator,
                                        streams);
              c.diameters = std::move(diameters);  // a mixture (validated with the state)
+             c.masses = std::move(masses);
              return PyEngine(en::make_simulation(c, xs, vs, time));
            }),
            py::arg("positions"), py::arg("velocities"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
            py::arg("mode"), py::arg("law"), py::arg("seed"), py::arg("bits"), py::arg("groups"),
            py::arg("group_tol"), py::arg("time"), py::arg("generator") = "philox",
-           py::arg("streams") = "per_particle", py::arg("diameters") = std::vector<double>{})
+           py::arg("streams") = "per_particle", py::arg("diameters") = std::vector<double>{},
+           py::arg("masses") = std::vector<double>{})
       .def_static("from_snapshot", &PyEngine::from_snapshot, py::arg("snapshot"))
       .def("run", &PyEngine::run, py::arg("collisions") = py::none(), py::arg("time") = py::none(),
            py::arg("callback") = py::none(), py::arg("every") = 10000)
@@ -375,6 +380,9 @@ void register_engine(py::module_& m) {
       .def_property_readonly(
           "diameters", [](const PyEngine& e) { return e.sim().config().diameters; },
           "A mixture's diameters, one per particle (empty: one size, `diameter`).")
+      .def_property_readonly(
+          "masses", [](const PyEngine& e) { return e.sim().config().masses; },
+          "The particles' masses, one per particle (empty: all 1).")
       .def_property_readonly("dim", [](const PyEngine& e) { return e.sim().config().dim; })
       .def_property_readonly("box",
                              [](const PyEngine& e) {
@@ -407,7 +415,8 @@ void register_engine(py::module_& m) {
   m.def(
       "engine_random_state",
       [](PyInt dim_arg, PyInt n_arg, PyReal phi_arg, const std::vector<std::string>& boundary, PyReal diameter_arg,
-         PyInt seed_arg, PyReal energy_arg, PyStr init_arg, bool equal_speeds, std::vector<double> diameters) {
+         PyInt seed_arg, PyReal energy_arg, PyStr init_arg, bool equal_speeds, std::vector<double> diameters,
+         std::vector<double> masses) {
         const std::string init = to_str(init_arg, "init");
         const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
         const double energy = to_real(energy_arg, "energy");
@@ -422,12 +431,14 @@ void register_engine(py::module_& m) {
         for (int k = 0; k < dim; ++k) c.boundary[k] = en::parse_boundary(boundary.size() == 1 ? boundary[0] : boundary[k]);
         c.diameter = diameter;
         c.diameters = std::move(diameters);  // a mixture: random_state sets diameter to the largest
+        c.masses = std::move(masses);        // velocities / sqrt(m), the centre of mass at rest
         const en::InitialState s = en::random_state(c, n, phi, seed, energy, init, equal_speeds);
         return py::make_tuple(to_array(s.x, n, dim), to_array(s.v, n, dim),
                               std::vector<double>(s.config.box.begin(), s.config.box.begin() + dim));
       },
       py::arg("dim"), py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"), py::arg("seed"),
-      py::arg("energy"), py::arg("init"), py::arg("equal_speeds"), py::arg("diameters") = std::vector<double>{});
+      py::arg("energy"), py::arg("init"), py::arg("equal_speeds"), py::arg("diameters") = std::vector<double>{},
+      py::arg("masses") = std::vector<double>{});
   // the counted Ctrl-C (revcol.progress.Interrupt) that both engines' polls read (args.hpp)
   m.def(
       "request_stop", [](bool on) { stop_requested() = on; }, py::arg("on"),

@@ -71,7 +71,7 @@ void register_engine_init(py::module_& m) {
   m.def(
       "engine_random_start",
       [](std::size_t n, const std::vector<double>& box, const std::vector<std::string>& boundary, double diameter,
-         std::uint64_t seed, double energy, const std::string& init, bool equal_speeds) {
+         std::uint64_t seed, double energy, const std::string& init, bool equal_speeds, std::vector<double> masses) {
         const int dim = static_cast<int>(box.size());
         require(dim >= lim::kMinDim && dim <= lim::kMaxDim,
                 [&] { return "box must have 1, 2 or 3 lengths, got " + std::to_string(dim); });
@@ -83,11 +83,12 @@ void register_engine_init(py::module_& m) {
           c.boundary[k] = en::parse_boundary(boundary.size() == 1 ? boundary[0] : boundary[k]);
         }
         c.diameter = diameter;
+        c.masses = std::move(masses);  // velocities / sqrt(m), the centre of mass at rest
         const en::InitialState s = en::random_start(c, n, seed, energy, init, equal_speeds);
         return py::make_tuple(rows(s.x, n, dim), rows(s.v, n, dim));
       },
       py::arg("n"), py::arg("box"), py::arg("boundary"), py::arg("diameter"), py::arg("seed"),
-      py::arg("energy") = 0.0, py::arg("init") = "auto", py::arg("equal_speeds") = false,
+      py::arg("energy") = 0.0, py::arg("init") = "auto", py::arg("equal_speeds") = false, py::arg("masses") = std::vector<double>{},
       "A random start of n particles in the box (engine/init.hpp): (positions, velocities), each (n, dim).");
 }
 

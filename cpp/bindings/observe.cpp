@@ -88,6 +88,7 @@ py::dict observation_dict(const engine::Observation& o) {
   d["helfand"] = h;
   // a mixture's species (empty for one species): the estimates per species, the MSD (block ends, S)
   d["species_diameter"] = array(o.species_diameter);
+  d["species_mass"] = array(o.species_mass);
   py::array_t<std::uint64_t> counts(static_cast<py::ssize_t>(o.species_count.size()));
   for (std::size_t u = 0; u < o.species_count.size(); ++u) counts.mutable_data()[u] = o.species_count[u];
   d["species_count"] = counts;

@@ -129,6 +129,25 @@ void validate_sizes(const Config& c, std::size_t n) {
     });
 }
 
+// Masses: one per particle, finite, > 0, within kMaxMassRatio of each other; not in paper mode.
+void validate_masses(const Config& c, std::size_t n) {
+  if (c.masses.empty()) return;
+  require(c.masses.size() == n, [&] {
+    return "masses must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(c.masses.size());
+  });
+  require(c.mode != Mode::paper, "paper mode collides equal masses only: use exact or specular mode with masses");
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = c.masses[i];
+    require(std::isfinite(m) && m > 0.0, [&] { return "mass of particle " + std::to_string(i) + " must be finite and > 0"; });
+    lo = std::min(lo, m);
+    hi = std::max(hi, m);
+  }
+  require(hi <= limits::kMaxMassRatio * lo, [&] {
+    return "masses range over a ratio of " + num(hi / lo) + ": at most " + num(limits::kMaxMassRatio);
+  });
+}
+
 // Throws InvalidArgument naming the first pair closer than D (1 - 1e-9): a cell grid of cells >= D,
 // the 3^d neighbouring cells, minimum images on periodic axes. x: n x d positions inside the box.
 void check_overlaps(const Config& c, const std::vector<double>& x, std::size_t n) {
@@ -202,10 +221,12 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
   const std::size_t n = x.size() / d;
   require(n <= limits::max_particles(d), [&] { return limits::too_many_particles(d, n); });
   validate_sizes(c, n);
+  validate_masses(c, n);
   double e = 0.0;
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < d; ++k) {
       const double r = radius_of(c, i);
+      const double m = c.masses.empty() ? 1.0 : c.masses[i];
       const double xk = x[i * d + k], vk = v[i * d + k];
       require(std::isfinite(xk), [&] { return "position of particle " + std::to_string(i) + " is not finite"; });
       require(std::isfinite(vk), [&] { return "velocity of particle " + std::to_string(i) + " is not finite"; });
@@ -220,7 +241,7 @@ void validate_state(const Config& c, const std::vector<double>& x, const std::ve
           return "particle " + std::to_string(i) + " is outside the periodic box on axis " + std::to_string(k) +
                  ": x = " + num(xk) + ", allowed [0, " + num(c.box[k]) + ")";
         });
-      e += 0.5 * vk * vk;
+      e += 0.5 * m * vk * vk;
     }
   require(std::isfinite(e), "kinetic energy overflows");
   require(e > 0.0, "zero kinetic energy: nothing would ever move");
@@ -306,8 +327,10 @@ void check_snapshot_shapes(const Snapshot& s) {
   const std::size_t n = s.n, d = static_cast<std::size_t>(s.config.dim);
   require(n > 0, "snapshot: n must be > 0 (no particles)");
   if (!s.config.diameters.empty()) require_size("diameters", s.config.diameters.size(), n, "n, or none");
+  if (!s.config.masses.empty()) require_size("masses", s.config.masses.size(), n, "n, or none");
   try {
     validate_sizes(s.config, n);
+    validate_masses(s.config, n);
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(std::string("snapshot: ") + e.what());
   }
@@ -350,21 +373,24 @@ void check_snapshot_motion(const Snapshot& s) {
   // both are conserved: the velocities must still carry them (round-off keeps them within
   // ~1e-12 over 10^9 collisions; 1e-6 is the bar). Momentum only on periodic axes without
   // bounce walls (specular walls flip their own component, bounce walls every component).
-  double e = 0.0;
+  double e = 0.0, mass = 0.0;
   std::array<double, 3> p{};
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = s.config.masses.empty() ? 1.0 : s.config.masses[i];
+    mass += m;
     for (std::size_t k = 0; k < d; ++k) {
-      e += 0.5 * s.v[i * d + k] * s.v[i * d + k];
-      p[k] += s.v[i * d + k];
+      e += 0.5 * m * s.v[i * d + k] * s.v[i * d + k];
+      p[k] += m * s.v[i * d + k];
     }
+  }
   require(std::fabs(e - s.energy0) <= 1e-6 * s.energy0,
           "snapshot: energy0 is not the kinetic energy of v (energy is conserved; 1e-6 relative)");
   bool bounce = false;
   for (std::size_t k = 0; k < d; ++k) bounce = bounce || s.config.boundary[k] == Boundary::bounce;
-  const double scale = std::sqrt(2.0 * s.energy0 * static_cast<double>(n));
+  const double scale = std::sqrt(2.0 * s.energy0 * mass);
   for (std::size_t k = 0; k < d && !bounce; ++k)
     require(s.config.boundary[k] != Boundary::periodic || std::fabs(p[k] - s.momentum0[k]) <= 1e-6 * scale,
-            "snapshot: momentum0 is not the momentum of v on a periodic axis (it is conserved; 1e-6 of sqrt(2 E0 N))");
+            "snapshot: momentum0 is not the momentum of v on a periodic axis (it is conserved; 1e-6 of sqrt(2 E0 M))");
 }
 
 // The list centres inside the box, and the positions at the clock inside the box (walls: to

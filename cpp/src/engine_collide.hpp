@@ -189,8 +189,8 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
     Group g;
     gather(a, b, s, t, g);
     if (g.n > 2 || g.overflow) {
-      if (!g.overflow && group_collide(g, t, reversed)) return true;
-      ++counters_.group_fallbacks;
+      if (!g.overflow && equal_masses(g) && group_collide(g, t, reversed)) return true;
+      ++counters_.group_fallbacks;  // (the group operator collides equal masses only)
     }
   }
   nl_.prefetch_list(a);  // both are predicted after the operator, whose work hides the loads
@@ -224,6 +224,13 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
     in.i[k] = p_[a].v[k];
     in.j[k] = p_[b].v[k];
   }
+  // Unequal masses: the operator (of equal masses) acts on the relative velocity w in the
+  // centre-of-mass frame, (w/2, -w/2); the centre-of-mass velocity V stays, and the members
+  // take V + m_b/M w', V - m_a/M w' (the elastic collision of any masses: the law of w' given
+  // w and the normal does not depend on them). Equal masses go straight through (same bits).
+  const bool heavy = !mass_.empty() && mass_[static_cast<std::size_t>(a)] != mass_[static_cast<std::size_t>(b)];
+  Vec vcm{};
+  if (heavy) [[unlikely]] in = to_relative(in, a, b, vcm);
   PairV<Dim> out;
   try {
     out = apply_pair(in, r, a, reversed);
@@ -237,6 +244,7 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
     trace_.diverge(net_, Divergence::operator_);
     out = Specular<Dim>::reflect(in, r);
   }
+  if (heavy) [[unlikely]] out = from_relative(out, a, b, vcm);
   for (int k = 0; k < Dim; ++k) {
     p_[a].v[k] = out.i[k];
     p_[b].v[k] = out.j[k];
@@ -263,6 +271,39 @@ bool EngineImpl<Dim, Op>::collide(int a, int b, double t, bool reversed) {
   validate_collision(slots, 2);
   repredict(a);
   repredict(b);
+  return true;
+}
+
+// Unequal masses: (v_a, v_b) -> (w/2, -w/2), w = v_a - v_b, and V = (m_a v_a + m_b v_b) / M.
+template <int Dim, PairOperator Op>
+PairV<Dim> EngineImpl<Dim, Op>::to_relative(const PairV<Dim>& v, int a, int b, Vec& vcm) const {
+  const double ma = mass(a), mb = mass(b), m = ma + mb;
+  PairV<Dim> out;
+  for (int k = 0; k < Dim; ++k) {
+    vcm[k] = (ma * v.i[k] + mb * v.j[k]) / m;
+    const double w = v.i[k] - v.j[k];
+    out.i[k] = 0.5 * w;
+    out.j[k] = -0.5 * w;
+  }
+  return out;
+}
+// ... and back: w' = u_a - u_b, v_a' = V + m_b / M w', v_b' = V - m_a / M w'.
+template <int Dim, PairOperator Op>
+PairV<Dim> EngineImpl<Dim, Op>::from_relative(const PairV<Dim>& u, int a, int b, const Vec& vcm) const {
+  const double ma = mass(a), mb = mass(b), m = ma + mb;
+  PairV<Dim> out;
+  for (int k = 0; k < Dim; ++k) {
+    const double w = u.i[k] - u.j[k];
+    out.i[k] = vcm[k] + (mb / m) * w;
+    out.j[k] = vcm[k] - (ma / m) * w;
+  }
+  return out;
+}
+// Whether a group's members all have one mass (the group operator's case).
+template <int Dim, PairOperator Op>
+bool EngineImpl<Dim, Op>::equal_masses(const Group& g) const {
+  for (int u = 1; u < g.n; ++u)
+    if (mass(g.id[u]) != mass(g.id[0])) return false;
   return true;
 }
 
@@ -487,12 +528,14 @@ void EngineImpl<Dim, Op>::check_conservation() {
   if (trace_.reason() != Divergence::none || !(e0_ > 0.0)) return;
   double e = 0.0;
   std::array<double, Dim> p{};
-  for (std::size_t i = 0; i < n_; ++i)  // in id order: the sums' bits do not depend on storage
+  for (std::size_t i = 0; i < n_; ++i) {  // in id order: the sums' bits do not depend on storage
+    const double m = mass(static_cast<int>(slot(i)));
     for (int k = 0; k < Dim; ++k) {
       const double vk = p_[slot(i)].v[k];
-      e += 0.5 * vk * vk;
-      p[k] += vk;
+      e += 0.5 * m * vk * vk;
+      p[k] += m * vk;
     }
+  }
   if (!(std::fabs(e - e0_) <= CollisionTrace::kConserveTol * e0_)) {
     trace_.diverge(net_, Divergence::energy);
     return;
@@ -500,7 +543,7 @@ void EngineImpl<Dim, Op>::check_conservation() {
   bool bounce = false;
   for (int k = 0; k < Dim; ++k) bounce = bounce || cfg_.boundary[k] == Boundary::bounce;
   if (bounce) return;
-  const double scale = std::sqrt(2.0 * e0_ * static_cast<double>(n_));
+  const double scale = std::sqrt(2.0 * e0_ * total_mass_);
   const double sign = rev_ ? -1.0 : 1.0;  // inside a reversed run the velocities are negated (flip)
   for (int k = 0; k < Dim; ++k)
     if (cfg_.boundary[k] == Boundary::periodic &&
@@ -519,7 +562,7 @@ void EngineImpl<Dim, Op>::observe(const ObserveConfig& c) {
   std::array<bool, 3> walls{};
   for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
   auto o = std::make_unique<Observer>(c, Dim, positions(), velocities(), clock_, cfg_.box, walls, cfg_.diameter);
-  if (!cfg_.diameters.empty()) o->set_sizes(radii());  // a mixture: species by size
+  describe_particles(*o);  // masses (m v^2, m Delta v) and species
   observer_ = std::move(o);
   obs_ = observer_.get();
 }

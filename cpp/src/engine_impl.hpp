@@ -213,7 +213,7 @@ class EngineImpl final : public Simulation {
 
   std::size_t memory_bytes() const override {
     return n_ * (sizeof(Particle<Dim>) + sizeof(Book)) + slot_.capacity() * sizeof(std::int32_t) +
-           (rad_.capacity() + cfg_.diameters.capacity()) * sizeof(double) +
+           (rad_.capacity() + cfg_.diameters.capacity() + mass_.capacity() + cfg_.masses.capacity()) * sizeof(double) +
            nl_.memory_bytes() + queue_.memory_bytes() + log_.bytes() + pre_.bytes() + wlog_.bytes() + trace_.bytes() +
            clcg_.size() * sizeof(rng::CLCG4);
   }
@@ -245,11 +245,18 @@ class EngineImpl final : public Simulation {
     return s * s;
   }
   double contact_tol(double s2) const { return rad_.empty() ? contact_tol_ : 2.0 * cfg_.group_tol * s2; }
-  // A mixture's radii in id order (the observer's species).
+  // Unequal masses (mass_, each slot's; empty: all 1).
+  double mass(int i) const { return mass_.empty() ? 1.0 : mass_[static_cast<std::size_t>(i)]; }
+  // The radii in id order (the observer's species).
   std::vector<double> radii() const {
-    std::vector<double> r(cfg_.diameters.size());
-    for (std::size_t i = 0; i < r.size(); ++i) r[i] = 0.5 * cfg_.diameters[i];
+    std::vector<double> r(n_, 0.5 * cfg_.diameter);
+    for (std::size_t i = 0; i < cfg_.diameters.size(); ++i) r[i] = 0.5 * cfg_.diameters[i];
     return r;
+  }
+  // A new or resumed observer learns the masses, then the species (by size, then mass).
+  void describe_particles(Observer& o) const {
+    if (!cfg_.masses.empty()) o.set_masses(cfg_.masses);
+    if (!cfg_.diameters.empty() || !cfg_.masses.empty()) o.set_sizes(radii());
   }
 
   // i's earliest event: a wall, its list renewal (in 1D on a ring: its wrap), or a
@@ -491,6 +498,9 @@ class EngineImpl final : public Simulation {
   void gather(int a, int b, const Vec& s, double t, Group& g) const;
   bool collide(int a, int b, double t, bool reversed);
   PairV<Dim> apply_pair(const PairV<Dim>& in, const Vec& r, int s, bool reversed);
+  PairV<Dim> to_relative(const PairV<Dim>& v, int a, int b, Vec& vcm) const;
+  PairV<Dim> from_relative(const PairV<Dim>& u, int a, int b, const Vec& vcm) const;
+  bool equal_masses(const Group& g) const;
   bool group_collide(Group& g, double t, bool reversed);
   bool group_operator(Group& g, const int* order, double t, bool reversed, const Reflection* w1);
   Reflection touch_walls(int i);
@@ -611,6 +621,8 @@ class EngineImpl final : public Simulation {
   double sigma2_ = 1.0, contact_tol_ = 0.0;  // one size's squared contact distance and tolerance
   std::vector<double> rad_;                // a mixture: each slot's radius (Config::diameters / 2); empty: one size
   double wrap_ = 0.0;                      // 1D ring: kWrap times the smallest diameter (setup_geometry)
+  std::vector<double> mass_;               // unequal masses: each slot's (Config::masses); empty: all 1
+  double total_mass_ = 0.0;                // sum of the masses (n for unit masses)
   double shell_ = 0.0, renew_h_ = 0.0, renew_h2_ = 0.0;  // the neighbour lists
   std::vector<Particle<Dim>> p_;
   NeighbourLists<Dim> nl_;

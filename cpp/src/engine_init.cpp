@@ -243,6 +243,35 @@ void draw_velocities(int d, std::size_t n, std::uint64_t seed, double energy, bo
   for (auto& q : v) q *= scale;
 }
 
+// Unequal masses (c.masses): each velocity divided by sqrt(m) (equipartition), the centre of
+// mass brought to rest (sum m v = 0), the kinetic energy sum m v^2 / 2 rescaled to the target.
+void weigh_velocities(const Config& c, std::size_t n, double energy, std::vector<double>& v) {
+  if (c.masses.empty()) return;
+  const int d = c.dim;
+  require(c.masses.size() == n, [&] {
+    return "masses must have one entry per particle (" + std::to_string(n) + "), got " + std::to_string(c.masses.size());
+  });
+  double total = 0.0;
+  for (const double m : c.masses) {
+    require(std::isfinite(m) && m > 0.0, "every mass must be finite and > 0");
+    total += m;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < d; ++k) v[i * d + k] /= std::sqrt(c.masses[i]);
+  if (n > 1)
+    for (int k = 0; k < d; ++k) {
+      double p = 0.0;
+      for (std::size_t i = 0; i < n; ++i) p += c.masses[i] * v[i * d + k];
+      for (std::size_t i = 0; i < n; ++i) v[i * d + k] -= p / total;
+    }
+  double e = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < d; ++k) e += 0.5 * c.masses[i] * v[i * d + k] * v[i * d + k];
+  require(e > 0.0, "drawn velocities have zero kinetic energy (N = 1 with zero momentum?)");
+  const double scale = std::sqrt((energy > 0.0 ? energy : 0.5 * static_cast<double>(n) * d) / e);
+  for (auto& q : v) q *= scale;
+}
+
 // The packing fraction (3 significant digits, rounded down) of the densest box of c's shape
 // and boundaries, scaled alike on every axis, in which a crystal of n fits (either placement).
 double densest_crystal(const Config& c, std::size_t n) {
@@ -288,6 +317,7 @@ InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, do
                           std::to_string(n) + " fits up to a packing fraction of " + num(densest_crystal(c, n)) + ")");
   }
   draw_velocities(c.dim, n, seed, energy, equal_speeds, s.v);
+  weigh_velocities(c, n, energy, s.v);
   s.config = c;
   return s;
 }

@@ -17,17 +17,19 @@ template <int Dim, PairOperator Op>
 Diagnostics EngineImpl<Dim, Op>::diagnostics() const {
   Diagnostics d;
   double e = 0.0;
-  for (std::size_t i = 0; i < n_; ++i)  // in id order: the sums' bits do not depend on storage
+  for (std::size_t i = 0; i < n_; ++i) {  // in id order: the sums' bits do not depend on storage
+    const double m = mass(static_cast<int>(slot(i)));  // (1: the same bits as without masses)
     for (int k = 0; k < Dim; ++k) {
       const double vk = p_[slot(i)].v[k];
-      e += 0.5 * vk * vk;
-      d.momentum[k] += vk;
+      e += 0.5 * m * vk * vk;
+      d.momentum[k] += m * vk;
     }
+  }
   d.energy = e;
   d.energy_drift = e0_ > 0 ? (e - e0_) / e0_ : 0.0;
   double dp = 0.0;
   for (int k = 0; k < Dim; ++k) dp += (d.momentum[k] - p0_[k]) * (d.momentum[k] - p0_[k]);
-  d.momentum_drift = e0_ > 0 ? std::sqrt(dp) / std::sqrt(2.0 * e0_ * static_cast<double>(n_)) : 0.0;
+  d.momentum_drift = e0_ > 0 ? std::sqrt(dp) / std::sqrt(2.0 * e0_ * total_mass_) : 0.0;
   d.log_bytes = log_.bytes() + pre_.bytes() + wlog_.bytes();
   d.wall_log_entries = wlog_.entries();
   d.log_pushed = log_.pushed() + log_offset_;
@@ -186,7 +188,7 @@ EngineImpl<Dim, Op>::EngineImpl(const Snapshot& s, Op op) : cfg_(s.config), n_(s
     for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
     observer_ = std::make_unique<Observer>(s.observer, s.observer_counts, Dim, s.v, clock_, cfg_.box, walls,
                                            cfg_.diameter);
-    if (!cfg_.diameters.empty()) observer_->set_sizes(radii());
+    describe_particles(*observer_);
     obs_ = observer_.get();
   }
 }
@@ -245,6 +247,9 @@ void EngineImpl<Dim, Op>::number_slots() {
   }
   rad_.clear();
   for (const double d : cfg_.diameters) rad_.push_back(0.5 * d);  // a mixture: slot i holds id i
+  mass_ = cfg_.masses;
+  total_mass_ = 0.0;
+  for (std::size_t i = 0; i < n_; ++i) total_mass_ += mass_.empty() ? 1.0 : mass_[i];
 }
 
 // Stores the particles in the order of their list centres' cells (the grid's row-major
@@ -269,6 +274,7 @@ void EngineImpl<Dim, Op>::sort_storage() {
   permute_in_place(p_, to);
   permute_in_place(bk_, to);
   if (!rad_.empty()) permute_in_place(rad_, to);
+  if (!mass_.empty()) permute_in_place(mass_, to);
   for (std::size_t j = 0; j < n_; ++j) {
     Book& q = bk_[j];
     if (q.ev.kind == kColl) q.ev.partner = to[static_cast<std::size_t>(q.ev.partner)];

@@ -320,7 +320,7 @@ template <int Dim>
     // nearest whole number by adding and subtracting 1.5 2^52 (|q| < 2^51; no branch)
     const double r0 = seg_[a].x[k] - seg_[b].x[k], q = r0 * inv_box_[k];
     r[k] = r0 - fold_[k] * ((q + kRound) - kRound);
-    dp[k] = va[k] - seg_[a].v[k];
+    dp[k] = mass_of(a) * (va[k] - seg_[a].v[k]);  // (1 x: the same bits for unit masses)
     w += r[k] * dp[k];
   }
   cur_.w += w;

@@ -29,7 +29,7 @@ void Observer::group(double t, int n, const int* ids, const double* x, const dou
 void Observer::group_virial(int i, const double* x, const double* v) {
   double dp[3];
   for (int k = 0; k < dim_; ++k) {
-    dp[k] = v[k] - seg_[i].v[k];
+    dp[k] = mass_of(i) * (v[k] - seg_[i].v[k]);
     cur_.w += x[k] * dp[k];
   }
   helfand_add<0>(x, dp);
@@ -47,7 +47,7 @@ void Observer::species_group_virial(int n, const int* ids, const double* x, cons
   for (int u = 0; u < n; ++u) {
     const int i = ids[u];
     double share = 0.0;
-    for (int k = 0; k < dim_; ++k) share += (x[u * dim_ + k] - c[k]) * (v[u * dim_ + k] - seg_[i].v[k]);
+    for (int k = 0; k < dim_; ++k) share += (x[u * dim_ + k] - c[k]) * (mass_of(i) * (v[u * dim_ + k] - seg_[i].v[k]));
     cur_.sp[2 * static_cast<std::size_t>(label_[i]) + 1] += share;
   }
 }
@@ -58,7 +58,7 @@ void Observer::wall(double t, int i, const double* v) {
   close_pairs(i, t);
   const double r = radius_of(i), tol = 1e-6 * diameter_;
   for (int k = 0; k < dim_; ++k) {
-    const double dv = v[k] - seg_[i].v[k], xk = seg_[i].x[k];
+    const double dv = mass_of(i) * (v[k] - seg_[i].v[k]), xk = seg_[i].x[k];  // Delta p
     if (!walls_[k] || dv == 0.0) continue;
     if (std::fabs(xk - r) > tol && std::fabs(xk - (box_[k] - r)) > tol) continue;  // a tangential flip (v -> -v)
     cur_.wall_dp[k] += std::fabs(dv);
@@ -93,7 +93,7 @@ void Observer::pair_at(double t, int a, int b, const double* xa, const double* x
   for (int k = 0; k < dim_; ++k) {
     r[k] = xa[k] - xb[k];
     if (!walls_[k]) r[k] -= box_[k] * std::nearbyint(r[k] * inv_box_[k]);  // the nearest image
-    dp[k] = va[k] - seg_[a].v[k];
+    dp[k] = mass_of(a) * (va[k] - seg_[a].v[k]);
     w += r[k] * dp[k];
   }
   cur_.w += w;
@@ -132,7 +132,7 @@ void Observer::wall_at(double t, int i, const double* x, const double* v, unsign
   const double r = radius_of(i);
   for (int k = 0; k < dim_; ++k) {
     if (!(axes >> k & 1u) || !walls_[k]) continue;
-    const double dv = v[k] - seg_[i].v[k];
+    const double dv = mass_of(i) * (v[k] - seg_[i].v[k]);  // Delta p
     cur_.wall_dp[k] += std::fabs(dv);
     cur_.w_wall += (v[k] > 0.0 ? r : box_[k] - r) * dv;  // the contact plane it left from
   }

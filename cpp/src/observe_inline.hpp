@@ -46,10 +46,11 @@ template <int K>
 [[gnu::always_inline]] inline void Observer::set_velocity(int i, const double* v) {
   Segment& s = seg_[i];
   const int d = K > 0 ? K : dim_;
-  if (d >= 2) vv_off_[0] += v[0] * v[1] - s.v[0] * s.v[1];  // sum_i v_ia v_ib (Helfand), before s.v changes
+  const double m = mass_of(i);  // (1 x: the same bits for unit masses)
+  if (d >= 2) vv_off_[0] += m * (v[0] * v[1] - s.v[0] * s.v[1]);  // sum_i m v_ia v_ib (Helfand), before s.v changes
   if (d >= 3) {
-    vv_off_[1] += v[0] * v[2] - s.v[0] * s.v[2];
-    vv_off_[2] += v[1] * v[2] - s.v[1] * s.v[2];
+    vv_off_[1] += m * (v[0] * v[2] - s.v[0] * s.v[2]);
+    vv_off_[2] += m * (v[1] * v[2] - s.v[1] * s.v[2]);
   }
   double v2 = v[0] * v[0];  // (what 0 + v[0]^2 gives, a square being never -0)
   s.v[0] = v[0];
@@ -58,6 +59,7 @@ template <int K>
     v2 += v[k] * v[k];
   }
   const double speed = root(v2);
+  v2 *= m;  // from here m v^2 (the kinetic sums); the speed is |v|
   if (ns_ > 0) [[unlikely]] v2_sp_[static_cast<std::size_t>(label_[i])] += v2 - s.v2;  // per species
   v2_sum_ += v2 - s.v2;  // sum_i v_i^2 and sum_i |v_i| (their time integrals: accumulate)
   speed_sum_ += speed - s.speed;

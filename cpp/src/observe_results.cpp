@@ -106,8 +106,12 @@ Observation Observer::results() const {
   o.helfand = helf_rec_;
   if (ns_ > 0) {
     o.species_diameter.assign(static_cast<std::size_t>(ns_), 0.0);
+    o.species_mass.assign(static_cast<std::size_t>(ns_), 1.0);
     o.species_count = sp_count_;
-    for (std::size_t i = 0; i < n_; ++i) o.species_diameter[static_cast<std::size_t>(label_[i])] = 2.0 * radius_[i];
+    for (std::size_t i = 0; i < n_; ++i) {
+      o.species_diameter[static_cast<std::size_t>(label_[i])] = 2.0 * radius_[i];
+      o.species_mass[static_cast<std::size_t>(label_[i])] = mass_of(static_cast<int>(i));
+    }
     for (std::size_t u = 0; u < static_cast<std::size_t>(ns_); ++u) {
       const double Ns = static_cast<double>(o.species_count[u]);
       o.species_temperature.push_back(est([&](const Block& b, double tau) { return b.sp[2 * u] / (d * Ns * tau); }));

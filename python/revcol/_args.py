@@ -122,6 +122,18 @@ def size(x, what: str) -> int:
     return int(round(v * SIZE_UNITS[unit]))
 
 
+def masses_arg(masses, n: int) -> list:
+    """The per-particle masses as the binding takes them ([] for unit masses)."""
+    if masses is None:
+        return []
+    m = real_array(masses, "masses")
+    if m.ndim != 1 or m.size != n:
+        raise ValueError(f"masses must have one entry per particle ({n}), got shape {m.shape}")
+    if not (np.isfinite(m).all() and (m > 0).all()):
+        raise ValueError("masses must be finite and > 0")
+    return [float(a) for a in m]
+
+
 def diameters_arg(diameters, n: int, diameter: float) -> list:
     """The per-particle diameters as the binding takes them ([] for one diameter)."""
     if diameters is None:

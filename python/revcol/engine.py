@@ -41,7 +41,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._args import diameters_arg, integer, names, placement, real_array
+from ._args import diameters_arg, integer, masses_arg, names, placement, real_array
 from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, write_checkpoint
 from .roundtrip import divergence_text
@@ -88,7 +88,7 @@ class Simulation(SimulationBase):
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  bits: int = 40, groups: bool = True, group_tol: float = 1e-9,
                  time: float = 0.0, generator: str = "philox", streams: str = "per-particle",
-                 diameters=None, _engine=None):
+                 diameters=None, masses=None, _engine=None):
         if _engine is not None:
             self._e = _engine
             return
@@ -101,11 +101,12 @@ class Simulation(SimulationBase):
         sizes = diameters_arg(diameters, x.shape[0], diameter)
         if sizes:  # a mixture: the engine's diameter is the largest (its lists' and cells' size)
             diameter = max(sizes)
+        weights = masses_arg(masses, x.shape[0])
         box = np.atleast_1d(real_array(box, "box")).tolist()
         # scalars go through as given: the engine names a wrong type or range (issue 17)
         self._e = _core.Engine(x, v, box, _boundary_list(boundary), diameter, mode, law,
                                seed, bits, bool(groups), group_tol, time,
-                               generator, streams, sizes)
+                               generator, streams, sizes, weights)
 
     @classmethod
     def random(cls, n: int, dim: int = 3, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
@@ -130,14 +131,15 @@ class Simulation(SimulationBase):
                 raise ValueError("engine='lattice' starts at kT = 1 with Gaussian velocities: energy and "
                                  "equal_speeds are not available")
             return lat.random(n, dim, phi, boundary=boundary, diameter=diameter, seed=seed, init=init, **kwargs)
-        diameters = kwargs.pop("diameters", None)
-        sizes = diameters_arg(diameters, n, diameter)
+        diameters, masses = kwargs.pop("diameters", None), kwargs.pop("masses", None)
+        sizes, weights = diameters_arg(diameters, n, diameter), masses_arg(masses, n)
+        if weights and equal_speeds:
+            raise ValueError("equal_speeds and masses: give one (with masses the speeds follow equipartition)")
         x, v, box = _core.engine_random_state(dim, n, phi, _boundary_list(boundary), diameter, seed,
                                               energy if energy is not None else 0.0, init,
-                                              bool(equal_speeds), sizes)
-        if sizes:
-            return cls(x, v, box, boundary=boundary, diameters=sizes, seed=seed, **kwargs)
-        return cls(x, v, box, boundary=boundary, diameter=diameter, seed=seed, **kwargs)
+                                              bool(equal_speeds), sizes, weights)
+        size = dict(diameters=sizes) if sizes else dict(diameter=diameter)
+        return cls(x, v, box, boundary=boundary, seed=seed, masses=weights or None, **size, **kwargs)
 
     # --- running -------------------------------------------------------------------------
 
@@ -271,6 +273,12 @@ class Simulation(SimulationBase):
 
     mixture = property(lambda self: bool(len(self._e.diameters)),
                        doc="True for a mixture (built with ``diameters``; sizes kept per particle).")
+
+    @property
+    def masses(self) -> np.ndarray:
+        """Each particle's mass, shape (n,) (all 1 unless built with ``masses``)."""
+        m = np.asarray(self._e.masses, dtype=float)
+        return m if m.size else np.ones(self.n)
 
     def diagnostics(self) -> dict:
         """Energy and momentum (and their drift from the start), rare-log bytes, collisions

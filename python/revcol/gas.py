@@ -62,7 +62,8 @@ def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
 
     def make() -> Simulation:  # the engine's start in the scene's box (random_start; a mixture's as its largest)
         x, v = _core.engine_random_start(scene.particles, list(scene.box), opts["boundary"], scene.diameter,
-                                         opts["seed"], scene.kinetic_energy or 0.0, init, False)
+                                         opts["seed"], scene.kinetic_energy or 0.0, init, False,
+                                         list(opts.get("masses", [])))
         return Simulation(x, v, scene.box, **opts)
     return _engine(scene, "[system] box", make)
 

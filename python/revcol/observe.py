@@ -239,10 +239,12 @@ def report_lines(d: dict[str, Any]) -> list[str]:
     if d["msd"]:
         rows.append(f"  msd              {d['msd'][-1]:.5g} at t = {d['msd_time'][-1]:.5g} after the start")
     pm = "+-" if d["blocks"] >= 2 else "~"
+    masses = list(d.get("species_mass") or [])
     for u, diam in enumerate(d.get("species_diameter") or []):
         (t, te), (p, pe) = d["species_temperature"][u], d["species_pressure"][u]
         msd = f", msd {d['species_msd'][-1][u]:.5g}" if len(d.get("species_msd") or []) else ""
-        rows.append(f"  species d={diam:.4g} ({d['species_count'][u]}): T {t:.5g} {pm} {te:.2g}, partial pressure "
+        m = f" m={masses[u]:.4g}" if any(q != 1.0 for q in masses) else ""
+        rows.append(f"  species d={diam:.4g}{m} ({d['species_count'][u]}): T {t:.5g} {pm} {te:.2g}, partial pressure "
                     f"{p:.5g} {pm} {pe:.2g}{msd}")
     return rows
 

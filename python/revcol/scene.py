@@ -98,9 +98,10 @@ file and the replacement.
     block_time = 1.0              # the first blocks' length (default D / v_rms); min_blocks = 16
     pair_bins = 100               # pair distances over [0, pair_rmax] (2-64 particles, walls on every axis)
 
-    [[species]]                   # gas, either engine, random start: a mixture of equal masses, one
+    [[species]]                   # gas, either engine, random start: a mixture, one
     name = "A"                    # table per species (no [system] diameter then); diameter > 0; count,
-    diameter = 1.0                # or fraction of [system] particles (the fractions add up to 1)
+    diameter = 1.0                # or fraction of [system] particles (the fractions add up to 1);
+    mass = 1.0                    # default 1 (unequal masses: engine = "float" only)
     fraction = 0.5
 
 **Scenes by name.** The example scenes ship with the package (``revcol/scenes``, the repository's
@@ -129,7 +130,7 @@ from .lattice import LatticeSimulation
 from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINE_MODES,  # noqa: F401 (__all__)
                            ENGINES, KINDS, LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES,
                            SceneError, _check, _check_lattice, _check_mode, _fail, _modernize, with_lattice_options)
-from ._species import parse_species, species_diameters, species_volume
+from ._species import check_masses, parse_species, sized_options, species_volume
 from .statesave import variants as statesave_variants
 from .verify import verify_cases
 
@@ -322,6 +323,7 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
         if arrays is not None:
             raise _fail(source, "[[species]]", "takes a random start (each species' count in id order), not "
                         "[system] initial_state")
+        check_masses(source, species, get("collisions", "engine", "float"))
         sigma = max(sp.diameter for sp in species)
 
     box = get("system", "box")
@@ -433,6 +435,7 @@ def with_engine(scene: Scene, engine: str) -> Scene:
     if engine == "float":
         out = dataclasses.replace(out, tick_bits=None, cell_bits=16, search="auto", workers=1)
     if engine == "lattice":
+        check_masses(scene.source, scene.species, engine, " (--engine lattice)")
         if "rng.generator" not in fields:  # the lattice's default generator, as in a scene file
             out = dataclasses.replace(out, generator="philox")
         try:
@@ -527,8 +530,9 @@ _read_initial = read_initial  # its name before it was public
 
 def engine_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.Simulation` that a gas scene sets."""
-    return _sized(scene, dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
-                              seed=scene.seed, bits=scene.bits, generator=scene.generator, streams=scene.streams))
+    return sized_options(scene.species, dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode,
+                         law=scene.law, seed=scene.seed, bits=scene.bits, generator=scene.generator,
+                         streams=scene.streams), masses=True)
 
 
 def lattice_options(scene: Scene) -> dict[str, Any]:
@@ -536,14 +540,7 @@ def lattice_options(scene: Scene) -> dict[str, Any]:
     opts = dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
                 seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search,
                 workers=scene.workers)
-    return _sized(scene, opts)
-
-
-def _sized(scene: Scene, opts: dict) -> dict:
-    if scene.species:  # a mixture: one diameter per particle instead
-        del opts["diameter"]
-        opts["diameters"] = species_diameters(scene.species)
-    return opts
+    return sized_options(scene.species, opts)
 
 
 def scene_dirs() -> list[Path]:

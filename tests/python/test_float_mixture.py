@@ -106,3 +106,60 @@ def test_a_species_scene_runs_on_the_float_engine(tmp_path):
     from revcol.scene import SceneError
     with pytest.raises(SceneError, match="random start"):
         scene_from_dict(doc, str(tmp_path / "mix.toml"))
+
+
+@pytest.mark.parametrize("dim,phi", [(2, 0.5), (3, 0.4)])
+def test_masses_leave_the_statics_of_one_size(dim, phi, tmp_path):
+    """Spheres of one size and masses 1 and 4: the equation of state is the one-size gas's
+    (statics do not depend on the masses: within 3 block errors of Liu's), equipartition holds
+    per species (within 4 block errors), sum m v and sum m v^2 / 2 are kept, and checkpoints
+    and pickles resume bit for bit."""
+    from revcol.studies.eos import liu_disks, liu_spheres
+    m = np.where(np.arange(1000) % 2 == 0, 1.0, 4.0)
+    sim = Simulation.random(1000, dim, phi, masses=m, seed=3)
+    assert np.array_equal(sim.masses, m) and not sim.mixture
+    p0 = (m[:, None] * sim.velocities).sum(0)
+    sim.run(collisions=60_000)
+    sim.observe(block_time=0.05)
+    sim.run(collisions=100_000)
+    sim.save(tmp_path / "m.npz")
+    copy = pickle.loads(pickle.dumps(sim))
+    sim.run(collisions=200_000)
+    o = sim.observation()
+    assert np.abs((m[:, None] * sim.velocities).sum(0) - p0).max() < 1e-10
+    assert abs(sim.diagnostics()["energy_drift"]) < 1e-12
+    z = liu_spheres(phi) if dim == 3 else liu_disks(phi)
+    assert abs(o.compressibility.value - z) < 3.0 * o.compressibility.error, (o.compressibility, z)
+    assert o.species_mass.tolist() == [1.0, 4.0] and o.species_count.tolist() == [500, 500]
+    (t1, e1), (t4, e4) = [(e.value, e.error) for e in o.species_temperature]
+    assert abs(t1 - t4) < 4.0 * np.hypot(e1, e4), o.species_temperature
+    assert any("m=4" in line for line in o.lines())
+    for resumed in (Simulation.load(tmp_path / "m.npz"), copy):
+        resumed.run(collisions=200_000)
+        assert np.array_equal(resumed.velocities, sim.velocities)
+        assert resumed.observation().to_dict() == o.to_dict()
+
+
+def test_masses_are_checked_by_name_and_scenes_carry_them(tmp_path):
+    x = np.array([[2.0, 2.0], [4.0, 2.0], [4.5, 4.5]])
+    v = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, 0.5]])
+    for masses, what in [([1.0, 2.0], "one entry per particle"), ([1.0, -2.0, 1.0], "finite and > 0"),
+                         ([1.0, 1e7, 1.0], "ratio")]:
+        with pytest.raises(ValueError, match=what):
+            Simulation(x, v, [6.0, 6.0], masses=masses)
+    with pytest.raises(ValueError, match="paper mode collides equal masses only"):
+        Simulation(x, v, [6.0, 6.0], masses=[1.0, 2.0, 1.0], mode="paper")
+    from revcol.gas import build_simulation
+    from revcol.scene import SceneError, scene_from_dict, with_engine
+    doc = {"system": {"dimension": 2, "particles": 400, "packing_fraction": 0.3, "boundaries": "periodic"},
+           "collisions": {"engine": "float"}, "run": {"collisions": 4000},
+           "species": [{"name": "light", "diameter": 1.0, "fraction": 0.5},
+                       {"name": "heavy", "diameter": 1.0, "mass": 9.0, "fraction": 0.5}]}
+    scene = scene_from_dict(doc, str(tmp_path / "m.toml"))
+    sim = build_simulation(scene)
+    assert sorted(set(sim.masses.tolist())) == [1.0, 9.0]
+    with pytest.raises(SceneError, match=r"mass: unequal masses run on engine = 'float' only.*--engine lattice"):
+        with_engine(scene, "lattice")
+    doc["collisions"]["engine"] = "lattice"
+    with pytest.raises(SceneError, match=r"\[\[species\]\] mass: unequal masses"):
+        scene_from_dict(doc, str(tmp_path / "m.toml"))

@@ -142,7 +142,8 @@ def test_scene_species_table_builds_the_mixture(tmp_path):
     assert scene_from_dict(counted, "c.toml").particles == 12
     bad = [({"system": {"diameter": 1.0}}, "not both"),
            ({"species": [{"name": "a", "diameter": 1.0, "fraction": 0.5}]}, "add up to 1"),
-           ({"species": [{"name": "a", "diameter": 1.0, "count": 3, "mass": 2.0}]}, "unknown field"),
+           ({"species": [{"name": "a", "diameter": 1.0, "count": 3, "charge": 2.0}]}, "unknown field"),
+           ({"species": [{"name": "a", "diameter": 1.0, "fraction": 1.0, "mass": -2.0}]}, "mass"),
            ({"species": [{"name": "a", "diameter": -1.0, "count": 3}]}, "diameter"),
            ({"species": [{"name": "a", "diameter": 1.0, "count": 3}, {"name": "a", "diameter": 0.5, "count": 3}]},
             "unique")]

@@ -132,6 +132,8 @@ struct Config {
   double diameter = 1.0;                         ///< D (a mixture: the largest of `diameters`)
   std::vector<double> diameters;                 ///< a mixture: one diameter per particle (id order),
                                                  ///< the largest equal to `diameter`; empty: one size
+  std::vector<double> masses;                    ///< one mass per particle (id order); empty: all 1. A pair of
+                                                 ///< unequal masses collides in its centre-of-mass frame
   Mode mode = Mode::exact;                       ///< the pair operator: exact (default), paper, ... (engine_operators.hpp)
   Law law = Law::flux;                           ///< exact mode's target law
   std::uint32_t seed = 1;                        ///< the generator family (rng/streams.hpp)

@@ -42,6 +42,9 @@ inline constexpr int kMinBits = FixedPoint::min_bits, kMaxBits = FixedPoint::max
 /// A mixture's sizes: the smallest diameter at least the largest / kMaxSizeRatio (the lists,
 /// sized by the largest, would list ratio^d small particles per small one).
 inline constexpr double kMaxSizeRatio = 16.0;
+/// Masses: the largest at most kMaxMassRatio times the smallest (a pair's centre-of-mass
+/// transform rounds its light member's velocity by about the ratio times the unit round-off).
+inline constexpr double kMaxMassRatio = 1e6;
 /// group_tol must lie in [0, kMaxGroupTol).
 inline constexpr double kMaxGroupTol = 1e-3;
 /// Seeds (and generator keys) are 32-bit: seed <= kMaxSeed.

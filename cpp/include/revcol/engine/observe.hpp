@@ -170,6 +170,7 @@ struct Observation {
                                      ///< empty for an observation resumed from a snapshot that did not keep it
   // Species (Observer::set_species; all empty for one species): S species in ascending size.
   std::vector<double> species_diameter;        ///< each species' diameter
+  std::vector<double> species_mass;            ///< each species' mass (1 without masses)
   std::vector<std::size_t> species_count;      ///< its particles N_s
   std::vector<Estimate> species_temperature;   ///< K2_s / (d N_s tau)
   std::vector<Estimate> species_pressure;      ///< partial pressure (K2_s + W_s) / (d V tau); their sum is pressure_virial
@@ -239,9 +240,15 @@ class Observer {
   /// none). Throws InvalidArgument on a bad label or radius, or another number of species
   /// than the snapshot's.
   void set_species(const std::vector<int>& label, const std::vector<double>& radius);
-  /// set_species from the radii alone: the species are the distinct radii in ascending order
-  /// (revcol.observe_species.species_labels); more than kMaxSpecies sizes, the radii only.
+  /// set_species from the radii (and masses, after set_masses) alone: the species are the
+  /// distinct radii in ascending order (revcol.observe_species.species_labels), each split by
+  /// mass in ascending order; more than kMaxSpecies of them, the radii only.
   void set_sizes(const std::vector<double>& radius);
+  /// Unequal masses (an engine whose particles have them calls it first, right after
+  /// constructing or resuming, before set_sizes): mass[i] > 0 per particle. The kinetic sums
+  /// become sum m v^2, the virial's and the walls' impulses m Delta v; a fresh observation's
+  /// running sums are rebuilt with them, a resumed one's come from its snapshot.
+  void set_masses(const std::vector<double>& mass);
   /// Every segment closed at t (the end of a run call); closes any block ended by then.
   void sync(double t);
   /// The results up to the last hook or sync.
@@ -333,6 +340,7 @@ class Observer {
   // species (set_species): all empty and ns_ = 0 for one species
   std::vector<int> label_;                 // each particle's species
   std::vector<double> radius_;             // each particle's radius (empty: diameter_ / 2)
+  std::vector<double> mass_;               // each particle's mass (set_masses; empty: all 1)
   int ns_ = 0;                             // species whose sums are kept (0: none)
   std::vector<double> v2_sp_;              // per species the running sum of v^2
   std::vector<double> msd_sp_;             // per species its MSD at each block end (ns_ per point)
@@ -344,6 +352,7 @@ class Observer {
     cur_.sp[2 * static_cast<std::size_t>(label_[b]) + 1] += 0.5 * w;
   }
   double radius_of(int i) const { return radius_.empty() ? 0.5 * diameter_ : radius_[i]; }
+  double mass_of(int i) const { return mass_.empty() ? 1.0 : mass_[static_cast<std::size_t>(i)]; }
   void species_group_virial(int n, const int* ids, const double* x, const double* v);  // observe_hooks.cpp
 
   // --- the collision record (see the header comment) ---
