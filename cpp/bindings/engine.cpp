@@ -189,6 +189,7 @@ class PyEngine {
     const en::Diagnostics g = sim().diagnostics();
     py::dict d;
     d["energy"] = g.energy;
+    d["potential"] = g.potential;
     d["momentum"] = std::vector<double>(g.momentum.begin(), g.momentum.begin() + sim().config().dim);
     d["energy_drift"] = g.energy_drift;
     d["momentum_drift"] = g.momentum_drift;
@@ -232,6 +233,7 @@ class PyEngine {
     d["diameter"] = c.diameter;
     if (!c.diameters.empty()) d["diameters"] = vec_array(c.diameters);  // a mixture
     if (!c.masses.empty()) d["masses"] = vec_array(c.masses);
+    if (c.gravity != std::array<double, 3>{}) d["gravity"] = vec_array(std::vector<double>(c.gravity.begin(), c.gravity.begin() + c.dim));
     d["mode"] = std::string(to_string(c.mode));
     d["law"] = std::string(to_string(c.law));
     d["seed"] = c.seed;
@@ -279,6 +281,11 @@ class PyEngine {
     c.diameter = checkpoint_field<double>(get("diameter"), "diameter");
     if (d.contains("diameters")) c.diameters = array_vec<double>(d, "diameters");  // a mixture
     if (d.contains("masses")) c.masses = array_vec<double>(d, "masses");
+    if (d.contains("gravity")) {
+      const auto g = array_vec<double>(d, "gravity");
+      require(static_cast<int>(g.size()) == c.dim, "checkpoint: gravity needs one component per axis");
+      for (std::size_t k = 0; k < g.size(); ++k) c.gravity[k] = g[k];
+    }
     c.mode = en::parse_engine_mode(checkpoint_field<std::string>(get("mode"), "mode"));
     c.law = parse_law(checkpoint_field<std::string>(get("law"), "law"));
     c.seed = checkpoint_field<std::uint32_t>(get("seed"), "seed");
@@ -343,7 +350,7 @@ void register_engine(py::module_& m) {
                        const std::vector<std::string>& boundary, PyReal diameter_arg, PyStr mode_arg,
                        PyStr law_arg, PyInt seed_arg, PyInt bits_arg, bool groups, PyReal group_tol_arg,
                        PyReal time_arg, PyStr generator_arg, PyStr streams_arg, std::vector<double> diameters,
-                       std::vector<double> masses) {
+                       std::vector<double> masses, std::vector<double> gravity) {
              const std::string mode = to_str(mode_arg, "mode"), law = to_str(law_arg, "law");
              const std::string generator = to_str(generator_arg, "generator"), streams = to_str(streams_arg, "streams");
              const double diameter = to_real(diameter_arg, "diameter"), group_tol = to_real(group_tol_arg, "group_tol");
@@ -358,13 +365,18 @@ void register_engine(py::module_& m) {
                                        streams);
              c.diameters = std::move(diameters);  // a mixture (validated with the state)
              c.masses = std::move(masses);
+             require(gravity.empty() || static_cast<int>(gravity.size()) == d, [&] {
+               return "gravity must have one component per axis (" + std::to_string(d) + "), got " +
+                      std::to_string(gravity.size());
+             });
+             for (std::size_t k = 0; k < gravity.size(); ++k) c.gravity[k] = gravity[k];
              return PyEngine(en::make_simulation(c, xs, vs, time));
            }),
            py::arg("positions"), py::arg("velocities"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
            py::arg("mode"), py::arg("law"), py::arg("seed"), py::arg("bits"), py::arg("groups"),
            py::arg("group_tol"), py::arg("time"), py::arg("generator") = "philox",
            py::arg("streams") = "per_particle", py::arg("diameters") = std::vector<double>{},
-           py::arg("masses") = std::vector<double>{})
+           py::arg("masses") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{})
       .def_static("from_snapshot", &PyEngine::from_snapshot, py::arg("snapshot"))
       .def("run", &PyEngine::run, py::arg("collisions") = py::none(), py::arg("time") = py::none(),
            py::arg("callback") = py::none(), py::arg("every") = 10000)
@@ -380,6 +392,13 @@ void register_engine(py::module_& m) {
       .def_property_readonly(
           "diameters", [](const PyEngine& e) { return e.sim().config().diameters; },
           "A mixture's diameters, one per particle (empty: one size, `diameter`).")
+.def_property_readonly(
+          "gravity",
+          [](const PyEngine& e) {
+            const auto& c = e.sim().config();
+            return std::vector<double>(c.gravity.begin(), c.gravity.begin() + c.dim);
+          },
+          "The uniform field (acceleration), one component per axis.")
       .def_property_readonly(
           "masses", [](const PyEngine& e) { return e.sim().config().masses; },
           "The particles' masses, one per particle (empty: all 1).")

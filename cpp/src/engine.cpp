@@ -79,6 +79,12 @@ void validate_config(const Config& c) {
           "group_tol must be finite and in [0, 1e-3)");
   require(std::isfinite(c.shell) && c.shell >= 0.0, "shell must be finite and >= 0 (0: from the packing fraction)");
   require(c.resort >= -1, "resort must be >= -1 (-1: chosen from N, 0: never)");
+  for (int k = 0; k < 3; ++k) {
+    require(std::isfinite(c.gravity[k]), "gravity must be finite");
+    require(c.gravity[k] == 0.0 || (k < c.dim && has_walls(c.boundary[k])), [&] {
+      return "gravity along axis " + std::to_string(k) + " needs walls on that axis (a periodic axis has no floor)";
+    });
+  }
   require(c.mode != Mode::paper || limits::paper_mode_allowed(c.dim),
           "paper mode has no invertible 3D pair operator (Pair3DPaper is not a bijection): use exact mode in 3D");
   for (int k = 0; k < c.dim; ++k) {
@@ -375,12 +381,19 @@ void check_snapshot_motion(const Snapshot& s) {
   // bounce walls (specular walls flip their own component, bounce walls every component).
   double e = 0.0, mass = 0.0;
   std::array<double, 3> p{};
+  const auto& g = s.config.gravity;  // a field: velocities and heights at the clock
   for (std::size_t i = 0; i < n; ++i) {
     const double m = s.config.masses.empty() ? 1.0 : s.config.masses[i];
+    const double dt = s.time - s.t_local[i];
     mass += m;
     for (std::size_t k = 0; k < d; ++k) {
-      e += 0.5 * m * s.v[i * d + k] * s.v[i * d + k];
-      p[k] += m * s.v[i * d + k];
+      const double vk = g[k] == 0.0 ? s.v[i * d + k] : s.v[i * d + k] + g[k] * dt;
+      e += 0.5 * m * vk * vk;
+      p[k] += m * vk;
+      if (g[k] != 0.0) {
+        const double x = s.x[i * d + k] + s.v[i * d + k] * dt + 0.5 * g[k] * dt * dt;
+        e += m * (g[k] < 0.0 ? -g[k] * x : g[k] * (s.config.box[k] - x));
+      }
     }
   }
   require(std::fabs(e - s.energy0) <= 1e-6 * s.energy0,
@@ -406,7 +419,8 @@ void check_snapshot_positions(const Snapshot& s) {
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t k = 0; k < d; ++k) {
       const double r = radius_of(c, i);
-      double q = s.x[i * d + k] + s.v[i * d + k] * (s.time - s.t_local[i]);
+      const double dt = s.time - s.t_local[i];
+      double q = s.x[i * d + k] + s.v[i * d + k] * dt + (c.gravity[k] == 0.0 ? 0.0 : 0.5 * c.gravity[k] * dt * dt);
       require(std::isfinite(q), "snapshot: x + v (time - t_local), a position at the clock, is not finite");
       if (has_walls(c.boundary[k])) {
         require(q >= r - slack && q <= c.box[k] - r + slack, [&] {

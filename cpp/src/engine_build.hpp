@@ -9,6 +9,7 @@
 #include "engine_check.hpp"
 #include "engine_collide.hpp"
 #include "engine_impl.hpp"
+#include "engine_predict.hpp"
 #include "engine_state.hpp"
 #include "engine_operators.hpp"
 

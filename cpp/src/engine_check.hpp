@@ -7,6 +7,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "engine_impl.hpp"
@@ -46,11 +47,20 @@ std::string EngineImpl<Dim, Op>::schedule_fault() const {
         return who(i) + " is " + std::to_string(std::sqrt(dd)) + " from its list centre, beyond its reach " +
                std::to_string(renew_h_);
       double tau;
-      if (Kin::renewal_time(pi, c, renew_h2_, tau) && before(std::max(pi.t + tau, clock_)))
+      const bool renews = field_ ? Kin::renewal_time(pi, c, renew_h_, gn_, tau) : Kin::renewal_time(pi, c, renew_h2_, tau);
+      if (renews && before(std::max(pi.t + tau, clock_)))
         return who(i) + " leaves its list's reach before its scheduled event";
     }
     for (int k = 0; k < Dim && !rev_; ++k) {
       const double vk = pi.v[k];
+      if (field_ && g_[k] != 0.0) {
+        double tau;
+        int up;
+        if (Kin::wall_time(pi, k, g_[k], box_.wall_at(k, 0, radius(i)), box_.wall_at(k, 1, radius(i)), tau, up) &&
+            before(std::max(pi.t + tau, clock_)))
+          return who(i) + " meets a wall on axis " + std::to_string(k) + " before its scheduled event";
+        continue;
+      }
       if (vk == 0.0 || !box_.walls(k)) continue;
       if (before(std::max(Kin::plane_time(pi, k, box_.wall_at(k, vk > 0.0 ? 1 : 0, radius(i))), clock_)))
         return who(i) + " meets a wall on axis " + std::to_string(k) + " before its scheduled event";
@@ -64,7 +74,9 @@ std::string EngineImpl<Dim, Op>::schedule_fault() const {
           double t;
           bool touching = false;
           const double s2 = sigma2(i, j);
-          const bool hit = Kin::pair_time(pi, p_[static_cast<std::size_t>(j)], sh, s2, contact_tol(s2), t, touching);
+          const bool hit = field_ ? Kin::template pair_time<true>(pi, p_[static_cast<std::size_t>(j)], sh, s2, contact_tol(s2),
+                                                                  t, touching, kInf, g_.data())
+                                  : Kin::pair_time(pi, p_[static_cast<std::size_t>(j)], sh, s2, contact_tol(s2), t, touching);
           if (live && j == e.partner) {
             found = true;
             if (fault.empty() && !(hit && std::fabs(std::max(t, clock_) - e.t) <= slack(e.t)))
@@ -114,6 +126,35 @@ template <int Dim, PairOperator Op>
 std::string EngineImpl<Dim, Op>::fault() const {
   std::string f = schedule_fault();
   return f.empty() ? first_overlap() : f;
+}
+
+// REVCOL_VALIDATE builds: after a collision, the members are not overlapping any listed
+// neighbour (beyond round-off), every list is symmetric (small systems) and the queue
+// keeps its invariants. Throws std::logic_error on a violation. A no-op otherwise.
+template <int Dim, PairOperator Op>
+void EngineImpl<Dim, Op>::validate_collision(const int* slots, int n) const {
+#ifdef REVCOL_VALIDATE
+  for (int u = 0; u < n; ++u) {
+    const int i = slots[u];
+    for_neighbours(i, [&](int j, const Vec& sh) {
+      double r2 = 0.0;
+      for (int k = 0; k < Dim; ++k) {
+        const double d = pos_at(i, k, clock_) - (pos_at(j, k, clock_) + sh[k]);
+        r2 += d * d;
+      }
+      const double s2 = sigma2(i, j);
+      if (!(r2 >= s2 * (1.0 - 1e-6)))
+        throw std::logic_error("REVCOL_VALIDATE: particles " + std::to_string(bk_[i].id) + " and " + std::to_string(bk_[j].id) +
+                               " overlap after a collision: |r| / D = " + std::to_string(std::sqrt(r2 / s2)) +
+                               (rev_ ? " (reversed run)" : " (forward run)") + " at t = " + std::to_string(clock_));
+    });
+  }
+  if (!queue_.valid()) throw std::logic_error("REVCOL_VALIDATE: event queue invariants broken");
+  if (n_ <= 2000 && !nl_.valid()) throw std::logic_error("REVCOL_VALIDATE: neighbour lists not symmetric");
+#else
+  (void)slots;
+  (void)n;
+#endif
 }
 
 }  // namespace revcol::engine::detail

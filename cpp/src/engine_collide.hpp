@@ -47,7 +47,7 @@ void EngineImpl<Dim, Op>::gather(int a, int b, const Vec& s, double t, Group& g)
       }
       const double s2 = sigma2(im, j);
       if (!(r2 - s2 <= contact_tol(s2))) return;
-      for (int k = 0; k < Dim; ++k) rw += r[k] * (p_[im].v[k] - p_[j].v[k]);
+      for (int k = 0; k < Dim; ++k) rw += r[k] * (vel_at(im, k, t) - vel_at(j, k, t));
       if (!(rw <= 0.0)) return;
       int q = -1;
       for (int u = 0; u < g.n; ++u)
@@ -529,13 +529,15 @@ void EngineImpl<Dim, Op>::check_conservation() {
   double e = 0.0;
   std::array<double, Dim> p{};
   for (std::size_t i = 0; i < n_; ++i) {  // in id order: the sums' bits do not depend on storage
-    const double m = mass(static_cast<int>(slot(i)));
+    const int j = static_cast<int>(slot(i));
+    const double m = mass(j);
     for (int k = 0; k < Dim; ++k) {
-      const double vk = p_[slot(i)].v[k];
+      const double vk = vel_at(j, k, clock_);
       e += 0.5 * m * vk * vk;
       p[k] += m * vk;
     }
   }
+  if (field_) e += potential();  // (a field: the energy with -m g . x)
   if (!(std::fabs(e - e0_) <= CollisionTrace::kConserveTol * e0_)) {
     trace_.diverge(net_, Divergence::energy);
     return;
@@ -559,6 +561,8 @@ void EngineImpl<Dim, Op>::check_conservation() {
 // config changes nothing.
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::observe(const ObserveConfig& c) {
+  require(!field_, "observe: a gas under gravity is not observed yet (its velocities change between events); "
+                   "take frames (positions, velocities) instead");
   std::array<bool, 3> walls{};
   for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
   auto o = std::make_unique<Observer>(c, Dim, positions(), velocities(), clock_, cfg_.box, walls, cfg_.diameter);
@@ -581,35 +585,6 @@ template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::stop_observing() {
   if (obs_) obs_->sync(clock_);
   obs_ = nullptr;
-}
-
-// REVCOL_VALIDATE builds: after a collision, the members are not overlapping any listed
-// neighbour (beyond round-off), every list is symmetric (small systems) and the queue
-// keeps its invariants. Throws std::logic_error on a violation. A no-op otherwise.
-template <int Dim, PairOperator Op>
-void EngineImpl<Dim, Op>::validate_collision(const int* slots, int n) const {
-#ifdef REVCOL_VALIDATE
-  for (int u = 0; u < n; ++u) {
-    const int i = slots[u];
-    for_neighbours(i, [&](int j, const Vec& sh) {
-      double r2 = 0.0;
-      for (int k = 0; k < Dim; ++k) {
-        const double d = pos_at(i, k, clock_) - (pos_at(j, k, clock_) + sh[k]);
-        r2 += d * d;
-      }
-      const double s2 = sigma2(i, j);
-      if (!(r2 >= s2 * (1.0 - 1e-6)))
-        throw std::logic_error("REVCOL_VALIDATE: particles " + std::to_string(bk_[i].id) + " and " + std::to_string(bk_[j].id) +
-                               " overlap after a collision: |r| / D = " + std::to_string(std::sqrt(r2 / s2)) +
-                               (rev_ ? " (reversed run)" : " (forward run)") + " at t = " + std::to_string(clock_));
-    });
-  }
-  if (!queue_.valid()) throw std::logic_error("REVCOL_VALIDATE: event queue invariants broken");
-  if (n_ <= 2000 && !nl_.valid()) throw std::logic_error("REVCOL_VALIDATE: neighbour lists not symmetric");
-#else
-  (void)slots;
-  (void)n;
-#endif
 }
 
 }  // namespace revcol::engine::detail

@@ -180,13 +180,13 @@ class EngineImpl final : public Simulation {
   std::vector<double> positions() const override {
     std::vector<double> out(n_ * Dim);
     for (std::size_t i = 0; i < n_; ++i)
-      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = Kin::pos_at(p_[slot(i)], k, clock_);
+      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = pos_at(static_cast<int>(slot(i)), k, clock_);
     return out;
   }
   std::vector<double> velocities() const override {
     std::vector<double> out(n_ * Dim);
     for (std::size_t i = 0; i < n_; ++i)
-      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = p_[slot(i)].v[k];
+      for (int k = 0; k < Dim; ++k) out[i * Dim + k] = vel_at(static_cast<int>(slot(i)), k, clock_);
     return out;
   }
   std::vector<std::uint64_t> collision_counts() const override {
@@ -222,7 +222,11 @@ class EngineImpl final : public Simulation {
   void setup_geometry();
   bool adjacent() const { return nl_.adjacent(); }  // a constant false in 2D and 3D
   void build_lists();
-  double pos_at(int j, int k, double t) const { return Kin::pos_at(p_[j], k, t); }
+  double pos_at(int j, int k, double t) const {
+    return field_ ? Kin::pos_at(p_[j], k, t, g_.data()) : Kin::pos_at(p_[j], k, t);
+  }
+  // Component k of j's velocity at t (a field changes it between events).
+  double vel_at(int j, int k, double t) const { return field_ ? Kin::vel_at(p_[j], k, t, g_.data()) : p_[j].v[k]; }
   template <class F>
   void for_neighbours(int i, F&& f) const {
     nl_.for_neighbours(i, f, [&](int j) { __builtin_prefetch(&p_[j]); });
@@ -245,6 +249,20 @@ class EngineImpl final : public Simulation {
     return s * s;
   }
   double contact_tol(double s2) const { return rad_.empty() ? contact_tol_ : 2.0 * cfg_.group_tol * s2; }
+  // A field's potential energy at the clock: per particle m |g_k| times its height above the
+  // wall the field pulls it to (-m g_k x_k, or m g_k (L_k - x_k)); >= 0, in id order.
+  double potential() const {
+    double u = 0.0;
+    for (std::size_t i = 0; i < n_; ++i) {
+      const int j = static_cast<int>(slot(i));
+      for (int k = 0; k < Dim; ++k)
+        if (g_[k] != 0.0) {
+          const double x = pos_at(j, k, clock_);
+          u += mass(j) * (g_[k] < 0.0 ? -g_[k] * x : g_[k] * (box_.length(k) - x));
+        }
+    }
+    return u;
+  }
   // Unequal masses (mass_, each slot's; empty: all 1).
   double mass(int i) const { return mass_.empty() ? 1.0 : mass_[static_cast<std::size_t>(i)]; }
   // The radii in id order (the observer's species).
@@ -264,120 +282,20 @@ class EngineImpl final : public Simulation {
   // a neighbour touches it (the group gate). A mixture's scan reads each pair's contact
   // distance; one size's reads no radius (a template: one branch per prediction).
   void predict(int i) {
-    if (rad_.empty()) predict_sized<false>(i);
-    else predict_sized<true>(i);
-  }
-  template <bool Mixed>
-  void predict_sized(int i) {
-    Ev best;
-    const double ti = p_[i].t;
-    const double r_own = Mixed ? rad_[static_cast<std::size_t>(i)] : Boundaries<Dim>::kOwn;  // the walls' radius
-    for (int k = 0; k < (walled_ ? Dim : 0); ++k) {  // a periodic box: no wall to test
-      const double vk = p_[i].v[k];
-      if (vk == 0.0 || !box_.walls(k)) continue;
-      const int up = vk > 0.0 ? 1 : 0;
-      bool wall_ok = true;
-      if (rev_ && box_.touches_ahead(k, p_[i].x[k] + vk * (clock_ - ti), up, r_own)) {
-        // touching and approaching in a reversed run at the instant of a logged collision
-        // of i: a reflection of its W2 is undone now; any other touched wall waits for the
-        // collision. With no such collision (m < 0) the wall is met on its own, as forward
-        // (the second wall of an exact corner)
-        const long m = wall_entry(i);
-        wall_ok = m < 0 || w2_covers(m, wall_mask(i, k, clock_));
-      }
-      if (wall_ok) {
-        double t = Kin::plane_time(p_[i], k, box_.wall_at(k, up, r_own));
-        if (t < clock_) t = clock_;
-        if (earlier(t, kWall, 2 * k + up, best)) best = Ev{t, kWall, 2 * k + up, 0};
-      }
-    }
-    if (adjacent()) {
-      // 1D: no renewal; on a periodic axis the wrap, kWrap D past either end of the box
-      const double vk = p_[i].v[0];
-      if (box_.periodic(0) && vk != 0.0) {
-        const double edge = vk > 0.0 ? box_.length(0) + wrap_ : -wrap_;
-        double t = Kin::plane_time(p_[i], 0, edge);
-        if (t < clock_) t = clock_;
-        if (earlier(t, kRenew, 0, best)) best = Ev{t, kRenew, 0, 0};
-      }
+    if (field_) [[unlikely]] {
+      if (rad_.empty()) predict_sized<false, true>(i);
+      else predict_sized<true, true>(i);
+    } else if (rad_.empty()) {
+      predict_sized<false, false>(i);
     } else {
-      double tau;
-      if (Kin::renewal_time(p_[i], nl_.centre(i), renew_h2_, tau)) {
-        double t = ti + tau;
-        if (t < clock_) t = clock_;
-        if (earlier(t, kRenew, 0, best)) best = Ev{t, kRenew, 0, 0};
-      }
+      predict_sized<true, false>(i);
     }
-    double first = kInf, second = kInf;  // the two earliest collision times (the group gate)
-    bool touch = false;
-    const Particle<Dim>& pi = p_[i];
-    double limit = prune_limit(best.t);
-    const auto record = [&](int j, double t) {  // a hit: the gate's two earliest, and the best
-      if (t < clock_) t = clock_;
-      if (t < first) {
-        second = first;
-        first = t;
-      } else if (t < second) {
-        second = t;
-      }
-      // (t, kind, partner's id): ids, not slots, so that the choice does not depend on storage
-      if (t < best.t || (t == best.t && (kColl < best.kind || (kColl == best.kind && bk_[j].id < bk_[best.partner].id)))) {
-        best = Ev{t, kColl, j, p_[j].stamp};
-        limit = prune_limit(best.t);
-      }
-    };
-    const auto touched = [&](int j) {  // j within the contact tolerance: the group gate
-      touch = true;
-      bk_[j].touching = 1;
-    };
-    [[maybe_unused]] const double ri = r_own;
-    const double tol_scale = 2.0 * cfg_.group_tol;  // (a mixture's: contact_tol(s2) = tol_scale s2)
-    const auto s2_of = [&](int j) {
-      if constexpr (Mixed) {
-        const double s = ri + rad_[static_cast<std::size_t>(j)];
-        return s * s;
-      } else {
-        (void)j;
-        return sigma2_;
-      }
-    };
-    const auto tol_of = [&](double s2) {
-      if constexpr (Mixed) return tol_scale * s2;
-      else {
-        (void)s2;
-        return contact_tol_;
-      }
-    };
-    const auto one = [&](int j, const Vec& sh) {
-      double t;
-      bool tj = false;
-      const double s2 = s2_of(j);
-      const bool hit = Kin::pair_time(pi, p_[j], sh, s2, tol_of(s2), t, tj, limit);
-      if (tj) touched(j);
-      if (hit) record(j, t);
-    };
-    // two list entries per step in two-lane vectors, with pair_time's bits lane by lane; the
-    // second lane's limit test is redone when the first lane's hit lowered the limit, so the
-    // scan decides exactly as one entry at a time would
-    const auto two = [&](int j0, const Vec& s0, int j1, const Vec& s1) {
-      typename Kin::Pair2 q;
-      const double s20 = s2_of(j0), s21 = s2_of(j1);
-      Kin::pair_test2(pi, p_[j0], p_[j1], s0, s1, s20, s21, tol_of(s20), tol_of(s21), limit, q);
-      if (q.touching[0]) touched(j0);
-      if (q.hit[0]) record(j0, q.finish(0));
-      if (q.touching[1]) touched(j1);
-      if (q.still_hit(1, limit)) record(j1, q.finish(1));
-    };
-    nl_.for_neighbour_pairs(i, two, one, [&](int j) { __builtin_prefetch(&p_[j]); });
-    Book& bi = bk_[i];
-    bi.ev = best;
-    // a second time beyond the final limit is one the scan kept only because it came before
-    // the best: which such times it kept depends on the list's order, and no decision reads
-    // them (the gate's window lies inside the limit), so they all read +inf and the stored
-    // state does not depend on that order (nor on where particles are stored)
-    bi.second = second <= limit ? second : kInf;
-    bi.touching = touch ? 1 : 0;
   }
+  template <bool Mixed, bool Field>
+  void predict_sized(int i);  // engine_predict.hpp
+  // Under a field along axis k: i's next wall on k, the floor or the ceiling, into `best`;
+  // in a reversed run, a wall i touches and approaches at the clock as on a field-free axis.
+  void field_wall(int i, int k, double r_own, Ev& best);  // engine_predict.hpp
 
   // Candidates provably later than this are skipped before their square root. The margin,
   // 2 kTieWindow (max(|t|, |clock|) + 1), is twice the group gate's window (collide): a collision
@@ -423,7 +341,11 @@ class EngineImpl final : public Simulation {
 
   // ---- state changes ------------------------------------------------------------------
 
-  void advance(int i, double t) { Kin::advance(p_[i], t); }
+  void advance(int i, double t) {
+    if (field_) [[unlikely]] advance_field(i, t);
+    else Kin::advance(p_[i], t);
+  }
+  [[gnu::noinline, gnu::cold]] void advance_field(int i, double t) { Kin::advance(p_[i], t, g_.data()); }
 
   void flip();
 
@@ -452,6 +374,12 @@ class EngineImpl final : public Simulation {
   // i's list is rebuilt (in 1D, the images of the rods beside it recoded: this is then the
   // wrap) and i is predicted again. Nothing physical changes: no stamp.
   void renew_event(int i, const Ev& e) {
+    if (field_) {  // a parabola's renewal time is bounded from its anchor: anchor it at e.t (the
+                   // same path, so no stamp changes and every prediction with i stands)
+      const std::uint64_t stamp = p_[i].stamp;
+      Kin::advance(p_[i], e.t, g_.data());
+      p_[i].stamp = stamp;
+    }
     move_centre(i, e.t);
     if (adjacent()) nl_.recode_beside(i, [&](int j) { return pos_at(j, 0, clock_); });
     else nl_.renew(i);
@@ -465,6 +393,10 @@ class EngineImpl final : public Simulation {
     const double dt = t - p_[i].t;
     double* c = nl_.centre(i);
     for (int k = 0; k < Dim; ++k) {
+      if (field_ && g_[k] != 0.0) {  // a walled axis: no wrap
+        c[k] = pos_at(i, k, t);
+        continue;
+      }
       double ck = p_[i].x[k] + p_[i].v[k] * dt;
       if (box_.wrap(k, p_[i].x[k], ck)) ck = p_[i].x[k] + p_[i].v[k] * dt;
       c[k] = ck;
@@ -622,6 +554,9 @@ class EngineImpl final : public Simulation {
   std::vector<double> rad_;                // a mixture: each slot's radius (Config::diameters / 2); empty: one size
   double wrap_ = 0.0;                      // 1D ring: kWrap times the smallest diameter (setup_geometry)
   std::vector<double> mass_;               // unequal masses: each slot's (Config::masses); empty: all 1
+  bool field_ = false;                     // a uniform field (Config::gravity): parabolas between events
+  std::array<double, Dim> g_{};            // its components
+  double gn_ = 0.0;                        // its magnitude
   double total_mass_ = 0.0;                // sum of the masses (n for unit masses)
   double shell_ = 0.0, renew_h_ = 0.0, renew_h2_ = 0.0;  // the neighbour lists
   std::vector<Particle<Dim>> p_;

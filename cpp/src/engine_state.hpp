@@ -18,15 +18,17 @@ Diagnostics EngineImpl<Dim, Op>::diagnostics() const {
   Diagnostics d;
   double e = 0.0;
   for (std::size_t i = 0; i < n_; ++i) {  // in id order: the sums' bits do not depend on storage
-    const double m = mass(static_cast<int>(slot(i)));  // (1: the same bits as without masses)
+    const int j = static_cast<int>(slot(i));
+    const double m = mass(j);  // (1: the same bits as without masses)
     for (int k = 0; k < Dim; ++k) {
-      const double vk = p_[slot(i)].v[k];
+      const double vk = vel_at(j, k, clock_);
       e += 0.5 * m * vk * vk;
       d.momentum[k] += m * vk;
     }
   }
-  d.energy = e;
-  d.energy_drift = e0_ > 0 ? (e - e0_) / e0_ : 0.0;
+  if (field_) d.potential = potential();
+  d.energy = e + d.potential;
+  d.energy_drift = e0_ > 0 ? (d.energy - e0_) / e0_ : 0.0;
   double dp = 0.0;
   for (int k = 0; k < Dim; ++k) dp += (d.momentum[k] - p0_[k]) * (d.momentum[k] - p0_[k]);
   d.momentum_drift = e0_ > 0 ? std::sqrt(dp) / std::sqrt(2.0 * e0_ * total_mass_) : 0.0;
@@ -200,6 +202,14 @@ EngineImpl<Dim, Op>::EngineImpl(const Snapshot& s, Op op) : cfg_(s.config), n_(s
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::setup_geometry() {
   sigma2_ = cfg_.diameter * cfg_.diameter;
+  field_ = false;
+  gn_ = 0.0;
+  for (int k = 0; k < Dim; ++k) {
+    g_[k] = cfg_.gravity[k];
+    field_ = field_ || g_[k] != 0.0;
+    gn_ += g_[k] * g_[k];
+  }
+  gn_ = std::sqrt(gn_);
   // 1D ring: stored positions stay within wrap_ of the box, so the rod beside a rod lies at
   // least its contact distance >= the smallest diameter > 2 wrap_ away (NeighbourLists::right_code)
   double smallest = cfg_.diameter;

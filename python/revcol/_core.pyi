@@ -268,7 +268,8 @@ class Engine(_ObserveMethods):
     def __init__(self, positions: _Arr, velocities: _Arr, box: Sequence[_Float], boundary: Sequence[str],
                  diameter: _Float, mode: str, law: str, seed: _Int, bits: _Int, groups: bool, group_tol: _Float,
                  time: _Float, generator: str = "philox", streams: str = "per_particle",
-                 diameters: Sequence[_Float] = ..., masses: Sequence[_Float] = ...) -> None: ...
+                 diameters: Sequence[_Float] = ..., masses: Sequence[_Float] = ...,
+                 gravity: Sequence[_Float] = ...) -> None: ...
     @staticmethod
     def from_snapshot(snapshot: dict[str, Any]) -> Engine: ...
     def run(self, collisions: Optional[_Int] = None, time: Optional[_Float] = None,
@@ -296,6 +297,8 @@ class Engine(_ObserveMethods):
     def diameters(self) -> list[float]: ...  # a mixture's, one per particle (empty: one size)
     @property
     def masses(self) -> list[float]: ...  # one per particle (empty: all 1)
+    @property
+    def gravity(self) -> list[float]: ...  # the uniform field, one component per axis
     @property
     def dim(self) -> int: ...
     @property

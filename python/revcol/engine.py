@@ -65,7 +65,9 @@ class Simulation(SimulationBase):
     energy, diameter too large, N = 0, a periodic axis under 3 diameters).
 
     ``generator``: ``"philox"`` (default) or ``"clcg4"``; ``streams``: ``"per-particle"``
-    (default; the smallest id of a collision draws) or ``"single"``.
+    (default; the smallest id of a collision draws) or ``"single"``. ``diameters`` and
+    ``masses`` (one per particle): a mixture; ``gravity`` (one component per axis, nonzero only
+    on walled axes): a uniform field (docs/mixtures.md, docs/engine.md).
 
     ``engine="lattice"`` builds the lattice engine's simulation instead
     (:class:`revcol.lattice.LatticeSimulation`, or ``LatticeSimulation3D`` for (n, 3)
@@ -88,7 +90,7 @@ class Simulation(SimulationBase):
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  bits: int = 40, groups: bool = True, group_tol: float = 1e-9,
                  time: float = 0.0, generator: str = "philox", streams: str = "per-particle",
-                 diameters=None, masses=None, _engine=None):
+                 diameters=None, masses=None, gravity=None, _engine=None):
         if _engine is not None:
             self._e = _engine
             return
@@ -106,7 +108,8 @@ class Simulation(SimulationBase):
         # scalars go through as given: the engine names a wrong type or range (issue 17)
         self._e = _core.Engine(x, v, box, _boundary_list(boundary), diameter, mode, law,
                                seed, bits, bool(groups), group_tol, time,
-                               generator, streams, sizes, weights)
+                               generator, streams, sizes, weights,
+                               [] if gravity is None else np.atleast_1d(real_array(gravity, "gravity")).tolist())
 
     @classmethod
     def random(cls, n: int, dim: int = 3, phi: Optional[float] = None, *, boundary: _Boundary = "periodic",
@@ -273,6 +276,11 @@ class Simulation(SimulationBase):
 
     mixture = property(lambda self: bool(len(self._e.diameters)),
                        doc="True for a mixture (built with ``diameters``; sizes kept per particle).")
+
+    @property
+    def gravity(self) -> np.ndarray:
+        """The uniform field (acceleration), shape (dim,): zero unless built with ``gravity``."""
+        return np.asarray(self._e.gravity, dtype=float)
 
     @property
     def masses(self) -> np.ndarray:

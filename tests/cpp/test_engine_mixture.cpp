@@ -354,4 +354,71 @@ TEST_CASE("masses: checkpoints resume bit for bit, the observer weighs them, bad
   CHECK(refused([&] { restore_simulation(snap); }, "snapshot: masses"));
 }
 
+// ---- a uniform field (Config::gravity) ----
+
+TEST_CASE("gravity: a lone disk bounces on the floor on its exact parabola, forward and back") {
+  // g = -2 along y, floor contact at y = 0.5: from y = 4.5 at rest it lands at t = 2 (speed 4)
+  // and rises back to 4.5 at t = 4; in x it flies at 0.25 on a periodic axis
+  Config c = config(2, Boundary::wall);
+  c.boundary = {Boundary::periodic, Boundary::wall, Boundary::periodic};
+  c.box = {10, 10, 1};
+  c.gravity = {0.0, -2.0, 0.0};
+  auto s = make_simulation(c, {1.0, 4.5, 8.0, 8.0}, {0.25, 0.0, 0.0, 0.0});
+  s->run(kAll, 1.0);
+  CHECK(std::fabs(s->positions()[1] - 3.5) < 1e-12 && std::fabs(s->velocities()[1] + 2.0) < 1e-12);
+  s->run(kAll, 3.0);  // bounced at t = 2: rising at 2 from 0.5, at t = 3 y = 0.5 + 4 - 1 = 3.5
+  CHECK(std::fabs(s->positions()[1] - 3.5) < 1e-12 && std::fabs(s->velocities()[1] - 2.0) < 1e-12);
+  CHECK(s->diagnostics().counters.wall_events == 2);  // (the other disk, dropped from 8, lands at t = sqrt(7.5))
+  CHECK(std::fabs(s->diagnostics().energy_drift) < 1e-15);
+  s->run(kAll, 4.0);
+  CHECK(std::fabs(s->positions()[1] - 4.5) < 1e-12 && std::fabs(s->velocities()[1]) < 1e-12);
+  s->run_back(kAll, 0.0);
+  CHECK(std::fabs(s->positions()[1] - 4.5) < 1e-12 && std::fabs(s->positions()[0] - 1.0) < 1e-12);
+}
+
+TEST_CASE("gravity: gases keep kinetic plus potential energy and return within the horizon") {
+  for (int d : {1, 2, 3}) {
+    Config c = config(d, Boundary::periodic);
+    c.boundary[static_cast<std::size_t>(d - 1)] = d == 3 ? Boundary::bounce : Boundary::wall;  // the field's axis
+    c.gravity[static_cast<std::size_t>(d - 1)] = d == 2 ? -0.5 : 0.3;                         // down; up in 1D and 3D
+    if (d == 2) c.diameters = binary(400, 1.4);
+    const InitialState st = random_state(c, 400, 0.3, 7);
+    auto s = make_simulation(st.config, st.x, st.v);
+    const auto x0 = s->positions(), v0 = s->velocities();
+    CHECK(s->diagnostics().potential > 0.0);
+    s->run(400, kInf);
+    CHECK(s->fault().empty());
+    s->run_back(kAll, 0.0);
+    CHECK(s->diagnostics().divergence == Divergence::none);
+    for (std::size_t q = 0; q < x0.size(); ++q) {  // periodic images folded
+      const double L = st.config.box[q % static_cast<std::size_t>(d)], e = std::fabs(s->positions()[q] - x0[q]);
+      CHECK(std::fmin(e, std::fabs(e - L)) < 1e-9 * L);
+    }
+    CHECK(max_error(s->velocities(), v0) < 1e-9);
+    s->run(20000, kInf);
+    const std::string f = s->fault();
+    CHECK(f.empty());
+    if (!f.empty()) std::fprintf(stderr, "    %s\n", f.c_str());
+    CHECK(std::fabs(s->diagnostics().energy_drift) < 1e-12);
+    auto r = restore_simulation(s->snapshot());  // and a checkpoint resumes bit for bit
+    s->run(3000, kInf);
+    r->run(3000, kInf);
+    CHECK(same_state(*s, *r));
+  }
+}
+
+TEST_CASE("gravity: refused by name on a periodic axis, and not observed yet") {
+  Config c = config(2, Boundary::periodic);
+  c.box = {10, 10, 1};
+  c.gravity = {0.0, -1.0, 0.0};
+  CHECK(refused([&] { make_simulation(c, {2, 2, 5, 5}, {1, 0, -1, 0}); }, "gravity along axis 1 needs walls"));
+  c.boundary[1] = Boundary::wall;
+  c.gravity[1] = NAN;
+  CHECK(refused([&] { make_simulation(c, {2, 2, 5, 5}, {1, 0, -1, 0}); }, "gravity must be finite"));
+  c.gravity[1] = -1.0;
+  auto s = make_simulation(c, {2, 2, 5, 5}, {1, 0, -1, 0});
+  CHECK(refused([&] { s->observe(ObserveConfig{}); }, "not observed yet"));
+  CHECK(!s->observing());
+}
+
 int main() { return check::run_all(); }

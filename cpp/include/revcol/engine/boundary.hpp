@@ -219,19 +219,19 @@ class Boundaries {
   static constexpr double kOwn = -1.0;
   /// The centre's position at axis k's wall ahead (walls only).
   [[gnu::always_inline]] double wall_at(int k, int up, double r = kOwn) const {
-    return visit(k, [&](auto a) { return decltype(a)::wall_at(up, L_[k], rad(r)); });
+    return visit(k, [&](auto a) __attribute__((always_inline)) { return decltype(a)::wall_at(up, L_[k], rad(r)); });
   }
   /// Whether the centre x touches axis k's wall ahead (walls only).
   [[gnu::always_inline]] bool touches_ahead(int k, double x, int up, double r = kOwn) const {
-    return visit(k, [&](auto a) { return decltype(a)::touches_ahead(x, up, L_[k], rad(r), tol_); });
+    return visit(k, [&](auto a) __attribute__((always_inline)) { return decltype(a)::touches_ahead(x, up, L_[k], rad(r), tol_); });
   }
   /// Whether the centre x touches a wall of axis k.
   [[gnu::always_inline]] bool touches(int k, double x, double r = kOwn) const {
-    return visit(k, [&](auto a) { return decltype(a)::touches(x, L_[k], rad(r), tol_); });
+    return visit(k, [&](auto a) __attribute__((always_inline)) { return decltype(a)::touches(x, L_[k], rad(r), tol_); });
   }
   /// Whether the centre x meets the wall of axis k that the component vk approaches.
   [[gnu::always_inline]] bool meets(int k, double x, double vk, double r = kOwn) const {
-    return visit(k, [&](auto a) { return decltype(a)::meets(x, vk, L_[k], rad(r), tol_); });
+    return visit(k, [&](auto a) __attribute__((always_inline)) { return decltype(a)::meets(x, vk, L_[k], rad(r), tol_); });
   }
   /// Whether axis k's reflection acts on the whole velocity.
   bool whole(int k) const {
@@ -284,11 +284,11 @@ class Boundaries {
 
  private:
   bool touches_ahead_within(int k, double x, int up, double tol, double r) const {
-    return visit(k, [&](auto a) { return decltype(a)::touches_ahead(x, up, L_[k], rad(r), tol); });
+    return visit(k, [&](auto a) __attribute__((always_inline)) { return decltype(a)::touches_ahead(x, up, L_[k], rad(r), tol); });
   }
   double rad(double r) const { return r < 0.0 ? radius_ : r; }
   Reflection axis_reflect(int k, Vec& v) const {
-    return visit(k, [&](auto a) { return decltype(a)::template reflect<Dim>(k, v); });
+    return visit(k, [&](auto a) __attribute__((always_inline)) { return decltype(a)::template reflect<Dim>(k, v); });
   }
 
   std::array<Boundary, Dim> kind_{};

@@ -134,6 +134,8 @@ struct Config {
                                                  ///< the largest equal to `diameter`; empty: one size
   std::vector<double> masses;                    ///< one mass per particle (id order); empty: all 1. A pair of
                                                  ///< unequal masses collides in its centre-of-mass frame
+  std::array<double, 3> gravity{0.0, 0.0, 0.0};  ///< a uniform field (acceleration), nonzero only on walled
+                                                 ///< axes; energy then includes -m g . x
   Mode mode = Mode::exact;                       ///< the pair operator: exact (default), paper, ... (engine_operators.hpp)
   Law law = Law::flux;                           ///< exact mode's target law
   std::uint32_t seed = 1;                        ///< the generator family (rng/streams.hpp)
@@ -308,7 +310,8 @@ struct Snapshot : Visitable<Snapshot> {
 
 /// Conservation and activity diagnostics.
 struct Diagnostics {
-  double energy = 0.0;                    ///< sum v^2 / 2 (unit mass)
+  double energy = 0.0;                    ///< sum m v^2 / 2, plus potential under a field
+  double potential = 0.0;                 ///< under a field: sum m |g_k| times the distance from the wall it pulls to
   std::array<double, 3> momentum{};       ///< sum v
   double energy_drift = 0.0;              ///< (E - E0) / E0
   double momentum_drift = 0.0;            ///< |P - P0| / sqrt(2 E0 N)

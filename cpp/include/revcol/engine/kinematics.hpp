@@ -65,17 +65,29 @@ struct FloatKinematics {
   /// The limit test comes before the square root: dt >= c / (-2 b), the skipped candidate's
   /// lower bound; it is rounded, so the caller keeps a margin of many ulps above any time it
   /// still needs (EngineImpl::prune_limit).
+  /// Field: under a uniform field g (d components; Field false: none, g unread) both move on
+  /// parabolas, so from the later local time the separation is still linear in time: r and w
+  /// are taken at that time (x + v d + g d^2 / 2, v + g d) and the rest is unchanged.
+  template <bool Field = false>
   [[gnu::always_inline]] static bool pair_time(const Particle<Dim>& a, const Particle<Dim>& b, const Vec& s,
                                                double sigma2, double contact_tol, double& t, bool& touching,
-                                               double limit = std::numeric_limits<double>::infinity()) {
+                                               double limit = std::numeric_limits<double>::infinity(),
+                                               const double* g = nullptr) {
     const double ta = a.t, tb = b.t;
     const double tr = ta > tb ? ta : tb;
     const double da = tr - ta, db = tr - tb;
     double r[Dim], w[Dim];
     for (int k = 0; k < Dim; ++k) {
       const double va = a.v[k], vb = b.v[k];
-      r[k] = ((a.x[k] + va * da) - (b.x[k] + vb * db)) - s[k];
-      w[k] = va - vb;
+      if constexpr (Field) {
+        const double h = 0.5 * g[k];
+        r[k] = ((a.x[k] + va * da + h * da * da) - (b.x[k] + vb * db + h * db * db)) - s[k];
+        w[k] = (va + g[k] * da) - (vb + g[k] * db);
+      } else {
+        (void)g;
+        r[k] = ((a.x[k] + va * da) - (b.x[k] + vb * db)) - s[k];
+        w[k] = va - vb;
+      }
     }
     // the sums start from their first term, not from 0.0 + it: the same values but for the
     // sign of a zero bb, which no test below and no hit's time can see (a hit has bb < 0)
@@ -124,10 +136,12 @@ struct FloatKinematics {
   }
   /// The same with each lane's own contact distance and tolerance (a mixture): lane l's
   /// sigma2_l, contact_tol_l.
+  template <bool Field = false>
   [[gnu::always_inline]] static void pair_test2(const Particle<Dim>& a, const Particle<Dim>& b0,
                                                 const Particle<Dim>& b1, const Vec& s0, const Vec& s1,
                                                 double sigma2_0, double sigma2_1, double contact_tol_0,
-                                                double contact_tol_1, double limit, Pair2& out) {
+                                                double contact_tol_1, double limit, Pair2& out,
+                                                const double* g = nullptr) {
     typedef double v2d __attribute__((vector_size(16)));
     typedef long long v2l __attribute__((vector_size(16)));
     const v2d ta = {a.t, a.t}, tb = {b0.t, b1.t};
@@ -137,8 +151,15 @@ struct FloatKinematics {
     for (int k = 0; k < Dim; ++k) {
       const v2d va = {a.v[k], a.v[k]}, vb = {b0.v[k], b1.v[k]};
       const v2d ax = {a.x[k], a.x[k]}, bx = {b0.x[k], b1.x[k]}, sk = {s0[k], s1[k]};
-      r[k] = ((ax + va * da) - (bx + vb * db)) - sk;
-      w[k] = va - vb;
+      if constexpr (Field) {  // pair_time's field terms, lane by lane
+        const v2d gk = {g[k], g[k]}, h = {0.5 * g[k], 0.5 * g[k]};
+        r[k] = ((ax + va * da + h * da * da) - (bx + vb * db + h * db * db)) - sk;
+        w[k] = (va + gk * da) - (vb + gk * db);
+      } else {
+        (void)g;
+        r[k] = ((ax + va * da) - (bx + vb * db)) - sk;
+        w[k] = va - vb;
+      }
     }
     v2d bb = r[0] * w[0], r2 = r[0] * r[0], w2 = w[0] * w[0];  // as pair_time: from the first term
     for (int k = 1; k < Dim; ++k) {
@@ -183,6 +204,71 @@ struct FloatKinematics {
 
   /// Time at which coordinate k of p reaches the plane x_k = at (v_k != 0).
   static double plane_time(const Particle<Dim>& p, int k, double at) { return p.t + (at - p.x[k]) / p.v[k]; }
+
+  // ---- under a uniform field g (gravity; d components) ----
+
+  /// Coordinate k of p's position at time t: x + v dt + g dt^2 / 2.
+  static double pos_at(const Particle<Dim>& p, int k, double t, const double* g) {
+    const double dt = t - p.t;
+    return p.x[k] + p.v[k] * dt + 0.5 * g[k] * dt * dt;
+  }
+  /// Component k of p's velocity at time t: v + g dt.
+  static double vel_at(const Particle<Dim>& p, int k, double t, const double* g) { return p.v[k] + g[k] * (t - p.t); }
+  /// Moves p's stored state to time t on its parabola; changes its stamp.
+  static void advance(Particle<Dim>& p, double t, const double* g) {
+    const double dt = t - p.t;
+    for (int k = 0; k < Dim; ++k) {
+      p.x[k] += p.v[k] * dt + 0.5 * g[k] * dt * dt;
+      p.v[k] += g[k] * dt;
+    }
+    p.t = t;
+    ++p.stamp;
+  }
+  /// The first time after p's local time at which coordinate k (field component gk != 0)
+  /// reaches the plane lo moving down or hi moving up (lo <= x <= hi); false: never. `up`:
+  /// which. Each root is the one arriving (velocity -sqrt(disc) at lo, +sqrt(disc) at hi), in
+  /// the form without cancellation: 2 D / (sqrt(disc) - v) when the particle heads for the
+  /// plane, (sqrt(disc) + |v|) / |g| when it first moves away and the field brings it back.
+  static bool wall_time(const Particle<Dim>& p, int k, double gk, double lo, double hi, double& tau, int& up) {
+    const double x = p.x[k], v = p.v[k];
+    bool found = false;
+    const auto offer = [&](double t, int u) {
+      if (!found || t < tau) {
+        tau = t;
+        up = u;
+        found = true;
+      }
+    };
+    const double dh = hi - x > 0.0 ? hi - x : 0.0, disc_h = v * v + 2.0 * gk * dh;  // up: x + v t + g t^2 / 2 = hi
+    if (disc_h >= 0.0) {
+      const double r = std::sqrt(disc_h);
+      if (v > 0.0) offer(2.0 * dh / (v + r), 1);
+      else if (gk > 0.0) offer((r - v) / gk, 1);
+    }
+    const double dl = x - lo > 0.0 ? x - lo : 0.0, disc_l = v * v - 2.0 * gk * dl;  // down: ... = lo
+    if (disc_l >= 0.0) {
+      const double r = std::sqrt(disc_l);
+      if (v < 0.0) offer(2.0 * dl / (r - v), 0);
+      else if (gk < 0.0) offer((r + v) / -gk, 0);
+    }
+    return found;
+  }
+  /// renewal_time under a field of magnitude gn > 0: a time by which p is still within h of c,
+  /// conservative: at distance d0 now, its straight line stays within h - e and its fall from
+  /// that line, gn t^2 / 2, within e = (h - d0) / 2. So the renewal comes no later than the
+  /// parabola leaves the list's reach (0: at or beyond it now).
+  static bool renewal_time(const Particle<Dim>& p, const double* c, double h, double gn, double& tau) {
+    double d2 = 0.0;
+    for (int k = 0; k < Dim; ++k) d2 += (p.x[k] - c[k]) * (p.x[k] - c[k]);
+    const double e = 0.5 * (h - std::sqrt(d2));
+    tau = 0.0;
+    if (!(e > 0.0)) return true;
+    double t_line = std::numeric_limits<double>::infinity();
+    const bool moving = renewal_time(p, c, (h - e) * (h - e), t_line);
+    const double t_fall = std::sqrt(2.0 * e / gn);
+    tau = moving && t_line < t_fall ? t_line : t_fall;
+    return true;
+  }
 };
 
 }  // namespace revcol::engine
