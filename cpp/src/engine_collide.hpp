@@ -526,18 +526,8 @@ void EngineImpl<Dim, Op>::trace_point(bool reversed) {
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::check_conservation() {
   if (trace_.reason() != Divergence::none || !(e0_ > 0.0)) return;
-  double e = 0.0;
-  std::array<double, Dim> p{};
-  for (std::size_t i = 0; i < n_; ++i) {  // in id order: the sums' bits do not depend on storage
-    const int j = static_cast<int>(slot(i));
-    const double m = mass(j);
-    for (int k = 0; k < Dim; ++k) {
-      const double vk = vel_at(j, k, clock_);
-      e += 0.5 * m * vk * vk;
-      p[k] += m * vk;
-    }
-  }
-  if (field_) e += potential();  // (a field: the energy with -m g . x)
+  std::array<double, 3> p{};
+  const double e = energy_momentum(p);
   if (!(std::fabs(e - e0_) <= CollisionTrace::kConserveTol * e0_)) {
     trace_.diverge(net_, Divergence::energy);
     return;

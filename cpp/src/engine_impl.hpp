@@ -263,6 +263,21 @@ class EngineImpl final : public Simulation {
     }
     return u;
   }
+  // The energy at the clock (sum m v^2 / 2, plus the field's potential) and the momentum sum m v
+  // into p, summed in id order (their bits do not depend on storage; unit masses multiply by 1).
+  double energy_momentum(std::array<double, 3>& p) const {
+    double e = 0.0;
+    for (std::size_t i = 0; i < n_; ++i) {
+      const int j = static_cast<int>(slot(i));
+      const double m = mass(j);
+      for (int k = 0; k < Dim; ++k) {
+        const double vk = vel_at(j, k, clock_);
+        e += 0.5 * m * vk * vk;
+        p[k] += m * vk;
+      }
+    }
+    return field_ ? e + potential() : e;
+  }
   // Unequal masses (mass_, each slot's; empty: all 1).
   double mass(int i) const { return mass_.empty() ? 1.0 : mass_[static_cast<std::size_t>(i)]; }
   // The radii in id order (the observer's species).

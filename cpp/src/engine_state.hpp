@@ -16,18 +16,8 @@ namespace revcol::engine::detail {
 template <int Dim, PairOperator Op>
 Diagnostics EngineImpl<Dim, Op>::diagnostics() const {
   Diagnostics d;
-  double e = 0.0;
-  for (std::size_t i = 0; i < n_; ++i) {  // in id order: the sums' bits do not depend on storage
-    const int j = static_cast<int>(slot(i));
-    const double m = mass(j);  // (1: the same bits as without masses)
-    for (int k = 0; k < Dim; ++k) {
-      const double vk = vel_at(j, k, clock_);
-      e += 0.5 * m * vk * vk;
-      d.momentum[k] += m * vk;
-    }
-  }
+  d.energy = energy_momentum(d.momentum);
   if (field_) d.potential = potential();
-  d.energy = e + d.potential;
   d.energy_drift = e0_ > 0 ? (d.energy - e0_) / e0_ : 0.0;
   double dp = 0.0;
   for (int k = 0; k < Dim; ++k) dp += (d.momentum[k] - p0_[k]) * (d.momentum[k] - p0_[k]);
