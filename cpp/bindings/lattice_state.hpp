@@ -82,6 +82,7 @@ py::dict units_dict(const la::UnitsN<D>& u) {
   d["tick"] = u.tick;
   d["tick_bits"] = u.tick_bits;
   d["cell_bits"] = u.cell_bits;
+  d["gravity"] = tuple_of(u.gravity);  // lattice units per tick^2 (even; zero: no field)
   return d;
 }
 template <std::size_t D>
@@ -116,6 +117,12 @@ la::UnitsN<D> units_from(const py::dict& d) {
   u.tick_bits = d.contains("tick_bits") ? get<int>(d, "tick_bits") : la::legacy_tick_bits;
   // cell_bits arrived with the coarser direction cells; units without it ran 2^20 cells
   u.cell_bits = d.contains("cell_bits") ? get<int>(d, "cell_bits") : la::max_units_cell_bits;
+  // gravity arrived with the uniform field; units without it have none
+  if (d.contains("gravity")) {
+    const auto g = get<std::vector<std::int64_t>>(d, "gravity");
+    require(g.size() == D, D == 2 ? "lattice units: gravity needs two entries" : "lattice units: gravity needs three entries (3D)");
+    for (std::size_t k = 0; k < D; ++k) u.gravity[k] = g[k];
+  }
   la::validate(u);
   return u;
 }
@@ -129,6 +136,7 @@ py::dict start_dict(const la::LatticeStartN<D>& s) {
   d["radius"] = flat_array(s.radius.data(), s.radius.size());  // (empty: one diameter)
   d["max_position_error"] = s.max_position_error;
   d["max_velocity_error"] = s.max_velocity_error;
+  d["gravity_error"] = s.gravity_error;  // a field: |g_lattice - g| / |g| (0: none)
   return d;
 }
 
@@ -277,8 +285,12 @@ void take(const py::dict& d, const char*, std::vector<la::GroupEntryN<D>>& group
 inline py::dict counters_dict(const la::Counters& c) {
   py::dict d;
   c.visit([&](const char* key, const auto& v) {
-    if constexpr (std::is_integral_v<std::decay_t<decltype(v)>>) {
+    using V = std::decay_t<decltype(v)>;
+    if constexpr (std::is_integral_v<V>) {
       d[key] = v;
+    } else if constexpr (std::tuple_size_v<V> == 4) {  // a field's wall impulse: (lower, upper), 128 bits each
+      auto word128 = [](std::uint64_t lo, std::uint64_t hi) { return (py::int_(hi).attr("__lshift__")(64)).attr("__or__")(py::int_(lo)); };
+      d[key] = py::make_tuple(word128(v[0], v[1]), word128(v[2], v[3]));
     } else {  // redraws, by reason
       py::dict r;
       for (int k = 1; k < 8; ++k) r[la::redraw_names[k]] = v[k];

@@ -99,6 +99,17 @@ _RANDOM_START = {2: "lattice_random_start", 3: "lattice3d_random_start"}
 _QUANTIZE = {2: "lattice_quantize", 3: "lattice3d_quantize"}
 
 
+def _gravity(gravity, dim: int, workers: int = 1) -> list:
+    """A uniform field's components for the engine (empty: none); a field runs on one worker."""
+    if gravity is None:
+        return []
+    g = np.atleast_1d(real_array(gravity, "gravity")).astype(float)
+    if g.shape != (dim,):
+        raise ValueError(f"gravity must have one component per axis ({dim}), got shape {g.shape}")
+    if np.any(g != 0.0) and integer(workers, "workers", 1) > 1:
+        raise ValueError("gravity runs on one worker: the parallel lattice engine is not built for a field yet")
+    return g.tolist()
+
 class LatticeSimulation(SimulationBase):
     """N hard disks on the integer lattice, run forward and back bit for bit (2D; spheres in 3D:
     :class:`LatticeSimulation3D`, the same API).
@@ -127,7 +138,11 @@ class LatticeSimulation(SimulationBase):
     docs/parallel.md). ``diameters`` (one per particle; instead of ``diameter``): a mixture of
     equal masses, binary, ternary or polydisperse (a pair meets at the sum of its radii; the
     largest diameter is the lattice's sigma and the others, within a ratio of 16, are quantized to
-    even lattice lengths; docs/mixtures.md). Bad input raises ``ValueError`` naming the problem.
+    even lattice lengths; docs/mixtures.md). ``gravity`` (one component per axis, nonzero on one
+    walled axis): a uniform field, exact on the lattice (quantized once to an even number of lattice
+    units per tick^2, :attr:`gravity` the value run and ``quantization()["gravity_error"]`` the
+    rounding; the cell grid searches; no observer, journal or parallel run yet; docs/engine.md).
+    Bad input raises ``ValueError`` naming the problem.
     """
 
     _DIM = 2  # LatticeSimulation3D: 3
@@ -136,7 +151,7 @@ class LatticeSimulation(SimulationBase):
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
-                 workers: int = 1, lps: Optional[int] = None, diameters=None, _engine=None,
+                 workers: int = 1, lps: Optional[int] = None, diameters=None, gravity=None, _engine=None,
                  _quantization: Optional[dict] = None):
         if _engine is not None:
             self._e = _engine
@@ -157,7 +172,8 @@ class LatticeSimulation(SimulationBase):
             raise ValueError(f"box must be one length or three (3D), got shape {box.shape}")
         sizes = diameters_arg(diameters, x.shape[0] if x.ndim == 2 else -1, diameter)
         start = getattr(_core, _QUANTIZE[dim])(x, v, [float(b) for b in np.broadcast_to(box, (dim,))],
-                                               _boundary(boundary), diameter, _tick(tick_bits), cell_bits, sizes)
+                                               _boundary(boundary), diameter, _tick(tick_bits), cell_bits, sizes,
+                                               _gravity(gravity, dim, workers))
         self._init_from_start(start, law, seed, dim, shell, mode)
 
     def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2, shell: float = -1.0,
@@ -167,6 +183,8 @@ class LatticeSimulation(SimulationBase):
                          radius=start["radius"])
         self._q = {"max_position_error": start["max_position_error"],
                    "max_velocity_error": start["max_velocity_error"]}
+        if any(start["units"].get("gravity", ())):
+            self._q["gravity_error"] = start["gravity_error"]
         self._search = -1.0
         self._set_shell(shell)
 
@@ -181,7 +199,7 @@ class LatticeSimulation(SimulationBase):
                diameter: float = 1.0, seed: int = 1, init: str = "auto", mode: str = "exact", law: str = "flux",
                tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
                packing_fraction: Optional[float] = None, workers: int = 1, lps: Optional[int] = None,
-               diameters=None) -> "LatticeSimulation":
+               diameters=None, gravity=None) -> "LatticeSimulation":
         """n disks (spheres for LatticeSimulation3D) at area (volume) fraction ``phi`` (or
         ``packing_fraction=``; default 0.3) in a square (cubic) box (the float engine's
         ``random_state``: ``init`` ``"rsa"``, random sequential addition, or ``"crystal"``, a
@@ -192,7 +210,8 @@ class LatticeSimulation(SimulationBase):
         the constructor's. ``diameters`` (one per particle): a mixture at packing fraction
         ``phi`` (the particles' own volumes), placed as spheres of the largest diameter (so a
         mixture's ``phi`` is bounded by the crystal of the largest: about 0.74 of its volume
-        fraction in a periodic cube, less in walls)."""
+        fraction in a periodic cube, less in walls). ``gravity``: a uniform field, as the
+        constructor's (the particles placed uniformly, then left to fall)."""
         n = integer(n, "n", 1)  # not a bool or a float (a named error)
         if dim is not None:
             dim = integer(dim, "dim", 1, 3)
@@ -208,7 +227,7 @@ class LatticeSimulation(SimulationBase):
             raise ValueError(f"LatticeSimulation3D is 3D, got dim={dim}")
         sizes = diameters_arg(diameters, n, diameter)
         start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, init,
-                                                   _tick(tick_bits), cell_bits, sizes)
+                                                   _tick(tick_bits), cell_bits, sizes, _gravity(gravity, dim, workers))
         sim = cls.__new__(cls)
         sim.set_parallel(workers, lps=lps)
         sim._init_from_start(start, law, seed, dim, shell, mode)
@@ -456,6 +475,14 @@ class LatticeSimulation(SimulationBase):
     def diameters(self) -> np.ndarray:
         """Each particle's diameter in float units (2 radii x length_unit), shape (n,)."""
         return 2.0 * self.radii.astype(float) * float(self._e.units["length_unit"])
+
+    @property
+    def gravity(self) -> np.ndarray:
+        """The uniform field run (acceleration in float units), shape (dim,): the lattice's even
+        integer per tick^2 times length_unit / tick^2; zero without a field."""
+        u = self._e.units
+        g = np.asarray(u.get("gravity", (0,) * self._DIM), dtype=float)
+        return g * (float(u["length_unit"]) / float(u["tick"]) ** 2)
 
     mixture = property(lambda self: bool(np.asarray(self._e.radius).size),
                        doc="True for a mixture (built with ``diameters``; sizes kept per particle).")

@@ -4,7 +4,7 @@ bench/results/lattice_validation_*.json.
 
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py matrix [--collisions 1e7]
         [--n 1000 10000] [--phi 0.1 0.3 0.5 0.7] [--boundary wall periodic bounce] [--mode exact|specular] [--out matrix]
-        [--sizes one|binary|gauss]
+        [--sizes one|binary|gauss] [--gravity G]
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py equilibrium [--n 1000] [--phi 0.5]
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py failures [--phi 0.5 0.7] [--seeds 4] [--collisions 2e6] --out failures
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py gas --n 1000 --phi 0.3 --boundary wall --collisions 1e5
@@ -33,6 +33,11 @@ average before and after.
 1.4 (``binary``), or a polydisperse gas (``gauss``: diameters 1 + 0.1 z, z a standard normal
 truncated at +-2, so the start's crystal of the largest holds area fraction 0.5 and volume
 fraction 0.4), the packing fraction counting each particle's own size.
+
+--gravity G (matrix, gas): a uniform field of G (float units, toward the lower wall for G < 0)
+along the last axis, which then has walls (a periodic --boundary keeps the other axes periodic);
+the row adds the field run, its quantization, the mean height at the start and the end and the
+walls' momentum against the column's weight over the second half (docs/engine.md).
 
 probe: forward only, one gas per (N, area fraction, boundary) for each tick (--ticks) and cell
 resolution (--cells): the rare log's entries, the group entries and the redraws by reason, the
@@ -216,9 +221,26 @@ def _forward(sim, c: int, samples: int) -> dict:
                              "log_entries": d["log_entries"], "energy_drift_relative": d["energy_drift"]})
         if done == c // 2:
             f["mid"] = (done, sim.snapshot())
+            f["impulse_mid"] = (d["field_wall_impulse"], d["clock"])  # (a field's walls: the weight check)
+        if done == c:
+            f["impulse_end"] = (d["field_wall_impulse"], d["clock"])
         elif done < c:
             f["prev"], f["last"] = f["last"], (done, sim.snapshot())
     return f
+
+
+def _weight_balance(f: dict, n: int, units: dict):
+    """Over the second half of the forward run, the momentum the field's walls gave the gas (the
+    wall pulled to less the other) over the column's weight N |g| t; None if the run stopped short."""
+    if "impulse_mid" not in f or "impulse_end" not in f:
+        return None
+    (a0, b0), t0 = f["impulse_mid"]
+    (a1, b1), t1 = f["impulse_end"]
+    g = int(units["gravity"][-1])
+    pulled, other = (a1 - a0, b1 - b0) if g < 0 else (b1 - b0, a1 - a0)
+    weight = n * abs(g) * (t1 - t0)
+    return {"wall_pulled_to": int(pulled), "other_wall": int(other), "weight": int(weight), "ticks": int(t1 - t0),
+            "ratio": (pulled - other) / weight if weight else None}
 
 
 def _after_failure(sim, f: dict):
@@ -252,22 +274,32 @@ def sizes_of(sizes: str, n: int, seed: int):
 
 
 def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, samples: int = 100,
-            law: str = "flux", tick_bits: int = 0, cell_bits: int = 16, mode: str = "exact", sizes: str = "one") -> dict:
+            law: str = "flux", tick_bits: int = 0, cell_bits: int = 16, mode: str = "exact", sizes: str = "one",
+            gravity: float = 0.0) -> dict:
     """One gas: C collisions forward (snapshot at C/2), back to C/2 (compared), back to 0
     (compared). Returns the row (see the module doc). If the engine fails on the way forward, the
     row says so (``completed`` false, ``forward_error``) and the checks run on the collisions done,
     the midpoint being the latest snapshot before the failure."""
     LatticeSimulation = _sim_cls()
     load0 = os.getloadavg()
-    sim = LatticeSimulation.random(n=n, phi=phi, boundary=boundary, seed=seed, init=_init_for(phi), law=law,
-                                   tick_bits=tick_bits or None, cell_bits=cell_bits, mode=mode,
-                                   diameters=sizes_of(sizes, n, seed))
+    field = {}
+    if gravity:  # along the last axis, walled
+        field = {"gravity": [0.0] * (DIM - 1) + [gravity],
+                 "boundary": [boundary] * (DIM - 1) + ["wall" if boundary == "periodic" else boundary]}
+    sim = LatticeSimulation.random(n=n, phi=phi, boundary=field.get("boundary", boundary), seed=seed, init=_init_for(phi),
+                                   law=law, tick_bits=tick_bits or None, cell_bits=cell_bits, mode=mode,
+                                   diameters=sizes_of(sizes, n, seed), gravity=field.get("gravity"))
     s0 = sim.snapshot()
     units = sim.units
     wall = [bool(w) for w in units["wall"]]
     e0 = float(np.sum(sim.lattice_velocities.astype(float) ** 2))
+    if gravity:  # the energy kept is kinetic and potential (2 |g| times the height above the floor)
+        g_l, z = int(units["gravity"][-1]), sim.lattice_positions[:, -1].astype(float)
+        e0 += 2.0 * abs(g_l) * float(np.sum(z if g_l < 0 else units["L"][-1] - z))
+    h0 = float(np.mean(sim.positions[:, -1]))
     bits0 = sim.diagnostics()["bits_length"]
     f = _forward(sim, int(collisions), samples)
+    h_end = float(np.mean(sim.positions[:, -1]))
     c = sim.collisions  # collisions done (= collisions unless the engine failed)
     d_end = sim.diagnostics()
     if f["error"] is not None:
@@ -314,6 +346,10 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
         "loadavg_start": list(load0), "loadavg_end": list(os.getloadavg()),
         "commit": _git_commit(),
     }
+    if gravity:
+        row["gravity"] = {"asked": gravity, "run": [float(g) for g in sim.gravity],
+                          "lattice_units_per_tick2": int(units["gravity"][-1]), "boundary": field["boundary"],
+                          "mean_height_start": h0, "mean_height_end": h_end, "weight_balance": _weight_balance(f, n, units)}
     hwm = [r["vmhwm_bytes"] for r in f["rss"] if r["collisions"] >= 100000]
     row["vmhwm_growth_from_1e5_bytes"] = (hwm[-1] - hwm[0]) if hwm else None
     return row
@@ -321,18 +357,19 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
 
 def _child(args) -> int:
     row = run_gas(args.n, args.phi, args.boundary, int(float(args.collisions)), args.seed,
-                  tick_bits=args.tick_bits, cell_bits=args.cell_bits, mode=args.mode, sizes=args.sizes)
+                  tick_bits=args.tick_bits, cell_bits=args.cell_bits, mode=args.mode, sizes=args.sizes,
+                  gravity=args.gravity)
     print("ROW " + json.dumps(row), flush=True)
     return 0
 
 
 def run_child(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, tick_bits: int = 0,
-              cell_bits: int = 16, mode: str = "exact", sizes: str = "one") -> dict:
+              cell_bits: int = 16, mode: str = "exact", sizes: str = "one", gravity: float = 0.0) -> dict:
     """``run_gas`` in a fresh subprocess; adds the child's ru_maxrss (wait4) and exit status."""
     cmd = [sys.executable, os.path.abspath(__file__), "gas", "--n", str(n), "--phi", str(phi),
            "--boundary", boundary, "--collisions", str(int(collisions)), "--seed", str(seed),
            "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits), "--dim", str(DIM), "--mode", mode,
-           "--sizes", sizes]
+           "--sizes", sizes, "--gravity", repr(gravity)]
     t0 = time.time()
     with tempfile.TemporaryFile(mode="w+") as ferr:
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=ferr, text=True)
@@ -360,7 +397,7 @@ def matrix(args) -> dict:
            "cell_bits": args.cell_bits, "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "rows": []}
     for phi, n, b, sizes in ((phi, n, b, sizes) for phi in args.phi for n in args.n for b in args.boundary
                              for sizes in args.sizes):  # in the order given: a run cut short still covers both N
-        row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits, args.mode, sizes)
+        row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits, args.mode, sizes, args.gravity)
         res["rows"].append(row)
         res["updated_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
         _write_atomic(path, res)
@@ -670,6 +707,8 @@ def main(argv=None) -> int:
     ap.add_argument("--batch", type=float, default=20.0, help="equilibrium: collisions per particle per batch")
     ap.add_argument("--batches", type=int, default=10)
     ap.add_argument("--dim", type=int, default=2, choices=[2, 3], help="2: disks (area fraction); 3: spheres (volume fraction)")
+    ap.add_argument("--gravity", type=float, default=0.0,
+                    help="matrix, gas: a uniform field along the last axis (walled), float units; 0: none")
     ap.add_argument("--sizes", nargs="+", default=["one"], choices=["one", "binary", "gauss"],
                     help="matrix, gas: a mixture (see the doc)")
     a = ap.parse_args(argv)

@@ -41,6 +41,10 @@ auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, cons
     if (xi[k] < lo_of(i) || xi[k] > hi_of(i, static_cast<int>(k))) return redraw_outside;
     if (xj[k] < lo_of(j) || xj[k] > hi_of(j, static_cast<int>(k))) return redraw_outside;
   }
+  if (gax_ >= 0) [[unlikely]] {  // (vi, vj: the tick's moves; a field's velocities at a are the moves plus h)
+    for (const Vec* vv : {&vi, &vj})
+      if ((*vv)[gax_] + hg_ > u_.vmax || (*vv)[gax_] + hg_ < -u_.vmax) return redraw_outside;
+  }
   int why = 0;
   multi = false;
   for (int s = 0; s < 2 && why == 0; ++s) {
@@ -58,7 +62,7 @@ auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, cons
       for (std::size_t k = 1; k < D; ++k) dd += static_cast<double>(d[k]) * d[k];
       if (dd > far2_) return;
       if (overlap(x, qa, o, q)) why = redraw_overlap_after;
-      else if (overlap(ghost, wrapped(sub(qa, ln_[q].v)), o, q)) why = redraw_ghost_tie;
+      else if (overlap(ghost, gax_ >= 0 ? pos(q, a - 1) : wrapped(sub(qa, ln_[q].v)), o, q)) why = redraw_ghost_tie;
       if (overlap(pre_a[s], qa, o, q)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
     };
     if (direct_) {  // the owner's list (x is within 2 vmax of its line), far ones dropped in double
@@ -92,6 +96,10 @@ void BasicEngine<Op, Bits, Queue>::apply(int i, int j, const Vec& xi, const Vec&
   ln_[j].x = xj;
   ln_[i].v = vi;
   ln_[j].v = vj;
+  if (gax_ >= 0) [[unlikely]] {  // (vi, vj: the moves of the tick into a; a field's velocities at a are the moves plus h)
+    ln_[i].v[gax_] += hg_;
+    ln_[j].v[gax_] += hg_;
+  }
   ln_[i].ta = ln_[j].ta = a;
   sync(i);
   sync(j);
@@ -127,6 +135,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
   // values stay within a few sigma of 0 whatever the box
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+  const Vec ui = move_of(i, a), uj = move_of(j, a);  // the tick's moves (field.hpp)
   Vec xi2, xj2, vi2, vj2;
   Bits out;
   std::optional<Op> opm;
@@ -135,7 +144,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   for (;;) {
     if (static_cast<std::int64_t>(redraws) > max_redraws) return group_collide(i, j, a, ctr0, reasons, !fallback);
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr++);
-    const auto rf = op.pair_forward(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi2, xj2, vi2, vj2, out);
+    const auto rf = op.pair_forward(xi, zero, ui, uj, g, own_[i].X, xi2, xj2, vi2, vj2, out);
     int why = static_cast<int>(rf);
     if (why == 0) {
       xi2 = shifted(xj, xi2);
@@ -160,7 +169,7 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   ++own_[j].pc;
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, gid(i), gid(j)});
-  if (obs_ || events || seen_) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
+  if (obs_ || events || seen_) [[unlikely]] note_pair(a, i, j, xi2, xj2, plus_h(vi2), plus_h(vj2));
   apply(i, j, xi2, xj2, vi2, vj2, a);
   return true;
 }
@@ -188,7 +197,7 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
   Vec xi0, xj0, vi0, vj0;
   if (own_[i].pc == 0 || own_[j].pc == 0) inconsistent("a collision count would step back past 0", i, j);
   std::optional<Op> opm;
-  op_of(i, j, opm).pair_reverse(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi0, xj0, vi0, vj0);
+  op_of(i, j, opm).pair_reverse(xi, zero, neg(move_of(i, a)), neg(move_of(j, a)), g, own_[i].X, xi0, xj0, vi0, vj0);
   xi0 = shifted(xj, xi0);
   xj0 = shifted(xj, xj0);
   own_[i].ctr -= 1 + redraws;
@@ -217,7 +226,7 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
   SpecularTrace tr;
   bool multi = false;
   std::optional<Specular> spm;
-  int why = static_cast<int>(spec_of(i, j, spm).pair_map(xi, zero, ln_[i].v, ln_[j].v, xi2, xj2, vi2, vj2, &tr));
+  int why = static_cast<int>(spec_of(i, j, spm).pair_map(xi, zero, move_of(i, a), move_of(j, a), xi2, xj2, vi2, vj2, &tr));
   if (why == 0) {
     xi2 = shifted(xj, xi2);
     xj2 = shifted(xj, xj2);
@@ -240,7 +249,7 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
   ++own_[j].pc;
   ++ncoll_;
   if (trace != nullptr) trace->push_back({a, gid(i), gid(j)});
-  if (obs_ || events || seen_) [[unlikely]] note_pair(a, i, j, xi2, xj2, vi2, vj2);
+  if (obs_ || events || seen_) [[unlikely]] note_pair(a, i, j, xi2, xj2, plus_h(vi2), plus_h(vj2));
   apply(i, j, xi2, xj2, vi2, vj2, a);
 }
 
@@ -250,7 +259,7 @@ void BasicEngine<Op, Bits, Queue>::back_specular(int i, int j, std::int64_t a) {
   const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
   Vec xi0, xj0, vi0, vj0;
   std::optional<Specular> spm;
-  if (spec_of(i, j, spm).pair_unmap(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi0, xj0, vi0, vj0) != Refusal::none)
+  if (spec_of(i, j, spm).pair_unmap(xi, zero, neg(move_of(i, a)), neg(move_of(j, a)), xi0, xj0, vi0, vj0) != Refusal::none)
     inconsistent("the specular map refuses the post state it is to take back", i, j);
   if (own_[i].pc == 0 || own_[j].pc == 0) inconsistent("a collision count would step back past 0", i, j);
   xi0 = shifted(xj, xi0);

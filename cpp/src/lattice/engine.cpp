@@ -48,7 +48,34 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
   const double dmax = c.diameters.empty() ? c.diameter : largest_diameter(c.diameters, n);
   LatticeStartN<D> s;
   s.units = choose_units_d<D>(c.box, dmax, v_rms, c.wall, c.tick_bits, c.cell_bits, n);
+  double gmax = 0.0;  // the strongest field component, float units
+  for (double g : c.gravity) gmax = std::max(gmax, std::isfinite(g) ? std::fabs(g) : 0.0);
+  if (c.tick_bits == auto_tick_bits && gmax > 0.0) {
+    // a field and the automatic tick: a coarser tick until g is at least 2^12 lattice units per
+    // tick^2 (its even rounding then within 2^-12 relative; each bit of tick is a factor 4; a
+    // coarser tick makes third bodies within a tick, so groups and redraws, more frequent)
+    int T = s.units.tick_bits;
+    while (T > min_tick_bits && gmax * s.units.tick * s.units.tick / s.units.length_unit < 0x1p12) {
+      --T;
+      s.units = choose_units_d<D>(c.box, dmax, v_rms, c.wall, T, c.cell_bits, n);
+    }
+  }
   s.units.bounce = c.bounce;
+  for (std::size_t k = 0; k < D; ++k) {  // a field, quantized once to even lattice units per tick^2
+    const double g = c.gravity[k];
+    require(std::isfinite(g), "lattice: gravity must be finite");
+    if (g == 0.0) continue;
+    require(c.wall[k], "lattice: gravity is allowed only along a walled axis (a periodic axis has no floor)");
+    const double gl = g * s.units.tick * s.units.tick / s.units.length_unit;
+    const double ge = 2.0 * std::round(0.5 * gl);
+    require(std::fabs(ge) >= 2.0, [&] {
+      return "lattice: gravity " + std::to_string(g) + " is below the lattice's resolution at this tick (" +
+             std::to_string(gl) + " lattice units per tick^2; 2 is the least): use a coarser tick (smaller tick_bits)";
+    });
+    require(std::fabs(ge) <= static_cast<double>(max_gravity), "lattice: gravity is too strong for the lattice at this tick (above 2^36 lattice units per tick^2): use a finer tick (larger tick_bits)");
+    s.units.gravity[k] = static_cast<std::int64_t>(ge);
+    s.gravity_error = std::max(s.gravity_error, std::fabs(ge - gl) / std::fabs(gl));
+  }
   validate(s.units);
   if (!c.diameters.empty()) {
     s.radius.resize(n);
@@ -100,7 +127,7 @@ namespace {
 template <class Eng>
 DiagnosticsN<Eng::D> diagnostics_of(const Eng& e) {
   DiagnosticsN<Eng::D> d;
-  const u128 E = kinetic2(e.velocities()), E0 = e.energy0();
+  const u128 E = energy2(e.units(), e.positions(), e.velocities()), E0 = e.energy0();
   const double dE = E >= E0 ? static_cast<double>(E - E0) : -static_cast<double>(E0 - E);
   d.energy_drift_units = dE;
   d.energy_drift = E0 > 0 ? dE / static_cast<double>(E0) : 0.0;

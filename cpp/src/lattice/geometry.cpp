@@ -159,6 +159,16 @@ void validate(const UnitsN<Dim>& u) {
   require(u.tick_bits >= min_tick_bits && u.tick_bits <= max_tick_bits, "lattice units: tick_bits must be in [16, 26]");
   require(u.cell_bits >= min_units_cell_bits && u.cell_bits <= max_units_cell_bits,
           "lattice units: cell_bits must be in [12, 20]");
+  int fields = 0;
+  for (std::size_t k = 0; k < Dim; ++k) {
+    const std::int64_t g = u.gravity[k];
+    if (g == 0) continue;
+    ++fields;
+    require(u.wall[k], "lattice units: gravity is allowed only along a walled axis (a periodic axis has no floor)");
+    require(g % 2 == 0, "lattice units: gravity must be an even number of lattice units per tick^2");
+    require(g >= -max_gravity && g <= max_gravity, "lattice units: |gravity| must be at most 2^36 lattice units per tick^2");
+  }
+  require(fields <= 1, "lattice units: gravity may act along one axis only");
 }
 
 template <std::size_t Dim>
@@ -200,6 +210,23 @@ UnitsN<Dim> choose_units_d(const std::array<double, Dim>& box, double D, double 
   u.cell_bits = cell_bits;
   validate(u);
   return u;
+}
+
+template <std::size_t Dim>
+u128 energy2(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v) noexcept {
+  u128 e = kinetic2(v);
+  const int k = field_axis(u);
+  if (k < 0) return e;
+  const auto K = static_cast<std::size_t>(k);
+  const std::int64_t g = u.gravity[K];
+  const u128 m = static_cast<u128>(2 * (g < 0 ? -g : g));
+  for (const VecN<Dim>& a : x) {
+    const std::int64_t h = g < 0 ? a[K] : u.L[K] - a[K];  // inside [0, L]: >= 0
+    const u128 s = e + m * static_cast<u128>(h < 0 ? 0 : h);
+    if (s < e) return ~u128{0};
+    e = s;
+  }
+  return e;
 }
 
 template <std::size_t Dim>
@@ -305,9 +332,11 @@ void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
       });
     }
   }
-  const u128 e = kinetic2(v);
+  // in a field, the energy with its potential: what a particle could reach falling to the floor
+  const u128 e = energy2(u, x, v);
   require(e <= static_cast<u128>(u.vmax) * static_cast<u128>(u.vmax),
-          "lattice: the total kinetic energy allows a speed beyond vmax (too many particles for the velocity scale)");
+          field_axis(u) < 0 ? "lattice: the total kinetic energy allows a speed beyond vmax (too many particles for the velocity scale)"
+                            : "lattice: the total energy (kinetic and potential) allows a speed beyond vmax (a field too strong for the box and the velocity scale)");
   check_overlaps(u, x, pending ? &v : nullptr, radius);
 }
 
@@ -497,6 +526,8 @@ template UnitsN<3> choose_units_d<3>(const std::array<double, 3>&, double, doubl
                                      std::size_t);
 template u128 kinetic2(const std::vector<VecN<2>>&) noexcept;
 template u128 kinetic2(const std::vector<VecN<3>>&) noexcept;
+template u128 energy2(const UnitsN<2>&, const std::vector<VecN<2>>&, const std::vector<VecN<2>>&) noexcept;
+template u128 energy2(const UnitsN<3>&, const std::vector<VecN<3>>&, const std::vector<VecN<3>>&) noexcept;
 template void validate_state(const UnitsN<2>&, const std::vector<VecN<2>>&, const std::vector<VecN<2>>&, bool, const std::vector<std::int64_t>&);
 template void validate_state(const UnitsN<3>&, const std::vector<VecN<3>>&, const std::vector<VecN<3>>&, bool, const std::vector<std::int64_t>&);
 template void validate_radii(const UnitsN<2>&, const std::vector<std::int64_t>&, std::size_t);

@@ -56,8 +56,10 @@ auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g,
   };
   const std::size_t n = g.size();
   std::vector<VecD> v(n);
+  std::vector<Vec> mv(n);  // the members' moves over the tick (a field: v + h, field.hpp)
+  for (std::size_t m = 0; m < n; ++m) mv[m] = plus_h(vel(g[m], a - 1));
   for (std::size_t m = 0; m < n; ++m)
-    for (std::size_t k = 0; k < D; ++k) v[m][k] = static_cast<double>(ln_[g[m]].v[k]);
+    for (std::size_t k = 0; k < D; ++k) v[m][k] = static_cast<double>(mv[m][k]);
   struct Touch {
     std::size_t p, q;
     VecD n;
@@ -119,12 +121,13 @@ auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g,
     for (std::size_t m = 0; m < n; ++m) {
       const double c = std::clamp(v[m][k], -static_cast<double>(tick_limit), static_cast<double>(tick_limit));
       out[m][k] = static_cast<std::int64_t>(std::llround(c));
-      before += ln_[g[m]].v[k];
+      before += mv[m][k];
       after += out[m][k];
       if (std::abs(out[m][k]) > std::abs(out[big][k])) big = m;
     }
     out[big][k] += static_cast<std::int64_t>(before - after);  // momentum kept exactly
   }
+  for (Vec& o : out) o = plus_h(o);  // the velocities at a
   return out;
 }
 
@@ -143,7 +146,7 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
       vel = resolve_velocities(g, post, a);
     } else {
       vel.assign(g.size(), Vec{});
-      for (std::size_t m = 0; m < g.size(); ++m) vel[m] = neg(ln_[g[m]].v);
+      for (std::size_t m = 0; m < g.size(); ++m) vel[m] = neg(this->vel(g[m], a - 1));  // (a field too: the stall's move negated)
     }
     bool grew = false;
     for (std::size_t m = 0; m < g.size() && !grew; ++m) {
@@ -151,7 +154,7 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
         if (vel[m][k] > u_.vmax || vel[m][k] < -u_.vmax) return false;
         if (u_.wall[k] && (post[m][k] < lo_of(g[m]) || post[m][k] > hi_of(g[m], static_cast<int>(k)))) return false;
       }
-      const Vec ghost = wrapped(sub(post[m], vel[m]));  // the new line at a-1
+      const Vec ghost = wrapped(sub(plus_h(post[m]), vel[m]));  // the new line at a-1 (a field: x - v + h)
       near(g[m], [&](int q) {
         if (grew || member(q)) return;
         if (overlap(post[m], pos(q, a), g[m], q) || overlap(ghost, pos(q, a - 1), g[m], q)) {
@@ -166,8 +169,8 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
     // was taken back from a reflection at a)
     for (std::size_t p = 0; p < g.size(); ++p)
       for (std::size_t q = p + 1; q < g.size(); ++q) {
-        const Vec gp = wrapped(sub(post[p], vel[p]));
-        const Vec gq = wrapped(sub(post[q], vel[q]));
+        const Vec gp = wrapped(sub(plus_h(post[p]), vel[p]));
+        const Vec gq = wrapped(sub(plus_h(post[q]), vel[q]));
         if (overlap(gp, gq, g[p], g[q])) return true;  // the reverse meets this pair at a-1
       }
     return false;
@@ -217,7 +220,7 @@ bool BasicEngine<Op, Bits, Queue>::group_collide(int i, int j, std::int64_t a, s
     if (jon_ && jhow_ != Rollback::reverse && !reversed_ && q != i && q != j) save_state(q);  // (i, j: saved by the loop)
   }
   if (resolve)
-    for (int q : g) pre_v.push_back(ln_[q].v);
+    for (int q : g) pre_v.push_back(this->vel(q, a - 1));
   ++ncoll_;
   std::vector<std::uint64_t> counts;
   for (int q : g) counts.push_back(++own_[q].pc);
@@ -268,7 +271,7 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Grou
   for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
   for (std::size_t m = 0; m < g.size(); ++m) {
     Line& l = ln_[g[m]];
-    const Vec v = pre_v.empty() ? neg(l.v) : neg(pre_v[m]);
+    const Vec v = pre_v.empty() ? neg(vel(g[m], a - 1)) : neg(pre_v[m]);
     l = Line{pre[m], v, a};
     sync(g[m]);
     ++slot_[static_cast<std::size_t>(g[m])].ver;

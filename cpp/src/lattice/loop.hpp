@@ -194,10 +194,15 @@ void BasicEngine<Op, Bits, Queue>::check_order(std::int64_t t, std::int32_t k) {
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   journal(p);
-  Vec x = pos(p, a - 1), v = ln_[p].v;
+  const Vec x0 = pos(p, a - 1), v0 = vel(p, a - 1);
+  // the mirror takes the tick's move (a field: the mid velocity v + h) and gives the move after,
+  // whose point at a-1 is x - move (the ghost); the velocity at a is that move plus h
+  Vec x = x0, v = plus_h(v0);
   const Vec old_line_at_a = pos(p, a);
   const unsigned axes = reflection(p, x, v);
   const Vec ghost = wrapped(sub(x, v));
+  v = plus_h(v);
+  if (gax_ >= 0 && (axes >> gax_ & 1u)) [[unlikely]] field_impulse(v0[gax_], v[gax_]);
   near(p, [&](int q) {
     if (q == p) return;
     // the forward's guard (its reverse would meet q first); the reverse replays the forward, and
@@ -210,7 +215,7 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
     if (overlap(old_line_at_a, pos(q, a), p, q)) ++cnt_.wall_body;
   });
   if (!reversed_ && (obs_ || events || seen_)) [[unlikely]] note_wall(a, p, x, v, axes);
-  pre_wall_[p] = Line{pos(p, a - 1), ln_[p].v, a - 1};  // a group collision at a may take it back
+  pre_wall_[p] = Line{x0, v0, a - 1};  // a group collision at a may take it back
   ln_[p].x = x;
   ln_[p].v = v;
   ln_[p].ta = a;
@@ -219,6 +224,22 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   wall_tick_[p] = a;
   ++cnt_.walls;
   predict(p, a);
+}
+
+// A reflection on the field's axis: |v_after - v_before| to the wall met (the lower one when the
+// velocity before points down, in either frame), added forward and taken off in reverse. (A
+// group that takes a reflection of its tick in, counted in wall_groups, keeps it counted.)
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::field_impulse(std::int64_t before, std::int64_t after) noexcept {
+  const std::int64_t d = after - before;
+  const u128 m = static_cast<u128>(d < 0 ? -d : d);
+  const bool lower = before < 0;
+  auto& w = cnt_.field_wall_impulse;
+  const std::size_t at = lower ? 0 : 2;
+  u128 sum = (static_cast<u128>(w[at + 1]) << 64) | w[at];
+  sum = reversed_ ? sum - m : sum + m;
+  w[at] = static_cast<std::uint64_t>(sum);
+  w[at + 1] = static_cast<std::uint64_t>(sum >> 64);
 }
 
 template <class Op, class Bits, class Queue>

@@ -12,6 +12,7 @@ namespace revcol::lattice {
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
+  require(gax_ < 0, "lattice observe: the observer does not take a field yet (its pressure and free paths assume straight lines); read snapshots instead");
   observer_ = make_observer(u_, positions(), velocities(), clock_, &c, nullptr, radii());
   obs_ = observer_.get();
 }
@@ -64,7 +65,7 @@ void BasicEngine<Op, Bits, Queue>::record(int kind, std::int64_t a, const std::v
   EventRecordN<D> r{a, kind, axes, {}, x, {}, v};  // by particle id
   for (int q : ids) {
     r.ids.push_back(gid(q));
-    r.v_before.push_back(ln_[q].v);
+    r.v_before.push_back(vel(q, a - 1));  // (a field: its velocity at a-1)
   }
   events->push_back(std::move(r));
 }

@@ -20,9 +20,10 @@ template <class Op, class Bits, class Queue>
   for (std::size_t k = 0; k < D; ++k) {
     std::int64_t m, y;
     // fast path (measure before changing): the displacement fits int64 and at most one wrap
+    // (axk_: 0 periodic, 1 walls, 2 walls and the field, whose axis is read in one test)
     if (!__builtin_mul_overflow(ln_[p].v[k], dt, &m) && !__builtin_add_overflow(ln_[p].x[k], m, &y)) {
-      if (u_.wall[k]) {
-        out[k] = y;
+      if (axk_[k] != 0) {
+        out[k] = axk_[k] == 1 ? y : field_at(p, k, dt);
         continue;
       }
       if (y >= u_.L[k]) y -= u_.L[k];
@@ -33,7 +34,7 @@ template <class Op, class Bits, class Queue>
       }
     }
     const i128 z = static_cast<i128>(ln_[p].x[k]) + static_cast<i128>(ln_[p].v[k]) * dt;
-    out[k] = u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
+    out[k] = axk_[k] == 2 ? field_at(p, k, dt) : u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
   }
   return out;
 }
@@ -63,6 +64,7 @@ auto BasicEngine<Op, Bits, Queue>::region_ticks(const Line& l) const noexcept ->
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::reanchor(int p, std::int64_t t) {
   ln_[p].x = pos(p, t);
+  if (gax_ >= 0) [[unlikely]] ln_[p].v = vel(p, t);
   ln_[p].ta = t;
   if (lists_) {  // a post point outside the ball (a collision moves it by ~vmax): renew now
     if (!nl_.inside(p, ln_[p].x)) nl_.renew(p, ln_[p].x);
@@ -109,6 +111,14 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
     }
   }
   for (std::size_t k = 0; k < D; ++k) {
+    if (static_cast<int>(k) == gax_) [[unlikely]] {  // the field's axis: quadratic times (cells only)
+      const int ck = c[k], kk = static_cast<int>(k), nc = grid_.count(kk);
+      const std::int64_t dt = field_exit_ticks(ln_[p].x[k], ln_[p].v[k], hg_, grid_.boundary(kk, ck), grid_.boundary(kk, ck + 1), ck == 0, ck + 1 == nc);
+      if (dt > 0) b.offer(lo + dt, 0, cross, -1, -1);
+      const std::int64_t dw = field_wall_ticks(ln_[p].x[k], ln_[p].v[k], hg_, lo_of(p), hi_of(p, kk));
+      if (dw >= 0) b.offer(lo + dw, wall_kind(), wall, -1, -1);
+      continue;
+    }
     if (!lists_) {
       const std::int64_t dt = grid_.exit_ticks(static_cast<int>(k), c[k], ln_[p].x[k], ln_[p].v[k]);
       if (dt > 0) b.offer(lo + dt, 0, cross, -1, -1);
@@ -118,8 +128,14 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
       if (dw >= 0) b.offer(lo + dw, wall_kind(), wall, -1, -1);
     }
   }
-  if (sz_.mixed()) scan<true>(p, lo, b);
-  else scan<false>(p, lo, b);
+  if (gax_ >= 0) [[unlikely]] {
+    if (sz_.mixed()) scan<true, true>(p, lo, b);
+    else scan<false, true>(p, lo, b);
+  } else if (sz_.mixed()) {
+    scan<true, false>(p, lo, b);
+  } else {
+    scan<false, false>(p, lo, b);
+  }
   schedule(p, b.type, b.t, b.k, b.q);
   if (b.type == coll) {  // write it into the partner's slot when before the event there
     // in offer's order (tick, kind, other particle): with (tick, kind) alone, a tie (two pairs of
@@ -136,7 +152,7 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
 
 // p's candidate partners (its list, or its 3^D cells) into b.
 template <class Op, class Bits, class Queue>
-template <bool Mixed>
+template <bool Mixed, bool Field>
 inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) {
   // The candidates. A double-precision filter drops the pairs that cannot collide, or not
   // before the best event so far; the others get the exact search (measure before changing).
@@ -151,12 +167,14 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
   double tb = b.type != none ? static_cast<double>(b.t - lo) : never;  // the best so far, ticks from lo
   auto exact = [&](int q, double guess) {
     const Vec r = diff(lp.x, pos(q, lo));
+    // (a field: q's velocity at lo; p is anchored there)
+    const Vec w = Field ? sub(lp.v, vel(q, lo)) : sub(lp.v, ln_[q].v);
     std::int64_t tau;
     if constexpr (D == 3) {
-      tau = first_overlap(r, sub(lp.v, ln_[q].v), Mixed ? sig2(p, q) : sigma2_, guess);
+      tau = first_overlap(r, w, Mixed ? sig2(p, q) : sigma2_, guess);
     } else {
       (void)guess;
-      tau = first_overlap(r, sub(lp.v, ln_[q].v), Mixed ? sig2(p, q) : sigma2_);
+      tau = first_overlap(r, w, Mixed ? sig2(p, q) : sigma2_);
     }
     if (tau >= 0) {
       b.offer(lo + tau, coll_kind(p, q), coll, q, gid(q));
@@ -228,8 +246,12 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
       for (std::size_t k = 0; k < D; ++k) {
         // (x_p - x_q) + s: the difference is in (-L, L) and a shift only ever brings it nearer 0
         // (+L for a partner near L seen from near 0), so no sum passes 2^63 however large L is
-        const double r = static_cast<double>((lp.x[k] - lq.x[k]) + s[k]) - static_cast<double>(lq.v[k]) * dtq;
-        const double w = static_cast<double>(lp.v[k] - lq.v[k]);
+        double r = static_cast<double>((lp.x[k] - lq.x[k]) + s[k]) - static_cast<double>(lq.v[k]) * dtq;
+        double w = static_cast<double>(lp.v[k] - lq.v[k]);
+        if (Field && static_cast<int>(k) == gax_) {  // q's fall since its anchor
+          r -= hgd_ * dtq * dtq;
+          w -= 2.0 * hgd_ * dtq;
+        }
         rr += r * r;
         bb += r * w;
         aa += w * w;
@@ -248,12 +270,14 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
         bool edge = false;
         for (std::size_t k = 0; k < D; ++k) {
           double r = (xp[k] - static_cast<double>(lq.x[k])) - static_cast<double>(lq.v[k]) * dtq;
+          if (Field && static_cast<int>(k) == gax_) r -= hgd_ * dtq * dtq;  // q's fall since its anchor
           if (!u_.wall[k]) {  // the nearest image (an inline rounding: libm's is a call)
             const double m = r * invL_[k];
             r -= Ld_[k] * static_cast<double>(static_cast<std::int64_t>(m + (m >= 0.0 ? 0.5 : -0.5)));
             edge = edge || std::fabs(r) > edge_[k];
           }
-          const double w = static_cast<double>(lp.v[k] - lq.v[k]);
+          double w = static_cast<double>(lp.v[k] - lq.v[k]);
+          if (Field && static_cast<int>(k) == gax_) w -= 2.0 * hgd_ * dtq;
           rr += r * r;
           bb += r * w;
           aa += w * w;

@@ -39,6 +39,7 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::keep_journal(bool on, Rollback how) {
   require(how == Rollback::reverse || how == Rollback::save_all || how == Rollback::save_changes,
           "lattice journal: rollback by reverse computation, save_all (SS1) or save_changes (SS2)");
+  require(!on || gax_ < 0, "lattice journal: not built for a gas in a field yet (rollback and the parallel engine run without gravity)");
   jon_ = on;
   jhow_ = how;
   restart_journal();

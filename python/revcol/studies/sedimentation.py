@@ -1,6 +1,7 @@
-"""Sedimentation: a hard-sphere gas under gravity (the float engine's uniform field) against
+"""Sedimentation: a hard-sphere gas under gravity (the uniform field of either engine) against
 hydrostatic equilibrium with the equation of state in the local-density approximation, and
-against the barometric law it reduces to at low density.
+against the barometric law it reduces to at low density; on the lattice engine also the walls'
+momentum against the column's weight, and the run taken back to its start bit for bit.
 
 A gas of N disks (spheres) of unit diameter and mass, dropped from a uniform start in a box
 periodic across and walled along the field (g < 0 along the last axis: the floor at 0); energy
@@ -13,7 +14,14 @@ diameters) is beyond the LDA: the comparison uses the mean height of the centres
 the profile there. The deviations are in the combined error of the mean height (8 blocks of
 frames) and of the prediction through kT's (the same blocks).
 
-    python -m revcol.studies.sedimentation --dim 2 --n 400 --width 200 --g 0.2 --json F
+``--engine lattice``: the same start quantized once onto the lattice engine, whose field is an
+even integer per tick^2 (the g run, ``sim.gravity``, is what the predictions use; it is within
+2^-12 of the one asked). Over the frames the momentum the floor gave the gas less the ceiling's
+is compared with the column's weight N m |g| t (``weight_ratio``, which momentum balance makes 1
+up to the change of the gas's own momentum), and at the end the whole run goes back to the
+start and is compared bit for bit (``back_bit_for_bit``).
+
+    python -m revcol.studies.sedimentation --dim 2 --n 400 --width 200 --g 0.2 [--engine lattice] --json F
 """
 from __future__ import annotations
 
@@ -72,7 +80,8 @@ def lda_profile(dim: int, n: int, area: float, height: float, g: float, kt: floa
 
 
 def measure(dim: int = 2, n: int = 400, width: float = 200.0, height: float = 60.0, g: float = 0.2,
-            seed: int = 1, settle: float = 200.0, frames: int = 400, every: float = 1.0, bins: int = 40) -> dict:
+            seed: int = 1, settle: float = 200.0, frames: int = 400, every: float = 1.0, bins: int = 40,
+            engine: str = "float") -> dict:
     """A gas dropped from a random start in the box (width^(d-1) x height), settled for
     ``settle`` time units, then ``frames`` frames ``every`` apart: the centres' density profile,
     their mean height above 2 D with its error from 8 blocks of frames, the LDA's and the
@@ -83,15 +92,19 @@ def measure(dim: int = 2, n: int = 400, width: float = 200.0, height: float = 60
     gravity = [0.0] * (dim - 1) + [-g]
     from .. import _core
     x, v = _core.engine_random_start(n, box, bnd, 1.0, seed)  # uniform in the box (kT = 1): then it falls
-    sim = Simulation(x, v, box, boundary=bnd, gravity=gravity, seed=seed)
+    sim = Simulation(x, v, box, boundary=bnd, gravity=gravity, seed=seed, engine=engine)
+    g = -float(sim.gravity[-1])  # the field run (the lattice's, quantized)
+    start = sim.snapshot() if engine == "lattice" else None
     t0 = time.perf_counter()
     sim.run(time=settle)
+    wall0 = _walls(sim)
     zs, k2 = [], []
     for k in range(frames):
         sim.run(time=settle + (k + 1) * every)
         zs.append(sim.positions[:, -1].copy())
         k2.append(float((sim.velocities ** 2).sum()) / (dim * n))
     zs = np.asarray(zs)
+    wall1 = _walls(sim)
     kt = float(np.mean(k2))  # the gas's own temperature: energy is kept, so the fall heats it
     kt_blocks = np.array([b.mean() for b in np.array_split(np.asarray(k2), 8)])
     kt_error = float(kt_blocks.std(ddof=1) / math.sqrt(len(kt_blocks)))
@@ -109,7 +122,19 @@ def measure(dim: int = 2, n: int = 400, width: float = 200.0, height: float = 60
            "mean_height_error": ze, "combined_error": ze_all,
            "profile_z": ((edges[1:] + edges[:-1]) / 2).tolist(), "profile": hist.mean(0).tolist(),
            "profile_error": (hist.std(0, ddof=1) / math.sqrt(frames)).tolist(),
-           "energy_drift": sim.diagnostics()["energy_drift"], "seconds": time.perf_counter() - t0}
+           "energy_drift": sim.diagnostics()["energy_drift"], "seconds": time.perf_counter() - t0,
+           "engine": engine, "g_run": g}
+    if wall0 is not None:  # the floor's momentum less the ceiling's over the frames, against N |g| t
+        (f0, c0, t_0), (f1, c1, t_1) = wall0, wall1
+        u = sim.units
+        out["weight_ratio"] = ((f1 - f0) - (c1 - c0)) / (n * abs(int(u["gravity"][-1])) * (t_1 - t_0))
+        out["collisions"] = int(sim.diagnostics()["collisions"])
+        t_back = time.perf_counter()
+        sim.run_back()
+        out["back_seconds"] = time.perf_counter() - t_back
+        end = sim.snapshot()
+        out["back_bit_for_bit"] = all(np.array_equal(np.asarray(start[k]), np.asarray(end[k]))
+                                      for k in ("x", "v", "streams", "bits", "clock", "collisions"))
     for name, ideal in (("lda", False), ("barometric", True)):
         z, nz = lda_profile(dim, n, area, height, g, kt=kt, ideal=ideal)
         sel = z >= 2.0
@@ -117,6 +142,15 @@ def measure(dim: int = 2, n: int = 400, width: float = 200.0, height: float = 60
         out[f"{name}_deviation_sd"] = (zm - out[f"{name}_mean_height"]) / ze_all
         out[f"{name}_bottom_fraction"] = float(nz[0] * {1: 1.0, 2: math.pi / 4, 3: math.pi / 6}[dim])
     return out
+
+
+def _walls(sim):
+    """The lattice's field walls (floor, ceiling) momentum and the clock; None on the float engine."""
+    if sim.engine != "lattice":
+        return None
+    d = sim.diagnostics()
+    floor, ceiling = d["field_wall_impulse"]
+    return floor, ceiling, int(d["clock"])
 
 
 def main(argv=None) -> int:
@@ -130,14 +164,17 @@ def main(argv=None) -> int:
     p.add_argument("--seeds", type=int, nargs="+", default=[1])
     p.add_argument("--frames", type=int, default=400)
     p.add_argument("--json", default=None)
+    p.add_argument("--engine", default="float", choices=["float", "lattice"])
     a = p.parse_args(argv)
     runs = []
     for seed in a.seeds:
-        r = measure(a.dim, a.n, a.width, a.height, a.g, seed=seed, frames=a.frames)
+        r = measure(a.dim, a.n, a.width, a.height, a.g, seed=seed, frames=a.frames, engine=a.engine)
         print(f"seed {seed}: mean height above 2 D {r['mean_height']:.4f} +- {r['mean_height_error']:.4f}; LDA "
               f"{r['lda_mean_height']:.4f} ({r['lda_deviation_sd']:+.1f} sd), barometric {r['barometric_mean_height']:.4f} "
               f"({r['barometric_deviation_sd']:+.1f} sd); bottom packing fraction (LDA) {r['lda_bottom_fraction']:.3f}; "
-              f"energy drift {r['energy_drift']:.1e}; {r['seconds']:.1f} s", flush=True)
+              f"energy drift {r['energy_drift']:.1e}; {r['seconds']:.1f} s"
+              + (f"; walls / weight {r['weight_ratio']:.5f}, back bit for bit {r['back_bit_for_bit']}"
+                 if "weight_ratio" in r else ""), flush=True)
         runs.append(r)
     if a.json:
         from .._io import atomic_open

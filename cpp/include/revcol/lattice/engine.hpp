@@ -56,6 +56,12 @@ struct LatticeConfigN {
   /// `diameter`). The largest is the units' sigma (`diameter` is then ignored); the others are
   /// quantized to even lattice lengths, radius = round(d / (2 length_unit)), within a ratio of 16.
   std::vector<double> diameters;
+  /// A uniform field: per axis the acceleration in float units (length / time^2), on at most
+  /// one walled axis. It is quantized once to an even number of lattice units per tick^2
+  /// (field.hpp), the rounding in LatticeStartN::gravity_error. The automatic tick is then
+  /// coarsened (down to tick_bits 16) until g is at least 2^12 units (rounding within 2^-12); a
+  /// field below 2 units at a given tick is refused.
+  std::array<double, D> gravity{};
 };
 /// The 2D configuration.
 using LatticeConfig = LatticeConfigN<2>;
@@ -71,6 +77,7 @@ struct LatticeStartN {
   double max_position_error = 0.0;  ///< max |x_float - x_lattice| / D
   double max_velocity_error = 0.0;  ///< max |v_float - v_lattice| / v_rms
   std::vector<std::int64_t> radius;  ///< a mixture: per particle its radius in lattice units (empty: one diameter)
+  double gravity_error = 0.0;        ///< a field: |g_lattice - g| / |g| after quantization (0: none)
 };
 /// A quantized 2D start.
 using LatticeStart = LatticeStartN<2>;

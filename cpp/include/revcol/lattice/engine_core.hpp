@@ -36,6 +36,7 @@
 #include "revcol/error.hpp"
 #include "revcol/visitable.hpp"
 #include "revcol/lattice/cell_grid.hpp"
+#include "revcol/lattice/field.hpp"
 #include "revcol/lattice/geometry.hpp"
 #include "revcol/lattice/lp.hpp"
 #include "revcol/lattice/lp_seen.hpp"
@@ -298,6 +299,31 @@ class BasicEngine {
   // ---- geometry of the lines ----
   // p's point at tick t on its line, wrapped on periodic axes (predict.hpp)
   [[gnu::always_inline]] inline Vec pos(int p, std::int64_t t) const noexcept;
+  // a uniform field (field.hpp): its axis (-1 none) and half its acceleration h = g / 2; p's
+  // velocity at tick t; a velocity at a-1 as its tick's move (mid = v + h) and back (v = mid + h)
+  int gax_ = -1;
+  std::int64_t hg_ = 0;
+  double hgd_ = 0.0;  // h as a double (the prediction's filter)
+  std::array<std::uint8_t, D> axk_{};  // per axis: 0 periodic, 1 walls, 2 walls and the field (pos)
+  // the parabola's point on the field's axis k, dt ticks from p's anchor (walled: no wrap), exact in 128 bits
+  [[gnu::noinline]] std::int64_t field_at(int p, std::size_t k, std::int64_t dt) const noexcept {
+    return static_cast<std::int64_t>(field_point(ln_[p].x[k], ln_[p].v[k], hg_, dt));
+  }
+  Vec vel(int p, std::int64_t t) const noexcept {
+    Vec v = ln_[p].v;
+    if (gax_ >= 0) [[unlikely]]
+      v[gax_] = static_cast<std::int64_t>(static_cast<std::uint64_t>(v[gax_]) + 2 * static_cast<std::uint64_t>(hg_) * static_cast<std::uint64_t>(t - ln_[p].ta));
+    return v;
+  }
+  // p's move over the tick a-1 -> a: its velocity there (a field: at a-1, plus h)
+  Vec move_of(int p, std::int64_t a) const noexcept {
+    if (gax_ < 0) [[likely]] return ln_[p].v;
+    return plus_h(vel(p, a - 1));
+  }
+  Vec plus_h(Vec v) const noexcept {
+    if (gax_ >= 0) [[unlikely]] v[gax_] += hg_;
+    return v;
+  }
   Vec diff(const Vec& a, const Vec& b) const noexcept {
     Vec r;
     for (std::size_t k = 0; k < D; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
@@ -334,7 +360,7 @@ class BasicEngine {
   void reanchor(int p, std::int64_t t);
   void schedule(int p, Type type, std::int64_t t, std::int32_t kind, int partner);
   void predict(int p, std::int64_t lo);
-  template <bool Mixed>  // a mixture's contact distances (a one-size gas's scan reads no radius)
+  template <bool Mixed, bool Field>  // a mixture's contact distances (a one-size gas's scan reads no radius); a field's fall
   [[gnu::always_inline]] void scan(int p, std::int64_t lo, Best& b);
   void rebuild();
   void flip();
@@ -348,6 +374,7 @@ class BasicEngine {
   void check_order(std::int64_t t, std::int32_t k);
   std::uint64_t loop(std::uint64_t want, std::int64_t until, bool back, std::uint64_t target, const std::function<bool()>& poll);
   void reflect(int p, std::int64_t a);
+  void field_impulse(std::int64_t before, std::int64_t after) noexcept;  // a field's wall momentum (loop.hpp)
   // a state the reverse cannot take back (a loaded state no run wrote): an error naming it, the
   // collision and the pair; run_back restores the state it began with
   [[noreturn, gnu::cold]] void inconsistent(const std::string& what, int i, int j) const;  // (collide.hpp)

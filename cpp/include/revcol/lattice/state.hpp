@@ -52,6 +52,11 @@ struct Counters : Visitable<Counters> {
   std::uint64_t wall_groups = 0;         ///< group members whose reflection at the same tick the group took in
   std::uint64_t backscatters = 0;        ///< specular mode: pairs turned back in place (specular.hpp; forward)
   std::uint64_t drawn_fallbacks = 0;     ///< specular mode: refused post states drawn by the randomized operator (logged)
+  /// A field: the momentum the walls of its axis gave the gas, sum |v_after - v_before| over the
+  /// reflections there, net of those run back (lattice units per tick, 128 bits each: lower
+  /// wall low and high word, upper wall low and high word). Over a run in steady state, the
+  /// lower wall's less the upper's is the weight N |g| times the ticks run.
+  std::array<std::uint64_t, 4> field_wall_impulse{};
 
   /// Calls f(name, count) for every counter, with the names of the diagnostics (redraws: the
   /// array by RedrawReason, index 0 unused).
@@ -71,6 +76,7 @@ struct Counters : Visitable<Counters> {
     f("wall_groups", c.wall_groups);
     f("backscatters", c.backscatters);
     f("drawn_fallbacks", c.drawn_fallbacks);
+    f("field_wall_impulse", c.field_wall_impulse);
   }
 };
 
@@ -168,7 +174,7 @@ template <std::size_t D>
 bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
   const UnitsN<D> &u = a.units, &w = b.units;
   return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.bounce == w.bounce && u.vmax == w.vmax &&
-         u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits &&
+         u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits && u.gravity == w.gravity &&
          a.law == b.law && a.mode == b.mode && a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.particle_collisions == b.particle_collisions &&
          a.bits == b.bits && a.bits_size == b.bits_size && a.log == b.log &&

@@ -65,7 +65,21 @@ struct UnitsN {
   double tick = 0.0;                         ///< float time of one tick
   int tick_bits = 20;                        ///< T: a particle of rms speed moves 2^-T sigma per tick
   int cell_bits = 20;                        ///< the pair operator's 2^cell_bits direction cells per turn
+  /// A uniform field: per axis the acceleration in lattice units per tick^2, even (so that a
+  /// line's point x + v n + (g/2) n^2 is an integer at every tick), |g| <= max_gravity, on at
+  /// most one axis, a walled one (every particle falls toward one of its walls). Zero: none.
+  std::array<std::int64_t, Dim> gravity{};
 };
+/// Largest |gravity| in lattice units per tick^2: 2^36 (the potential sum 2 |g| x over 2^24
+/// particles stays inside 128 bits; the default units put g = 1 sigma / tau^2 near 2^12).
+inline constexpr std::int64_t max_gravity = std::int64_t{1} << 36;
+/// The axis of a field (-1: none).
+template <std::size_t Dim>
+int field_axis(const UnitsN<Dim>& u) noexcept {
+  for (std::size_t k = 0; k < Dim; ++k)
+    if (u.gravity[k] != 0) return static_cast<int>(k);
+  return -1;
+}
 /// The boundary kind of axis k (engine/boundary_kind.hpp): periodic, wall or bounce.
 template <std::size_t Dim>
 engine::Boundary boundary_of(const UnitsN<Dim>& u, std::size_t k) noexcept {
@@ -155,5 +169,10 @@ void validate_radii(const UnitsN<Dim>& u, const std::vector<std::int64_t>& radiu
 /// Kinetic energy sum |v|^2 in 128 bits (lattice units).
 template <std::size_t Dim>
 u128 kinetic2(const std::vector<VecN<Dim>>& v) noexcept;
+/// Twice the energy in lattice units, 128 bits: sum |v|^2 plus, in a field, 2 |g| times each
+/// centre's distance from the wall plane the field pulls toward (0 or L; the potential, >= 0).
+/// Without a field it is kinetic2. Saturates at 2^128 - 1 (only a state far beyond vmax).
+template <std::size_t Dim>
+u128 energy2(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v) noexcept;
 
 }  // namespace revcol::lattice

@@ -1,0 +1,107 @@
+"""A uniform field on the lattice engine (docs/engine.md, "A uniform field"): the value run and
+its quantization, a gas under gravity forward and back bit for bit (2D and 3D, exact and
+specular, a mixture), a checkpoint resumed bit for bit, energy with the potential kept, the
+wall pressure equal to the column's weight, and what a field refuses."""
+import numpy as np
+import pytest
+
+import revcol
+from revcol.lattice import LatticeSimulation, LatticeSimulation3D
+
+KEYS = ("x", "v", "streams", "bits", "bits_size", "particle_collisions", "clock", "collisions")
+
+
+def same(a: dict, b: dict) -> bool:
+    return all(np.array_equal(np.asarray(a[k]), np.asarray(b[k])) for k in KEYS)
+
+
+def gas(dim=2, n=300, g=-1.0, seed=5, **kw):
+    boundary = ["periodic"] * (dim - 1) + ["wall"]
+    cls = LatticeSimulation3D if dim == 3 else LatticeSimulation
+    return cls.random(n, phi=0.2, boundary=boundary, gravity=[0.0] * (dim - 1) + [g], seed=seed, **kw)
+
+
+def test_the_field_run_is_the_one_asked_within_its_quantization():
+    s = gas(g=-0.8)
+    g = s.gravity
+    assert g[0] == 0.0 and g[1] < 0.0
+    err = s.quantization["gravity_error"]
+    assert err <= 2.0 ** -12  # the automatic tick keeps |g| >= 2^12 lattice units per tick^2
+    assert abs(g[1] / -0.8 - 1.0) <= err * (1 + 1e-9)
+    u = s.units
+    assert u["gravity"][1] % 2 == 0 and abs(u["gravity"][1]) >= 2 ** 12
+    # one engine's keyword: Simulation.random(engine="lattice") hands it over
+    t = revcol.Simulation.random(200, 2, 0.2, boundary=["periodic", "wall"], gravity=[0.0, -0.8], engine="lattice", seed=5)
+    assert t.engine == "lattice" and t.gravity[1] < 0
+
+
+@pytest.mark.parametrize("dim,mode,sizes", [(2, "exact", None), (2, "specular", None), (3, "exact", None),
+                                            (2, "exact", "binary")])
+def test_forward_and_back_bit_for_bit_from_a_midpoint(dim, mode, sizes):
+    n = 300
+    diameters = None if sizes is None else [1.0 if i % 2 else 1.4 for i in range(n)]
+    s = gas(dim, n, mode=mode, diameters=diameters)
+    s0 = s.snapshot()
+    h0 = s.positions[:, -1].mean()
+    s.run(collisions=6000)
+    s1 = s.snapshot()
+    s.run(collisions=6000)
+    assert s.positions[:, -1].mean() < h0  # it fell
+    d = s.diagnostics()
+    assert abs(d["energy_drift"]) < 1e-8  # kinetic and potential, relative
+    lower, upper = d["field_wall_impulse"]
+    assert lower > 0
+    # a checkpoint at the midpoint resumes on the same bits
+    r = type(s).from_snapshot(s1)
+    r.run(collisions=6000)
+    assert same(r.snapshot(), s.snapshot())
+    s.run_back(to_collision=6000)
+    assert same(s.snapshot(), s1)
+    s.run_back()
+    assert same(s.snapshot(), s0)
+
+
+def test_a_checkpoint_file_carries_the_field(tmp_path):
+    s = gas(seed=7)
+    s.run(collisions=3000)
+    f = tmp_path / "g.npz"
+    s.save(str(f))
+    r = LatticeSimulation.load(str(f))
+    assert np.array_equal(r.gravity, s.gravity)
+    s.run(collisions=2000)
+    r.run(collisions=2000)
+    assert same(r.snapshot(), s.snapshot())
+
+
+def test_the_walls_carry_the_weight_of_the_column():
+    # momentum balance over a window: lower wall less upper = N |g| t, up to the change of the
+    # gas's own momentum (bounded by a few thermal momenta: sqrt(N) v_rms), here < 1%
+    s = gas(n=400, g=-0.5, seed=11)
+    s.run(collisions=40000)
+    d0 = s.diagnostics()
+    s.run(collisions=200000)
+    d1 = s.diagnostics()
+    lower = d1["field_wall_impulse"][0] - d0["field_wall_impulse"][0]
+    upper = d1["field_wall_impulse"][1] - d0["field_wall_impulse"][1]
+    weight = 400 * abs(s.units["gravity"][1]) * (d1["clock"] - d0["clock"])
+    assert abs((lower - upper) / weight - 1.0) < 0.01
+
+
+def test_what_a_field_refuses():
+    with pytest.raises(ValueError, match="walled axis"):
+        LatticeSimulation.random(100, phi=0.2, boundary="periodic", gravity=[0.0, -1.0])
+    with pytest.raises(ValueError, match="one component per axis"):
+        LatticeSimulation.random(100, phi=0.2, boundary=["periodic", "wall"], gravity=[-1.0])
+    with pytest.raises(ValueError, match="one axis"):
+        LatticeSimulation.random(100, phi=0.2, boundary="wall", gravity=[-1.0, -1.0])
+    with pytest.raises(ValueError, match="one worker"):
+        LatticeSimulation.random(100, phi=0.2, boundary=["periodic", "wall"], gravity=[0.0, -1.0], workers=2)
+    with pytest.raises(ValueError, match="resolution"):
+        LatticeSimulation.random(100, phi=0.2, boundary=["periodic", "wall"], gravity=[0.0, -1e-12], tick_bits=26)
+    s = gas()
+    before = s.snapshot()
+    with pytest.raises(ValueError, match="field"):
+        s.observe()
+    with pytest.raises(ValueError, match="field"):
+        s.search = 1.0
+    assert same(s.snapshot(), before)
