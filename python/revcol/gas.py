@@ -297,11 +297,12 @@ class _GasRun:
             "interrupted": self.interrupted,
             "energy_drift_turn": float(diag_turn["energy_drift"]), "energy_drift_end": float(diag_end["energy_drift"]),
             "momentum_drift_turn": self.momentum_drift(diag_turn), "momentum_drift_end": self.momentum_drift(diag_end),
-            "drift_definitions": {"energy": "(E - E0) / E0",
+            "drift_definitions": {"energy": "(E - E0) / E0, E kinetic (plus the potential in a field)",
                                   "momentum": "|P - P0| / sqrt(2 E0 N) over the periodic axes (None: walls only, or a bounce-back wall)"},
             "log_bytes_turn": int(diag_turn["log_bytes"]), "log_bytes_end": int(diag_end["log_bytes"]),
             "reverse_failures": int(diag_end["events"]["reverse_failures"]),
             "observe": self.observation.to_dict() if self.observation is not None else None,
+            "gravity": sim.gravity.tolist() if sim.gravity.any() else None,  # the field run (None: none)
             # the collision trace (docs/robustness.md): where the reversal was found off the forward run
             "divergence": diag_end["divergence"], "diverged_at": diag_end["diverged_at"],
             "verified_at": diag_end["verified_at"],

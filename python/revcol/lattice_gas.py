@@ -308,6 +308,8 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "parallel_back": None if run.parallel_back is None else {**sim.parallel, **run.parallel_back},
         "mode": sim.mode,
         "quantization": sim.quantization,
+        # the field run, quantized once (its relative rounding: quantization's gravity_error); None: none
+        "gravity": sim.gravity.tolist() if sim.gravity.any() else None,
         "collisions_forward": done, "collisions_back": run.back, "per_particle": 2.0 * done / n,
         "time_start": 0.0, "time_turn": run.t_turn, "time_end": sim.time, "clock_turn": run.clock_turn,
         "clock_end": sim.clock,
@@ -332,7 +334,8 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "multi_body": int(d_turn["multi_body"]), "wall_body": int(d_turn["wall_body"]),
         "energy_drift_turn": float(d_turn["energy_drift"]), "energy_drift_end": float(d_end["energy_drift"]),
         "momentum_drift_turn": momentum(d_turn), "momentum_drift_end": momentum(d_end),
-        "drift_definitions": {"energy": "(E - E0) / E0, E = sum |v|^2 on the integers",
+        "drift_definitions": {"energy": "(E - E0) / E0, E = sum |v|^2 on the integers (in a field plus the potential, "
+                                        "2 |g| times each centre's height above the floor)",
                               "momentum": "P - P0 per periodic axis in lattice units (the operator moves it by "
                                           "at most one unit per collision), and |P - P0| / sqrt(2 E0 N)"},
         "events_turn": {k: int(d_turn[k]) for k in ("events", "walls", "crossings", "stale")},

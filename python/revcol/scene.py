@@ -47,6 +47,7 @@ file and the replacement.
                                   # auto: random up to the engine's rsa_fraction, else crystal
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
+    gravity = [0.0, -1.0]         # a uniform field, one component per axis, along one walled axis (default none)
 
     [collisions]
     engine = "float"              # gas only: "float" | "lattice" (2D and 3D, exact or specular mode,
@@ -126,10 +127,11 @@ import numpy as np
 from . import _core
 from ._toml import read_toml, shipped_dirs
 from .engine import Simulation
-from .lattice import LatticeSimulation
+from .lattice import LatticeSimulation, LatticeSimulation3D
 from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINE_MODES,  # noqa: F401 (__all__)
                            ENGINES, KINDS, LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES,
-                           SceneError, _check, _check_lattice, _check_mode, _fail, _modernize, with_lattice_options)
+                           SceneError, _check, _check_lattice, _check_mode, _fail, _modernize, field_text, scene_field,
+                           with_lattice_options)
 from ._species import check_masses, parse_species, sized_options, species_volume
 from .statesave import variants as statesave_variants
 from .verify import verify_cases
@@ -184,6 +186,7 @@ class Scene:
     max_output: int | None = None  # [output] max_output in bytes, 0: no limit (None: revcol._outputs' default)
     observe: dict[str, Any] | None = None  # [observe]: Simulation.observe's arguments (None: no table)
     species: tuple = ()  # [[species]] (revcol._species.Species): a mixture; () one diameter
+    gravity: tuple[float, ...] | None = None  # [system] gravity: a uniform field (None: none)
     name: str = "scene"
     description: str = ""
     source: str = "<built-in>"
@@ -206,8 +209,9 @@ class Scene:
         engine = "lattice engine, " if self.engine == "lattice" else ""
         sizes = (", ".join(f"{s.count} {s.name} (d = {s.diameter:g})" for s in self.species) if self.species
                  else f"sigma = {self.diameter:g}")
+        field = f", gravity {field_text(self.gravity)}" if self.gravity else ""
         return (f"{self.name}: {self.particles} particles in {self.dimension}D, {sizes}, "
-                f"box {box} ({', '.join(self.boundaries)}), {engine}{self.mode}{law}, {self.generator} "
+                f"box {box} ({', '.join(self.boundaries)}){field}, {engine}{self.mode}{law}, {self.generator} "
                 f"{self.streams} seed {self.seed}, {end}")
 
     def to_dict(self) -> dict[str, Any]:
@@ -389,6 +393,7 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
         raise _fail(source, "[output] trajectory", f"must end in .xyz (extended XYZ) or .gsd, got {trajectory.name!r}")
 
     observe = _observe(source, values, d, n, bounds, engine) if "observe" in common["extra"]["tables"] else None
+    gravity = scene_field(source, get, d, bounds, engine, observe is not None)
 
     scene = Scene(
         dimension=d, particles=n, diameter=sigma, box=tuple(box), packing_fraction=phi,
@@ -401,7 +406,7 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
         checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
         json=out("json"), plot=out("plot"), trajectory=trajectory,
         trajectory_every=get("output", "trajectory_every", 100), max_output=get("output", "max_output"),
-        observe=observe, species=species, **common)
+        observe=observe, species=species, gravity=gravity, **common)
     if arrays is not None:
         _check_initial(source, scene, *arrays)
     return scene
@@ -518,7 +523,7 @@ def _check_initial(source: str, scene: Scene, x, v) -> None:
     speed range it cannot hold, an overlap after rounding) is the one the run will meet."""
     try:
         if scene.engine == "lattice":
-            LatticeSimulation(x, v, scene.box, **lattice_options(scene))
+            (LatticeSimulation3D if scene.dimension == 3 else LatticeSimulation)(x, v, scene.box, **lattice_options(scene))
         else:
             Simulation(x, v, scene.box, **engine_options(scene))
     except ValueError as e:
@@ -532,14 +537,14 @@ def engine_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.Simulation` that a gas scene sets."""
     return sized_options(scene.species, dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode,
                          law=scene.law, seed=scene.seed, bits=scene.bits, generator=scene.generator,
-                         streams=scene.streams), masses=True)
+                         streams=scene.streams, gravity=scene.gravity), masses=True)
 
 
 def lattice_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.lattice.LatticeSimulation` that a gas scene sets."""
     opts = dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
                 seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search,
-                workers=scene.workers)
+                workers=scene.workers, gravity=scene.gravity)
     return sized_options(scene.species, opts)
 
 
@@ -555,9 +560,9 @@ def scene_names() -> list[str]:
 
 
 def observes_frames(scene: Scene, trajectory) -> bool:
-    """Whether a run writing ``trajectory`` observes (unreported, in its checkpoints) for the image
-    flags of a periodic box's frames: when the scene's own ``[observe]`` does not already."""
-    return trajectory is not None and scene.observe is None and "periodic" in scene.boundaries
+    """Whether a run writing ``trajectory`` observes (unreported, in its checkpoints) for the image flags of a
+    periodic box's frames: when its own ``[observe]`` does not already, nor a field forbids it (then inferred)."""
+    return trajectory is not None and scene.observe is None and not scene.gravity and "periodic" in scene.boundaries
 
 
 def find_scene(name: str) -> Path | None:

@@ -1,20 +1,22 @@
 """The scene file's schema: its tables and fields, each with its type and allowed values; the
-fields each kind of scene uses; the old spellings still read; the built-in default scene; and
-the check of one field against them (:class:`SceneError` naming it). :mod:`revcol.scene`
-reads a scene with them (and re-exports the public names).
+fields each kind of scene uses; the old spellings still read; the built-in default scene; the
+check of one field against them (:class:`SceneError` naming it); and the uniform field's checks
+against the system and the engine's options (``[system] gravity``: :func:`scene_field`).
+:mod:`revcol.scene` reads a scene with them (and re-exports the public names).
 """
 from __future__ import annotations
 
 import dataclasses
 import math
 import warnings
-from typing import Any
+from typing import Any, Iterable, Sequence
 
 from . import _core
 from ._args import size
 
 __all__ = ["KINDS", "ENGINES", "ENGINE_MODES", "LIMITS", "DEFAULT_SCENE", "SCHEMA", "USES", "DEPRECATED",
-           "LATTICE_FIELDS", "SceneError", "with_lattice_options"]
+           "LATTICE_FIELDS", "SceneError", "with_lattice_options", "check_gravity", "check_field_options",
+           "scene_field", "field_text"]
 
 #: the kinds of scene
 KINDS = ("gas", "reversal", "statesave")
@@ -55,6 +57,7 @@ SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "start": ("str", ("auto", "random", "crystal")),
         "kinetic_energy": ("float", (0.0, None)),
         "initial_state": ("str", None),
+        "gravity": ("vector", None),  # a uniform field, one component per axis (scene_field)
     },
     "collisions": {
         "engine": ("str", ENGINES),
@@ -216,6 +219,13 @@ def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: An
             return value if isinstance(value, str) else float(value)
         raise _fail(source, where, f"must be 'auto', 'cells' or a shell in diameters, {allowed[0]:g}..{allowed[1]:g}, "
                     f"got {value!r}")
+    if kind == "vector":  # components of any sign, one per axis (the length is the system's: check_gravity)
+        if not isinstance(value, list) or not value:
+            raise _fail(source, where, f"must be a list of numbers, one per axis, got {value!r}")
+        for k, v in enumerate(value):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise _fail(source, where, f"component {k} must be a finite number, got {v!r}")
+        return tuple(float(v) for v in value)
     if kind in ("floats", "ints"):
         if not isinstance(value, list) or not value:
             raise _fail(source, where, f"must be a non-empty list of numbers, got {value!r}")
@@ -247,7 +257,8 @@ def with_lattice_options(scene, *, tick_bits: int | None = None, cell_bits: int 
                          search: str | float | None = None, workers: int | None = None):
     """``scene`` with the lattice engine's options that are not None replaced (``revcol run`` and
     ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``, ``--workers``), each checked as its
-    ``[collisions]`` field; a scene that does not run the lattice engine refuses them."""
+    ``[collisions]`` field; a scene that does not run the lattice engine refuses them, and one with a
+    field (``[system] gravity``) more than one worker and a neighbour-list shell (check_field_options)."""
     given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search, workers)) if v is not None}
     flags = {k: "--" + k.replace("_", "-") for k in given}
     if given and (scene.kind != "gas" or scene.engine != "lattice"):
@@ -258,4 +269,74 @@ def with_lattice_options(scene, *, tick_bits: int | None = None, cell_bits: int 
             given[k] = _check(scene.source, "collisions", k, v, *SCHEMA["collisions"][k])
         except SceneError as e:
             raise SceneError(str(e).replace(f"[collisions] {k}", flags[k])) from None
-    return dataclasses.replace(scene, **given)
+    out = dataclasses.replace(scene, **given)
+    check_field_options(scene.source, out.gravity, out.engine, workers=out.workers, search=out.search, names=flags)
+    return out
+
+
+# --- the uniform field: [system] gravity ---------------------------------------------------------
+# an acceleration in the scene's units (diameters per time unit squared, unit mass), one component
+# per axis, nonzero along one walled axis at most (docs/run.md "A uniform field"); checked against
+# the system and against what runs no field yet before any engine is built, so that a scene is
+# refused by name rather than by the engine mid-run
+
+_GRAVITY = "[system] gravity"
+
+
+def check_gravity(source: str, gravity: Sequence[float] | None, d: int,
+                  bounds: Sequence[str]) -> tuple[float, ...] | None:
+    """The field a scene runs (None: none; a zero field is none), checked against its ``d`` axes
+    and their ``bounds``: one component per axis, nonzero on one axis at most, and that axis
+    walled (a periodic axis has no floor). ``gravity`` has passed the schema (finite numbers)."""
+    if gravity is None:
+        return None
+    if len(gravity) != d:
+        raise _fail(source, _GRAVITY, f"needs {d} components for dimension {d} (one per axis), got {len(gravity)}")
+    axes = [k for k, g in enumerate(gravity) if g != 0.0]
+    if not axes:
+        return None
+    if len(axes) > 1:
+        raise _fail(source, _GRAVITY, f"must be nonzero along one axis at most, got {list(gravity)}")
+    if bounds[axes[0]] == "periodic":
+        raise _fail(source, _GRAVITY, f"points along axis {axes[0]}, which is periodic: a field needs walls "
+                    "('wall' or 'bounce') on its axis (a periodic axis has no floor)")
+    return tuple(gravity)
+
+
+def check_field_options(source: str, gravity: Sequence[float] | None, engine: str, *, workers: int = 1,
+                        search: str | float = "auto", observe: bool = False, names: dict | None = None) -> None:
+    """Refuses, naming the option, what runs no field yet: on the lattice engine more than one
+    worker or neighbour lists (``search`` a shell; ``"auto"`` takes the cell grid there), and on
+    either engine an observed run (``observe``: an ``[observe]`` table; the observer assumes
+    straight lines between events). ``names`` renames an option where it came from the command
+    line (``{"workers": "--workers"}``)."""
+    if gravity is None:
+        return
+    names = names or {}
+    why = "in a field ([system] gravity)"
+    if observe:
+        raise _fail(source, "[observe]", f"is not available {why}: neither engine's observer takes one yet "
+                    "(it assumes straight lines between events); take trajectory frames instead")
+    if engine != "lattice":
+        return
+    if workers > 1:
+        raise _fail(source, names.get("workers", "[collisions] workers"), f"engine = 'lattice' runs a gas {why} on "
+                    f"one worker (the parallel engine is not built for a field yet), got {workers}")
+    if search not in ("auto", "cells"):
+        raise _fail(source, names.get("search", "[collisions] search"), f"engine = 'lattice' searches a gas {why} with "
+                    f"the cell grid only ('auto' or 'cells'; no neighbour lists for curved paths yet), got {search!r}")
+
+
+def scene_field(source: str, get, d: int, bounds: Sequence[str], engine: str,
+                observed: bool) -> tuple[float, ...] | None:
+    """A gas scene's field from its checked fields (``get(table, key, default)``), its ``d`` axes'
+    ``bounds`` and its ``engine``, ``observed`` when it has an ``[observe]`` table: both checks."""
+    gravity = check_gravity(source, get("system", "gravity"), d, bounds)
+    check_field_options(source, gravity, engine, workers=get("collisions", "workers", 1),
+                        search=get("collisions", "search", "auto"), observe=observed)
+    return gravity
+
+
+def field_text(gravity: Iterable[float] | None) -> str:
+    """A field as the reports write it, ``"(0, -1)"`` (6 significant digits), or ``"none"``."""
+    return "none" if gravity is None else f"({', '.join(f'{float(c):.6g}' for c in gravity)})"

@@ -8,9 +8,10 @@ import math
 from pathlib import Path
 
 from ..roundtrip import BAR, ERROR_DEFINITIONS, divergence_text
+from ..scene_schema import field_text
 from ..studies.statesave.output import format_table
 
-__all__ = ["format_report", "format_horizon", "verify_lines"]
+__all__ = ["format_report", "format_horizon", "verify_lines", "field_line"]
 
 
 def _si(x: float | None, unit: str = "") -> str:
@@ -47,12 +48,26 @@ def format_report(r: dict) -> str:
     return "\n".join(lines)
 
 
+def field_line(r: dict) -> list[str]:
+    """The uniform field's line (none without one): the field run, on the lattice (a report with
+    ``quantization``) its relative rounding; the energy drifts then include its potential."""
+    g = r.get("gravity")
+    if not g:
+        return []
+    axis = next(k for k, c in enumerate(g) if c)
+    err = (r.get("quantization") or {}).get("gravity_error")
+    rounding = "" if err is None else f", quantized once to an even integer per tick^2 (within {err:.2g} relative)"
+    return [f"  field            gravity {field_text(g)} along axis {axis}{rounding}; "
+            "the energy includes its potential"]
+
+
 def _float_lines(r: dict) -> list[str]:
     """A float-engine gas round trip: rates, errors against the bar, drifts, log, memory."""
     drift_p = ("n/a (walls on every axis)" if r["momentum_drift_turn"] is None else
                f"{r['momentum_drift_turn']:+.2g} at the turn, {_si(r['momentum_drift_end'])} after reversal "
                "(periodic axes)")
     lines = [
+        *field_line(r),
         f"  forward          {r['collisions_forward']:,} collisions ({r['per_particle']:.3g} per particle) to "
         f"t = {r['time_turn']:.6g} in {_duration(r['forward_s'])}: {_si(r['forward_per_s'])} collisions/s",
         f"  reverse          {r['collisions_back']:,} collisions back to t = {r['time_end']:.6g} in "
@@ -134,6 +149,7 @@ def _lattice_lines(r: dict) -> list[str]:
         f"units (a typical particle moves 2^-{u['tick_bits']} sigma per tick), 2^{u['cell_bits']} direction cells",
         f"  settings         mode {r.get('mode', 'exact')}, tick_bits {u['tick_bits']}, cell_bits {u['cell_bits']}, "
         f"search {_search(r.get('search'))}",
+        *field_line(r),
         *parallel_line(r.get("parallel")),
         *parallel_line(r.get("parallel_back"), back=True),
         f"  start            quantized once: positions within {_err(q['max_position_error'], 'diameters')}, "

@@ -44,6 +44,8 @@ import time as _time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .._args import integer
 from .._io import write_json
 from .._version import __version__
@@ -54,11 +56,12 @@ from .._outputs import Output, check_outputs, checkpoint_names, estimates, outpu
 from ..gas import build_simulation, check_memory
 from ..lattice import LatticeSimulation, add_reports
 from ..lattice_gas import geometry as lattice_geometry
-from .report import parallel_line
+from .report import field_line, parallel_line
 from ..observe import report_lines
 from ..progress import Bar, Interrupt, peak_rss
 from ..roundtrip import geometry
 from ..scene import Scene, SceneError, load_scene, observes_frames, with_engine, with_lattice_options, with_mode
+from ..scene_schema import field_text
 from ..trajectory import _species, check_format, open_trajectory, true_images  # revcol simulate writes frames
 
 __all__ = ["simulate", "format_simulate"]
@@ -139,7 +142,21 @@ def _build(scene: Scene, resume):
     if mode != scene.mode:  # the checkpoint's dynamics go on; a scene asking for others is a mistake
         raise SceneError(f"{scene.source}: --resume {os.fspath(resume)!r}: the checkpoint runs {mode} mode, the "
                          f"scene {scene.mode} mode (--mode {mode} resumes it)")
+    rounding = sim.quantization.get("gravity_error", 0.0) if isinstance(sim, LatticeSimulation) else 0.0
+    if _field_mismatch(sim.gravity, scene.gravity, rounding):  # nor another field
+        raise SceneError(f"{scene.source}: --resume {os.fspath(resume)!r}: the checkpoint runs gravity "
+                         f"{field_text(sim.gravity if sim.gravity.any() else None)}, the scene "
+                         f"{field_text(scene.gravity)} ([system] gravity)")
     return sim
+
+
+def _field_mismatch(run: np.ndarray, scene: tuple[float, ...] | None, rounding: float = 0.0) -> bool:
+    """Whether the field an engine runs (``run``, its ``.gravity``) is not the scene's (None:
+    none), beyond the relative ``rounding`` the lattice quantized it with (its
+    ``quantization["gravity_error"]``): a checkpoint resumed under another scene's field."""
+    want = np.zeros_like(run) if scene is None else np.asarray(scene, dtype=float)
+    scale = float(np.abs(want).max(initial=0.0))
+    return bool(np.abs(run - want).max(initial=0.0) > (rounding + 1e-12) * scale)
 
 
 def _mode(sim) -> str:
@@ -304,6 +321,9 @@ class _Production:
             "parallel": None if self.parallel is None else {**sim.parallel, **self.parallel},
             # the lattice's specular pairs turned back in place (specular.hpp); None on the float engine
             "backscatters": int(d["backscatters"]) if self.lattice else None,
+            # the field run (None: none) and, on the lattice, its rounding (quantization's gravity_error)
+            "gravity": sim.gravity.tolist() if sim.gravity.any() else None,
+            "quantization": sim.quantization if self.lattice else None,
             "resumed_from": None if resume is None else os.fspath(resume),
             "collisions": ran, "net_collisions": self.done, "collisions_per_particle": 2.0 * ran / sim.n,
             "time_start": self.t_start, "time_end": sim.time,
@@ -419,6 +439,7 @@ def format_simulate(r: dict) -> str:
              + (f"  (resumed from {r['resumed_from']})" if r["resumed_from"] else "")
              + (f"  (tick_bits {r['lattice']['tick_bits']}, cell_bits {r['lattice']['cell_bits']}, search "
                 f"{r['lattice']['search']})" if r.get("lattice") else ""),
+             *field_line(r),
              *parallel_line(r.get("parallel")),
              f"  collisions       {r['collisions']:,} ({r['collisions_per_particle']:.3g} per particle; "
              f"net count now {r['net_collisions']:,})",
