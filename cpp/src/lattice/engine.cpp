@@ -51,11 +51,13 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
   double gmax = 0.0;  // the strongest field component, float units
   for (double g : c.gravity) gmax = std::max(gmax, std::isfinite(g) ? std::fabs(g) : 0.0);
   if (c.tick_bits == auto_tick_bits && gmax > 0.0) {
-    // a field and the automatic tick: a coarser tick until g is at least 2^12 lattice units per
-    // tick^2 (its even rounding then within 2^-12 relative; each bit of tick is a factor 4; a
-    // coarser tick makes third bodies within a tick, so groups and redraws, more frequent)
+    // a field and the automatic tick: a coarser tick until g is at least 2^8 lattice units per
+    // tick^2 (its even rounding then within 2^-8 relative; each bit of tick is a factor 4). A
+    // coarser tick makes third bodies within a tick, so groups and redraws, more frequent, and
+    // the fall heats the gas (kT ~ 50 in a 2D box 160 tall under g = 1), which coarsens it
+    // again: at 2^12 the rare log passed 1e-5 per collision (docs/engine.md, measured)
     int T = s.units.tick_bits;
-    while (T > min_tick_bits && gmax * s.units.tick * s.units.tick / s.units.length_unit < 0x1p12) {
+    while (T > min_tick_bits && gmax * s.units.tick * s.units.tick / s.units.length_unit < 0x1p8) {
       --T;
       s.units = choose_units_d<D>(c.box, dmax, v_rms, c.wall, T, c.cell_bits, n);
     }

@@ -17,7 +17,6 @@
 // discriminant (128 bits: |v| <= vmax <= 2^52, |h| <= 2^35, |x| < 2^62) and checked by exact
 // evaluation at the tick, never from a double root alone.
 #pragma once
-#include <cmath>
 #include <cstdint>
 
 #include "revcol/lattice/int128.hpp"
@@ -32,15 +31,6 @@ inline i128 field_point(std::int64_t x, std::int64_t v, std::int64_t h, std::int
                            static_cast<u128>(static_cast<i128>(h)) * N * N);
 }
 
-/// floor(sqrt(a)) for a >= 0, exact.
-inline u128 isqrt128(u128 a) noexcept {
-  if (a == 0) return 0;
-  u128 r = static_cast<u128>(std::sqrt(static_cast<long double>(a)));
-  while (r > 0 && r * r > a) --r;
-  while ((r + 1) * (r + 1) <= a) ++r;
-  return r;
-}
-
 /// The first integer n >= 1 with A n^2 + B n + C < 0, or -1 if none; C >= 0 (not below at n = 0).
 /// The root comes from an exact integer square root; each candidate is evaluated exactly.
 inline std::int64_t first_negative(i128 A, i128 B, i128 C) noexcept {
@@ -52,7 +42,7 @@ inline std::int64_t first_negative(i128 A, i128 B, i128 C) noexcept {
   const i128 disc = B * B - 4 * A * C;
   if (A > 0) {  // convex: negative only between the roots, if any integer lies between them
     if (B >= 0 || disc <= 0) return -1;
-    const i128 s = static_cast<i128>(isqrt128(static_cast<u128>(disc)));
+    const i128 s = static_cast<i128>(isqrt(static_cast<u128>(disc)));
     // the lower root is (-B - sqrt(disc)) / 2A >= (-B - s - 1) / 2A: start at or before it
     i128 n = (-B - s - 1) / (2 * A);
     if (n < 1) n = 1;
@@ -64,7 +54,7 @@ inline std::int64_t first_negative(i128 A, i128 B, i128 C) noexcept {
   }
   // concave: negative beyond the upper root (B + sqrt(disc)) / 2|A|, which is >= 0 since C >= 0
   const i128 a = -A;
-  const i128 s = static_cast<i128>(isqrt128(static_cast<u128>(disc)));
+  const i128 s = static_cast<i128>(isqrt(static_cast<u128>(disc)));
   i128 n = (B + s) / (2 * a);
   if (n < 1) n = 1;
   while (q(n) >= 0) ++n;  // at most two steps from the floor of the root
