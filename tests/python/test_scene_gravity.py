@@ -114,7 +114,7 @@ def test_the_lattice_runs_the_field_and_reverses_it_bit_for_bit():
     sim = build_simulation(scene("lattice"))
     # quantized once to an even integer per tick^2: the value run is the scene's within its rounding
     err = sim.quantization["gravity_error"]
-    assert sim.gravity[0] == 0.0 and 0.0 <= err < 1e-3 and sim.gravity[1] == pytest.approx(-1.0, rel=2 * err + 1e-15)
+    assert sim.gravity[0] == 0.0 and 0.0 <= err <= 2.0 ** -8 and sim.gravity[1] == pytest.approx(-1.0, rel=2 * err + 1e-15)
     s0, y0 = sim.snapshot(), mean_height(sim)
     sim.run(collisions=2000)
     assert mean_height(sim) < y0 - 0.5
@@ -138,7 +138,7 @@ def test_every_start_gets_the_field(engine, tmp_path):
     for s in (box, scene_from_dict(mixture, "m.toml"), scene_from_dict(initial, "i.toml")):
         sim = build_simulation(s)
         g = s.gravity[1]
-        assert sim.gravity[0] == 0.0 and sim.gravity[1] == pytest.approx(g, rel=1e-3), s.source
+        assert sim.gravity[0] == 0.0 and sim.gravity[1] == pytest.approx(g, rel=2.0 ** -8), s.source
 
 
 @pytest.mark.parametrize("engine", ["float", "lattice"])
@@ -153,7 +153,7 @@ def test_a_3d_initial_state_falls_along_z(engine, tmp_path):
            "collisions": {"engine": engine}, "rng": {"generator": "philox"}, "run": {"collisions": 50}}
     sim = build_simulation(scene_from_dict(doc, "s3.toml", tmp_path))
     z0 = float(np.mean(sim.positions[:, 2]))
-    assert sim.gravity[2] == pytest.approx(-1.0, rel=1e-3) and not sim.gravity[:2].any()
+    assert sim.gravity[2] == pytest.approx(-1.0, rel=2.0 ** -8) and not sim.gravity[:2].any()
     sim.run(collisions=50)
     assert float(np.mean(sim.positions[:, 2])) < z0
 
@@ -167,7 +167,7 @@ def test_revcol_run_the_shipped_scene(engine, tmp_path, capsys):
     text = capsys.readouterr().out
     assert rc == 0, text
     r = json.loads(out.read_text())
-    assert r["passed"] and r["gravity"][0] == 0.0 and r["gravity"][1] == pytest.approx(-1.0, rel=1e-3)
+    assert r["passed"] and r["gravity"][0] == 0.0 and r["gravity"][1] == pytest.approx(-1.0, rel=2.0 ** -8)
     assert "  field            gravity (0, -1) along axis 1" in text and "gravity (0, -1)" in r["summary"]
     if engine == "lattice":
         assert r["bit_for_bit"] and "quantized once to an even integer per tick^2" in text
@@ -179,7 +179,7 @@ def test_revcol_simulate_runs_the_field_and_resumes_it(engine, tmp_path):
     ckpt = tmp_path / "ck"
     r = simulate(SCENES / "sedimentation.toml", engine=engine, collisions=400, checkpoints=ckpt, checkpoint_every=200,
                  progress=False)
-    assert r["gravity"][1] == pytest.approx(-1.0, rel=1e-3) and abs(r["energy_drift"]) < 1e-6
+    assert r["gravity"][1] == pytest.approx(-1.0, rel=2.0 ** -8) and abs(r["energy_drift"]) < 1e-6
     last = ckpt / "checkpoint-000000000400.npz"
     assert last.is_file()
     on = simulate(SCENES / "sedimentation.toml", engine=engine, collisions=100, resume=last, progress=False)

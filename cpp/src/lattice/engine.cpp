@@ -51,13 +51,18 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
   double gmax = 0.0;  // the strongest field component, float units
   for (double g : c.gravity) gmax = std::max(gmax, std::isfinite(g) ? std::fabs(g) : 0.0);
   if (c.tick_bits == auto_tick_bits && gmax > 0.0) {
-    // a field and the automatic tick: a coarser tick until g is at least 2^8 lattice units per
-    // tick^2 (its even rounding then within 2^-8 relative; each bit of tick is a factor 4). A
-    // coarser tick makes third bodies within a tick, so groups and redraws, more frequent, and
-    // the fall heats the gas (kT ~ 50 in a 2D box 160 tall under g = 1), which coarsens it
-    // again: at 2^12 the rare log passed 1e-5 per collision (docs/engine.md, measured)
+    // a field and the automatic tick: a coarser tick (each bit a factor 4 on g in lattice units)
+    // until g's rounding to an even integer is within 2^-8 relative; g = 1 at kT = 1, a power of
+    // two there, keeps the tick. A coarser tick makes third bodies within a tick, so groups and
+    // redraws, more frequent, and the fall heats the gas (kT ~ 50 in a 2D box 160 tall under
+    // g = 1), which coarsens it again: a tick coarsened until |g| >= 2^12 units, then 2^8,
+    // passed 1e-5 log entries per collision there (docs/engine.md, measured)
+    auto rounding = [&](const UnitsN<D>& u) {
+      const double gl = gmax * u.tick * u.tick / u.length_unit;
+      return gl < 2.0 ? 1.0 : std::fabs(2.0 * std::round(0.5 * gl) - gl) / gl;
+    };
     int T = s.units.tick_bits;
-    while (T > min_tick_bits && gmax * s.units.tick * s.units.tick / s.units.length_unit < 0x1p8) {
+    while (T > min_tick_bits && rounding(s.units) > 0x1p-8) {
       --T;
       s.units = choose_units_d<D>(c.box, dmax, v_rms, c.wall, T, c.cell_bits, n);
     }

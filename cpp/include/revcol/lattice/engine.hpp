@@ -59,7 +59,7 @@ struct LatticeConfigN {
   /// A uniform field: per axis the acceleration in float units (length / time^2), on at most
   /// one walled axis. It is quantized once to an even number of lattice units per tick^2
   /// (field.hpp), the rounding in LatticeStartN::gravity_error. The automatic tick is then
-  /// coarsened (down to tick_bits 16) until g is at least 2^8 units (rounding within 2^-8); a
+  /// coarsened (down to tick_bits 16) until that rounding is within 2^-8 (the largest component's); a
   /// field below 2 units at a given tick is refused.
   std::array<double, D> gravity{};
 };
