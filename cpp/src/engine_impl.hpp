@@ -384,39 +384,10 @@ class EngineImpl final : public Simulation {
     repredict(i);
   }
 
-  // The list renewal: the centre moves to where i is now (wrapped into the box on periodic
-  // axes, moving the stored position by L: its line, and so every prediction, is unchanged),
-  // i's list is rebuilt (in 1D, the images of the rods beside it recoded: this is then the
-  // wrap) and i is predicted again. Nothing physical changes: no stamp.
-  void renew_event(int i, const Ev& e) {
-    if (field_) {  // a parabola's renewal time is bounded from its anchor: anchor it at e.t (the
-                   // same path, so no stamp changes and every prediction with i stands)
-      const std::uint64_t stamp = p_[i].stamp;
-      Kin::advance(p_[i], e.t, g_.data());
-      p_[i].stamp = stamp;
-    }
-    move_centre(i, e.t);
-    if (adjacent()) nl_.recode_beside(i, [&](int j) { return pos_at(j, 0, clock_); });
-    else nl_.renew(i);
-    ++counters_.list_renewals;
-    repredict(i);
-  }
-
-  // i's centre to where i is at t; on a periodic axis a position outside the box is first
-  // moved by L (its line, and so every prediction, is unchanged).
-  void move_centre(int i, double t) {
-    const double dt = t - p_[i].t;
-    double* c = nl_.centre(i);
-    for (int k = 0; k < Dim; ++k) {
-      if (field_ && g_[k] != 0.0) {  // a walled axis: no wrap
-        c[k] = pos_at(i, k, t);
-        continue;
-      }
-      double ck = p_[i].x[k] + p_[i].v[k] * dt;
-      if (box_.wrap(k, p_[i].x[k], ck)) ck = p_[i].x[k] + p_[i].v[k] * dt;
-      c[k] = ck;
-    }
-  }
+  // The list renewal (nothing physical changes: no stamp) and i's centre moved to where i is at
+  // t (engine_predict.hpp)
+  void renew_event(int i, const Ev& e);
+  void move_centre(int i, double t);
 
   // ---- random numbers -----------------------------------------------------------------
 

@@ -33,82 +33,26 @@ operator (``diagnostics()["drawn_fallbacks"]``).
 from __future__ import annotations
 
 import os
-from typing import Optional, Sequence, Union
+from typing import Optional, Union
 
 import numpy as np
 
 from . import _core
-from ._args import diameters_arg, integer, name, names, placement, real, real_array
+from ._args import diameters_arg, integer, name, placement, real, real_array
 from ._args import packing_fraction as _packing_fraction
 from ._io import write_checkpoint
+from ._lattice_args import MODES, _Boundary, _boundary, _gravity, _mode, _shell, _tick
 from ._lattice_state import (add_reports, legacy_snapshot as _legacy_snapshot, read_state as _read_state,
                              snapshot_shell as _snapshot_shell)
 from .simulation import SimulationBase, register_engine
 
 __all__ = ["LatticeSimulation", "LatticeSimulation3D", "MODES", "restart_from_legacy"]
 
-#: the lattice engine's modes: "exact" (the randomized pair operator, drawing its post direction
-#: by ``law``) and "specular" (deterministic specular dynamics: no draws; docs/lattice.md)
-MODES = ("exact", "specular")
-
-_Boundary = Union[str, Sequence[str]]
-
-
-def _boundary(boundary: _Boundary) -> list:
-    """One boundary name or one per axis, as the binding takes them (the C++ parser,
-    revcol/engine/boundary_kind.hpp, names a wrong one or a wrong count)."""
-    return names(boundary, "boundary")
-
-
-def _mode(mode, law) -> str:
-    """``mode`` checked against ``law``: a ValueError naming ``mode`` unless it is one of
-    :data:`MODES`, or naming ``law`` when specular mode is given a law other than the default
-    (it draws no post direction, so no law applies)."""
-    if not isinstance(mode, str) or mode not in MODES:
-        raise ValueError(f"mode must be 'exact' or 'specular', got {mode!r}")
-    if mode == "specular" and law != "flux":
-        raise ValueError(f"law applies to mode='exact' only (specular mode draws nothing), got law={law!r}")
-    return mode
-
-
-def _tick(tick_bits: Optional[int]) -> int:
-    """The binding's tick_bits: 0 asks for the automatic tick."""
-    return 0 if tick_bits is None else integer(tick_bits, "tick_bits", 16, 26)
-
-
-#: the neighbour searches by name, as the engine's list shell (BasicEngine::set_list_shell)
-SEARCHES = {"auto": -1.0, "cells": 0.0}
-
-
-def _shell(search: Union[str, float]) -> float:
-    """The engine's list shell for ``search``: ``"auto"`` -1, ``"cells"`` 0, or a shell in
-    diameters in [0.02, 2]; a ValueError naming ``search`` otherwise."""
-    if isinstance(search, str):
-        if search in SEARCHES:
-            return SEARCHES[search]
-        raise ValueError(f"search must be 'auto', 'cells' or a shell in diameters in [0.02, 2], got {search!r}")
-    s = real(search, "search")
-    if not 0.02 <= s <= 2.0:
-        raise ValueError(f"search = {s!r} is outside [0.02, 2] (a shell in diameters; or 'auto', 'cells')")
-    return s
-
-
 # the binding's engine class and start functions per dimension
 _ENGINE = {2: "LatticeEngine", 3: "LatticeEngine3D"}
 _RANDOM_START = {2: "lattice_random_start", 3: "lattice3d_random_start"}
 _QUANTIZE = {2: "lattice_quantize", 3: "lattice3d_quantize"}
 
-
-def _gravity(gravity, dim: int, workers: int = 1) -> list:
-    """A uniform field's components for the engine (empty: none); a field runs on one worker."""
-    if gravity is None:
-        return []
-    g = np.atleast_1d(real_array(gravity, "gravity")).astype(float)
-    if g.shape != (dim,):
-        raise ValueError(f"gravity must have one component per axis ({dim}), got shape {g.shape}")
-    if np.any(g != 0.0) and integer(workers, "workers", 1) > 1:
-        raise ValueError("gravity runs on one worker: the parallel lattice engine is not built for a field yet")
-    return g.tolist()
 
 class LatticeSimulation(SimulationBase):
     """N hard disks on the integer lattice, run forward and back bit for bit (2D; spheres in 3D:

@@ -127,7 +127,7 @@ import numpy as np
 from . import _core
 from ._toml import read_toml, shipped_dirs
 from .engine import Simulation
-from .lattice import LatticeSimulation, LatticeSimulation3D
+from . import lattice as _lattice  # noqa: F401 (registers engine="lattice": Simulation builds its classes)
 from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINE_MODES,  # noqa: F401 (__all__)
                            ENGINES, KINDS, LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES,
                            SceneError, _check, _check_lattice, _check_mode, _fail, _modernize, field_text, scene_field,
@@ -521,11 +521,9 @@ def _check_initial(source: str, scene: Scene, x, v) -> None:
     """Builds the engine once from the explicit state: its validation (finite values, inside
     the box, no overlap, non-zero kinetic energy; on the lattice also the quantization: a box or
     speed range it cannot hold, an overlap after rounding) is the one the run will meet."""
-    try:
-        if scene.engine == "lattice":
-            (LatticeSimulation3D if scene.dimension == 3 else LatticeSimulation)(x, v, scene.box, **lattice_options(scene))
-        else:
-            Simulation(x, v, scene.box, **engine_options(scene))
+    try:  # (engine="lattice": the lattice class of the positions' dimension, Simulation.__new__)
+        opts = lattice_options(scene) if scene.engine == "lattice" else engine_options(scene)
+        Simulation(x, v, scene.box, engine=scene.engine, **opts)
     except ValueError as e:
         raise _fail(source, "[system] initial_state", f"{scene.initial_state.name}: {e}") from None
 

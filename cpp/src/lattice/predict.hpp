@@ -39,6 +39,47 @@ template <class Op, class Bits, class Queue>
   return out;
 }
 
+// ---- a uniform field (field.hpp) ----
+// the parabola's point on the field's axis k, dt ticks from p's anchor (walled: no wrap), exact in 128 bits
+template <class Op, class Bits, class Queue>
+[[gnu::noinline]] std::int64_t BasicEngine<Op, Bits, Queue>::field_at(int p, std::size_t k, std::int64_t dt) const noexcept {
+  return static_cast<std::int64_t>(field_point(ln_[p].x[k], ln_[p].v[k], hg_, dt));
+}
+
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::vel(int p, std::int64_t t) const noexcept -> Vec {
+  Vec v = ln_[p].v;
+  if (gax_ >= 0) [[unlikely]]
+    v[gax_] = static_cast<std::int64_t>(static_cast<std::uint64_t>(v[gax_]) + 2 * static_cast<std::uint64_t>(hg_) * static_cast<std::uint64_t>(t - ln_[p].ta));
+  return v;
+}
+
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::move_of(int p, std::int64_t a) const noexcept -> Vec {
+  if (gax_ < 0) [[likely]] return ln_[p].v;
+  return plus_h(vel(p, a - 1));
+}
+
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::plus_h(Vec v) const noexcept -> Vec {
+  if (gax_ >= 0) [[unlikely]] v[gax_] += hg_;
+  return v;
+}
+
+// A position x (wrapped) unwrapped about p's list centre: c_p + min_image(x - c_p), in
+// (-L/2, 3L/2), as doubles (two roundings, each within 2^10 lattice units: no integer sum,
+// which could overflow a 2D box near 2^63). In exact arithmetic, two of them less the pair's
+// image shift (neighbour_lists.hpp) are the minimum-image difference of the two positions.
+template <class Op, class Bits, class Queue>
+inline std::array<double, BasicEngine<Op, Bits, Queue>::D> BasicEngine<Op, Bits, Queue>::unwrapped_about(int p, const Vec& x) const noexcept {
+  std::array<double, D> a{};
+  const Vec& c = nl_.centre(p);
+  for (std::size_t k = 0; k < D; ++k)
+    a[k] = u_.wall[k] ? static_cast<double>(x[k])
+                      : static_cast<double>(c[k]) + static_cast<double>(min_image(x[k] - c[k], u_.L[k]));
+  return a;
+}
+
 // Ticks from the anchor to the first at which the line's centre is in the next slab along the
 // regions' axis (set_regions), or -1 (still, or no face ahead before a wall).
 template <class Op, class Bits, class Queue>

@@ -299,31 +299,16 @@ class BasicEngine {
   // ---- geometry of the lines ----
   // p's point at tick t on its line, wrapped on periodic axes (predict.hpp)
   [[gnu::always_inline]] inline Vec pos(int p, std::int64_t t) const noexcept;
-  // a uniform field (field.hpp): its axis (-1 none) and half its acceleration h = g / 2; p's
-  // velocity at tick t; a velocity at a-1 as its tick's move (mid = v + h) and back (v = mid + h)
+  // a uniform field (field.hpp): its axis (-1 none) and half its acceleration h = g / 2
   int gax_ = -1;
   std::int64_t hg_ = 0;
   double hgd_ = 0.0;  // h as a double (the prediction's filter)
   std::array<std::uint8_t, D> axk_{};  // per axis: 0 periodic, 1 walls, 2 walls and the field (pos)
-  // the parabola's point on the field's axis k, dt ticks from p's anchor (walled: no wrap), exact in 128 bits
-  [[gnu::noinline]] std::int64_t field_at(int p, std::size_t k, std::int64_t dt) const noexcept {
-    return static_cast<std::int64_t>(field_point(ln_[p].x[k], ln_[p].v[k], hg_, dt));
-  }
-  Vec vel(int p, std::int64_t t) const noexcept {
-    Vec v = ln_[p].v;
-    if (gax_ >= 0) [[unlikely]]
-      v[gax_] = static_cast<std::int64_t>(static_cast<std::uint64_t>(v[gax_]) + 2 * static_cast<std::uint64_t>(hg_) * static_cast<std::uint64_t>(t - ln_[p].ta));
-    return v;
-  }
-  // p's move over the tick a-1 -> a: its velocity there (a field: at a-1, plus h)
-  Vec move_of(int p, std::int64_t a) const noexcept {
-    if (gax_ < 0) [[likely]] return ln_[p].v;
-    return plus_h(vel(p, a - 1));
-  }
-  Vec plus_h(Vec v) const noexcept {
-    if (gax_ >= 0) [[unlikely]] v[gax_] += hg_;
-    return v;
-  }
+  // the parabola's point on axis k; p's velocity at t; its move over a-1 -> a; v + h (predict.hpp)
+  [[gnu::noinline]] std::int64_t field_at(int p, std::size_t k, std::int64_t dt) const noexcept;
+  Vec vel(int p, std::int64_t t) const noexcept;
+  Vec move_of(int p, std::int64_t a) const noexcept;
+  Vec plus_h(Vec v) const noexcept;
   Vec diff(const Vec& a, const Vec& b) const noexcept {
     Vec r;
     for (std::size_t k = 0; k < D; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
@@ -447,18 +432,8 @@ class BasicEngine {
     double r;                 // a mixture: the radius (set by rebuild; the filter's contact distance)
   };
   std::vector<LineD> lnd_;
-  // a position x (wrapped) unwrapped about p's list centre: c_p + min_image(x - c_p), in
-  // (-L/2, 3L/2), as doubles (two roundings, each within 2^10 lattice units: no integer sum,
-  // which could overflow a 2D box near 2^63). In exact arithmetic, two of them less the pair's
-  // image shift (neighbour_lists.hpp) are the minimum-image difference of the two positions.
-  std::array<double, D> unwrapped_about(int p, const Vec& x) const noexcept {
-    std::array<double, D> a{};
-    const Vec& c = nl_.centre(p);
-    for (std::size_t k = 0; k < D; ++k)
-      a[k] = u_.wall[k] ? static_cast<double>(x[k])
-                        : static_cast<double>(c[k]) + static_cast<double>(min_image(x[k] - c[k], u_.L[k]));
-    return a;
-  }
+  // a position x (wrapped) unwrapped about p's list centre, as doubles (predict.hpp)
+  std::array<double, D> unwrapped_about(int p, const Vec& x) const noexcept;
   [[gnu::always_inline]] void sync(int p) noexcept {
     LineD& d = lnd_[static_cast<std::size_t>(p)];
     const Line& l = ln_[static_cast<std::size_t>(p)];
