@@ -91,7 +91,7 @@ void set_gravity(la::LatticeConfigN<D>& c, const std::vector<double>& g) {
 template <std::size_t D>
 py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<std::string> boundary, PyReal diameter_arg, PyInt seed_arg,
                         const std::string& init, PyInt tick_bits_arg, PyInt cell_bits_arg, std::vector<double> diameters,
-                        std::vector<double> gravity) {
+                        std::vector<double> gravity, PyReal shear_rate_arg) {
   const auto n = to_int<std::size_t>(n_arg, "n");
   const double phi = to_real(phi_arg, "phi"), diameter = to_real(diameter_arg, "diameter");
   const auto seed = to_int<std::uint64_t>(seed_arg, "seed", 0, 0xFFFFFFFFull);
@@ -104,13 +104,15 @@ py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<std::string> bo
   c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
   c.diameters = std::move(diameters);
   set_gravity(c, gravity);
+  c.shear_rate = to_real(shear_rate_arg, "shear_rate");
   return start_dict(la::random_start(c, n, phi, seed, init));
 }
 
 // lattice_quantize (2D) and lattice3d_quantize
 template <std::size_t D>
 py::dict quantize_d(const FArray& x, const FArray& v, std::vector<double> box, std::vector<std::string> boundary, PyReal diameter_arg,
-                    PyInt tick_bits_arg, PyInt cell_bits_arg, std::vector<double> diameters, std::vector<double> gravity) {
+                    PyInt tick_bits_arg, PyInt cell_bits_arg, std::vector<double> diameters, std::vector<double> gravity,
+                    PyReal shear_rate_arg) {
   const double diameter = to_real(diameter_arg, "diameter");
   const int tick_bits = to_int<int>(tick_bits_arg, "tick_bits");
   require(box.size() == D, D == 2 ? "lattice: box needs two lengths (2D)" : "lattice: box needs three lengths (3D)");
@@ -125,6 +127,7 @@ py::dict quantize_d(const FArray& x, const FArray& v, std::vector<double> box, s
   c.cell_bits = to_int<int>(cell_bits_arg, "cell_bits");
   c.diameters = std::move(diameters);
   set_gravity(c, gravity);
+  c.shear_rate = to_real(shear_rate_arg, "shear_rate");
   return start_dict(la::quantize_start(c, std::vector<double>(x.data(), x.data() + x.size()),
                                        std::vector<double>(v.data(), v.data() + v.size())));
 }
@@ -288,19 +291,19 @@ void register_engine(py::module_& m, const char* name, const char* doc) {
 void register_lattice(py::module_& m) {
   m.def("lattice_random_start", &random_start_d<2>, py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"),
         py::arg("seed"), py::arg("init"), py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
-        py::arg("diameters") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{},
+        py::arg("diameters") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{}, py::arg("shear_rate") = 0.0,
         "A random 2D start as engine_random_state, quantized once: {units, x, v, errors}.");
   m.def("lattice3d_random_start", &random_start_d<3>, py::arg("n"), py::arg("phi"), py::arg("boundary"), py::arg("diameter"),
         py::arg("seed"), py::arg("init"), py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
-        py::arg("diameters") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{},
+        py::arg("diameters") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{}, py::arg("shear_rate") = 0.0,
         "A random 3D start (spheres) as engine_random_state, quantized once: {units, x, v, errors}.");
   m.def("lattice_quantize", &quantize_d<2>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
         py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
-        py::arg("diameters") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{},
+        py::arg("diameters") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{}, py::arg("shear_rate") = 0.0,
         "Units from the box and rms speed, and one quantization: {units, x, v, errors}.");
   m.def("lattice3d_quantize", &quantize_d<3>, py::arg("x"), py::arg("v"), py::arg("box"), py::arg("boundary"), py::arg("diameter"),
         py::arg("tick_bits") = la::default_tick_bits, py::arg("cell_bits") = la::default_cell_bits,
-        py::arg("diameters") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{},
+        py::arg("diameters") = std::vector<double>{}, py::arg("gravity") = std::vector<double>{}, py::arg("shear_rate") = 0.0,
         "3D units from the box and rms speed, and one quantization of (n, 3) arrays: {units, x, v, errors}.");
   m.def(
       "lattice_initial_bits",

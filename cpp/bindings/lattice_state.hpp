@@ -83,6 +83,7 @@ py::dict units_dict(const la::UnitsN<D>& u) {
   d["tick_bits"] = u.tick_bits;
   d["cell_bits"] = u.cell_bits;
   d["gravity"] = tuple_of(u.gravity);  // lattice units per tick^2 (even; zero: no field)
+  d["shear"] = u.shear;                // Lees-Edwards: lattice units per tick (zero: none)
   return d;
 }
 template <std::size_t D>
@@ -123,6 +124,8 @@ la::UnitsN<D> units_from(const py::dict& d) {
     require(g.size() == D, D == 2 ? "lattice units: gravity needs two entries" : "lattice units: gravity needs three entries (3D)");
     for (std::size_t k = 0; k < D; ++k) u.gravity[k] = g[k];
   }
+  // shear arrived with Lees-Edwards; units without it have none
+  if (d.contains("shear")) u.shear = get<std::int64_t>(d, "shear");
   la::validate(u);
   return u;
 }
@@ -137,6 +140,7 @@ py::dict start_dict(const la::LatticeStartN<D>& s) {
   d["max_position_error"] = s.max_position_error;
   d["max_velocity_error"] = s.max_velocity_error;
   d["gravity_error"] = s.gravity_error;  // a field: |g_lattice - g| / |g| (0: none)
+  d["shear_error"] = s.shear_error;      // shear: |s_lattice - s| / |s| (0: none)
   return d;
 }
 

@@ -67,3 +67,13 @@ def _gravity(gravity, dim: int, workers: int = 1) -> list:
     if np.any(g != 0.0) and integer(workers, "workers", 1) > 1:
         raise ValueError("gravity runs on one worker: the parallel lattice engine is not built for a field yet")
     return g.tolist()
+
+
+def _shear(shear_rate, workers: int = 1) -> float:
+    """A Lees-Edwards shear rate for the engine (0: none); shear runs on one worker."""
+    if shear_rate is None:
+        return 0.0
+    g = real(shear_rate, "shear_rate")
+    if g != 0.0 and integer(workers, "workers", 1) > 1:
+        raise ValueError("shear runs on one worker: the parallel lattice engine is not built for shear yet")
+    return g

@@ -41,7 +41,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
-from ._args import diameters_arg, integer, masses_arg, names, placement, real_array
+from ._args import diameters_arg, integer, masses_arg, names, placement, real, real_array
 from ._args import packing_fraction as _packing_fraction
 from ._io import read_checkpoint, write_checkpoint
 from .roundtrip import divergence_text
@@ -90,10 +90,13 @@ class Simulation(SimulationBase):
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  bits: int = 40, groups: bool = True, group_tol: float = 1e-9,
                  time: float = 0.0, generator: str = "philox", streams: str = "per-particle",
-                 diameters=None, masses=None, gravity=None, _engine=None):
+                 diameters=None, masses=None, gravity=None, shear_rate=None, _engine=None):
         if _engine is not None:
             self._e = _engine
             return
+        if shear_rate is not None and real(shear_rate, "shear_rate") != 0.0:
+            raise ValueError("shear_rate: Lees-Edwards shear runs on the lattice engine (engine='lattice'); "
+                             "the float engine's is not built yet")
         x = real_array(positions, "positions")
         v = real_array(velocities, "velocities")
         if x.ndim == 1:

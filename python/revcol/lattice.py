@@ -41,7 +41,7 @@ from . import _core
 from ._args import diameters_arg, integer, name, placement, real, real_array
 from ._args import packing_fraction as _packing_fraction
 from ._io import write_checkpoint
-from ._lattice_args import MODES, _Boundary, _boundary, _gravity, _mode, _shell, _tick
+from ._lattice_args import MODES, _Boundary, _boundary, _gravity, _mode, _shear, _shell, _tick
 from ._lattice_state import (add_reports, legacy_snapshot as _legacy_snapshot, read_state as _read_state,
                              snapshot_shell as _snapshot_shell)
 from .simulation import SimulationBase, register_engine
@@ -86,6 +86,11 @@ class LatticeSimulation(SimulationBase):
     walled axis): a uniform field, exact on the lattice (quantized once to an even number of lattice
     units per tick^2, :attr:`gravity` the value run and ``quantization()["gravity_error"]`` the
     rounding; the cell grid searches; no observer, journal or parallel run yet; docs/engine.md).
+    ``shear_rate``: Lees-Edwards shear, exact on the lattice: the flow along axis 0, the gradient
+    along axis 1 (both periodic), the box above moving ``shear_rate * box[1]`` faster (quantized
+    once to lattice units per tick, :attr:`shear_rate` the value run and
+    ``quantization()["shear_error"]`` the rounding; the cell grid searches; no observer, journal
+    or parallel run yet; energy grows by viscous heating; docs/shear.md).
     Bad input raises ``ValueError`` naming the problem.
     """
 
@@ -95,8 +100,8 @@ class LatticeSimulation(SimulationBase):
     def __init__(self, positions, velocities, box, *, boundary: _Boundary = "periodic",
                  diameter: float = 1.0, mode: str = "exact", law: str = "flux", seed: int = 1,
                  tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
-                 workers: int = 1, lps: Optional[int] = None, diameters=None, gravity=None, _engine=None,
-                 _quantization: Optional[dict] = None):
+                 workers: int = 1, lps: Optional[int] = None, diameters=None, gravity=None, shear_rate=None,
+                 _engine=None, _quantization: Optional[dict] = None):
         if _engine is not None:
             self._e = _engine
             self._q = dict(_quantization or {})
@@ -117,7 +122,7 @@ class LatticeSimulation(SimulationBase):
         sizes = diameters_arg(diameters, x.shape[0] if x.ndim == 2 else -1, diameter)
         start = getattr(_core, _QUANTIZE[dim])(x, v, [float(b) for b in np.broadcast_to(box, (dim,))],
                                                _boundary(boundary), diameter, _tick(tick_bits), cell_bits, sizes,
-                                               _gravity(gravity, dim, workers))
+                                               _gravity(gravity, dim, workers), _shear(shear_rate, workers))
         self._init_from_start(start, law, seed, dim, shell, mode)
 
     def _init_from_start(self, start: dict, law: str, seed: int, dim: int = 2, shell: float = -1.0,
@@ -129,6 +134,8 @@ class LatticeSimulation(SimulationBase):
                    "max_velocity_error": start["max_velocity_error"]}
         if any(start["units"].get("gravity", ())):
             self._q["gravity_error"] = start["gravity_error"]
+        if start["units"].get("shear", 0):
+            self._q["shear_error"] = start["shear_error"]
         self._search = -1.0
         self._set_shell(shell)
 
@@ -143,7 +150,7 @@ class LatticeSimulation(SimulationBase):
                diameter: float = 1.0, seed: int = 1, init: str = "auto", mode: str = "exact", law: str = "flux",
                tick_bits: Optional[int] = None, cell_bits: int = 16, search: Union[str, float] = "auto",
                packing_fraction: Optional[float] = None, workers: int = 1, lps: Optional[int] = None,
-               diameters=None, gravity=None) -> "LatticeSimulation":
+               diameters=None, gravity=None, shear_rate=None) -> "LatticeSimulation":
         """n disks (spheres for LatticeSimulation3D) at area (volume) fraction ``phi`` (or
         ``packing_fraction=``; default 0.3) in a square (cubic) box (the float engine's
         ``random_state``: ``init`` ``"rsa"``, random sequential addition, or ``"crystal"``, a
@@ -155,7 +162,9 @@ class LatticeSimulation(SimulationBase):
         ``phi`` (the particles' own volumes), placed as spheres of the largest diameter (so a
         mixture's ``phi`` is bounded by the crystal of the largest: about 0.74 of its volume
         fraction in a periodic cube, less in walls). ``gravity``: a uniform field, as the
-        constructor's (the particles placed uniformly, then left to fall)."""
+        constructor's (the particles placed uniformly, then left to fall). ``shear_rate``:
+        Lees-Edwards shear, as the constructor's, the velocities along axis 0 given the steady
+        profile ``shear_rate * (y - mean(y))`` (no momentum added)."""
         n = integer(n, "n", 1)  # not a bool or a float (a named error)
         if dim is not None:
             dim = integer(dim, "dim", 1, 3)
@@ -171,7 +180,8 @@ class LatticeSimulation(SimulationBase):
             raise ValueError(f"LatticeSimulation3D is 3D, got dim={dim}")
         sizes = diameters_arg(diameters, n, diameter)
         start = getattr(_core, _RANDOM_START[dim])(n, phi, _boundary(boundary), diameter, seed, init,
-                                                   _tick(tick_bits), cell_bits, sizes, _gravity(gravity, dim, workers))
+                                                   _tick(tick_bits), cell_bits, sizes, _gravity(gravity, dim, workers),
+                                                   _shear(shear_rate, workers))
         sim = cls.__new__(cls)
         sim.set_parallel(workers, lps=lps)
         sim._init_from_start(start, law, seed, dim, shell, mode)
@@ -427,6 +437,13 @@ class LatticeSimulation(SimulationBase):
         u = self._e.units
         g = np.asarray(u.get("gravity", (0,) * self._DIM), dtype=float)
         return g * (float(u["length_unit"]) / float(u["tick"]) ** 2)
+
+    @property
+    def shear_rate(self) -> float:
+        """The Lees-Edwards shear rate run (1 / time, float units): the lattice's integer shear
+        (lattice units per tick) over the box's gradient length; 0 without shear."""
+        u = self._e.units
+        return float(u.get("shear", 0)) / (float(u["L"][1]) * float(u["tick"]))
 
     mixture = property(lambda self: bool(np.asarray(self._e.radius).size),
                        doc="True for a mixture (built with ``diameters``; sizes kept per particle).")

@@ -65,7 +65,9 @@ LATTICE_HORIZON_GRID = (1.0, 10.0, 100.0)
 def build_lattice(scene: Scene, seed: int | None = None) -> LatticeSimulation:
     """The lattice engine for a gas scene: the float engine's random start quantized once
     (``[system] packing_fraction`` without ``kinetic_energy``: ``LatticeSimulation.random``),
-    else the float start in the scene's box, or its initial-state file, quantized once.
+    else the float start in the scene's box, or its initial-state file, quantized once. Under
+    shear a random start gets the steady profile (as ``LatticeSimulation.random``'s), an
+    initial state runs its velocities as given.
     ``seed`` overrides the scene's. A state the lattice refuses raises :class:`SceneError`."""
     if scene.kind != "gas" or scene.engine != "lattice":
         raise SceneError(f"{scene.source}: [collisions] engine: build_lattice needs a lattice gas scene")
@@ -84,6 +86,9 @@ def build_lattice(scene: Scene, seed: int | None = None) -> LatticeSimulation:
     def make() -> LatticeSimulation:  # the float engine's start in the scene's box, quantized
         x, v = _core.engine_random_start(scene.particles, list(scene.box), list(scene.boundaries), scene.diameter,
                                          opts["seed"], scene.kinetic_energy or 0.0, init, False)
+        if scene.shear_rate:  # the steady profile, centred (no momentum added), as random()'s
+            x, v = np.asarray(x, dtype=float), np.array(v, dtype=float)
+            v[:, 0] += scene.shear_rate * (x[:, 1] - x[:, 1].mean())
         return cls(x, v, scene.box, **opts)
     return _make(scene, "[system] box" if scene.packing_fraction is None else "[system] kinetic_energy", make)
 
@@ -310,6 +315,9 @@ def lattice_report(run: _LatticeRun) -> dict[str, Any]:
         "quantization": sim.quantization,
         # the field run, quantized once (its relative rounding: quantization's gravity_error); None: none
         "gravity": sim.gravity.tolist() if sim.gravity.any() else None,
+        # Lees-Edwards shear run (1 / time; None: none) and its integer, lattice units per tick (the
+        # rounding: quantization's shear_error)
+        "shear_rate": sim.shear_rate or None, "shear_per_tick": int(units.get("shear", 0)) or None,
         "collisions_forward": done, "collisions_back": run.back, "per_particle": 2.0 * done / n,
         "time_start": 0.0, "time_turn": run.t_turn, "time_end": sim.time, "clock_turn": run.clock_turn,
         "clock_end": sim.clock,

@@ -48,6 +48,7 @@ file and the replacement.
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
     gravity = [0.0, -1.0]         # a uniform field, one component per axis, along one walled axis (default none)
+    shear_rate = 0.1              # Lees-Edwards shear, 1/time, lattice only: flow axis 0, gradient 1 (default none)
 
     [collisions]
     engine = "float"              # gas only: "float" | "lattice" (2D and 3D, exact or specular mode,
@@ -115,12 +116,11 @@ directory and nothing is written into the installed package.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-
-import difflib
 
 import numpy as np
 
@@ -130,8 +130,8 @@ from .engine import Simulation
 from . import lattice as _lattice  # noqa: F401 (registers engine="lattice": Simulation builds its classes)
 from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINE_MODES,  # noqa: F401 (__all__)
                            ENGINES, KINDS, LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES,
-                           SceneError, _check, _check_lattice, _check_mode, _fail, _modernize, field_text, scene_field,
-                           with_lattice_options)
+                           SceneError, _check, _check_lattice, _check_mode, _fail, _modernize, check_shear_engine,
+                           field_summary, observes_frames, scene_field, with_lattice_options)
 from ._species import check_masses, parse_species, sized_options, species_volume
 from .statesave import variants as statesave_variants
 from .verify import verify_cases
@@ -187,6 +187,7 @@ class Scene:
     observe: dict[str, Any] | None = None  # [observe]: Simulation.observe's arguments (None: no table)
     species: tuple = ()  # [[species]] (revcol._species.Species): a mixture; () one diameter
     gravity: tuple[float, ...] | None = None  # [system] gravity: a uniform field (None: none)
+    shear_rate: float | None = None  # [system] shear_rate: Lees-Edwards shear, lattice only (None: none)
     name: str = "scene"
     description: str = ""
     source: str = "<built-in>"
@@ -209,7 +210,7 @@ class Scene:
         engine = "lattice engine, " if self.engine == "lattice" else ""
         sizes = (", ".join(f"{s.count} {s.name} (d = {s.diameter:g})" for s in self.species) if self.species
                  else f"sigma = {self.diameter:g}")
-        field = f", gravity {field_text(self.gravity)}" if self.gravity else ""
+        field = field_summary(self.gravity, self.shear_rate)
         return (f"{self.name}: {self.particles} particles in {self.dimension}D, {sizes}, "
                 f"box {box} ({', '.join(self.boundaries)}){field}, {engine}{self.mode}{law}, {self.generator} "
                 f"{self.streams} seed {self.seed}, {end}")
@@ -393,7 +394,7 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
         raise _fail(source, "[output] trajectory", f"must end in .xyz (extended XYZ) or .gsd, got {trajectory.name!r}")
 
     observe = _observe(source, values, d, n, bounds, engine) if "observe" in common["extra"]["tables"] else None
-    gravity = scene_field(source, get, d, bounds, engine, observe is not None)
+    gravity, shear = scene_field(source, get, d, bounds, engine, observe is not None, box, sigma)
 
     scene = Scene(
         dimension=d, particles=n, diameter=sigma, box=tuple(box), packing_fraction=phi,
@@ -406,7 +407,7 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
         checkpoint_interval=checkpoint_interval, checkpoints=checkpoints,
         json=out("json"), plot=out("plot"), trajectory=trajectory,
         trajectory_every=get("output", "trajectory_every", 100), max_output=get("output", "max_output"),
-        observe=observe, species=species, gravity=gravity, **common)
+        observe=observe, species=species, gravity=gravity, shear_rate=shear, **common)
     if arrays is not None:
         _check_initial(source, scene, *arrays)
     return scene
@@ -430,11 +431,12 @@ def with_engine(scene: Scene, engine: str) -> Scene:
     ``[collisions] engine = ...`` would be: a scene that names no generator gets the engine's
     default one (Philox on the lattice); a lattice scene moved to the float engine keeps its
     Philox streams, gets the float engine's default chart bits, 40, and drops the lattice's own
-    options (tick_bits, cell_bits, search, workers)."""
+    options (tick_bits, cell_bits, search, workers); a sheared scene runs on the lattice only."""
     if engine not in ENGINES:
         raise SceneError(f"{scene.source}: --engine must be one of {', '.join(map(repr, ENGINES))}, got {engine!r}")
     if scene.kind != "gas":
         raise SceneError(f"{scene.source}: --engine applies to 'gas' scenes, not {scene.kind!r}")
+    check_shear_engine(scene.source, scene.shear_rate, engine, " (--engine)")
     fields = scene.extra.get("fields", ())
     out = dataclasses.replace(scene, engine=engine)
     if engine == "float":
@@ -542,7 +544,7 @@ def lattice_options(scene: Scene) -> dict[str, Any]:
     """The keyword arguments of :class:`revcol.lattice.LatticeSimulation` that a gas scene sets."""
     opts = dict(boundary=list(scene.boundaries), diameter=scene.diameter, mode=scene.mode, law=scene.law,
                 seed=scene.seed, tick_bits=scene.tick_bits, cell_bits=scene.cell_bits, search=scene.search,
-                workers=scene.workers, gravity=scene.gravity)
+                workers=scene.workers, gravity=scene.gravity, shear_rate=scene.shear_rate)
     return sized_options(scene.species, opts)
 
 
@@ -555,12 +557,6 @@ def scene_dirs() -> list[Path]:
 def scene_names() -> list[str]:
     """The names of the scenes shipped with revcol (``revcol run NAME``)."""
     return sorted({p.stem for d in scene_dirs() for p in d.glob("*.toml")})
-
-
-def observes_frames(scene: Scene, trajectory) -> bool:
-    """Whether a run writing ``trajectory`` observes (unreported, in its checkpoints) for the image flags of a
-    periodic box's frames: when its own ``[observe]`` does not already, nor a field forbids it (then inferred)."""
-    return trajectory is not None and scene.observe is None and not scene.gravity and "periodic" in scene.boundaries
 
 
 def find_scene(name: str) -> Path | None:

@@ -1,7 +1,8 @@
 """The scene file's schema: its tables and fields, each with its type and allowed values; the
 fields each kind of scene uses; the old spellings still read; the built-in default scene; the
-check of one field against them (:class:`SceneError` naming it); and the uniform field's checks
-against the system and the engine's options (``[system] gravity``: :func:`scene_field`).
+check of one field against them (:class:`SceneError` naming it); and the checks of the uniform field
+and of Lees-Edwards shear against the system and the engine's options (``[system] gravity`` and
+``shear_rate``: :func:`scene_field`).
 :mod:`revcol.scene` reads a scene with them (and re-exports the public names).
 """
 from __future__ import annotations
@@ -15,8 +16,9 @@ from . import _core
 from ._args import size
 
 __all__ = ["KINDS", "ENGINES", "ENGINE_MODES", "LIMITS", "DEFAULT_SCENE", "SCHEMA", "USES", "DEPRECATED",
-           "LATTICE_FIELDS", "SceneError", "with_lattice_options", "check_gravity", "check_field_options",
-           "scene_field", "field_text"]
+           "LATTICE_FIELDS", "SceneError", "with_lattice_options", "check_gravity", "check_shear", "check_shear_engine",
+           "check_field_options", "scene_field", "observes_frames", "field_text", "shear_text", "field_summary",
+           "SHEAR_CELLS"]
 
 #: the kinds of scene
 KINDS = ("gas", "reversal", "statesave")
@@ -58,6 +60,7 @@ SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "kinetic_energy": ("float", (0.0, None)),
         "initial_state": ("str", None),
         "gravity": ("vector", None),  # a uniform field, one component per axis (scene_field)
+        "shear_rate": ("real", None),  # Lees-Edwards shear, 1 / time, on the lattice engine (scene_field)
     },
     "collisions": {
         "engine": ("str", ENGINES),
@@ -192,10 +195,10 @@ def _check(source: str, table: str, key: str, value: Any, kind: str, allowed: An
             span = f"{lo}..{hi}" if hi is not None else f">= {lo}"
             raise _fail(source, where, f"must be {span}, got {value}")
         return value
-    if kind == "float":
+    if kind in ("float", "real"):  # "real": of any sign
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise _fail(source, where, f"must be a finite number, got {value!r}")
-        if not value > allowed[0]:
+        if kind == "float" and not value > allowed[0]:
             raise _fail(source, where, f"must be > {allowed[0]:g}, got {value}")
         return float(value)
     if kind == "bool":
@@ -258,7 +261,8 @@ def with_lattice_options(scene, *, tick_bits: int | None = None, cell_bits: int 
     """``scene`` with the lattice engine's options that are not None replaced (``revcol run`` and
     ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``, ``--workers``), each checked as its
     ``[collisions]`` field; a scene that does not run the lattice engine refuses them, and one with a
-    field (``[system] gravity``) more than one worker and a neighbour-list shell (check_field_options)."""
+    field (``[system] gravity``) or shear (``shear_rate``) more than one worker and a neighbour-list shell
+    (check_field_options)."""
     given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search, workers)) if v is not None}
     flags = {k: "--" + k.replace("_", "-") for k in given}
     if given and (scene.kind != "gas" or scene.engine != "lattice"):
@@ -270,7 +274,8 @@ def with_lattice_options(scene, *, tick_bits: int | None = None, cell_bits: int 
         except SceneError as e:
             raise SceneError(str(e).replace(f"[collisions] {k}", flags[k])) from None
     out = dataclasses.replace(scene, **given)
-    check_field_options(scene.source, out.gravity, out.engine, workers=out.workers, search=out.search, names=flags)
+    check_field_options(scene.source, out.gravity, out.engine, workers=out.workers, search=out.search, names=flags,
+                        shear=out.shear_rate)
     return out
 
 
@@ -303,40 +308,117 @@ def check_gravity(source: str, gravity: Sequence[float] | None, d: int,
     return tuple(gravity)
 
 
+# what runs neither a field nor shear yet, in the words of each refusal: where the gas is, what the
+# parallel engine and the neighbour lists are not built for yet, and why there is no observer
+_UNBUILT = {
+    "gravity": ("in a field ([system] gravity)", "a field", "curved paths",
+                "neither engine's observer takes one yet (it assumes straight lines between events)"),
+    "shear": ("under shear ([system] shear_rate)", "shear", "moving images",
+              "the lattice observer does not take a sheared gas yet (its pair separations ignore the moving images)"),
+}
+
+
 def check_field_options(source: str, gravity: Sequence[float] | None, engine: str, *, workers: int = 1,
-                        search: str | float = "auto", observe: bool = False, names: dict | None = None) -> None:
-    """Refuses, naming the option, what runs no field yet: on the lattice engine more than one
-    worker or neighbour lists (``search`` a shell; ``"auto"`` takes the cell grid there), and on
-    either engine an observed run (``observe``: an ``[observe]`` table; the observer assumes
-    straight lines between events). ``names`` renames an option where it came from the command
+                        search: str | float = "auto", observe: bool = False, names: dict | None = None,
+                        shear: float | None = None) -> None:
+    """Refuses, naming the option, what runs no field (``gravity``) or no shear (``shear``, a rate;
+    None: none) yet: on the lattice engine more than one worker or neighbour lists (``search`` a
+    shell; ``"auto"`` takes the cell grid there), and on either engine an observed run
+    (``observe``: an ``[observe]`` table; the observer assumes straight lines between events and
+    periodic images at rest). ``names`` renames an option where it came from the command
     line (``{"workers": "--workers"}``)."""
-    if gravity is None:
-        return
     names = names or {}
-    why = "in a field ([system] gravity)"
-    if observe:
-        raise _fail(source, "[observe]", f"is not available {why}: neither engine's observer takes one yet "
-                    "(it assumes straight lines between events); take trajectory frames instead")
-    if engine != "lattice":
-        return
-    if workers > 1:
-        raise _fail(source, names.get("workers", "[collisions] workers"), f"engine = 'lattice' runs a gas {why} on "
-                    f"one worker (the parallel engine is not built for a field yet), got {workers}")
-    if search not in ("auto", "cells"):
-        raise _fail(source, names.get("search", "[collisions] search"), f"engine = 'lattice' searches a gas {why} with "
-                    f"the cell grid only ('auto' or 'cells'; no neighbour lists for curved paths yet), got {search!r}")
+    for kind, on in (("gravity", gravity is not None), ("shear", shear is not None)):
+        if not on:
+            continue
+        where, what, lists, observer = _UNBUILT[kind]
+        if observe:
+            raise _fail(source, "[observe]", f"is not available {where}: {observer}; take trajectory frames instead")
+        if engine != "lattice":
+            continue
+        if workers > 1:
+            raise _fail(source, names.get("workers", "[collisions] workers"), f"engine = 'lattice' runs a gas "
+                        f"{where} on one worker (the parallel engine is not built for {what} yet), got {workers}")
+        if search not in ("auto", "cells"):
+            raise _fail(source, names.get("search", "[collisions] search"), f"engine = 'lattice' searches a gas "
+                        f"{where} with the cell grid only ('auto' or 'cells'; no neighbour lists for {lists} yet), "
+                        f"got {search!r}")
 
 
-def scene_field(source: str, get, d: int, bounds: Sequence[str], engine: str,
-                observed: bool) -> tuple[float, ...] | None:
-    """A gas scene's field from its checked fields (``get(table, key, default)``), its ``d`` axes'
-    ``bounds`` and its ``engine``, ``observed`` when it has an ``[observe]`` table: both checks."""
+# --- Lees-Edwards shear: [system] shear_rate ------------------------------------------------------
+# a rate in 1 / time units, of either sign: the flow along axis 0, the gradient along axis 1, the
+# images above the box moving shear_rate * L_1 faster (docs/run.md "Shear", docs/shear.md); checked,
+# as the field, before any engine is built
+
+_SHEAR = "[system] shear_rate"
+
+#: the least box of a sheared gas, in the lattice engine's cells along axis 0 (the flow) and axis 1
+#: (the gradient): a crossing pair's image is the nearest one only in such a box (geometry.cpp validate)
+SHEAR_CELLS = (9, 5)
+_SHEAR_CELL = 1.0 + 2.0 ** -7  # a cell's width in (largest) diameters: sigma + 2 vmax, vmax = sigma / 2^8
+
+
+def check_shear_engine(source: str, shear_rate: float | None, engine: str, note: str = "") -> None:
+    """Refuses shear (``shear_rate`` not None nor 0) on another engine than the lattice's, naming the key."""
+    if shear_rate and engine != "lattice":
+        raise _fail(source, _SHEAR, f"Lees-Edwards shear runs on the lattice engine only (engine = 'lattice'; the "
+                    f"float engine's is not built yet), got engine = {engine!r}{note}")
+
+
+def check_shear(source: str, shear_rate: float | None, engine: str, bounds: Sequence[str], box: Sequence[float],
+                sigma: float, gravity: Sequence[float] | None = None) -> float | None:
+    """The shear rate a scene runs (None: none; a zero rate is none), checked against its engine (the
+    lattice's only), its axes' ``bounds`` (0 and 1 periodic), its ``box`` in (largest) diameters
+    ``sigma`` (:data:`SHEAR_CELLS`) and a field (``gravity``, as given: none together with shear yet).
+    ``shear_rate`` has passed the schema (a finite number)."""
+    if not shear_rate:
+        return None
+    check_shear_engine(source, shear_rate, engine)
+    if gravity is not None and any(gravity):
+        raise _fail(source, _SHEAR, "is refused together with [system] gravity: shear and a field together are not "
+                    "built yet")
+    if len(bounds) < 2 or bounds[0] != "periodic" or bounds[1] != "periodic":
+        raise _fail(source, _SHEAR, "needs axes 0 (the flow) and 1 (the gradient) periodic, got boundaries "
+                    f"({', '.join(bounds)})")
+    least = [c * _SHEAR_CELL * sigma for c in SHEAR_CELLS]
+    if box[0] < least[0] or box[1] < least[1]:
+        raise _fail(source, _SHEAR, f"needs a box of at least {least[0]:.6g} along axis 0 (the flow) and "
+                    f"{least[1]:.6g} along axis 1 (the gradient), {SHEAR_CELLS[0]} and {SHEAR_CELLS[1]} of the "
+                    f"lattice's cells of 1 + 2^-7 diameters; got {box[0]:.6g} x {box[1]:.6g}")
+    return float(shear_rate)
+
+
+def scene_field(source: str, get, d: int, bounds: Sequence[str], engine: str, observed: bool,
+                box: Sequence[float] = (), sigma: float = 1.0) -> tuple[tuple[float, ...] | None, float | None]:
+    """A gas scene's field and shear rate (None: none) from its checked fields (``get(table, key,
+    default)``), its ``d`` axes' ``bounds``, its ``box``, its (largest) diameter ``sigma`` and its
+    ``engine``, ``observed`` when it has an ``[observe]`` table: every check of both."""
+    shear = check_shear(source, get("system", "shear_rate"), engine, bounds, box, sigma, get("system", "gravity"))
     gravity = check_gravity(source, get("system", "gravity"), d, bounds)
     check_field_options(source, gravity, engine, workers=get("collisions", "workers", 1),
-                        search=get("collisions", "search", "auto"), observe=observed)
-    return gravity
+                        search=get("collisions", "search", "auto"), observe=observed, shear=shear)
+    return gravity, shear
+
+
+def observes_frames(scene, trajectory) -> bool:
+    """Whether a run of ``scene`` writing ``trajectory`` observes (unreported, in its checkpoints) for the
+    image flags of a periodic box's frames: when its own ``[observe]`` does not already, nor a field or
+    shear forbids it (check_field_options: the flags are then inferred between frames)."""
+    return (trajectory is not None and scene.observe is None and not (scene.gravity or scene.shear_rate)
+            and "periodic" in scene.boundaries)
 
 
 def field_text(gravity: Iterable[float] | None) -> str:
     """A field as the reports write it, ``"(0, -1)"`` (6 significant digits), or ``"none"``."""
     return "none" if gravity is None else f"({', '.join(f'{float(c):.6g}' for c in gravity)})"
+
+
+def shear_text(shear_rate: float | None) -> str:
+    """A shear rate as the reports write it, ``"0.1"`` (6 significant digits), or ``"none"``."""
+    return f"{float(shear_rate):.6g}" if shear_rate else "none"
+
+
+def field_summary(gravity: Iterable[float] | None, shear_rate: float | None) -> str:
+    """A scene summary's field and shear, ``", gravity (0, -1)"``, ``", shear rate 0.1"``; "" without."""
+    return ((f", gravity {field_text(gravity)}" if gravity else "")
+            + (f", shear rate {shear_text(shear_rate)}" if shear_rate else ""))

@@ -1,7 +1,8 @@
 // A lattice gas for the engine tests (test_lattice_local.cpp, test_lattice_specular_engine.cpp,
 // test_lattice_rollback.cpp): the engine of a dimension, a random start with one boundary kind on
 // every axis, and a check that a call is refused with a given message; run_config, the parallel
-// engine's settings for a run_parallel(_back) (test_lattice_parallel_run.cpp, _back.cpp).
+// engine's settings for a run_parallel(_back) (test_lattice_parallel_run.cpp, _back.cpp);
+// check_replays, the end of a gas's round trip (test_lattice_field.cpp, test_lattice_shear.cpp).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -54,6 +55,50 @@ bool refused(F&& f, const std::string& what) {
     std::printf("    unexpected message: %s\n", e.what());
   }
   return false;
+}
+
+/// The engine of a quantized start (a mixture's radii too), in `mode`, its streams keyed by `seed`.
+template <std::size_t D>
+EngineOf<D> engine_of(const revcol::lattice::LatticeStartN<D>& s, std::uint32_t seed, revcol::Mode mode) {
+  const auto op = revcol::lattice::operator_for(s.units);
+  if (s.radius.empty()) return {s.units, s.x, s.v, seed, op, 0, mode};
+  return {s.units, s.x, s.v, s.radius, seed, op, 0, mode};
+}
+
+/// What a gas in a field or under shear refuses by name (InvalidArgument), its state untouched:
+/// neighbour lists, the rollback journal, the observer, regions (the parallel engine).
+template <class Engine>
+void check_refuses_lists_journal_observer_regions(Engine& e) {
+  const auto before = e.snapshot();
+  CHECK_THROWS_AS(e.set_list_shell(1.0), revcol::InvalidArgument);
+  CHECK_THROWS_AS(e.keep_journal(true), revcol::InvalidArgument);
+  CHECK_THROWS_AS(e.observe(revcol::engine::ObserveConfig{}), revcol::InvalidArgument);
+  CHECK_THROWS_AS(e.set_regions(0, {0}), revcol::InvalidArgument);
+  CHECK(revcol::lattice::same_state(e.snapshot(), before));
+}
+
+/// The end of a gas's round trip: engine `e` ran `collisions` forward from s0 through s1 (after
+/// half of them) to s2. The same run with every candidate pair sent to the exact search (no double
+/// filter; `fresh()` gives a new engine at s0) and the run from the checkpoint s1 end on s2; e run
+/// back reaches s1, then s0, bit for bit. (CHECK: include check.hpp first.)
+template <class Engine, class Fresh, class Snap>
+void check_replays(Engine& e, Fresh fresh, const Snap& s0, const Snap& s1, const Snap& s2, std::uint64_t collisions) {
+  namespace la = revcol::lattice;
+  {
+    Engine x = fresh();
+    x.exhaustive_search = true;
+    x.run(collisions, la::tick_limit - 1);
+    CHECK(la::same_state(x.snapshot(), s2));
+  }
+  {
+    Engine r(s1, la::operator_for(s1.units));
+    r.run(collisions - collisions / 2, la::tick_limit - 1);
+    CHECK(la::same_state(r.snapshot(), s2));
+  }
+  e.run_back(collisions / 2, s0.origin);
+  CHECK(la::same_state(e.snapshot(), s1));
+  e.run_back(0, s0.origin);
+  CHECK(la::same_state(e.snapshot(), s0));
 }
 
 }  // namespace lattice_test

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "check.hpp"
+#include "lattice_gas_util.hpp"
 #include "revcol/lattice/engine.hpp"
 
 using namespace revcol::lattice;
@@ -40,11 +41,6 @@ LatticeStartN<D> start(std::size_t n, double phi, const std::array<en::Boundary,
   return random_start(c, n, phi, seed);
 }
 
-template <std::size_t D>
-EngineOf<D> make(const LatticeStartN<D>& s, std::uint32_t seed, Mode mode) {
-  if (s.radius.empty()) return {s.units, s.x, s.v, seed, operator_for(s.units), 0, mode};
-  return {s.units, s.x, s.v, s.radius, seed, operator_for(s.units), 0, mode};
-}
 
 // the mean height on the field's axis (lattice units), by the snapshot's positions
 template <std::size_t D>
@@ -59,7 +55,7 @@ double mean_height(const SnapshotN<D>& s, int axis) {
 // kept; the gas falls (mean height down) and every reflection on the field's axis reverses it
 template <std::size_t D>
 void round_trip(const LatticeStartN<D>& st, Mode mode, std::uint64_t collisions, std::uint32_t seed, int axis) {
-  EngineOf<D> e = make<D>(st, seed, mode);
+  EngineOf<D> e = lattice_test::engine_of<D>(st, seed, mode);
   CHECK(e.units().gravity[static_cast<std::size_t>(axis)] != 0);
   const SnapshotN<D> s0 = e.snapshot();
   std::vector<EventRecordN<D>> events;
@@ -83,23 +79,8 @@ void round_trip(const LatticeStartN<D>& st, Mode mode, std::uint64_t collisions,
   // the gas fell: with g pulling toward 0 (g < 0) its mean height went down
   const double g = static_cast<double>(s0.units.gravity[static_cast<std::size_t>(axis)]);
   CHECK((g < 0 ? 1.0 : -1.0) * (mean_height(s2, axis) - mean_height(s0, axis)) < 0.0);
-  // the same events without the double filter
-  {
-    EngineOf<D> x = make<D>(st, seed, mode);
-    x.exhaustive_search = true;
-    x.run(collisions, tick_limit - 1);
-    CHECK(same_state(x.snapshot(), s2));
-  }
-  // a checkpoint at the midpoint resumes on the same bits
-  {
-    EngineOf<D> r(s1, operator_for(s1.units));
-    r.run(collisions - collisions / 2, tick_limit - 1);
-    CHECK(same_state(r.snapshot(), s2));
-  }
-  e.run_back(collisions / 2, s0.origin);
-  CHECK(same_state(e.snapshot(), s1));
-  e.run_back(0, s0.origin);
-  CHECK(same_state(e.snapshot(), s0));
+  // the same events without the double filter, from the midpoint's checkpoint, and back
+  lattice_test::check_replays(e, [&] { return lattice_test::engine_of<D>(st, seed, mode); }, s0, s1, s2, collisions);
 }
 
 }  // namespace
@@ -183,11 +164,7 @@ TEST_CASE("a field's refusals: a periodic axis, two axes, an odd field, lists, j
   LatticeEngine e(s.units, s.x, s.v, 41, operator_for(s.units));
   CHECK(e.neighbour_search() == 0);
   const Snapshot before = e.snapshot();
-  CHECK_THROWS_AS(e.set_list_shell(1.0), revcol::InvalidArgument);
-  CHECK_THROWS_AS(e.keep_journal(true), revcol::InvalidArgument);
-  CHECK_THROWS_AS(e.observe(en::ObserveConfig{}), revcol::InvalidArgument);
-  CHECK_THROWS_AS(e.set_regions(0, {0}), revcol::InvalidArgument);
-  CHECK(same_state(e.snapshot(), before));
+  lattice_test::check_refuses_lists_journal_observer_regions(e);
   // a state whose potential would let a particle pass vmax is refused
   UnitsN<2> strong = s.units;
   strong.gravity[1] = -max_gravity;

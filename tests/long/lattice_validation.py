@@ -4,7 +4,7 @@ bench/results/lattice_validation_*.json.
 
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py matrix [--collisions 1e7]
         [--n 1000 10000] [--phi 0.1 0.3 0.5 0.7] [--boundary wall periodic bounce] [--mode exact|specular] [--out matrix]
-        [--sizes one|binary|gauss] [--gravity G]
+        [--sizes one|binary|gauss] [--gravity G] [--shear RATE]
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py equilibrium [--n 1000] [--phi 0.5]
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py failures [--phi 0.5 0.7] [--seeds 4] [--collisions 2e6] --out failures
     PYTHONPATH=build-dev/pkg python3 tests/long/lattice_validation.py gas --n 1000 --phi 0.3 --boundary wall --collisions 1e5
@@ -38,6 +38,10 @@ fraction 0.4), the packing fraction counting each particle's own size.
 along the last axis, which then has walls (a periodic --boundary keeps the other axes periodic);
 the row adds the field run, its quantization, the mean height at the start and the end and the
 walls' momentum against the column's weight over the second half (docs/engine.md).
+
+--shear RATE (matrix, gas): Lees-Edwards shear at that rate (float units; flow along x, gradient
+along y, both periodic; in 3D a --boundary wall walls z only); the row adds the shear run, its
+quantization and the boundary's work (the energy's rise: viscous heating; docs/shear.md).
 
 probe: forward only, one gas per (N, area fraction, boundary) for each tick (--ticks) and cell
 resolution (--cells): the rare log's entries, the group entries and the redraws by reason, the
@@ -275,7 +279,7 @@ def sizes_of(sizes: str, n: int, seed: int):
 
 def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, samples: int = 100,
             law: str = "flux", tick_bits: int = 0, cell_bits: int = 16, mode: str = "exact", sizes: str = "one",
-            gravity: float = 0.0) -> dict:
+            gravity: float = 0.0, shear: float = 0.0) -> dict:
     """One gas: C collisions forward (snapshot at C/2), back to C/2 (compared), back to 0
     (compared). Returns the row (see the module doc). If the engine fails on the way forward, the
     row says so (``completed`` false, ``forward_error``) and the checks run on the collisions done,
@@ -286,9 +290,12 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     if gravity:  # along the last axis, walled
         field = {"gravity": [0.0] * (DIM - 1) + [gravity],
                  "boundary": [boundary] * (DIM - 1) + ["wall" if boundary == "periodic" else boundary]}
+    if shear:  # Lees-Edwards: x and y periodic (3D: z as asked)
+        field = {"boundary": ["periodic", "periodic"] + [boundary] * (DIM - 2)}
     sim = LatticeSimulation.random(n=n, phi=phi, boundary=field.get("boundary", boundary), seed=seed, init=_init_for(phi),
                                    law=law, tick_bits=tick_bits or None, cell_bits=cell_bits, mode=mode,
-                                   diameters=sizes_of(sizes, n, seed), gravity=field.get("gravity"))
+                                   diameters=sizes_of(sizes, n, seed), gravity=field.get("gravity"),
+                                   shear_rate=shear or None)
     s0 = sim.snapshot()
     units = sim.units
     wall = [bool(w) for w in units["wall"]]
@@ -350,6 +357,9 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
         row["gravity"] = {"asked": gravity, "run": [float(g) for g in sim.gravity],
                           "lattice_units_per_tick2": int(units["gravity"][-1]), "boundary": field["boundary"],
                           "mean_height_start": h0, "mean_height_end": h_end, "weight_balance": _weight_balance(f, n, units)}
+    if shear:
+        row["shear"] = {"asked": shear, "run": sim.shear_rate, "lattice_units_per_tick": int(units["shear"]),
+                        "boundary": field["boundary"], "energy_rise_relative": float(d_end["energy_drift"])}
     hwm = [r["vmhwm_bytes"] for r in f["rss"] if r["collisions"] >= 100000]
     row["vmhwm_growth_from_1e5_bytes"] = (hwm[-1] - hwm[0]) if hwm else None
     return row
@@ -358,18 +368,19 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
 def _child(args) -> int:
     row = run_gas(args.n, args.phi, args.boundary, int(float(args.collisions)), args.seed,
                   tick_bits=args.tick_bits, cell_bits=args.cell_bits, mode=args.mode, sizes=args.sizes,
-                  gravity=args.gravity)
+                  gravity=args.gravity, shear=args.shear)
     print("ROW " + json.dumps(row), flush=True)
     return 0
 
 
 def run_child(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, tick_bits: int = 0,
-              cell_bits: int = 16, mode: str = "exact", sizes: str = "one", gravity: float = 0.0) -> dict:
+              cell_bits: int = 16, mode: str = "exact", sizes: str = "one", gravity: float = 0.0,
+              shear: float = 0.0) -> dict:
     """``run_gas`` in a fresh subprocess; adds the child's ru_maxrss (wait4) and exit status."""
     cmd = [sys.executable, os.path.abspath(__file__), "gas", "--n", str(n), "--phi", str(phi),
            "--boundary", boundary, "--collisions", str(int(collisions)), "--seed", str(seed),
            "--tick-bits", str(tick_bits), "--cell-bits", str(cell_bits), "--dim", str(DIM), "--mode", mode,
-           "--sizes", sizes, "--gravity", repr(gravity)]
+           "--sizes", sizes, "--gravity", repr(gravity), "--shear", repr(shear)]
     t0 = time.time()
     with tempfile.TemporaryFile(mode="w+") as ferr:
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=ferr, text=True)
@@ -397,7 +408,7 @@ def matrix(args) -> dict:
            "cell_bits": args.cell_bits, "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "rows": []}
     for phi, n, b, sizes in ((phi, n, b, sizes) for phi in args.phi for n in args.n for b in args.boundary
                              for sizes in args.sizes):  # in the order given: a run cut short still covers both N
-        row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits, args.mode, sizes, args.gravity)
+        row = run_child(n, phi, b, c, args.seed, args.tick_bits, args.cell_bits, args.mode, sizes, args.gravity, args.shear)
         res["rows"].append(row)
         res["updated_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
         _write_atomic(path, res)
@@ -709,6 +720,8 @@ def main(argv=None) -> int:
     ap.add_argument("--dim", type=int, default=2, choices=[2, 3], help="2: disks (area fraction); 3: spheres (volume fraction)")
     ap.add_argument("--gravity", type=float, default=0.0,
                     help="matrix, gas: a uniform field along the last axis (walled), float units; 0: none")
+    ap.add_argument("--shear", type=float, default=0.0,
+                    help="matrix, gas: Lees-Edwards shear rate (float units; x flow, y gradient); 0: none")
     ap.add_argument("--sizes", nargs="+", default=["one"], choices=["one", "binary", "gauss"],
                     help="matrix, gas: a mixture (see the doc)")
     a = ap.parse_args(argv)

@@ -37,7 +37,8 @@ LEGAL = {
     ("lattice", "quantization.max_velocity_error", "huge"): "a reported error, finite",
     **{("lattice", k, "missing"): "written before the entry existed: a default" for k in
        ("engine", "mode", "units.tick_bits", "units.cell_bits", "units.boundary",
-        "quantization.max_position_error", "quantization.max_velocity_error", "search", "units.gravity")},
+        "quantization.max_position_error", "quantization.max_velocity_error", "search", "units.gravity",
+        "units.shear")},
 }
 
 

@@ -26,8 +26,10 @@ PNG = b"\x89PNG\r\n\x1a\n"
 def reduced_doc(doc: dict, particles: int = 200, collisions: int = 20_000) -> dict:
     """A lattice scene's document in its CI form: fewer particles and collisions, no outputs."""
     doc = copy.deepcopy(doc)
-    # (a mixture starts on a crystal of its largest size: 256 spheres fill whole face-centred cells)
-    doc["system"]["particles"] = 256 if doc.get("species") and doc["system"]["dimension"] == 3 else particles
+    # (a mixture starts on a crystal of its largest size: 256 spheres fill whole face-centred cells;
+    # a sheared box is at least 9 diameters along the flow: 500 spheres at 0.3)
+    doc["system"]["particles"] = (256 if doc.get("species") and doc["system"]["dimension"] == 3 else
+                                  500 if doc["system"].get("shear_rate") else particles)
     counts = [sp.pop("count") for sp in doc.get("species", []) if "count" in sp]
     for sp, c in zip(doc.get("species", []), counts):  # a mixture: its species' shares of the fewer particles
         sp["fraction"] = c / sum(counts)

@@ -34,6 +34,16 @@ void BasicEngine<Op, Bits, Queue>::inconsistent(const std::string& what, int i, 
 // a third body at a: complete whenever 0 is returned (every neighbour was looked at).
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const -> int {
+  if (sh_ != 0) [[unlikely]] return post_reason_t<true>(i, j, xi, xj, vi, vj, a, pre_a, multi);
+  return post_reason_t<false>(i, j, xi, xj, vi, vj, a, pre_a, multi);
+}
+
+// (Sheared: every distance through the nearest moving image at its tick, shear.hpp)
+template <class Op, class Bits, class Queue>
+template <bool Sheared>
+auto BasicEngine<Op, Bits, Queue>::post_reason_t(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const -> int {
+  auto dist = [&](const Vec& x, const Vec& y, std::int64_t t) { return Sheared ? diff_at(x, y, t) : diff(x, y); };
+  auto meet = [&](const Vec& x, const Vec& y, int p, int q, std::int64_t t) { return norm2(dist(x, y, t)) < sig2(p, q); };
   for (std::size_t k = 0; k < D; ++k) {
     for (const Vec* vv : {&vi, &vj})
       if ((*vv)[k] > u_.vmax || (*vv)[k] < -u_.vmax) return redraw_outside;
@@ -51,19 +61,19 @@ auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, cons
     const Vec& x = s == 0 ? xi : xj;
     const Vec& v = s == 0 ? vi : vj;
     const int o = s == 0 ? i : j;  // whose post point
-    const Vec ghost = wrapped(sub(x, v));
+    const Vec ghost = Sheared ? back_at(x, v, a - 1) : wrapped(sub(x, v));
     auto third = [&](int q) {
       if (why != 0 || q == i || q == j) return;
       const Vec qa = pos(q, a);
       // exit (measure before changing): farther than sigma + 4 vmax, none of the three can hold
       // (the ghost and the pre point are within 2 vmax of x, q moves at most vmax per tick)
-      const Vec d = diff(x, qa);
+      const Vec d = dist(x, qa, a);
       double dd = static_cast<double>(d[0]) * d[0];
       for (std::size_t k = 1; k < D; ++k) dd += static_cast<double>(d[k]) * d[k];
       if (dd > far2_) return;
-      if (overlap(x, qa, o, q)) why = redraw_overlap_after;
-      else if (overlap(ghost, gax_ >= 0 ? pos(q, a - 1) : wrapped(sub(qa, ln_[q].v)), o, q)) why = redraw_ghost_tie;
-      if (overlap(pre_a[s], qa, o, q)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
+      if (meet(x, qa, o, q, a)) why = redraw_overlap_after;
+      else if (meet(ghost, gax_ >= 0 || Sheared ? pos(q, a - 1) : wrapped(sub(qa, ln_[q].v)), o, q, a - 1)) why = redraw_ghost_tie;
+      if (meet(pre_a[s], qa, o, q, a)) multi = true;  // complete: pre_a[s] is within 2 vmax of x
     };
     if (direct_) {  // the owner's list (x is within 2 vmax of its line), far ones dropped in double
       const std::array<double, D> ax = unwrapped_about(o, x);
@@ -83,6 +93,8 @@ auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, cons
       }
     } else if (lists_) {
       nl_.for_each(s == 0 ? i : j, third);
+    } else if (Sheared) {
+      grid_.for_neighbours_sheared(grid_.cell_id(x), third);
     } else {
       grid_.for_neighbours(grid_.cell_id(x), third);
     }
@@ -134,8 +146,12 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
   std::array<std::uint64_t, 8> reasons{};
   // the operator runs in coordinates centred on x_j (it is translation equivariant), so its
   // values stay within a few sigma of 0 whatever the box
-  const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
-  const Vec ui = move_of(i, a), uj = move_of(j, a);  // the tick's moves (field.hpp)
+  // (shear: i's image nearest j, -n boxes up, moving n s slower; shear.hpp)
+  std::int64_t n;
+  const Vec xj = pos(j, a - 1), xi = diff_at(pos(i, a - 1), xj, a - 1, n), zero{};
+  Vec ui = move_of(i, a);  // the tick's moves (field.hpp)
+  const Vec uj = move_of(j, a);
+  ui[0] -= n * sh_;
   Vec xi2, xj2, vi2, vj2;
   Bits out;
   std::optional<Op> opm;
@@ -147,8 +163,8 @@ bool BasicEngine<Op, Bits, Queue>::collide_drawn(int i, int j, std::int64_t a, b
     const auto rf = op.pair_forward(xi, zero, ui, uj, g, own_[i].X, xi2, xj2, vi2, vj2, out);
     int why = static_cast<int>(rf);
     if (why == 0) {
-      xi2 = shifted(xj, xi2);
-      xj2 = shifted(xj, xj2);
+      xi2 = shifted_at(xj, xi2, a, vi2);
+      xj2 = shifted_at(xj, xj2, a, vj2);
       why = post_reason(i, j, xi2, xj2, vi2, vj2, a, pre_a, multi);
     }
     if (why == 0) break;
@@ -190,22 +206,26 @@ void BasicEngine<Op, Bits, Queue>::collide_back(int i, int j, std::int64_t a) {
     back_specular(i, j, a);
     return;
   }
-  const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+  std::int64_t n;
+  const Vec xj = pos(j, a - 1), xi = diff_at(pos(i, a - 1), xj, a - 1, n), zero{};
   const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
   if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) inconsistent("particle " + std::to_string(gid(i)) + "'s stream would step back past draw 0", i, j);
   const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr - 1);
   Vec xi0, xj0, vi0, vj0;
   if (own_[i].pc == 0 || own_[j].pc == 0) inconsistent("a collision count would step back past 0", i, j);
   std::optional<Op> opm;
-  op_of(i, j, opm).pair_reverse(xi, zero, neg(move_of(i, a)), neg(move_of(j, a)), g, own_[i].X, xi0, xj0, vi0, vj0);
-  xi0 = shifted(xj, xi0);
-  xj0 = shifted(xj, xj0);
+  Vec ui = neg(move_of(i, a));
+  ui[0] += n * sh_;  // (shear: the image's velocity, negated)
+  op_of(i, j, opm).pair_reverse(xi, zero, ui, neg(move_of(j, a)), g, own_[i].X, xi0, xj0, vi0, vj0);
+  vi0 = neg(vi0), vj0 = neg(vj0);  // (this frame's velocities)
+  xi0 = shifted_at(xj, xi0, a, vi0);
+  xj0 = shifted_at(xj, xj0, a, vj0);
   own_[i].ctr -= 1 + redraws;
   if (logged != log_.end()) log_.erase(logged);
   --own_[i].pc;
   --own_[j].pc;
   --ncoll_;
-  apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
+  apply(i, j, xi0, xj0, vi0, vj0, a);
 }
 
 // Specular mode (specular.hpp): one deterministic post state. When the map refuses it or it
@@ -221,15 +241,18 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
   journal(j);
   if (wall_tick_[i] == a || wall_tick_[j] == a) ++cnt_.wall_body;
   const Vec pre_a[2] = {pos(i, a), pos(j, a)};
-  const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+  std::int64_t n;
+  const Vec xj = pos(j, a - 1), xi = diff_at(pos(i, a - 1), xj, a - 1, n), zero{};
   Vec xi2, xj2, vi2, vj2;
   SpecularTrace tr;
   bool multi = false;
   std::optional<Specular> spm;
-  int why = static_cast<int>(spec_of(i, j, spm).pair_map(xi, zero, move_of(i, a), move_of(j, a), xi2, xj2, vi2, vj2, &tr));
+  Vec ui = move_of(i, a);
+  ui[0] -= n * sh_;  // (shear: i's image nearest j; shear.hpp)
+  int why = static_cast<int>(spec_of(i, j, spm).pair_map(xi, zero, ui, move_of(j, a), xi2, xj2, vi2, vj2, &tr));
   if (why == 0) {
-    xi2 = shifted(xj, xi2);
-    xj2 = shifted(xj, xj2);
+    xi2 = shifted_at(xj, xi2, a, vi2);
+    xj2 = shifted_at(xj, xj2, a, vj2);
     why = post_reason(i, j, xi2, xj2, vi2, vj2, a, pre_a, multi);
   }
   if (why != 0) {
@@ -256,18 +279,22 @@ void BasicEngine<Op, Bits, Queue>::collide_specular(int i, int j, std::int64_t a
 // The reverse of a specular collision: the map's exact inverse on the negated lines.
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::back_specular(int i, int j, std::int64_t a) {
-  const Vec xj = pos(j, a - 1), xi = diff(pos(i, a - 1), xj), zero{};
+  std::int64_t n;
+  const Vec xj = pos(j, a - 1), xi = diff_at(pos(i, a - 1), xj, a - 1, n), zero{};
   Vec xi0, xj0, vi0, vj0;
   std::optional<Specular> spm;
-  if (spec_of(i, j, spm).pair_unmap(xi, zero, neg(move_of(i, a)), neg(move_of(j, a)), xi0, xj0, vi0, vj0) != Refusal::none)
+  Vec ui = neg(move_of(i, a));
+  ui[0] += n * sh_;  // (shear: the image's velocity, negated)
+  if (spec_of(i, j, spm).pair_unmap(xi, zero, ui, neg(move_of(j, a)), xi0, xj0, vi0, vj0) != Refusal::none)
     inconsistent("the specular map refuses the post state it is to take back", i, j);
   if (own_[i].pc == 0 || own_[j].pc == 0) inconsistent("a collision count would step back past 0", i, j);
-  xi0 = shifted(xj, xi0);
-  xj0 = shifted(xj, xj0);
+  vi0 = neg(vi0), vj0 = neg(vj0);  // (this frame's velocities)
+  xi0 = shifted_at(xj, xi0, a, vi0);
+  xj0 = shifted_at(xj, xj0, a, vj0);
   --own_[i].pc;
   --own_[j].pc;
   --ncoll_;
-  apply(i, j, xi0, xj0, neg(vi0), neg(vj0), a);
+  apply(i, j, xi0, xj0, vi0, vj0, a);
 }
 
 }  // namespace revcol::lattice

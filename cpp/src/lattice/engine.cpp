@@ -83,6 +83,16 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
     s.units.gravity[k] = static_cast<std::int64_t>(ge);
     s.gravity_error = std::max(s.gravity_error, std::fabs(ge - gl) / std::fabs(gl));
   }
+  require(std::isfinite(c.shear_rate), "lattice: shear_rate must be finite");
+  if (c.shear_rate != 0.0) {  // Lees-Edwards, quantized once to lattice units per tick (shear.hpp)
+    require(!c.wall[0] && !c.wall[1], "lattice: shear needs axes 0 (the flow) and 1 (the gradient) periodic");
+    const double sl = c.shear_rate * c.box[1] * s.units.tick / s.units.length_unit;
+    const double se = std::round(sl);
+    require(std::fabs(se) >= 1.0, "lattice: the shear rate is below the lattice's resolution at this tick");
+    require(std::fabs(se) <= static_cast<double>(s.units.vmax / 4), "lattice: the shear rate is too high for the lattice (gamma L_1 above vmax / 4)");
+    s.units.shear = static_cast<std::int64_t>(se);
+    s.shear_error = std::fabs(se - sl) / std::fabs(sl);
+  }
   validate(s.units);
   if (!c.diameters.empty()) {
     s.radius.resize(n);
@@ -122,6 +132,13 @@ LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double 
   }
   LatticeConfigN<D> lc = c;
   for (std::size_t k = 0; k < D; ++k) lc.box[k] = st.config.box[k];
+  require(std::isfinite(c.shear_rate), "lattice: shear_rate must be finite");
+  if (c.shear_rate != 0.0) {  // the steady profile about the particles' mean height (no momentum added)
+    double ym = 0.0;
+    for (std::size_t p = 0; p < n; ++p) ym += st.x[D * p + 1];
+    ym /= static_cast<double>(n);
+    for (std::size_t p = 0; p < n; ++p) st.v[D * p] += c.shear_rate * (st.x[D * p + 1] - ym);
+  }
   return quantize_start(lc, st.x, st.v);
 }
 

@@ -169,6 +169,17 @@ void validate(const UnitsN<Dim>& u) {
     require(g >= -max_gravity && g <= max_gravity, "lattice units: |gravity| must be at most 2^36 lattice units per tick^2");
   }
   require(fields <= 1, "lattice units: gravity may act along one axis only");
+  if (u.shear != 0) {
+    require(!u.wall[0] && !u.wall[1], "lattice units: shear (Lees-Edwards) needs axes 0 (the flow) and 1 (the gradient) periodic");
+    require(u.shear >= -u.vmax / 4 && u.shear <= u.vmax / 4, "lattice units: |shear| must be at most vmax / 4 lattice units per tick");
+    require(fields == 0, "lattice units: shear and gravity together are not built yet");
+    for (std::size_t k = 2; k < Dim; ++k)  // (its stall of the other axes would move the images across a gradient face)
+      require(!u.bounce[k], "lattice units: shear with bounce-back walls is not built yet (specular walls on axis 2)");
+    // the engine's cells along the flow and the gradient (cell_grid.hpp): a crossing pair's image
+    // is the one nearest at its prediction only while the box is >= 9 cells along the flow
+    const std::int64_t w = u.sigma + 2 * u.vmax + 2;
+    require(u.L[0] / w >= 9 && u.L[1] / w >= 5, "lattice units: a sheared box must be at least 9 diameters along axis 0 (the flow) and 5 along axis 1 (the gradient)");
+  }
 }
 
 template <std::size_t Dim>
@@ -249,7 +260,8 @@ namespace {
 // (at most sigma, the cells' width).
 template <std::size_t Dim>
 void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>* v,
-                    const std::vector<std::int64_t>& radius) {
+                    const std::vector<std::int64_t>& radius, std::int64_t clock) {
+  const std::int64_t delta = shear_offset(u, clock);
   const u128 sigma2 = static_cast<u128>(u.sigma) * static_cast<u128>(u.sigma);
   std::array<std::int64_t, Dim> nc{};
   for (std::size_t k = 0; k < Dim; ++k) nc[k] = std::max<std::int64_t>(1, u.L[k] / u.sigma);
@@ -282,6 +294,13 @@ void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
         }
       }
       if (skip) continue;
+      // Lees-Edwards: across the gradient axis's faces the images are offset along axis 0, so
+      // that row's every cell along axis 0 is looked at (once, from the middle offset)
+      const bool across = u.shear != 0 && (c0[1] + ((o / (Dim == 3 ? 3 : 1)) % 3) - 1 < 0 || c0[1] + ((o / (Dim == 3 ? 3 : 1)) % 3) - 1 >= nc[1]);
+      const int first0 = static_cast<int>(o / (Dim == 3 ? 9 : 3)) - 1;
+      if (across && first0 != 0) continue;
+      for (std::int64_t a0 = 0; a0 < (across ? nc[0] : 1); ++a0) {
+      if (across) c[0] = a0;
       auto it = grid.find(key(c));
       if (it == grid.end()) continue;
       for (int j : it->second) {
@@ -292,16 +311,20 @@ void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
           const std::int64_t d = x[i][k] - x[j][k];
           r[k] = u.wall[k] ? d : min_image(d, u.L[k]);
         }
+        std::int64_t n = 0;  // j's image: n boxes up the gradient axis (offset n delta along axis 0; shear.hpp)
+        if (u.shear != 0) r = sheared_diff<Dim>(x[i], x[static_cast<std::size_t>(j)], u.L, u.wall, delta, n);
         if (norm2(r) >= s2) continue;
         if (v != nullptr) {  // pending at the clock: apart at the tick before (differences below 2^62 + 2^53)
           VecN<Dim> before;
           for (std::size_t k = 0; k < Dim; ++k) before[k] = r[k] - ((*v)[i][k] - (*v)[j][k]);
+          before[0] += n * u.shear;  // (the image's velocity: v_j + n shear along axis 0)
           if (norm2(before) >= s2) continue;
         }
         require(false, [&] {
           return "lattice: particles " + std::to_string(i) + " and " + std::to_string(j) +
                  (v != nullptr ? " overlap, and did one tick before (not a collision pending at the clock)" : " overlap");
         });
+      }
       }
     }
   }
@@ -310,7 +333,7 @@ void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
 
 template <std::size_t Dim>
 void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v,
-                    bool pending, const std::vector<std::int64_t>& radius) {
+                    bool pending, const std::vector<std::int64_t>& radius, std::int64_t clock) {
   validate(u);
   require(x.size() == v.size(), "lattice: x (positions) and v (velocities) differ in length");
   require(!x.empty(), "lattice: no particles");
@@ -337,7 +360,7 @@ void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
   require(e <= static_cast<u128>(u.vmax) * static_cast<u128>(u.vmax),
           field_axis(u) < 0 ? "lattice: the total kinetic energy allows a speed beyond vmax (too many particles for the velocity scale)"
                             : "lattice: the total energy (kinetic and potential) allows a speed beyond vmax (a field too strong for the box and the velocity scale)");
-  check_overlaps(u, x, pending ? &v : nullptr, radius);
+  check_overlaps(u, x, pending ? &v : nullptr, radius, clock);
 }
 
 template <std::size_t Dim>
@@ -413,6 +436,10 @@ void CellGridN<Dim>::build(const UnitsN<Dim>& u, std::size_t n, std::int64_t wmi
     const double f = Dim == 2 ? std::sqrt(total / cap) : std::cbrt(total / cap);
     for (std::size_t k = 0; k < Dim; ++k)
       ncl[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(static_cast<double>(ncl[k]) / f));
+  }
+  if (u.shear != 0) {  // a sheared box keeps >= 9 cells along the flow, 5 along the gradient (shear.hpp)
+    ncl[0] = std::max<std::int64_t>(ncl[0], std::min<std::int64_t>(9, u.L[0] / wmin));
+    ncl[1] = std::max<std::int64_t>(ncl[1], std::min<std::int64_t>(5, u.L[1] / wmin));
   }
   for (std::size_t k = 0; k < Dim; ++k) {
     all_[k] = !u.wall[k] && ncl[k] < 2 * span_ + 3;
@@ -528,8 +555,8 @@ template u128 kinetic2(const std::vector<VecN<2>>&) noexcept;
 template u128 kinetic2(const std::vector<VecN<3>>&) noexcept;
 template u128 energy2(const UnitsN<2>&, const std::vector<VecN<2>>&, const std::vector<VecN<2>>&) noexcept;
 template u128 energy2(const UnitsN<3>&, const std::vector<VecN<3>>&, const std::vector<VecN<3>>&) noexcept;
-template void validate_state(const UnitsN<2>&, const std::vector<VecN<2>>&, const std::vector<VecN<2>>&, bool, const std::vector<std::int64_t>&);
-template void validate_state(const UnitsN<3>&, const std::vector<VecN<3>>&, const std::vector<VecN<3>>&, bool, const std::vector<std::int64_t>&);
+template void validate_state(const UnitsN<2>&, const std::vector<VecN<2>>&, const std::vector<VecN<2>>&, bool, const std::vector<std::int64_t>&, std::int64_t);
+template void validate_state(const UnitsN<3>&, const std::vector<VecN<3>>&, const std::vector<VecN<3>>&, bool, const std::vector<std::int64_t>&, std::int64_t);
 template void validate_radii(const UnitsN<2>&, const std::vector<std::int64_t>&, std::size_t);
 template void validate_radii(const UnitsN<3>&, const std::vector<std::int64_t>&, std::size_t);
 template QuantizedN<2> quantize(const UnitsN<2>&, const std::vector<double>&, const std::vector<double>&, const std::vector<std::int64_t>&);

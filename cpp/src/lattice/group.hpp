@@ -37,13 +37,30 @@ auto BasicEngine<Op, Bits, Queue>::group_of(int i, int j, std::int64_t a) const 
   for (std::size_t m = 0; m < g.size(); ++m) {
     const Vec xa = pos(g[m], a);
     near(g[m], [&](int q) {
-      if (!member(q) && overlap(xa, pos(q, a), g[m], q)) g.push_back(q);
+      if (!member(q) && overlap_at(xa, pos(q, a), g[m], q, a)) g.push_back(q);
     });
   }
   return g;
 }
 
-// Post velocities of a resolve for the members g (positions at a-1: x): sequential specular
+// A group's stall (shear.hpp): the members' points at a from their points x at a-1, at rest in
+// the frame of the first (the lowest id): a member whose image next to it is n boxes up moves by
+// -n s along the flow, so no two members' relative vectors change (their points at a overlap no
+// more than at a-1). Without shear, or within one box, the a-1 points themselves. Returns each
+// member's n (empty without shear): a bounce negates the velocities in that frame too, v -> -v +
+// 2 n s. The reverse takes the same rules in its frame (-s, the same n), which undo them.
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::stall(std::vector<Vec>& x, std::int64_t a) const -> std::vector<std::int64_t> {
+  if (sh_ == 0) [[likely]] return {};
+  std::vector<std::int64_t> up(x.size(), 0);
+  for (std::size_t m = 1; m < x.size(); ++m) {
+    diff_at(x[m], x[0], a - 1, up[m]);  // the first's image n boxes up is next to m: m's image next to it is -n up
+    if (up[m] != 0) x[m][0] = wrap(static_cast<i128>(x[m][0]) + static_cast<i128>(up[m]) * sh_, u_.L[0]);
+  }
+  return up;
+}
+
+// Post velocities of a resolve for the members g (their points at a, the stall's: x): sequential specular
 // collisions of the pairs whose pre lines overlap at a, then integer rounding with the sum kept.
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const -> std::vector<Vec> {
@@ -63,22 +80,25 @@ auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g,
   struct Touch {
     std::size_t p, q;
     VecD n;
+    double s;  // shear: q's image's extra speed along the flow, n s (shear.hpp)
   };
   std::vector<Touch> touch;
   for (std::size_t p = 0; p < n; ++p)
     for (std::size_t q = p + 1; q < n; ++q) {
-      const Vec r = diff(x[p], x[q]);
+      std::int64_t up;
+      const Vec r = diff_at(x[p], x[q], a, up);
+      const double s = static_cast<double>(up * sh_);
       VecD rd, w;
       for (std::size_t k = 0; k < D; ++k) {
         rd[k] = static_cast<double>(r[k]);
-        w[k] = v[p][k] - v[q][k];
+        w[k] = v[p][k] - v[q][k] - (k == 0 ? s : 0.0);
       }
       const double len = std::sqrt(ddot(rd, rd));
       // touching: the pre lines overlap at a, or the pair is within one tick's relative travel at a-1
       const bool near = len < static_cast<double>(rad(g[p]) + rad(g[q])) + std::sqrt(ddot(w, w));
-      if (len > 0.0 && (near || overlap(pos(g[p], a), pos(g[q], a), g[p], g[q]))) {
+      if (len > 0.0 && (near || overlap_at(pos(g[p], a), pos(g[q], a), g[p], g[q], a))) {
         for (std::size_t k = 0; k < D; ++k) rd[k] /= len;
-        touch.push_back({p, q, rd});
+        touch.push_back({p, q, rd, s});
       }
     }
   // a wall is met within the tick by a member whose line is beyond it at a: -1 lower, +1 upper
@@ -103,7 +123,7 @@ auto BasicEngine<Op, Bits, Queue>::resolve_velocities(const std::vector<int>& g,
         }
     for (const Touch& t : touch) {
       VecD w;
-      for (std::size_t k = 0; k < D; ++k) w[k] = v[t.p][k] - v[t.q][k];
+      for (std::size_t k = 0; k < D; ++k) w[k] = v[t.p][k] - v[t.q][k] - (k == 0 ? t.s : 0.0);
       const double wn = ddot(w, t.n);
       if (wn >= -eps) continue;  // not approaching along the normal
       for (std::size_t k = 0; k < D; ++k) {
@@ -142,11 +162,15 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
     std::sort(g.begin(), g.end(), [&](int a, int b) { return gid(a) < gid(b); });  // by particle id
     post.assign(g.size(), Vec{});
     for (std::size_t m = 0; m < g.size(); ++m) post[m] = pos(g[m], a - 1);
+    const std::vector<std::int64_t> up = stall(post, a);
     if (resolve) {
       vel = resolve_velocities(g, post, a);
     } else {
       vel.assign(g.size(), Vec{});
-      for (std::size_t m = 0; m < g.size(); ++m) vel[m] = neg(this->vel(g[m], a - 1));  // (a field too: the stall's move negated)
+      for (std::size_t m = 0; m < g.size(); ++m) {
+        vel[m] = neg(this->vel(g[m], a - 1));  // (a field too: the stall's move negated)
+        if (!up.empty()) vel[m][0] += 2 * up[m] * sh_;  // (shear: negated in the first's frame)
+      }
     }
     bool grew = false;
     for (std::size_t m = 0; m < g.size() && !grew; ++m) {
@@ -154,10 +178,10 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
         if (vel[m][k] > u_.vmax || vel[m][k] < -u_.vmax) return false;
         if (u_.wall[k] && (post[m][k] < lo_of(g[m]) || post[m][k] > hi_of(g[m], static_cast<int>(k)))) return false;
       }
-      const Vec ghost = wrapped(sub(plus_h(post[m]), vel[m]));  // the new line at a-1 (a field: x - v + h)
+      const Vec ghost = back_at(plus_h(post[m]), vel[m], a - 1);  // the new line at a-1 (a field: x - v + h)
       near(g[m], [&](int q) {
         if (grew || member(q)) return;
-        if (overlap(post[m], pos(q, a), g[m], q) || overlap(ghost, pos(q, a - 1), g[m], q)) {
+        if (overlap_at(post[m], pos(q, a), g[m], q, a) || overlap_at(ghost, pos(q, a - 1), g[m], q, a - 1)) {
           g.push_back(q);
           grew = true;
         }
@@ -169,9 +193,9 @@ auto BasicEngine<Op, Bits, Queue>::group_post(std::vector<int>& g, std::int64_t 
     // was taken back from a reflection at a)
     for (std::size_t p = 0; p < g.size(); ++p)
       for (std::size_t q = p + 1; q < g.size(); ++q) {
-        const Vec gp = wrapped(sub(plus_h(post[p]), vel[p]));
-        const Vec gq = wrapped(sub(plus_h(post[q]), vel[q]));
-        if (overlap(gp, gq, g[p], g[q])) return true;  // the reverse meets this pair at a-1
+        const Vec gp = back_at(plus_h(post[p]), vel[p], a - 1);
+        const Vec gq = back_at(plus_h(post[q]), vel[q], a - 1);
+        if (overlap_at(gp, gq, g[p], g[q], a - 1)) return true;  // the reverse meets this pair at a-1
       }
     return false;
   }
@@ -269,9 +293,11 @@ void BasicEngine<Op, Bits, Queue>::group_back(int i, int j, std::int64_t a, Grou
   const std::vector<Vec> pre_v = entry.pre_v;  // forward frame; empty: a bounce (a copy: popped below)
   std::vector<Vec> pre(g.size());
   for (std::size_t m = 0; m < g.size(); ++m) pre[m] = pos(g[m], a - 1);
+  const std::vector<std::int64_t> up = stall(pre, a);
   for (std::size_t m = 0; m < g.size(); ++m) {
     Line& l = ln_[g[m]];
-    const Vec v = pre_v.empty() ? neg(vel(g[m], a - 1)) : neg(pre_v[m]);
+    Vec v = pre_v.empty() ? neg(vel(g[m], a - 1)) : neg(pre_v[m]);
+    if (pre_v.empty() && !up.empty()) v[0] += 2 * up[m] * sh_;  // (a bounce under shear: stall())
     l = Line{pre[m], v, a};
     sync(g[m]);
     ++slot_[static_cast<std::size_t>(g[m])].ver;

@@ -199,8 +199,8 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   // whose point at a-1 is x - move (the ghost); the velocity at a is that move plus h
   Vec x = x0, v = plus_h(v0);
   const Vec old_line_at_a = pos(p, a);
-  const unsigned axes = reflection(p, x, v);
-  const Vec ghost = wrapped(sub(x, v));
+  const unsigned axes = reflection(p, x, v, a);
+  const Vec ghost = back_at(x, v, a - 1);
   v = plus_h(v);
   if (gax_ >= 0 && (axes >> gax_ & 1u)) [[unlikely]] field_impulse(v0[gax_], v[gax_]);
   near(p, [&](int q) {
@@ -208,11 +208,11 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
     // the forward's guard (its reverse would meet q first); the reverse replays the forward, and
     // its ghost is the forward's pre-wall line at a, beyond the wall (right after a collision
     // undone on this tick, a body may well overlap it there)
-    if (!reversed_ && overlap(ghost, pos(q, a - 1), p, q)) {
+    if (!reversed_ && overlap_at(ghost, pos(q, a - 1), p, q, a - 1)) {
       throw std::runtime_error("lattice engine: a wall and a body within one tick that the rule cannot resolve (particle " +
                                std::to_string(p) + ", tick " + std::to_string(a) + "); not supported yet");
     }
-    if (overlap(old_line_at_a, pos(q, a), p, q)) ++cnt_.wall_body;
+    if (overlap_at(old_line_at_a, pos(q, a), p, q, a)) ++cnt_.wall_body;
   });
   if (!reversed_ && (obs_ || events || seen_)) [[unlikely]] note_wall(a, p, x, v, axes);
   pre_wall_[p] = Line{x0, v0, a - 1};  // a group collision at a may take it back
@@ -243,7 +243,7 @@ void BasicEngine<Op, Bits, Queue>::field_impulse(std::int64_t before, std::int64
 }
 
 template <class Op, class Bits, class Queue>
-unsigned BasicEngine<Op, Bits, Queue>::reflection(int p, Vec& x, Vec& v) const noexcept {
+unsigned BasicEngine<Op, Bits, Queue>::reflection(int p, Vec& x, Vec& v, std::int64_t a) const noexcept {
   unsigned axes = 0;  // the walls it meets
   bool whole = false;  // one of them bounces back
   for (std::size_t k = 0; k < D; ++k)
@@ -252,12 +252,13 @@ unsigned BasicEngine<Op, Bits, Queue>::reflection(int p, Vec& x, Vec& v) const n
       whole = whole || u_.bounce[k];
     }
   const Vec v0 = v;
+  Vec d{};  // the move of the axes that fly on (shear: shifted_at below, across a gradient face)
   for (std::size_t k = 0; k < D; ++k) {
     if (axes >> k & 1u) wall_mirror(x[k], v[k], lo_of(p), hi_of(p, static_cast<int>(k)));
-    else if (!whole) x[k] += v[k];  // a bounce back: the other axes stall at their a-1 point
-    if (!u_.wall[k]) x[k] = wrap(x[k], u_.L[k]);
+    else if (!whole) d[k] = v[k];  // a bounce back: the other axes stall at their a-1 point
   }
   if (whole) v = neg(v0);
+  x = shifted_at(x, d, a, v);
   return axes;
 }
 

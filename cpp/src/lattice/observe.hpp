@@ -13,6 +13,7 @@ namespace revcol::lattice {
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
   require(gax_ < 0, "lattice observe: the observer does not take a field yet (its pressure and free paths assume straight lines); read snapshots instead");
+  require(sh_ == 0, "lattice observe: the observer does not take a sheared gas yet (its pair separations ignore the moving images); read snapshots and diagnostics() instead");
   observer_ = make_observer(u_, positions(), velocities(), clock_, &c, nullptr, radii());
   obs_ = observer_.get();
 }

@@ -20,10 +20,10 @@ template <class Op, class Bits, class Queue>
   for (std::size_t k = 0; k < D; ++k) {
     std::int64_t m, y;
     // fast path (measure before changing): the displacement fits int64 and at most one wrap
-    // (axk_: 0 periodic, 1 walls, 2 walls and the field, whose axis is read in one test)
+    // (axk_: 0 periodic, 1 walls, 2 walls and the field, 3 the sheared gradient, read in one test)
     if (!__builtin_mul_overflow(ln_[p].v[k], dt, &m) && !__builtin_add_overflow(ln_[p].x[k], m, &y)) {
       if (axk_[k] != 0) {
-        out[k] = axk_[k] == 1 ? y : field_at(p, k, dt);
+        out[k] = axk_[k] == 1 ? y : axk_[k] == 2 ? field_at(p, k, dt) : sheared_at(p, t, out);
         continue;
       }
       if (y >= u_.L[k]) y -= u_.L[k];
@@ -34,9 +34,48 @@ template <class Op, class Bits, class Queue>
       }
     }
     const i128 z = static_cast<i128>(ln_[p].x[k]) + static_cast<i128>(ln_[p].v[k]) * dt;
-    out[k] = axk_[k] == 2 ? field_at(p, k, dt) : u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
+    out[k] = axk_[k] == 2 ? field_at(p, k, dt) : axk_[k] == 3 ? sheared_at(p, t, out) : u_.wall[k] ? static_cast<std::int64_t>(z) : wrap(z, u_.L[k]);
   }
   return out;
+}
+
+// ---- line helpers (declared in engine_core.hpp) ----
+// origin + d, wrapped on periodic axes (128-bit sum: no overflow whatever the box)
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::shifted(const Vec& origin, const Vec& d) const noexcept -> Vec {
+  Vec o;
+  for (std::size_t k = 0; k < D; ++k) {
+    const i128 y = static_cast<i128>(origin[k]) + d[k];
+    o[k] = u_.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u_.L[k]);
+  }
+  return o;
+}
+
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::wrapped(const Vec& x) const noexcept -> Vec {
+  Vec o = x;
+  for (std::size_t k = 0; k < D; ++k)
+    if (!u_.wall[k]) o[k] = wrap(x[k], u_.L[k]);
+  return o;
+}
+
+// the prediction's double mirror of p's line, after every change of ln_[p]
+template <class Op, class Bits, class Queue>
+[[gnu::always_inline]] inline void BasicEngine<Op, Bits, Queue>::sync(int p) noexcept {
+  LineD& d = lnd_[static_cast<std::size_t>(p)];
+  const Line& l = ln_[static_cast<std::size_t>(p)];
+  if (lists_) {
+    d.a = unwrapped_about(p, l.x);
+  } else {
+    for (std::size_t k = 0; k < D; ++k) d.a[k] = static_cast<double>(l.x[k]);
+  }
+  for (std::size_t k = 0; k < D; ++k) d.v[k] = static_cast<double>(l.v[k]);
+  d.ta = l.ta;
+}
+
+template <class Op, class Bits, class Queue>
+inline std::int64_t BasicEngine<Op, Bits, Queue>::ups(int p, std::int64_t t) const noexcept {
+  return floor_div128(static_cast<i128>(ln_[p].x[1]) + static_cast<i128>(ln_[p].v[1]) * (t - ln_[p].ta), u_.L[1]);
 }
 
 // ---- a uniform field (field.hpp) ----
@@ -51,19 +90,82 @@ inline auto BasicEngine<Op, Bits, Queue>::vel(int p, std::int64_t t) const noexc
   Vec v = ln_[p].v;
   if (gax_ >= 0) [[unlikely]]
     v[gax_] = static_cast<std::int64_t>(static_cast<std::uint64_t>(v[gax_]) + 2 * static_cast<std::uint64_t>(hg_) * static_cast<std::uint64_t>(t - ln_[p].ta));
+  if (sh_ != 0) [[unlikely]] v[0] -= ups(p, t) * sh_;  // (shear: the jumps of its crossings)
   return v;
 }
 
 template <class Op, class Bits, class Queue>
 inline auto BasicEngine<Op, Bits, Queue>::move_of(int p, std::int64_t a) const noexcept -> Vec {
-  if (gax_ < 0) [[likely]] return ln_[p].v;
-  return plus_h(vel(p, a - 1));
+  if (!moving_) [[likely]] return ln_[p].v;
+  return plus_h(vel(p, a - 1));  // (shear: the velocity of its point at a-1, past a crossing at a)
 }
 
 template <class Op, class Bits, class Queue>
 inline auto BasicEngine<Op, Bits, Queue>::plus_h(Vec v) const noexcept -> Vec {
   if (gax_ >= 0) [[unlikely]] v[gax_] += hg_;
   return v;
+}
+
+// ---- Lees-Edwards shear (shear.hpp) ----
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::diff_at(const Vec& a, const Vec& b, std::int64_t t, std::int64_t& n) const noexcept -> Vec {
+  n = 0;
+  if (sh_ == 0) [[likely]] return diff(a, b);
+  return sheared_diff<D>(a, b, u_.L, u_.wall, delta(t), n);  // (a template of shear.hpp: out of line)
+}
+
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::diff_at(const Vec& a, const Vec& b, std::int64_t t) const noexcept -> Vec {
+  std::int64_t n;
+  return diff_at(a, b, t, n);
+}
+
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::shifted_at(const Vec& origin, const Vec& d, std::int64_t t, Vec& v) const noexcept -> Vec {
+  if (sh_ == 0) [[likely]] return shifted(origin, d);
+  return sheared_shift(origin, d, t, v);
+}
+
+template <class Op, class Bits, class Queue>
+auto BasicEngine<Op, Bits, Queue>::sheared_shift(const Vec& origin, const Vec& d, std::int64_t t, Vec& v) const noexcept -> Vec {
+  Vec o = shifted(origin, d);
+  const std::int64_t m = floor_div128(static_cast<i128>(origin[1]) + d[1], u_.L[1]);
+  if (m != 0) {
+    o[0] = wrap(static_cast<i128>(o[0]) - static_cast<i128>(m) * delta(t), u_.L[0]);
+    v[0] -= m * sh_;
+  }
+  return o;
+}
+
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::back_at(const Vec& x, const Vec& v, std::int64_t t) const noexcept -> Vec {
+  if (sh_ == 0) [[likely]] return wrapped(sub(x, v));
+  Vec w = v;
+  return shifted_at(x, neg(v), t, w);
+}
+
+template <class Op, class Bits, class Queue>
+std::int64_t BasicEngine<Op, Bits, Queue>::sheared_at(int p, std::int64_t t, Vec& out) const noexcept {
+  const i128 z = static_cast<i128>(ln_[p].x[1]) + static_cast<i128>(ln_[p].v[1]) * (t - ln_[p].ta);
+  const std::int64_t m = floor_div128(z, u_.L[1]);  // across the gradient faces m times: the images' offset along the flow
+  if (m != 0) out[0] = wrap(static_cast<i128>(out[0]) - static_cast<i128>(m) * delta(t), u_.L[0]);
+  return static_cast<std::int64_t>(z - static_cast<i128>(m) * u_.L[1]);
+}
+
+// The first tick after lo at which floor(s t / W) changes, W the narrowest cell along the flow:
+// between two such ticks the images across the gradient faces move by less than a cell, so a
+// crossing pair's nearest image at a prediction is the one it can meet (a neutral event of the
+// particles next to a gradient face; shear.hpp, cell_grid.hpp).
+template <class Op, class Bits, class Queue>
+std::int64_t BasicEngine<Op, Bits, Queue>::next_offset(std::int64_t lo) const noexcept {
+  const std::int64_t W = u_.L[0] / grid_.count(0);
+  if (sh_ > 0) {
+    const i128 k = floor_div128(static_cast<i128>(sh_) * lo, W);
+    return floor_div128((k + 1) * W + sh_ - 1, sh_);
+  }
+  const std::int64_t s = -sh_;
+  const i128 j = -static_cast<i128>(floor_div128(-static_cast<i128>(s) * lo, W));  // ceil(s lo / W)
+  return floor_div128(j * W, s) + 1;
 }
 
 // A position x (wrapped) unwrapped about p's list centre: c_p + min_image(x - c_p), in
@@ -104,8 +206,8 @@ auto BasicEngine<Op, Bits, Queue>::region_ticks(const Line& l) const noexcept ->
 // ---- prediction ----
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::reanchor(int p, std::int64_t t) {
-  ln_[p].x = pos(p, t);
-  if (gax_ >= 0) [[unlikely]] ln_[p].v = vel(p, t);
+  if (moving_) [[unlikely]] reanchor_moving(p, t);
+  else ln_[p].x = pos(p, t);
   ln_[p].ta = t;
   if (lists_) {  // a post point outside the ball (a collision moves it by ~vmax): renew now
     if (!nl_.inside(p, ln_[p].x)) nl_.renew(p, ln_[p].x);
@@ -117,6 +219,18 @@ void BasicEngine<Op, Bits, Queue>::reanchor(int p, std::int64_t t) {
     grid_.remove(p);
     grid_.insert(p, id);
   }
+}
+
+// a field's or shear's line re-anchored at t: its point and its velocity there (read before the
+// anchor moves: shear counts the old line's crossings)
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::reanchor_moving(int p, std::int64_t t) {
+  const Vec v = vel(p, t);
+  ln_[p].x = pos(p, t);
+  ln_[p].v = v;
+  if (sh_ != 0 && (v[0] > u_.vmax || v[0] < -u_.vmax))
+    throw std::runtime_error("lattice engine: shear has heated the gas beyond the lattice's speed limit vmax (particle " + std::to_string(gid(p)) +
+                             ", tick " + std::to_string(t) + "): the run stops here");
 }
 
 template <class Op, class Bits, class Queue>
@@ -151,6 +265,8 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
       region_[static_cast<std::size_t>(p)] = r;
     }
   }
+  if (sh_ != 0 && !lists_ && (c[1] == 0 || c[1] + 1 == grid_.count(1))) [[unlikely]]
+    b.offer(next_offset(lo), 0, cross, -1, -1);  // next to a gradient face: the images move on (shear.hpp)
   for (std::size_t k = 0; k < D; ++k) {
     if (static_cast<int>(k) == gax_) [[unlikely]] {  // the field's axis: quadratic times (cells only)
       const int ck = c[k], kk = static_cast<int>(k), nc = grid_.count(kk);
@@ -169,7 +285,7 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
       if (dw >= 0) b.offer(lo + dw, wall_kind(), wall, -1, -1);
     }
   }
-  if (gax_ >= 0) [[unlikely]] {
+  if (moving_) [[unlikely]] {  // (Field: curved lines or moving images)
     if (sz_.mixed()) scan<true, true>(p, lo, b);
     else scan<false, true>(p, lo, b);
   } else if (sz_.mixed()) {
@@ -207,9 +323,11 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
   constexpr double never = std::numeric_limits<double>::infinity();
   double tb = b.type != none ? static_cast<double>(b.t - lo) : never;  // the best so far, ticks from lo
   auto exact = [&](int q, double guess) {
-    const Vec r = diff(lp.x, pos(q, lo));
-    // (a field: q's velocity at lo; p is anchored there)
-    const Vec w = Field ? sub(lp.v, vel(q, lo)) : sub(lp.v, ln_[q].v);
+    // (a field: q's velocity at lo, p is anchored there; shear: q's nearest image, n boxes up)
+    std::int64_t n = 0;
+    const Vec r = Field ? diff_at(lp.x, pos(q, lo), lo, n) : diff(lp.x, pos(q, lo));
+    Vec w = Field ? sub(lp.v, vel(q, lo)) : sub(lp.v, ln_[q].v);
+    if (Field) w[0] -= n * sh_;
     std::int64_t tau;
     if constexpr (D == 3) {
       tau = first_overlap(r, w, Mixed ? sig2(p, q) : sigma2_, guess);
@@ -302,6 +420,8 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
   } else {
     std::array<double, D> xp{};
     for (std::size_t k = 0; k < D; ++k) xp[k] = static_cast<double>(lp.x[k]);
+    // shear: the images' offset at lo and their speed (shear.hpp)
+    const double deltad = Field && sh_ != 0 ? static_cast<double>(delta(lo)) : 0.0, shd = Field ? static_cast<double>(sh_) : 0.0;
     near(p, [&](int q) {
       if (q == p) return;
       const Line& lq = ln_[q];
@@ -309,9 +429,17 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
         const double dtq = static_cast<double>(lo - lq.ta);
         double rr = 0.0, bb = 0.0, aa = 0.0;
         bool edge = false;
+        double s0 = 0.0, sw = 0.0;  // shear: q's image across the gradient faces nearest p, n boxes up
+        if (Field && sh_ != 0) {
+          const double m = ((xp[1] - static_cast<double>(lq.x[1])) - static_cast<double>(lq.v[1]) * dtq) * invL_[1];
+          const double n = static_cast<double>(static_cast<std::int64_t>(m + (m >= 0.0 ? 0.5 : -0.5)));
+          s0 = n * deltad;
+          sw = n * shd;
+        }
         for (std::size_t k = 0; k < D; ++k) {
           double r = (xp[k] - static_cast<double>(lq.x[k])) - static_cast<double>(lq.v[k]) * dtq;
           if (Field && static_cast<int>(k) == gax_) r -= hgd_ * dtq * dtq;  // q's fall since its anchor
+          if (Field && k == 0) r -= s0;
           if (!u_.wall[k]) {  // the nearest image (an inline rounding: libm's is a call)
             const double m = r * invL_[k];
             r -= Ld_[k] * static_cast<double>(static_cast<std::int64_t>(m + (m >= 0.0 ? 0.5 : -0.5)));
@@ -319,6 +447,7 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
           }
           double w = static_cast<double>(lp.v[k] - lq.v[k]);
           if (Field && static_cast<int>(k) == gax_) w -= 2.0 * hgd_ * dtq;
+          if (Field && k == 0) w -= sw;
           rr += r * r;
           bb += r * w;
           aa += w * w;

@@ -40,6 +40,7 @@ void BasicEngine<Op, Bits, Queue>::keep_journal(bool on, Rollback how) {
   require(how == Rollback::reverse || how == Rollback::save_all || how == Rollback::save_changes,
           "lattice journal: rollback by reverse computation, save_all (SS1) or save_changes (SS2)");
   require(!on || gax_ < 0, "lattice journal: not built for a gas in a field yet (rollback and the parallel engine run without gravity)");
+  require(!on || sh_ == 0, "lattice journal: not built for a sheared gas yet (rollback and the parallel engine run without shear)");
   jon_ = on;
   jhow_ = how;
   restart_journal();
@@ -295,7 +296,7 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::undo_wall(int p, std::int64_t a, const WallDone& w) {
   Vec x = pos(p, a), v = neg(ln_[p].v);
-  if (reflection(p, x, v) == 0) throw std::logic_error("lattice rollback: a reflection's post line meets no wall (a bug)");
+  if (reflection(p, x, v, a) == 0) throw std::logic_error("lattice rollback: a reflection's post line meets no wall (a bug)");
   ln_[p] = Line{x, neg(v), a - 1};
   pre_wall_[p] = w.pre_wall;
   wall_tick_[p] = w.wall_tick;
@@ -450,7 +451,7 @@ void BasicEngine<Op, Bits, Queue>::undo_group(std::int64_t a, const Group& entry
     const int m = s == 0 ? i : j;
     pre_wall_[m] = ln_[m];
     Vec x = pos(m, a - 1), v = ln_[m].v;
-    if (reflection(m, x, v) == 0) throw std::logic_error("lattice rollback: a group member's reflection meets no wall (a bug)");
+    if (reflection(m, x, v, a) == 0) throw std::logic_error("lattice rollback: a group member's reflection meets no wall (a bug)");
     ln_[m] = Line{x, v, a};
     wall_tick_[m] = a;
   }

@@ -83,9 +83,11 @@ void BasicEngine<Op, Bits, Queue>::check_log(const Snapshot& s) const {
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<std::uint32_t>& order) {
-  validate_state(s.units, s.x, s.v, true, s.radius);  // collisions may be pending at the clock (rebuild finds them)
+  validate_state(s.units, s.x, s.v, true, s.radius, s.clock);  // collisions may be pending at the clock (rebuild finds them)
   if (!s.radius.empty()) Sizes::require_resizable<Op>();
   require(field_axis(s.units) < 0 || (rax_ < 0 && !jon_ && s.observer.empty()), "lattice: a gas in a field runs without regions, journal or observation (not built for curved lines yet)");
+  require(s.units.shear == 0 || (rax_ < 0 && !jon_ && s.observer.empty() && list_shell_ <= 0.0),
+          "lattice: a sheared gas runs without regions, journal, observation or neighbour lists (not built for moving images yet)");
   if (!order.empty()) {
     require(order.size() == s.x.size(), "lattice: an order must name every particle once (a permutation of [0, N))");
     std::vector<char> seen(order.size(), 0);
@@ -95,7 +97,7 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<
     }
   }
   require(s.streams.size() == s.x.size(), "lattice snapshot: streams must hold one counter per particle");
-  {
+  if (s.units.shear == 0) {
     // energy is kept by every collision to the lattice's rounding (~1e-11 relative over 10^4
     // collisions per particle): a checkpoint whose energy0 is not its velocities' (1e-6
     // relative) was not written by a run. (Momentum is not checked: a group bounce reverses
@@ -103,7 +105,7 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<
     const double E = static_cast<double>(energy2(s.units, s.x, s.v));
     const double E0 = static_cast<double>((static_cast<u128>(s.energy0[1]) << 64) | s.energy0[0]);
     require(std::fabs(E - E0) <= 1e-6 * E0, "lattice snapshot: energy0 is not the sum |v|^2 of v (1e-6 relative)");
-  }
+  }  // (shear: the boundary does work, energy0 is the start's)
   check_log(s);
   require(s.origin <= s.clock && tick_limit / 2 > s.clock && s.origin > -tick_limit / 2,
           "lattice snapshot: origin <= clock within +-2^60 required");
@@ -183,7 +185,7 @@ auto BasicEngine<Op, Bits, Queue>::fresh(const Units& u, std::vector<Vec> x, std
                                          std::int64_t clock, Mode mode, std::vector<std::int64_t> radius) const -> Snapshot {
   check_operator(u);
   require(mode == Mode::exact || mode == Mode::specular, "lattice: mode must be 'exact' or 'specular'");
-  validate_state(u, x, v, false, radius);
+  validate_state(u, x, v, false, radius, clock);
   if (!radius.empty()) Sizes::require_resizable<Op>();
   require(clock > -tick_limit / 2 && clock < tick_limit / 2, "lattice: the start tick must be within +-2^60");
   Snapshot s;
@@ -217,9 +219,12 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::load(const Snapshot& s, const std::vector<std::uint32_t>& order) {
   u_ = s.units;
   gax_ = field_axis(u_);
+  sh_ = load_back_ ? -u_.shear : u_.shear;  // the frame's rate (shear.hpp)
+  moving_ = gax_ >= 0 || sh_ != 0;
   hg_ = gax_ >= 0 ? u_.gravity[static_cast<std::size_t>(gax_)] / 2 : 0;
   hgd_ = static_cast<double>(hg_);
   for (std::size_t k = 0; k < D; ++k) axk_[k] = static_cast<std::uint8_t>(static_cast<int>(k) == gax_ ? 2 : u_.wall[k] ? 1 : 0);
+  if (u_.shear != 0) axk_[1] = 3;  // the gradient axis: a crossing moves the flow coordinate too (pos)
   seed_ = s.seed;
   mode_ = s.mode;
   if (mode_ == Mode::specular) spec_ = Specular(u_.sigma);
@@ -294,8 +299,9 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
     b.vself = b.vpart = 0;
   }
   for (std::size_t p = 0; p < n; ++p) {
+    const Vec v = vel(static_cast<int>(p), clock_);  // (before the anchor moves: shear reads the old line's crossings)
     ln_[p].x = pos(static_cast<int>(p), clock_);
-    ln_[p].v = vel(static_cast<int>(p), clock_);
+    ln_[p].v = v;
     ln_[p].ta = clock_;
   }
   const double shell = list_shell_ < 0.0 ? auto_list_shell() : list_shell_;
@@ -316,7 +322,7 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
   } else {
     grid_.build(u_, n);
     for (std::size_t p = 0; p < n; ++p) grid_.insert(static_cast<int>(p), grid_.cell_id(ln_[p].x));
-    shifted_ = grid_.shifted();
+    shifted_ = grid_.shifted() && sh_ == 0;  // (shear: the images across the gradient faces move)
   }
   lnd_.resize(n);
   for (std::size_t p = 0; p < n; ++p) {
@@ -369,6 +375,7 @@ void BasicEngine<Op, Bits, Queue>::flip() {
     l.ta = -l.ta;
   }
   clock_ = -clock_;
+  sh_ = -sh_;  // the images' offset at a physical time stays (shear.hpp)
   for (auto& t : wall_tick_) t = std::numeric_limits<std::int64_t>::min();
   reversed_ = !reversed_;
   rebuild();
@@ -499,6 +506,7 @@ void BasicEngine<Op, Bits, Queue>::set_regions(int axis, std::vector<std::int64_
     faces_.clear();
   } else {
     require(gax_ < 0, "lattice regions: not built for a gas in a field yet (the parallel engine runs without gravity)");
+    require(sh_ == 0, "lattice regions: not built for a sheared gas yet (the parallel engine runs without shear)");
     require(axis >= 0 && axis < static_cast<int>(D), "lattice regions: the axis must be 0, 1 or (3D) 2");
     const std::int64_t L = u_.L[static_cast<std::size_t>(axis)];
     for (std::size_t k = 0; k < faces.size(); ++k)
@@ -514,13 +522,14 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::set_list_shell(double s) {
   require(std::isfinite(s) && (s <= 0.0 || (s >= 0.02 && s <= 2.0)), "lattice: the list shell must be 0 (cells), negative (automatic) or in [0.02, 2] diameters");
   require(s <= 0.0 || gax_ < 0, "lattice: a gas in a field searches with the cell grid (neighbour lists are not built for curved lines yet): shell 0 or automatic");
+  require(s <= 0.0 || sh_ == 0, "lattice: a sheared gas searches with the cell grid (neighbour lists are not built for moving images yet): shell 0 or automatic");
   list_shell_ = s;
   rebuild();
 }
 
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::auto_list_shell() const noexcept -> double {
-  if (gax_ >= 0) return 0.0;  // a field: the cell grid (its crossings are exact quadratics; a list's ball is not)
+  if (gax_ >= 0 || sh_ != 0) return 0.0;  // a field or shear: the cell grid (its crossings are exact quadratics; a list's ball is not)
   if constexpr (D == 2) {
     return 0.0;
   } else {

@@ -8,10 +8,10 @@ import math
 from pathlib import Path
 
 from ..roundtrip import BAR, ERROR_DEFINITIONS, divergence_text
-from ..scene_schema import field_text
+from ..scene_schema import field_text, shear_text
 from ..studies.statesave.output import format_table
 
-__all__ = ["format_report", "format_horizon", "verify_lines", "field_line"]
+__all__ = ["format_report", "format_horizon", "verify_lines", "field_line", "shear_line"]
 
 
 def _si(x: float | None, unit: str = "") -> str:
@@ -50,15 +50,28 @@ def format_report(r: dict) -> str:
 
 def field_line(r: dict) -> list[str]:
     """The uniform field's line (none without one): the field run, on the lattice (a report with
-    ``quantization``) its relative rounding; the energy drifts then include its potential."""
+    ``quantization``) its relative rounding; the energy drifts then include its potential. Then
+    the shear's (:func:`shear_line`)."""
     g = r.get("gravity")
     if not g:
-        return []
+        return shear_line(r)
     axis = next(k for k, c in enumerate(g) if c)
     err = (r.get("quantization") or {}).get("gravity_error")
     rounding = "" if err is None else f", quantized once to an even integer per tick^2 (within {err:.2g} relative)"
     return [f"  field            gravity {field_text(g)} along axis {axis}{rounding}; "
-            "the energy includes its potential"]
+            "the energy includes its potential"] + shear_line(r)
+
+
+def shear_line(r: dict) -> list[str]:
+    """Lees-Edwards shear's line (none without): the rate run and, on the lattice (``shear_per_tick``),
+    its integer and relative rounding; the energy then grows (viscous heating: not a drift)."""
+    rate = r.get("shear_rate")
+    if not rate:
+        return []
+    per, err = r.get("shear_per_tick"), (r.get("quantization") or {}).get("shear_error")
+    lattice = "" if per is None else f" (lattice: {per:,} units per tick, within {err or 0.0:.2g} relative)"
+    return [f"  shear            rate {shear_text(rate)}{lattice}, flow axis 0, gradient axis 1 (Lees-Edwards); "
+            "the energy grows by viscous heating"]
 
 
 def _float_lines(r: dict) -> list[str]:
@@ -253,9 +266,10 @@ def _lattice_horizon(r: dict) -> str:
         lines.append(f"  {row['collisions']:>10,}  {row['per_particle']:>12.4g}  {row['bit_for_bit']}/{row['seeds']}")
         lines += [f"      engine error: {e}" for e in row["errors"]]
     if r["passed"]:
+        other = ("the float engine runs no shear" if r["scene"].get("shear_rate") else
+                 "the float engine's horizon for this gas: --horizon --engine float")
         lines.append("  horizon: none. The lattice engine's state is integers and each collision an exact "
-                     "bijection, so the round trip is exact at every N_c (checked above bit for bit); the float "
-                     "engine's horizon for this gas: --horizon --engine float")
+                     f"bijection, so the round trip is exact at every N_c (checked above bit for bit); {other}")
     else:
         lines.append("  FAILED: a lattice round trip did not come back bit for bit (above)")
     if r["interrupted"]:

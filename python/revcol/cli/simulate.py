@@ -61,7 +61,7 @@ from ..observe import report_lines
 from ..progress import Bar, Interrupt, peak_rss
 from ..roundtrip import geometry
 from ..scene import Scene, SceneError, load_scene, observes_frames, with_engine, with_lattice_options, with_mode
-from ..scene_schema import field_text
+from ..scene_schema import field_text, shear_text
 from ..trajectory import _species, check_format, open_trajectory, true_images  # revcol simulate writes frames
 
 __all__ = ["simulate", "format_simulate"]
@@ -147,13 +147,19 @@ def _build(scene: Scene, resume):
         raise SceneError(f"{scene.source}: --resume {os.fspath(resume)!r}: the checkpoint runs gravity "
                          f"{field_text(sim.gravity if sim.gravity.any() else None)}, the scene "
                          f"{field_text(scene.gravity)} ([system] gravity)")
+    rate = float(getattr(sim, "shear_rate", 0.0))  # nor another shear (the float engine runs none)
+    rounding = sim.quantization.get("shear_error", 0.0) if isinstance(sim, LatticeSimulation) else 0.0
+    if _field_mismatch(np.array([rate]), (scene.shear_rate,) if scene.shear_rate else None, rounding):
+        raise SceneError(f"{scene.source}: --resume {os.fspath(resume)!r}: the checkpoint runs shear rate "
+                         f"{shear_text(rate)}, the scene {shear_text(scene.shear_rate)} ([system] shear_rate)")
     return sim
 
 
 def _field_mismatch(run: np.ndarray, scene: tuple[float, ...] | None, rounding: float = 0.0) -> bool:
-    """Whether the field an engine runs (``run``, its ``.gravity``) is not the scene's (None:
-    none), beyond the relative ``rounding`` the lattice quantized it with (its
-    ``quantization["gravity_error"]``): a checkpoint resumed under another scene's field."""
+    """Whether the field an engine runs (``run``, its ``.gravity``; or its shear rate, one
+    component) is not the scene's (None: none), beyond the relative ``rounding`` the lattice
+    quantized it with (its ``quantization["gravity_error"]``, ``["shear_error"]``): a checkpoint
+    resumed under another scene's field or shear."""
     want = np.zeros_like(run) if scene is None else np.asarray(scene, dtype=float)
     scale = float(np.abs(want).max(initial=0.0))
     return bool(np.abs(run - want).max(initial=0.0) > (rounding + 1e-12) * scale)
@@ -323,6 +329,9 @@ class _Production:
             "backscatters": int(d["backscatters"]) if self.lattice else None,
             # the field run (None: none) and, on the lattice, its rounding (quantization's gravity_error)
             "gravity": sim.gravity.tolist() if sim.gravity.any() else None,
+            # the shear run (None: none) and, on the lattice, its integer per tick (quantization's shear_error)
+            "shear_rate": float(getattr(sim, "shear_rate", 0.0)) or None,
+            "shear_per_tick": (int(sim.units.get("shear", 0)) or None) if self.lattice else None,
             "quantization": sim.quantization if self.lattice else None,
             "resumed_from": None if resume is None else os.fspath(resume),
             "collisions": ran, "net_collisions": self.done, "collisions_per_particle": 2.0 * ran / sim.n,

@@ -127,6 +127,34 @@ class CellGridN {
         }
     }
   }
+  /// for_neighbours in a sheared box (shear.hpp; span 1): a cell next to a gradient face (axis 1)
+  /// takes, beyond the face, every cell of the far row along the flow (axis 0), whose images move
+  /// past it; elsewhere the neighbours of for_neighbours.
+  template <class F>
+  void for_neighbours_sheared(int id, F&& f) const {
+    const std::array<int, Dim> c = coords(id);
+    const int* a1 = &nbr_[1][static_cast<std::size_t>(c[1]) * 8];
+    const int n1 = nbrn_[1][static_cast<std::size_t>(c[1])];
+    const int* a0 = &nbr_[0][static_cast<std::size_t>(c[0]) * 8];
+    const int n0 = nbrn_[0][static_cast<std::size_t>(c[0])];
+    const int last = nc_[1] - 1;
+    for (int j = 0; j < n1; ++j) {
+      const bool across = (c[1] == 0 && a1[j] == last) || (c[1] == last && a1[j] == 0);
+      const int m0 = across ? nc_[0] : n0;
+      for (int i = 0; i < m0; ++i) {
+        const int x0 = across ? i : a0[i];
+        const std::size_t row = static_cast<std::size_t>(x0) * nc_[1] + a1[j];
+        if constexpr (Dim == 2) {
+          for (std::size_t k = 0, e = count_[row]; k < e; ++k) f(slots_[row * cap_ + k]);
+        } else {
+          const int* a2 = &nbr_[2][static_cast<std::size_t>(c[2]) * 8];
+          const int n2 = nbrn_[2][static_cast<std::size_t>(c[2])];
+          for (int l = 0; l < n2; ++l)
+            for (std::size_t id2 = row * nc_[2] + a2[l], k = 0, e = count_[id2]; k < e; ++k) f(slots_[id2 * cap_ + k]);
+        }
+      }
+    }
+  }
   /// Whether no periodic axis takes every cell as a neighbour (each has >= 2 span + 3 cells): a
   /// neighbouring cell's members are then seen at one image, for_neighbours_shifted's.
   bool shifted() const noexcept {

@@ -62,6 +62,12 @@ struct LatticeConfigN {
   /// coarsened (down to tick_bits 16) until that rounding is within 2^-8 (the largest component's); a
   /// field below 2 units at a given tick is refused.
   std::array<double, D> gravity{};
+  /// Lees-Edwards shear (shear.hpp): the shear rate gamma in float units (1 / time), the flow
+  /// along axis 0, the gradient along axis 1 (both periodic): the box above moves gamma L_1
+  /// faster. Quantized once to an integer shear (lattice units per tick), the rounding in
+  /// LatticeStartN::shear_error; random_start adds the steady profile gamma (x_1 - <x_1>) to the
+  /// velocities along axis 0 (about the particles' mean height: no momentum added). Zero: none.
+  double shear_rate = 0.0;
 };
 /// The 2D configuration.
 using LatticeConfig = LatticeConfigN<2>;
@@ -78,6 +84,7 @@ struct LatticeStartN {
   double max_velocity_error = 0.0;  ///< max |v_float - v_lattice| / v_rms
   std::vector<std::int64_t> radius;  ///< a mixture: per particle its radius in lattice units (empty: one diameter)
   double gravity_error = 0.0;        ///< a field: |g_lattice - g| / |g| after quantization (0: none)
+  double shear_error = 0.0;          ///< shear: |s_lattice - s| / |s| after quantization (0: none)
 };
 /// A quantized 2D start.
 using LatticeStart = LatticeStartN<2>;

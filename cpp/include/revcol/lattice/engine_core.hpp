@@ -42,6 +42,7 @@
 #include "revcol/lattice/lp_seen.hpp"
 #include "revcol/lattice/state.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
+#include "revcol/lattice/shear.hpp"
 #include "revcol/lattice/sizes.hpp"
 #include "revcol/lattice/specular.hpp"
 #include "revcol/lattice/streams.hpp"
@@ -303,13 +304,26 @@ class BasicEngine {
   int gax_ = -1;
   std::int64_t hg_ = 0;
   double hgd_ = 0.0;  // h as a double (the prediction's filter)
-  std::array<std::uint8_t, D> axk_{};  // per axis: 0 periodic, 1 walls, 2 walls and the field (pos)
+  std::array<std::uint8_t, D> axk_{};  // per axis: 0 periodic, 1 walls, 2 walls and the field, 3 the sheared gradient (pos)
+  // Lees-Edwards shear (shear.hpp): the frame's rate s (u_.shear forward, -u_.shear reversed; 0 none)
+  std::int64_t sh_ = 0;
+  std::int64_t delta(std::int64_t t) const noexcept { return wrap(static_cast<i128>(sh_) * t, u_.L[0]); }
+  std::int64_t ups(int p, std::int64_t t) const noexcept;  // boxes up the gradient p's unwrapped line is at t
+  [[gnu::noinline]] std::int64_t sheared_at(int p, std::int64_t t, Vec& out) const noexcept;  // (pos)
+  // shear's forms of diff, shifted and x - v at tick t (predict.hpp: inline without shear)
+  [[gnu::always_inline]] Vec diff_at(const Vec& a, const Vec& b, std::int64_t t, std::int64_t& n) const noexcept;
+  [[gnu::always_inline]] Vec diff_at(const Vec& a, const Vec& b, std::int64_t t) const noexcept;
+  [[gnu::always_inline]] Vec shifted_at(const Vec& origin, const Vec& d, std::int64_t t, Vec& v) const noexcept;
+  [[gnu::always_inline]] Vec back_at(const Vec& x, const Vec& v, std::int64_t t) const noexcept;
+  [[gnu::noinline]] Vec sheared_shift(const Vec& origin, const Vec& d, std::int64_t t, Vec& v) const noexcept;
+  bool moving_ = false;  // a field or shear: lines are read through vel (gax_ >= 0 || sh_ != 0)
+  [[gnu::noinline]] void reanchor_moving(int p, std::int64_t t);  // (predict.hpp)
   // the parabola's point on axis k; p's velocity at t; its move over a-1 -> a; v + h (predict.hpp)
   [[gnu::noinline]] std::int64_t field_at(int p, std::size_t k, std::int64_t dt) const noexcept;
   Vec vel(int p, std::int64_t t) const noexcept;
   Vec move_of(int p, std::int64_t a) const noexcept;
   Vec plus_h(Vec v) const noexcept;
-  Vec diff(const Vec& a, const Vec& b) const noexcept {
+  [[gnu::always_inline]] Vec diff(const Vec& a, const Vec& b) const noexcept {
     Vec r;
     for (std::size_t k = 0; k < D; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
     return r;
@@ -318,12 +332,14 @@ class BasicEngine {
   std::int64_t rad(int p) const noexcept { return sz_.rad(p); }
   u128 sig2(int p, int q) const noexcept { return sz_.sig2(p, q); }
   bool overlap(const Vec& a, const Vec& b, int p, int q) const noexcept { return norm2(diff(a, b)) < sig2(p, q); }
+  bool overlap_at(const Vec& a, const Vec& b, int p, int q, std::int64_t t) const noexcept { return norm2(diff_at(a, b, t)) < sig2(p, q); }
   std::int64_t lo_of(int p) const noexcept { return rad(p); }
   std::int64_t hi_of(int p, int k) const noexcept { return u_.L[k] - rad(p); }
   // f(q) for every q that may be near p: p's neighbour list, or the particles of its 3^D cells
   template <class F>
   void near(int p, F&& f) const {
     if (lists_) nl_.for_each(p, f);
+    else if (sh_ != 0) [[unlikely]] grid_.for_neighbours_sheared(grid_.cell_of_particle(p), f);
     else grid_.for_neighbours(grid_.cell_of_particle(p), f);
   }
 
@@ -365,25 +381,15 @@ class BasicEngine {
   [[noreturn, gnu::cold]] void inconsistent(const std::string& what, int i, int j) const;  // (collide.hpp)
   // the reflection map of a line whose tick-(a-1) point is x with velocity v (beyond the walls of
   // the returned axes at a): x becomes its point at a, v its velocity after (loop.hpp)
-  unsigned reflection(int p, Vec& x, Vec& v) const noexcept;  // p's wall range
+  unsigned reflection(int p, Vec& x, Vec& v, std::int64_t a) const noexcept;  // p's wall range
 
   // ---- collisions ----
-  // origin + d, wrapped on periodic axes (128-bit sum: no overflow whatever the box)
-  Vec shifted(const Vec& origin, const Vec& d) const noexcept {
-    Vec o;
-    for (std::size_t k = 0; k < D; ++k) {
-      const i128 y = static_cast<i128>(origin[k]) + d[k];
-      o[k] = u_.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u_.L[k]);
-    }
-    return o;
-  }
-  Vec wrapped(const Vec& x) const noexcept {
-    Vec o = x;
-    for (std::size_t k = 0; k < D; ++k)
-      if (!u_.wall[k]) o[k] = wrap(x[k], u_.L[k]);
-    return o;
-  }
+  Vec shifted(const Vec& origin, const Vec& d) const noexcept;  // origin + d, wrapped (128-bit sum; predict.hpp)
+  Vec wrapped(const Vec& x) const noexcept;                      // x wrapped on periodic axes
   int post_reason(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const;
+  template <bool Sheared>
+  int post_reason_t(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const;
+  std::int64_t next_offset(std::int64_t lo) const noexcept;  // shear: the next tick the images move on by a cell (predict.hpp)
   void apply(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a);
   void collide_forward(int i, int j, std::int64_t a);
   void collide_back(int i, int j, std::int64_t a);
@@ -391,6 +397,7 @@ class BasicEngine {
   void collide_specular(int i, int j, std::int64_t a);
   void back_specular(int i, int j, std::int64_t a);
   std::vector<int> group_of(int i, int j, std::int64_t a) const;
+  std::vector<std::int64_t> stall(std::vector<Vec>& x, std::int64_t a) const;  // a group's a-1 points -> its points at a (group.hpp)
   std::vector<Vec> resolve_velocities(const std::vector<int>& g, const std::vector<Vec>& x, std::int64_t a) const;
   bool group_post(std::vector<int>& g, std::int64_t a, bool resolve, std::vector<Vec>& post, std::vector<Vec>& vel) const;
   // false when it can neither resolve nor bounce (nothing changed) and !must; must: throws then
@@ -434,17 +441,7 @@ class BasicEngine {
   std::vector<LineD> lnd_;
   // a position x (wrapped) unwrapped about p's list centre, as doubles (predict.hpp)
   std::array<double, D> unwrapped_about(int p, const Vec& x) const noexcept;
-  [[gnu::always_inline]] void sync(int p) noexcept {
-    LineD& d = lnd_[static_cast<std::size_t>(p)];
-    const Line& l = ln_[static_cast<std::size_t>(p)];
-    if (lists_) {
-      d.a = unwrapped_about(p, l.x);
-    } else {
-      for (std::size_t k = 0; k < D; ++k) d.a[k] = static_cast<double>(l.x[k]);
-    }
-    for (std::size_t k = 0; k < D; ++k) d.v[k] = static_cast<double>(l.v[k]);
-    d.ta = l.ta;
-  }
+  [[gnu::always_inline]] inline void sync(int p) noexcept;  // (predict.hpp)
   std::vector<std::int64_t> wall_tick_;
   std::vector<Line> pre_wall_;  // a particle's line before its reflection at wall_tick_ (that tick only)
   // ---- the forward run's undo journal (run(): an engine error restores the state) ----

@@ -174,7 +174,7 @@ template <std::size_t D>
 bool same_state(const SnapshotN<D>& a, const SnapshotN<D>& b) {
   const UnitsN<D> &u = a.units, &w = b.units;
   return u.S == w.S && u.sigma == w.sigma && u.L == w.L && u.wall == w.wall && u.bounce == w.bounce && u.vmax == w.vmax &&
-         u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits && u.gravity == w.gravity &&
+         u.tick_bits == w.tick_bits && u.cell_bits == w.cell_bits && u.gravity == w.gravity && u.shear == w.shear &&
          a.law == b.law && a.mode == b.mode && a.seed == b.seed && a.clock == b.clock && a.origin == b.origin && a.collisions == b.collisions &&
          a.x == b.x && a.v == b.v && a.streams == b.streams && a.particle_collisions == b.particle_collisions &&
          a.bits == b.bits && a.bits_size == b.bits_size && a.log == b.log &&

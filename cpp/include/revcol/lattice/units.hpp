@@ -37,6 +37,7 @@
 
 #include "revcol/engine/boundary_kind.hpp"
 #include "revcol/lattice/geometry.hpp"
+#include "revcol/lattice/shear.hpp"
 
 namespace revcol::lattice {
 
@@ -69,7 +70,16 @@ struct UnitsN {
   /// line's point x + v n + (g/2) n^2 is an integer at every tick), |g| <= max_gravity, on at
   /// most one axis, a walled one (every particle falls toward one of its walls). Zero: none.
   std::array<std::int64_t, Dim> gravity{};
+  /// Lees-Edwards shear (shear.hpp): the images of the box above it (axis 1 + L_1) move along
+  /// axis 0 at `shear` lattice units per tick, offset by delta(t) = shear t mod L_0 at tick t, and
+  /// those below at -shear; axes 0 and 1 periodic, |shear| <= vmax / 4. Zero: none.
+  std::int64_t shear = 0;
 };
+/// The offset delta(t) = shear t mod L_0 of the images above the box at tick t (Lees-Edwards).
+template <std::size_t Dim>
+std::int64_t shear_offset(const UnitsN<Dim>& u, std::int64_t t) noexcept {
+  return wrap(static_cast<i128>(u.shear) * t, u.L[0]);
+}
 /// Largest |gravity| in lattice units per tick^2: 2^36 (the potential sum 2 |g| x over 2^24
 /// particles stays inside 128 bits; the default units put g = 1 sigma / tau^2 near 2^12).
 inline constexpr std::int64_t max_gravity = std::int64_t{1} << 36;
@@ -152,9 +162,11 @@ QuantizedN<Dim> quantize(const UnitsN<Dim>& u, const std::vector<double>& x, con
 /// stops after a collision, other collisions of that tick still to come) and is accepted.
 /// `radius` (a mixture, validate_radii): per particle its radius, a pair overlapping when
 /// |r| < r_i + r_j and a particle its radius from a wall; empty: every diameter sigma.
+/// `clock`: the tick of the state (shear: the images across the gradient faces are offset by
+/// shear_offset(u, clock)).
 template <std::size_t Dim>
 void validate_state(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const std::vector<VecN<Dim>>& v,
-                    bool pending = false, const std::vector<std::int64_t>& radius = {});
+                    bool pending = false, const std::vector<std::int64_t>& radius = {}, std::int64_t clock = 0);
 
 /// The smallest radius a mixture may hold: sigma / 32 (sigma = 2^S, the largest diameter), so
 /// diameters are within a ratio of 16 and a relative move per tick (below sigma / 128 per axis)
