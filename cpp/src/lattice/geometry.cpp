@@ -283,40 +283,28 @@ void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
   for (std::size_t k = 0; k < Dim; ++k) offsets *= 3;
   for (std::size_t i = 0; i < x.size(); ++i) {
     const Cell c0 = cell_of(x[i]);
-    for (int o = 0; o < offsets; ++o) {  // the 3^Dim neighbour cells, the last axis fastest
-      Cell c = c0;
-      bool skip = false;
-      for (int k = static_cast<int>(Dim) - 1, rest = o; k >= 0; --k, rest /= 3) {
-        c[k] += rest % 3 - 1;
-        if (c[k] < 0 || c[k] >= nc[k]) {
-          if (u.wall[k]) skip = true;
-          c[k] = (c[k] + nc[k]) % nc[k];
-        }
-      }
-      if (skip) continue;
-      // Lees-Edwards: across the gradient axis's faces the images are offset along axis 0, so
-      // that row's every cell along axis 0 is looked at (once, from the middle offset)
-      const bool across = u.shear != 0 && (c0[1] + ((o / (Dim == 3 ? 3 : 1)) % 3) - 1 < 0 || c0[1] + ((o / (Dim == 3 ? 3 : 1)) % 3) - 1 >= nc[1]);
-      const int first0 = static_cast<int>(o / (Dim == 3 ? 9 : 3)) - 1;
-      if (across && first0 != 0) continue;
-      for (std::int64_t a0 = 0; a0 < (across ? nc[0] : 1); ++a0) {
-      if (across) c[0] = a0;
-      auto it = grid.find(key(c));
-      if (it == grid.end()) continue;
+    // the pairs (i, j > i) with j in cell c: an overlap at the clock is refused unless pending
+    auto pairs_in = [&](const Cell& c) {
+      const auto it = grid.find(key(c));
+      if (it == grid.end()) return;
       for (int j : it->second) {
         if (j <= static_cast<int>(i)) continue;
-        const u128 s2 = radius.empty() ? sigma2 : contact2(radius[i] + radius[static_cast<std::size_t>(j)]);
-        VecN<Dim> r;
-        for (std::size_t k = 0; k < Dim; ++k) {
-          const std::int64_t d = x[i][k] - x[j][k];
-          r[k] = u.wall[k] ? d : min_image(d, u.L[k]);
-        }
+        const auto sj = static_cast<std::size_t>(j);
+        const u128 s2 = radius.empty() ? sigma2 : contact2(radius[i] + radius[sj]);
         std::int64_t n = 0;  // j's image: n boxes up the gradient axis (offset n delta along axis 0; shear.hpp)
-        if (u.shear != 0) r = sheared_diff<Dim>(x[i], x[static_cast<std::size_t>(j)], u.L, u.wall, delta, n);
+        VecN<Dim> r;
+        if (u.shear != 0) {
+          r = sheared_diff<Dim>(x[i], x[sj], u.L, u.wall, delta, n);
+        } else {
+          for (std::size_t k = 0; k < Dim; ++k) {
+            const std::int64_t d = x[i][k] - x[sj][k];
+            r[k] = u.wall[k] ? d : min_image(d, u.L[k]);
+          }
+        }
         if (norm2(r) >= s2) continue;
         if (v != nullptr) {  // pending at the clock: apart at the tick before (differences below 2^62 + 2^53)
           VecN<Dim> before;
-          for (std::size_t k = 0; k < Dim; ++k) before[k] = r[k] - ((*v)[i][k] - (*v)[j][k]);
+          for (std::size_t k = 0; k < Dim; ++k) before[k] = r[k] - ((*v)[i][k] - (*v)[sj][k]);
           before[0] += n * u.shear;  // (the image's velocity: v_j + n shear along axis 0)
           if (norm2(before) >= s2) continue;
         }
@@ -325,6 +313,32 @@ void check_overlaps(const UnitsN<Dim>& u, const std::vector<VecN<Dim>>& x, const
                  (v != nullptr ? " overlap, and did one tick before (not a collision pending at the clock)" : " overlap");
         });
       }
+    };
+    for (int o = 0; o < offsets; ++o) {  // the 3^Dim neighbour cells, the last axis fastest
+      Cell c = c0;
+      bool skip = false, across = false;  // across: beyond a gradient face of a sheared box
+      int d0 = 0;                          // the offset along axis 0
+      for (int k = static_cast<int>(Dim) - 1, rest = o; k >= 0; --k, rest /= 3) {
+        const int d = rest % 3 - 1;
+        c[k] += d;
+        if (k == 0) d0 = d;
+        if (c[k] < 0 || c[k] >= nc[k]) {
+          if (u.wall[k]) skip = true;
+          if (k == 1 && u.shear != 0) across = true;
+          c[k] = (c[k] + nc[k]) % nc[k];
+        }
+      }
+      if (skip) continue;
+      if (!across) {
+        pairs_in(c);
+        continue;
+      }
+      // Lees-Edwards: across a gradient face the images are offset along axis 0, so that row's
+      // every cell along axis 0 is looked at (once, from the middle offset)
+      if (d0 != 0) continue;
+      for (std::int64_t a0 = 0; a0 < nc[0]; ++a0) {
+        c[0] = a0;
+        pairs_in(c);
       }
     }
   }

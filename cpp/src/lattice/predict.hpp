@@ -88,9 +88,10 @@ template <class Op, class Bits, class Queue>
 template <class Op, class Bits, class Queue>
 inline auto BasicEngine<Op, Bits, Queue>::vel(int p, std::int64_t t) const noexcept -> Vec {
   Vec v = ln_[p].v;
-  if (gax_ >= 0) [[unlikely]]
+  if (!moving_) [[likely]] return v;
+  if (gax_ >= 0)
     v[gax_] = static_cast<std::int64_t>(static_cast<std::uint64_t>(v[gax_]) + 2 * static_cast<std::uint64_t>(hg_) * static_cast<std::uint64_t>(t - ln_[p].ta));
-  if (sh_ != 0) [[unlikely]] v[0] -= ups(p, t) * sh_;  // (shear: the jumps of its crossings)
+  if (sh_ != 0) v[0] -= ups(p, t) * sh_;  // (shear: the jumps of its crossings)
   return v;
 }
 
