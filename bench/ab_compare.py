@@ -7,7 +7,7 @@ studies of bench/engine_study.py run against each build's staged package.
         [--json bench/results/ab_throughput.json]
     python3 bench/ab_compare.py studies    OLD_BUILD NEW_BUILD
     python3 bench/ab_compare.py callgrind  OLD_BUILD NEW_BUILD [--case engine/d2/n10000/phi0.5 ...]
-        [--setting lattice/periodic/n10000/phi0.3:REVCOL_LATTICE=observe=1 ...]
+        [--setting lattice/periodic/n10000/phi0.3:REVCOL_LATTICE=observe=1 ...] [--both CASE:VAR=VALUE ...]
 
 A build directory is one made by scripts/dev_build.sh (it holds revcol-bench and pkg/).
 Throughput: each round runs every case once per build, alternating which build goes first,
@@ -24,7 +24,8 @@ Callgrind: instructions per collision, which a loaded host does not change: for 
 build, valgrind's Ir of the whole benchmark at two collision counts C1 < C2, and their
 difference over C2 - C1 (forward and back, the start and setup cancelling); `--setting
 CASE:VAR=VALUE` adds a case run with that environment on the new build (e.g. an observed
-lattice run) against the plain case on the old build: the setting's cost. Default cases: the float engine 2D and 3D and the lattice engine 2D and 3D.
+lattice run) against the plain case on the old build: the setting's cost; `--both CASE:VAR=VALUE`
+runs it so on both builds (a change to what the setting runs). Default cases: the float engine 2D and 3D and the lattice engine 2D and 3D.
 Studies: engine_study.py horizon and memory, once per build, with each build's package on
 PYTHONPATH; their JSON goes to a temporary folder and the report keeps both. Writes
 bench/results/ab_<what>.json (or --json).
@@ -101,7 +102,7 @@ def _instructions(build: str, case: str, collisions: int) -> int:
 
 
 def callgrind(args) -> dict:
-    custom = [f"engine/custom:REVCOL_ENGINE={c}" for c in (args.custom or [])]
+    custom = [f"engine/custom:REVCOL_ENGINE={c}" for c in (args.custom or [])] + (args.both or [])
     cases = (args.case or ([] if custom else CALLGRIND_CASES)) + (args.setting or []) + custom
     c1, c2 = args.c1, args.c2
     rows = []
@@ -109,7 +110,7 @@ def callgrind(args) -> dict:
         row = {"case": case}
         for label, build in (("old", args.old), ("new", args.new)):
             # a setting runs on the new build only; the old one runs the case without it (a
-            # --custom case runs on both: the same gas)
+            # --custom or --both case runs on both: the same gas)
             run = case if label == "new" or case in custom else case.partition(":")[0]
             a, b = _instructions(build, run, c1), _instructions(build, run, c2)
             row[label] = (b - a) / (c2 - c1)
@@ -233,6 +234,8 @@ def main() -> None:
     ap.add_argument("--case", action="append", help="a named engine bench, or floor/pair2d, floor/pair3d (repeatable; default: the five engine cases)")
     ap.add_argument("--custom", action="append", help="an engine/custom case: its REVCOL_ENGINE (repeatable)")
     ap.add_argument("--setting", action="append", help="callgrind: CASE:VAR=VALUE, a case run with that environment")
+    ap.add_argument("--both", action="append",
+                    help="callgrind: CASE:VAR=VALUE run with that environment on both builds (an observed run's cost)")
     ap.add_argument("--c1", type=int, default=2000, help="callgrind: the smaller collision count")
     ap.add_argument("--c2", type=int, default=22000, help="callgrind: the larger collision count")
     ap.add_argument("--json", help="where the report goes (default bench/results/ab_<what>.json)")

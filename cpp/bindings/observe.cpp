@@ -78,6 +78,12 @@ py::dict observation_dict(const engine::Observation& o) {
   d["slab_temperature"] = profile(o.slab_temperature);
   d["speed"] = profile(o.speed);
   d["pair_distance"] = profile(o.pair_distance);
+  d["slab_velocity"] = profile(o.slab_velocity);  // (shear only)
+  if (o.shear_rate != 0.0) {  // a sheared gas: the rate, P_xy and -P_xy / rate
+    d["shear_rate"] = o.shear_rate;
+    d["shear_stress"] = estimate(o.shear_stress);
+    d["viscosity"] = estimate(o.viscosity);
+  }
   d["msd_time"] = array(o.msd_time);
   d["msd"] = array(o.msd);
   d["vacf"] = array(o.vacf);

@@ -15,20 +15,6 @@
 
 namespace revcol::engine {
 
-namespace {
-
-// Time tau in [0, span] with a tau^2 + 2 b tau + c < q (a >= 0): the measure of the
-// interval between the roots of the quadratic, clipped to [0, span].
-double time_below(double a, double b, double c, double q, double span) {
-  if (!(a > 0.0)) return c < q ? span : 0.0;
-  const double disc = b * b - a * (c - q);
-  if (!(disc > 0.0)) return 0.0;
-  const double sq = std::sqrt(disc);
-  const double lo = std::max(0.0, (-b - sq) / a), hi = std::min(span, (-b + sq) / a);
-  return hi > lo ? hi - lo : 0.0;
-}
-
-}  // namespace
 
 void Observer::Block::add(const Block& b) {
   t1 = b.t1;
@@ -48,6 +34,8 @@ void Observer::Block::add(const Block& b) {
   sum(speed, b.speed);
   sum(pair, b.pair);
   sum(sp, b.sp);
+  pyx += b.pyx;
+  sum(slab_vx, b.slab_vx);
 }
 
 // The config's checks (the constructor's and a snapshot's): n particles in dim dimensions.
@@ -136,6 +124,7 @@ Observer::Block Observer::empty_block(double t0) const {
   b.speed.assign(cfg_.speed_bins + 1, 0.0);  // + the overflow bin (set_velocity)
   b.pair.assign(cfg_.pair_bins, 0.0);
   b.sp.assign(2 * static_cast<std::size_t>(ns_), 0.0);
+  if (gamma_ != 0.0) b.slab_vx.assign(static_cast<std::size_t>(cfg_.slabs), 0.0);
   return b;
 }
 
@@ -257,8 +246,16 @@ void Observer::end_block() {
   if (!start_v_.empty()) {  // velocities are constant on segments: the segment's is the one at te
     double c = 0.0;
     for (std::size_t i = 0; i < n_; ++i)
-      for (int k = 0; k < dim_; ++k) c += seg_[i].v[k] * start_v_[i * dim_ + k];
+      for (int k = 0; k < dim_; ++k) {
+        double v = seg_[i].v[k];  // (shear: the peculiar velocity at te)
+        if (k == 0 && gamma_ != 0.0) v -= gamma_ * (pos(static_cast<int>(i), 1, te) - yref_);
+        c += v * start_v_[i * dim_ + k];
+      }
     vacf_.push_back(c / static_cast<double>(n_));
+  }
+  if (gamma_ != 0.0) {  // the shear stress of the block (integrated to te above)
+    cur_.pyx = pyx_ - pyx_open_;
+    pyx_open_ = pyx_;
   }
   cur_.t1 = te;
   blocks_.push_back(cur_);

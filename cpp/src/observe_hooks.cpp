@@ -84,6 +84,7 @@ void Observer::place(int i, const double* x) {
 
 void Observer::pair_at(double t, int a, int b, const double* xa, const double* xb, const double* va,
                        const double* vb) {
+  if (gamma_ != 0.0) [[unlikely]] return pair_sheared(t, a, b, xa, xb, va, vb);
   reach(t);
   close<3>(a, t);
   close<3>(b, t);
@@ -109,6 +110,7 @@ void Observer::pair_at(double t, int a, int b, const double* xa, const double* x
 }
 
 void Observer::group_at(double t, int n, const int* ids, const double* x, const double* v) {
+  if (gamma_ != 0.0) [[unlikely]] return group_sheared(t, n, ids, x, v);
   reach(t);
   if (ns_ > 0) species_group_virial(n, ids, x, v);
   for (int u = 0; u < n; ++u) {
@@ -126,6 +128,7 @@ void Observer::group_at(double t, int n, const int* ids, const double* x, const 
 }
 
 void Observer::wall_at(double t, int i, const double* x, const double* v, unsigned axes) {
+  if (gamma_ != 0.0) [[unlikely]] return wall_sheared(t, i, x, v, axes);
   reach(t);
   close<3>(i, t);
   close_pairs(i, t);

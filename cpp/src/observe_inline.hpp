@@ -33,6 +33,17 @@ inline double root(double x) {
 #endif
 }
 
+// Time tau in [0, span] with a tau^2 + 2 b tau + c < q (a >= 0): the measure of the
+// interval between the roots of the quadratic, clipped to [0, span].
+inline double time_below(double a, double b, double c, double q, double span) {
+  if (!(a > 0.0)) return c < q ? span : 0.0;
+  const double disc = b * b - a * (c - q);
+  if (!(disc > 0.0)) return 0.0;
+  const double sq = std::sqrt(disc);
+  const double lo = std::max(0.0, (-b - sq) / a), hi = std::min(span, (-b + sq) / a);
+  return hi > lo ? hi - lo : 0.0;
+}
+
 /// The config's checks (the constructor's and a snapshot's): n particles in dim dimensions.
 void check_config(const ObserveConfig& c, int dim, std::size_t n, const std::array<bool, 3>& walls);
 
@@ -76,6 +87,7 @@ template <int K>
 // d are 0 whatever dt).
 template <int K>
 [[gnu::always_inline]] inline void Observer::close(int i, double t) {
+  if (gamma_ != 0.0) [[unlikely]] return close_sheared(i, t);
   Segment& s = seg_[i];
   const double dt = t - s.t0;
   cur_.speed[s.bin] += dt;
@@ -119,6 +131,11 @@ template <int K>
 // (those beyond hc_ stay 0: no test of the dimension).
 [[gnu::always_inline]] inline void Observer::accumulate(double t) {
   const double dt = t - t_now_;
+  if (gamma_ != 0.0) [[unlikely]] {  // peculiar velocities: polynomials between events (observe_shear.cpp)
+    accumulate_sheared(dt);
+    t_now_ = t;
+    return;
+  }
   cur_.k2 += v2_sum_ * dt;
   cur_.dist += speed_sum_ * dt;
   for (int c = 0; c < 3; ++c) helf_[c] += vv_off_[c] * dt;

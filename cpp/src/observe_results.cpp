@@ -31,7 +31,9 @@ Observation Observer::results() const {
   o.t_end = t_now_;
   Block tot = empty_block(t_start_);
   for (const Block& b : blocks_) tot.add(b);
-  tot.add(cur_);
+  Block open = cur_;
+  if (gamma_ != 0.0) open.pyx = pyx_ - pyx_open_;  // (a complete block's is set at its end)
+  tot.add(open);
   tot.t1 = t_now_;
   o.pair_collisions = tot.pairs;
   o.group_collisions = tot.groups;
@@ -87,8 +89,21 @@ Observation Observer::results() const {
   if (cfg_.slabs > 0) {
     const double w = box_[cfg_.slab_axis] / cfg_.slabs, vol = volume_ / cfg_.slabs;
     o.slab_density = profile(cfg_.slabs, w, [&](const Block& b, double tau, int u) { return b.slab[2 * u] / (tau * vol); });
-    o.slab_temperature =
-        profile(cfg_.slabs, w, [&](const Block& b, double, int u) { return ratio(b.slab[2 * u + 1], d * b.slab[2 * u]); });
+    if (gamma_ == 0.0) {
+      o.slab_temperature =
+          profile(cfg_.slabs, w, [&](const Block& b, double, int u) { return ratio(b.slab[2 * u + 1], d * b.slab[2 * u]); });
+    } else {  // shear: the box frame's, less the slab's mean flow (observe_shear.cpp)
+      o.slab_temperature = profile(cfg_.slabs, w, [&](const Block& b, double, int u) {
+        const double t = b.slab[2 * u], vx = b.slab_vx[u];
+        return ratio(b.slab[2 * u + 1] - ratio(vx * vx, t), d * t);
+      });
+      o.slab_velocity = profile(cfg_.slabs, w, [&](const Block& b, double, int u) { return ratio(b.slab_vx[u], b.slab[2 * u]); });
+    }
+  }
+  if (gamma_ != 0.0) {
+    o.shear_rate = gamma_;
+    o.shear_stress = est([&](const Block& b, double tau) { return b.pyx / (volume_ * tau); });
+    o.viscosity = est([&](const Block& b, double tau) { return -b.pyx / (volume_ * tau * gamma_); });
   }
   if (cfg_.speed_bins > 0) {
     const double h = speed_max_ / cfg_.speed_bins;

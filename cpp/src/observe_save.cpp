@@ -53,6 +53,7 @@ void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& coun
       reals.insert(reals.end(), cur_.sp.begin(), cur_.sp.end());
       reals.insert(reals.end(), msd_sp_.begin(), msd_sp_.end());
     }
+    if (gamma_ != 0.0) save_shear(reals);  // shear's sums (observe_shear.cpp; absent without shear)
   }
 }
 
@@ -99,13 +100,23 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
   const std::size_t hc = static_cast<std::size_t>(hc_), vacf = size + n_ * d + nm, helf = vacf + hc * (2 + nm);
   // with the VACF and the Helfand moment (and a mixture's species sums), with the VACF only, or
   // neither (older snapshots)
-  std::size_t species = 0;
-  if (reals.size() > helf) {
+  // then a mixture's species sums (S >= 1 first), then shear's (-1 first; observe_shear.cpp)
+  std::size_t species = 0, shear = 0;
+  if (reals.size() > helf && reals[helf] >= 0.0) {
     ns_saved_ = static_cast<int>(whole(helf, 1, kMaxSpecies, "species count"));
     species = static_cast<std::size_t>(ns_saved_) * (2 * (nb + 1) + nm + 1) + 1;
   }
-  require(reals.size() == helf + species || reals.size() == vacf || reals.size() == size,
-          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points, species)");
+  const std::size_t sheared = helf + species;
+  if (reals.size() > sheared) {
+    require(reals[sheared] == -1.0, "snapshot: observer: an unknown section follows the Helfand moment");
+    shear = 9 + 5 * static_cast<std::size_t>(ns_saved_) + (nb + 1) * (1 + static_cast<std::size_t>(cfg_.slabs));
+  }
+  require(reals.size() == sheared + shear || reals.size() == vacf || reals.size() == size,
+          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points, species, shear)");
+  // under shear a segment moves in the image it is in: its flow velocity is the particle's plus
+  // a whole number of times the images' relative speed
+  const double image_speed = shear > 0 ? reals[sheared + 1] * box[1] : 0.0;
+  require(shear == 0 || (image_speed != 0.0 && std::isfinite(image_speed)), "snapshot: observer: its shear rate must be nonzero");
   require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
   bin_scale_ = cfg_.speed_bins / speed_max_;
   bin_cap_ = cfg_.speed_bins;
@@ -118,8 +129,14 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
     for (int k = 0; k < 3; ++k) s.x[k] = s.v[k] = 0.0;
     s.v2 = s.speed = 0.0;
     for (std::size_t k = 0; k < d; ++k) s.x[k] = reals[u++];
-    for (std::size_t k = 0; k < d; ++k)
-      require(reals[u++] == v[i * d + k], "snapshot: observer: a segment's velocity is not its particle's");
+    double sv[3] = {0.0, 0.0, 0.0};
+    for (std::size_t k = 0; k < d; ++k) {
+      sv[k] = reals[u++];
+      const double off = sv[k] - v[i * d + k], m = k == 0 && shear > 0 ? std::nearbyint(off / image_speed) : 0.0;
+      require(k == 0 && shear > 0 ? std::fabs(off - m * image_speed) <= 1e-9 * (std::fabs(sv[k]) + std::fabs(v[i * d + k]))
+                                  : off == 0.0,
+              "snapshot: observer: a segment's velocity is not its particle's");
+    }
     s.t0 = reals[u++];
     require(s.t0 >= t_start_ && s.t0 <= t, "snapshot: observer: a segment starts outside the observed time");
     if (cfg_.slabs > 0) {
@@ -129,7 +146,7 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
               "snapshot: observer: a segment's slab cell must be a whole number (in [0, slabs) between walls)");
       set_cell(s, cell);
     }
-    set_velocity<0>(static_cast<int>(i), &v[i * d]);
+    set_velocity<0>(static_cast<int>(i), sv);  // (the particle's, but under shear)
   }
   auto take = [&](std::vector<double>& out, std::size_t m) {
     out.assign(reals.begin() + static_cast<std::ptrdiff_t>(u), reals.begin() + static_cast<std::ptrdiff_t>(u + m));
@@ -181,6 +198,7 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
     take(cur_.sp, 2 * ns);
     take(msd_sp_, nm * ns);
   }
+  take(shear_saved_, shear);  // set_shear reads it
   resumed_ = true;
   v2_sum_ = reals[16];  // the running sums as they were (set_velocity above rebuilt them afresh)
   speed_sum_ = reals[17];

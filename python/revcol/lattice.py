@@ -89,8 +89,9 @@ class LatticeSimulation(SimulationBase):
     ``shear_rate``: Lees-Edwards shear, exact on the lattice: the flow along axis 0, the gradient
     along axis 1 (both periodic), the box above moving ``shear_rate * box[1]`` faster (quantized
     once to lattice units per tick, :attr:`shear_rate` the value run and
-    ``quantization()["shear_error"]`` the rounding; the cell grid searches; no observer, journal
-    or parallel run yet; energy grows by viscous heating; docs/shear.md).
+    ``quantization()["shear_error"]`` the rounding; the cell grid searches; no journal or parallel
+    run yet; energy grows by viscous heating; :meth:`observe` gives the shear stress, the viscosity
+    and, with slabs along axis 1, the velocity profile; docs/shear.md).
     Bad input raises ``ValueError`` naming the problem.
     """
 

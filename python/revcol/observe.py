@@ -108,7 +108,7 @@ class Profile:
 
 _SCALARS = ("temperature", "pressure_virial", "compressibility", "collision_rate", "mean_free_time",
             "mean_free_path", "virial_balance")
-_PROFILES = ("slab_density", "slab_temperature", "speed", "pair_distance")
+_PROFILES = ("slab_density", "slab_temperature", "speed", "pair_distance", "slab_velocity")
 _COUNTS = ("dim", "n", "t_start", "t_end", "blocks", "block_time", "pair_collisions", "group_collisions",
            "particle_collisions", "wall_reflections")
 _SPECIES = ("species_temperature", "species_pressure")  # a mixture's estimates per species
@@ -135,7 +135,15 @@ class Observation:
     ``species_diameter``, ``species_count``, ``species_temperature`` and ``species_pressure``
     (lists of :class:`Estimate`: K2_s / (d N_s tau) and the partial pressure (K2_s + W_s) /
     (d V tau), W_s half of each pair's virial to each member's species; their sum is
-    ``pressure_virial``), ``species_msd`` (block ends, S) at ``msd_time``. Any other entry the C++
+    ``pressure_virial``), ``species_msd`` (block ends, S) at ``msd_time``. A sheared gas (the
+    lattice engine with ``shear_rate``; docs/shear.md): ``shear_rate``, ``shear_stress``
+    (:class:`Estimate` of P_yx, the x momentum carried across planes of constant y, kinetic plus
+    collisional, from the peculiar velocities u = v - rate (y - L_1 / 2) e_0: the peculiar energy
+    changes by -rate V P_yx dt), ``viscosity`` (-P_yx / rate) and, with slabs along axis 1,
+    ``slab_velocity`` (the mean flow velocity per slab); the temperature, the speeds and the
+    kinetic sums are then the peculiar ones (``helfand`` keeps r_x Delta p_y, its equilibrium
+    formula does not apply to a driven gas). Without shear ``shear_rate`` is 0 and the other three
+    None. Any other entry the C++
     observer reports appears as an attribute of its own name. Counts: ``pair_collisions``,
     ``group_collisions``, ``particle_collisions``, ``wall_reflections``; ``t_start``, ``t_end``,
     ``blocks``, ``block_time``.
@@ -162,6 +170,10 @@ class Observation:
     slab_temperature: Optional[Profile]
     speed: Optional[Profile]
     pair_distance: Optional[Profile]
+    slab_velocity: Optional[Profile]
+    shear_rate: float = 0.0
+    shear_stress: Optional[Estimate] = None
+    viscosity: Optional[Estimate] = None
 
     def __init__(self, raw: dict[str, Any]):
         self.raw = raw
@@ -173,7 +185,7 @@ class Observation:
         for key in _SPECIES:
             setattr(self, key, [Estimate(float(e["value"]), float(e["error"])) for e in raw.get(key, [])])
         for key in _PROFILES:
-            p = raw[key]
+            p = raw.get(key)  # (slab_velocity: absent from observations saved before it)
             setattr(self, key, None if p is None else Profile(np.asarray(p["edges"]), np.asarray(p["value"]),
                                                               np.asarray(p["error"])))
         # every other entry as it comes (an observable added in C++ needs no change here):
@@ -236,8 +248,14 @@ def report_lines(d: dict[str, Any]) -> list[str]:
     for k, (v, e) in enumerate(d["pressure_wall"]):
         if v != 0.0:
             rows.append(f"  pressure_wall[{k}] {v:.5g}" + (f" +- {e:.2g}" if d["blocks"] >= 2 else ""))
+    for key in ("shear_stress", "viscosity"):  # a sheared gas's
+        if key in d:
+            v, e = d[key]
+            rows.append(f"  {key:<16} {v:.5g}" + (f" +- {e:.2g}" if d["blocks"] >= 2 else "")
+                        + (f" at shear rate {d['shear_rate']:.5g}" if key == "viscosity" else ""))
     if d["msd"]:
-        rows.append(f"  msd              {d['msd'][-1]:.5g} at t = {d['msd_time'][-1]:.5g} after the start")
+        rows.append(f"  msd              {d['msd'][-1]:.5g} at t = {d['msd_time'][-1]:.5g} after the start"
+                    + (" (unwrapped through the sheared images: the flow's advection included)" if "shear_rate" in d else ""))
     pm = "+-" if d["blocks"] >= 2 else "~"
     masses = list(d.get("species_mass") or [])
     for u, diam in enumerate(d.get("species_diameter") or []):

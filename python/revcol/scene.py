@@ -131,7 +131,7 @@ from . import lattice as _lattice  # noqa: F401 (registers engine="lattice": Sim
 from .scene_schema import (DEFAULT_PER_PARTICLE, DEFAULT_SCENE, DEPRECATED, ENGINE_MODES,  # noqa: F401 (__all__)
                            ENGINES, KINDS, LATTICE_DEFAULT_COLLISIONS, LATTICE_FIELDS, LIMITS, SCHEMA, USES,
                            SceneError, _check, _check_lattice, _check_mode, _fail, _modernize, check_shear_engine,
-                           field_summary, observes_frames, scene_field, with_lattice_options)
+                           check_shear_observe, field_summary, observes_frames, scene_field, with_lattice_options)
 from ._species import check_masses, parse_species, sized_options, species_volume
 from .statesave import variants as statesave_variants
 from .verify import verify_cases
@@ -395,6 +395,7 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
 
     observe = _observe(source, values, d, n, bounds, engine) if "observe" in common["extra"]["tables"] else None
     gravity, shear = scene_field(source, get, d, bounds, engine, observe is not None, box, sigma)
+    check_shear_observe(source, shear, observe)
 
     scene = Scene(
         dimension=d, particles=n, diameter=sigma, box=tuple(box), packing_fraction=phi,

@@ -271,7 +271,10 @@ def true_images(sim, positions=None) -> np.ndarray | None:
     """The particles' periodic crossings since the observation began (n x d integers), from the
     observer, which never wraps its positions: (unwrapped - wrapped) / L on periodic axes, 0 on
     walled ones; None when ``sim`` is not observing. Exact at any frame spacing (the inferred
-    flags assume less than L/2 between frames)."""
+    flags assume less than L/2 between frames). None too for a sheared gas: the observer's
+    unwrapped flow coordinate there includes the moving images' offset, not whole box lengths."""
+    if getattr(sim, "shear_rate", None):
+        return None
     e = getattr(sim, "_e", None)
     u = e.observed_positions() if e is not None and hasattr(e, "observed_positions") else None
     if u is None:

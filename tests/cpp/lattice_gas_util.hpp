@@ -2,7 +2,8 @@
 // test_lattice_rollback.cpp): the engine of a dimension, a random start with one boundary kind on
 // every axis, and a check that a call is refused with a given message; run_config, the parallel
 // engine's settings for a run_parallel(_back) (test_lattice_parallel_run.cpp, _back.cpp);
-// check_replays, the end of a gas's round trip (test_lattice_field.cpp, test_lattice_shear.cpp).
+// check_replays, the end of a gas's round trip (test_lattice_field.cpp, test_lattice_shear.cpp);
+// sheared_start, a sheared gas's start.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -10,6 +11,8 @@
 #include <exception>
 #include <string>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "revcol/lattice/engine.hpp"
 
@@ -18,6 +21,19 @@ namespace lattice_test {
 /// The lattice engine of dimension D (2: disks, 3: spheres).
 template <std::size_t D>
 using EngineOf = std::conditional_t<D == 2, revcol::lattice::LatticeEngine, revcol::lattice::LatticeEngine3D>;
+
+/// N particles at packing fraction phi sheared at `rate` (3D: walls across z if asked; a mixture's
+/// diameters), the random start of `seed` (test_lattice_shear.cpp, test_lattice_shear_observe.cpp).
+template <std::size_t D>
+revcol::lattice::LatticeStartN<D> sheared_start(std::size_t n, double phi, double rate, std::uint32_t seed,
+                                                bool walls = false, std::vector<double> diameters = {}) {
+  revcol::lattice::LatticeConfigN<D> c;
+  c.seed = seed;
+  c.diameters = std::move(diameters);
+  c.shear_rate = rate;
+  if constexpr (D == 3) c.wall[2] = walls;
+  return revcol::lattice::random_start(c, n, phi, seed);
+}
 
 /// N particles at packing fraction phi, `kind` on every axis, the random start of `seed`, in `mode`.
 template <std::size_t D>
@@ -66,13 +82,14 @@ EngineOf<D> engine_of(const revcol::lattice::LatticeStartN<D>& s, std::uint32_t 
 }
 
 /// What a gas in a field or under shear refuses by name (InvalidArgument), its state untouched:
-/// neighbour lists, the rollback journal, the observer, regions (the parallel engine).
+/// neighbour lists, the rollback journal, regions (the parallel engine), and with `observer`
+/// the observer (a field's; a sheared gas is observed).
 template <class Engine>
-void check_refuses_lists_journal_observer_regions(Engine& e) {
+void check_refusals(Engine& e, bool observer) {
   const auto before = e.snapshot();
   CHECK_THROWS_AS(e.set_list_shell(1.0), revcol::InvalidArgument);
   CHECK_THROWS_AS(e.keep_journal(true), revcol::InvalidArgument);
-  CHECK_THROWS_AS(e.observe(revcol::engine::ObserveConfig{}), revcol::InvalidArgument);
+  if (observer) CHECK_THROWS_AS(e.observe(revcol::engine::ObserveConfig{}), revcol::InvalidArgument);
   CHECK_THROWS_AS(e.set_regions(0, {0}), revcol::InvalidArgument);
   CHECK(revcol::lattice::same_state(e.snapshot(), before));
 }

@@ -164,7 +164,7 @@ TEST_CASE("a field's refusals: a periodic axis, two axes, an odd field, lists, j
   LatticeEngine e(s.units, s.x, s.v, 41, operator_for(s.units));
   CHECK(e.neighbour_search() == 0);
   const Snapshot before = e.snapshot();
-  lattice_test::check_refuses_lists_journal_observer_regions(e);
+  lattice_test::check_refusals(e, true);
   // a state whose potential would let a particle pass vmax is refused
   UnitsN<2> strong = s.units;
   strong.gravity[1] = -max_gravity;

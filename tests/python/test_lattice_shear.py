@@ -1,5 +1,6 @@
 """Lees-Edwards shear on the lattice engine from Python: the rate run and its rounding, the steady
-start profile, forward and back bit for bit (also through a checkpoint), the refusals by name,
+start profile, forward and back bit for bit (also through a checkpoint), the observer's stress,
+viscosity and velocity profile (resumed from a checkpoint to the same bits), the refusals by name,
 and a reduced run of the viscosity study (python -m revcol.studies.shear)."""
 import math
 
@@ -51,6 +52,30 @@ def test_forward_and_back_bit_for_bit(cls, n, phi, mode, tmp_path):
     assert _same(s.snapshot(), s0)
 
 
+@pytest.mark.parametrize("cls,n", [(LatticeSimulation, 400), (LatticeSimulation3D, 900)])
+def test_observed_shear_stress_profile_and_checkpoint(cls, n, tmp_path):
+    s = cls.random(n, phi=0.3, shear_rate=0.2, mode="specular", seed=6)
+    s.run(collisions=2000)
+    s.observe(slabs=6, slab_axis=1, speed_bins=20)
+    s.run(collisions=4000)
+    path = tmp_path / "observed.npz"
+    s.save(path)  # with the running observation
+    s.run(collisions=4000)
+    r = cls.load(path)
+    r.run(collisions=4000)
+    a, b = s.observation(), r.observation()
+    assert a.to_dict() == b.to_dict()  # resumed to the same bits
+    assert a.shear_rate == pytest.approx(s.shear_rate) and a.viscosity.value > 0
+    assert a.shear_stress.value == pytest.approx(-a.viscosity.value * a.shear_rate)
+    assert np.polyfit(a.slab_velocity.centres, a.slab_velocity.value, 1)[0] == pytest.approx(0.2, rel=0.2)
+    assert np.sum(a.speed.value) * (a.speed.edges[1] - a.speed.edges[0]) == pytest.approx(1.0, abs=1e-3)
+    plain = cls.random(n, phi=0.3, seed=6)
+    plain.observe()
+    plain.run(collisions=2000)
+    p = plain.observation()
+    assert p.shear_rate == 0.0 and p.shear_stress is None and p.slab_velocity is None
+
+
 def test_refusals_by_name():
     with pytest.raises(ValueError, match="lattice engine"):
         revcol.Simulation.random(100, dim=3, phi=0.3, shear_rate=0.1)  # the float engine's is not built
@@ -68,8 +93,8 @@ def test_refusals_by_name():
     before = s.snapshot()
     with pytest.raises(ValueError, match="neighbour lists"):
         s.search = 0.5
-    with pytest.raises(ValueError, match="sheared"):
-        s.observe()
+    with pytest.raises(ValueError, match="slab_axis 1"):
+        s.observe(slabs=4)  # across the flow: the profile is along the gradient
     with pytest.raises(ValueError, match="sheared"):
         s.keep_journal(True)
     assert _same(s.snapshot(), before)
@@ -82,6 +107,7 @@ def test_viscosity_study_reduced():
     # eta* of the specular gas at 0.3 is about 0.72 (docs/shear.md); a short run within 40%
     assert 0.4 < r["eta"] < 1.1
     assert 0.0 < r["eta_kinetic"] < r["eta"]
+    assert r["eta_stress"] == pytest.approx(r["eta"], rel=0.25)  # the stress route: the same viscosity
     assert r["profile_slope_over_rate"] == pytest.approx(1.0, abs=0.15)
     fit = shear.extrapolate(np.array([0.05, 0.1, 0.2]), np.array([0.70, 0.72, 0.745]), np.array([0.02, 0.01, 0.01]))
     assert fit["quadratic"]["eta0"] == pytest.approx(0.71, abs=0.02)

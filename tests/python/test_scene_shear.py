@@ -73,10 +73,9 @@ def test_the_key_is_parsed_and_shown():
      "[system] shear_rate: needs a box of at least 9.07031 along axis 0 (the flow) and 5.03906 along axis 1 (the "
      "gradient), 9 and 5 of the lattice's cells of 1 + 2^-7 diameters; got 9 x 20"),
     ({"system": {"packing_fraction": None, "box": [20.0, 5.0]}}, "[system] shear_rate: needs a box of at least"),
-    ({"observe": {"slabs": 4}}, "[observe]: is not available under shear ([system] shear_rate): the lattice observer "
-                                "does not take a sheared gas yet (its pair separations ignore the moving images); "
-                                "take trajectory frames instead"),
-    ({"observe": {}}, "[observe]: is not available under shear ([system] shear_rate)"),
+    ({"observe": {"slabs": 4}}, "[observe] slab_axis: must be 1 (the gradient) under [system] shear_rate: a sheared "
+                                "gas's slabs give its velocity profile across the gradient, got 0"),
+    ({"observe": {"slabs": 4, "slab_axis": 0}}, "[observe] slab_axis: must be 1 (the gradient) under [system] shear_rate"),
     ({"collisions": {"workers": 4}}, "[collisions] workers: engine = 'lattice' runs a gas under shear ([system] "
                                      "shear_rate) on one worker (the parallel engine is not built for shear yet), got 4"),
     ({"collisions": {"search": 0.3}}, "[collisions] search: engine = 'lattice' searches a gas under shear ([system] "
@@ -89,7 +88,7 @@ def test_bad_shear_is_refused_by_name(fields, needle):
     assert needle in str(e.value) and str(e.value).startswith("s.toml: ")
 
 
-@pytest.mark.parametrize("fields", [{"observe": {}}, {"collisions": {"workers": 4}}, {"collisions": {"search": 0.3}},
+@pytest.mark.parametrize("fields", [{"observe": {"slabs": 4}}, {"collisions": {"workers": 4}}, {"collisions": {"search": 0.3}},
                                     {"collisions": {"engine": "float"}}, {"system": {"boundaries": "wall"}}])
 def test_the_same_options_without_shear_load(fields):
     assert scene(**{**fields, "system": {**fields.get("system", {}), "shear_rate": 0.0}}).shear_rate is None
@@ -108,8 +107,22 @@ def test_the_command_lines_options_are_refused_by_flag():
                                              r"engine only .*got engine = 'float' \(--engine\)"):
             move()
     assert with_mode(s, "specular").shear_rate == 0.1
-    # no observer for the frames' image flags under shear (it refuses a sheared gas)
+    # no observer for the frames' image flags under shear (its unwrapped flow coordinate holds the
+    # moving images' offset, not whole box lengths: the frames infer their flags)
     assert not observes_frames(s, "t.xyz") and observes_frames(scene(system={"shear_rate": None}), "t.xyz")
+
+
+def test_an_observed_sheared_scene_reports_its_stress_and_profile(tmp_path, capsys):
+    s = scene(observe={"slabs": 6, "slab_axis": 1}, run={"collisions": 6000})
+    assert s.observe == {"slabs": 6, "slab_axis": 1}
+    sim = build_simulation(s)
+    sim.observe(**s.observe)
+    sim.run(collisions=6000)
+    o = sim.observation()
+    assert o.shear_rate == pytest.approx(0.1, rel=1e-6) and o.viscosity.value > 0.0
+    assert o.shear_stress.value == pytest.approx(-o.viscosity.value * o.shear_rate)
+    assert np.polyfit(o.slab_velocity.centres, o.slab_velocity.value, 1)[0] == pytest.approx(0.1, rel=0.3)
+    assert any(line.lstrip().startswith("viscosity") and "at shear rate 0.1" in line for line in o.lines())
 
 
 def test_the_lattice_runs_the_shear_and_reverses_it_bit_for_bit():

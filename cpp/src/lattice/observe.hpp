@@ -13,7 +13,6 @@ namespace revcol::lattice {
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
   require(gax_ < 0, "lattice observe: the observer does not take a field yet (its pressure and free paths assume straight lines); read snapshots instead");
-  require(sh_ == 0, "lattice observe: the observer does not take a sheared gas yet (its pair separations ignore the moving images); read snapshots and diagnostics() instead");
   observer_ = make_observer(u_, positions(), velocities(), clock_, &c, nullptr, radii());
   obs_ = observer_.get();
 }
@@ -48,6 +47,9 @@ auto BasicEngine<Op, Bits, Queue>::make_observer(const Units& u, const std::vect
     for (std::size_t q = 0; q < n; ++q) rf[q] = static_cast<double>(radius[q]) * len;  // distinct radii stay distinct (< 2^52)
     o->set_sizes(rf);
   }
+  // shear: the observer takes the images one box up as moving s lattice units per tick faster
+  if (u.shear != 0) o->set_shear(static_cast<double>(u.shear) * speed / box[1]);
+  require(u.shear != 0 || o->saved_shear() == 0.0, "snapshot: observer: it was taken of a sheared gas, this one is not");
   return o;
 }
 
@@ -114,8 +116,9 @@ template <class Op, class Bits, class Queue>
   for (std::size_t m = 0; m < n; ++m) ids[m] = gid(g[m]);
   for (std::size_t m = 0; m < n; ++m)
     for (std::size_t k = 0; k < D; ++k) {
-      // positions image-consistent about the first member's
-      x[m * D + k] = to_length(m > 0 ? xg[0][k] + diff(xg[m], xg[0])[k] : xg[m][k]);
+      // positions image-consistent about the first member's (under shear each its own: the
+      // observer takes the moving images, Observer::group_at)
+      x[m * D + k] = to_length(m > 0 && sh_ == 0 ? xg[0][k] + diff(xg[m], xg[0])[k] : xg[m][k]);
       v[m * D + k] = to_speed(vg[m][k]);
     }
   if (seen_) seen_->add(lp_->key, LpSeen::group, time_of(a), 0, n, ids.data(), x.data(), v.data());

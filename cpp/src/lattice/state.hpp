@@ -86,8 +86,8 @@ void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<
   validate_state(s.units, s.x, s.v, true, s.radius, s.clock);  // collisions may be pending at the clock (rebuild finds them)
   if (!s.radius.empty()) Sizes::require_resizable<Op>();
   require(field_axis(s.units) < 0 || (rax_ < 0 && !jon_ && s.observer.empty()), "lattice: a gas in a field runs without regions, journal or observation (not built for curved lines yet)");
-  require(s.units.shear == 0 || (rax_ < 0 && !jon_ && s.observer.empty() && list_shell_ <= 0.0),
-          "lattice: a sheared gas runs without regions, journal, observation or neighbour lists (not built for moving images yet)");
+  require(s.units.shear == 0 || (rax_ < 0 && !jon_ && list_shell_ <= 0.0),
+          "lattice: a sheared gas runs without regions, journal or neighbour lists (not built for moving images yet)");
   if (!order.empty()) {
     require(order.size() == s.x.size(), "lattice: an order must name every particle once (a permutation of [0, N))");
     std::vector<char> seen(order.size(), 0);

@@ -14,7 +14,11 @@ falls: each run sweeps a range of reduced rates, reported.
 
 The kinetic part of the stress, P_xy^kin = sum u_x v_y / V, u the peculiar velocity (v less the
 profile of slope gamma through the centre of mass, as for kT), is read from
-the frames; the collisional part is the total less it. The velocity profile (mean v_x in bins
+the frames; the collisional part is the total less it. The same eta from the stress itself
+(a second route, independent of the energy): the observer, started afresh at each frame,
+integrates the kinetic stress exactly between events and adds each collision's r_x Delta p_y
+(the pairs across the gradient faces through the moving images, docs/shear.md "Observables");
+each interval's -P_xy / gamma at its own observed temperature is eta_stress. The velocity profile (mean v_x in bins
 along y, over the frames) is fitted by a line whose slope is compared with gamma (Lees-Edwards
 has no walls, so no slip). At the end every run goes back to its start, bit for bit.
 
@@ -62,11 +66,14 @@ def measure(n: int, phi: float, rate: float, mode: str = "specular", seed: int =
     vol = float(np.prod(box))
     ly = float(box[1])
     sim.run(collisions=int(warm * n))
-    t, e, kt, pkin = [], [], [], []
+    t, e, kt, pkin, eta_st = [], [], [], [], []
     prof = np.zeros(bins)
     for f in range(frames + 1):
         if f:
+            sim.observe()  # (afresh: this interval's stress and temperature)
             sim.run(collisions=int(per_frame * n))
+            o = sim.observation()
+            eta_st.append(o.viscosity.value / math.sqrt(o.temperature.value))  # reduced at its own kT
         x, v = sim.positions, sim.velocities
         u = _peculiar(x, v, g)
         t.append(sim.time)
@@ -86,7 +93,7 @@ def measure(n: int, phi: float, rate: float, mode: str = "specular", seed: int =
     slope = float(np.polyfit(centres, prof, 1)[0])
     out = {"n": n, "phi": phi, "rate": g, "mode": mode, "seed": seed, "shear_error": sim.quantization.get("shear_error", 0.0),
            "collisions": sim.collisions, "time": float(t[-1]), "kT_first": float(kt[0]), "kT_last": float(kt[-1]),
-           "eta": float(np.mean(eta)), "eta_kinetic": float(np.mean(eta_kin)), "gamma_star": float(np.mean(gam)),
+           "eta": float(np.mean(eta)), "eta_stress": float(np.mean(eta_st)), "eta_kinetic": float(np.mean(eta_kin)), "gamma_star": float(np.mean(gam)),
            "gamma_star_range": [float(gam.min()), float(gam.max())], "profile_slope_over_rate": slope / g,
            "profile": (prof / (g * ly)).tolist(), "log_entries": int(sim.diagnostics()["log_entries"])}
     if back:
@@ -135,7 +142,10 @@ def figure(data: dict, path: str) -> None:
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
     for s in data["summary"]:
         gs, es, ee = (np.asarray(s[k]) for k in ("gamma_star", "eta", "eta_error"))
-        a.errorbar(gs, es, ee, fmt="o" if s["mode"] == "specular" else "s", label=f"phi {s['phi']} {s['mode']}")
+        line = a.errorbar(gs, es, ee, fmt="o" if s["mode"] == "specular" else "s", label=f"phi {s['phi']} {s['mode']}")
+        if "eta_stress" in s:  # the stress route, open markers beside it
+            a.errorbar(np.asarray(gs) * 1.03, s["eta_stress"], s["eta_stress_error"], fmt="o" if s["mode"] == "specular" else "s",
+                       mfc="none", color=line[0].get_color())
         q = s["fit"]["quadratic"]
         xs = np.linspace(0, gs.max(), 50)
         a.plot(xs, q["eta0"] + q["slope"] * xs ** 2, "-", lw=0.8)
@@ -144,7 +154,8 @@ def figure(data: dict, path: str) -> None:
     a.set_xlabel("gamma* (reduced shear rate)")
     a.set_ylabel("eta* (reduced shear viscosity)")
     a.legend(fontsize=7)
-    a.set_title("Lees-Edwards on the lattice engine (stars: equilibrium Helfand)", fontsize=8)
+    a.set_title("Lees-Edwards on the lattice engine (filled: energy, open: stress; stars: equilibrium Helfand)",
+                fontsize=8)
     for r in data["runs"][:: max(1, len(data["runs"]) // 6)]:
         p = np.asarray(r["profile"])
         yb = (np.arange(p.size) + 0.5) / p.size
@@ -184,7 +195,7 @@ def main(argv=None) -> int:
     for phi in a.phi:
         ref = _reference(phi, a.reference)
         for mode in a.modes:
-            gs, es, ee, ks = [], [], [], []
+            gs, es, ee, ks, ss, se = [], [], [], [], [], []
             for rate in a.rates:
                 # the boundary heats the gas as gamma^2: a run's length scales as 1 / gamma^2 (at most 4x
                 # the frames), so every rate heats it alike and the errors (~ 1 / (gamma sqrt(time))) match
@@ -196,18 +207,23 @@ def main(argv=None) -> int:
                 es.append(float(eta.mean()))
                 ee.append(float(eta.std(ddof=1) / math.sqrt(len(rs))) if len(rs) > 1 else float("nan"))
                 ks.append(float(np.mean([r["eta_kinetic"] for r in rs])))
+                st = np.array([r["eta_stress"] for r in rs])
+                ss.append(float(st.mean()))
+                se.append(float(st.std(ddof=1) / math.sqrt(len(rs))) if len(rs) > 1 else float("nan"))
                 print(f"phi {phi} {mode} rate {rate}: gamma* {gs[-1]:.4f} eta* {es[-1]:.4f} +- {ee[-1]:.4f} "
-                      f"(kinetic {ks[-1]:.4f}) slope/rate {np.mean([r['profile_slope_over_rate'] for r in rs]):.4f} "
+                      f"(stress {ss[-1]:.4f} +- {se[-1]:.4f}, kinetic {ks[-1]:.4f}) slope/rate {np.mean([r['profile_slope_over_rate'] for r in rs]):.4f} "
                       f"back {all(r['back_bit_for_bit'] for r in rs)}", flush=True)
             fit = extrapolate(np.array(gs), np.array(es), np.array(ee))
-            s = {"phi": phi, "mode": mode, "gamma_star": gs, "eta": es, "eta_error": ee, "eta_kinetic": ks, "fit": fit,
-                 "reference": ref}
+            s = {"phi": phi, "mode": mode, "gamma_star": gs, "eta": es, "eta_error": ee, "eta_stress": ss,
+                 "eta_stress_error": se, "eta_kinetic": ks, "fit": fit,
+                 "fit_stress": extrapolate(np.array(gs), np.array(ss), np.array(se)), "reference": ref}
             if "eta_helfand" in ref:
                 q = fit["quadratic"]
                 s["eta0_minus_helfand_sd"] = (q["eta0"] - ref["eta_helfand"]) / math.hypot(q["eta0_error"], ref["eta_helfand_error"])
             summary.append(s)
             print(f"phi {phi} {mode}: eta0* {fit['quadratic']['eta0']:.4f} +- {fit['quadratic']['eta0_error']:.4f} "
-                  f"(sqrt fit {fit['sqrt']['eta0']:.4f}); reference {ref}", flush=True)
+                  f"(sqrt fit {fit['sqrt']['eta0']:.4f}; stress {s['fit_stress']['quadratic']['eta0']:.4f} +- "
+                  f"{s['fit_stress']['quadratic']['eta0_error']:.4f}); reference {ref}", flush=True)
     data = {"command": "python -m revcol.studies.shear " + " ".join(sys.argv[1:] if argv is None else argv),
             "loadavg": os.getloadavg(), "wall_s": time.time() - t0, "n": a.n, "warm": a.warm, "per_frame": a.per_frame,
             "frames": a.frames, "seeds": a.seeds, "summary": summary, "runs": runs}

@@ -101,6 +101,21 @@
 // kept. Loading checks every size, that every real is finite, the times are ordered and
 // the segments' velocities are the particles' (InvalidArgument naming the first problem).
 //
+// Shear (set_shear; the lattice engine's Lees-Edwards gas; cpp/src/observe_shear.cpp has the
+// details). Positions and velocities are held unwrapped in the sheared lattice of images, so a
+// flight is one line across the gradient faces; the hooks give box points and velocities and
+// the observer takes the image nearest each flight. Kinetic sums, speeds, the VACF and the
+// Helfand moment use the peculiar velocity u = v - gamma (y - L_1 / 2) e_0, whose sums over the
+// particles are polynomials in the time between events (integrated exactly). The shear stress
+// is the x momentum carried across planes of constant y, P_yx = (integral of sum u_x u_y dt +
+// sum r_y Delta p_x) / (V tau) (kinetic plus collisional, pairs across a face through the moving
+// images), and eta = -P_yx / gamma, with block errors: the peculiar energy changes by exactly
+// -gamma V P_yx dt (a collision's r_y Delta p_x, not r_x Delta p_y: a randomized law's impulse
+// is not central, and only the specular gas's stress is symmetric). Slabs lie along the gradient and keep each stretch's box-frame v_x: the
+// velocity profile. The MSD is of the unwrapped positions, so along the flow it includes the
+// advection by the imposed profile. Cost without shear: one test of gamma_ in accumulate and
+// close (the float engine's pair hook takes none of the sheared paths).
+//
 // The collision record (optional, ObserveConfig::collision_record; the randomness study's
 // gas streams, revcol/studies/randomness.hpp). Per pair collision, in order: the unit contact
 // normal n = r / |r| (r = x_a - x_b from the observer's positions, nearest image) and the
@@ -175,6 +190,13 @@ struct Observation {
   std::vector<Estimate> species_temperature;   ///< K2_s / (d N_s tau)
   std::vector<Estimate> species_pressure;      ///< partial pressure (K2_s + W_s) / (d V tau); their sum is pressure_virial
   std::vector<double> species_msd;             ///< each species' MSD at each block end (msd_time), S per point (row-major)
+  // Shear (Observer::set_shear; 0 and empty without): flow along axis 0, gradient along axis 1.
+  double shear_rate = 0.0;           ///< gamma, the imposed rate
+  Estimate shear_stress;             ///< P_yx = (integral sum m u_x u_y dt + sum r_y Delta p_x) / (V tau), u peculiar:
+                                     ///< the x momentum carried across planes of constant y (the boundary's work is
+                                     ///< -gamma V P_yx dt); = P_xy for central impulses (specular)
+  Estimate viscosity;                ///< -P_yx / gamma
+  Profile slab_velocity;             ///< the mean flow velocity (axis 0, the box's frame) per slab (slabs along axis 1)
 };
 
 /// The accumulator behind Simulation::observe (any d; the engine calls the hooks).
@@ -222,7 +244,8 @@ class Observer {
   /// the nearest image of the difference (the MSD stays unwrapped and exact), and the virial
   /// takes these positions: r . Delta v_a with r = x_a - x_b (nearest image) for a pair.
   void pair_at(double t, int a, int b, const double* xa, const double* xb, const double* va, const double* vb);
-  /// A group collision at t with the members' positions after (image-consistent, n x dim).
+  /// A group collision at t with the members' positions after (image-consistent, n x dim; under
+  /// shear each member's own position with its own velocity: the observer takes the images).
   void group_at(double t, int n, const int* ids, const double* x, const double* v);
   /// A wall reflection of i at t with its position and velocity after; bit k of `axes`: it
   /// met a wall of axis k (the lower one if it now moves up, else the upper one), whose
@@ -249,6 +272,19 @@ class Observer {
   /// become sum m v^2, the virial's and the walls' impulses m Delta v; a fresh observation's
   /// running sums are rebuilt with them, a resumed one's come from its snapshot.
   void set_masses(const std::vector<double>& mass);
+  /// Lees-Edwards shear at `rate` (flow along axis 0, gradient along axis 1, both periodic; the
+  /// image one box up moves rate L_1 faster and is offset by rate L_1 t mod L_0): an engine of
+  /// *_at hooks whose box shears calls it right after constructing or resuming, after
+  /// set_sizes. Positions and velocities are then held unwrapped in the sheared lattice of
+  /// images (continuous across the gradient faces: the hooks take the box's positions and
+  /// velocities and find the image), and the kinetic sums, the speeds and the Helfand moment use
+  /// the peculiar velocity u = v - rate (y - L_1 / 2) e_0 (observe_shear.cpp). A fresh
+  /// observation (no event yet) starts its sums there; a resumed one takes them from its
+  /// snapshot, which must have been taken at the same rate. Throws InvalidArgument otherwise,
+  /// for walls on axis 0 or 1, unequal masses, or slabs along another axis than 1.
+  void set_shear(double rate);
+  /// The shear rate a resumed snapshot was taken at (0: none, or not resumed).
+  double saved_shear() const { return shear_saved_.empty() ? 0.0 : shear_saved_[1]; }
   /// Every segment closed at t (the end of a run call); closes any block ended by then.
   void sync(double t);
   /// The results up to the last hook or sync.
@@ -284,6 +320,8 @@ class Observer {
     std::vector<double> slab;  // per slab its time, then its v^2 time (interleaved: one address)
     std::vector<double> speed, pair;
     std::vector<double> sp;    // per species its K2, then its virial W (interleaved)
+    double pyx = 0.0;          // shear: the x momentum carried across y (V P_yx tau)
+    std::vector<double> slab_vx;  // shear: per slab its flow velocity (box frame) times time
     void add(const Block& b);
   };
   void reach(double t);  // closes every block that ends at or before t
@@ -354,6 +392,33 @@ class Observer {
   double radius_of(int i) const { return radius_.empty() ? 0.5 * diameter_ : radius_[i]; }
   double mass_of(int i) const { return mass_.empty() ? 1.0 : mass_[static_cast<std::size_t>(i)]; }
   void species_group_virial(int n, const int* ids, const double* x, const double* v);  // observe_hooks.cpp
+
+  // --- shear (set_shear; observe_shear.cpp). At t_now_, with u_x = v_x - gamma (y - yref), per
+  // particle mass 1: a0 = sum u^2, a1 = sum u_x v_y, a2 = sum v_y^2, b = sum u_x v_z, c = sum v_y v_z.
+  // Between events u_x falls at gamma v_y, so their integrals are polynomials in the time.
+  struct ShearSums {
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, b = 0.0, c = 0.0;
+  };
+  double gamma_ = 0.0;        // the rate (0: not sheared)
+  double image_speed_ = 0.0;  // gamma L_1: the image one box up moves this much faster
+  double yref_ = 0.0;         // L_1 / 2: where the imposed flow is at rest
+  ShearSums shs_;
+  std::vector<ShearSums> shs_sp_;     // per species (ns_)
+  double pyx_ = 0.0;                  // integral of sum u_x u_y dt + sum r_y Delta p_x (V P_yx tau so far)
+  double pyx_open_ = 0.0;             // pyx_ when the open block began
+  std::vector<double> shear_saved_;   // a resumed snapshot's shear section (set_shear reads it)
+  double offset(double t) const;      // the image one box up's offset along the flow at t
+  void fold_sheared(double* r, double t, double& n) const;  // r to its nearest image; n: the image's box index
+  int place_sheared(int i, const double* x, double t);     // place() through the moving images; the image index
+  void shear_terms(int i, double sign);
+  void accumulate_sheared(double dt);
+  void close_sheared(int i, double t);
+  void speed_sheared(double ux0, double g, double p2, double span);
+  void slab_sheared(Segment& s, double t, double dt);
+  void pair_sheared(double t, int a, int b, const double* xa, const double* xb, const double* va, const double* vb);
+  void group_sheared(double t, int n, const int* ids, const double* x, const double* v);
+  void wall_sheared(double t, int i, const double* x, const double* v, unsigned axes);
+  void save_shear(std::vector<double>& reals) const;
 
   // --- the collision record (see the header comment) ---
  public:
