@@ -247,8 +247,9 @@ void Observer::end_block() {
     double c = 0.0;
     for (std::size_t i = 0; i < n_; ++i)
       for (int k = 0; k < dim_; ++k) {
-        double v = seg_[i].v[k];  // (shear: the peculiar velocity at te)
+        double v = seg_[i].v[k];  // (shear: the peculiar velocity at te; a field: the velocity then)
         if (k == 0 && gamma_ != 0.0) v -= gamma_ * (pos(static_cast<int>(i), 1, te) - yref_);
+        if (k == fax_) v += g_ * (te - seg_[i].t0);
         c += v * start_v_[i * dim_ + k];
       }
     vacf_.push_back(c / static_cast<double>(n_));

@@ -90,6 +90,10 @@ void Observer::pair_at(double t, int a, int b, const double* xa, const double* x
   close<3>(b, t);
   close_pairs(a, t);
   close_pairs(b, t);
+  if (fax_ >= 0) [[unlikely]] {  // a field's running sums: the pair's terms out, in after (observe_field.cpp)
+    field_terms(a, -1.0);
+    field_terms(b, -1.0);
+  }
   double w = 0.0, r[3], dp[3];
   for (int k = 0; k < dim_; ++k) {
     r[k] = xa[k] - xb[k];
@@ -105,6 +109,10 @@ void Observer::pair_at(double t, int a, int b, const double* xa, const double* x
   if (cfg_.collision_record) [[unlikely]] record_pair(a, b, va, vb);
   set_velocity<0>(a, va);
   set_velocity<0>(b, vb);
+  if (fax_ >= 0) [[unlikely]] {
+    field_terms(a, 1.0);
+    field_terms(b, 1.0);
+  }
   ++cur_.pairs;
   cur_.parts += 2;
 }
@@ -117,11 +125,13 @@ void Observer::group_at(double t, int n, const int* ids, const double* x, const 
     const int i = ids[u];
     close<3>(i, t);
     close_pairs(i, t);
+    if (fax_ >= 0) [[unlikely]] field_terms(i, -1.0);
     group_virial(i, x + u * dim_, v + u * dim_);
   }
   for (int u = 0; u < n; ++u) {
     place(ids[u], x + u * dim_);
     set_velocity<0>(ids[u], v + u * dim_);
+    if (fax_ >= 0) [[unlikely]] field_terms(ids[u], 1.0);
   }
   ++cur_.groups;
   cur_.parts += static_cast<std::uint64_t>(n);
@@ -132,6 +142,7 @@ void Observer::wall_at(double t, int i, const double* x, const double* v, unsign
   reach(t);
   close<3>(i, t);
   close_pairs(i, t);
+  if (fax_ >= 0) [[unlikely]] field_terms(i, -1.0);
   const double r = radius_of(i);
   for (int k = 0; k < dim_; ++k) {
     if (!(axes >> k & 1u) || !walls_[k]) continue;
@@ -141,6 +152,7 @@ void Observer::wall_at(double t, int i, const double* x, const double* v, unsign
   }
   place(i, x);
   set_velocity<0>(i, v);
+  if (fax_ >= 0) [[unlikely]] field_terms(i, 1.0);
   ++cur_.walls;
 }
 

@@ -44,6 +44,30 @@ inline double time_below(double a, double b, double c, double q, double span) {
   return hi > lo ? hi - lo : 0.0;
 }
 
+// The integral over [0, span] of sqrt((w0 - g h)^2 + p2) dh: the distance covered at a velocity
+// one component of which changes at -g (shear's peculiar u_x, a field's v_f), p2 >= 0 the square
+// of the rest. In w = w0 - g h it is (G(w0) - G(w1)) / g, G(w) = (w S + p2 asinh(w / p)) / 2,
+// S = sqrt(w^2 + p2), written without the cancellation of two large G (every term a multiple of
+// w0 - w1 = g span).
+inline double quadratic_distance(double w0, double g, double p2, double span) {
+  const double w1 = w0 - g * span;
+  const double s0 = std::sqrt(w0 * w0 + p2), s1 = std::sqrt(w1 * w1 + p2);
+  if (g == 0.0) return s0 * span;
+  if (!(p2 > 0.0))  // |w| along a line: through zero or not
+    return w0 * w1 >= 0.0 ? 0.5 * std::fabs(w0 + w1) * span : (w0 * w0 + w1 * w1) / (2.0 * std::fabs(g));
+  const double p = std::sqrt(p2), a = w0 / p, b = w1 / p;
+  // asinh(a) - asinh(b), from one asinh when a and b have one sign (no cancellation)
+  double dasinh;
+  if (a * b > 0.0) {
+    const double q = (g * span / p) * (a + b) / (a * std::sqrt(1.0 + b * b) + b * std::sqrt(1.0 + a * a));
+    dasinh = std::asinh(q);
+  } else {
+    dasinh = std::asinh(a) - std::asinh(b);
+  }
+  const double sum = w0 + w1;
+  return 0.5 * (0.5 * span * (s0 + s1) + 0.5 * span * sum * sum / (s0 + s1)) + 0.5 * p2 * dasinh / g;
+}
+
 /// The config's checks (the constructor's and a snapshot's): n particles in dim dimensions.
 void check_config(const ObserveConfig& c, int dim, std::size_t n, const std::array<bool, 3>& walls);
 
@@ -87,7 +111,7 @@ template <int K>
 // d are 0 whatever dt).
 template <int K>
 [[gnu::always_inline]] inline void Observer::close(int i, double t) {
-  if (gamma_ != 0.0) [[unlikely]] return close_sheared(i, t);
+  if (curved_) [[unlikely]] return gamma_ != 0.0 ? close_sheared(i, t) : close_field(i, t);
   Segment& s = seg_[i];
   const double dt = t - s.t0;
   cur_.speed[s.bin] += dt;
@@ -131,8 +155,9 @@ template <int K>
 // (those beyond hc_ stay 0: no test of the dimension).
 [[gnu::always_inline]] inline void Observer::accumulate(double t) {
   const double dt = t - t_now_;
-  if (gamma_ != 0.0) [[unlikely]] {  // peculiar velocities: polynomials between events (observe_shear.cpp)
-    accumulate_sheared(dt);
+  if (curved_) [[unlikely]] {  // shear's peculiar velocities, a field's parabolas: polynomials between events
+    if (gamma_ != 0.0) accumulate_sheared(dt);
+    else accumulate_field(dt);
     t_now_ = t;
     return;
   }

@@ -54,6 +54,7 @@ void Observer::save(std::vector<double>& reals, std::vector<std::uint64_t>& coun
       reals.insert(reals.end(), msd_sp_.begin(), msd_sp_.end());
     }
     if (gamma_ != 0.0) save_shear(reals);  // shear's sums (observe_shear.cpp; absent without shear)
+    if (fax_ >= 0) save_field(reals);      // a field's (observe_field.cpp)
   }
 }
 
@@ -106,17 +107,25 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
     ns_saved_ = static_cast<int>(whole(helf, 1, kMaxSpecies, "species count"));
     species = static_cast<std::size_t>(ns_saved_) * (2 * (nb + 1) + nm + 1) + 1;
   }
+  // then shear's section (-1 first; observe_shear.cpp) or a field's (-2 first; observe_field.cpp)
   const std::size_t sheared = helf + species;
+  std::size_t field = 0;
   if (reals.size() > sheared) {
-    require(reals[sheared] == -1.0, "snapshot: observer: an unknown section follows the Helfand moment");
-    shear = 9 + 5 * static_cast<std::size_t>(ns_saved_) + (nb + 1) * (1 + static_cast<std::size_t>(cfg_.slabs));
+    require(reals[sheared] == -1.0 || reals[sheared] == -2.0, "snapshot: observer: an unknown section follows the Helfand moment");
+    if (reals[sheared] == -1.0)
+      shear = 9 + 5 * static_cast<std::size_t>(ns_saved_) + (nb + 1) * (1 + static_cast<std::size_t>(cfg_.slabs));
+    else
+      field = 10 + 2 * static_cast<std::size_t>(ns_saved_);
   }
-  require(reals.size() == sheared + shear || reals.size() == vacf || reals.size() == size,
-          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points, species, shear)");
+  require(reals.size() == sheared + shear + field || reals.size() == vacf || reals.size() == size,
+          "snapshot: observer: its size does not match its header (particles, bins, blocks, MSD points, species, shear, field)");
   // under shear a segment moves in the image it is in: its flow velocity is the particle's plus
-  // a whole number of times the images' relative speed
+  // a whole number of times the images' relative speed; in a field its velocity was the
+  // particle's at its start, g (t - t0) from the particle's now along the field's axis
   const double image_speed = shear > 0 ? reals[sheared + 1] * box[1] : 0.0;
   require(shear == 0 || (image_speed != 0.0 && std::isfinite(image_speed)), "snapshot: observer: its shear rate must be nonzero");
+  const int fax = field > 0 ? static_cast<int>(whole(sheared + 1, 0, dim - 1, "field axis")) : -1;
+  const double fg = field > 0 ? reals[sheared + 2] : 0.0;
   require(counts.size() == (nb + 1) * kBlockCounts, "snapshot: observer_counts must hold 4 counts per block");
   bin_scale_ = cfg_.speed_bins / speed_max_;
   bin_cap_ = cfg_.speed_bins;
@@ -130,14 +139,16 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
     s.v2 = s.speed = 0.0;
     for (std::size_t k = 0; k < d; ++k) s.x[k] = reals[u++];
     double sv[3] = {0.0, 0.0, 0.0};
+    for (std::size_t k = 0; k < d; ++k) sv[k] = reals[u++];
+    s.t0 = reals[u++];
     for (std::size_t k = 0; k < d; ++k) {
-      sv[k] = reals[u++];
-      const double off = sv[k] - v[i * d + k], m = k == 0 && shear > 0 ? std::nearbyint(off / image_speed) : 0.0;
-      require(k == 0 && shear > 0 ? std::fabs(off - m * image_speed) <= 1e-9 * (std::fabs(sv[k]) + std::fabs(v[i * d + k]))
-                                  : off == 0.0,
+      const double now = static_cast<int>(k) == fax ? sv[k] + fg * (t - s.t0) : sv[k];
+      const double off = now - v[i * d + k], m = k == 0 && shear > 0 ? std::nearbyint(off / image_speed) : 0.0;
+      const double tol = 1e-9 * (std::fabs(now) + std::fabs(v[i * d + k]) + std::fabs(fg * (t - s.t0)));
+      require(k == 0 && shear > 0 ? std::fabs(off - m * image_speed) <= tol : static_cast<int>(k) == fax ? std::fabs(off) <= tol
+                                                                                                       : off == 0.0,
               "snapshot: observer: a segment's velocity is not its particle's");
     }
-    s.t0 = reals[u++];
     require(s.t0 >= t_start_ && s.t0 <= t, "snapshot: observer: a segment starts outside the observed time");
     if (cfg_.slabs > 0) {
       const double cell = reals[u++];
@@ -199,6 +210,7 @@ Observer::Observer(const std::vector<double>& reals, const std::vector<std::uint
     take(msd_sp_, nm * ns);
   }
   take(shear_saved_, shear);  // set_shear reads it
+  take(field_saved_, field);  // set_field reads it
   resumed_ = true;
   v2_sum_ = reals[16];  // the running sums as they were (set_velocity above rebuilt them afresh)
   speed_sum_ = reals[17];

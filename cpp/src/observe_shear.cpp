@@ -26,7 +26,7 @@
 // changes by exactly -gamma V P_yx dt. (The Helfand moment keeps r_x Delta p_y, a < b: a
 // randomized law's impulse is not central, so only the specular gas's stress is symmetric.) A segment's peculiar speed |u(h)| is the root of a quadratic: the speed
 // histogram takes the exact time below each bin edge (time_below) and the distance flown the
-// exact integral (sheared_distance) when the segment closes.
+// exact integral (quadratic_distance) when the segment closes.
 //
 // Slabs (along the gradient axis only): a stretch of a flight in unwrapped cell c is in the
 // image floor(c / slabs) boxes up, where its velocity in the box is v - floor(c / slabs) gamma
@@ -42,30 +42,6 @@
 #include "revcol/error.hpp"
 
 namespace revcol::engine {
-namespace {
-
-// The integral over [0, span] of sqrt((ux0 - g h)^2 + p2) dh, p2 > 0 when g != 0: the distance a
-// peculiar velocity whose flow component falls at g covers. In w = ux0 - g h it is
-// (G(w0) - G(w1)) / g, G(w) = (w S + p2 asinh(w / p)) / 2, S = sqrt(w^2 + p2), written without
-// the cancellation of two large G (every term a multiple of w0 - w1 = g span).
-double sheared_distance(double ux0, double g, double p2, double span) {
-  const double w0 = ux0, w1 = ux0 - g * span;
-  const double s0 = std::sqrt(w0 * w0 + p2), s1 = std::sqrt(w1 * w1 + p2);
-  if (g == 0.0) return s0 * span;
-  const double p = std::sqrt(p2), a = w0 / p, b = w1 / p;
-  // asinh(a) - asinh(b), from one asinh when a and b have one sign (no cancellation)
-  double dasinh;
-  if (a * b > 0.0) {
-    const double q = (g * span / p) * (a + b) / (a * std::sqrt(1.0 + b * b) + b * std::sqrt(1.0 + a * a));
-    dasinh = std::asinh(q);
-  } else {
-    dasinh = std::asinh(a) - std::asinh(b);
-  }
-  const double sum = w0 + w1;
-  return 0.5 * (0.5 * span * (s0 + s1) + 0.5 * span * sum * sum / (s0 + s1)) + 0.5 * p2 * dasinh / g;
-}
-
-}  // namespace
 
 double Observer::offset(double t) const {
   const double d = std::fmod(image_speed_ * t, box_[0]);
@@ -148,7 +124,7 @@ void Observer::close_sheared(int i, double t) {
   if (dt > 0.0) {
     const double ux0 = s.v[0] - gamma_ * (s.x[1] - yref_), g = gamma_ * s.v[1];
     const double p2 = s.v[1] * s.v[1] + s.v[2] * s.v[2];
-    cur_.dist += sheared_distance(ux0, g, p2, dt);
+    cur_.dist += quadratic_distance(ux0, g, p2, dt);
     if (cfg_.speed_bins > 0) speed_sheared(ux0, g, p2, dt);
     if (cfg_.slabs > 0) slab_sheared(s, t, dt);
   }
@@ -293,7 +269,9 @@ void Observer::set_shear(double rate) {
   require(mass_.empty(), "observe: shear with unequal masses is not built");
   require(cfg_.slabs == 0 || cfg_.slab_axis == 1,
           "observe: under shear the slabs lie along the gradient (slab_axis 1): the velocity profile's axis");
+  require(fax_ < 0, "observe: shear with a field is not built");
   gamma_ = rate;
+  curved_ = true;
   image_speed_ = rate * box_[1];
   yref_ = 0.5 * box_[1];
   shs_sp_.assign(static_cast<std::size_t>(ns_), ShearSums{});

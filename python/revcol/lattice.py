@@ -85,7 +85,8 @@ class LatticeSimulation(SimulationBase):
     even lattice lengths; docs/mixtures.md). ``gravity`` (one component per axis, nonzero on one
     walled axis): a uniform field, exact on the lattice (quantized once to an even number of lattice
     units per tick^2, :attr:`gravity` the value run and ``quantization()["gravity_error"]`` the
-    rounding; the cell grid searches; no observer, journal or parallel run yet; docs/engine.md).
+    rounding; the cell grid searches; no journal or parallel run yet; :meth:`observe` follows the
+    parabolas between events: a column's density profile from its slabs; docs/engine.md).
     ``shear_rate``: Lees-Edwards shear, exact on the lattice: the flow along axis 0, the gradient
     along axis 1 (both periodic), the box above moving ``shear_rate * box[1]`` faster (quantized
     once to lattice units per tick, :attr:`shear_rate` the value run and

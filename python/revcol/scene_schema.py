@@ -312,7 +312,8 @@ def check_gravity(source: str, gravity: Sequence[float] | None, d: int,
 # parallel engine and the neighbour lists are not built for yet, and why there is no observer
 _UNBUILT = {
     "gravity": ("in a field ([system] gravity)", "a field", "curved paths",
-                "neither engine's observer takes one yet (it assumes straight lines between events)"),
+                "the float engine's observer does not take one yet (its velocities change between events; "
+                "engine = 'lattice' observes a gas in a field)"),
     "shear": ("under shear ([system] shear_rate)", "shear", "moving images", None),  # (observed: docs/shear.md)
 }
 
@@ -322,8 +323,8 @@ def check_field_options(source: str, gravity: Sequence[float] | None, engine: st
                         shear: float | None = None) -> None:
     """Refuses, naming the option, what runs no field (``gravity``) or no shear (``shear``, a rate;
     None: none) yet: on the lattice engine more than one worker or neighbour lists (``search`` a
-    shell; ``"auto"`` takes the cell grid there), and in a field an observed run on either engine
-    (``observe``: an ``[observe]`` table; the observer assumes straight lines between events; a
+    shell; ``"auto"`` takes the cell grid there), and in a field an observed run on the float
+    engine (``observe``: an ``[observe]`` table; the lattice's observer follows the parabolas; a
     sheared gas is observed, its slabs along axis 1 only: check_shear_observe). ``names`` renames an option where it came from the command
     line (``{"workers": "--workers"}``)."""
     names = names or {}
@@ -331,7 +332,7 @@ def check_field_options(source: str, gravity: Sequence[float] | None, engine: st
         if not on:
             continue
         where, what, lists, observer = _UNBUILT[kind]
-        if observe and observer is not None:
+        if observe and observer is not None and engine != "lattice":
             raise _fail(source, "[observe]", f"is not available {where}: {observer}; take trajectory frames instead")
         if engine != "lattice":
             continue
@@ -411,8 +412,8 @@ def observes_frames(scene, trajectory) -> bool:
     """Whether a run of ``scene`` writing ``trajectory`` observes (unreported, in its checkpoints) for the
     image flags of a periodic box's frames: when its own ``[observe]`` does not already, nor a field or
     shear forbids it (check_field_options: the flags are then inferred between frames)."""
-    return (trajectory is not None and scene.observe is None and not (scene.gravity or scene.shear_rate)
-            and "periodic" in scene.boundaries)
+    return (trajectory is not None and scene.observe is None and not scene.shear_rate
+            and not (scene.gravity and scene.engine != "lattice") and "periodic" in scene.boundaries)
 
 
 def field_text(gravity: Iterable[float] | None) -> str:

@@ -10,6 +10,7 @@
 
 #include "check.hpp"
 #include "lattice_gas_util.hpp"
+#include "observe_util.hpp"
 #include "revcol/lattice/engine.hpp"
 
 using namespace revcol::lattice;
@@ -30,23 +31,11 @@ double rate_of(const UnitsN<D>& u) {
   return static_cast<double>(u.shear) * (u.length_unit / u.tick) / (static_cast<double>(u.L[1]) * u.length_unit);
 }
 
-en::ObserveConfig profile_config() {
-  en::ObserveConfig c;
-  c.slabs = 8;
-  c.slab_axis = 1;
-  c.speed_bins = 40;
-  return c;
-}
+en::ObserveConfig profile_config() { return observe_test::config(0.0, 8, 1, 40); }
 
 double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
 
-std::vector<double> saved(const en::Observer& o) {
-  std::vector<double> r;
-  std::vector<std::uint64_t> c;
-  o.save(r, c);
-  for (std::uint64_t q : c) r.push_back(static_cast<double>(q));
-  return r;
-}
+using observe_test::saved;
 
 // sum of |v|^2 / 2 in float units
 template <std::size_t D>

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "observe_util.hpp"
 #include "revcol/engine/observe.hpp"
 #include "revcol/error.hpp"
 
@@ -70,12 +71,7 @@ TEST_CASE("sheared free flights: a face crossed, the peculiar kinetic integral, 
                         {{9.0, 5.0, 0.0}, {0.2, 0.0, 0.0}, 0.0}};
   std::vector<double> x, v;
   for (const Flight& q : f) x.insert(x.end(), {q.x0[0], q.x0[1]}), v.insert(v.end(), {q.v[0], q.v[1]});
-  ObserveConfig c;
-  c.block_time = 100.0;
-  c.slabs = 5;
-  c.slab_axis = 1;
-  c.speed_bins = 40;
-  c.speed_max = 4.0;
+  ObserveConfig c = observe_test::config(100.0, 5, 1, 40, 4.0);
   c.collision_record = true;
   Observer o(c, 2, x, v, 0.0, {kL0, kL1, 1.0}, {false, false, false}, 1.0);
   o.set_shear(kRate);
@@ -113,14 +109,9 @@ TEST_CASE("sheared free flights: a face crossed, the peculiar kinetic integral, 
   CHECK(std::fabs(un[0] - (3.0 + 0.5 * t2)) < 1e-12);
   CHECK(std::fabs(un[1] - (9.0 + 0.8 * t2)) < 1e-12);
   // the speed histogram: a density of the peculiar speed, its mean the distance over N tau
-  double norm = 0.0, mean = 0.0;
-  const double h = c.speed_max / c.speed_bins;
-  for (int k = 0; k < c.speed_bins; ++k) {
-    norm += r.speed.value[k] * h;
-    mean += r.speed.value[k] * h * (k + 0.5) * h;
-  }
+  const auto [norm, mean] = observe_test::speed_moments(r, c);
   CHECK(std::fabs(norm - 1.0) < 1e-12);
-  CHECK(std::fabs(mean - tot.dist / (3.0 * t2)) < 0.5 * h);
+  CHECK(std::fabs(mean - tot.dist / (3.0 * t2)) < 0.5 * c.speed_max / c.speed_bins);
   // slabs: occupancy and the box-frame flow velocity per slab, sampled finely
   std::vector<double> occ(5, 0.0), vx(5, 0.0);
   const int n = 500000;
@@ -144,13 +135,8 @@ TEST_CASE("sheared free flights: a face crossed, the peculiar kinetic integral, 
 
 TEST_CASE("sheared 3D flights with a wall on z: the xz and yz stresses, the wall impulse, and a snapshot resumed to the same bits") {
   std::vector<Flight> f{{{2.0, 8.5, 2.0}, {0.4, 0.9, -0.5}, 0.0}, {{7.0, 3.0, 6.0}, {-0.2, 0.3, 0.25}, 0.0}};
-  std::vector<double> x, v;
-  for (const Flight& q : f) {
-    x.insert(x.end(), q.x0, q.x0 + 3);
-    v.insert(v.end(), q.v, q.v + 3);
-  }
-  ObserveConfig c;
-  c.block_time = 1.0;
+  const auto [x, v] = observe_test::starts(f, 3);
+  const ObserveConfig c = observe_test::config(1.0, 0, 0, 0);
   const std::array<double, 3> box{kL0, kL1, 8.0};
   const std::array<bool, 3> walls{false, false, true};
   Observer o(c, 3, x, v, 0.0, box, walls, 1.0);
@@ -182,12 +168,7 @@ TEST_CASE("sheared 3D flights with a wall on z: the xz and yz stresses, the wall
   back.set_shear(kRate);
   o.sync(t2);
   back.sync(t2);
-  std::vector<double> r1, r2;
-  std::vector<std::uint64_t> c1, c2;
-  o.save(r1, c1);
-  back.save(r2, c2);
-  CHECK(r1 == r2);
-  CHECK(c1 == c2);
+  CHECK(observe_test::saved(o) == observe_test::saved(back));
   const Observation r = o.results();
   Flight after{{f[0].x0[0] + f[0].v[0] * tw, f[0].y(tw), 0.5}, {f[0].v[0], f[0].v[1], 0.5}, tw};
   Integrals a = integrate(f[0], 0.0, tw), b = integrate(after, tw, t2), q = integrate(f[1], 0.0, t2);

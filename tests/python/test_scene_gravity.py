@@ -60,7 +60,8 @@ def test_the_key_is_parsed_and_shown():
     ({"system": {"gravity": [-1.0, 0.0]}}, "[system] gravity: points along axis 0, which is periodic: a field needs walls"),
     ({"system": {"gravity": [0.0, -1.0], "boundaries": "periodic"}}, "[system] gravity: points along axis 1, which is periodic"),
     ({"system": {"gravity": [0.5, -1.0], "boundaries": "wall"}}, "[system] gravity: must be nonzero along one axis at most"),
-    ({"observe": {"slabs": 4}}, "[observe]: is not available in a field ([system] gravity)"),
+    ({"observe": {"slabs": 4}}, "[observe]: is not available in a field ([system] gravity): the float engine's "
+                                "observer does not take one yet"),
 ])
 def test_bad_fields_are_refused_by_name(fields, needle):
     with pytest.raises(SceneError) as e:
@@ -71,7 +72,6 @@ def test_bad_fields_are_refused_by_name(fields, needle):
 @pytest.mark.parametrize("fields,needle", [
     ({"collisions": {"workers": 4}}, "[collisions] workers: engine = 'lattice' runs a gas in a field ([system] "
                                      "gravity) on one worker"),
-    ({"observe": {}}, "[observe]: is not available in a field"),
     ({"collisions": {"search": 0.3}}, "[collisions] search: engine = 'lattice' searches a gas in a field"),
 ])
 def test_the_lattice_refuses_what_runs_no_field_at_load(fields, needle):
@@ -81,6 +81,17 @@ def test_the_lattice_refuses_what_runs_no_field_at_load(fields, needle):
     # the same options without a field load
     no_field = {**fields, "system": {"gravity": [0.0, 0.0]}}
     assert scene("lattice", **no_field).gravity is None
+
+
+def test_the_lattice_observes_a_scene_in_a_field():
+    s = scene("lattice", observe={"slabs": 5, "slab_axis": 1}, run={"collisions": 4000})
+    sim = build_simulation(s)
+    sim.observe(**s.observe)
+    sim.run(collisions=4000)
+    o = sim.observation()
+    assert o.slab_density.value[0] > o.slab_density.value[-1]  # the column is denser below
+    assert np.sum(o.slab_density.value) * np.prod(sim.box) / 5 == pytest.approx(200, rel=1e-12)  # every particle
+    assert o.temperature.value > 0 and o.pressure_wall[1].value > 0
 
 
 def test_the_command_lines_lattice_options_are_refused_by_flag():

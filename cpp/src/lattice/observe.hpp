@@ -12,7 +12,6 @@ namespace revcol::lattice {
 
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::observe(const engine::ObserveConfig& c) {
-  require(gax_ < 0, "lattice observe: the observer does not take a field yet (its pressure and free paths assume straight lines); read snapshots instead");
   observer_ = make_observer(u_, positions(), velocities(), clock_, &c, nullptr, radii());
   obs_ = observer_.get();
 }
@@ -50,6 +49,10 @@ auto BasicEngine<Op, Bits, Queue>::make_observer(const Units& u, const std::vect
   // shear: the observer takes the images one box up as moving s lattice units per tick faster
   if (u.shear != 0) o->set_shear(static_cast<double>(u.shear) * speed / box[1]);
   require(u.shear != 0 || o->saved_shear() == 0.0, "snapshot: observer: it was taken of a sheared gas, this one is not");
+  // a field: flights are parabolas (acceleration gravity[k] lattice units per tick^2)
+  const int fk = field_axis(u);
+  if (fk >= 0) o->set_field(fk, static_cast<double>(u.gravity[static_cast<std::size_t>(fk)]) * len / (u.tick * u.tick));
+  require(fk >= 0 || o->saved_field_axis() < 0, "snapshot: observer: it was taken of a gas in a field, this one is in none");
   return o;
 }
 

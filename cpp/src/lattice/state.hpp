@@ -85,7 +85,7 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<std::uint32_t>& order) {
   validate_state(s.units, s.x, s.v, true, s.radius, s.clock);  // collisions may be pending at the clock (rebuild finds them)
   if (!s.radius.empty()) Sizes::require_resizable<Op>();
-  require(field_axis(s.units) < 0 || (rax_ < 0 && !jon_ && s.observer.empty()), "lattice: a gas in a field runs without regions, journal or observation (not built for curved lines yet)");
+  require(field_axis(s.units) < 0 || (rax_ < 0 && !jon_), "lattice: a gas in a field runs without regions or journal (not built for curved lines yet)");
   require(s.units.shear == 0 || (rax_ < 0 && !jon_ && list_shell_ <= 0.0),
           "lattice: a sheared gas runs without regions, journal or neighbour lists (not built for moving images yet)");
   if (!order.empty()) {

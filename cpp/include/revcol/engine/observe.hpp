@@ -113,8 +113,15 @@
 // -gamma V P_yx dt (a collision's r_y Delta p_x, not r_x Delta p_y: a randomized law's impulse
 // is not central, and only the specular gas's stress is symmetric). Slabs lie along the gradient and keep each stretch's box-frame v_x: the
 // velocity profile. The MSD is of the unwrapped positions, so along the flow it includes the
-// advection by the imposed profile. Cost without shear: one test of gamma_ in accumulate and
+// advection by the imposed profile. Cost without shear: one test (curved_) in accumulate and
 // close (the float engine's pair hook takes none of the sheared paths).
+//
+// A field (set_field; the lattice engine's gas under gravity; cpp/src/observe_field.cpp). Flights
+// are parabolas along the field's axis; closing a segment moves its position and velocity on
+// along it, so each event's velocity change is taken from the velocity then; the kinetic sums
+// and the Helfand moment are polynomials between events, integrated exactly; slabs solve each
+// crossing from the quadratic (the column's profiles), speeds and distances likewise. Cost
+// without a field: the same test as shear's (curved_), and one in each *_at hook.
 //
 // The collision record (optional, ObserveConfig::collision_record; the randomness study's
 // gas streams, revcol/studies/randomness.hpp). Per pair collision, in order: the unit contact
@@ -285,6 +292,15 @@ class Observer {
   void set_shear(double rate);
   /// The shear rate a resumed snapshot was taken at (0: none, or not resumed).
   double saved_shear() const { return shear_saved_.empty() ? 0.0 : shear_saved_[1]; }
+  /// A uniform field: acceleration g (nonzero, finite) along `axis`, which has walls. Flights are
+  /// then parabolas, x0 + v (t - t0) + g (t - t0)^2 / 2 along the axis: the kinetic sums, the
+  /// Helfand moment, speeds, distances, slabs and the MSD follow them exactly
+  /// (observe_field.cpp). An engine of *_at hooks calls it as set_shear (a fresh observation
+  /// before any event; a resumed one checks its snapshot's field). Throws InvalidArgument on a
+  /// bad axis or value, unequal masses, pair distances, or a snapshot of another field.
+  void set_field(int axis, double g);
+  /// The field a resumed snapshot was taken in: its axis (-1: none, or not resumed).
+  int saved_field_axis() const { return field_saved_.empty() ? -1 : static_cast<int>(field_saved_[1]); }
   /// Every segment closed at t (the end of a run call); closes any block ended by then.
   void sync(double t);
   /// The results up to the last hook or sync.
@@ -350,7 +366,10 @@ class Observer {
   void end_block();
   Block empty_block(double t0) const;
   void set_geometry(const std::array<double, 3>& box);
-  double pos(int i, int k, double t) const { return seg_[i].x[k] + seg_[i].v[k] * (t - seg_[i].t0); }
+  double pos(int i, int k, double t) const {
+    const double dt = t - seg_[i].t0, x = seg_[i].x[k] + seg_[i].v[k] * dt;
+    return k == fax_ ? x + 0.5 * g_ * dt * dt : x;  // (a field: a parabola along its axis)
+  }
 
   ObserveConfig cfg_;
   int dim_;
@@ -399,6 +418,7 @@ class Observer {
   struct ShearSums {
     double a0 = 0.0, a1 = 0.0, a2 = 0.0, b = 0.0, c = 0.0;
   };
+  bool curved_ = false;       // sheared or in a field: the kinetic sums are polynomials between events
   double gamma_ = 0.0;        // the rate (0: not sheared)
   double image_speed_ = 0.0;  // gamma L_1: the image one box up moves this much faster
   double yref_ = 0.0;         // L_1 / 2: where the imposed flow is at rest
@@ -419,6 +439,24 @@ class Observer {
   void group_sheared(double t, int n, const int* ids, const double* x, const double* v);
   void wall_sheared(double t, int i, const double* x, const double* v, unsigned axes);
   void save_shear(std::vector<double>& reals) const;
+
+  // --- a field (set_field; observe_field.cpp). At t_now_, mass 1: a0 = sum v^2, m[k] = sum v_k,
+  // vv[c] = sum v_a v_b (the Helfand pairs); per species its sum v^2 and sum v_f. Between events
+  // v_f grows at g, so their integrals are polynomials in the time.
+  struct FieldSums {
+    double a0 = 0.0;
+    std::array<double, 3> m{}, vv{};
+  };
+  int fax_ = -1;      // the field's axis (-1: none)
+  double g_ = 0.0;    // its acceleration
+  FieldSums fs_;
+  std::vector<double> fsp_;           // per species: sum v^2, sum v_f (interleaved)
+  std::vector<double> field_saved_;   // a resumed snapshot's field section (set_field reads it)
+  void field_terms(int i, double sign);
+  void accumulate_field(double dt);
+  void close_field(int i, double t);
+  void slab_field(Segment& s, double dt);
+  void save_field(std::vector<double>& reals) const;
 
   // --- the collision record (see the header comment) ---
  public:
