@@ -1,7 +1,8 @@
 // The observer on a lattice gas in a field (engine hooks -> Observer::set_field): an observed run
 // is the unobserved run bit for bit and still reverses; a checkpoint mid-observation resumes to
 // the same observation, bit for bit; its temperature is the frames' kinetic energy integrated over
-// time, its slabs hold every particle at every instant, and the column is denser below.
+// time, its slabs hold every particle at every instant, and the column is denser below; a
+// mixture's species sums add up to the gas's.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -104,6 +105,28 @@ TEST_CASE("an observed gas in a field is the unobserved one, resumes bit for bit
   observed<2>(fallen<2>(400, 0.3, -0.2, 3), Mode::exact, 3, "2D exact g -0.2");
   observed<2>(fallen<2>(400, 0.3, -0.2, 4, true), Mode::specular, 4, "2D specular, bounce-back walls");
   observed<3>(fallen<3>(500, 0.2, -0.2, 5), Mode::exact, 5, "3D exact g -0.2");
+}
+
+TEST_CASE("a binary mixture in a field observed: the species' temperatures add up to the gas's") {
+  LatticeConfigN<2> c;
+  c.wall = filled<2>(true);
+  c.gravity[1] = -0.2;
+  c.seed = 8;
+  for (int q = 0; q < 300; ++q) c.diameters.push_back(q % 2 ? 1.4 : 1.0);
+  const LatticeStartN<2> st = random_start(c, 300, 0.3, 8);
+  EngineOf<2> e = lattice_test::engine_of<2>(st, 8, Mode::exact);
+  e.run(3000, tick_limit - 1);
+  e.observe(profile_config(2));
+  e.run(8000, tick_limit - 1);
+  const en::Observation o = e.observer()->results();
+  CHECK(o.species_count.size() == 2);
+  double t = 0.0, p = 0.0;
+  for (std::size_t u = 0; u < 2; ++u) {
+    t += static_cast<double>(o.species_count[u]) * o.species_temperature[u].value;
+    p += o.species_pressure[u].value;
+  }
+  CHECK(std::fabs(t / 300.0 / o.temperature.value - 1.0) < 1e-9);
+  CHECK(std::fabs(p / o.pressure_virial.value - 1.0) < 1e-9);
 }
 
 CHECK_MAIN()
