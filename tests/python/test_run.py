@@ -183,11 +183,20 @@ def test_trajectory_gsd(tmp_path):
 
 
 def test_bad_output_requests_run_nothing(tmp_path, capsys, monkeypatch):
+    import collections
+    import revcol._outputs as outs
     import revcol.trajectory as tr
 
-    assert cli_main(["run", "--trajectory", str(tmp_path / "t.pdb"), "--no-progress"]) == 2
-    err = capsys.readouterr().err
-    assert "the suffix must be .xyz (extended XYZ) or .gsd" in err and err.count("\n") == 1
+    # a bad name is refused the same way on every machine: before the sizes are held against a
+    # file system's free space (CI once ran this with 604 MiB free, and the space refusal came first)
+    usage = collections.namedtuple("usage", "total used free")
+    with monkeypatch.context() as m:
+        m.setattr(outs.shutil, "disk_usage", lambda where: usage(1 << 20, 1 << 20, 0))
+        assert cli_main(["run", "--trajectory", str(tmp_path / "t.pdb"), "--no-progress"]) == 2
+        err = capsys.readouterr().err
+        assert "the suffix must be .xyz (extended XYZ) or .gsd" in err and err.count("\n") == 1
+        assert cli_main(["run", "--trajectory", str(tmp_path / "t.xyz"), "--no-progress"]) == 2
+        assert "free on the file system" in capsys.readouterr().err  # the space check itself is live
     real = tr.check_format
 
     def no_gsd(path):  # as if gsd were not installed

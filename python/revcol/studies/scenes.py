@@ -111,6 +111,12 @@ def run_scene(scene: Scene | str | os.PathLike | None = None, *, json_path: str 
     if plot is not None:
         require_matplotlib()
         check_format(plot_format)
+    if trajectory is not None and scene.kind == "gas":  # its format before its size: a bad name fails
+        from ..trajectory import check_format as check_frames  # the same on every machine, whatever is free
+        try:
+            check_frames(trajectory)
+        except ValueError as e:
+            raise SceneError(str(e)) from None
     # every output and the memory are checked before anything runs: a run must not be lost to
     # an unwritable report at its end (issue 17), nor overwrite its own inputs, nor fill the disk (issue 59)
     limit = output_limit(scene.source, max_output, scene.max_output)
