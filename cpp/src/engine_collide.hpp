@@ -547,12 +547,10 @@ void EngineImpl<Dim, Op>::check_conservation() {
 
 // ---- observation (revcol/engine/observe.hpp) ------------------------------------------------
 
-// A new observer from the state at the clock; built before the old one goes, so a bad
-// config changes nothing.
+// A new observer from the state at the clock (in a field: the velocities there); built
+// before the old one goes, so a bad config changes nothing.
 template <int Dim, PairOperator Op>
 void EngineImpl<Dim, Op>::observe(const ObserveConfig& c) {
-  require(!field_, "observe: a gas under gravity is not observed yet (its velocities change between events); "
-                   "take frames (positions, velocities) instead");
   std::array<bool, 3> walls{};
   for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
   auto o = std::make_unique<Observer>(c, Dim, positions(), velocities(), clock_, cfg_.box, walls, cfg_.diameter);

@@ -286,10 +286,20 @@ class EngineImpl final : public Simulation {
     for (std::size_t i = 0; i < cfg_.diameters.size(); ++i) r[i] = 0.5 * cfg_.diameters[i];
     return r;
   }
-  // A new or resumed observer learns the masses, then the species (by size, then mass).
+  // A new or resumed observer learns the masses, then the species (by size, then mass), then
+  // the field (one axis: Observer::set_field follows the parabolas).
   void describe_particles(Observer& o) const {
     if (!cfg_.masses.empty()) o.set_masses(cfg_.masses);
     if (!cfg_.diameters.empty() || !cfg_.masses.empty()) o.set_sizes(radii());
+    if (!field_) return;
+    int axis = -1;
+    for (int k = 0; k < Dim; ++k)
+      if (g_[k] != 0.0) {
+        require(axis < 0, "observe: a field along more than one axis is not observed (the observer follows a "
+                          "parabola along one axis); take frames (positions, velocities) instead");
+        axis = k;
+      }
+    o.set_field(axis, g_[static_cast<std::size_t>(axis)]);
   }
 
   // i's earliest event: a wall, its list renewal (in 1D on a ring: its wrap), or a

@@ -178,7 +178,9 @@ EngineImpl<Dim, Op>::EngineImpl(const Snapshot& s, Op op) : cfg_(s.config), n_(s
   if (!s.observer.empty()) {  // a running observation resumes (revcol/engine/observe.hpp)
     std::array<bool, 3> walls{};
     for (int k = 0; k < Dim; ++k) walls[k] = box_.walls(k);
-    observer_ = std::make_unique<Observer>(s.observer, s.observer_counts, Dim, s.v, clock_, cfg_.box, walls,
+    // (in a field the snapshot's velocities are at each particle's own time: the observer's
+    // segments are checked against those at the clock)
+    observer_ = std::make_unique<Observer>(s.observer, s.observer_counts, Dim, field_ ? velocities() : s.v, clock_, cfg_.box, walls,
                                            cfg_.diameter);
     describe_particles(*observer_);
     obs_ = observer_.get();

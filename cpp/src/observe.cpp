@@ -101,9 +101,10 @@ Observer::Observer(const ObserveConfig& c, int dim, const std::vector<double>& x
 }
 
 // The pair hook's fast path runs while t < fast_until_: the open block's end, or -inf
-// with pair distances or the collision record (every hook then takes pair_general).
+// with pair distances, the collision record or curved flights (a field: every hook then takes
+// pair_general).
 void Observer::set_fast_until() {
-  const bool extras = cfg_.pair_bins > 0 || cfg_.collision_record;
+  const bool extras = cfg_.pair_bins > 0 || cfg_.collision_record || curved_;
   fast_until_ = extras ? -std::numeric_limits<double>::infinity() : cur_.t0 + block_time_;
 }
 
@@ -332,12 +333,20 @@ void Observer::pair_general(double t, int a, int b, const double* va, const doub
   reach(t);
   close<Dim>(a, t);
   close<Dim>(b, t);
+  if (fax_ >= 0) [[unlikely]] {  // a field's running sums: the pair's terms out, in after (observe_field.cpp)
+    field_terms(a, -1.0);
+    field_terms(b, -1.0);
+  }
   if (cfg_.collision_record) [[unlikely]] record_pair(a, b, va, vb);
   virial<Dim>(a, b, va);
   close_pairs(a, t);
   close_pairs(b, t);
   set_velocity<Dim>(a, va);
   set_velocity<Dim>(b, vb);
+  if (fax_ >= 0) [[unlikely]] {
+    field_terms(a, 1.0);
+    field_terms(b, 1.0);
+  }
   ++cur_.pairs;
   cur_.parts += 2;
 }

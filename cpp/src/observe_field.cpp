@@ -33,24 +33,25 @@ namespace revcol::engine {
 // i's terms of the running sums at t_now_ (its segment closed there) in (sign 1) or out (-1).
 void Observer::field_terms(int i, double sign) {
   const Segment& s = seg_[i];
+  const double w = sign * mass_of(i);  // (1 x: the same bits for unit masses)
   double v2 = 0.0;
   for (int k = 0; k < 3; ++k) {
     v2 += s.v[k] * s.v[k];
-    fs_.m[k] += sign * s.v[k];
+    fs_.m[k] += w * s.v[k];
   }
-  fs_.a0 += sign * v2;
-  fs_.vv[0] += sign * s.v[0] * s.v[1];
-  fs_.vv[1] += sign * s.v[0] * s.v[2];
-  fs_.vv[2] += sign * s.v[1] * s.v[2];
+  fs_.a0 += w * v2;
+  fs_.vv[0] += w * s.v[0] * s.v[1];
+  fs_.vv[1] += w * s.v[0] * s.v[2];
+  fs_.vv[2] += w * s.v[1] * s.v[2];
   if (ns_ > 0) {
     double* q = &fsp_[2 * static_cast<std::size_t>(label_[i])];
-    q[0] += sign * v2;
-    q[1] += sign * s.v[fax_];
+    q[0] += w * v2;
+    q[1] += w * s.v[fax_];
   }
 }
 
 void Observer::accumulate_field(double h) {
-  const double g = g_, N = static_cast<double>(n_);
+  const double g = g_, N = fs_.total;  // sum m
   const int f = fax_;
   // sum v^2: a0 + 2 g m_f h' + g^2 N h'^2 over [0, h]
   cur_.k2 += h * (fs_.a0 + g * h * (fs_.m[f] + g * N * h / 3.0));
@@ -62,7 +63,7 @@ void Observer::accumulate_field(double h) {
   }
   for (int u = 0; u < ns_; ++u) {
     double* q = &fsp_[2 * static_cast<std::size_t>(u)];
-    const double Ns = static_cast<double>(sp_count_[static_cast<std::size_t>(u)]);
+    const double Ns = fs_.species_mass[static_cast<std::size_t>(u)];
     cur_.sp[2 * static_cast<std::size_t>(u)] += h * (q[0] + g * h * (q[1] + g * Ns * h / 3.0));
     q[0] += g * h * (2.0 * q[1] + g * Ns * h);
     q[1] += g * Ns * h;
@@ -83,7 +84,7 @@ void Observer::close_field(int i, double t) {
       if (k != f) p2 += s.v[k] * s.v[k];
     cur_.dist += quadratic_distance(s.v[f], -g_, p2, dt);
     if (cfg_.speed_bins > 0) speed_sheared(s.v[f], -g_, p2, dt);
-    if (cfg_.slabs > 0) slab_field(s, dt);
+    if (cfg_.slabs > 0) slab_field(s, mass_of(i), dt);
   }
   for (int k = 0; k < 3; ++k) s.x[k] += s.v[k] * dt;
   s.x[fax_] += 0.5 * g_ * dt * dt;
@@ -92,19 +93,19 @@ void Observer::close_field(int i, double t) {
   // the quantities set_velocity derives from the velocity, for the velocity now (a resumed
   // snapshot rebuilds them so: the same bits either way)
   const double v2 = s.v[0] * s.v[0] + s.v[1] * s.v[1] + s.v[2] * s.v[2];
-  s.v2 = v2;
+  s.v2 = mass_of(i) * v2;  // m v^2, as set_velocity; the speed is |v|
   s.speed = root(v2);
   s.bin = static_cast<int>(std::min(s.speed * bin_scale_, bin_cap_));
 }
 
-// The stretches of s's flight over [t0, t0 + dt] to the slabs: each cell it passes gets its time
-// and the integral of v^2 over it. z(h) = z0 + w h + a h^2 / 2 along the slab axis (a = g on the
+// The stretches of s's flight (mass m) over [t0, t0 + dt] to the slabs: each cell it passes gets
+// its time and the integral of m v^2 over it. z(h) = z0 + w h + a h^2 / 2 along the slab axis (a = g on the
 // field's axis, else 0), split at its turning point into monotone pieces.
-void Observer::slab_field(Segment& s, double dt) {
+void Observer::slab_field(Segment& s, double m, double dt) {
   const int ax = cfg_.slab_axis, ns = cfg_.slabs, f = fax_;
   const double z0 = s.x[ax], w = s.v[ax], a = ax == f ? g_ : 0.0, W = slab_w_;
   const double v2 = s.v[0] * s.v[0] + s.v[1] * s.v[1] + s.v[2] * s.v[2], vf = s.v[f], g = g_;
-  auto k2 = [&](double h) { return h * (v2 + g * h * (vf + g * h / 3.0)); };  // integral of v^2 over [0, h]
+  auto k2 = [&](double h) { return m * (h * (v2 + g * h * (vf + g * h / 3.0))); };  // integral of m v^2 over [0, h]
   auto z = [&](double h) { return z0 + h * (w + 0.5 * a * h); };
   double cell = std::nearbyint(s.lo / W);
   auto credit = [&](double h0, double h1) {
@@ -155,13 +156,19 @@ void Observer::slab_field(Segment& s, double dt) {
 void Observer::set_field(int axis, double g) {
   require(axis >= 0 && axis < dim_ && walls_[axis], "observe: a field lies along an axis with walls");
   require(std::isfinite(g) && g != 0.0, [&] { return "observe: the field must be finite and nonzero, got " + num(g); });
-  require(mass_.empty(), "observe: a field with unequal masses is not built");
   require(gamma_ == 0.0, "observe: shear with a field is not built");
   require(cfg_.pair_bins == 0, "observe: pair distances in a field are not built");
   fax_ = axis;
   g_ = g;
   curved_ = true;
+  set_fast_until();  // the float engine's pair hook takes pair_general (the flights are parabolas)
   fsp_.assign(2 * static_cast<std::size_t>(ns_), 0.0);
+  fs_.total = 0.0;
+  fs_.species_mass.assign(static_cast<std::size_t>(ns_), 0.0);
+  for (std::size_t i = 0; i < n_; ++i) {
+    fs_.total += mass_of(static_cast<int>(i));
+    if (ns_ > 0) fs_.species_mass[static_cast<std::size_t>(label_[i])] += mass_of(static_cast<int>(i));
+  }
   if (!resumed_) {
     require(blocks_.empty() && cur_.pairs == 0 && cur_.groups == 0 && cur_.walls == 0,
             "observe: set_field must come before the first event");

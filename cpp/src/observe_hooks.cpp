@@ -12,14 +12,18 @@ namespace revcol::engine {
 
 void Observer::group(double t, int n, const int* ids, const double* x, const double* v) {
   reach(t);
-  if (ns_ > 0) species_group_virial(n, ids, x, v);
-  for (int u = 0; u < n; ++u) {
+  for (int u = 0; u < n; ++u) {  // the members closed first: in a field their velocities move on to t
     const int i = ids[u];
-    group_virial(i, x + u * dim_, v + u * dim_);
     close<3>(i, t);
     close_pairs(i, t);
+    if (fax_ >= 0) [[unlikely]] field_terms(i, -1.0);
   }
-  for (int u = 0; u < n; ++u) set_velocity<0>(ids[u], v + u * dim_);
+  if (ns_ > 0) species_group_virial(n, ids, x, v);
+  for (int u = 0; u < n; ++u) group_virial(ids[u], x + u * dim_, v + u * dim_);
+  for (int u = 0; u < n; ++u) {
+    set_velocity<0>(ids[u], v + u * dim_);
+    if (fax_ >= 0) [[unlikely]] field_terms(ids[u], 1.0);
+  }
   ++cur_.groups;
   cur_.parts += static_cast<std::uint64_t>(n);
 }
@@ -56,6 +60,7 @@ void Observer::wall(double t, int i, const double* v) {
   reach(t);
   close<3>(i, t);
   close_pairs(i, t);
+  if (fax_ >= 0) [[unlikely]] field_terms(i, -1.0);
   const double r = radius_of(i), tol = 1e-6 * diameter_;
   for (int k = 0; k < dim_; ++k) {
     const double dv = mass_of(i) * (v[k] - seg_[i].v[k]), xk = seg_[i].x[k];  // Delta p
@@ -65,6 +70,7 @@ void Observer::wall(double t, int i, const double* v) {
     cur_.w_wall += xk * dv;
   }
   set_velocity<0>(i, v);
+  if (fax_ >= 0) [[unlikely]] field_terms(i, 1.0);
   ++cur_.walls;
 }
 

@@ -11,6 +11,7 @@
 namespace revcol::engine {
 
 void Observer::set_species(const std::vector<int>& label, const std::vector<double>& radius) {
+  require(fax_ < 0 && gamma_ == 0.0, "observe: set_species must come before set_field and set_shear");
   require((label.empty() || label.size() == n_) && radius.size() == n_, [&] {
     return "observe: species need a label and a radius per particle (" + std::to_string(n_) + "), got " +
            std::to_string(label.size()) + " and " + std::to_string(radius.size());
@@ -66,6 +67,7 @@ void Observer::set_masses(const std::vector<double>& mass) {
             [&] { return "observe: particle " + std::to_string(i) + "'s mass must be finite and > 0"; });
   require(resumed_ || (blocks_.empty() && cur_.parts == 0 && cur_.walls == 0 && t_now_ == t_start_ && ns_ == 0),
           "observe: set_masses must come before the first event and before set_species");
+  require(fax_ < 0 && gamma_ == 0.0, "observe: set_masses must come before set_field and set_shear");
   mass_ = mass;
   // each segment's m v^2; a fresh observation's running sums with the masses (a resumed one's
   // are its snapshot's)

@@ -394,7 +394,7 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
         raise _fail(source, "[output] trajectory", f"must end in .xyz (extended XYZ) or .gsd, got {trajectory.name!r}")
 
     observe = _observe(source, values, d, n, bounds, engine) if "observe" in common["extra"]["tables"] else None
-    gravity, shear = scene_field(source, get, d, bounds, engine, observe is not None, box, sigma)
+    gravity, shear = scene_field(source, get, d, bounds, engine, box, sigma)
     check_shear_observe(source, shear, observe)
 
     scene = Scene(

@@ -308,32 +308,28 @@ def check_gravity(source: str, gravity: Sequence[float] | None, d: int,
     return tuple(gravity)
 
 
-# what runs neither a field nor shear yet, in the words of each refusal: where the gas is, what the
-# parallel engine and the neighbour lists are not built for yet, and why there is no observer
+# what runs neither a field nor shear yet on the lattice engine, in the words of each refusal: where
+# the gas is, what the parallel engine and the neighbour lists are not built for yet (both engines
+# observe either: the observer follows parabolas and moving images)
 _UNBUILT = {
-    "gravity": ("in a field ([system] gravity)", "a field", "curved paths",
-                "the float engine's observer does not take one yet (its velocities change between events; "
-                "engine = 'lattice' observes a gas in a field)"),
-    "shear": ("under shear ([system] shear_rate)", "shear", "moving images", None),  # (observed: docs/shear.md)
+    "gravity": ("in a field ([system] gravity)", "a field", "curved paths"),
+    "shear": ("under shear ([system] shear_rate)", "shear", "moving images"),
 }
 
 
 def check_field_options(source: str, gravity: Sequence[float] | None, engine: str, *, workers: int = 1,
-                        search: str | float = "auto", observe: bool = False, names: dict | None = None,
+                        search: str | float = "auto", names: dict | None = None,
                         shear: float | None = None) -> None:
     """Refuses, naming the option, what runs no field (``gravity``) or no shear (``shear``, a rate;
-    None: none) yet: on the lattice engine more than one worker or neighbour lists (``search`` a
-    shell; ``"auto"`` takes the cell grid there), and in a field an observed run on the float
-    engine (``observe``: an ``[observe]`` table; the lattice's observer follows the parabolas; a
-    sheared gas is observed, its slabs along axis 1 only: check_shear_observe). ``names`` renames an option where it came from the command
-    line (``{"workers": "--workers"}``)."""
+    None: none) yet on the lattice engine: more than one worker or neighbour lists (``search`` a
+    shell; ``"auto"`` takes the cell grid there). (A sheared gas's slabs lie along axis 1 only:
+    check_shear_observe.) ``names`` renames an option where it came from the command line
+    (``{"workers": "--workers"}``)."""
     names = names or {}
     for kind, on in (("gravity", gravity is not None), ("shear", shear is not None)):
         if not on:
             continue
-        where, what, lists, observer = _UNBUILT[kind]
-        if observe and observer is not None and engine != "lattice":
-            raise _fail(source, "[observe]", f"is not available {where}: {observer}; take trajectory frames instead")
+        where, what, lists = _UNBUILT[kind]
         if engine != "lattice":
             continue
         if workers > 1:
@@ -396,24 +392,24 @@ def check_shear_observe(source: str, shear_rate: float | None, observe: dict | N
                     f"gas's slabs give its velocity profile across the gradient, got {observe.get('slab_axis', 0)}")
 
 
-def scene_field(source: str, get, d: int, bounds: Sequence[str], engine: str, observed: bool,
+def scene_field(source: str, get, d: int, bounds: Sequence[str], engine: str,
                 box: Sequence[float] = (), sigma: float = 1.0) -> tuple[tuple[float, ...] | None, float | None]:
     """A gas scene's field and shear rate (None: none) from its checked fields (``get(table, key,
     default)``), its ``d`` axes' ``bounds``, its ``box``, its (largest) diameter ``sigma`` and its
-    ``engine``, ``observed`` when it has an ``[observe]`` table: every check of both."""
+    ``engine``: every check of both."""
     shear = check_shear(source, get("system", "shear_rate"), engine, bounds, box, sigma, get("system", "gravity"))
     gravity = check_gravity(source, get("system", "gravity"), d, bounds)
     check_field_options(source, gravity, engine, workers=get("collisions", "workers", 1),
-                        search=get("collisions", "search", "auto"), observe=observed, shear=shear)
+                        search=get("collisions", "search", "auto"), shear=shear)
     return gravity, shear
 
 
 def observes_frames(scene, trajectory) -> bool:
     """Whether a run of ``scene`` writing ``trajectory`` observes (unreported, in its checkpoints) for the
-    image flags of a periodic box's frames: when its own ``[observe]`` does not already, nor a field or
-    shear forbids it (check_field_options: the flags are then inferred between frames)."""
+    image flags of a periodic box's frames: when its own ``[observe]`` does not already, nor shear
+    forbids it (the flags are then inferred between frames)."""
     return (trajectory is not None and scene.observe is None and not scene.shear_rate
-            and not (scene.gravity and scene.engine != "lattice") and "periodic" in scene.boundaries)
+            and "periodic" in scene.boundaries)
 
 
 def field_text(gravity: Iterable[float] | None) -> str:

@@ -47,6 +47,20 @@ inline int run_all() {
   std::printf("%zu passed, %d failed\n", cases().size() - failed_cases, failed_cases);
   return failed_cases == 0 ? 0 : 1;
 }
+
+/// True when f() throws an exception whose message contains `words` (another message, or none
+/// thrown, is printed).
+inline bool refused(const std::function<void()>& f, const std::string& words) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    if (std::string(e.what()).find(words) != std::string::npos) return true;
+    std::fprintf(stderr, "    unexpected message: %s\n", e.what());
+    return false;
+  }
+  std::fprintf(stderr, "    not refused (wanted '%s')\n", words.c_str());
+  return false;
+}
 }  // namespace check
 
 #define CHECK_CAT2(a, b) a##b

@@ -60,8 +60,6 @@ def test_the_key_is_parsed_and_shown():
     ({"system": {"gravity": [-1.0, 0.0]}}, "[system] gravity: points along axis 0, which is periodic: a field needs walls"),
     ({"system": {"gravity": [0.0, -1.0], "boundaries": "periodic"}}, "[system] gravity: points along axis 1, which is periodic"),
     ({"system": {"gravity": [0.5, -1.0], "boundaries": "wall"}}, "[system] gravity: must be nonzero along one axis at most"),
-    ({"observe": {"slabs": 4}}, "[observe]: is not available in a field ([system] gravity): the float engine's "
-                                "observer does not take one yet"),
 ])
 def test_bad_fields_are_refused_by_name(fields, needle):
     with pytest.raises(SceneError) as e:
@@ -83,8 +81,9 @@ def test_the_lattice_refuses_what_runs_no_field_at_load(fields, needle):
     assert scene("lattice", **no_field).gravity is None
 
 
-def test_the_lattice_observes_a_scene_in_a_field():
-    s = scene("lattice", observe={"slabs": 5, "slab_axis": 1}, run={"collisions": 4000})
+@pytest.mark.parametrize("engine", ["lattice", "float"])
+def test_either_engine_observes_a_scene_in_a_field(engine):
+    s = scene(engine, observe={"slabs": 5, "slab_axis": 1}, run={"collisions": 4000})
     sim = build_simulation(s)
     sim.observe(**s.observe)
     sim.run(collisions=4000)

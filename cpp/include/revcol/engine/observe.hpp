@@ -116,12 +116,13 @@
 // advection by the imposed profile. Cost without shear: one test (curved_) in accumulate and
 // close (the float engine's pair hook takes none of the sheared paths).
 //
-// A field (set_field; the lattice engine's gas under gravity; cpp/src/observe_field.cpp). Flights
+// A field (set_field; either engine's gas under gravity; cpp/src/observe_field.cpp). Flights
 // are parabolas along the field's axis; closing a segment moves its position and velocity on
 // along it, so each event's velocity change is taken from the velocity then; the kinetic sums
 // and the Helfand moment are polynomials between events, integrated exactly; slabs solve each
-// crossing from the quadratic (the column's profiles), speeds and distances likewise. Cost
-// without a field: the same test as shear's (curved_), and one in each *_at hook.
+// crossing from the quadratic (the column's profiles), speeds and distances likewise. The float
+// engine's pair hook then always takes pair_general. Cost without a field: the same test as
+// shear's (curved_), and one in each *_at hook and in pair_general, wall and group.
 //
 // The collision record (optional, ObserveConfig::collision_record; the randomness study's
 // gas streams, revcol/studies/randomness.hpp). Per pair collision, in order: the unit contact
@@ -295,9 +296,10 @@ class Observer {
   /// A uniform field: acceleration g (nonzero, finite) along `axis`, which has walls. Flights are
   /// then parabolas, x0 + v (t - t0) + g (t - t0)^2 / 2 along the axis: the kinetic sums, the
   /// Helfand moment, speeds, distances, slabs and the MSD follow them exactly
-  /// (observe_field.cpp). An engine of *_at hooks calls it as set_shear (a fresh observation
-  /// before any event; a resumed one checks its snapshot's field). Throws InvalidArgument on a
-  /// bad axis or value, unequal masses, pair distances, or a snapshot of another field.
+  /// (observe_field.cpp), weighted by the masses (set_masses and set_sizes come first). An
+  /// engine calls it as set_shear (a fresh observation before any event; a resumed one checks
+  /// its snapshot's field). Throws InvalidArgument on a bad axis or value, pair distances, or a
+  /// snapshot of another field.
   void set_field(int axis, double g);
   /// The field a resumed snapshot was taken in: its axis (-1: none, or not resumed).
   int saved_field_axis() const { return field_saved_.empty() ? -1 : static_cast<int>(field_saved_[1]); }
@@ -440,12 +442,15 @@ class Observer {
   void wall_sheared(double t, int i, const double* x, const double* v, unsigned axes);
   void save_shear(std::vector<double>& reals) const;
 
-  // --- a field (set_field; observe_field.cpp). At t_now_, mass 1: a0 = sum v^2, m[k] = sum v_k,
-  // vv[c] = sum v_a v_b (the Helfand pairs); per species its sum v^2 and sum v_f. Between events
-  // v_f grows at g, so their integrals are polynomials in the time.
+  // --- a field (set_field; observe_field.cpp). At t_now_: a0 = sum m v^2, m[k] = sum m v_k,
+  // vv[c] = sum m v_a v_b (the Helfand pairs); per species its sum m v^2 and sum m v_f. Between
+  // events v_f grows at g, so their integrals are polynomials in the time, whose rates hold the
+  // masses: sum m (total), and per species (species_mass).
   struct FieldSums {
     double a0 = 0.0;
     std::array<double, 3> m{}, vv{};
+    double total = 0.0;                // sum m (set_field; not saved: the masses give it)
+    std::vector<double> species_mass;  // per species sum m
   };
   int fax_ = -1;      // the field's axis (-1: none)
   double g_ = 0.0;    // its acceleration
@@ -455,7 +460,7 @@ class Observer {
   void field_terms(int i, double sign);
   void accumulate_field(double dt);
   void close_field(int i, double t);
-  void slab_field(Segment& s, double dt);
+  void slab_field(Segment& s, double m, double dt);
   void save_field(std::vector<double>& reals) const;
 
   // --- the collision record (see the header comment) ---
