@@ -173,13 +173,17 @@ void Observer::slab_cross(Segment& s, double t, double end) {
   set_cell(s, std::floor(end / slab_w_));
 }
 
-// Pair (i, j) from t0 to t1: the time |r| spends in each distance bin, exactly.
+// Pair (i, j) from t0 to t1: the time |r| spends in each distance bin, exactly. In a field the
+// two fall alike, so r is still linear in the time: its rate is the difference of the velocities
+// at one instant (a segment's velocity is the one at its own start).
 void Observer::pair_interval(int i, int j, double t0, double t1) {
   const double span = t1 - t0;
   if (!(span > 0.0)) return;
   double a = 0.0, b = 0.0, c = 0.0;
   for (int k = 0; k < dim_; ++k) {
-    const double r = pos(i, k, t0) - pos(j, k, t0), w = seg_[i].v[k] - seg_[j].v[k];
+    const double r = pos(i, k, t0) - pos(j, k, t0);
+    double w = seg_[i].v[k] - seg_[j].v[k];
+    if (k == fax_) [[unlikely]] w -= g_ * (seg_[i].t0 - seg_[j].t0);
     a += w * w;
     b += r * w;
     c += r * r;

@@ -157,7 +157,6 @@ void Observer::set_field(int axis, double g) {
   require(axis >= 0 && axis < dim_ && walls_[axis], "observe: a field lies along an axis with walls");
   require(std::isfinite(g) && g != 0.0, [&] { return "observe: the field must be finite and nonzero, got " + num(g); });
   require(gamma_ == 0.0, "observe: shear with a field is not built");
-  require(cfg_.pair_bins == 0, "observe: pair distances in a field are not built");
   fax_ = axis;
   g_ = g;
   curved_ = true;

@@ -121,7 +121,7 @@ TEST_CASE("a wall reflection in a field, and a snapshot resumed to the same bits
   CHECK_THROWS_AS(Observer(reals, counts, 2, wrong, 2.2, {kL, kL, 1.0}, {true, true, false}, 1.0), InvalidArgument);
 }
 
-TEST_CASE("field refusals: a periodic axis, a bad value, after an event, with pair distances") {
+TEST_CASE("field refusals: a periodic axis, a bad value, after an event; masses and sizes after it") {
   const std::vector<double> x{1.0, 1.0, 5.0, 5.0}, v{0.3, 0.1, -0.3, -0.1};
   Observer periodic(ObserveConfig{}, 2, x, v, 0.0, {kL, kL, 1.0}, {true, false, false}, 1.0);
   CHECK_THROWS_AS(periodic.set_field(1, kG), InvalidArgument);
@@ -134,11 +134,14 @@ TEST_CASE("field refusals: a periodic axis, a bad value, after an event, with pa
   const double xa[2] = {1.3, 1.1}, xb[2] = {4.7, 4.9};
   late.pair_at(1.0, 0, 1, xa, xb, v.data(), v.data() + 2);
   CHECK_THROWS_AS(late.set_field(1, kG), InvalidArgument);
-  ObserveConfig pc;
+  ObserveConfig pc;  // pair distances take a field (test_float_field_observe.cpp has a worked pair)
   pc.pair_bins = 10;
   pc.pair_rmax = 5.0;
   Observer pairs(pc, 2, x, v, 0.0, {kL, kL, 1.0}, {true, true, false}, 1.0);
-  CHECK_THROWS_AS(pairs.set_field(1, kG), InvalidArgument);
+  pairs.set_field(1, kG);
+  // the field's running sums are weighted by the masses and kept per species: both come first
+  CHECK_THROWS_AS(pairs.set_masses({1.0, 2.0}), InvalidArgument);
+  CHECK_THROWS_AS(pairs.set_sizes({0.5, 0.3}), InvalidArgument);
 }
 
 CHECK_MAIN()

@@ -114,6 +114,25 @@ def test_the_observed_column_its_walls_and_a_checkpoint(dim, tmp_path):
     assert np.sum(o.slab_density.value) * np.prod(s.box) / 8 == pytest.approx(300, rel=1e-12)
 
 
+@pytest.mark.parametrize("engine", ["lattice", "float"])
+def test_pair_distances_of_a_small_column(engine):
+    """Pair distances in a field (2 to 64 particles, walls all round): a density over [0, rmax]
+    that integrates to 1 and is 0 below the contact distance (the separation of two particles,
+    both falling, is a line between events; the exact worked case is
+    tests/cpp/test_float_field_observe.cpp)."""
+    kw = dict(boundary="wall", gravity=[0.0, -0.5], seed=5)
+    s = (LatticeSimulation.random(40, phi=0.2, **kw) if engine == "lattice"
+         else revcol.Simulation.random(40, 2, 0.2, **kw))
+    s.run(collisions=500)
+    s.observe(pair_bins=100, pair_rmax=float(np.hypot(*s.box)))
+    s.run(collisions=4000)
+    o = s.observation()
+    h = o.pair_distance.edges[1] - o.pair_distance.edges[0]
+    assert np.sum(o.pair_distance.value) * h == pytest.approx(1.0, rel=1e-9)
+    below = np.asarray(o.pair_distance.edges[1:]) < 0.999  # bins wholly inside a contact
+    assert below.sum() >= 1 and np.all(np.asarray(o.pair_distance.value)[below] == 0.0)
+
+
 def test_what_a_field_refuses():
     with pytest.raises(ValueError, match="walled axis"):
         LatticeSimulation.random(100, phi=0.2, boundary="periodic", gravity=[0.0, -1.0])

@@ -298,8 +298,9 @@ class Observer {
   /// Helfand moment, speeds, distances, slabs and the MSD follow them exactly
   /// (observe_field.cpp), weighted by the masses (set_masses and set_sizes come first). An
   /// engine calls it as set_shear (a fresh observation before any event; a resumed one checks
-  /// its snapshot's field). Throws InvalidArgument on a bad axis or value, pair distances, or a
-  /// snapshot of another field.
+  /// its snapshot's field). Pair distances follow each pair's separation, which stays a line
+  /// (both fall alike). Throws InvalidArgument on a bad axis or value, or a snapshot of another
+  /// field.
   void set_field(int axis, double g);
   /// The field a resumed snapshot was taken in: its axis (-1: none, or not resumed).
   int saved_field_axis() const { return field_saved_.empty() ? -1 : static_cast<int>(field_saved_[1]); }
