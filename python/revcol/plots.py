@@ -192,8 +192,8 @@ def _energy_figure(r: dict, out: Path, plt, title: str, fmt: str, exact: bool) -
 def _snapshots_figure(r: dict, out: Path, plt, title: str, start, turn, end, fmt: str) -> str:
     d, box = r["dimension"], np.asarray(r["box"], float)
     periodic = list(r.get("periodic", [False] * d))
-    species = r["scene"].get("species") or []  # a mixture: (name, diameter, count), ids in blocks
-    sigma = np.concatenate([np.full(int(c), float(s)) for _, s, c in species]) if species else r["scene"]["diameter"]
+    species = r["scene"].get("species") or []  # a mixture: (name, diameter, count, mass), ids in blocks
+    sigma = np.concatenate([np.full(int(sp[2]), float(sp[1])) for sp in species]) if species else r["scene"]["diameter"]
     shots = [("start", *start), (f"after {r['collisions_forward']:,} collisions forward", *turn),
              ("after reversal", *end)]
     vmax = max(float(np.max(np.linalg.norm(np.asarray(v, float).reshape(len(v), -1), axis=1), initial=0.0))
