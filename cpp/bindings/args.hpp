@@ -25,6 +25,7 @@
 
 #include "revcol/error.hpp"
 #include "revcol/interrupt.hpp"
+#include "revcol/interrupt.hpp"
 
 namespace revcol::bind {
 
@@ -214,6 +215,12 @@ inline bool& stop_requested() {
 /// exception pending, the run stops at a valid point and the caller raises it; or once a
 /// counted Ctrl-C asked runs to stop, the run stops there and returns as at its end.
 inline bool poll_signals() { return PyErr_CheckSignals() == 0 && !stop_requested(); }
+
+/// An interrupt check (revcol/interrupt.hpp) for a loop that holds the GIL (a relaxed random
+/// start): stop once Ctrl-C left a KeyboardInterrupt pending (the translator raises it).
+inline InterruptCheck held_signal_check() {
+  return [] { return PyErr_CheckSignals() != 0; };
+}
 
 /// A study's interrupt check (revcol/interrupt.hpp) for a loop that runs with the GIL
 /// released: takes the GIL and says stop once Ctrl-C left a KeyboardInterrupt pending (the

@@ -451,7 +451,7 @@ void register_engine(py::module_& m) {
         c.diameter = diameter;
         c.diameters = std::move(diameters);  // a mixture: random_state sets diameter to the largest
         c.masses = std::move(masses);        // velocities / sqrt(m), the centre of mass at rest
-        const en::InitialState s = en::random_state(c, n, phi, seed, energy, init, equal_speeds);
+        const en::InitialState s = en::random_state(c, n, phi, seed, energy, init, equal_speeds, held_signal_check());
         return py::make_tuple(to_array(s.x, n, dim), to_array(s.v, n, dim),
                               std::vector<double>(s.config.box.begin(), s.config.box.begin() + dim));
       },

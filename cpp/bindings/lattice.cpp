@@ -105,7 +105,7 @@ py::dict random_start_d(PyInt n_arg, PyReal phi_arg, std::vector<std::string> bo
   c.diameters = std::move(diameters);
   set_gravity(c, gravity);
   c.shear_rate = to_real(shear_rate_arg, "shear_rate");
-  return start_dict(la::random_start(c, n, phi, seed, init));
+  return start_dict(la::random_start(c, n, phi, seed, init, held_signal_check()));
 }
 
 // lattice_quantize (2D) and lattice3d_quantize

@@ -13,6 +13,7 @@
 #include "revcol/engine/limits.hpp"
 #include "revcol/error.hpp"
 #include "revcol/rng/philox.hpp"
+#include "init_relax.hpp"
 
 namespace revcol::engine {
 namespace {
@@ -322,6 +323,51 @@ InitialState start_in_box(const Config& c, std::size_t n, std::uint64_t seed, do
   return s;
 }
 
+// The relaxed start in c's box (validated by the caller): centres uniform in their ranges at
+// their own diameters (c.diameters, or c.diameter for every particle), the overlaps relaxed
+// away (init_relax.hpp), velocities as start_in_box's.
+InitialState relax_in_box(const Config& c, std::size_t n, std::uint64_t seed, double energy, bool equal_speeds,
+                          const InterruptCheck& interrupt) {
+  const int d = c.dim;
+  const std::vector<double> diam = c.diameters.empty() ? std::vector<double>(n, c.diameter) : c.diameters;
+  double vol = 1.0, own = 0.0;
+  for (int k = 0; k < d; ++k) vol *= c.box[k];
+  for (const double q : diam) own += limits::particle_volume(d, q);
+  const double phi = own / vol;
+  require(phi <= limits::max_relax_fraction(d), [&] {
+    return "packing fraction " + num(phi) + " is above what a relaxed random start reaches (" +
+           num(limits::max_relax_fraction(d)) + " in " + std::to_string(d) + "D)";
+  });
+  detail::RelaxBox box;
+  box.d = d;
+  for (int k = 0; k < d; ++k) {  // (the caller checked the largest diameter against the walls)
+    box.L[k] = c.box[k];
+    box.wall[k] = has_walls(c.boundary[k]);
+  }
+  InitialState s;
+  s.x.assign(n * d, 0.0);
+  s.v.assign(n * d, 0.0);
+  Draws pos(0xFFFFFF00u, seed);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < d; ++k) {
+      const double m = box.wall[k] ? 0.5 * diam[i] * (1.0 + limits::kWallMargin) : 0.0;
+      double p = m + (c.box[k] - 2.0 * m) * pos.u();
+      if (!box.wall[k] && p >= c.box[k]) p = 0.0;
+      s.x[i * d + k] = p;
+    }
+  const detail::RelaxResult r = detail::relax_overlaps(box, diam, s.x, limits::kRelaxSteps, interrupt);
+  if (!r.done)
+    throw InvalidArgument("the overlaps of a random placement did not relax away in " + std::to_string(r.steps) +
+                          " steps at packing fraction " + num(phi) + " (the largest left: " + num(r.overlap) +
+                          " of a contact distance): it is at or near this gas's jamming (random packings of "
+                          "equal spheres jam near 0.64, of a 1:1 mixture of size ratio 1.4 near 0.65 in 3D and "
+                          "0.84 in 2D); make the packing fraction lower");
+  draw_velocities(d, n, seed, energy, equal_speeds, s.v);
+  weigh_velocities(c, n, energy, s.v);
+  s.config = c;
+  return s;
+}
+
 void check_energy(double energy) {
   // 0 asks for the default (kT = 1); NaN or a negative energy was taken as the default silently (issue 17)
   require(std::isfinite(energy) && energy >= 0.0,
@@ -344,7 +390,8 @@ Placement parse_placement(const std::string& s) {
   if (s == "rsa") return Placement::rsa;
   // "lattice" is the crystal's old name, still read ("lattice" names the integer engine now)
   if (s == "crystal" || s == "lattice") return Placement::crystal;
-  throw InvalidArgument("init must be 'auto', 'rsa' or 'crystal', got '" + s + "'");
+  if (s == "relax") return Placement::relax;
+  throw InvalidArgument("init must be 'auto', 'rsa', 'crystal' or 'relax', got '" + s + "'");
 }
 
 double particle_volume(int d, double D) { return limits::particle_volume(d, D); }
@@ -355,8 +402,18 @@ double box_fraction(const Config& c, std::size_t n) {
   return static_cast<double>(n) * limits::particle_volume(c.dim, c.diameter) / vol;
 }
 
-InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, double energy,
-                          const std::string& init, bool equal_speeds) {
+InitialState random_start(const Config& config, std::size_t n, std::uint64_t seed, double energy,
+                          const std::string& init, bool equal_speeds, const InterruptCheck& interrupt) {
+  Config c = config;
+  const bool mixed = !c.diameters.empty();
+  if (mixed) {  // each particle's own diameter; the checks below take the largest
+    require(c.diameters.size() == n, [&] {
+      return "diameters must have one entry per particle (" + std::to_string(n) + "), got " +
+             std::to_string(c.diameters.size());
+    });
+    for (const double q : c.diameters) require(std::isfinite(q) && q > 0.0, "every diameter must be finite and > 0");
+    c.diameter = *std::max_element(c.diameters.begin(), c.diameters.end());
+  }
   check_common(c, n, seed);
   check_energy(energy);
   const Placement how = parse_placement(init);
@@ -374,15 +431,25 @@ InitialState random_start(const Config& c, std::size_t n, std::uint64_t seed, do
       require(limits::periodic_axis_fits(L, D), "periodic box too small for the neighbour lists: " + axis +
                                                     " < 3 diameters");
   }
+  if (how == Placement::relax) return relax_in_box(c, n, seed, energy, equal_speeds, interrupt);
+  // a mixture's automatic start: as spheres of the largest diameter (rsa or crystal) when they
+  // fit, else relaxed at the particles' own diameters (so every start that fitted is unchanged)
+  const bool or_relax = mixed && how == Placement::automatic;
   const double phi = box_fraction(c, n);
-  require(phi <= limits::max_fraction(d), [&] {
-    return std::to_string(n) + " particles of diameter " + num(D) +
-           " do not fit in this box: packing fraction " + num(phi) +
-           " above what the initialiser reaches (" + num(limits::max_fraction(d)) + " in " +
-           std::to_string(d) + "D)";
-  });
+  if (phi > limits::max_fraction(d)) {
+    if (or_relax) return relax_in_box(c, n, seed, energy, equal_speeds, interrupt);
+    throw InvalidArgument(std::to_string(n) + " particles of diameter " + num(D) +
+                          " do not fit in this box: packing fraction " + num(phi) +
+                          " above what the initialiser reaches (" + num(limits::max_fraction(d)) + " in " +
+                          std::to_string(d) + "D; init='relax' places them at random, overlaps relaxed away)");
+  }
   const bool rsa = how == Placement::rsa || (how == Placement::automatic && phi <= limits::rsa_fraction(d));
-  return start_in_box(c, n, seed, energy, rsa, how == Placement::automatic, equal_speeds);
+  if (!or_relax) return start_in_box(c, n, seed, energy, rsa, how == Placement::automatic, equal_speeds);
+  try {
+    return start_in_box(c, n, seed, energy, rsa, true, equal_speeds);
+  } catch (const InvalidArgument&) {
+    return relax_in_box(c, n, seed, energy, equal_speeds, interrupt);
+  }
 }
 
 namespace {
@@ -390,7 +457,7 @@ namespace {
 // A mixture's start (random_state with diameters): the cube of the particles' own volumes at
 // phi, placed as spheres of the largest diameter.
 InitialState mixture_state(Config c, std::size_t n, double phi, std::uint64_t seed, double energy,
-                           const std::string& init, bool equal_speeds) {
+                           const std::string& init, bool equal_speeds, const InterruptCheck& interrupt) {
   require(c.diameters.size() == n, [&] {
     return "diameters must have one entry per particle (" + std::to_string(n) + "), got " +
            std::to_string(c.diameters.size());
@@ -410,8 +477,10 @@ InitialState mixture_state(Config c, std::size_t n, double phi, std::uint64_t se
   });
   for (int k = 0; k < 3; ++k) c.box[k] = k < c.dim ? L : 1.0;
   try {
-    return random_start(c, n, seed, energy, init, equal_speeds);
+    return random_start(c, n, seed, energy, init, equal_speeds, interrupt);
   } catch (const InvalidArgument& e) {
+    const Placement how = parse_placement(init);  // (a bad name is thrown from here, as it is)
+    if (how == Placement::automatic || how == Placement::relax) throw;  // each names its own problem
     const double as_largest = static_cast<double>(n) * limits::particle_volume(c.dim, dmax) / vol * phi;
     throw InvalidArgument("a mixture's random start places every particle as one of the largest (diameter " +
                           num(dmax) + "), which at packing fraction " + num(phi) + " would fill " + num(as_largest) +
@@ -422,10 +491,10 @@ InitialState mixture_state(Config c, std::size_t n, double phi, std::uint64_t se
 }  // namespace
 
 InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t seed, double energy,
-                          const std::string& init, bool equal_speeds) {
+                          const std::string& init, bool equal_speeds, const InterruptCheck& interrupt) {
   if (!c.diameters.empty()) {
     check_common(c, n, seed);
-    return mixture_state(std::move(c), n, phi, seed, energy, init, equal_speeds);
+    return mixture_state(std::move(c), n, phi, seed, energy, init, equal_speeds, interrupt);
   }
   check_common(c, n, seed);
   check_energy(energy);
@@ -443,6 +512,7 @@ InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t see
            "): choose a diameter between 1e-100 and 1e100";
   });
   for (int k = 0; k < 3; ++k) c.box[k] = k < d ? L : 1.0;
+  if (how == Placement::relax) return relax_in_box(c, n, seed, energy, equal_speeds, interrupt);
   // "auto" decides on the phi asked for, not on the cube's (which differs in the last bits)
   const bool rsa = how == Placement::rsa || (how == Placement::automatic && phi <= limits::rsa_fraction(d));
   return start_in_box(c, n, seed, energy, rsa, how == Placement::automatic, equal_speeds);

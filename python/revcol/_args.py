@@ -78,8 +78,9 @@ def real_array(a, name: str) -> np.ndarray:
 
 
 def placement(init, stacklevel: int = 3) -> str:
-    """A random start's placement, ``init``: ``"auto"``, ``"rsa"`` (random sequential addition)
-    or ``"crystal"`` (a jittered crystal: square in 1D/2D, face-centred cubic in 3D). The old
+    """A random start's placement, ``init``: ``"auto"``, ``"rsa"`` (random sequential addition),
+    ``"crystal"`` (a jittered crystal: square in 1D/2D, face-centred cubic in 3D) or ``"relax"``
+    (uniform at random, the overlaps then relaxed away: dense amorphous starts). The old
     name ``"lattice"`` (the word names the integer engine now) gives ``"crystal"`` with a
     DeprecationWarning; any other name is passed on for the engine to refuse by name."""
     init = name(init, "init")

@@ -121,8 +121,11 @@ class Simulation(SimulationBase):
                packing_fraction: Optional[float] = None, **kwargs) -> "Simulation":
         """n particles at packing fraction ``phi`` (or ``packing_fraction=``, the scenes' name;
         default 0.3) in a cubic box: ``init`` ``"rsa"``, random sequential addition, or
-        ``"crystal"``, a jittered crystal (square in 1D/2D, face-centred cubic in 3D); ``"auto"``
-        picks (the old name ``"lattice"`` still works, with a DeprecationWarning); Gaussian
+        ``"crystal"``, a jittered crystal (square in 1D/2D, face-centred cubic in 3D), or
+        ``"relax"``, uniform at random with the overlaps then relaxed away (FIRE on a harmonic
+        overlap energy; dense amorphous starts, mixtures up to near jamming); ``"auto"`` picks (a
+        mixture: as spheres of its largest size when they fit, else relaxed; the old name
+        ``"lattice"`` still works, with a DeprecationWarning); Gaussian
         velocities with zero momentum scaled to kinetic ``energy`` (default n d / 2, kT = 1), or
         all of one speed (``equal_speeds``). Other keywords go to the constructor (mode, law, ...);
         the same ``seed`` keys the collision streams. ``engine="lattice"``: the lattice engine's

@@ -54,16 +54,17 @@ def build_simulation(scene: Scene, seed: int | None = None) -> Simulation:
     if scene.initial_state is not None:
         x, v = read_initial(scene.source, scene.initial_state, scene.dimension)
         return _engine(scene, "[system] initial_state", lambda: Simulation(x, v, scene.box, **opts))
-    init = {"auto": "auto", "random": "rsa", "crystal": "crystal"}[scene.start]
+    init = {"auto": "auto", "random": "rsa", "crystal": "crystal", "relax": "relax"}[scene.start]
     if scene.packing_fraction is not None:  # the engine's cube for that fraction (random_state)
         return _engine(scene, "[system] packing_fraction", lambda: Simulation.random(
             scene.particles, scene.dimension, scene.packing_fraction, init=init,
             energy=scene.kinetic_energy, **opts))
 
-    def make() -> Simulation:  # the engine's start in the scene's box (random_start; a mixture's as its largest)
+    def make() -> Simulation:  # the engine's start in the scene's box (random_start; a mixture's as its largest,
+        # else relaxed at its own sizes)
         x, v = _core.engine_random_start(scene.particles, list(scene.box), opts["boundary"], scene.diameter,
                                          opts["seed"], scene.kinetic_energy or 0.0, init, False,
-                                         list(opts.get("masses", [])))
+                                         list(opts.get("masses", [])), list(opts.get("diameters", [])))
         return Simulation(x, v, scene.box, **opts)
     return _engine(scene, "[system] box", make)
 

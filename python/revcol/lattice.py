@@ -155,15 +155,17 @@ class LatticeSimulation(SimulationBase):
                diameters=None, gravity=None, shear_rate=None) -> "LatticeSimulation":
         """n disks (spheres for LatticeSimulation3D) at area (volume) fraction ``phi`` (or
         ``packing_fraction=``; default 0.3) in a square (cubic) box (the float engine's
-        ``random_state``: ``init`` ``"rsa"``, random sequential addition, or ``"crystal"``, a
-        jittered crystal, square in 2D and face-centred cubic in 3D; ``"auto"`` picks; the old
+        ``random_state``: ``init`` ``"rsa"``, random sequential addition, ``"crystal"``, a
+        jittered crystal, square in 2D and face-centred cubic in 3D, or ``"relax"``, uniform with
+        the overlaps relaxed away; ``"auto"`` picks; the old
         name ``"lattice"`` still works, with a DeprecationWarning; Gaussian velocities with zero
         momentum, kT = 1), quantized once. The same ``seed`` keys the streams. ``dim`` (default:
         the class's, 2 or 3) must be the class's; the other keywords (``mode``, ``law``, ...) as
         the constructor's. ``diameters`` (one per particle): a mixture at packing fraction
-        ``phi`` (the particles' own volumes), placed as spheres of the largest diameter (so a
-        mixture's ``phi`` is bounded by the crystal of the largest: about 0.74 of its volume
-        fraction in a periodic cube, less in walls). ``gravity``: a uniform field, as the
+        ``phi`` (the particles' own volumes), placed as spheres of the largest diameter when they
+        fit so, else (``"auto"``, or ``"relax"`` always) at random at their own sizes with the
+        overlaps relaxed away, up to near the mixture's jamming (a 1:1 mixture of size ratio 1.4:
+        about 0.84 in 2D, 0.64 in 3D). ``gravity``: a uniform field, as the
         constructor's (the particles placed uniformly, then left to fall). ``shear_rate``:
         Lees-Edwards shear, as the constructor's, the velocities along axis 0 given the steady
         profile ``shear_rate * (y - mean(y))`` (no momentum added)."""

@@ -74,7 +74,7 @@ def build_lattice(scene: Scene, seed: int | None = None) -> LatticeSimulation:
     opts = lattice_options(scene)
     if seed is not None:
         opts["seed"] = int(seed)
-    init = {"auto": "auto", "random": "rsa", "crystal": "crystal"}[scene.start]
+    init = {"auto": "auto", "random": "rsa", "crystal": "crystal", "relax": "relax"}[scene.start]
     cls = LatticeSimulation3D if scene.dimension == 3 else LatticeSimulation
     if scene.initial_state is not None:
         x, v = read_initial(scene.source, scene.initial_state, scene.dimension)
@@ -85,7 +85,8 @@ def build_lattice(scene: Scene, seed: int | None = None) -> LatticeSimulation:
 
     def make() -> LatticeSimulation:  # the float engine's start in the scene's box, quantized
         x, v = _core.engine_random_start(scene.particles, list(scene.box), list(scene.boundaries), scene.diameter,
-                                         opts["seed"], scene.kinetic_energy or 0.0, init, False)
+                                         opts["seed"], scene.kinetic_energy or 0.0, init, False,
+                                         diameters=list(opts.get("diameters", [])))
         if scene.shear_rate:  # the steady profile, centred (no momentum added), as random()'s
             x, v = np.asarray(x, dtype=float), np.array(v, dtype=float)
             v[:, 0] += scene.shear_rate * (x[:, 1] - x[:, 1].mean())

@@ -43,8 +43,10 @@ file and the replacement.
     packing_fraction = 0.3        # sets a cubic box; or give box = [Lx, Ly]
     boundaries = "wall"           # "wall" | "periodic" | "bounce" (float engine), or one per axis ("walls": deprecated)
     start = "auto"                # "auto" | "random" (sequential addition) | "crystal" (jittered:
-                                  # square in 2D, face-centred cubic in 3D; "lattice": deprecated);
-                                  # auto: random up to the engine's rsa_fraction, else crystal
+                                  # square in 2D, face-centred cubic in 3D; "lattice": deprecated)
+                                  # | "relax" (at random, the overlaps relaxed away: dense, amorphous);
+                                  # auto: random up to the engine's rsa_fraction, else crystal; a
+                                  # mixture as its largest size, else relaxed
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
     gravity = [0.0, -1.0]         # a uniform field, one component per axis, along one walled axis (default none)
@@ -337,10 +339,12 @@ def _gas(source, get, values, base, common, mode, law, out, species_doc=None) ->
         raise _fail(source, "[system] packing_fraction", "give either box or packing_fraction, not both")
     if box is None and phi is None:
         raise _fail(source, "[system] box", "give box = [lengths] or packing_fraction")
-    if phi is not None:
-        top = LIMITS["max_fraction"][d]
+    if phi is not None:  # a mixture, or a relaxed start, may go past the crystal's limit
+        relaxed = bool(species) or get("system", "start", "auto") == "relax"
+        top = LIMITS["max_relax_fraction" if relaxed else "max_fraction"][d]
         if phi > top:
-            raise _fail(source, "[system] packing_fraction", f"must be at most {top} in {d}D, got {phi}")
+            raise _fail(source, "[system] packing_fraction", f"must be at most {top} in {d}D"
+                        f"{' for a relaxed start' if relaxed else ''}, got {phi}")
         vol = species_volume(species, d) if species else n * _core.engine_particle_volume(d, sigma)
         side = (vol / phi) ** (1.0 / d)
         box = (side,) * d

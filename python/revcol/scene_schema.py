@@ -56,7 +56,7 @@ SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "packing_fraction": ("float", (0.0, None)),
         "box": ("floats", (0.0, None)),
         "boundaries": ("strs", tuple(LIMITS["boundaries"])),
-        "start": ("str", ("auto", "random", "crystal")),
+        "start": ("str", ("auto", "random", "crystal", "relax")),
         "kinetic_energy": ("float", (0.0, None)),
         "initial_state": ("str", None),
         "gravity": ("vector", None),  # a uniform field, one component per axis (scene_field)

@@ -158,7 +158,7 @@ TEST_CASE("parse_placement: \"crystal\", and \"lattice\" its old name for the sa
   CHECK(a.x == b.x);
   CHECK(a.v == b.v);
   const std::string e = error_of([&] { parse_placement("grid"); });
-  CHECK(e.find("'auto', 'rsa' or 'crystal'") != std::string::npos);
+  CHECK(e.find("'auto', 'rsa', 'crystal' or 'relax'") != std::string::npos);
 }
 
 TEST_CASE("random_state is random_start in the cube of its packing fraction") {

@@ -292,7 +292,9 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
                  "boundary": [boundary] * (DIM - 1) + ["wall" if boundary == "periodic" else boundary]}
     if shear:  # Lees-Edwards: x and y periodic (3D: z as asked)
         field = {"boundary": ["periodic", "periodic"] + [boundary] * (DIM - 2)}
-    sim = LatticeSimulation.random(n=n, phi=phi, boundary=field.get("boundary", boundary), seed=seed, init=_init_for(phi),
+    # a mixture's "auto": as the largest on a crystal where that fits (the crystal's bits), else relaxed
+    init = _init_for(phi) if sizes == "one" else "auto"
+    sim = LatticeSimulation.random(n=n, phi=phi, boundary=field.get("boundary", boundary), seed=seed, init=init,
                                    law=law, tick_bits=tick_bits or None, cell_bits=cell_bits, mode=mode,
                                    diameters=sizes_of(sizes, n, seed), gravity=field.get("gravity"),
                                    shear_rate=shear or None)

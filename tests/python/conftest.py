@@ -1,4 +1,8 @@
 import os
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pytest
@@ -34,3 +38,30 @@ def run_cli(folder, args, capsys):
     finally:
         os.chdir(cwd)
     return rc, capsys.readouterr().err.strip().splitlines()
+
+
+def interrupt_child(tmp_path, code, args, ready_s=120, after_s=0.3, wait_s=60):
+    """Runs `code` in a child, sends SIGINT `after_s` after it prints "ready"; returns (rc, output)
+    (the Ctrl-C tests: ``from conftest import interrupt_child``)."""
+    script = tmp_path / "child.py"
+    script.write_text(code)
+    out = tmp_path / "out.txt"
+    with open(out, "w") as f:
+        # SIGINT at its default in the child, whatever this process inherited: a shell's
+        # background job (`cmd &`) starts with SIGINT ignored, and a Python started that way
+        # keeps ignoring it instead of raising KeyboardInterrupt
+        child = subprocess.Popen([sys.executable, str(script), *args], stdout=f, stderr=subprocess.STDOUT,
+                                 env=dict(os.environ), preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        deadline = time.monotonic() + ready_s
+        while "ready" not in out.read_text():
+            assert child.poll() is None, out.read_text()
+            assert time.monotonic() < deadline, "child never got ready"
+            time.sleep(0.05)
+        time.sleep(after_s)
+        child.send_signal(signal.SIGINT)
+        rc = child.wait(timeout=wait_s)  # was: never (the loops did not look at signals)
+    finally:
+        if child.poll() is None:
+            child.kill()
+    return rc, out.read_text()

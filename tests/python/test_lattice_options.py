@@ -162,7 +162,7 @@ def test_the_old_crystal_name_warns_and_starts_the_same(tmp_path):
         assert np.array_equal(old.positions, new.positions)
     with pytest.warns(DeprecationWarning, match="init='crystal'"):
         LatticeSimulation3D.random(100, phi=0.3, seed=4, init="lattice")
-    with pytest.raises(ValueError, match="'auto', 'rsa' or 'crystal'"):
+    with pytest.raises(ValueError, match="'auto', 'rsa', 'crystal' or 'relax'"):
         Simulation.random(60, 2, 0.3, seed=4, init="grid")
     p = tmp_path / "old.toml"
     p.write_text("[system]\ndimension = 2\nparticles = 60\npacking_fraction = 0.5\nstart = 'lattice'\n")

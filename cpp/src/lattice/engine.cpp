@@ -112,7 +112,7 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
 
 template <std::size_t D>
 LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double phi, std::uint64_t seed,
-                              const std::string& init) {
+                              const std::string& init, const InterruptCheck& interrupt) {
   engine::Config fc;
   fc.dim = static_cast<int>(D);
   fc.diameter = c.diameter;
@@ -125,7 +125,7 @@ LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double 
     fc.diameter = 1.0;                 // (it sets the largest)
   }
   try {
-    st = engine::random_state(fc, n, phi, seed, 0.0, init);
+    st = engine::random_state(fc, n, phi, seed, 0.0, init, false, interrupt);
   } catch (const InvalidArgument& e) {
     if (c.diameters.empty()) throw;
     throw InvalidArgument(std::string("lattice: ") + e.what());
@@ -144,8 +144,10 @@ LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double 
 
 template LatticeStartN<2> quantize_start(const LatticeConfigN<2>&, const std::vector<double>&, const std::vector<double>&);
 template LatticeStartN<3> quantize_start(const LatticeConfigN<3>&, const std::vector<double>&, const std::vector<double>&);
-template LatticeStartN<2> random_start(const LatticeConfigN<2>&, std::size_t, double, std::uint64_t, const std::string&);
-template LatticeStartN<3> random_start(const LatticeConfigN<3>&, std::size_t, double, std::uint64_t, const std::string&);
+template LatticeStartN<2> random_start(const LatticeConfigN<2>&, std::size_t, double, std::uint64_t, const std::string&,
+                                       const InterruptCheck&);
+template LatticeStartN<3> random_start(const LatticeConfigN<3>&, std::size_t, double, std::uint64_t, const std::string&,
+                                       const InterruptCheck&);
 
 namespace {
 template <class Eng>

@@ -28,6 +28,7 @@
 #include <string>
 
 #include "revcol/engine/engine.hpp"
+#include "revcol/interrupt.hpp"
 
 namespace revcol::engine {
 
@@ -50,14 +51,16 @@ double particle_volume(int d, double D);
 /// set to the largest): the cube whose packing fraction, from the particles' own volumes, is
 /// phi, every particle placed as one of the largest (so each pair starts at least the largest
 /// diameter apart, and phi is bounded by the largest ones' crystal).
+/// `interrupt`: polled during a relaxed start (every few steps); when it says stop the start
+/// throws revcol::Interrupted (the bindings pass Ctrl-C).
 InitialState random_state(Config config, std::size_t n, double phi, std::uint64_t seed,
                           double energy = 0.0, const std::string& init = "auto",
-                          bool equal_speeds = false);
+                          bool equal_speeds = false, const InterruptCheck& interrupt = {});
 
 
 /// How a random start places particles: automatic, random sequential addition, or a jittered
 /// crystal (square in 1D/2D, face-centred cubic in 3D).
-enum class Placement { automatic, rsa, crystal };
+enum class Placement { automatic, rsa, crystal, relax };
 
 /// Parses "auto" / "rsa" / "crystal" ("lattice": the crystal's old name, still read; the word
 /// names the integer engine now); throws InvalidArgument otherwise.
@@ -71,6 +74,7 @@ double box_fraction(const Config& config, std::size_t n);
 /// (N = 0, a bad box or diameter, a packing fraction above limits::max_fraction, N not
 /// fitting on the crystal, a seed of 2^32 or more) and draws nothing then.
 InitialState random_start(const Config& config, std::size_t n, std::uint64_t seed, double energy = 0.0,
-                          const std::string& init = "auto", bool equal_speeds = false);
+                          const std::string& init = "auto", bool equal_speeds = false,
+                          const InterruptCheck& interrupt = {});
 
 }  // namespace revcol::engine

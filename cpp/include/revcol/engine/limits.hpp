@@ -57,6 +57,15 @@ inline constexpr double kMinGap = 1e-12, kLatticeGap = 1e-9;
 /// Largest packing fraction the random start accepts in d dimensions (1..3).
 constexpr double max_fraction(int d) { return d == 1 ? 0.95 : d == 2 ? 0.75 : 0.70; }
 
+/// Largest packing fraction a relaxed random start (init "relax", and a mixture's "auto" past the
+/// crystal of its largest) is asked for, from the particles' own volumes (1..3): a little above
+/// the jamming of random packings of binary and modestly polydisperse gases (0.64-0.66 in 3D,
+/// 0.84-0.86 in 2D), so a start between jamming and this bound fails by the relaxation's own
+/// tests (init_relax.cpp), and one above it at once.
+constexpr double max_relax_fraction(int d) { return d == 1 ? 0.95 : d == 2 ? 0.88 : 0.68; }
+/// The relaxation's budget: FIRE steps before a relaxed start gives up (init_relax.hpp).
+inline constexpr long kRelaxSteps = 20000;
+
 /// Largest packing fraction at which "auto" starts by random sequential addition (1..3).
 constexpr double rsa_fraction(int d) { return d == 1 ? 0.3 : d == 2 ? 0.35 : 0.2; }
 

@@ -23,6 +23,7 @@
 #include "revcol/lattice/engine_core.hpp"
 #include "revcol/lattice/pair2d.hpp"
 #include "revcol/lattice/pair3d.hpp"
+#include "revcol/interrupt.hpp"
 
 namespace revcol::lattice {
 
@@ -99,10 +100,11 @@ LatticeStartN<D> quantize_start(const LatticeConfigN<D>& c, const std::vector<do
 
 /// A random start as the float engine's engine::random_state (n disks or spheres at area or
 /// volume fraction phi in the square or cubic box it chooses, Gaussian velocities with zero
-/// momentum, kT = 1, init "auto", "rsa" or "lattice"), quantized once.
+/// momentum, kT = 1, init "auto", "rsa", "crystal" or "relax"; `interrupt` polled by a relaxed
+/// start), quantized once.
 template <std::size_t D>
 LatticeStartN<D> random_start(const LatticeConfigN<D>& c, std::size_t n, double phi, std::uint64_t seed,
-                              const std::string& init = "auto");
+                              const std::string& init = "auto", const InterruptCheck& interrupt = {});
 
 /// Diagnostics of a lattice state (all exact integers converted only for reporting).
 template <std::size_t D>
