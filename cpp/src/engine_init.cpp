@@ -501,9 +501,10 @@ InitialState random_state(Config c, std::size_t n, double phi, std::uint64_t see
   require(std::isfinite(phi) && phi > 0.0, "packing fraction must be finite and > 0");
   const Placement how = parse_placement(init);
   const int d = c.dim;
-  const double maxphi = limits::max_fraction(d);
+  // (a relaxed start goes past the crystal's bound to its own, as in a given box)
+  const double maxphi = how == Placement::relax ? limits::max_relax_fraction(d) : limits::max_fraction(d);
   require(phi <= maxphi, "packing fraction " + num(phi) + " above what the initialiser reaches (" +
-                             std::to_string(maxphi) + " in " + std::to_string(d) + "D)");
+                             num(maxphi) + " in " + std::to_string(d) + "D)");
   const double L = std::pow(static_cast<double>(n) * limits::particle_volume(d, c.diameter) / phi, 1.0 / d);
   // a tiny diameter underflows the particle volume and the box to 0 (issue 17)
   require(std::isfinite(L) && L > 0.0 && limits::box_ratio_fits(L, c.diameter), [&] {

@@ -55,6 +55,11 @@ def test_the_float_engine_and_one_size_relax_too():
     assert _min_gap(one.positions, np.ones(400), one.box, [True] * 3) >= 1.001 * (1 - 1e-12)
     assert not np.array_equal(one.positions, Simulation.random(400, 3, 0.55, init="crystal", seed=3).positions)
     assert engine_limits()["max_relax_fraction"] == {1: 0.95, 2: 0.88, 3: 0.68}
+    # one size in a cube: a relaxed start has the relaxed bound, as in a given box (the crystal's is 0.75 in 2D)
+    disks = Simulation.random(300, 2, 0.8, init="relax", seed=4)
+    assert _min_gap(disks.positions, np.ones(300), disks.box, [True, True]) >= 1.001 * (1 - 1e-12)
+    with pytest.raises(ValueError, match=r"above what the initialiser reaches \(0\.75 in 2D\)"):
+        Simulation.random(300, 2, 0.8, init="crystal", seed=4)
 
 
 def test_scenes_take_a_relaxed_start_and_dense_species():
