@@ -43,10 +43,9 @@ file and the replacement.
     packing_fraction = 0.3        # sets a cubic box; or give box = [Lx, Ly]
     boundaries = "wall"           # "wall" | "periodic" | "bounce" (float engine), or one per axis ("walls": deprecated)
     start = "auto"                # "auto" | "random" (sequential addition) | "crystal" (jittered:
-                                  # square in 2D, face-centred cubic in 3D; "lattice": deprecated)
-                                  # | "relax" (at random, the overlaps relaxed away: dense, amorphous);
-                                  # auto: random up to the engine's rsa_fraction, else crystal; a
-                                  # mixture as its largest size, else relaxed
+                                  # square in 2D, fcc in 3D; "lattice": deprecated) | "relax" (overlaps
+                                  # relaxed away: dense, amorphous); auto: random up to the engine's
+                                  # rsa_fraction, else crystal; a mixture as its largest, else relaxed
     kinetic_energy = 1000.0       # total; default N d / 2 (unit temperature)
     initial_state = "start.npz"   # arrays positions (N, d), velocities (N, d); relative to the file
     gravity = [0.0, -1.0]         # a uniform field, one component per axis, along one walled axis (default none)
