@@ -261,8 +261,8 @@ def with_lattice_options(scene, *, tick_bits: int | None = None, cell_bits: int 
     """``scene`` with the lattice engine's options that are not None replaced (``revcol run`` and
     ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``, ``--workers``), each checked as its
     ``[collisions]`` field; a scene that does not run the lattice engine refuses them, and one with a
-    field (``[system] gravity``) or shear (``shear_rate``) more than one worker and a neighbour-list shell
-    (check_field_options)."""
+    field (``[system] gravity``) or shear (``shear_rate``) more than one worker, under shear a
+    neighbour-list shell too (check_field_options)."""
     given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search, workers)) if v is not None}
     flags = {k: "--" + k.replace("_", "-") for k in given}
     if given and (scene.kind != "gas" or scene.engine != "lattice"):
@@ -309,10 +309,10 @@ def check_gravity(source: str, gravity: Sequence[float] | None, d: int,
 
 
 # what runs neither a field nor shear yet on the lattice engine, in the words of each refusal: where
-# the gas is, what the parallel engine and the neighbour lists are not built for yet (both engines
-# observe either: the observer follows parabolas and moving images)
+# the gas is, what the parallel engine and the neighbour lists are not built for yet (None: built; both
+# engines observe either: the observer follows parabolas and moving images)
 _UNBUILT = {
-    "gravity": ("in a field ([system] gravity)", "a field", "curved paths"),
+    "gravity": ("in a field ([system] gravity)", "a field", None),
     "shear": ("under shear ([system] shear_rate)", "shear", "moving images"),
 }
 
@@ -321,8 +321,8 @@ def check_field_options(source: str, gravity: Sequence[float] | None, engine: st
                         search: str | float = "auto", names: dict | None = None,
                         shear: float | None = None) -> None:
     """Refuses, naming the option, what runs no field (``gravity``) or no shear (``shear``, a rate;
-    None: none) yet on the lattice engine: more than one worker or neighbour lists (``search`` a
-    shell; ``"auto"`` takes the cell grid there). (A sheared gas's slabs lie along axis 1 only:
+    None: none) yet on the lattice engine: more than one worker, and under shear neighbour lists
+    (``search`` a shell; ``"auto"`` takes the cell grid there). (A sheared gas's slabs lie along axis 1 only:
     check_shear_observe.) ``names`` renames an option where it came from the command line
     (``{"workers": "--workers"}``)."""
     names = names or {}
@@ -335,7 +335,7 @@ def check_field_options(source: str, gravity: Sequence[float] | None, engine: st
         if workers > 1:
             raise _fail(source, names.get("workers", "[collisions] workers"), f"engine = 'lattice' runs a gas "
                         f"{where} on one worker (the parallel engine is not built for {what} yet), got {workers}")
-        if search not in ("auto", "cells"):
+        if lists is not None and search not in ("auto", "cells"):
             raise _fail(source, names.get("search", "[collisions] search"), f"engine = 'lattice' searches a gas "
                         f"{where} with the cell grid only ('auto' or 'cells'; no neighbour lists for {lists} yet), "
                         f"got {search!r}")

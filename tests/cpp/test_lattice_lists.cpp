@@ -3,7 +3,8 @@
 // their image codes exact and mirrored), the ball's renewal tick against brute force (never late, rarely
 // early), and the engine with lists (several shells, both prediction paths) against the cell
 // grid with every candidate sent to the exact search: the same collisions (trace), the same
-// state bit for bit, in 2D and 3D, periodic, walled, dense with redraws and with groups forced.
+// state bit for bit, in 2D and 3D, periodic, walled, dense with redraws and with groups forced,
+// and in a field (whose renewals leave a cube inside the ball at an exact tick, also brute-forced).
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -268,6 +269,50 @@ TEST_CASE("neighbour lists: the renewal tick is never late and rarely early (bru
   CHECK(early == 0);
 }
 
+TEST_CASE("neighbour lists in a field: the cube's renewal tick is the exact first tick out (brute force over the ticks)") {
+  for (const int axis : {2, 0}) {
+    UnitsN<3> u = box_units<3>({true, true, true}, 10.0, 50);
+    NeighbourListsN<3> nl;
+    const std::int64_t h = u.sigma / 8, half_g = -(std::int64_t{1} << 20);  // a field along `axis`
+    nl.set_field(axis, half_g);
+    std::vector<VecN<3>> c(1, VecN<3>{u.L[0] / 2, u.L[1] / 2, u.L[2] / 2});
+    nl.build(u, h, c);
+    // the cube's half-width w: the largest with 3 w^2 <= h^2 (inside the ball), read off inside()
+    std::int64_t w = 0;
+    for (std::int64_t step = h; step > 0; step /= 2)
+      while (nl.inside(0, VecN<3>{c[0][0] + w + step, c[0][1], c[0][2]})) w += step;
+    CHECK(static_cast<long double>(3) * w * w <= static_cast<long double>(h) * h);
+    CHECK(static_cast<long double>(3) * (w + 1) * (w + 1) > static_cast<long double>(h) * h);
+    CHECK(nl.inside(0, VecN<3>{c[0][0] + w, c[0][1] - w, c[0][2] + w}));    // a corner of the cube: in
+    CHECK(!nl.inside(0, VecN<3>{c[0][0], c[0][1] - w - 1, c[0][2]}));       // past a face: out
+    std::mt19937_64 rng(13);
+    std::uniform_int_distribution<std::int64_t> off(-w, w);
+    int cases = 0, wrong = 0;
+    for (int m = 0; m < 1500; ++m) {
+      const int bits = 1 + static_cast<int>(rng() % 22);  // speeds of 1 .. 2^21 units per tick
+      VecN<3> x{}, v{};
+      for (int k = 0; k < 3; ++k) {
+        x[k] = c[0][k] + off(rng);
+        v[k] = static_cast<std::int64_t>(rng() % (std::uint64_t{1} << bits)) - (std::int64_t{1} << (bits - 1));
+      }
+      if (m % 5 == 0) v = {0, 0, 0};  // still: the field alone moves it out
+      auto at = [&](std::int64_t t) {
+        VecN<3> y;
+        for (int k = 0; k < 3; ++k) y[k] = x[k] + v[k] * t + (k == axis ? half_g * t * t : 0);
+        return y;
+      };
+      const std::int64_t tau = nl.exit_ticks(0, x, v);
+      std::int64_t first_out = 1;
+      while (nl.inside(0, at(first_out))) ++first_out;
+      ++cases;
+      if (tau != first_out) ++wrong;
+    }
+    std::printf("  field along axis %d: %d lines, %d renewal ticks not the first tick out\n", axis, cases, wrong);
+    CHECK(cases == 1500);
+    CHECK(wrong == 0);
+  }
+}
+
 namespace {
 
 template <std::size_t D>
@@ -280,6 +325,7 @@ struct Gas {
   std::uint64_t collisions;
   bool groups;  // every collision a group collision (max_redraws = -1)
   int shifted = -1;  // 1 / 0: the cell grid knows / does not know each neighbouring cell's image (-1: either)
+  double gravity = 0.0;  // a field along the last axis (walled), in kT / sigma; 0: none
 };
 
 // the reference: the cell grid, every candidate to the exact search
@@ -289,7 +335,9 @@ void run_equivalence(const Gas<D>& g) {
   cfg.wall = g.wall;
   cfg.seed = 7;
   if (g.tick_bits != 0) cfg.tick_bits = g.tick_bits;
+  cfg.gravity[D - 1] = g.gravity;
   const LatticeStartN<D> st = random_start(cfg, g.n, g.phi, 7);
+  CHECK((st.units.gravity[D - 1] != 0) == (g.gravity != 0.0));
   if (g.shifted >= 0) {  // the engine's cell grid (shell 0): the image-known filter, or the per-pair image
     CellGridN<D> grid;
     grid.build(st.units, g.n);
@@ -342,6 +390,18 @@ TEST_CASE("3D engine: lists (shells 0.02 .. 2, both paths) find exactly the exha
                           Gas<3>{"N=500 phi=0.45 slab, T=16 (redraws)", 500, 0.45, slab, 16, 15000, false},
                           Gas<3>{"N=200 phi=0.3 walls, groups forced", 200, 0.3, walls, 0, 2000, true}})
     run_equivalence<3, LatticeEngine3D>(g);
+}
+
+TEST_CASE("3D and 2D engines in a field: lists (the cube's renewals) find exactly the exhaustive cell search's collisions, bit for bit") {
+  const std::array<bool, 3> walls{true, true, true}, slab{false, false, true};
+  for (const Gas<3>& g : {Gas<3>{"3D N=1000 phi=0.3 walls, g=-1", 1000, 0.3, walls, 0, 20000, false, -1, -1.0},
+                          Gas<3>{"3D N=500 phi=0.45 slab, g=-3, T=16 (redraws)", 500, 0.45, slab, 16, 15000, false, -1, -3.0},
+                          Gas<3>{"3D N=80 phi=0.4 slab, g=-2 (every cell a neighbour)", 80, 0.4, slab, 0, 3000, false, 0, -2.0},
+                          Gas<3>{"3D N=200 phi=0.3 walls, g=+1, groups forced", 200, 0.3, walls, 0, 2000, true, -1, 1.0},
+                          Gas<3>{"3D N=400 phi=0.2 slab, g=-20, T=16 (coarse ticks: redraws)", 400, 0.2, slab, 16, 15000, false, -1, -20.0}})
+    run_equivalence<3, LatticeEngine3D>(g);
+  const std::array<bool, 2> channel{false, true};
+  run_equivalence<2, LatticeEngine>(Gas<2>{"2D N=600 phi=0.5 channel, g=-2", 600, 0.5, channel, 0, 10000, false, 1, -2.0});
 }
 
 TEST_CASE("2D engine: lists find exactly the exhaustive cell search's collisions, bit for bit") {

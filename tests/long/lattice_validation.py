@@ -329,6 +329,7 @@ def run_gas(n: int, phi: float, boundary: str, collisions: int, seed: int = 1, s
     row = {
         "dim": DIM, "n": n, "phi": phi, "boundary": boundary, "mode": mode, "law": law, "seed": seed, "sizes": sizes,
         "collisions_asked": int(collisions), "backscatters": d_end.get("backscatters"),
+        "search": None if sim is None else sim.search,
         "collisions": c, "completed": f["error"] is None, "forward_error": f["error"],
         "run_back_from_failure": f.get("run_back_from_failure"), "collisions_checked_back": checked,
         "collisions_per_particle": 2.0 * c / n,

@@ -70,7 +70,6 @@ def test_bad_fields_are_refused_by_name(fields, needle):
 @pytest.mark.parametrize("fields,needle", [
     ({"collisions": {"workers": 4}}, "[collisions] workers: engine = 'lattice' runs a gas in a field ([system] "
                                      "gravity) on one worker"),
-    ({"collisions": {"search": 0.3}}, "[collisions] search: engine = 'lattice' searches a gas in a field"),
 ])
 def test_the_lattice_refuses_what_runs_no_field_at_load(fields, needle):
     with pytest.raises(SceneError, match=None) as e:
@@ -97,8 +96,7 @@ def test_the_command_lines_lattice_options_are_refused_by_flag():
     s = scene("lattice")
     with pytest.raises(SceneError, match="--workers: engine = 'lattice' runs a gas in a field"):
         with_lattice_options(s, workers=2)
-    with pytest.raises(SceneError, match="--search: engine = 'lattice' searches a gas in a field"):
-        with_lattice_options(s, search=0.5)
+    assert with_lattice_options(s, search=0.5).search == 0.5  # a field takes neighbour lists
     assert with_lattice_options(s, search="cells", workers=1).search == "cells"
     # a float scene moved to the lattice keeps its field
     assert with_engine(scene(), "lattice").gravity == (0.0, -1.0)

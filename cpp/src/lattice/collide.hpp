@@ -35,12 +35,14 @@ void BasicEngine<Op, Bits, Queue>::inconsistent(const std::string& what, int i, 
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::post_reason(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const -> int {
   if (sh_ != 0) [[unlikely]] return post_reason_t<true>(i, j, xi, xj, vi, vj, a, pre_a, multi);
+  if (gax_ >= 0 && direct_) [[unlikely]] return post_reason_t<false, true>(i, j, xi, xj, vi, vj, a, pre_a, multi);
   return post_reason_t<false>(i, j, xi, xj, vi, vj, a, pre_a, multi);
 }
 
-// (Sheared: every distance through the nearest moving image at its tick, shear.hpp)
+// (Sheared: every distance through the nearest moving image at its tick, shear.hpp; Fall: the
+// lists' double filter follows the partners' fall in a field)
 template <class Op, class Bits, class Queue>
-template <bool Sheared>
+template <bool Sheared, bool Fall>
 auto BasicEngine<Op, Bits, Queue>::post_reason_t(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const -> int {
   auto dist = [&](const Vec& x, const Vec& y, std::int64_t t) { return Sheared ? diff_at(x, y, t) : diff(x, y); };
   auto meet = [&](const Vec& x, const Vec& y, int p, int q, std::int64_t t) { return norm2(dist(x, y, t)) < sig2(p, q); };
@@ -86,7 +88,8 @@ auto BasicEngine<Op, Bits, Queue>::post_reason_t(int i, int j, const Vec& xi, co
         const double* sh = shift_[codes[e]].data();
         double dd = 0.0;
         for (std::size_t k = 0; k < D; ++k) {
-          const double r = ((ax[k] - dq.a[k]) - sh[k]) - dq.v[k] * dt;
+          double r = ((ax[k] - dq.a[k]) - sh[k]) - dq.v[k] * dt;
+          if (Fall && static_cast<int>(k) == gax_) r -= hgd_ * dt * dt;  // q's fall since its anchor
           dd += r * r;
         }
         if (dd <= far2_ * (1.0 + 1e-6)) third(ids[e]);

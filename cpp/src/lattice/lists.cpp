@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "revcol/error.hpp"
+#include "revcol/lattice/field.hpp"
 #include "revcol/lattice/neighbour_lists.hpp"
 
 namespace revcol::lattice {
@@ -18,6 +19,9 @@ void NeighbourListsN<Dim>::build(const UnitsN<Dim>& u, std::int64_t h, const std
   reach_ = u.sigma + 2 * h + 8 * u.vmax + 8;
   h2_ = static_cast<u128>(h) * static_cast<u128>(h);
   reach2_ = static_cast<double>(reach_) * static_cast<double>(reach_);
+  w_ = static_cast<std::int64_t>(std::sqrt(static_cast<double>(h) * static_cast<double>(h) / static_cast<double>(Dim)));
+  while (w_ > 0 && static_cast<u128>(Dim) * static_cast<u128>(w_) * static_cast<u128>(w_) > h2_) --w_;  // the cube inside the ball, exactly
+  while (static_cast<u128>(Dim) * static_cast<u128>(w_ + 1) * static_cast<u128>(w_ + 1) <= h2_) ++w_;
   const std::size_t n = centres.size();
   // 3^D cells of R (measured against 5^D cells of R / 2, which hold half the candidates, at 3D
   // N = 10^4: 1.11 / 1.07x the collisions per second at volume fraction 0.1, 1.05x at 0.3, level
@@ -291,6 +295,11 @@ typename NeighbourListsN<Dim>::Vec NeighbourListsN<Dim>::diff(const Vec& a, cons
 template <std::size_t Dim>
 bool NeighbourListsN<Dim>::inside(int p, const Vec& x) const noexcept {
   const Vec d = diff(x, node_[static_cast<std::size_t>(p)].c);
+  if (fax_ >= 0) [[unlikely]] {  // a field: the cube
+    for (std::size_t k = 0; k < Dim; ++k)
+      if (d[k] > w_ || d[k] < -w_) return false;
+    return true;
+  }
   double f = 0.0;
   for (std::size_t k = 0; k < Dim; ++k) {
     if (d[k] > h_ || d[k] < -h_) return false;
@@ -305,6 +314,7 @@ bool NeighbourListsN<Dim>::inside(int p, const Vec& x) const noexcept {
 template <std::size_t Dim>
 std::int64_t NeighbourListsN<Dim>::exit_ticks(int p, const Vec& x, const Vec& v) const noexcept {
   const Vec d = diff(x, node_[static_cast<std::size_t>(p)].c);
+  if (fax_ >= 0) [[unlikely]] return exit_cube(d, v);
   double A = 0.0, B = 0.0, C = 0.0;
   for (std::size_t k = 0; k < Dim; ++k) {
     const double dk = static_cast<double>(d[k]), vk = static_cast<double>(v[k]);
@@ -340,6 +350,22 @@ std::int64_t NeighbourListsN<Dim>::exit_ticks(int p, const Vec& x, const Vec& v)
   };
   while (tg > 0 && !in_at(tg)) tg /= 2;
   return tg + 1;
+}
+
+// A field's renewal tick: the first tick n >= 1 at which d + v n (+ fh_ n^2 on the field's axis)
+// leaves the cube [-w, w]^D, each axis exactly (d inside: inside(), the caller's precondition).
+template <std::size_t Dim>
+std::int64_t NeighbourListsN<Dim>::exit_cube(const Vec& d, const Vec& v) const noexcept {
+  std::int64_t best = -1;
+  for (std::size_t k = 0; k < Dim; ++k) {
+    std::int64_t n;
+    if (static_cast<int>(k) == fax_) n = field_exit_ticks(d[k], v[k], fh_, -w_, w_ + 1, false, false);
+    else if (v[k] > 0) n = (w_ - d[k]) / v[k] + 1;  // d + v n > w first
+    else if (v[k] < 0) n = (d[k] + w_) / -v[k] + 1;  // d + v n < -w first
+    else continue;
+    if (n >= 0 && (best < 0 || n < best)) best = n;
+  }
+  return best;
 }
 
 template <std::size_t Dim>

@@ -269,10 +269,13 @@ void BasicEngine<Op, Bits, Queue>::predict(int p, std::int64_t lo) {
   if (sh_ != 0 && !lists_ && (c[1] == 0 || c[1] + 1 == grid_.count(1))) [[unlikely]]
     b.offer(next_offset(lo), 0, cross, -1, -1);  // next to a gradient face: the images move on (shear.hpp)
   for (std::size_t k = 0; k < D; ++k) {
-    if (static_cast<int>(k) == gax_) [[unlikely]] {  // the field's axis: quadratic times (cells only)
-      const int ck = c[k], kk = static_cast<int>(k), nc = grid_.count(kk);
-      const std::int64_t dt = field_exit_ticks(ln_[p].x[k], ln_[p].v[k], hg_, grid_.boundary(kk, ck), grid_.boundary(kk, ck + 1), ck == 0, ck + 1 == nc);
-      if (dt > 0) b.offer(lo + dt, 0, cross, -1, -1);
+    if (static_cast<int>(k) == gax_) [[unlikely]] {  // the field's axis: quadratic times (lists: their cube's, above)
+      const int kk = static_cast<int>(k);
+      if (!lists_) {
+        const int ck = c[k], nc = grid_.count(kk);
+        const std::int64_t dt = field_exit_ticks(ln_[p].x[k], ln_[p].v[k], hg_, grid_.boundary(kk, ck), grid_.boundary(kk, ck + 1), ck == 0, ck + 1 == nc);
+        if (dt > 0) b.offer(lo + dt, 0, cross, -1, -1);
+      }
       const std::int64_t dw = field_wall_ticks(ln_[p].x[k], ln_[p].v[k], hg_, lo_of(p), hi_of(p, kk));
       if (dw >= 0) b.offer(lo + dw, wall_kind(), wall, -1, -1);
       continue;
@@ -381,8 +384,12 @@ inline void BasicEngine<Op, Bits, Queue>::scan(int p, std::int64_t lo, Best& b) 
       const double* sh = shift_[codes[e]].data();
       double rr = 0.0, bb = 0.0, aa = 0.0;
       for (std::size_t k = 0; k < D; ++k) {
-        const double r = ((dp.a[k] - dq.a[k]) - sh[k]) - dq.v[k] * dtq;
-        const double w = dp.v[k] - dq.v[k];
+        double r = ((dp.a[k] - dq.a[k]) - sh[k]) - dq.v[k] * dtq;
+        double w = dp.v[k] - dq.v[k];
+        if (Field && static_cast<int>(k) == gax_) {  // q's fall since its anchor
+          r -= hgd_ * dtq * dtq;
+          w -= 2.0 * hgd_ * dtq;
+        }
         rr += r * r;
         bb += r * w;
         aa += w * w;

@@ -313,6 +313,7 @@ void BasicEngine<Op, Bits, Queue>::rebuild() {
     const double h = std::max(1.0, std::round(0.5 * shell * static_cast<double>(u_.sigma)));
     std::vector<Vec> centres(n);
     for (std::size_t p = 0; p < n; ++p) centres[p] = ln_[p].x;
+    if (gax_ >= 0) nl_.set_field(gax_, hg_);
     nl_.build(u_, static_cast<std::int64_t>(std::min(h, static_cast<double>(u_.sigma))), centres);
     // the prediction takes r from the centre offsets when no periodic axis is short enough
     // for a relative vector (< R + 2 h + 4 vmax) to reach half the box
@@ -521,7 +522,6 @@ void BasicEngine<Op, Bits, Queue>::set_regions(int axis, std::vector<std::int64_
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::set_list_shell(double s) {
   require(std::isfinite(s) && (s <= 0.0 || (s >= 0.02 && s <= 2.0)), "lattice: the list shell must be 0 (cells), negative (automatic) or in [0.02, 2] diameters");
-  require(s <= 0.0 || gax_ < 0, "lattice: a gas in a field searches with the cell grid (neighbour lists are not built for curved lines yet): shell 0 or automatic");
   require(s <= 0.0 || sh_ == 0, "lattice: a sheared gas searches with the cell grid (neighbour lists are not built for moving images yet): shell 0 or automatic");
   list_shell_ = s;
   rebuild();
@@ -529,7 +529,7 @@ void BasicEngine<Op, Bits, Queue>::set_list_shell(double s) {
 
 template <class Op, class Bits, class Queue>
 auto BasicEngine<Op, Bits, Queue>::auto_list_shell() const noexcept -> double {
-  if (gax_ >= 0 || sh_ != 0) return 0.0;  // a field or shear: the cell grid (its crossings are exact quadratics; a list's ball is not)
+  if (sh_ != 0) return 0.0;  // shear: the cell grid (its images move; a list's would go stale)
   if constexpr (D == 2) {
     return 0.0;
   } else {

@@ -387,7 +387,7 @@ class BasicEngine {
   Vec shifted(const Vec& origin, const Vec& d) const noexcept;  // origin + d, wrapped (128-bit sum; predict.hpp)
   Vec wrapped(const Vec& x) const noexcept;                      // x wrapped on periodic axes
   int post_reason(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const;
-  template <bool Sheared>
+  template <bool Sheared, bool Fall = false>
   int post_reason_t(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a, const Vec (&pre_a)[2], bool& multi) const;
   std::int64_t next_offset(std::int64_t lo) const noexcept;  // shear: the next tick the images move on by a cell (predict.hpp)
   void apply(int i, int j, const Vec& xi, const Vec& xj, const Vec& vi, const Vec& vj, std::int64_t a);

@@ -34,6 +34,11 @@
 // vector without looking for an image (engine_core.hpp). A renewal touches a neighbour's list
 // only where the neighbour joins, leaves or changes its code (rare), not at every neighbour:
 // the lists are a memory-bound part of the engine (measure before changing).
+// A uniform field (set_field) bends the lines along one axis, and a parabola can leave a ball and
+// come back, so a renewal tick checked at its end would prove nothing. There the region about the
+// centre is the cube of half-width w = floor(h / sqrt(D)) inside the ball: per axis an interval
+// left at an exact tick (a linear one, or field.hpp's exact quadratic), so the ball's argument holds
+// unchanged, at more renewals (the cube is the ball's 1 / sqrt(D) in width).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -60,10 +65,14 @@ class NeighbourListsN {
   void remove(int p);
   /// Puts a removed p back with centre c (a wrapped position): its list and its neighbours'.
   void insert(int p, const Vec& c);
-  /// True when x (a wrapped position) is within h of p's centre, exactly.
+  /// A uniform field along `axis` (half its acceleration, h = g / 2, per tick^2; field.hpp): the
+  /// region about each centre is then the cube inside the ball (see the header comment). Before build.
+  void set_field(int axis, std::int64_t half_g) noexcept { fax_ = axis, fh_ = half_g; }
+  /// True when x (a wrapped position) is within h of p's centre (in a field: in its cube), exactly.
   bool inside(int p, const Vec& x) const noexcept;
-  /// Ticks tau >= 1 such that the line x + v t stays within h of p's centre for t in [0, tau - 1]
-  /// (x inside; conservative, see the header comment); -1 if v = 0 (never leaves).
+  /// Ticks tau >= 1 such that the line x + v t (in a field, + h t^2 along its axis) stays within h
+  /// of p's centre (in its cube) for t in [0, tau - 1] (x inside; conservative, see the header
+  /// comment); -1 if it never leaves.
   std::int64_t exit_ticks(int p, const Vec& x, const Vec& v) const noexcept;
   /// Calls f(q) for every q on p's list.
   template <class F>
@@ -110,6 +119,9 @@ class NeighbourListsN {
   std::array<std::int64_t, Dim> L_{};
   std::array<bool, Dim> wall_{};
   std::int64_t h_ = 0, reach_ = 0;
+  int fax_ = -1;                          // a field's axis (set_field), -1 without
+  std::int64_t fh_ = 0, w_ = 0;           // half its acceleration; the cube's half-width
+  std::int64_t exit_cube(const Vec& d, const Vec& v) const noexcept;
   u128 h2_ = 0;
   double reach2_ = 0.0;  // R^2 in double: a symmetric, deterministic test (R holds a margin)
   void link(int p, int cell);    // p at the head of cell's chain
