@@ -38,13 +38,18 @@ revcol::lattice::LatticeStartN<D> sheared_start(std::size_t n, double phi, doubl
 /// N particles at packing fraction phi, `kind` on every axis, the random start of `seed`, in `mode`.
 template <std::size_t D>
 EngineOf<D> make_gas(std::size_t n, double phi, revcol::engine::Boundary kind, std::uint32_t seed,
-                     int tick_bits = revcol::lattice::default_tick_bits, revcol::Mode mode = revcol::Mode::exact) {
+                     int tick_bits = revcol::lattice::default_tick_bits, revcol::Mode mode = revcol::Mode::exact,
+                     double gravity = 0.0) {
   namespace la = revcol::lattice;
   la::LatticeConfigN<D> c;
   c.tick_bits = tick_bits;
   for (std::size_t k = 0; k < D; ++k) {
     c.wall[k] = revcol::engine::has_walls(kind);
     c.bounce[k] = kind == revcol::engine::Boundary::bounce;
+  }
+  if (gravity != 0.0) {  // a field along the last axis, walled (specular walls in a periodic box)
+    c.gravity[D - 1] = gravity;
+    c.wall[D - 1] = true;
   }
   c.seed = seed;
   const la::LatticeStartN<D> s = la::random_start(c, n, phi, seed);
@@ -82,13 +87,13 @@ EngineOf<D> engine_of(const revcol::lattice::LatticeStartN<D>& s, std::uint32_t 
 }
 
 /// What a gas in a field or under shear refuses by name (InvalidArgument), its state untouched:
-/// the rollback journal, regions (the parallel engine), and under shear (`lists` false) neighbour
-/// lists. (Both are observed; a field takes lists.)
+/// regions (the parallel engine), and under shear (`sheared`) neighbour lists and the rollback
+/// journal. (Both are observed; a field takes lists and the journal.)
 template <class Engine>
-void check_refusals(Engine& e, bool lists) {
+void check_refusals(Engine& e, bool sheared) {
   const auto before = e.snapshot();
-  if (!lists) CHECK_THROWS_AS(e.set_list_shell(1.0), revcol::InvalidArgument);
-  CHECK_THROWS_AS(e.keep_journal(true), revcol::InvalidArgument);
+  if (sheared) CHECK_THROWS_AS(e.set_list_shell(1.0), revcol::InvalidArgument);
+  if (sheared) CHECK_THROWS_AS(e.keep_journal(true), revcol::InvalidArgument);
   CHECK_THROWS_AS(e.set_regions(0, {0}), revcol::InvalidArgument);
   CHECK(revcol::lattice::same_state(e.snapshot(), before));
 }

@@ -2,7 +2,7 @@
 // forward frame, and the state is bit for bit the one the forward run had at the target
 // (collision count or tick), in every mode the lattice has: 2D and 3D, periodic, specular and
 // bounce-back walls, exact and specular collisions, the cell grid and neighbour lists, forced
-// groups (resolved and bounced). Checked three ways: rollbacks to stored forward states and a run
+// groups (resolved and bounced), and in a field (a field's wall momentum taken off too). Checked three ways: rollbacks to stored forward states and a run
 // on that rejoins the forward run; the rollback check of ROSS (each collision done, undone,
 // compared, done again); and a fuzz of random runs, rollbacks and commits against the forward
 // run's state hash at every collision count. Bad requests are refused with the state unchanged.
@@ -68,11 +68,12 @@ struct Scene {
   double shell;     // < 0: the engine's choice; 0: cells; > 0: lists
   int max_redraws;  // -1: every collision a group
   bool resolve;     // groups resolve (else bounce)
+  double gravity = 0.0;  // a field along the last axis (walled), kT / sigma
 };
 
 template <std::size_t D>
 EngineOf<D> make(const Scene& sc, std::uint32_t seed) {
-  auto e = lattice_test::make_gas<D>(sc.n, sc.phi, sc.kind, seed, 16, sc.mode);
+  auto e = lattice_test::make_gas<D>(sc.n, sc.phi, sc.kind, seed, 16, sc.mode, sc.gravity);
   if (sc.shell >= 0.0) e.set_list_shell(sc.shell);
   e.max_redraws = sc.max_redraws;
   e.group_resolve = sc.resolve;
@@ -83,17 +84,21 @@ template <std::size_t D>
 void check_scene(const Scene& sc, std::uint64_t total, std::uint32_t seed) {
   // the forward run's state (hash) after every collision, and whole snapshots at a few counts
   auto r = make<D>(sc, seed);
+  // (and a field's wall momentum, a counter, not state: a rollback takes off what it undoes)
   std::vector<std::uint64_t> ref{state_hash(r.snapshot())};
+  std::vector<std::array<std::uint64_t, 4>> ref_imp{r.counters().field_wall_impulse};
   std::vector<SnapshotN<D>> snaps{r.snapshot()};
   const std::uint64_t every = total / 6;
   for (std::uint64_t c = 1; c <= total; ++c) {
     r.run(1, tick_limit - 1);
     const auto s = r.snapshot();
     ref.push_back(state_hash(s));
+    ref_imp.push_back(r.counters().field_wall_impulse);
     if (c % every == 0) snaps.push_back(s);
   }
   const auto cnt = r.counters();
   const SnapshotN<D> end = r.snapshot();
+  if (sc.gravity != 0.0) CHECK(ref_imp.back() != ref_imp.front());
 
   // 1. rollbacks to stored states, latest first, then a run on that rejoins the forward run
   auto e = make<D>(sc, seed);
@@ -103,7 +108,7 @@ void check_scene(const Scene& sc, std::uint64_t total, std::uint32_t seed) {
   bool all = true;
   for (std::size_t k = snaps.size(); k-- > 0;) {
     e.rollback(snaps[k].collisions);
-    all = all && same_state(e.snapshot(), snaps[k]);
+    all = all && same_state(e.snapshot(), snaps[k]) && e.counters().field_wall_impulse == ref_imp[snaps[k].collisions];
   }
   CHECK(all);
   e.run(total, tick_limit - 1);
@@ -132,9 +137,9 @@ void check_scene(const Scene& sc, std::uint64_t total, std::uint32_t seed) {
     for (std::uint64_t k = 1; k <= ross; ++k) {
       c.run(1, tick_limit - 1);
       c.rollback(k - 1);
-      if (state_hash(c.snapshot()) != ref[k - 1]) ++ross_bad;
+      if (state_hash(c.snapshot()) != ref[k - 1] || c.counters().field_wall_impulse != ref_imp[k - 1]) ++ross_bad;
       c.run(1, tick_limit - 1);
-      if (state_hash(c.snapshot()) != ref[k]) ++ross_bad;
+      if (state_hash(c.snapshot()) != ref[k] || c.counters().field_wall_impulse != ref_imp[k]) ++ross_bad;
     }
     auto z = make<D>(sc, seed);
     z.keep_journal(true, how);
@@ -153,7 +158,7 @@ void check_scene(const Scene& sc, std::uint64_t total, std::uint32_t seed) {
         z.commit(lo + rng() % (now - lo + 1) / 2);
         ++commits;
       }
-      if (state_hash(z.snapshot()) != ref[z.collisions()]) ++fuzz_bad;
+      if (state_hash(z.snapshot()) != ref[z.collisions()] || z.counters().field_wall_impulse != ref_imp[z.collisions()]) ++fuzz_bad;
     }
     z.run(total - z.collisions(), tick_limit - 1);
     if (!same_state(z.snapshot(), end)) ++fuzz_bad;
@@ -234,10 +239,24 @@ TEST_CASE("3D rollback is exact: periodic, walls, bounce back; exact and specula
   check_scene<3>({"3D 0.4 walls specular", 300, 0.4, B::wall, Mode::specular, -1.0, 256, true}, 3000, 27);
 }
 
-TEST_CASE("3D walls: collisions right after a reflection on one tick roll back exactly") {
+TEST_CASE("rollback in a field is exact: 2D and 3D, walls and slabs, exact and specular, bounce back, cells and lists, groups") {
+  using B = en::Boundary;
+  check_scene<2>({"2D 0.4 channel g=-2 exact cells", 300, 0.4, B::periodic, Mode::exact, -1.0, 256, true, -2.0}, 2400, 31);
+  check_scene<2>({"2D 0.5 walls g=-1 specular lists", 300, 0.5, B::wall, Mode::specular, 0.4, 256, true, -1.0}, 2400, 32);
+  check_scene<2>({"2D 0.4 bounce-back walls g=+2", 250, 0.4, B::bounce, Mode::exact, -1.0, 256, true, 2.0}, 2000, 33);
+  check_scene<2>({"2D 0.4 walls g=-2 forced groups (resolve)", 150, 0.4, B::wall, Mode::exact, -1.0, -1, true, -2.0}, 900, 34);
+  check_scene<2>({"2D 0.4 channel g=-2 forced groups (bounce)", 150, 0.4, B::periodic, Mode::exact, -1.0, -1, false, -2.0}, 900, 35);
+  check_scene<3>({"3D 0.3 slab g=-2 exact lists", 300, 0.3, B::periodic, Mode::exact, -1.0, 256, true, -2.0}, 2400, 36);
+  check_scene<3>({"3D 0.3 walls g=-1 exact cells", 250, 0.3, B::wall, Mode::exact, 0.0, 256, true, -1.0}, 2000, 37);
+  check_scene<3>({"3D 0.4 walls g=-1 specular", 300, 0.4, B::wall, Mode::specular, -1.0, 256, true, -1.0}, 2400, 38);
+  check_scene<3>({"3D 0.3 walls g=-2 forced groups", 150, 0.3, B::wall, Mode::exact, -1.0, -1, true, -2.0}, 700, 39);
+}
+
+TEST_CASE("3D walls: collisions right after a reflection on one tick roll back exactly (also in a field)") {
   // (test_lattice_engine3d.cpp: ~ every 30 000 collisions at N = 256, 0.45, walls, T = 16)
-  auto e = lattice_test::make_gas<3>(256, 0.45, en::Boundary::wall, 1, 16);
-  auto f = lattice_test::make_gas<3>(256, 0.45, en::Boundary::wall, 1, 16);  // forward only, lazily behind
+  for (const double g : {0.0, -2.0}) {
+  auto e = lattice_test::make_gas<3>(256, 0.45, en::Boundary::wall, 1, 16, Mode::exact, g);
+  auto f = lattice_test::make_gas<3>(256, 0.45, en::Boundary::wall, 1, 16, Mode::exact, g);  // forward only, lazily behind
   e.keep_journal(true);
   int seen = 0, bad = 0;
   for (std::uint64_t k = 1; k <= 100000; ++k) {
@@ -258,10 +277,11 @@ TEST_CASE("3D walls: collisions right after a reflection on one tick roll back e
     e.run(k - back, tick_limit - 1);
     if (!same_state(e.snapshot(), after)) ++bad;
   }
-  std::printf("  N = 256, 0.45, walls: %d collisions right after a reflection in 10^5, rolled back and redone: %s\n", seen,
-              bad == 0 ? "bit for bit" : "DIFFERENT");
+  std::printf("  N = 256, 0.45, walls, g = %g: %d collisions right after a reflection in 10^5 (%llu groups with one), rolled back and redone: %s\n", g,
+              seen, static_cast<unsigned long long>(e.counters().wall_groups), bad == 0 ? "bit for bit" : "DIFFERENT");
   CHECK(seen >= 2);
   CHECK(bad == 0);
+  }
 }
 
 TEST_CASE("rollback before a key (a straggler's): the events before it kept, a run on rejoins the forward run") {

@@ -202,7 +202,7 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   const unsigned axes = reflection(p, x, v, a);
   const Vec ghost = back_at(x, v, a - 1);
   v = plus_h(v);
-  if (gax_ >= 0 && (axes >> gax_ & 1u)) [[unlikely]] field_impulse(v0[gax_], v[gax_]);
+  if (gax_ >= 0 && (axes >> gax_ & 1u)) [[unlikely]] field_impulse(v0[gax_], v[gax_], reversed_);
   near(p, [&](int q) {
     if (q == p) return;
     // the forward's guard (its reverse would meet q first); the reverse replays the forward, and
@@ -227,17 +227,18 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
 }
 
 // A reflection on the field's axis: |v_after - v_before| to the wall met (the lower one when the
-// velocity before points down, in either frame), added forward and taken off in reverse. (A
-// group that takes a reflection of its tick in, counted in wall_groups, keeps it counted.)
+// velocity before points down, in either frame), added forward and taken off (`off`) in reverse
+// and by a rollback. (A group that takes a reflection of its tick in, counted in wall_groups, keeps
+// it counted.)
 template <class Op, class Bits, class Queue>
-void BasicEngine<Op, Bits, Queue>::field_impulse(std::int64_t before, std::int64_t after) noexcept {
+void BasicEngine<Op, Bits, Queue>::field_impulse(std::int64_t before, std::int64_t after, bool off) noexcept {
   const std::int64_t d = after - before;
   const u128 m = static_cast<u128>(d < 0 ? -d : d);
   const bool lower = before < 0;
   auto& w = cnt_.field_wall_impulse;
   const std::size_t at = lower ? 0 : 2;
   u128 sum = (static_cast<u128>(w[at + 1]) << 64) | w[at];
-  sum = reversed_ ? sum - m : sum + m;
+  sum = off ? sum - m : sum + m;
   w[at] = static_cast<std::uint64_t>(sum);
   w[at + 1] = static_cast<std::uint64_t>(sum >> 64);
 }

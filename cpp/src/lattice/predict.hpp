@@ -107,6 +107,12 @@ inline auto BasicEngine<Op, Bits, Queue>::plus_h(Vec v) const noexcept -> Vec {
   return v;
 }
 
+template <class Op, class Bits, class Queue>
+inline auto BasicEngine<Op, Bits, Queue>::minus_h(Vec v) const noexcept -> Vec {
+  if (gax_ >= 0) [[unlikely]] v[gax_] -= hg_;
+  return v;
+}
+
 // ---- Lees-Edwards shear (shear.hpp) ----
 template <class Op, class Bits, class Queue>
 inline auto BasicEngine<Op, Bits, Queue>::diff_at(const Vec& a, const Vec& b, std::int64_t t, std::int64_t& n) const noexcept -> Vec {

@@ -39,7 +39,6 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::keep_journal(bool on, Rollback how) {
   require(how == Rollback::reverse || how == Rollback::save_all || how == Rollback::save_changes,
           "lattice journal: rollback by reverse computation, save_all (SS1) or save_changes (SS2)");
-  require(!on || gax_ < 0, "lattice journal: not built for a gas in a field yet (rollback and the parallel engine run without gravity)");
   require(!on || sh_ == 0, "lattice journal: not built for a sheared gas yet (rollback and the parallel engine run without shear)");
   jon_ = on;
   jhow_ = how;
@@ -247,7 +246,9 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
     }
     if (jhow_ != Rollback::reverse && (d.type == wall || d.type == coll)) {  // state saving
       if (d.type == coll) touch(d.q);
+      const Vec post = vel(d.p, d.t);  // (a wall: its velocity after, for a field's impulse)
       restore_kept(d);
+      if (d.type == wall && gax_ >= 0) [[unlikely]] unreflect_impulse(d.p, d.t, post);
       if (d.type == wall) {
         if (jhow_ == Rollback::save_changes) {  // (SS1's record holds the cache)
           pre_wall_[d.p] = jwall_.back().pre_wall;
@@ -293,11 +294,26 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
   if (seen_ != nullptr) seen_->drop_after(last_key());  // an LP's: the undone events' observer calls
 }
 
+// A field's wall momentum taken off for p's reflection at a undone by state saving: p's line is
+// again the one before it; `post` its velocity at a after it. The forward's test of the walls met
+// (reflection() on the tick's move) tells whether the field's axis was one.
+template <class Op, class Bits, class Queue>
+void BasicEngine<Op, Bits, Queue>::unreflect_impulse(int p, std::int64_t a, const Vec& post) noexcept {
+  const Vec pre = vel(p, a - 1);
+  Vec x = pos(p, a - 1), v = plus_h(pre);
+  if (reflection(p, x, v, a) >> gax_ & 1u) field_impulse(pre[gax_], post[gax_], true);
+}
+
+// (a field: the mirror takes the tick's moves, the mid velocities: v at a less h after, the
+// velocity at a-1 is the move before less h; the field's wall momentum is taken off)
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::undo_wall(int p, std::int64_t a, const WallDone& w) {
-  Vec x = pos(p, a), v = neg(ln_[p].v);
-  if (reflection(p, x, v, a) == 0) throw std::logic_error("lattice rollback: a reflection's post line meets no wall (a bug)");
-  ln_[p] = Line{x, neg(v), a - 1};
+  const Vec post = vel(p, a);
+  Vec x = pos(p, a), v = neg(minus_h(post));
+  const unsigned axes = reflection(p, x, v, a);
+  if (axes == 0) throw std::logic_error("lattice rollback: a reflection's post line meets no wall (a bug)");
+  ln_[p] = Line{x, minus_h(neg(v)), a - 1};
+  if (gax_ >= 0 && (axes >> gax_ & 1u)) [[unlikely]] field_impulse(ln_[p].v[gax_], post[gax_], true);
   pre_wall_[p] = w.pre_wall;
   wall_tick_[p] = w.wall_tick;
   sync(p);
@@ -318,25 +334,27 @@ void BasicEngine<Op, Bits, Queue>::undo_collision(int i, int j, std::int64_t a, 
   if (own_[i].pc == 0 || own_[j].pc == 0) throw std::logic_error("lattice rollback: a collision count would step back past 0 (a bug)");
   const auto logged = log_.empty() ? log_.end() : log_.find(key);
   const Vec xj = pos(j, a), xi = diff(pos(i, a), xj), zero{};
+  // the post moves (a field: the velocities at a less h; field.hpp) give the pre moves
+  const Vec ui = minus_h(vel(i, a)), uj = minus_h(vel(j, a));
   Vec xi0, xj0, vi0, vj0;
   if (mode_ == Mode::specular && logged == log_.end()) {  // (a log entry: a drawn fallback)
     std::optional<Specular> spm;
-    if (spec_of(i, j, spm).pair_unmap(xi, zero, ln_[i].v, ln_[j].v, xi0, xj0, vi0, vj0) != Refusal::none)
+    if (spec_of(i, j, spm).pair_unmap(xi, zero, ui, uj, xi0, xj0, vi0, vj0) != Refusal::none)
       throw std::logic_error("lattice rollback: the specular map refused a post state it wrote (a bug)");
   } else {
     const std::uint32_t redraws = logged != log_.end() ? logged->second : 0;
     if (own_[i].ctr < 1 + static_cast<std::uint64_t>(redraws)) throw std::logic_error("lattice rollback: a stream would step back past draw 0 (a bug)");
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr - 1);
     std::optional<Op> opm;
-    op_of(i, j, opm).pair_reverse(xi, zero, ln_[i].v, ln_[j].v, g, own_[i].X, xi0, xj0, vi0, vj0);
+    op_of(i, j, opm).pair_reverse(xi, zero, ui, uj, g, own_[i].X, xi0, xj0, vi0, vj0);
     own_[i].ctr -= 1 + redraws;
     if (logged != log_.end()) log_.erase(logged);
   }
   --own_[i].pc;
   --own_[j].pc;
   --ncoll_;
-  ln_[i] = Line{shifted(xj, xi0), vi0, a - 1};
-  ln_[j] = Line{shifted(xj, xj0), vj0, a - 1};
+  ln_[i] = Line{shifted(xj, xi0), minus_h(vi0), a - 1};
+  ln_[j] = Line{shifted(xj, xj0), minus_h(vj0), a - 1};
   sync(i);
   sync(j);
   ++cnt_.collisions;
@@ -433,8 +451,9 @@ void BasicEngine<Op, Bits, Queue>::undo_group(std::int64_t a, const Group& entry
   if (own_[drawer].ctr < draws) throw std::logic_error("lattice rollback: a stream would step back past draw 0 (a bug)");
   for (std::size_t m = 0; m < g.size(); ++m) {
     Line& l = ln_[g[m]];
-    // a member's point at a is its a-1 point (the stall)
-    l = Line{pos(g[m], a), pre_v.empty() ? neg(l.v) : pre_v[m], a - 1};
+    // a member's point at a is its a-1 point (the stall); a bounce's velocities at a are the
+    // negated ones at a-1 (a field's too: the moves negated, h added)
+    l = Line{pos(g[m], a), pre_v.empty() ? neg(vel(g[m], a)) : pre_v[m], a - 1};
     touch(g[m]);
   }
   own_[drawer].ctr -= draws;
@@ -450,9 +469,9 @@ void BasicEngine<Op, Bits, Queue>::undo_group(std::int64_t a, const Group& entry
     if (!(unreflected >> s & 1u)) continue;
     const int m = s == 0 ? i : j;
     pre_wall_[m] = ln_[m];
-    Vec x = pos(m, a - 1), v = ln_[m].v;
+    Vec x = pos(m, a - 1), v = plus_h(ln_[m].v);  // (as reflect(): the tick's move, then h on)
     if (reflection(m, x, v, a) == 0) throw std::logic_error("lattice rollback: a group member's reflection meets no wall (a bug)");
-    ln_[m] = Line{x, v, a};
+    ln_[m] = Line{x, plus_h(v), a};
     wall_tick_[m] = a;
   }
   for (int q : g) sync(q);

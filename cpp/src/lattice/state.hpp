@@ -85,7 +85,7 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<std::uint32_t>& order) {
   validate_state(s.units, s.x, s.v, true, s.radius, s.clock);  // collisions may be pending at the clock (rebuild finds them)
   if (!s.radius.empty()) Sizes::require_resizable<Op>();
-  require(field_axis(s.units) < 0 || (rax_ < 0 && !jon_), "lattice: a gas in a field runs without regions or journal (not built for curved lines yet)");
+  require(field_axis(s.units) < 0 || rax_ < 0, "lattice: a gas in a field runs without regions (the parallel engine is not built for curved lines yet)");
   require(s.units.shear == 0 || (rax_ < 0 && !jon_ && list_shell_ <= 0.0),
           "lattice: a sheared gas runs without regions, journal or neighbour lists (not built for moving images yet)");
   if (!order.empty()) {
@@ -539,6 +539,7 @@ auto BasicEngine<Op, Bits, Queue>::auto_list_shell() const noexcept -> double {
     // Enskog mean free path in diameters; the shell grows with it (docs/lattice.md, measured)
     const double g = (1.0 - 0.5 * phi) / ((1.0 - phi) * (1.0 - phi) * (1.0 - phi));
     const double lam = phi > 0.0 ? 1.0 / (6.0 * std::numbers::sqrt2 * phi * g) : 1e9;
+    if (gax_ >= 0 && lam > kFieldListsMaxLambda) return 0.0;  // a sparse gas in a field: the cell grid
     return std::clamp(kShellBase + kShellSlope * lam, kShellMin, kShellMax);
   }
 }
