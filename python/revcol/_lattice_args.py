@@ -58,14 +58,16 @@ def _shell(search: Union[str, float]) -> float:
 
 
 def _gravity(gravity, dim: int, workers: int = 1) -> list:
-    """A uniform field's components for the engine (empty: none); a field runs on one worker."""
+    """A uniform field's components for the engine (empty: none). More than one worker cuts the box
+    along axis 0 (set_parallel's default), which must then be another axis than the field's."""
     if gravity is None:
         return []
     g = np.atleast_1d(real_array(gravity, "gravity")).astype(float)
     if g.shape != (dim,):
         raise ValueError(f"gravity must have one component per axis ({dim}), got shape {g.shape}")
-    if np.any(g != 0.0) and integer(workers, "workers", 1) > 1:
-        raise ValueError("gravity runs on one worker: the parallel lattice engine is not built for a field yet")
+    if g[0] != 0.0 and integer(workers, "workers", 1) > 1:
+        raise ValueError("gravity along axis 0 runs on one worker here: the parallel engine cuts the box across "
+                         "the field, and its default slabs lie along axis 0 (set_parallel(axis=...) after building)")
     return g.tolist()
 
 

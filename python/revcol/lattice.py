@@ -290,6 +290,9 @@ class LatticeSimulation(SimulationBase):
         if workers > k:
             raise ValueError(f"workers must be at most lps (the logical processes), got workers={workers} > lps={k}")
         axis = integer(axis, "axis", 0, self._DIM - 1)
+        if k > 1 and hasattr(self, "_e") and self.gravity[axis] != 0.0:
+            raise ValueError(f"axis: a gas in a field is cut across the field, not along it (the field is along "
+                             f"axis {axis}): choose another axis for the slabs")
         rollback = name(rollback, "rollback")
         if rollback not in ("reverse", "save_all", "save_changes"):
             raise ValueError(f"rollback must be 'reverse', 'save_all' (SS1) or 'save_changes' (SS2), not {rollback!r}")

@@ -260,9 +260,9 @@ def with_lattice_options(scene, *, tick_bits: int | None = None, cell_bits: int 
                          search: str | float | None = None, workers: int | None = None):
     """``scene`` with the lattice engine's options that are not None replaced (``revcol run`` and
     ``revcol simulate``'s ``--tick-bits``, ``--cell-bits``, ``--search``, ``--workers``), each checked as its
-    ``[collisions]`` field; a scene that does not run the lattice engine refuses them, and one with a
-    field (``[system] gravity``) or shear (``shear_rate``) more than one worker, under shear a
-    neighbour-list shell too (check_field_options)."""
+    ``[collisions]`` field; a scene that does not run the lattice engine refuses them, one under shear
+    (``shear_rate``) more than one worker and a neighbour-list shell, and one with a field (``[system]
+    gravity``) along axis 0 more than one worker (check_field_options)."""
     given = {k: v for k, v in zip(LATTICE_FIELDS, (tick_bits, cell_bits, search, workers)) if v is not None}
     flags = {k: "--" + k.replace("_", "-") for k in given}
     if given and (scene.kind != "gas" or scene.engine != "lattice"):
@@ -308,11 +308,11 @@ def check_gravity(source: str, gravity: Sequence[float] | None, d: int,
     return tuple(gravity)
 
 
-# what runs neither a field nor shear yet on the lattice engine, in the words of each refusal: where
-# the gas is, what the parallel engine and the neighbour lists are not built for yet (None: built; both
-# engines observe either: the observer follows parabolas and moving images)
+# what runs no shear yet on the lattice engine, in the words of each refusal: where the gas is, what
+# the parallel engine and the neighbour lists are not built for yet (both engines observe it: the
+# observer follows moving images). A field runs on either search and on many workers (the slabs,
+# along axis 0, across the field: check_field_options)
 _UNBUILT = {
-    "gravity": ("in a field ([system] gravity)", "a field", None),
     "shear": ("under shear ([system] shear_rate)", "shear", "moving images"),
 }
 
@@ -320,13 +320,18 @@ _UNBUILT = {
 def check_field_options(source: str, gravity: Sequence[float] | None, engine: str, *, workers: int = 1,
                         search: str | float = "auto", names: dict | None = None,
                         shear: float | None = None) -> None:
-    """Refuses, naming the option, what runs no field (``gravity``) or no shear (``shear``, a rate;
-    None: none) yet on the lattice engine: more than one worker, and under shear neighbour lists
-    (``search`` a shell; ``"auto"`` takes the cell grid there). (A sheared gas's slabs lie along axis 1 only:
-    check_shear_observe.) ``names`` renames an option where it came from the command line
+    """Refuses, naming the option, what runs no shear (``shear``, a rate; None: none) yet on the
+    lattice engine: more than one worker and neighbour lists (``search`` a shell; ``"auto"`` takes the
+    cell grid there); and a field (``gravity``) along axis 0 on more than one worker (the parallel
+    engine's slabs lie along axis 0 and must cut across the field). (A sheared gas's slabs lie along
+    axis 1 only: check_shear_observe.) ``names`` renames an option where it came from the command line
     (``{"workers": "--workers"}``)."""
     names = names or {}
-    for kind, on in (("gravity", gravity is not None), ("shear", shear is not None)):
+    if engine == "lattice" and gravity is not None and gravity[0] != 0.0 and workers > 1:
+        raise _fail(source, names.get("workers", "[collisions] workers"), f"engine = 'lattice' runs a gas in a field "
+                    f"along axis 0 on one worker (the parallel engine's slabs lie along axis 0 and cut across the field "
+                    f"only: put the field on another axis), got {workers}")
+    for kind, on in (("shear", shear is not None),):
         if not on:
             continue
         where, what, lists = _UNBUILT[kind]
@@ -335,7 +340,7 @@ def check_field_options(source: str, gravity: Sequence[float] | None, engine: st
         if workers > 1:
             raise _fail(source, names.get("workers", "[collisions] workers"), f"engine = 'lattice' runs a gas "
                         f"{where} on one worker (the parallel engine is not built for {what} yet), got {workers}")
-        if lists is not None and search not in ("auto", "cells"):
+        if search not in ("auto", "cells"):
             raise _fail(source, names.get("search", "[collisions] search"), f"engine = 'lattice' searches a gas "
                         f"{where} with the cell grid only ('auto' or 'cells'; no neighbour lists for {lists} yet), "
                         f"got {search!r}")

@@ -86,15 +86,16 @@ EngineOf<D> engine_of(const revcol::lattice::LatticeStartN<D>& s, std::uint32_t 
   return {s.units, s.x, s.v, s.radius, seed, op, 0, mode};
 }
 
-/// What a gas in a field or under shear refuses by name (InvalidArgument), its state untouched:
-/// regions (the parallel engine), and under shear (`sheared`) neighbour lists and the rollback
-/// journal. (Both are observed; a field takes lists and the journal.)
+/// What a gas under shear (`sheared`) or in a field along `field_axis` refuses by name
+/// (InvalidArgument), its state untouched: under shear neighbour lists, the rollback journal and
+/// regions (the parallel engine); in a field regions along the field (its slabs cut across it).
+/// (Both are observed; a field takes lists, the journal and regions on another axis.)
 template <class Engine>
-void check_refusals(Engine& e, bool sheared) {
+void check_refusals(Engine& e, bool sheared, int field_axis = -1) {
   const auto before = e.snapshot();
   if (sheared) CHECK_THROWS_AS(e.set_list_shell(1.0), revcol::InvalidArgument);
   if (sheared) CHECK_THROWS_AS(e.keep_journal(true), revcol::InvalidArgument);
-  CHECK_THROWS_AS(e.set_regions(0, {0}), revcol::InvalidArgument);
+  CHECK_THROWS_AS(e.set_regions(sheared ? 0 : field_axis, {0}), revcol::InvalidArgument);
   CHECK(revcol::lattice::same_state(e.snapshot(), before));
 }
 

@@ -142,7 +142,7 @@ TEST_CASE("3D gas under gravity along z, walls all round; a binary mixture (rati
   round_trip<2>(start<2>(200, 0.4, ch, 1, -0.5, 33, d), Mode::exact, 6000, 33, 1);
 }
 
-TEST_CASE("a field's refusals: a periodic axis, two axes, an odd field, regions") {
+TEST_CASE("a field's refusals: a periodic axis, two axes, an odd field, regions along it") {
   LatticeStartN<2> s = start<2>(100, 0.2, std::array<en::Boundary, 2>{en::Boundary::periodic, en::Boundary::wall}, 1, -0.5, 41);
   CHECK(s.units.gravity[1] % 2 == 0 && s.units.gravity[1] < 0);
   CHECK(s.gravity_error < 1e-3);
@@ -164,7 +164,7 @@ TEST_CASE("a field's refusals: a periodic axis, two axes, an odd field, regions"
   LatticeEngine e(s.units, s.x, s.v, 41, operator_for(s.units));
   CHECK(e.neighbour_search() == 0);  // 2D: the cell grid unless lists are asked for
   const Snapshot before = e.snapshot();
-  lattice_test::check_refusals(e, false);
+  lattice_test::check_refusals(e, false, 1);
   // a state whose potential would let a particle pass vmax is refused
   UnitsN<2> strong = s.units;
   strong.gravity[1] = -max_gravity;

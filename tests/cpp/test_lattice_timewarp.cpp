@@ -75,7 +75,8 @@ void check_parallel(EngineOf<D> e, int axis, const std::vector<int>& ks, const s
       for (const auto& w : want) {
         tw.run_until(w.clock);
         const SnapshotN<D> got = tw.snapshot();
-        const bool eq = same_state(got, w) && got.observer == w.observer && got.observer_counts == w.observer_counts;
+        const bool eq = same_state(got, w) && got.observer == w.observer && got.observer_counts == w.observer_counts &&
+                        got.counters.field_wall_impulse == w.counters.field_wall_impulse;  // (a field's walls' momentum)
         CHECK(!observe || got.observer.size() > 100);
         if (!eq) {
           const SnapshotN<D>& g = got;
@@ -141,6 +142,24 @@ TEST_CASE("the parallel engine commits the sequential state bit for bit (3D)") {
   check_parallel<3>(lattice_test::make_gas<3>(1000, 0.35, B::bounce, 76, 16), 0, {3}, {11, kThreads}, scaled(3000), "3D 0.35 bounce walls, observed",
                     -1.0, true);
   check_parallel<3>(lattice_test::make_gas<3>(600, 0.25, B::wall, 77, 16, Mode::specular), 1, {2}, {12}, scaled(2000), "3D 0.25 walls specular");
+}
+
+TEST_CASE("the parallel engine commits the sequential state bit for bit in a field (cut across it)") {
+  using B = en::Boundary;
+  check_parallel<2>(lattice_test::make_gas<2>(600, 0.4, B::periodic, 171, 16, Mode::exact, -2.0), 0, {1, 2, 3, 8}, {0, 5, 1006, kThreads},
+                    scaled(2000), "2D 0.4 channel, g = -2");
+  check_parallel<2>(lattice_test::make_gas<2>(600, 0.4, B::periodic, 171, 16, Mode::exact, -2.0), 0, {3}, {5, kThreads}, scaled(2000),
+                    "2D 0.4 channel, g = -2, observed", -1.0, true);
+  check_parallel<3>(lattice_test::make_gas<3>(1000, 0.3, B::wall, 175, 16, Mode::exact, -1.0), 0, {2, 4}, {0, 1010, kThreads}, scaled(3000),
+                    "3D 0.3 walls, g = -1");
+  check_parallel<3>(lattice_test::make_gas<3>(1000, 0.3, B::periodic, 176, 16, Mode::specular, -2.0), 1, {2, 3}, {14, kThreads}, scaled(3000),
+                    "3D 0.3 slab specular, g = -2", 0.0);
+  // along the field: refused by name, nothing built
+  auto e = lattice_test::make_gas<2>(200, 0.3, B::periodic, 172, 16, Mode::exact, -2.0);
+  typename TimeWarp<EngineOf<2>>::Config c;
+  c.lps = 2;
+  c.axis = 1;
+  CHECK(lattice_test::refused([&] { TimeWarp<EngineOf<2>> tw(e.snapshot(), c); }, "cut across the field"));
 }
 
 // the threaded schedule caps a turn by the other LPs on its worker: share_of must name the

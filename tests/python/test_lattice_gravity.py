@@ -140,10 +140,27 @@ def test_what_a_field_refuses():
         LatticeSimulation.random(100, phi=0.2, boundary=["periodic", "wall"], gravity=[-1.0])
     with pytest.raises(ValueError, match="one axis"):
         LatticeSimulation.random(100, phi=0.2, boundary="wall", gravity=[-1.0, -1.0])
-    with pytest.raises(ValueError, match="one worker"):
-        LatticeSimulation.random(100, phi=0.2, boundary=["periodic", "wall"], gravity=[0.0, -1.0], workers=2)
+    with pytest.raises(ValueError, match="gravity along axis 0 runs on one worker"):
+        LatticeSimulation.random(100, phi=0.2, boundary=["wall", "periodic"], gravity=[-1.0, 0.0], workers=2)
+    s = LatticeSimulation.random(100, phi=0.2, boundary=["periodic", "wall"], gravity=[0.0, -1.0])
+    with pytest.raises(ValueError, match="cut across the field"):
+        s.set_parallel(2, axis=1)
     with pytest.raises(ValueError, match="resolution"):
         LatticeSimulation.random(100, phi=0.2, boundary=["periodic", "wall"], gravity=[0.0, -1e-12], tick_bits=26)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_gas_in_a_field_runs_on_workers_with_the_sequential_bits(dim):
+    # slabs across the field (axis 0), more LPs than cores: forward and back, the sequential run's bits
+    seq, par = gas(dim=dim, n=1500, g=-2.0, seed=6), gas(dim=dim, n=1500, g=-2.0, seed=6, workers=2, lps=3)
+    start, impulse0 = seq.snapshot(), seq.diagnostics()["field_wall_impulse"]
+    seq.run(collisions=12_000)
+    r = par.run(collisions=12_000)
+    assert len(r["parallel"]["lp_events"]) == 3 and r["parallel"]["parallel_collisions"] > 0
+    assert same(seq.snapshot(), par.snapshot())
+    assert seq.diagnostics()["field_wall_impulse"] == par.diagnostics()["field_wall_impulse"]
+    par.run_back(collisions=12_000)
+    assert same(par.snapshot(), start) and par.diagnostics()["field_wall_impulse"] == impulse0
 
 
 @pytest.mark.parametrize("by", ["reverse", "save_all", "save_changes"])

@@ -67,17 +67,15 @@ def test_bad_fields_are_refused_by_name(fields, needle):
     assert needle in str(e.value) and str(e.value).startswith("g.toml: ")
 
 
-@pytest.mark.parametrize("fields,needle", [
-    ({"collisions": {"workers": 4}}, "[collisions] workers: engine = 'lattice' runs a gas in a field ([system] "
-                                     "gravity) on one worker"),
-])
-def test_the_lattice_refuses_what_runs_no_field_at_load(fields, needle):
-    with pytest.raises(SceneError, match=None) as e:
-        scene("lattice", **fields)
-    assert needle in str(e.value)
-    # the same options without a field load
-    no_field = {**fields, "system": {"gravity": [0.0, 0.0]}}
-    assert scene("lattice", **no_field).gravity is None
+def test_the_lattice_runs_a_field_on_workers_across_it_only():
+    # the parallel engine's slabs lie along axis 0: a field along axis 1 runs on 4 workers, one along 0 is refused
+    assert scene("lattice", collisions={"workers": 4}).gravity == (0.0, -1.0)
+    along = {"system": {"gravity": [-1.0, 0.0], "boundaries": ["wall", "periodic"]}, "collisions": {"workers": 4}}
+    with pytest.raises(SceneError) as e:
+        scene("lattice", **along)
+    assert "[collisions] workers: engine = 'lattice' runs a gas in a field along axis 0 on one worker" in str(e.value)
+    assert scene("lattice", **{**along, "collisions": {"workers": 1}}).gravity == (-1.0, 0.0)
+    assert scene("float", system=along["system"]).gravity == (-1.0, 0.0)
 
 
 @pytest.mark.parametrize("engine", ["lattice", "float"])
@@ -94,8 +92,10 @@ def test_either_engine_observes_a_scene_in_a_field(engine):
 
 def test_the_command_lines_lattice_options_are_refused_by_flag():
     s = scene("lattice")
-    with pytest.raises(SceneError, match="--workers: engine = 'lattice' runs a gas in a field"):
-        with_lattice_options(s, workers=2)
+    assert with_lattice_options(s, workers=2).workers == 2  # a field takes workers (slabs across it)
+    along = scene("lattice", system={"gravity": [-1.0, 0.0], "boundaries": ["wall", "periodic"]})
+    with pytest.raises(SceneError, match="--workers: engine = 'lattice' runs a gas in a field along axis 0"):
+        with_lattice_options(along, workers=2)
     assert with_lattice_options(s, search=0.5).search == 0.5  # a field takes neighbour lists
     assert with_lattice_options(s, search="cells", workers=1).search == "cells"
     # a float scene moved to the lattice keeps its field

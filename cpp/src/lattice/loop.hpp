@@ -130,7 +130,7 @@ auto BasicEngine<Op, Bits, Queue>::loop(std::uint64_t want, std::int64_t until, 
       if (journal) {
         jkept_ = 0;
         if (jhow_ != Rollback::reverse) save_state(p);
-        jwall_.push_back(WallDone{wall_tick_[p], pre_wall_[p]});
+        jwall_.push_back(WallDone{wall_tick_[p], pre_wall_[p], impulse_here(p)});
         jdone_.push_back(Done{t, kind, p, -1, wall, 0, jkept_});
       }
       reflect(p, t);
@@ -202,7 +202,7 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   const unsigned axes = reflection(p, x, v, a);
   const Vec ghost = back_at(x, v, a - 1);
   v = plus_h(v);
-  if (gax_ >= 0 && (axes >> gax_ & 1u)) [[unlikely]] field_impulse(v0[gax_], v[gax_], reversed_);
+  if (gax_ >= 0 && (axes >> gax_ & 1u) && impulse_here(p)) [[unlikely]] field_impulse(v0[gax_], v[gax_], reversed_);
   near(p, [&](int q) {
     if (q == p) return;
     // the forward's guard (its reverse would meet q first); the reverse replays the forward, and

@@ -248,7 +248,7 @@ void BasicEngine<Op, Bits, Queue>::unwind(Keep keep, std::int64_t clock) {
       if (d.type == coll) touch(d.q);
       const Vec post = vel(d.p, d.t);  // (a wall: its velocity after, for a field's impulse)
       restore_kept(d);
-      if (d.type == wall && gax_ >= 0) [[unlikely]] unreflect_impulse(d.p, d.t, post);
+      if (d.type == wall && gax_ >= 0 && jwall_.back().counted) [[unlikely]] unreflect_impulse(d.p, d.t, post);
       if (d.type == wall) {
         if (jhow_ == Rollback::save_changes) {  // (SS1's record holds the cache)
           pre_wall_[d.p] = jwall_.back().pre_wall;
@@ -301,11 +301,12 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::unreflect_impulse(int p, std::int64_t a, const Vec& post) noexcept {
   const Vec pre = vel(p, a - 1);
   Vec x = pos(p, a - 1), v = plus_h(pre);
-  if (reflection(p, x, v, a) >> gax_ & 1u) field_impulse(pre[gax_], post[gax_], true);
+  if (reflection(p, x, v, a) >> gax_ & 1u) field_impulse(pre[gax_], post[gax_], !reversed_);
 }
 
 // (a field: the mirror takes the tick's moves, the mid velocities: v at a less h after, the
-// velocity at a-1 is the move before less h; the field's wall momentum is taken off)
+// velocity at a-1 is the move before less h; the field's wall momentum is taken off, or, in an LP
+// running back, given back)
 template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::undo_wall(int p, std::int64_t a, const WallDone& w) {
   const Vec post = vel(p, a);
@@ -313,7 +314,7 @@ void BasicEngine<Op, Bits, Queue>::undo_wall(int p, std::int64_t a, const WallDo
   const unsigned axes = reflection(p, x, v, a);
   if (axes == 0) throw std::logic_error("lattice rollback: a reflection's post line meets no wall (a bug)");
   ln_[p] = Line{x, minus_h(neg(v)), a - 1};
-  if (gax_ >= 0 && (axes >> gax_ & 1u)) [[unlikely]] field_impulse(ln_[p].v[gax_], post[gax_], true);
+  if (gax_ >= 0 && (axes >> gax_ & 1u) && w.counted) [[unlikely]] field_impulse(ln_[p].v[gax_], post[gax_], !reversed_);
   pre_wall_[p] = w.pre_wall;
   wall_tick_[p] = w.wall_tick;
   sync(p);
@@ -413,17 +414,19 @@ void BasicEngine<Op, Bits, Queue>::redo_collision(const Done& d) {
     return;
   }
   const Vec xj = pos(j, a), xi = diff(pos(i, a), xj), zero{};
+  // the back step's moves into a (a field: the velocities at a less h), negated: the forward's
+  const Vec ui = neg(minus_h(vel(i, a))), uj = neg(minus_h(vel(j, a)));
   Vec xi2, xj2, vi2, vj2;
   const bool logged = (d.unreflected & 8u) != 0;
   if (mode_ == Mode::specular && !logged) {
     std::optional<Specular> spm;
-    if (spec_of(i, j, spm).pair_map(xi, zero, neg(ln_[i].v), neg(ln_[j].v), xi2, xj2, vi2, vj2, nullptr) != Refusal::none)
+    if (spec_of(i, j, spm).pair_map(xi, zero, ui, uj, xi2, xj2, vi2, vj2, nullptr) != Refusal::none)
       throw std::logic_error("lattice rollback: the specular map refused a collision a back step took back (a bug)");
   } else {
     const std::uint64_t g = draw48(static_cast<std::uint32_t>(gid(i)), seed_, own_[i].ctr + side.redraws);
     Bits out;
     std::optional<Op> opm;
-    if (op_of(i, j, opm).pair_forward(xi, zero, neg(ln_[i].v), neg(ln_[j].v), g, own_[i].X, xi2, xj2, vi2, vj2, out) != Refusal::none)
+    if (op_of(i, j, opm).pair_forward(xi, zero, ui, uj, g, own_[i].X, xi2, xj2, vi2, vj2, out) != Refusal::none)
       throw std::logic_error("lattice rollback: the operator refused the draw a back step took back (a bug)");
     own_[i].X = std::move(out);
     own_[i].ctr += 1 + static_cast<std::uint64_t>(side.redraws);
@@ -432,8 +435,8 @@ void BasicEngine<Op, Bits, Queue>::redo_collision(const Done& d) {
   ++own_[i].pc;
   ++own_[j].pc;
   ++ncoll_;
-  ln_[i] = Line{shifted(xj, xi2), neg(vi2), a - 1};
-  ln_[j] = Line{shifted(xj, xj2), neg(vj2), a - 1};
+  ln_[i] = Line{shifted(xj, xi2), minus_h(neg(vi2)), a - 1};  // (a field: the move before less h)
+  ln_[j] = Line{shifted(xj, xj2), minus_h(neg(vj2)), a - 1};
   sync(i);
   sync(j);
   ++cnt_.collisions;

@@ -85,7 +85,7 @@ template <class Op, class Bits, class Queue>
 void BasicEngine<Op, Bits, Queue>::restore(const Snapshot& s, const std::vector<std::uint32_t>& order) {
   validate_state(s.units, s.x, s.v, true, s.radius, s.clock);  // collisions may be pending at the clock (rebuild finds them)
   if (!s.radius.empty()) Sizes::require_resizable<Op>();
-  require(field_axis(s.units) < 0 || rax_ < 0, "lattice: a gas in a field runs without regions (the parallel engine is not built for curved lines yet)");
+  require(rax_ < 0 || rax_ != field_axis(s.units), "lattice: a gas in a field is cut across the field, not along it (regions' axis must be another than the field's)");
   require(s.units.shear == 0 || (rax_ < 0 && !jon_ && list_shell_ <= 0.0),
           "lattice: a sheared gas runs without regions, journal or neighbour lists (not built for moving images yet)");
   if (!order.empty()) {
@@ -506,9 +506,9 @@ void BasicEngine<Op, Bits, Queue>::set_regions(int axis, std::vector<std::int64_
     rax_ = -1;
     faces_.clear();
   } else {
-    require(gax_ < 0, "lattice regions: not built for a gas in a field yet (the parallel engine runs without gravity)");
     require(sh_ == 0, "lattice regions: not built for a sheared gas yet (the parallel engine runs without shear)");
     require(axis >= 0 && axis < static_cast<int>(D), "lattice regions: the axis must be 0, 1 or (3D) 2");
+    require(axis != gax_, "lattice regions: a gas in a field is cut across the field, not along it (its slabs' axis must be another than the field's)");
     const std::int64_t L = u_.L[static_cast<std::size_t>(axis)];
     for (std::size_t k = 0; k < faces.size(); ++k)
       require(faces[k] >= 0 && faces[k] < L && (k == 0 || faces[k - 1] < faces[k]),

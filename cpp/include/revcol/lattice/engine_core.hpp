@@ -378,6 +378,11 @@ class BasicEngine {
   void reflect(int p, std::int64_t a);
   void field_impulse(std::int64_t before, std::int64_t after, bool off) noexcept;  // a field's wall momentum (loop.hpp)
   void unreflect_impulse(int p, std::int64_t a, const Vec& post) noexcept;  // rollback.hpp
+  // whether a reflection of p now adds to the field's wall momentum: always, but in an LP of the
+  // parallel engine only for a particle in a region it owns (the authority: each reflection once)
+  bool impulse_here(int p) const noexcept {
+    return lp_ == nullptr || lp_->mine == nullptr || (*lp_->mine)[static_cast<std::size_t>(region_[static_cast<std::size_t>(p)])] != 0;
+  }
   // a state the reverse cannot take back (a loaded state no run wrote): an error naming it, the
   // collision and the pair; run_back restores the state it began with
   [[noreturn, gnu::cold]] void inconsistent(const std::string& what, int i, int j) const;  // (collide.hpp)
@@ -555,7 +560,7 @@ class BasicEngine {
     std::uint8_t unreflected;  // a group: bit 0 (p), bit 1 (q) took in their reflection at t; bit 2: q was popped; bit 3: a jback_ entry
     std::uint8_t kept;         // state saving: the particle states saved before it
   };
-  struct WallDone { std::int64_t wall_tick; Line pre_wall; };  // a reflection's replaced one-tick cache
+  struct WallDone { std::int64_t wall_tick; Line pre_wall; bool counted; };  // a reflection's replaced one-tick cache; a field's momentum counted (impulse_here)
   bool jon_ = false;
   Rollback jhow_ = Rollback::reverse;
   std::deque<Done> jdone_;

@@ -65,6 +65,7 @@ struct LpNotes {
   std::array<std::size_t, 7> marks{};  ///< (the engine's journal sizes before the event under way)
   bool in_after = false;           ///< (after is running: its exceptions are not the engine's)
   LpSeen* seen = nullptr;          ///< an observed run: where the engine keeps its observer calls (lp_seen.hpp)
+  const std::vector<std::uint8_t>* mine = nullptr;  ///< per fine region: this LP owns it (a field's wall momentum counts only the owner's reflections)
 };
 
 /// The counts of a parallel run (all LPs).

@@ -98,6 +98,7 @@ class TimeWarp {
   TimeWarp(const TimeWarp&) = delete;  // (its LPs' engines call back into it)
   TimeWarp& operator=(const TimeWarp&) = delete;
   TimeWarp(const Snapshot& s, const Config& c) : c_(c), rng_(c.fuzz) {
+    base_.counters = s.counters;  // (the LPs' counters start from these: committed_state)
     require(c.axis >= 0 && c.axis < static_cast<int>(D), "parallel lattice engine: the slabs' axis must be 0, 1 or (3D) 2");
     require(c.max_delay >= 0 && c.gvt_every >= 1 && c.batch >= 1, "parallel lattice engine: max_delay >= 0, gvt_every >= 1, batch >= 1");
     require(c.workers >= 1 && c.workers <= c.lps, "parallel lattice engine: 1 to K (the logical processes) workers");
@@ -125,6 +126,9 @@ class TimeWarp {
       lp.notes.after = &TimeWarp::after_hook;
       lp.notes.ctx = &lp.hook;
       if (obs_) lp.notes.seen = &lp.seen;
+      lp.mine.resize(sv_.faces().size());  // the fine regions it owns (a field's wall momentum: its authority's)
+      for (std::size_t r = 0; r < lp.mine.size(); ++r) lp.mine[r] = sv_.owner(static_cast<int>(r)) == m ? 1 : 0;
+      lp.notes.mine = &lp.mine;
       lp.eng.keep_journal(true, c.how);
       lp.eng.lp_begin(held, &lp.notes);
       lp.last = lp.eng.last_key();
@@ -153,7 +157,7 @@ class TimeWarp {
   Snapshot snapshot() const {
     std::vector<const Engine*> engines;
     for (const auto& lp : lps_) engines.push_back(&lp->eng);
-    Snapshot s = committed_state(engines, sv_, horizon_, c_.back);
+    Snapshot s = committed_state(engines, sv_, horizon_, c_.back, &base_);
     if (obs_) obs_->save(s.observer, s.observer_counts);  // (not synced: run_parallel syncs the whole run's once)
     return s;
   }
@@ -192,6 +196,7 @@ class TimeWarp {
     int me = 0;
     Engine eng;
     LpNotes notes;
+    std::vector<std::uint8_t> mine;                   // per fine region: this LP owns it (notes.mine)
     LpSeen seen;                                      // an observed run: the observer's calls of its events
     EventKey last;                                    // the last key processed
     std::map<MKey, Message> pending, taken;           // input not yet processed; processed (written or confirming)
@@ -566,6 +571,7 @@ class TimeWarp {
 
   // ---- helpers ----
   std::size_t pick(int k) { return static_cast<std::size_t>(rng_() % static_cast<std::uint64_t>(k)); }
+  Snapshot base_;  // the counters the LPs were built with (committed_state)
   Config c_;
   std::mt19937_64 rng_;
   SlabViews sv_;

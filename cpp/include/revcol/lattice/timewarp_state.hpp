@@ -24,16 +24,30 @@ template <class Record, std::size_t D>
 VecN<D> record_at(const Record& r, std::int64_t t, const UnitsN<D>& u) {
   VecN<D> x;
   for (std::size_t k = 0; k < D; ++k) {
-    const __int128 y = static_cast<__int128>(r.x[k]) + static_cast<__int128>(r.v[k]) * (t - r.ta);
+    const std::int64_t n = t - r.ta;
+    __int128 y = static_cast<__int128>(r.x[k]) + static_cast<__int128>(r.v[k]) * n;
+    if (u.gravity[k] != 0) y += static_cast<__int128>(u.gravity[k] / 2) * n * n;  // a field's parabola (field.hpp)
     x[k] = u.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u.L[k]);
   }
   return x;
 }
 
+/// The velocity of a record's line at tick t (a field's changes by g per tick along its axis).
+template <class Record, std::size_t D>
+VecN<D> record_velocity(const Record& r, std::int64_t t, const UnitsN<D>& u) {
+  VecN<D> v = r.v;
+  for (std::size_t k = 0; k < D; ++k)
+    if (u.gravity[k] != 0) v[k] += u.gravity[k] * (t - r.ta);
+  return v;
+}
+
 /// The state at tick `clock` of LPs (their engines, LP m's at m) that have processed every event
 /// up to it and none after, by particle id; `back`: LPs of a run back (clock in their frame).
+/// Its counters are zero but a field's wall momentum (a physical sum, the column's weight): the
+/// state's `base` (the counters the LPs were built with) and what each LP added to it since.
 template <class Engine>
-auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv, std::int64_t clock, bool back = false) {
+auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv, std::int64_t clock, bool back = false,
+                     const typename Engine::Snapshot* base = nullptr) {
   using Snapshot = typename Engine::Snapshot;
   constexpr std::size_t D = Engine::D;
   Snapshot s = lps.front()->snapshot();
@@ -51,7 +65,7 @@ auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv,
       from[id] = static_cast<int>(m);
       const auto r = e.record(i);
       s.x[id] = record_at(r, clock, s.units);
-      s.v[id] = back ? neg(r.v) : r.v;
+      s.v[id] = back ? neg(record_velocity(r, clock, s.units)) : record_velocity(r, clock, s.units);
       s.streams[id] = r.ctr;
       s.particle_collisions[id] = r.pc;
       const auto w = r.X.words();
@@ -87,6 +101,20 @@ auto committed_state(const std::vector<const Engine*>& lps, const SlabViews& sv,
   for (const auto& g : s.groups) sum -= g.members.size() - 2;
   s.collisions = sum / 2;
   s.counters = Counters{};
+  if (base != nullptr) {  // (each LP's own rollbacks took off what they undid: field_impulse)
+    const auto& b = base->counters.field_wall_impulse;
+    auto& w = s.counters.field_wall_impulse;
+    for (std::size_t at : {std::size_t{0}, std::size_t{2}}) {
+      const unsigned __int128 b0 = (static_cast<unsigned __int128>(b[at + 1]) << 64) | b[at];
+      unsigned __int128 sum = b0;
+      for (const Engine* e : lps) {
+        const auto& c = e->counters().field_wall_impulse;
+        sum += ((static_cast<unsigned __int128>(c[at + 1]) << 64) | c[at]) - b0;  // (modular: exact)
+      }
+      w[at] = static_cast<std::uint64_t>(sum);
+      w[at + 1] = static_cast<std::uint64_t>(sum >> 64);
+    }
+  }
   return s;
 }
 
