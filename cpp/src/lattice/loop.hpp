@@ -226,6 +226,13 @@ void BasicEngine<Op, Bits, Queue>::reflect(int p, std::int64_t a) {
   predict(p, a);
 }
 
+// Whether a reflection of p adds to the field's wall momentum: always, but in an LP of the parallel
+// engine only for a particle in a region it owns (the authority: each reflection counted once).
+template <class Op, class Bits, class Queue>
+bool BasicEngine<Op, Bits, Queue>::impulse_here(int p) const noexcept {
+  return lp_ == nullptr || lp_->mine == nullptr || (*lp_->mine)[static_cast<std::size_t>(region_[static_cast<std::size_t>(p)])] != 0;
+}
+
 // A reflection on the field's axis: |v_after - v_before| to the wall met (the lower one when the
 // velocity before points down, in either frame), added forward and taken off (`off`) in reverse
 // and by a rollback. (A group that takes a reflection of its tick in, counted in wall_groups, keeps

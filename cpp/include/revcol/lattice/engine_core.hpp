@@ -322,8 +322,7 @@ class BasicEngine {
   [[gnu::noinline]] std::int64_t field_at(int p, std::size_t k, std::int64_t dt) const noexcept;
   Vec vel(int p, std::int64_t t) const noexcept;
   Vec move_of(int p, std::int64_t a) const noexcept;
-  Vec plus_h(Vec v) const noexcept;
-  Vec minus_h(Vec v) const noexcept;  // (a field: a velocity at a tick from the mid velocity after it, field.hpp)
+  Vec plus_h(Vec v) const noexcept, minus_h(Vec v) const noexcept;  // +- h on a field's axis (moves and velocities, field.hpp)
   [[gnu::always_inline]] Vec diff(const Vec& a, const Vec& b) const noexcept {
     Vec r;
     for (std::size_t k = 0; k < D; ++k) r[k] = u_.wall[k] ? a[k] - b[k] : min_image(a[k] - b[k], u_.L[k]);
@@ -378,11 +377,7 @@ class BasicEngine {
   void reflect(int p, std::int64_t a);
   void field_impulse(std::int64_t before, std::int64_t after, bool off) noexcept;  // a field's wall momentum (loop.hpp)
   void unreflect_impulse(int p, std::int64_t a, const Vec& post) noexcept;  // rollback.hpp
-  // whether a reflection of p now adds to the field's wall momentum: always, but in an LP of the
-  // parallel engine only for a particle in a region it owns (the authority: each reflection once)
-  bool impulse_here(int p) const noexcept {
-    return lp_ == nullptr || lp_->mine == nullptr || (*lp_->mine)[static_cast<std::size_t>(region_[static_cast<std::size_t>(p)])] != 0;
-  }
+  bool impulse_here(int p) const noexcept;  // p's reflection counts in that momentum here (loop.hpp)
   // a state the reverse cannot take back (a loaded state no run wrote): an error naming it, the
   // collision and the pair; run_back restores the state it began with
   [[noreturn, gnu::cold]] void inconsistent(const std::string& what, int i, int j) const;  // (collide.hpp)
@@ -513,11 +508,7 @@ class BasicEngine {
   bool reversed_ = false, load_back_ = false;  // load_back_: load into the reversed frame (an LP running back)
   // the neighbour search (set_list_shell): the cell grid, or neighbour lists (measured: docs/lattice.md)
   static constexpr double kShellBase = 0.545, kShellSlope = 1.0, kShellMin = 0.6, kShellMax = 1.2;
-  // in a field the lists' cube renews more often than the ball: the automatic search takes them only
-  // where the Enskog mean free path is below this many diameters (measured, 3D N = 10^4, g = 1: lists
-  // / cells 1.29 / 1.18 at volume fraction 0.3 (lambda 0.16), 1.03 / 0.88 at 0.2 (0.34), 0.85 / 0.75
-  // at 0.1 (0.91); bench/lattice_field_search.py, docs/lattice.md)
-  static constexpr double kFieldListsMaxLambda = 0.3;
+  static constexpr double kFieldListsMaxLambda = 0.3;  // a field: lists below this Enskog free path (docs/lattice.md)
   double list_shell_ = -1.0;
   // the periodic re-sort (state.hpp, resort; docs/lattice.md "The storage order")
   static constexpr std::size_t kResortMinN = 32768;
