@@ -127,6 +127,8 @@ def main(argv=None) -> int:
     p.add_argument("--workers", type=int, nargs="+", default=[2], help="parallel variants, 2 or more (K = workers LPs)")
     p.add_argument("--memory", action="store_true", help="peak RSS per variant, each in a fresh process")
     p.add_argument("--child", type=int, default=0, help=argparse.SUPPRESS)
+    p.add_argument("--gravity", type=float, default=0.0,
+                   help="a field along the last axis (walled; the others periodic), kT / sigma: the slabs cut across it")
     p.add_argument("--json", required=True)
     a = p.parse_args(argv)
     if a.child:
@@ -139,11 +141,13 @@ def main(argv=None) -> int:
                   "command": " ".join(["python", "bench/parallel_python.py", *(argv if argv is not None else sys.argv[1:])]),
                   "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip(),
                   "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "load_before": load0,
-                  "dim": a.dim, "n": a.n, "phi": a.phi, "runs": memory(a, argv)}
+                  "dim": a.dim, "n": a.n, "phi": a.phi, "runs": memory(a, argv)}  # (no field: --gravity is for the timing)
         result["load_after"] = os.getloadavg()[0]
         _write(result, a.json)
         return 0
-    sim = cls.random(a.n, phi=a.phi, seed=1)
+    field = {} if a.gravity == 0.0 else {"boundary": ["periodic"] * (a.dim - 1) + ["wall"],
+                                         "gravity": [0.0] * (a.dim - 1) + [a.gravity]}
+    sim = cls.random(a.n, phi=a.phi, seed=1, **field)
     sim.run(collisions=a.n)  # warmed: the start's relaxation behind it
     s0 = sim.snapshot()
     runs = {c: measure(cls, s0, c, a.rounds, a.workers) for c in a.collisions}
@@ -153,7 +157,7 @@ def main(argv=None) -> int:
         "command": " ".join(["python", "bench/parallel_python.py", *(argv if argv is not None else sys.argv[1:])]),
         "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip(),
         "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "load_before": load0, "load_after": os.getloadavg()[0],
-        "cores": os.cpu_count(), "dim": a.dim, "n": a.n, "phi": a.phi, "rounds": a.rounds,
+        "cores": os.cpu_count(), "dim": a.dim, "n": a.n, "phi": a.phi, "gravity": a.gravity, "rounds": a.rounds,
         "runs": {str(c): v for c, v in runs.items()},
     }
     _write(result, a.json)
