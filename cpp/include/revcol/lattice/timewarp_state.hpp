@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "revcol/lattice/field.hpp"
 #include "revcol/lattice/geometry.hpp"
 #include "revcol/lattice/slab_views.hpp"
 #include "revcol/lattice/state.hpp"
@@ -24,9 +25,7 @@ template <class Record, std::size_t D>
 VecN<D> record_at(const Record& r, std::int64_t t, const UnitsN<D>& u) {
   VecN<D> x;
   for (std::size_t k = 0; k < D; ++k) {
-    const std::int64_t n = t - r.ta;
-    __int128 y = static_cast<__int128>(r.x[k]) + static_cast<__int128>(r.v[k]) * n;
-    if (u.gravity[k] != 0) y += static_cast<__int128>(u.gravity[k] / 2) * n * n;  // a field's parabola (field.hpp)
+    const __int128 y = field_point(r.x[k], r.v[k], u.gravity[k] / 2, t - r.ta);  // (a line without a field: h = 0)
     x[k] = u.wall[k] ? static_cast<std::int64_t>(y) : wrap(y, u.L[k]);
   }
   return x;
